@@ -1,0 +1,156 @@
+"""The vessel: CyberShip II hull, actuators, steering gear and waves, integrated by RK4.
+
+This is the in-process model that ``ship_slave`` wraps as an FMU and that tests and
+the in-process master call directly. Its parameters carry the FMU's names.
+
+Integration: classical fixed-step RK4 over (x, y, psi, u, v, r, xi), with the
+inputs held over the communication step (zero-order hold, as a co-simulation
+master delivers them). A communication step h is cut into ceil(h / h_max) equal
+sub-steps. The rudder angle is the steering gear's exact piecewise-linear
+response, and the wave loads are evaluated at every RK4 stage. The heading psi
+is integrated continuously (not wrapped), so it shows full turns.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+from .data import Actuators, Hull
+from .hull import coriolis_forces, damping_forces, kinematics, mass_matrix
+from .steering_gear import DELTA_MAX, DELTA_RATE_MAX, rudder_angle
+from .thrusters import actuator_forces
+from .waves import WaveComponents, WaveLoads
+
+N_PROPELLER = 8.13
+"""Main propeller speed of the paper's runs, rev/s: 0.3 m/s in calm water."""
+
+
+@dataclass(frozen=True)
+class VesselParameters:
+    """Initial state, steering gear and sea state; names as in the FMU."""
+
+    x0: float = 0.0
+    y0: float = 0.0
+    psi0: float = 0.0
+    u0: float = 0.3
+    v0: float = 0.0
+    r0: float = 0.0
+    delta_max: float = DELTA_MAX
+    delta_rate_max: float = DELTA_RATE_MAX
+    Hs: float = 0.0             # m, 0 = calm water
+    T0: float = 0.8             # s, modal period
+    psi_w: float = math.pi      # rad, wave direction
+    wave_seed: int = 0
+    wave_components: int = 50
+    h_max: float = 0.1          # s, largest RK4 step
+
+    def validate(self) -> None:
+        """Raise ValueError naming the first invalid parameter."""
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if not math.isfinite(value):
+                raise ValueError(f"parameter {f.name} = {value} is not finite")
+        for name, ok, rule in (
+            ("delta_max", self.delta_max > 0.0, "> 0"),
+            ("delta_rate_max", self.delta_rate_max > 0.0, "> 0"),
+            ("Hs", self.Hs >= 0.0, ">= 0 (0 = calm water)"),
+            ("T0", self.T0 > 0.0, "> 0"),
+            ("wave_components", self.wave_components >= 1, ">= 1"),
+            ("h_max", self.h_max > 0.0, "> 0"),
+        ):
+            if not ok:
+                raise ValueError(f"parameter {name} must be {rule}, got {getattr(self, name)}")
+
+
+class Vessel:
+    """CyberShip II in calm water or waves, stepped with inputs held."""
+
+    STATE = ("x", "y", "psi", "u", "v", "r", "delta", "xi", "t")
+
+    def __init__(self, params: VesselParameters = VesselParameters(),
+                 hull: Hull = Hull(), actuators: Actuators = Actuators()):
+        params.validate()
+        self.params = params
+        self.hull = hull
+        self.actuators = actuators
+        M = mass_matrix(hull).tolist()
+        det = M[1][1] * M[2][2] - M[1][2] * M[2][1]
+        self._m11_inv = 1.0 / M[0][0]
+        self._minv = (M[2][2] / det, -M[1][2] / det, -M[2][1] / det, M[1][1] / det)
+        self.waves = None
+        if params.Hs > 0.0:
+            components = WaveComponents.from_spectrum(
+                params.Hs, params.T0, params.wave_components, params.wave_seed)
+            self.waves = WaveLoads(components, hull, params.psi_w)
+        self.x, self.y, self.psi = params.x0, params.y0, params.psi0
+        self.u, self.v, self.r = params.u0, params.v0, params.r0
+        self.delta = 0.0
+        self.xi = 0.0
+        self.t = 0.0
+        self.wave_loads = self._wave_loads(self.t, self.xi, self.psi)
+
+    def _wave_loads(self, t: float, xi: float, psi: float) -> tuple[float, float, float]:
+        return (0.0, 0.0, 0.0) if self.waves is None else self.waves(t, xi, psi)
+
+    def rates(self, t: float, state: tuple[float, ...], delta: float,
+              n1: float, n2: float, n3: float) -> tuple[float, ...]:
+        """Time derivative of (x, y, psi, u, v, r, xi), eqs (1)-(17)."""
+        _, _, psi, u, v, r, xi = state
+        cX, cY, cN = coriolis_forces(self.hull, u, v, r)
+        dX, dY, dN = damping_forces(self.hull, u, v, r)
+        tX, tY, tN = actuator_forces(self.actuators, n1, n2, n3, delta)
+        wX, wY, wN = self._wave_loads(t, xi, psi)
+        fX = tX + wX - cX - dX
+        fY = tY + wY - cY - dY
+        fN = tN + wN - cN - dN
+        i22, i23, i32, i33 = self._minv
+        x_dot, y_dot, psi_dot = kinematics(psi, u, v, r)
+        xi_dot = math.hypot(u, v) * math.cos(self.params.psi_w - psi)
+        return (x_dot, y_dot, psi_dot, fX * self._m11_inv,
+                i22 * fY + i23 * fN, i32 * fY + i33 * fN, xi_dot)
+
+    def step(self, t: float, h: float, delta_c: float,
+             n1: float = N_PROPELLER, n2: float = N_PROPELLER, n3: float = 0.0) -> None:
+        """Advance from communication point t to t + h with the inputs held."""
+        for name, value in (("delta_c", delta_c), ("n1", n1), ("n2", n2), ("n3", n3)):
+            if not math.isfinite(value):
+                raise ValueError(f"input {name} = {value} is not finite")
+        p = self.params
+        n_sub = max(1, math.ceil(h / p.h_max - 1e-9))
+        hs = h / n_sub
+        delta0 = self.delta
+
+        def gear(s: float) -> float:
+            return rudder_angle(delta0, delta_c, s, p.delta_max, p.delta_rate_max)
+
+        y = (self.x, self.y, self.psi, self.u, self.v, self.r, self.xi)
+        for j in range(n_sub):
+            s = j * hs
+            ts = t + s
+            d0, d1, d2 = gear(s), gear(s + 0.5 * hs), gear(s + hs)
+            k1 = self.rates(ts, y, d0, n1, n2, n3)
+            k2 = self.rates(ts + 0.5 * hs, _axpy(0.5 * hs, k1, y), d1, n1, n2, n3)
+            k3 = self.rates(ts + 0.5 * hs, _axpy(0.5 * hs, k2, y), d1, n1, n2, n3)
+            k4 = self.rates(ts + hs, _axpy(hs, k3, y), d2, n1, n2, n3)
+            c = hs / 6.0
+            y = tuple(yi + c * (a + 2.0 * b + 2.0 * e + f)
+                      for yi, a, b, e, f in zip(y, k1, k2, k3, k4))
+        self.x, self.y, self.psi, self.u, self.v, self.r, self.xi = y
+        self.delta = gear(h)
+        self.t = t + h
+        self.wave_loads = self._wave_loads(self.t, self.xi, self.psi)
+
+    def snapshot(self) -> dict[str, float]:
+        """The complete dynamic state, as plain floats."""
+        return {name: getattr(self, name) for name in self.STATE}
+
+    def restore(self, snapshot: dict[str, float]) -> None:
+        """Return to a state taken by ``snapshot``."""
+        for name in self.STATE:
+            setattr(self, name, float(snapshot[name]))
+        self.wave_loads = self._wave_loads(self.t, self.xi, self.psi)
+
+
+def _axpy(a: float, x: tuple[float, ...], y: tuple[float, ...]) -> tuple[float, ...]:
+    """y + a x, elementwise."""
+    return tuple(yi + a * xi for xi, yi in zip(x, y))
