@@ -87,7 +87,7 @@ class Vessel:
         self.delta = 0.0
         self.xi = 0.0
         self.t = 0.0
-        self.wave_loads = self._wave_loads(self.t, self.xi, self.psi)
+        self.X_w, self.Y_w, self.N_w = self._wave_loads(self.t, self.xi, self.psi)
 
     def _wave_loads(self, t: float, xi: float, psi: float) -> tuple[float, float, float]:
         return (0.0, 0.0, 0.0) if self.waves is None else self.waves(t, xi, psi)
@@ -138,7 +138,7 @@ class Vessel:
         self.x, self.y, self.psi, self.u, self.v, self.r, self.xi = y
         self.delta = gear(h)
         self.t = t + h
-        self.wave_loads = self._wave_loads(self.t, self.xi, self.psi)
+        self.X_w, self.Y_w, self.N_w = self._wave_loads(self.t, self.xi, self.psi)
 
     def snapshot(self) -> dict[str, float]:
         """The complete dynamic state, as plain floats."""
@@ -148,7 +148,7 @@ class Vessel:
         """Return to a state taken by ``snapshot``."""
         for name in self.STATE:
             setattr(self, name, float(snapshot[name]))
-        self.wave_loads = self._wave_loads(self.t, self.xi, self.psi)
+        self.X_w, self.Y_w, self.N_w = self._wave_loads(self.t, self.xi, self.psi)
 
 
 def _axpy(a: float, x: tuple[float, ...], y: tuple[float, ...]) -> tuple[float, ...]:

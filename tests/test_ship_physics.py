@@ -144,7 +144,7 @@ def _wave_run(seed: int) -> list[tuple[float, ...]]:
     for k in range(300):
         vessel.step(k * DT, DT, 0.0)
         rows.append((vessel.x, vessel.y, vessel.psi, vessel.u, vessel.v, vessel.r,
-                     *vessel.wave_loads))
+                     vessel.X_w, vessel.Y_w, vessel.N_w))
     return rows
 
 

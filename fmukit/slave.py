@@ -1,0 +1,315 @@
+"""A thin, declarative layer over pythonfmu's Fmi2Slave.
+
+An FMU class lists its variables once, as ``Var`` entries with unit, causality,
+start value and, for outputs, the variables they depend on. From that list this
+base class
+
+- registers the variables with pythonfmu (parameters and inputs live as
+  attributes of the slave, outputs are read from its model);
+- writes a complete modelDescription.xml: unit definitions with degree display
+  units, ``initial="calculated"`` outputs, output ``dependencies`` (so masters
+  see which outputs are not direct feedthrough) and ``InitialUnknowns``;
+- follows the FMI 2.0 call sequence and refuses what breaks it;
+- saves and restores the whole state (fmi2Get/SetFMUstate, serialisable).
+
+Errors. pythonfmu 0.7 turns every Python exception into fmi2Fatal, and a False
+return of do_step into fmi2Discard. Its C++ layer also releases the instance, its
+class and its log queue once per exception and again at fmi2FreeInstance, a
+use-after-free that crashes the host later. Every FMI entry point here therefore
+passes through ``_fmi_entry``, which takes one extra reference on those three
+objects before an exception leaves Python, so the host survives. With that:
+
+- invalid parameters: the model raises ValueError at exitInitializationMode,
+  reported as fmi2Fatal with the message naming the parameter;
+- invalid inputs, step sizes, or doStep out of sequence: the step is refused with
+  fmi2Discard and an error log naming the cause; the state is left as it was,
+  so a master may correct the input and retry;
+- setting an output, or a fixed parameter after initialisation: fmi2Fatal with
+  a message naming the variable; the value is not applied.
+
+The subclass supplies ``build_model`` (a model object from the parameter
+attributes) and ``step_model``; the model supplies ``snapshot``/``restore``.
+"""
+from __future__ import annotations
+
+import ctypes
+import functools
+import json
+import math
+from dataclasses import dataclass
+from typing import Any, Callable, ClassVar
+from xml.etree.ElementTree import Element, SubElement
+
+from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability
+from pythonfmu import Integer, Real, String
+from pythonfmu import __version__ as PYTHONFMU_VERSION
+from pythonfmu.enums import Fmi2Status
+
+from .units import DISPLAY_UNIT, unit_definitions
+
+_PYTHONFMU_TYPE = {float: Real, int: Integer, str: String}
+_RELEASES_ON_EXCEPTION = PYTHONFMU_VERSION == "0.7.0"
+
+
+def _fmi_entry(method):
+    """Let an exception reach pythonfmu's C++ layer without corrupting the host."""
+    @functools.wraps(method)
+    def entry(self, *args):
+        try:
+            return method(self, *args)
+        except Exception:
+            if _RELEASES_ON_EXCEPTION:
+                for obj in (self, type(self), self.log_queue):
+                    ctypes.pythonapi.Py_IncRef(ctypes.py_object(obj))
+            raise
+    return entry
+
+
+@dataclass(frozen=True)
+class Var:
+    """One FMU variable, declared once. Build it with the class methods."""
+
+    name: str
+    causality: str                    # "parameter" | "input" | "output"
+    unit: str = "1"                   # key of fmukit.units.UNITS (Real only)
+    description: str = ""
+    start: float | int | str | None = None
+    kind: type = float                # float (Real), int (Integer) or str (String)
+    depends: tuple[str, ...] = ()     # outputs: inputs and parameters they depend on
+    get: Callable[[Any], Any] | None = None   # outputs: value from the slave
+
+    @classmethod
+    def parameter(cls, name: str, start: float | int | str, unit: str = "1",
+                  description: str = "") -> Var:
+        """A fixed parameter; its Python type (float, int, str) sets the FMI type."""
+        return cls(name, "parameter", unit, description, start, type(start))
+
+    @classmethod
+    def input(cls, name: str, start: float, unit: str = "1", description: str = "") -> Var:
+        """A continuous Real input."""
+        return cls(name, "input", unit, description, float(start))
+
+    @classmethod
+    def output(cls, name: str, unit: str = "1", description: str = "",
+               depends: tuple[str, ...] = (), get: Callable[[Any], Any] | None = None,
+               kind: type = float) -> Var:
+        """An output read from the slave by ``get`` (default: the model's attribute)."""
+        return cls(name, "output", unit, description, None, kind, depends, get)
+
+    @property
+    def is_real(self) -> bool:
+        return self.kind is float
+
+
+class ModelSlave(Fmi2Slave):
+    """Base of every FMU in this project; see the module docstring."""
+
+    model_name: ClassVar[str]
+    variables: ClassVar[tuple[Var, ...]]
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.modelName = self.model_name
+        self.phase = "instantiated"
+        self._model = None
+        self._by_vr: dict[int, Var] = {}
+        for var in self.variables:
+            self._register(var)
+
+    def _register(self, var: Var) -> None:
+        kind = _PYTHONFMU_TYPE[var.kind]
+        if var.causality == "output":
+            get = var.get or (lambda slave, name=var.name: getattr(slave.model, name))
+            sv = kind(var.name, causality=Fmi2Causality.output,
+                      variability=(Fmi2Variability.continuous if var.is_real
+                                   else Fmi2Variability.discrete),
+                      initial=Fmi2Initial.calculated, description=var.description,
+                      getter=lambda: get(self))
+        else:
+            setattr(self, var.name, var.start)
+            variability = (Fmi2Variability.fixed if var.causality == "parameter"
+                           else Fmi2Variability.continuous)
+            sv = kind(var.name, causality=Fmi2Causality[var.causality],
+                      variability=variability, description=var.description)
+        self.register_variable(sv)
+        self._by_vr[sv.value_reference] = var
+
+    # -- model ---------------------------------------------------------------
+    def build_model(self) -> Any:
+        """A fresh model from the current parameter attributes."""
+        raise NotImplementedError
+
+    def step_model(self, t: float, h: float) -> None:
+        """Advance the model from t to t + h with the current inputs."""
+        raise NotImplementedError
+
+    @property
+    def model(self) -> Any:
+        """The model; before initialisation, built from the parameters as they are."""
+        if self._model is None:
+            self._model = self.build_model()
+        return self._model
+
+    # -- FMI call sequence -----------------------------------------------------
+    @_fmi_entry
+    def enter_initialization_mode(self) -> None:
+        self.phase = "initialization"
+
+    @_fmi_entry
+    def exit_initialization_mode(self) -> None:
+        self._model = self.build_model()      # ValueError names a bad parameter
+        self.phase = "step"
+
+    @_fmi_entry
+    def terminate(self) -> None:
+        self.phase = "terminated"
+
+    @_fmi_entry
+    def do_step(self, current_time: float, step_size: float) -> bool:
+        if self.phase != "step":
+            return self._refuse(f"doStep called in phase '{self.phase}': "
+                                "call exitInitializationMode first, and not after terminate")
+        if not (step_size > 0.0 and math.isfinite(step_size) and math.isfinite(current_time)):
+            return self._refuse(f"doStep at t = {current_time} with communication step "
+                                f"{step_size}: the step must be finite and > 0")
+        try:
+            self.step_model(current_time, step_size)
+        except ValueError as error:
+            return self._refuse(f"doStep at t = {current_time}: {error}; step refused, "
+                                "state unchanged")
+        return True
+
+    def _refuse(self, message: str) -> bool:
+        self.log(message, Fmi2Status.error)
+        return False
+
+    # -- setters: refuse what the standard does not allow ----------------------
+    def _check_settable(self, vrs: list[int]) -> None:
+        for vr in vrs:
+            var = self._by_vr.get(vr)
+            if var is None:
+                raise ValueError(f"no variable has value reference {vr}")
+            if var.causality == "output":
+                raise ValueError(f"{var.name} is an output and cannot be set")
+            if var.causality == "parameter" and self.phase not in ("instantiated",
+                                                                   "initialization"):
+                raise ValueError(f"parameter {var.name} is fixed after initialisation "
+                                 f"(phase '{self.phase}')")
+            if self.phase == "terminated":
+                raise ValueError(f"cannot set {var.name} after terminate")
+
+    def _set(self, vrs: list[int], values: list, convert: type) -> None:
+        self._check_settable(vrs)
+        for vr, value in zip(vrs, values):
+            var = self._by_vr[vr]
+            if var.kind is not convert:
+                raise ValueError(f"{var.name} is not of type {convert.__name__}")
+            setattr(self, var.name, convert(value))
+            if var.causality == "parameter":
+                self._model = None
+
+    @_fmi_entry
+    def set_real(self, vrs: list[int], values: list[float]) -> None:
+        self._set(vrs, values, float)
+
+    @_fmi_entry
+    def set_integer(self, vrs: list[int], values: list[int]) -> None:
+        self._set(vrs, values, int)
+
+    @_fmi_entry
+    def set_string(self, vrs: list[int], values: list[str]) -> None:
+        self._set(vrs, values, str)
+
+    # -- FMU state ---------------------------------------------------------------
+    @_fmi_entry
+    def _get_fmu_state(self) -> dict[str, Any]:
+        return {
+            "phase": self.phase,
+            "values": {v.name: getattr(self, v.name) for v in self.variables
+                       if v.causality != "output"},
+            "model": self._model.snapshot() if self._model is not None else None,
+        }
+
+    @_fmi_entry
+    def _set_fmu_state(self, state: dict[str, Any]) -> None:
+        if "invalid" in state:
+            raise ValueError(f"cannot restore FMU state: {state['invalid']}")
+        for name, value in state["values"].items():
+            setattr(self, name, value)
+        self.phase = state["phase"]
+        self._model = None
+        if state["model"] is not None:
+            self.model.restore(state["model"])
+
+    @staticmethod
+    def _fmu_state_from_bytes(state: bytes) -> dict[str, Any]:
+        # Called on the class, where an exception cannot be made safe: report it
+        # through the state, and let _set_fmu_state refuse it.
+        try:
+            decoded = json.loads(state.decode("utf-8"))
+            if not {"phase", "values", "model"} <= set(decoded):
+                raise ValueError("not a state of this FMU")
+            return decoded
+        except (ValueError, UnicodeDecodeError, TypeError) as error:
+            return {"invalid": f"serialized state unreadable ({error})"}
+
+    @_fmi_entry
+    def setup_experiment(self, start_time: float, stop_time: float | None = None,
+                         tolerance: float | None = None) -> None:
+        pass
+
+    @_fmi_entry
+    def get_real(self, vrs: list[int]) -> list[float]:
+        return super().get_real(vrs)
+
+    @_fmi_entry
+    def get_integer(self, vrs: list[int]) -> list[int]:
+        return super().get_integer(vrs)
+
+    @_fmi_entry
+    def get_string(self, vrs: list[int]) -> list[str]:
+        return super().get_string(vrs)
+
+    @_fmi_entry
+    def get_boolean(self, vrs: list[int]) -> list[bool]:
+        return super().get_boolean(vrs)
+
+    @_fmi_entry
+    def set_boolean(self, vrs: list[int], values: list[bool]) -> None:
+        raise ValueError("this FMU has no Boolean variables")
+
+    # -- modelDescription.xml ------------------------------------------------------
+    def to_xml(self, model_options: dict[str, str] = dict()) -> Element:
+        root = super().to_xml(model_options)
+        index = {v.name: i + 1 for i, v in enumerate(self.variables)}
+        for element, var in zip(root.find("ModelVariables"), self.variables):
+            if var.is_real:
+                real = element.find("Real")
+                if var.start is not None:
+                    real.set("start", repr(float(var.start)))   # shortest exact form
+                real.set("unit", var.unit)
+                if var.unit in DISPLAY_UNIT:
+                    real.set("displayUnit", DISPLAY_UNIT[var.unit])
+        used = {v.unit for v in self.variables if v.is_real}
+        root.insert(list(root).index(root.find("CoSimulation")) + 1, unit_definitions(used))
+
+        structure = root.find("ModelStructure")
+        structure.clear()
+        outputs = [v for v in self.variables if v.causality == "output"]
+        if outputs:
+            causality = {v.name: v.causality for v in self.variables}
+            listed = SubElement(structure, "Outputs")
+            for v in outputs:
+                inputs = [d for d in v.depends if causality[d] == "input"]
+                SubElement(listed, "Unknown", index=str(index[v.name]),
+                           dependencies=_indices(inputs, index))
+            initial = SubElement(structure, "InitialUnknowns")
+            for v in outputs:
+                SubElement(initial, "Unknown", index=str(index[v.name]),
+                           dependencies=_indices(v.depends, index))
+        return root
+
+
+def _indices(names: tuple[str, ...] | list[str], index: dict[str, int]) -> str:
+    """Ordered, space-separated 1-based indices, as ModelStructure wants them."""
+    return " ".join(str(i) for i in sorted(index[n] for n in names))

@@ -1,0 +1,64 @@
+"""The vessel as an FMI 2.0 co-simulation FMU (fmus/ship.fmu): wraps ship_fmu.vessel.
+
+Inputs are held over each communication step. No output depends on an input at
+the same instant (the rudder acts through the steering gear and the hull's
+inertia), so the model structure declares no direct feedthrough.
+"""
+from dataclasses import fields
+
+from pythonfmu import DefaultExperiment
+
+from fmukit.slave import ModelSlave, Var
+from ship_fmu.vessel import N_PROPELLER, Vessel, VesselParameters
+
+_P = VesselParameters()
+_SEA = ("Hs", "T0", "psi_w", "wave_seed", "wave_components", "psi0")
+
+
+class ShipSlave(ModelSlave):
+    model_name = "ship"
+    description = ("CyberShip II (1:70 supply ship model), nonlinear 3-DOF manoeuvring model "
+                   "with propellers, rudders, rate-limited steering gear and wave loads "
+                   "(Tomera 2010, eqs 1-17)")
+    default_experiment = DefaultExperiment(start_time=0.0, stop_time=400.0, step_size=0.1)
+    variables = (
+        Var.input("delta_c", 0.0, "rad", "commanded rudder angle, both rudders; "
+                  "positive turns the ship to port"),
+        Var.input("n1", N_PROPELLER, "rev/s", "main propeller 1 shaft speed"),
+        Var.input("n2", N_PROPELLER, "rev/s", "main propeller 2 shaft speed"),
+        Var.input("n3", 0.0, "rev/s", "bow thruster shaft speed"),
+        Var.output("x", "m", "north position", depends=("x0",)),
+        Var.output("y", "m", "east position", depends=("y0",)),
+        Var.output("psi", "rad", "heading, continuous (not wrapped)", depends=("psi0",)),
+        Var.output("u", "m/s", "surge velocity", depends=("u0",)),
+        Var.output("v", "m/s", "sway velocity", depends=("v0",)),
+        Var.output("r", "rad/s", "yaw rate", depends=("r0",)),
+        Var.output("delta", "rad", "actual rudder angle (steering gear output)"),
+        Var.output("X_w", "N", "wave surge force, eq (14)", depends=_SEA),
+        Var.output("Y_w", "N", "wave sway force, eq (15)", depends=_SEA),
+        Var.output("N_w", "N.m", "wave yaw moment, eq (16)", depends=_SEA),
+        Var.parameter("x0", _P.x0, "m", "initial north position"),
+        Var.parameter("y0", _P.y0, "m", "initial east position"),
+        Var.parameter("psi0", _P.psi0, "rad", "initial heading"),
+        Var.parameter("u0", _P.u0, "m/s", "initial surge velocity"),
+        Var.parameter("v0", _P.v0, "m/s", "initial sway velocity"),
+        Var.parameter("r0", _P.r0, "rad/s", "initial yaw rate"),
+        Var.parameter("delta_max", _P.delta_max, "rad", "rudder stops, > 0"),
+        Var.parameter("delta_rate_max", _P.delta_rate_max, "rad/s",
+                      "steering gear rate limit, > 0"),
+        Var.parameter("Hs", _P.Hs, "m", "significant wave height; 0 = calm water"),
+        Var.parameter("T0", _P.T0, "s", "modal period of the wave spectrum, > 0"),
+        Var.parameter("psi_w", _P.psi_w, "rad", "wave direction"),
+        Var.parameter("wave_seed", _P.wave_seed, description="seed of the wave realisation"),
+        Var.parameter("wave_components", _P.wave_components,
+                      description="number of regular wave components, >= 1"),
+        Var.parameter("h_max", _P.h_max, "s", "largest RK4 step; a communication step is "
+                      "cut into equal sub-steps no longer than this"),
+    )
+
+    def build_model(self) -> Vessel:
+        return Vessel(VesselParameters(**{f.name: getattr(self, f.name)
+                                          for f in fields(VesselParameters)}))
+
+    def step_model(self, t: float, h: float) -> None:
+        self.model.step(t, h, self.delta_c, self.n1, self.n2, self.n3)

@@ -1,0 +1,203 @@
+"""The ship FMU through FMI: conformance, equality with the in-process model, state, errors."""
+from __future__ import annotations
+
+import csv
+import gc
+import math
+import subprocess
+import sys
+import textwrap
+
+import pytest
+from fmpy import read_model_description
+from fmpy.validation import validate_fmu
+
+from cosim.fmu import FmuCallError, FmuInstance
+from ship_fmu.vessel import Vessel, VesselParameters
+
+OUTPUTS = ["x", "y", "psi", "u", "v", "r", "delta", "X_w", "Y_w", "N_w"]
+DT = 0.1
+
+
+@pytest.fixture
+def ship(fmu_paths):
+    instance = FmuInstance(fmu_paths["ship"], "ship")
+    yield instance
+    instance.free()
+    gc.collect()            # a corrupted host would crash here, inside the test
+
+
+def rudder_program(k: int) -> float:
+    return 0.3 * math.sin(0.05 * k) + (0.2 if k % 97 < 40 else -0.1)
+
+
+def test_model_description_validates_with_units_and_dependencies(fmu_paths):
+    assert validate_fmu(str(fmu_paths["ship"])) == []
+    md = read_model_description(str(fmu_paths["ship"]))
+    units = {u.name: [d.name for d in u.displayUnits] for u in md.unitDefinitions}
+    assert {"m", "m/s", "rad", "rad/s", "N", "N.m", "s", "rev/s"} <= set(units)
+    assert "deg" in units["rad"] and "deg/s" in units["rad/s"]
+    for v in md.modelVariables:
+        if v.type == "Real":
+            assert v.unit in units, v.name
+    assert {o.variable.name for o in md.outputs} == set(OUTPUTS)
+    assert all(o.dependencies == [] for o in md.outputs), "no direct feedthrough"
+    assert md.coSimulation.canGetAndSetFMUstate and md.coSimulation.canSerializeFMUstate
+
+
+def _fmpy_cli(*args: str, cwd) -> None:
+    subprocess.run([sys.executable, "-m", "fmpy.cli", *args], cwd=cwd, check=True,
+                   capture_output=True, text=True, timeout=120)
+
+
+def _read_csv(path) -> list[dict[str, float]]:
+    with open(path) as f:
+        return [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
+
+
+def test_fmpy_simulate_on_defaults_runs_straight_at_0_3_m_per_s(fmu_paths, tmp_path):
+    _fmpy_cli("simulate", str(fmu_paths["ship"]), "--stop-time", "100",
+              "--output-file", "out.csv", cwd=tmp_path)
+    rows = _read_csv(tmp_path / "out.csv")
+    assert rows[-1]["time"] == pytest.approx(100.0)
+    assert all(row["u"] == pytest.approx(0.300, abs=0.001) for row in rows)
+    assert all(row["psi"] == 0.0 and row["v"] == 0.0 for row in rows)
+
+
+def test_fmpy_simulate_with_an_input_file_drives_the_rudder(fmu_paths, tmp_path):
+    (tmp_path / "in.csv").write_text('"time","delta_c"\n0,0\n10,0\n10,0.2\n60,0.2\n')
+    _fmpy_cli("simulate", str(fmu_paths["ship"]), "--stop-time", "60",
+              "--input-file", "in.csv", "--output-file", "out.csv", cwd=tmp_path)
+    rows = _read_csv(tmp_path / "out.csv")
+    assert rows[-1]["delta"] == pytest.approx(0.2)
+    assert rows[-1]["psi"] < -0.5          # positive rudder: turn to port
+
+
+@pytest.mark.parametrize("Hs", [0.0, 0.005])
+def test_fmu_equals_the_in_process_model(ship, Hs):
+    ship.initialize({"Hs": Hs, "wave_seed": 11})
+    vessel = Vessel(VesselParameters(Hs=Hs, wave_seed=11))
+    worst = 0.0
+    for k in range(600):
+        t, delta_c = k * DT, rudder_program(k)
+        ship.set({"delta_c": delta_c})
+        ship.do_step(t, DT)
+        vessel.step(t, DT, delta_c)
+        got = ship.get(OUTPUTS)
+        worst = max(worst, *(abs(got[n] - getattr(vessel, n)) for n in OUTPUTS))
+    assert worst <= 1e-12
+
+
+def _run(ship: FmuInstance, k0: int, steps: int) -> list[dict[str, float]]:
+    rows = []
+    for k in range(k0, k0 + steps):
+        ship.set({"delta_c": rudder_program(k)})
+        ship.do_step(k * DT, DT)
+        rows.append(ship.get(OUTPUTS))
+    return rows
+
+
+def test_saved_state_reproduces_the_run_bit_for_bit(ship, fmu_paths):
+    ship.initialize({"Hs": 0.005, "wave_seed": 5})
+    _run(ship, 0, 100)
+    state = ship.slave.getFMUstate()
+    first = _run(ship, 100, 200)
+    ship.slave.setFMUstate(state)
+    assert _run(ship, 100, 200) == first
+
+    serialized = ship.slave.serializeFMUstate(state)
+    other = FmuInstance(fmu_paths["ship"], "other")
+    try:
+        other.initialize({"Hs": 0.005, "wave_seed": 99})
+        other.slave.setFMUstate(other.slave.deSerializeFMUstate(serialized))
+        assert other.get(["Hs"]) == {"Hs": 0.005}
+        assert _run(other, 100, 200) == first
+    finally:
+        other.free()
+
+
+@pytest.mark.parametrize("name", ["delta_c", "n1", "n2", "n3"])
+@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf])
+def test_non_finite_inputs_are_refused_by_name(ship, name, bad):
+    ship.initialize()
+    _run(ship, 0, 5)
+    before = ship.get(OUTPUTS)
+    ship.set({name: bad})
+    with pytest.raises(FmuCallError) as refused:
+        ship.do_step(5 * DT, DT)
+    assert refused.value.status == "discard"
+    assert any(name in m and "not finite" in m for m in refused.value.messages)
+    assert ship.get(OUTPUTS) == before
+    ship.set({name: 1.0 if name != "delta_c" else 0.0})
+    ship.do_step(5 * DT, DT)                   # recovers once the input is valid
+
+
+@pytest.mark.parametrize("name, value", [
+    ("Hs", -0.01), ("T0", 0.0), ("T0", -1.0), ("wave_components", 0),
+    ("delta_max", 0.0), ("delta_rate_max", 0.0), ("delta_rate_max", -1.0), ("u0", math.nan),
+])
+def test_invalid_parameters_are_refused_by_name(ship, name, value):
+    with pytest.raises(FmuCallError) as refused:
+        ship.initialize({name: value})
+    assert refused.value.call == "exitInitializationMode"
+    assert refused.value.status in ("error", "fatal")
+    assert any(f"parameter {name}" in m for m in refused.value.messages)
+
+
+@pytest.mark.parametrize("h", [0.0, -0.1, math.nan])
+def test_bad_communication_steps_are_refused(ship, h):
+    ship.initialize()
+    with pytest.raises(FmuCallError) as refused:
+        ship.do_step(0.0, h)
+    assert refused.value.status == "discard"
+    assert any("communication step" in m for m in refused.value.messages)
+
+
+def test_the_fmu_runs_on_its_bundled_code_alone(fmu_paths, tmp_path):
+    """In a fresh interpreter that cannot see this repository, the FMU still runs."""
+    script = textwrap.dedent(f"""
+        import sys
+        sys.path = [p for p in sys.path if p not in ("", {str(fmu_paths['ship'].parent.parent)!r})]
+        sys.meta_path = [f for f in sys.meta_path if "editable" not in repr(f).lower()]
+        import fmpy
+        result = fmpy.simulate_fmu({str(fmu_paths['ship'])!r}, stop_time=5.0,
+                                   start_values={{"Hs": 0.005}})
+        import ship_fmu, fmukit
+        print(ship_fmu.__file__)
+        print(fmukit.__file__)
+        print(result["u"][-1])
+    """)
+    out = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True,
+                         text=True, timeout=120, check=True).stdout.split()
+    assert all("/resources/" in path for path in out[:2]), out
+    assert 0.25 < float(out[2]) < 0.35
+
+
+def test_setting_an_output_or_a_fixed_parameter_late_is_refused(ship):
+    ship.initialize()
+    with pytest.raises(FmuCallError) as refused:
+        ship.set({"psi": 1.0})
+    assert any("psi is an output" in m for m in refused.value.messages)
+    with pytest.raises(FmuCallError) as refused:
+        ship.set({"Hs": 0.01})
+    assert any("parameter Hs is fixed" in m for m in refused.value.messages)
+    assert ship.get(["psi", "Hs"]) == {"psi": 0.0, "Hs": 0.0}
+
+
+def test_step_before_initialisation_is_refused(ship):
+    with pytest.raises(FmuCallError) as refused:
+        ship.do_step(0.0, DT)
+    assert refused.value.status == "discard"
+    assert any("exitInitializationMode" in m for m in refused.value.messages)
+
+
+def test_many_refusals_leave_the_host_alive(fmu_paths):
+    """pythonfmu 0.7 frees objects on every exception; fmukit must compensate."""
+    for i in range(25):
+        instance = FmuInstance(fmu_paths["ship"], f"ship{i}")
+        with pytest.raises(FmuCallError):
+            instance.initialize({"Hs": -1.0})
+        with pytest.raises(FmuCallError):
+            instance.set({"x": 1.0})
+        instance.free()
+        gc.collect()
