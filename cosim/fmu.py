@@ -14,8 +14,7 @@ from fmpy.fmi1 import calloc, free
 
 STATUS = ("ok", "warning", "discard", "error", "fatal", "pending")
 BUILD_HINT = "build the FMUs with: python -m fmukit.build"
-_CONVERT = {"Real": float, "Integer": int, "Boolean": bool,
-            "String": lambda value: str(value).encode("utf-8")}
+_CONVERT = {"Real": float, "Integer": int, "Boolean": bool, "String": str}
 
 
 class FmuCallError(RuntimeError):

@@ -76,6 +76,7 @@ class Var:
     start: float | int | str | None = None
     kind: type = float                # float (Real), int (Integer) or str (String)
     depends: tuple[str, ...] = ()     # outputs: inputs and parameters they depend on
+    initial_depends: tuple[str, ...] = ()     # outputs: further knowns, at initialisation only
     get: Callable[[Any], Any] | None = None   # outputs: value from the slave
 
     @classmethod
@@ -91,10 +92,15 @@ class Var:
 
     @classmethod
     def output(cls, name: str, unit: str = "1", description: str = "",
-               depends: tuple[str, ...] = (), get: Callable[[Any], Any] | None = None,
-               kind: type = float) -> Var:
-        """An output read from the slave by ``get`` (default: the model's attribute)."""
-        return cls(name, "output", unit, description, None, kind, depends, get)
+               depends: tuple[str, ...] = (), initial_depends: tuple[str, ...] = (),
+               get: Callable[[Any], Any] | None = None, kind: type = float) -> Var:
+        """An output read from the slave by ``get`` (default: the model's attribute).
+
+        ``depends``: the inputs (direct feedthrough) and parameters it depends on;
+        ``initial_depends``: inputs it depends on only at initialisation.
+        """
+        return cls(name, "output", unit, description, None, kind, depends, initial_depends,
+                   get)
 
     @property
     def is_real(self) -> bool:
@@ -306,7 +312,7 @@ class ModelSlave(Fmi2Slave):
             initial = SubElement(structure, "InitialUnknowns")
             for v in outputs:
                 SubElement(initial, "Unknown", index=str(index[v.name]),
-                           dependencies=_indices(v.depends, index))
+                           dependencies=_indices(v.depends + v.initial_depends, index))
         return root
 
 

@@ -1,6 +1,7 @@
 """Shared fixtures: FMUs built from the current sources."""
 from __future__ import annotations
 
+import gc
 from pathlib import Path
 
 import pytest
@@ -24,3 +25,22 @@ def fmu_paths() -> dict[str, Path]:
         if _stale(name):
             build(name)
     return {name: FMU_DIR / f"{name}.fmu" for name in FMUS}
+
+
+@pytest.fixture
+def open_fmu(fmu_paths):
+    """Factory of FmuInstance objects, freed (and garbage-collected) after the test."""
+    from cosim.fmu import FmuInstance
+
+    opened = []
+
+    def open_(name: str, instance_name: str | None = None) -> FmuInstance:
+        instance = FmuInstance(fmu_paths[name], instance_name or name)
+        opened.append(instance)
+        return instance
+
+    yield open_
+    for instance in opened:
+        instance.free()
+    gc.collect()            # a host corrupted by an FMU would crash here, inside the test
+

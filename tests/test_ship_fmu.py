@@ -1,7 +1,6 @@
 """The ship FMU through FMI: conformance, equality with the in-process model, state, errors."""
 from __future__ import annotations
 
-import csv
 import gc
 import math
 import subprocess
@@ -13,6 +12,7 @@ from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 
 from cosim.fmu import FmuCallError, FmuInstance
+from helpers import fmpy_cli, read_csv
 from ship_fmu.vessel import Vessel, VesselParameters
 
 OUTPUTS = ["x", "y", "psi", "u", "v", "r", "delta", "X_w", "Y_w", "N_w"]
@@ -20,11 +20,8 @@ DT = 0.1
 
 
 @pytest.fixture
-def ship(fmu_paths):
-    instance = FmuInstance(fmu_paths["ship"], "ship")
-    yield instance
-    instance.free()
-    gc.collect()            # a corrupted host would crash here, inside the test
+def ship(open_fmu) -> FmuInstance:
+    return open_fmu("ship")
 
 
 def rudder_program(k: int) -> float:
@@ -45,20 +42,10 @@ def test_model_description_validates_with_units_and_dependencies(fmu_paths):
     assert md.coSimulation.canGetAndSetFMUstate and md.coSimulation.canSerializeFMUstate
 
 
-def _fmpy_cli(*args: str, cwd) -> None:
-    subprocess.run([sys.executable, "-m", "fmpy.cli", *args], cwd=cwd, check=True,
-                   capture_output=True, text=True, timeout=120)
-
-
-def _read_csv(path) -> list[dict[str, float]]:
-    with open(path) as f:
-        return [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
-
-
 def test_fmpy_simulate_on_defaults_runs_straight_at_0_3_m_per_s(fmu_paths, tmp_path):
-    _fmpy_cli("simulate", str(fmu_paths["ship"]), "--stop-time", "100",
+    fmpy_cli("simulate", str(fmu_paths["ship"]), "--stop-time", "100",
               "--output-file", "out.csv", cwd=tmp_path)
-    rows = _read_csv(tmp_path / "out.csv")
+    rows = read_csv(tmp_path / "out.csv")
     assert rows[-1]["time"] == pytest.approx(100.0)
     assert all(row["u"] == pytest.approx(0.300, abs=0.001) for row in rows)
     assert all(row["psi"] == 0.0 and row["v"] == 0.0 for row in rows)
@@ -66,9 +53,9 @@ def test_fmpy_simulate_on_defaults_runs_straight_at_0_3_m_per_s(fmu_paths, tmp_p
 
 def test_fmpy_simulate_with_an_input_file_drives_the_rudder(fmu_paths, tmp_path):
     (tmp_path / "in.csv").write_text('"time","delta_c"\n0,0\n10,0\n10,0.2\n60,0.2\n')
-    _fmpy_cli("simulate", str(fmu_paths["ship"]), "--stop-time", "60",
+    fmpy_cli("simulate", str(fmu_paths["ship"]), "--stop-time", "60",
               "--input-file", "in.csv", "--output-file", "out.csv", cwd=tmp_path)
-    rows = _read_csv(tmp_path / "out.csv")
+    rows = read_csv(tmp_path / "out.csv")
     assert rows[-1]["delta"] == pytest.approx(0.2)
     assert rows[-1]["psi"] < -0.5          # positive rudder: turn to port
 
@@ -97,7 +84,7 @@ def _run(ship: FmuInstance, k0: int, steps: int) -> list[dict[str, float]]:
     return rows
 
 
-def test_saved_state_reproduces_the_run_bit_for_bit(ship, fmu_paths):
+def test_saved_state_reproduces_the_run_bit_for_bit(ship, open_fmu):
     ship.initialize({"Hs": 0.005, "wave_seed": 5})
     _run(ship, 0, 100)
     state = ship.slave.getFMUstate()
@@ -106,14 +93,11 @@ def test_saved_state_reproduces_the_run_bit_for_bit(ship, fmu_paths):
     assert _run(ship, 100, 200) == first
 
     serialized = ship.slave.serializeFMUstate(state)
-    other = FmuInstance(fmu_paths["ship"], "other")
-    try:
-        other.initialize({"Hs": 0.005, "wave_seed": 99})
-        other.slave.setFMUstate(other.slave.deSerializeFMUstate(serialized))
-        assert other.get(["Hs"]) == {"Hs": 0.005}
-        assert _run(other, 100, 200) == first
-    finally:
-        other.free()
+    other = open_fmu("ship", "other")
+    other.initialize({"Hs": 0.005, "wave_seed": 99})
+    other.slave.setFMUstate(other.slave.deSerializeFMUstate(serialized))
+    assert other.get(["Hs"]) == {"Hs": 0.005}
+    assert _run(other, 100, 200) == first
 
 
 @pytest.mark.parametrize("name", ["delta_c", "n1", "n2", "n3"])

@@ -1,0 +1,116 @@
+"""Linear design models of the sliding-mode autopilot, eqs (22)-(32) and (45)-(46).
+
+Two sources for the sway-yaw model M nu_dot + N(u0) nu = b delta, nu = [v, r]:
+
+- ``PAPER_EQ45``: eq (45) as printed, to reproduce the paper. Its M and n_11, n_12,
+  n_21 follow from the hull data at u0 = 0.3 m/s; its n_22 lacks the factor u0 on
+  the Coriolis term and its b_1 does not follow from the rudder constants (see
+  ../shared/cybership2.md, erratum 4). Eq (46) follows from it exactly.
+- ``linearised_ship(u0)``: the Jacobian of our own ship model at nu = [u0, 0, 0],
+  zero rudder and the paper's propeller speed. It is taken numerically from the
+  same functions the vessel integrates, so it cannot drift from the physics.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from ship_fmu.data import Actuators, Hull
+from ship_fmu.hull import coriolis_forces, damping_forces, mass_matrix
+from ship_fmu.thrusters import actuator_forces
+from ship_fmu.vessel import N_PROPELLER
+
+
+@dataclass(frozen=True)
+class SwayYawModel:
+    """M nu_dot + N nu = b delta with nu = [v, r], eq (23)."""
+
+    M: np.ndarray
+    N: np.ndarray
+    b: np.ndarray
+
+
+PAPER_EQ45 = SwayYawModel(
+    M=np.array([[33.8000, 1.0948], [1.0948, 2.7600]]),
+    N=np.array([[0.8897, 14.9900], [2.3687, 2.9948]]),
+    b=np.array([0.4304, -0.2363]),
+)
+
+
+def _derivative(f: Callable[[float], np.ndarray], x: float, step: float = 1e-3) -> np.ndarray:
+    """df/dx by central differences with one Richardson step.
+
+    The model's nonlinear terms are of the form |a| b; their central difference at
+    a = 0 carries an error proportional to the step, which the Richardson step
+    removes exactly.
+    """
+    def central(h: float) -> np.ndarray:
+        return (f(x + h) - f(x - h)) / (2.0 * h)
+    return 2.0 * central(step / 2.0) - central(step)
+
+
+def linearised_ship(u0: float, n: float = N_PROPELLER, hull: Hull = Hull(),
+                    actuators: Actuators = Actuators()) -> SwayYawModel:
+    """Sway-yaw model of the ship linearised at surge speed u0, eqs (23)-(25)."""
+    def hydrodynamic(v: float, r: float) -> np.ndarray:
+        forces = np.add(coriolis_forces(hull, u0, v, r), damping_forces(hull, u0, v, r))
+        return forces[1:]
+
+    N = np.column_stack([_derivative(lambda v: hydrodynamic(v, 0.0), 0.0),
+                         _derivative(lambda r: hydrodynamic(0.0, r), 0.0)])
+    b = _derivative(lambda d: np.array(actuator_forces(actuators, n, n, 0.0, d)[1:]), 0.0)
+    return SwayYawModel(M=mass_matrix(hull)[1:, 1:], N=N, b=b)
+
+
+@dataclass(frozen=True)
+class NomotoModel:
+    """psi/delta = K / (s (1 + T s)), eqs (26)-(34), as the state model (33)."""
+
+    K_R: float      # eq (29)
+    T3: float       # eq (30)
+    T: float        # T1 + T2 - T3, s
+
+    @classmethod
+    def from_sway_yaw(cls, model: SwayYawModel) -> NomotoModel:
+        (m11, m12), (m21, m22) = model.M
+        (n11, n12), (n21, n22) = model.N
+        b1, b2 = model.b
+        det_N = np.linalg.det(model.N)
+        T1_plus_T2 = (n11 * m22 + n22 * m11 - n12 * m21 - n21 * m12) / det_N   # (28)
+        K_R = (n21 * b1 - n11 * b2) / det_N                                     # (29)
+        T3 = (m21 * b1 - m11 * b2) / det_N / K_R                                # (30)
+        return cls(K_R=float(K_R), T3=float(T3), T=float(T1_plus_T2 - T3))
+
+    @property
+    def K(self) -> float:
+        """Eq (31): K = -K_R."""
+        return -self.K_R
+
+    @property
+    def a22(self) -> float:
+        """-1/T (the paper writes a_11 after eq (34); it is a_22)."""
+        return -1.0 / self.T
+
+    @property
+    def b2(self) -> float:
+        """K / T."""
+        return self.K / self.T
+
+    def state_model(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+        """(A_h, B_h, C_h, D_h) of eqs (33)-(36), state [psi, r]."""
+        return (np.array([[0.0, 1.0], [0.0, self.a22]]), np.array([0.0, self.b2]),
+                np.array([1.0, 0.0]), 0.0)
+
+
+def design_model(name: str, u0: float) -> SwayYawModel:
+    """The sway-yaw model the parameter ``design_model`` names: 'paper' or 'ship'."""
+    if name == "paper":
+        return PAPER_EQ45
+    if name == "ship":
+        if not u0 > 0.0:
+            raise ValueError(f"parameter u0 must be > 0 for design_model 'ship', got {u0}")
+        return linearised_ship(u0)
+    raise ValueError(f"parameter design_model must be 'paper' (eq 45 as printed) or 'ship' "
+                     f"(our model linearised at u0), got {name!r}")

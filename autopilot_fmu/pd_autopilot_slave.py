@@ -1,0 +1,33 @@
+"""The PD autopilot as an FMI 2.0 co-simulation FMU (fmus/pd_autopilot.fmu).
+
+delta_c is direct feedthrough from psi, r and psi_d: it is evaluated when read.
+"""
+from pythonfmu import DefaultExperiment
+
+from autopilot_fmu.angles import require_finite
+from autopilot_fmu.pd import PDAutopilot
+from fmukit.slave import ModelSlave, Var
+
+_P = PDAutopilot()
+
+
+class PDAutopilotSlave(ModelSlave):
+    model_name = "pd_autopilot"
+    description = "PD heading autopilot, delta_c = Kp (psi - psi_d) + Kd r (Tomera 2010, eq 20)"
+    default_experiment = DefaultExperiment(start_time=0.0, stop_time=400.0, step_size=0.1)
+    variables = (
+        Var.input("psi", 0.0, "rad", "ship heading"),
+        Var.input("r", 0.0, "rad/s", "ship yaw rate"),
+        Var.input("psi_d", 0.0, "rad", "desired course"),
+        Var.output("delta_c", "rad", "commanded rudder angle; positive turns the ship to port",
+                   depends=("psi", "r", "psi_d", "Kp", "Kd"),
+                   get=lambda s: s.model.command(s.psi, s.r, s.psi_d)),
+        Var.parameter("Kp", _P.Kp, "1", "heading error gain, rad of rudder per rad"),
+        Var.parameter("Kd", _P.Kd, "s", "yaw rate gain, rad of rudder per rad/s"),
+    )
+
+    def build_model(self) -> PDAutopilot:
+        return PDAutopilot(self.Kp, self.Kd)
+
+    def step_model(self, t: float, h: float) -> None:
+        require_finite(psi=self.psi, r=self.r, psi_d=self.psi_d)

@@ -1,0 +1,142 @@
+"""Sliding-mode autopilot, eqs (35)-(44).
+
+Design (computed, never typed in): sway-yaw model -> Nomoto model (33) ->
+pole placement of A_c = A_h - B_h K^T at lambda_1, lambda_2 (38) -> h, the
+eigenvector of A_c^T for the eigenvalue of smaller magnitude -> N from (40)-(41).
+
+Control law, delta_c = u_eq + u_sw (43), with x = [psi, r] and the reference
+state [psi_z, r_z] of eq (44):
+
+    u_eq  = N psi_z - K^T x                                  (39), stabilising reading
+    u_sw  = h^T [r_z, r_z_dot] - eta_h tanh(sigma_h / phi_h)  (42)
+    sigma_h = h_1 (psi_z - psi) + h_2 (r_z - r)              (37)
+
+Eq (39) prints u_eq = -N psi_z + K x. A_c = A_h - B_h K^T is the closed loop of
+delta = -K^T x, and for this ship b_2 < 0, so K = [k_1, k_2] comes out negative
+(about [-0.987, -2000]): taken literally, +K x feeds the heading back with the
+wrong sign and the loop diverges. The reading that makes A_c the closed loop is
+u_eq = N psi_z - K^T x. Since A_h has a free integrator, eq (41) gives N_x = [1, 0]
+and N_u = 0, so N = k_1 and u_eq = k_1 (psi_z - psi) - k_2 r: the same sign
+structure as the PD law (20), K_P (psi - psi_d) + K_D r, with K_P -> -k_1 and
+K_D -> -k_2. Heading differences are wrapped to (-pi, pi].
+
+The switching term is taken as printed. With sigma_h = h^T (x_z - x) and b_2 < 0,
+-eta_h tanh(sigma_h / phi_h) pushes the heading toward psi_z; the feed-forward
+h^T x_z_dot is small (h_1 r_z is about 0.01 rad in a 40 deg turn).
+
+The reference model (44) follows psi_d through the wrapped error
+psi_d - psi_z, so a course change across +-180 deg takes the short way; psi_z is
+continuous. It is integrated by RK4 with psi_d held over the step.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .angles import require_finite, wrap
+from .design import NomotoModel, SwayYawModel
+
+H_MAX = 0.1
+"""Largest RK4 step of the reference model, s."""
+
+
+@dataclass(frozen=True)
+class SlidingModeDesign:
+    """Gains of the sliding-mode autopilot for a Nomoto model, eqs (38)-(41)."""
+
+    nomoto: NomotoModel
+    lambda1: float
+    lambda2: float
+    K: tuple[float, float]
+    h: tuple[float, float]
+    N: float
+
+    @classmethod
+    def from_model(cls, model: SwayYawModel, lambda1: float = -0.0005,
+                   lambda2: float = -7.8128) -> SlidingModeDesign:
+        for name, value in (("lambda1", lambda1), ("lambda2", lambda2)):
+            if not (math.isfinite(value) and value < 0.0):
+                raise ValueError(f"parameter {name} must be a finite closed-loop eigenvalue "
+                                 f"< 0, got {value}")
+        nomoto = NomotoModel.from_sway_yaw(model)
+        A, B, C, D = nomoto.state_model()
+        b2, a22 = nomoto.b2, nomoto.a22
+        # Pole placement, eq (38): det(sI - A_c) = s^2 - (a22 - b2 k2) s + b2 k1.
+        k1 = lambda1 * lambda2 / b2
+        k2 = (a22 - lambda1 - lambda2) / b2
+        A_c = A - np.outer(B, [k1, k2])
+        eigenvalues, vectors = np.linalg.eig(A_c.T)
+        h = np.real(vectors[:, np.argmin(np.abs(eigenvalues))])
+        h = h / np.linalg.norm(h) * np.sign(h[0])
+        # Eqs (40)-(41): [N_x; N_u] = [[A, B], [C, D]]^-1 [0; 1].
+        system = np.block([[A, B[:, None]], [C[None, :], np.array([[D]])]])
+        N_xu = np.linalg.solve(system, [0.0, 0.0, 1.0])
+        N = N_xu[2] + k1 * N_xu[0] + k2 * N_xu[1]
+        return cls(nomoto=nomoto, lambda1=lambda1, lambda2=lambda2,
+                   K=(float(k1), float(k2)), h=(float(h[0]), float(h[1])), N=float(N))
+
+
+class SlidingModeAutopilot:
+    """Reference model (44) as state, control law (37)-(43) as output."""
+
+    STATE = ("psi_z", "r_z")
+
+    def __init__(self, design: SlidingModeDesign, eta_h: float = 10.0, phi_h: float = 0.3,
+                 omega_n: float = 0.1, zeta: float = 0.85, psi_z: float = 0.0,
+                 r_z: float = 0.0):
+        for name, value, ok, rule in (
+            ("eta_h", eta_h, eta_h >= 0.0, ">= 0"), ("phi_h", phi_h, phi_h > 0.0, "> 0"),
+            ("omega_n", omega_n, omega_n > 0.0, "> 0"), ("zeta", zeta, zeta > 0.0, "> 0"),
+        ):
+            if not (math.isfinite(value) and ok):
+                raise ValueError(f"parameter {name} must be finite and {rule}, got {value}")
+        require_finite(psi=psi_z, r=r_z)
+        self.design = design
+        self.eta_h, self.phi_h, self.omega_n, self.zeta = eta_h, phi_h, omega_n, zeta
+        self.psi_z, self.r_z = psi_z, r_z
+
+    def r_z_dot(self, psi_d: float, psi_z: float | None = None,
+                r_z: float | None = None) -> float:
+        """Desired yaw acceleration from the reference model, eq (44)."""
+        psi_z = self.psi_z if psi_z is None else psi_z
+        r_z = self.r_z if r_z is None else r_z
+        w = self.omega_n
+        return w * w * wrap(psi_d - psi_z) - 2.0 * self.zeta * w * r_z
+
+    def sigma(self, psi: float, r: float) -> float:
+        """Sliding surface sigma_h, eq (37)."""
+        h1, h2 = self.design.h
+        return h1 * wrap(self.psi_z - psi) + h2 * (self.r_z - r)
+
+    def command(self, psi: float, r: float, psi_d: float) -> float:
+        """Commanded rudder angle delta_c = u_eq + u_sw, eq (43), rad."""
+        (k1, k2), (h1, h2) = self.design.K, self.design.h
+        u_eq = k1 * wrap(self.psi_z - psi) - k2 * r
+        u_sw = (h1 * self.r_z + h2 * self.r_z_dot(psi_d)
+                - self.eta_h * math.tanh(self.sigma(psi, r) / self.phi_h))
+        return u_eq + u_sw
+
+    def step(self, t: float, h: float, psi_d: float) -> None:
+        """Advance the reference model from t to t + h with psi_d held (RK4)."""
+        require_finite(psi_d=psi_d)
+        n = max(1, math.ceil(h / H_MAX - 1e-9))
+        hs = h / n
+        psi_z, r_z = self.psi_z, self.r_z
+        for _ in range(n):
+            a1, b1 = r_z, self.r_z_dot(psi_d, psi_z, r_z)
+            a2, b2 = r_z + 0.5 * hs * b1, self.r_z_dot(psi_d, psi_z + 0.5 * hs * a1,
+                                                       r_z + 0.5 * hs * b1)
+            a3, b3 = r_z + 0.5 * hs * b2, self.r_z_dot(psi_d, psi_z + 0.5 * hs * a2,
+                                                       r_z + 0.5 * hs * b2)
+            a4, b4 = r_z + hs * b3, self.r_z_dot(psi_d, psi_z + hs * a3, r_z + hs * b3)
+            psi_z += hs / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
+            r_z += hs / 6.0 * (b1 + 2.0 * b2 + 2.0 * b3 + b4)
+        self.psi_z, self.r_z = psi_z, r_z
+
+    def snapshot(self) -> dict[str, float]:
+        return {"psi_z": self.psi_z, "r_z": self.r_z}
+
+    def restore(self, snapshot: dict[str, float]) -> None:
+        self.psi_z, self.r_z = float(snapshot["psi_z"]), float(snapshot["r_z"])

@@ -1,0 +1,54 @@
+"""The sliding-mode autopilot as an FMI 2.0 co-simulation FMU (fmus/smc_autopilot.fmu).
+
+The reference model (44) is the FMU's state; it starts at the heading and yaw
+rate the FMU sees at initialisation. delta_c and sigma are direct feedthrough
+from the inputs and are evaluated when read; psi_z and r_z are states.
+"""
+from pythonfmu import DefaultExperiment
+
+from autopilot_fmu.angles import require_finite
+from autopilot_fmu.design import design_model
+from autopilot_fmu.smc import SlidingModeAutopilot, SlidingModeDesign
+from fmukit.slave import ModelSlave, Var
+
+_DESIGN = ("lambda1", "lambda2", "u0", "design_model")
+_LAW = _DESIGN + ("eta_h", "phi_h", "omega_n", "zeta")
+
+
+class SMCAutopilotSlave(ModelSlave):
+    model_name = "smc_autopilot"
+    description = ("Sliding-mode heading autopilot with reference model "
+                   "(Tomera 2010, eqs 33-44), design computed from the linear model")
+    default_experiment = DefaultExperiment(start_time=0.0, stop_time=400.0, step_size=0.1)
+    variables = (
+        Var.input("psi", 0.0, "rad", "ship heading"),
+        Var.input("r", 0.0, "rad/s", "ship yaw rate"),
+        Var.input("psi_d", 0.0, "rad", "desired course"),
+        Var.output("delta_c", "rad", "commanded rudder angle, eq (43)",
+                   depends=("psi", "r", "psi_d") + _LAW,
+                   get=lambda s: s.model.command(s.psi, s.r, s.psi_d)),
+        Var.output("psi_z", "rad", "reference heading, eq (44)", initial_depends=("psi",)),
+        Var.output("r_z", "rad/s", "reference yaw rate, eq (44)", initial_depends=("r",)),
+        Var.output("sigma", "1", "sliding surface, eq (37)", depends=("psi", "r") + _DESIGN,
+                   get=lambda s: s.model.sigma(s.psi, s.r)),
+        Var.parameter("lambda1", -0.0005, "1/s", "closed-loop eigenvalue of smaller magnitude"),
+        Var.parameter("lambda2", -7.8128, "1/s", "closed-loop eigenvalue of larger magnitude"),
+        Var.parameter("eta_h", 10.0, "rad", "switching gain"),
+        Var.parameter("phi_h", 0.3, "rad", "boundary layer thickness, > 0"),
+        Var.parameter("omega_n", 0.1, "rad/s", "reference model natural frequency, > 0"),
+        Var.parameter("zeta", 0.85, "1", "reference model relative damping, > 0"),
+        Var.parameter("u0", 0.3, "m/s", "design surge speed (design_model 'ship')"),
+        Var.parameter("design_model", "paper", description=(
+            "linear design model: 'paper' = eq (45) as printed, 'ship' = this ship "
+            "model linearised at u0")),
+    )
+
+    def build_model(self) -> SlidingModeAutopilot:
+        design = SlidingModeDesign.from_model(design_model(self.design_model, self.u0),
+                                              self.lambda1, self.lambda2)
+        return SlidingModeAutopilot(design, self.eta_h, self.phi_h, self.omega_n, self.zeta,
+                                    psi_z=self.psi, r_z=self.r)
+
+    def step_model(self, t: float, h: float) -> None:
+        require_finite(psi=self.psi, r=self.r, psi_d=self.psi_d)
+        self.model.step(t, h, self.psi_d)
