@@ -20,6 +20,14 @@ and N_u = 0, so N = k_1 and u_eq = k_1 (psi_z - psi) - k_2 r: the same sign
 structure as the PD law (20), K_P (psi - psi_d) + K_D r, with K_P -> -k_1 and
 K_D -> -k_2. Heading differences are wrapped to (-pi, pi].
 
+Eq (39) scales only psi_z, so u_eq damps the yaw rate itself, not its error: with
+k_2 ~ -2000 it holds r near zero, and the switching term (at most eta_h) has to
+overpower it to turn the ship. ``equivalent_control='tracking'`` offers the
+full-state reading u_eq = -K^T (x - x_z) = k_1 (psi_z - psi) + k_2 (r_z - r),
+which tracks the reference yaw rate too; it is not the paper's law, and exists to
+show where the difference between the paper's figures and ours comes from
+(docs/reproduction.md).
+
 The switching term is taken as printed. With sigma_h = h^T (x_z - x) and b_2 < 0,
 -eta_h tanh(sigma_h / phi_h) pushes the heading toward psi_z; the feed-forward
 h^T x_z_dot is small (h_1 r_z is about 0.01 rad in a 40 deg turn).
@@ -40,6 +48,8 @@ from .design import NomotoModel, SwayYawModel
 
 H_MAX = 0.1
 """Largest RK4 step of the reference model, s."""
+
+EQUIVALENT_CONTROLS = ("paper", "tracking")
 
 
 @dataclass(frozen=True)
@@ -85,15 +95,19 @@ class SlidingModeAutopilot:
 
     def __init__(self, design: SlidingModeDesign, eta_h: float = 10.0, phi_h: float = 0.3,
                  omega_n: float = 0.1, zeta: float = 0.85, psi_z: float = 0.0,
-                 r_z: float = 0.0):
+                 r_z: float = 0.0, equivalent_control: str = "paper"):
         for name, value, ok, rule in (
             ("eta_h", eta_h, eta_h >= 0.0, ">= 0"), ("phi_h", phi_h, phi_h > 0.0, "> 0"),
             ("omega_n", omega_n, omega_n > 0.0, "> 0"), ("zeta", zeta, zeta > 0.0, "> 0"),
         ):
             if not (math.isfinite(value) and ok):
                 raise ValueError(f"parameter {name} must be finite and {rule}, got {value}")
+        if equivalent_control not in EQUIVALENT_CONTROLS:
+            raise ValueError(f"parameter equivalent_control must be 'paper' (eq 39) or "
+                             f"'tracking' (-K^T (x - x_z)), got {equivalent_control!r}")
         require_finite(psi=psi_z, r=r_z)
         self.design = design
+        self.tracking = equivalent_control == "tracking"
         self.eta_h, self.phi_h, self.omega_n, self.zeta = eta_h, phi_h, omega_n, zeta
         self.psi_z, self.r_z = psi_z, r_z
 
@@ -113,7 +127,7 @@ class SlidingModeAutopilot:
     def command(self, psi: float, r: float, psi_d: float) -> float:
         """Commanded rudder angle delta_c = u_eq + u_sw, eq (43), rad."""
         (k1, k2), (h1, h2) = self.design.K, self.design.h
-        u_eq = k1 * wrap(self.psi_z - psi) - k2 * r
+        u_eq = k1 * wrap(self.psi_z - psi) + k2 * ((self.r_z if self.tracking else 0.0) - r)
         u_sw = (h1 * self.r_z + h2 * self.r_z_dot(psi_d)
                 - self.eta_h * math.tanh(self.sigma(psi, r) / self.phi_h))
         return u_eq + u_sw

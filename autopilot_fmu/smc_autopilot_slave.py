@@ -12,7 +12,7 @@ from autopilot_fmu.smc import SlidingModeAutopilot, SlidingModeDesign
 from fmukit.slave import ModelSlave, Var
 
 _DESIGN = ("lambda1", "lambda2", "u0", "design_model")
-_LAW = _DESIGN + ("eta_h", "phi_h", "omega_n", "zeta")
+_LAW = _DESIGN + ("eta_h", "phi_h", "omega_n", "zeta", "equivalent_control")
 
 
 class SMCAutopilotSlave(ModelSlave):
@@ -41,13 +41,17 @@ class SMCAutopilotSlave(ModelSlave):
         Var.parameter("design_model", "paper", description=(
             "linear design model: 'paper' = eq (45) as printed, 'ship' = this ship "
             "model linearised at u0")),
+        Var.parameter("equivalent_control", "paper", description=(
+            "'paper' = eq (39), u_eq = N psi_z - K^T x; 'tracking' = -K^T (x - x_z), "
+            "not the paper's law (see docs/reproduction.md)")),
     )
 
     def build_model(self) -> SlidingModeAutopilot:
         design = SlidingModeDesign.from_model(design_model(self.design_model, self.u0),
                                               self.lambda1, self.lambda2)
         return SlidingModeAutopilot(design, self.eta_h, self.phi_h, self.omega_n, self.zeta,
-                                    psi_z=self.psi, r_z=self.r)
+                                    psi_z=self.psi, r_z=self.r,
+                                    equivalent_control=self.equivalent_control)
 
     def step_model(self, t: float, h: float) -> None:
         require_finite(psi=self.psi, r=self.r, psi_d=self.psi_d)
