@@ -48,6 +48,11 @@ class FmuInstance:
         self._owns_unzip_dir = unzip_dir is None
         self.unzip_dir = str(unzip_dir) if unzip_dir else extract(str(self.path))
         self.variables = {v.name: v for v in self.description.modelVariables}
+        self.feedthrough = {o.variable.name: frozenset(d.name for d in o.dependencies)
+                            if o.dependencies is not None else frozenset(
+                                v.name for v in self.description.modelVariables
+                                if v.causality == "input")
+                            for o in self.description.outputs}
         self.log: deque[str] = deque(maxlen=50)
         self._callbacks = fmi2CallbackFunctions()
         self._callbacks.logger = fmi2CallbackLoggerTYPE(self._on_log)
@@ -109,14 +114,30 @@ class FmuInstance:
     def initialize(self, parameters: dict[str, Any] | None = None,
                    start_time: float = 0.0) -> None:
         """setupExperiment, parameters, enter and exit initialisation mode."""
+        self.enter_initialization(start_time)
+        self.set(parameters or {}, time=start_time)
+        self.exit_initialization(start_time)
+
+    def enter_initialization(self, start_time: float = 0.0) -> None:
         self.call("setupExperiment", self.slave.setupExperiment, startTime=start_time)
         self.call("enterInitializationMode", self.slave.enterInitializationMode)
-        self.set(parameters or {}, time=start_time)
+
+    def exit_initialization(self, start_time: float = 0.0) -> None:
         self.call("exitInitializationMode", self.slave.exitInitializationMode,
                   time=start_time)
 
     def do_step(self, t: float, h: float) -> None:
         self.call("doStep", self.slave.doStep, t, h, time=t)
+
+    # Batched calls by value reference, for the master's loop.
+    def get_real(self, vrs: list[int]) -> list[float]:
+        return self.call("getReal", self.slave.getReal, vrs)
+
+    def get_integer(self, vrs: list[int]) -> list[int]:
+        return self.call("getInteger", self.slave.getInteger, vrs)
+
+    def set_real(self, vrs: list[int], values: list[float]) -> None:
+        self.call("setReal", self.slave.setReal, vrs, values)
 
     def free(self) -> None:
         """Terminate, free the instance and remove the extracted files."""

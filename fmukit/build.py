@@ -22,6 +22,7 @@ FMU_DIR = ROOT / "fmus"
 # FMU name: (slave script, packages it needs at run time)
 FMUS: dict[str, tuple[str, tuple[str, ...]]] = {
     "ship": ("ship_fmu/ship_slave.py", ("fmukit", "ship_fmu")),
+    "manoeuvre": ("ship_fmu/manoeuvre_slave.py", ("fmukit", "ship_fmu")),
     "pd_autopilot": ("autopilot_fmu/pd_autopilot_slave.py", ("fmukit", "autopilot_fmu")),
     # design_model 'ship' linearises the vessel model: the SMC carries ship_fmu too.
     "smc_autopilot": ("autopilot_fmu/smc_autopilot_slave.py",

@@ -1,0 +1,59 @@
+"""The paper's block diagram wired by hand from the plain modules: no FMI, no master.
+
+guidance -> autopilot -> ship, in that order at every step, as in the paper's
+Simulink model and the master's Gauss-Seidel coupling. The models are built by
+the same ``build_model`` code the FMUs use, from the parameters of a course-keeping
+system description (components named guidance, autopilot and ship). This is the
+in-process limit the benchmark measures and the reference the equality tests use.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ship_fmu.vessel import N_PROPELLER
+
+from .inprocess import InProcessInstance
+from .ssd import SystemDescription
+
+SIGNALS = ("guidance.psi_d", "autopilot.delta_c", "ship.x", "ship.y", "ship.psi", "ship.u",
+           "ship.v", "ship.r", "ship.delta")
+
+
+def build_models(system: SystemDescription) -> dict:
+    """Each component's model, built from the system's parameters by its slave class."""
+    ship_start = system.components["ship"].parameters
+    models = {}
+    for name, component in system.components.items():
+        instance = InProcessInstance(component.source, name)
+        instance.enter_initialization(system.start_time)
+        instance.set(component.parameters)
+        if name == "autopilot":             # the reference model starts at the ship's state
+            instance.set({"psi": ship_start.get("psi0", 0.0), "r": ship_start.get("r0", 0.0)})
+        instance.exit_initialization(system.start_time)
+        models[name] = instance.slave.model
+    return models
+
+
+def run_direct(system: SystemDescription, stop_time: float | None = None) -> dict[str, np.ndarray]:
+    """Simulate; each signal sampled at t_k = k h, k = 0 .. N, like the master's rows."""
+    models = build_models(system)
+    guidance, autopilot, ship = (models[n] for n in ("guidance", "autopilot", "ship"))
+    ship_inputs = system.components["ship"].parameters
+    n1, n2, n3 = (ship_inputs.get(n, N_PROPELLER if n != "n3" else 0.0)
+                  for n in ("n1", "n2", "n3"))
+    stepping_pilot = hasattr(autopilot, "step")
+    h, t0 = system.step_size, system.start_time
+    n_steps = round(((system.stop_time if stop_time is None else stop_time) - t0) / h)
+    out = np.empty((n_steps + 1, len(SIGNALS)))
+    for k in range(n_steps + 1):
+        t = t0 + k * h
+        psi_d = guidance.psi_d(ship.x, ship.y)
+        delta_c = autopilot.command(ship.psi, ship.r, psi_d)
+        out[k] = (psi_d, delta_c, ship.x, ship.y, ship.psi, ship.u, ship.v, ship.r, ship.delta)
+        if k == n_steps:
+            break
+        guidance.update(ship.x, ship.y)
+        if stepping_pilot:
+            autopilot.step(t, h, psi_d)
+        ship.step(t, h, delta_c, n1, n2, n3)
+    return dict(zip(SIGNALS, out.T))

@@ -1,0 +1,126 @@
+"""The master's in-process backend: the FMUs' Python classes, called without FMI.
+
+An ``InProcessInstance`` has the same interface as ``cosim.fmu.FmuInstance`` but
+instantiates the slave class an FMU was built from (``fmukit.build.FMUS``) in this
+process and calls its methods directly. A run on this backend differs from a
+co-simulation only by the FMI layer (C wrapper, fmpy, ctypes), which is what the
+equality tests compare.
+"""
+from __future__ import annotations
+
+import importlib
+import inspect
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Iterable
+
+from fmukit.build import FMUS
+from fmukit.slave import ModelSlave
+
+from .fmu import FmuCallError
+
+_FMI_TYPE = {float: "Real", int: "Integer", str: "String"}
+
+
+@dataclass(frozen=True)
+class VariableInfo:
+    name: str
+    valueReference: int
+    type: str
+    causality: str
+
+
+def slave_class(fmu_name: str) -> type[ModelSlave]:
+    """The ModelSlave subclass that ``fmus/<fmu_name>.fmu`` is built from."""
+    if fmu_name not in FMUS:
+        raise ValueError(f"no FMU named '{fmu_name}' is built by this project "
+                         f"(known: {', '.join(FMUS)})")
+    module_name = FMUS[fmu_name][0].removesuffix(".py").replace("/", ".")
+    module = importlib.import_module(module_name)
+    return next(cls for _, cls in inspect.getmembers(module, inspect.isclass)
+                if issubclass(cls, ModelSlave) and getattr(cls, "model_name", None) == fmu_name)
+
+
+class InProcessInstance:
+    """A slave class instantiated and driven in this process."""
+
+    def __init__(self, path: str | Path, name: str):
+        self.path, self.name = Path(path), name
+        self.slave = slave_class(self.path.stem)(instance_name=name)
+        self.variables = {}
+        for vr, var in self.slave._by_vr.items():
+            self.variables[var.name] = VariableInfo(var.name, vr, _FMI_TYPE[var.kind],
+                                                    var.causality)
+        inputs = {v.name for v in self.slave.variables if v.causality == "input"}
+        self.feedthrough = {v.name: frozenset(v.depends) & inputs
+                            for v in self.slave.variables if v.causality == "output"}
+        self.log: list[str] = []
+
+    def call(self, what: str, function, *args, time: float | None = None) -> Any:
+        """Call a slave method; an exception or a refused step becomes FmuCallError."""
+        try:
+            result = function(*args)
+        except Exception as error:
+            raise FmuCallError(self.name, what, time, "fatal", [*self._drain(), repr(error)]) \
+                from error
+        if result is False:
+            raise FmuCallError(self.name, what, time, "discard", self._drain())
+        self._drain()
+        return result
+
+    def _drain(self) -> list[str]:
+        messages = [f"[{m.status.name}] {m.msg}" for m in self.slave.log_queue]
+        self.slave.log_queue.clear()
+        self.log.extend(messages)
+        return messages
+
+    def variable(self, name: str) -> VariableInfo:
+        try:
+            return self.variables[name]
+        except KeyError:
+            raise ValueError(f"FMU '{self.name}' ({self.path.name}) has no variable '{name}'; "
+                             f"it has: {', '.join(self.variables)}") from None
+
+    def vr(self, name: str) -> int:
+        return self.variable(name).valueReference
+
+    def set(self, values: dict[str, Any], time: float | None = None) -> None:
+        for name, value in values.items():
+            setter = getattr(self.slave, f"set_{self.variable(name).type.lower()}")
+            self.call(f"set {name} = {value!r}", setter, [self.vr(name)], [value], time=time)
+
+    def get(self, names: Iterable[str]) -> dict[str, Any]:
+        out = {}
+        for name in names:
+            getter = getattr(self.slave, f"get_{self.variable(name).type.lower()}")
+            out[name] = self.call(f"get {name}", getter, [self.vr(name)])[0]
+        return out
+
+    def initialize(self, parameters: dict[str, Any] | None = None,
+                   start_time: float = 0.0) -> None:
+        self.enter_initialization(start_time)
+        self.set(parameters or {}, time=start_time)
+        self.exit_initialization(start_time)
+
+    def enter_initialization(self, start_time: float = 0.0) -> None:
+        self.call("setupExperiment", self.slave.setup_experiment, start_time)
+        self.call("enterInitializationMode", self.slave.enter_initialization_mode)
+
+    def exit_initialization(self, start_time: float = 0.0) -> None:
+        self.call("exitInitializationMode", self.slave.exit_initialization_mode,
+                  time=start_time)
+
+    def do_step(self, t: float, h: float) -> None:
+        self.call("doStep", self.slave.do_step, t, h, time=t)
+
+    def get_real(self, vrs: list[int]) -> list[float]:
+        return self.call("getReal", self.slave.get_real, vrs)
+
+    def get_integer(self, vrs: list[int]) -> list[int]:
+        return self.call("getInteger", self.slave.get_integer, vrs)
+
+    def set_real(self, vrs: list[int], values: list[float]) -> None:
+        self.call("setReal", self.slave.set_real, vrs, values)
+
+    def free(self) -> None:
+        self.slave.terminate()

@@ -1,0 +1,229 @@
+"""The master: exchanged signals, equality with the plain modules, couplings, bad input."""
+from __future__ import annotations
+
+import math
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from autopilot_fmu.guidance import parse_waypoints
+from autopilot_fmu.pd import PDAutopilot
+from cosim import run as cli
+from cosim.direct import SIGNALS, run_direct
+from cosim.master import Master, WiringError
+from cosim.metrics import cost_terms
+from cosim.report import LAMBDA
+from cosim.ssd import read_ssd, write_ssd
+
+SCENARIOS = Path(cli.__file__).parent / "scenarios"
+PAPER = ["calm_pd", "calm_smc", "waves_pd", "waves_smc"]
+_cache: dict = {}
+
+
+def system(name: str):
+    return read_ssd(SCENARIOS / f"{name}.ssd")
+
+
+def run(name: str, coupling: str = "gauss-seidel", backend: str = "fmi", **kwargs):
+    """A recorded run, cached: several tests look at the same runs."""
+    key = (name, coupling, backend, tuple(sorted(kwargs.items())))
+    if key not in _cache:
+        master = Master(system(name), coupling=coupling, backend=backend, **kwargs)
+        try:
+            _cache[key] = master.run()
+        finally:
+            master.free()
+        assert _cache[key].error is None
+    return _cache[key]
+
+
+@pytest.fixture(scope="module", autouse=True)
+def fmus_built(fmu_paths):
+    return fmu_paths
+
+
+# -- what travels along the connections ---------------------------------------------
+def test_gauss_seidel_signals_arrive_unchanged_and_in_step():
+    rec = run("calm_pd", verify_inputs=True)         # inputs as read back from the FMUs
+    assert rec.rows == 4001 and rec.t[-1] == 400.0
+    np.testing.assert_array_equal(rec["ship.delta_c"], rec["autopilot.delta_c"])
+    np.testing.assert_array_equal(rec["autopilot.psi"], rec["ship.psi"])
+    np.testing.assert_array_equal(rec["autopilot.r"], rec["ship.r"])
+    np.testing.assert_array_equal(rec["autopilot.psi_d"], rec["guidance.psi_d"])
+    np.testing.assert_array_equal(rec["guidance.x"], rec["ship.x"])
+    pd = PDAutopilot()
+    sent = [pd.command(p, r, d) for p, r, d in
+            zip(rec["ship.psi"], rec["ship.r"], rec["guidance.psi_d"])]
+    np.testing.assert_array_equal(rec["autopilot.delta_c"], sent)
+
+
+def test_jacobi_autopilot_answers_the_inputs_of_the_previous_step():
+    rec = run("calm_pd", coupling="jacobi", verify_inputs=True)
+    np.testing.assert_array_equal(rec["ship.delta_c"], rec["autopilot.delta_c"])
+    pd = PDAutopilot()
+    sent = [pd.command(p, r, d) for p, r, d in
+            zip(rec["autopilot.psi"], rec["autopilot.r"], rec["autopilot.psi_d"])]
+    np.testing.assert_array_equal(rec["autopilot.delta_c"][1:], sent[:-1])
+
+
+def test_psi_d_is_eq_18_of_the_active_leg():
+    rec = run("calm_pd")
+    points = parse_waypoints(system("calm_pd").components["guidance"].parameters["waypoints"])
+    legs = np.minimum(rec["guidance.wp_index"].astype(int), len(points) - 1)
+    expected = [math.atan2(points[k][1] - points[k - 1][1], points[k][0] - points[k - 1][0])
+                for k in legs]
+    np.testing.assert_array_equal(rec["guidance.psi_d"], expected)
+    assert set(rec["guidance.wp_index"]) == {1.0, 2.0, 3.0, 4.0}   # the whole route
+
+
+# -- equality with the plain modules ---------------------------------------------------
+@pytest.mark.parametrize("name", PAPER)
+def test_cosimulation_equals_the_plain_modules_wired_by_hand(name):
+    rec, direct = run(name), run_direct(system(name))
+    worst = max(np.abs(rec[s] - direct[s]).max() for s in SIGNALS)
+    assert worst <= 1e-9
+
+
+@pytest.mark.parametrize("name", PAPER + ["turning_circle", "zigzag_20_20"])
+def test_fmi_and_inprocess_backends_agree(name):
+    fmi, inprocess = run(name), run(name, backend="inprocess")
+    assert fmi.columns == inprocess.columns
+    assert np.abs(fmi.data - inprocess.data).max() <= 1e-9
+
+
+# -- coupling orders ------------------------------------------------------------------------
+def _first_rudder_step(rec) -> int:
+    return int(np.argmax(np.abs(rec["ship.delta_c"]) > 0.0))
+
+
+def test_jacobi_delays_the_rudder_one_step_per_feedthrough_fmu():
+    """Rudder answers the heading one step later, a course change two (guidance, autopilot)."""
+    gs, jac = run("waves_pd"), run("waves_pd", coupling="jacobi")
+    assert _first_rudder_step(jac) - _first_rudder_step(gs) == 1       # heading feedback
+    gs, jac = run("calm_pd"), run("calm_pd", coupling="jacobi")
+    assert _first_rudder_step(jac) - _first_rudder_step(gs) == 2       # course change
+    assert np.degrees(np.abs(gs["ship.psi"] - jac["ship.psi"]).max()) < 0.5
+
+
+def test_gauss_seidel_order_follows_the_signal_flow():
+    master = Master(system("calm_smc"))
+    try:
+        assert master.order == ["guidance", "autopilot", "ship"]
+    finally:
+        master.free()
+
+
+# -- lambda and the reports ------------------------------------------------------------------
+def test_lambda_is_calibrated_on_calm_pd():
+    rec = run("calm_pd")
+    psi_E, sum_delta2 = cost_terms(rec["guidance.psi_d"], rec["ship.psi"], rec["ship.delta"])
+    assert LAMBDA == pytest.approx(psi_E / sum_delta2, rel=1e-9)
+
+
+def test_run_writes_every_signal_and_a_figure(tmp_path, capsys):
+    assert cli.main(["calm_smc", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    for word in ("psi_E", "sum delta^2", "lambda", "J ="):
+        assert word in out
+    header, *rows = (tmp_path / "calm_smc.csv").read_text().splitlines()
+    columns = header.split(",")
+    assert len(rows) == 4001 and {"autopilot.psi_z", "ship.delta", "guidance.psi_d",
+                                  "ship.delta_c", "ship.X_w"} <= set(columns)
+    assert (tmp_path / "calm_smc.png").stat().st_size > 10_000
+
+
+def test_all_prints_tables_1_and_2_beside_the_paper(tmp_path, capsys):
+    assert cli.main(["--all", "--out", str(tmp_path), "--no-plot"]) == 0
+    out = capsys.readouterr().out
+    assert "Table 1, calm water" in out and "Table 2, waves" in out
+    assert "256.94" in out and "390.55" in out          # the paper's J for PD calm, SMC waves
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(PAPER)
+
+
+def test_stop_time_and_set_reach_the_fmus(tmp_path):
+    assert cli.main(["calm_pd", "--out", str(tmp_path), "--no-plot", "--stop-time", "20",
+                     "--set", "ship.Hs=0.004", "--set", "ship.wave_seed=3"]) == 0
+    header, *rows = (tmp_path / "calm_pd.csv").read_text().splitlines()
+    assert len(rows) == 201
+    X_w = [float(r.split(",")[header.split(",").index("ship.X_w")]) for r in rows]
+    assert max(map(abs, X_w)) > 0.1
+
+
+def test_manoeuvre_scenarios_report_their_figures(tmp_path, capsys):
+    assert cli.main(["zigzag_20_20", "--out", str(tmp_path), "--no-plot"]) == 0
+    assert "first overshoot 31.66 deg, second overshoot 7.25 deg" in capsys.readouterr().out
+
+
+# -- bad input ---------------------------------------------------------------------------
+def test_unknown_scenario_lists_the_valid_ones(capsys):
+    with pytest.raises(SystemExit) as exit_:
+        cli.main(["calm_xyz"])
+    assert exit_.value.code == 2
+    err = capsys.readouterr().err
+    assert "unknown scenario 'calm_xyz'" in err and "waves_smc" in err
+
+
+def _variant(tmp_path: Path, name: str, edit) -> Path:
+    description = system(name)
+    edit(description)
+    path = tmp_path / f"{name}.ssd"
+    sources = {c: str(description.fmu_path(c)) for c in description.components}
+    sources.update({c: comp.source for c, comp in description.components.items()
+                    if not comp.source.startswith("../../fmus")})
+    write_ssd(description, path, sources)
+    return path
+
+
+def test_missing_fmu_says_how_to_build_it(tmp_path):
+    def edit(d):
+        d.components["ship"].source = str(tmp_path / "nowhere" / "ship.fmu")
+    with pytest.raises(FileNotFoundError, match="python -m fmukit.build"):
+        Master(read_ssd(_variant(tmp_path, "calm_pd", edit)))
+
+
+def test_corrupt_fmu_says_how_to_build_it(tmp_path):
+    corrupt = tmp_path / "ship.fmu"
+    corrupt.write_bytes(b"PK\x03\x04 this is not an FMU")
+
+    def edit(d):
+        d.components["ship"].source = str(corrupt)
+    with pytest.raises(ValueError, match="not a readable FMU.*python -m fmukit.build"):
+        Master(read_ssd(_variant(tmp_path, "calm_pd", edit)))
+
+
+def test_connection_to_a_missing_variable_is_refused_by_name(tmp_path):
+    def edit(d):
+        d.connections[0] = type(d.connections[0])("guidance", "psi_desired", "autopilot", "psi_d")
+    with pytest.raises(WiringError, match="guidance.psi_desired.*no variable 'psi_desired'"):
+        Master(read_ssd(_variant(tmp_path, "calm_pd", edit)))
+
+
+def test_unwritable_output_folder_is_refused_before_simulating(tmp_path, monkeypatch):
+    blocker = tmp_path / "a_file"
+    blocker.write_text("")
+
+    def no_simulation(*args, **kwargs):
+        raise AssertionError("simulated although the output folder is unusable")
+    monkeypatch.setattr(cli, "Master", no_simulation)
+    with pytest.raises(SystemExit, match="not writable"):
+        cli.main(["calm_pd", "--out", str(blocker / "results")])
+
+
+def test_fmu_error_mid_run_names_fmu_call_and_time_and_keeps_the_rows(tmp_path, monkeypatch,
+                                                                      capsys):
+    from ship_fmu.vessel import Vessel
+    step = Vessel.step
+
+    def failing_step(self, t, h, delta_c, *args):
+        if t >= 50.0:
+            raise ValueError("injected fault")
+        return step(self, t, h, delta_c, *args)
+    monkeypatch.setattr(Vessel, "step", failing_step)
+    code = cli.main(["calm_pd", "--out", str(tmp_path), "--backend", "inprocess"])
+    assert code == 1
+    err = capsys.readouterr().err
+    assert "FMU 'ship': doStep at t = 50 s" in err and "injected fault" in err
+    header, *rows = (tmp_path / "calm_pd.csv").read_text().splitlines()
+    assert len(rows) == 500 and rows[-1].startswith("49.9")
