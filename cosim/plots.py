@@ -1,6 +1,7 @@
 """Figures of a run, in degrees for display: the layout of the paper's Figs 2-3."""
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import matplotlib
@@ -55,7 +56,7 @@ def save_figure(recording: Recording, report: str, path: Path, title: str) -> bo
         a.set_xlabel("time (s)")
         a.grid(alpha=0.3)
     ax[0].grid(alpha=0.3)
-    fig.suptitle(title, fontsize=10)
+    fig.suptitle("\n".join(textwrap.wrap(title, 80)), fontsize=9)
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return True
