@@ -3,8 +3,6 @@
 psi_d and wp_index are direct feedthrough from the position: evaluated when read,
 with the leg switch committed at the end of each step.
 """
-from pythonfmu import DefaultExperiment
-
 from autopilot_fmu.guidance import PAPER_ROUTE, SHIP_LENGTH, WaypointGuidance
 from fmukit.slave import ModelSlave, Var
 
@@ -13,7 +11,6 @@ class GuidanceSlave(ModelSlave):
     model_name = "guidance"
     description = ("Waypoint guidance: desired course of the active leg (Tomera 2010, eq 18), "
                    "switching inside the circle of acceptance or once past the waypoint")
-    default_experiment = DefaultExperiment(start_time=0.0, stop_time=400.0, step_size=0.1)
     variables = (
         Var.input("x", 0.0, "m", "ship north position"),
         Var.input("y", 0.0, "m", "ship east position"),

@@ -2,8 +2,6 @@
 
 delta_c is direct feedthrough from psi, r and psi_d: it is evaluated when read.
 """
-from pythonfmu import DefaultExperiment
-
 from autopilot_fmu.angles import require_finite
 from autopilot_fmu.pd import PDAutopilot
 from fmukit.slave import ModelSlave, Var
@@ -14,7 +12,6 @@ _P = PDAutopilot()
 class PDAutopilotSlave(ModelSlave):
     model_name = "pd_autopilot"
     description = "PD heading autopilot, delta_c = Kp (psi - psi_d) + Kd r (Tomera 2010, eq 20)"
-    default_experiment = DefaultExperiment(start_time=0.0, stop_time=400.0, step_size=0.1)
     variables = (
         Var.input("psi", 0.0, "rad", "ship heading"),
         Var.input("r", 0.0, "rad/s", "ship yaw rate"),

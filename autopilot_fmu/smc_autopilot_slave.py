@@ -4,8 +4,6 @@ The reference model (44) is the FMU's state; it starts at the heading and yaw
 rate the FMU sees at initialisation. delta_c and sigma are direct feedthrough
 from the inputs and are evaluated when read; psi_z and r_z are states.
 """
-from pythonfmu import DefaultExperiment
-
 from autopilot_fmu.angles import require_finite
 from autopilot_fmu.design import design_model
 from autopilot_fmu.smc import SlidingModeAutopilot, SlidingModeDesign
@@ -19,7 +17,6 @@ class SMCAutopilotSlave(ModelSlave):
     model_name = "smc_autopilot"
     description = ("Sliding-mode heading autopilot with reference model "
                    "(Tomera 2010, eqs 33-44), design computed from the linear model")
-    default_experiment = DefaultExperiment(start_time=0.0, stop_time=400.0, step_size=0.1)
     variables = (
         Var.input("psi", 0.0, "rad", "ship heading"),
         Var.input("r", 0.0, "rad/s", "ship yaw rate"),

@@ -4,7 +4,7 @@ from __future__ import annotations
 import shutil
 from collections import deque
 from pathlib import Path
-from typing import Any, Iterable
+from typing import Any
 
 from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
@@ -12,9 +12,10 @@ from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFr
                        fmi2CallbackFunctions, fmi2CallbackLoggerTYPE)
 from fmpy.fmi1 import calloc, free
 
+from .instance import Instance
+
 STATUS = ("ok", "warning", "discard", "error", "fatal", "pending")
 BUILD_HINT = "build the FMUs with: python -m fmukit.build"
-_CONVERT = {"Real": float, "Integer": int, "Boolean": bool, "String": str}
 
 
 class FmuCallError(RuntimeError):
@@ -29,7 +30,7 @@ class FmuCallError(RuntimeError):
         super().__init__(f"FMU '{instance}': {call}{at} returned {status}{log}")
 
 
-class FmuInstance:
+class FmuInstance(Instance):
     """An instantiated co-simulation FMU.
 
     Raises FileNotFoundError or ValueError, naming the file and how to build it,
@@ -78,66 +79,12 @@ class FmuInstance:
             fresh = list(self.log)[before:] if len(self.log) > before else list(self.log)[-3:]
             raise FmuCallError(self.name, what, time, status, fresh) from error
 
-    def variable(self, name: str):
-        """The model variable, or ValueError listing the valid names."""
-        try:
-            return self.variables[name]
-        except KeyError:
-            raise ValueError(f"FMU '{self.name}' ({self.path.name}) has no variable '{name}'; "
-                             f"it has: {', '.join(self.variables)}") from None
-
-    def vr(self, name: str) -> int:
-        return self.variable(name).valueReference
-
-    def set(self, values: dict[str, Any], time: float | None = None) -> None:
-        """Set variables by name, each with the FMI type of its declaration."""
-        for name, value in values.items():
-            kind = self.variable(name).type
-            try:
-                converted = _CONVERT[kind](value)
-            except (TypeError, ValueError):
-                raise ValueError(f"FMU '{self.name}': {name} needs a {kind} value, "
-                                 f"got {value!r}") from None
-            setter = getattr(self.slave, f"set{kind}")
-            self.call(f"set {name} = {value!r}", setter, [self.vr(name)], [converted],
-                      time=time)
-
-    def get(self, names: Iterable[str]) -> dict[str, Any]:
-        """Current values of variables by name."""
-        out = {}
-        for name in names:
-            getter = getattr(self.slave, f"get{self.variable(name).type}")
-            value = self.call(f"get {name}", getter, [self.vr(name)])[0]
-            out[name] = value.decode("utf-8") if isinstance(value, bytes) else value
-        return out
-
-    def initialize(self, parameters: dict[str, Any] | None = None,
-                   start_time: float = 0.0) -> None:
-        """setupExperiment, parameters, enter and exit initialisation mode."""
-        self.enter_initialization(start_time)
-        self.set(parameters or {}, time=start_time)
-        self.exit_initialization(start_time)
+    def fmi(self, name: str):
+        return getattr(self.slave, name)
 
     def enter_initialization(self, start_time: float = 0.0) -> None:
         self.call("setupExperiment", self.slave.setupExperiment, startTime=start_time)
         self.call("enterInitializationMode", self.slave.enterInitializationMode)
-
-    def exit_initialization(self, start_time: float = 0.0) -> None:
-        self.call("exitInitializationMode", self.slave.exitInitializationMode,
-                  time=start_time)
-
-    def do_step(self, t: float, h: float) -> None:
-        self.call("doStep", self.slave.doStep, t, h, time=t)
-
-    # Batched calls by value reference, for the master's loop.
-    def get_real(self, vrs: list[int]) -> list[float]:
-        return self.call("getReal", self.slave.getReal, vrs)
-
-    def get_integer(self, vrs: list[int]) -> list[int]:
-        return self.call("getInteger", self.slave.getInteger, vrs)
-
-    def set_real(self, vrs: list[int], values: list[float]) -> None:
-        self.call("setReal", self.slave.setReal, vrs, values)
 
     def free(self) -> None:
         """Terminate, free the instance and remove the extracted files."""

@@ -10,14 +10,16 @@ from __future__ import annotations
 
 import importlib
 import inspect
+import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Iterable
+from typing import Any
 
 from fmukit.build import FMUS
 from fmukit.slave import ModelSlave
 
 from .fmu import FmuCallError
+from .instance import Instance
 
 _FMI_TYPE = {float: "Real", int: "Integer", str: "String"}
 
@@ -41,7 +43,7 @@ def slave_class(fmu_name: str) -> type[ModelSlave]:
                 if issubclass(cls, ModelSlave) and getattr(cls, "model_name", None) == fmu_name)
 
 
-class InProcessInstance:
+class InProcessInstance(Instance):
     """A slave class instantiated and driven in this process."""
 
     def __init__(self, path: str | Path, name: str):
@@ -74,53 +76,13 @@ class InProcessInstance:
         self.log.extend(messages)
         return messages
 
-    def variable(self, name: str) -> VariableInfo:
-        try:
-            return self.variables[name]
-        except KeyError:
-            raise ValueError(f"FMU '{self.name}' ({self.path.name}) has no variable '{name}'; "
-                             f"it has: {', '.join(self.variables)}") from None
-
-    def vr(self, name: str) -> int:
-        return self.variable(name).valueReference
-
-    def set(self, values: dict[str, Any], time: float | None = None) -> None:
-        for name, value in values.items():
-            setter = getattr(self.slave, f"set_{self.variable(name).type.lower()}")
-            self.call(f"set {name} = {value!r}", setter, [self.vr(name)], [value], time=time)
-
-    def get(self, names: Iterable[str]) -> dict[str, Any]:
-        out = {}
-        for name in names:
-            getter = getattr(self.slave, f"get_{self.variable(name).type.lower()}")
-            out[name] = self.call(f"get {name}", getter, [self.vr(name)])[0]
-        return out
-
-    def initialize(self, parameters: dict[str, Any] | None = None,
-                   start_time: float = 0.0) -> None:
-        self.enter_initialization(start_time)
-        self.set(parameters or {}, time=start_time)
-        self.exit_initialization(start_time)
+    def fmi(self, name: str):
+        """The slave method behind an FMI call name: setReal -> set_real."""
+        return getattr(self.slave, re.sub(r"(?<!^)([A-Z])", r"_\1", name).lower())
 
     def enter_initialization(self, start_time: float = 0.0) -> None:
         self.call("setupExperiment", self.slave.setup_experiment, start_time)
         self.call("enterInitializationMode", self.slave.enter_initialization_mode)
-
-    def exit_initialization(self, start_time: float = 0.0) -> None:
-        self.call("exitInitializationMode", self.slave.exit_initialization_mode,
-                  time=start_time)
-
-    def do_step(self, t: float, h: float) -> None:
-        self.call("doStep", self.slave.do_step, t, h, time=t)
-
-    def get_real(self, vrs: list[int]) -> list[float]:
-        return self.call("getReal", self.slave.get_real, vrs)
-
-    def get_integer(self, vrs: list[int]) -> list[int]:
-        return self.call("getInteger", self.slave.get_integer, vrs)
-
-    def set_real(self, vrs: list[int], values: list[float]) -> None:
-        self.call("setReal", self.slave.set_real, vrs, values)
 
     def free(self) -> None:
         self.slave.terminate()

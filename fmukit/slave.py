@@ -40,7 +40,7 @@ from dataclasses import dataclass
 from typing import Any, Callable, ClassVar
 from xml.etree.ElementTree import Element, SubElement
 
-from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability
+from pythonfmu import DefaultExperiment, Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability
 from pythonfmu import Integer, Real, String
 from pythonfmu import __version__ as PYTHONFMU_VERSION
 from pythonfmu.enums import Fmi2Status
@@ -112,6 +112,7 @@ class ModelSlave(Fmi2Slave):
 
     model_name: ClassVar[str]
     variables: ClassVar[tuple[Var, ...]]
+    default_experiment = DefaultExperiment(start_time=0.0, stop_time=400.0, step_size=0.1)
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)

@@ -6,8 +6,6 @@ inertia), so the model structure declares no direct feedthrough.
 """
 from dataclasses import fields
 
-from pythonfmu import DefaultExperiment
-
 from fmukit.slave import ModelSlave, Var
 from ship_fmu.vessel import N_PROPELLER, Vessel, VesselParameters
 
@@ -20,7 +18,6 @@ class ShipSlave(ModelSlave):
     description = ("CyberShip II (1:70 supply ship model), nonlinear 3-DOF manoeuvring model "
                    "with propellers, rudders, rate-limited steering gear and wave loads "
                    "(Tomera 2010, eqs 1-17)")
-    default_experiment = DefaultExperiment(start_time=0.0, stop_time=400.0, step_size=0.1)
     variables = (
         Var.input("delta_c", 0.0, "rad", "commanded rudder angle, both rudders; "
                   "positive turns the ship to port"),

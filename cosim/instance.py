@@ -1,0 +1,85 @@
+"""What the master needs of a component, whichever backend runs it.
+
+A backend supplies ``call`` (run a function, turning failure into FmuCallError),
+``fmi(name)`` (the function behind an FMI 2.0 call name such as "setReal"),
+``enter_initialization`` and ``free``; everything else is shared here.
+"""
+from __future__ import annotations
+
+from typing import Any, Callable, Iterable
+
+_CONVERT = {"Real": float, "Integer": int, "Boolean": bool, "String": str}
+
+
+class Instance:
+    name: str
+    path: Any
+    variables: dict[str, Any]          # name: object with valueReference, type, causality
+    feedthrough: dict[str, frozenset[str]]
+
+    def call(self, what: str, function: Callable, *args, time: float | None = None) -> Any:
+        raise NotImplementedError
+
+    def fmi(self, name: str) -> Callable:
+        raise NotImplementedError
+
+    def enter_initialization(self, start_time: float = 0.0) -> None:
+        raise NotImplementedError
+
+    def free(self) -> None:
+        raise NotImplementedError
+
+    def variable(self, name: str):
+        """The model variable, or ValueError listing the valid names."""
+        try:
+            return self.variables[name]
+        except KeyError:
+            raise ValueError(f"FMU '{self.name}' ({self.path.name}) has no variable '{name}'; "
+                             f"it has: {', '.join(self.variables)}") from None
+
+    def vr(self, name: str) -> int:
+        return self.variable(name).valueReference
+
+    def set(self, values: dict[str, Any], time: float | None = None) -> None:
+        """Set variables by name, each with the FMI type of its declaration."""
+        for name, value in values.items():
+            kind = self.variable(name).type
+            try:
+                converted = _CONVERT[kind](value)
+            except (TypeError, ValueError):
+                raise ValueError(f"FMU '{self.name}': {name} needs a {kind} value, "
+                                 f"got {value!r}") from None
+            self.call(f"set {name} = {value!r}", self.fmi(f"set{kind}"), [self.vr(name)],
+                      [converted], time=time)
+
+    def get(self, names: Iterable[str]) -> dict[str, Any]:
+        """Current values of variables by name."""
+        out = {}
+        for name in names:
+            getter = self.fmi(f"get{self.variable(name).type}")
+            value = self.call(f"get {name}", getter, [self.vr(name)])[0]
+            out[name] = value.decode("utf-8") if isinstance(value, bytes) else value
+        return out
+
+    def initialize(self, parameters: dict[str, Any] | None = None,
+                   start_time: float = 0.0) -> None:
+        """setupExperiment, enter initialisation, parameters, exit initialisation."""
+        self.enter_initialization(start_time)
+        self.set(parameters or {}, time=start_time)
+        self.exit_initialization(start_time)
+
+    def exit_initialization(self, start_time: float = 0.0) -> None:
+        self.call("exitInitializationMode", self.fmi("exitInitializationMode"), time=start_time)
+
+    def do_step(self, t: float, h: float) -> None:
+        self.call("doStep", self.fmi("doStep"), t, h, time=t)
+
+    # Batched calls by value reference, for the master's loop.
+    def get_real(self, vrs: list[int]) -> list[float]:
+        return self.call("getReal", self.fmi("getReal"), vrs)
+
+    def get_integer(self, vrs: list[int]) -> list[int]:
+        return self.call("getInteger", self.fmi("getInteger"), vrs)
+
+    def set_real(self, vrs: list[int], values: list[float]) -> None:
+        self.call("setReal", self.fmi("setReal"), vrs, values)
