@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from fmukit.timebase import communication_point
 from ship_fmu.vessel import N_PROPELLER
 
 from .inprocess import InProcessInstance
@@ -46,7 +47,7 @@ def run_direct(system: SystemDescription, stop_time: float | None = None) -> dic
     n_steps = round(((system.stop_time if stop_time is None else stop_time) - t0) / h)
     out = np.empty((n_steps + 1, len(SIGNALS)))
     for k in range(n_steps + 1):
-        t = t0 + k * h
+        t = communication_point(t0, k, h)
         psi_d = guidance.psi_d(ship.x, ship.y)
         delta_c = autopilot.command(ship.psi, ship.r, psi_d)
         out[k] = (psi_d, delta_c, ship.x, ship.y, ship.psi, ship.u, ship.v, ship.r, ship.delta)

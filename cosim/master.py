@@ -1,7 +1,8 @@
 """The co-simulation master: FMUs wired by an SSP system description, fixed step.
 
-Time is counted in integer steps, t_k = t_0 + k h, so no rounding accumulates and
-a 400 s run at 0.1 s has exactly 4000 steps and 4001 recorded rows.
+Time is counted in integer steps, t_k = t_0 + k h computed in whole nanoseconds
+(``fmukit.timebase``, the FMUs' own time base), so no rounding accumulates and a
+400 s run at 0.1 s has exactly 4000 steps and 4001 recorded rows.
 
 Coupling orders:
 
@@ -23,12 +24,13 @@ the rows recorded up to then are kept.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from graphlib import CycleError, TopologicalSorter
 from typing import Any, Callable
 
 import numpy as np
+
+from fmukit.timebase import communication_point, nanoseconds, seconds
 
 from .fmu import FmuCallError, FmuInstance
 from .inprocess import InProcessInstance
@@ -203,13 +205,14 @@ class Master:
             progress: Callable[[int, int], None] | None = None) -> Recording:
         """Simulate to stop_time (default: the system's); never raises on an FMU error."""
         system = self.system
-        h, t0 = system.step_size, system.start_time
+        t0, h = system.start_time, seconds(nanoseconds(system.step_size))
         stop = system.stop_time if stop_time is None else stop_time
-        n_steps = round((stop - t0) / h)
-        if not math.isclose(t0 + n_steps * h, stop, rel_tol=0.0, abs_tol=1e-9 * max(1.0, stop)):
+        n_steps, remainder = divmod(nanoseconds(stop) - nanoseconds(t0), nanoseconds(h))
+        if remainder or n_steps < 1:
             raise ValueError(f"stop time {stop} s is not a whole number of {h} s steps "
-                             f"from {t0} s")
-        recording = Recording(self.columns, t0 + h * np.arange(n_steps + 1),
+                             f"after {t0} s")
+        times = np.array([communication_point(t0, k, h) for k in range(n_steps + 1)])
+        recording = Recording(self.columns, times,
                               np.full((n_steps + 1, len(self.columns)), np.nan),
                               meta={"system": system.name, "coupling": self.coupling,
                                     "step_size": h})
@@ -219,7 +222,7 @@ class Master:
         try:
             self.initialize()
             for k in range(n_steps + 1):
-                t = t0 + k * h
+                t = float(times[k])
                 if gauss_seidel:
                     for node in self.nodes:
                         self._read(node, values, node.state_out, node.state_cols)

@@ -45,6 +45,7 @@ from pythonfmu import Integer, Real, String
 from pythonfmu import __version__ as PYTHONFMU_VERSION
 from pythonfmu.enums import Fmi2Status
 
+from .timebase import nanoseconds, seconds
 from .units import DISPLAY_UNIT, unit_definitions
 
 _PYTHONFMU_TYPE = {float: Real, int: Integer, str: String}
@@ -176,11 +177,12 @@ class ModelSlave(Fmi2Slave):
         if self.phase != "step":
             return self._refuse(f"doStep called in phase '{self.phase}': "
                                 "call exitInitializationMode first, and not after terminate")
-        if not (step_size > 0.0 and math.isfinite(step_size) and math.isfinite(current_time)):
+        if not (step_size >= 1e-9 and math.isfinite(step_size) and math.isfinite(current_time)):
             return self._refuse(f"doStep at t = {current_time} with communication step "
-                                f"{step_size}: the step must be finite and > 0")
+                                f"{step_size}: the step must be finite and at least 1 ns")
         try:
-            self.step_model(current_time, step_size)
+            # The time base of fmukit.timebase: whole nanoseconds, whatever the master.
+            self.step_model(seconds(nanoseconds(current_time)), seconds(nanoseconds(step_size)))
         except ValueError as error:
             return self._refuse(f"doStep at t = {current_time}: {error}; step refused, "
                                 "state unchanged")

@@ -12,6 +12,7 @@ from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 
 from cosim.fmu import FmuCallError, FmuInstance
+from fmukit.timebase import communication_point
 from helpers import fmpy_cli, read_csv
 from ship_fmu.vessel import Vessel, VesselParameters
 
@@ -65,8 +66,8 @@ def test_fmu_equals_the_in_process_model(ship, Hs):
     ship.initialize({"Hs": Hs, "wave_seed": 11})
     vessel = Vessel(VesselParameters(Hs=Hs, wave_seed=11))
     worst = 0.0
-    for k in range(600):
-        t, delta_c = k * DT, rudder_program(k)
+    for k in range(600):       # the in-process model at the FMUs' nanosecond time base
+        t, delta_c = communication_point(0.0, k, DT), rudder_program(k)
         ship.set({"delta_c": delta_c})
         ship.do_step(t, DT)
         vessel.step(t, DT, delta_c)

@@ -1,0 +1,26 @@
+"""The time base: communication points and steps in whole nanoseconds.
+
+Masters form time differently: OSP libcosim counts integer nanoseconds, fmpy's SSP
+runner adds 0.1 to a float at every step, ours multiplies. The results differ in
+the last bits, and a chattering controller or an unstable hull amplifies such
+differences until runs of the same system disagree. Every FMU here therefore
+rounds the time and step it is given to whole nanoseconds before using them, and
+the master computes t_k = (t_0 + k h) in integer nanoseconds: any two masters that
+agree on the time to within half a nanosecond drive the FMUs bit for bit alike.
+"""
+NANOSECONDS = 1_000_000_000
+
+
+def nanoseconds(t: float) -> int:
+    """Seconds -> whole nanoseconds (exact up to 2^53 ns, about 104 days)."""
+    return round(t * NANOSECONDS)
+
+
+def seconds(ns: int) -> float:
+    """Whole nanoseconds -> seconds, correctly rounded."""
+    return ns / NANOSECONDS
+
+
+def communication_point(t0: float, k: int, h: float) -> float:
+    """t_k = t_0 + k h, computed in integer nanoseconds."""
+    return seconds(nanoseconds(t0) + k * nanoseconds(h))
