@@ -36,6 +36,8 @@ import ctypes
 import functools
 import json
 import math
+import os
+import sys
 from dataclasses import dataclass
 from typing import Any, Callable, ClassVar
 from xml.etree.ElementTree import Element, SubElement
@@ -52,13 +54,23 @@ _PYTHONFMU_TYPE = {float: Real, int: Integer, str: String}
 _RELEASES_ON_EXCEPTION = PYTHONFMU_VERSION == "0.7.0"
 
 
+def _echo(slave: Fmi2Slave, message: str) -> None:
+    """Also write an error to standard error if FMUKIT_LOG_STDERR is set.
+
+    For hosts that drop FMU log messages (ecos 0.7 installs a no-op logger).
+    """
+    if os.environ.get("FMUKIT_LOG_STDERR"):
+        print(f"[{slave.instance_name}] {message}", file=sys.stderr, flush=True)
+
+
 def _fmi_entry(method):
     """Let an exception reach pythonfmu's C++ layer without corrupting the host."""
     @functools.wraps(method)
     def entry(self, *args):
         try:
             return method(self, *args)
-        except Exception:
+        except Exception as error:
+            _echo(self, f"{method.__name__}: {error!r}")
             if _RELEASES_ON_EXCEPTION:
                 for obj in (self, type(self), self.log_queue):
                     ctypes.pythonapi.Py_IncRef(ctypes.py_object(obj))
@@ -132,7 +144,7 @@ class ModelSlave(Fmi2Slave):
                       variability=(Fmi2Variability.continuous if var.is_real
                                    else Fmi2Variability.discrete),
                       initial=Fmi2Initial.calculated, description=var.description,
-                      getter=lambda: get(self))
+                      getter=lambda: self._output(get, var))
         else:
             setattr(self, var.name, var.start)
             variability = (Fmi2Variability.fixed if var.causality == "parameter"
@@ -150,6 +162,23 @@ class ModelSlave(Fmi2Slave):
     def step_model(self, t: float, h: float) -> None:
         """Advance the model from t to t + h with the current inputs."""
         raise NotImplementedError
+
+    def _output(self, get: Callable[[Any], Any], var: Var) -> Any:
+        """An output's value, or NaN (0 if Integer) when it cannot be evaluated.
+
+        A read never fails: a failed getReal aborts some hosts (libcosim throws
+        from a worker thread). Masters read outputs during initialisation, when
+        parameters may still be invalid, and feedthrough outputs are evaluated from
+        inputs that may be invalid; then the output is undefined, and the call
+        that commits (exitInitializationMode, doStep) refuses with a message. A
+        master that ignores those statuses still sees NaN outputs.
+        """
+        try:
+            if self._model is None:
+                self._model = self.build_model()
+            return get(self)
+        except ValueError:
+            return math.nan if var.is_real else 0
 
     @property
     def model(self) -> Any:
@@ -190,6 +219,7 @@ class ModelSlave(Fmi2Slave):
 
     def _refuse(self, message: str) -> bool:
         self.log(message, Fmi2Status.error)
+        _echo(self, message)
         return False
 
     # -- setters: refuse what the standard does not allow ----------------------
