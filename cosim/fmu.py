@@ -86,6 +86,9 @@ class FmuInstance(Instance):
         self.call("setupExperiment", self.slave.setupExperiment, startTime=start_time)
         self.call("enterInitializationMode", self.slave.enterInitializationMode)
 
+    def reset(self) -> None:
+        self.call("reset", self.slave.reset)
+
     def free(self) -> None:
         """Terminate, free the instance and remove the extracted files."""
         try:

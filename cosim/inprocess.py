@@ -84,5 +84,9 @@ class InProcessInstance(Instance):
         self.call("setupExperiment", self.slave.setup_experiment, start_time)
         self.call("enterInitializationMode", self.slave.enter_initialization_mode)
 
+    def reset(self) -> None:
+        """A fresh slave object, as pythonfmu's fmi2Reset makes one."""
+        self.slave = type(self.slave)(instance_name=self.name)
+
     def free(self) -> None:
         self.slave.terminate()

@@ -26,6 +26,10 @@ class Instance:
     def enter_initialization(self, start_time: float = 0.0) -> None:
         raise NotImplementedError
 
+    def reset(self) -> None:
+        """Back to the state after instantiation (fmi2Reset)."""
+        raise NotImplementedError
+
     def free(self) -> None:
         raise NotImplementedError
 

@@ -97,12 +97,7 @@ class Master:
         if coupling not in COUPLINGS:
             raise ValueError(f"coupling must be one of {', '.join(COUPLINGS)}, got {coupling!r}")
         self.system, self.coupling, self.verify_inputs = system, coupling, verify_inputs
-        self.parameters = {name: dict(c.parameters) for name, c in system.components.items()}
-        for component, values in (overrides or {}).items():
-            if component not in self.parameters:
-                raise ValueError(f"--set names the component '{component}'; the system has "
-                                 f"{', '.join(self.parameters)}")
-            self.parameters[component].update(values)
+        self.configure(overrides)
         self.instances: dict[str, Any] = {}
         try:
             for name in system.components:
@@ -172,6 +167,21 @@ class Master:
                                                else self.instances)]
 
     # -- running -------------------------------------------------------------------
+    def configure(self, overrides: dict[str, dict[str, Any]] | None = None) -> None:
+        """Parameters for the next run: the system's, updated by ``overrides``."""
+        parameters = {name: dict(c.parameters) for name, c in self.system.components.items()}
+        for component, values in (overrides or {}).items():
+            if component not in parameters:
+                raise ValueError(f"--set names the component '{component}'; the system has "
+                                 f"{', '.join(parameters)}")
+            parameters[component].update(values)
+        self.parameters = parameters
+
+    def reset(self) -> None:
+        """Return every FMU to its state after instantiation (fmi2Reset), for another run."""
+        for instance in self.instances.values():
+            instance.reset()
+
     def initialize(self) -> None:
         """Enter initialisation, set parameters, propagate initial outputs, exit."""
         t0 = self.system.start_time

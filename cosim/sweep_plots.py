@@ -1,0 +1,85 @@
+"""Figures of a sweep: J per controller and sea state, and the J_SMC / J_PD map."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+SEA_AXES = ("sea_state", "Hs")
+
+
+def _sea_axis(spec) -> str | None:
+    return next((a for a in SEA_AXES if a in spec.axes), None)
+
+
+def distribution(spec, rows: list[dict], path: Path) -> Path:
+    """Box plot of J per controller, grouped by sea state when that is an axis."""
+    ok = [r for r in rows if r["status"] == "ok"]
+    sea = _sea_axis(spec)
+    groups = spec.axes[sea] if sea else [None]
+    fig, ax = plt.subplots(figsize=(max(6, 1.6 * len(groups) * len(spec.controllers)), 4.5),
+                           constrained_layout=True)
+    positions, data, labels = [], [], []
+    for g, group in enumerate(groups):
+        for c, controller in enumerate(spec.controllers):
+            J = [r["J"] for r in ok if r["controller"] == controller
+                 and (sea is None or r[sea] == group)]
+            positions.append(g * (len(spec.controllers) + 1) + c)
+            data.append(J if J else [np.nan])
+            labels.append(f"{controller}\n{sea} {group}" if sea else controller)
+    ax.boxplot(data, positions=positions, widths=0.7)
+    ax.set_xticks(positions, labels, fontsize=8)
+    ax.set_yscale("log")
+    ax.set_ylabel("J of eq (19)")
+    ax.set_title(f"{spec.name}: J per controller" + (f" and {sea}" if sea else ""), fontsize=10)
+    ax.grid(alpha=0.3, axis="y")
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def ratio_map(spec, rows: list[dict], path: Path, numerator: str = "smc",
+              denominator: str = "pd") -> Path | None:
+    """Mean J of one controller over the other's, over the two map axes (other axes pooled)."""
+    if len(spec.map_axes) != 2 or not {numerator, denominator} <= set(spec.controllers):
+        return None
+    x_axis, y_axis = spec.map_axes
+    xs, ys = spec.axes[x_axis], spec.axes[y_axis]
+    ratio = np.full((len(ys), len(xs)), np.nan)
+    for i, y in enumerate(ys):
+        for j, x in enumerate(xs):
+            means = []
+            for controller in (numerator, denominator):
+                J = [r["J"] for r in rows if r["status"] == "ok" and r["controller"] == controller
+                     and r[x_axis] == x and r[y_axis] == y]
+                means.append(np.mean(J) if J else np.nan)
+            ratio[i, j] = means[0] / means[1]
+    fig, ax = plt.subplots(figsize=(6.5, 4.5), constrained_layout=True)
+    image = ax.imshow(np.log2(ratio), cmap="RdBu_r", vmin=-3, vmax=3, origin="lower",
+                      aspect="auto")
+    for i in range(len(ys)):
+        for j in range(len(xs)):
+            ax.text(j, i, f"{ratio[i, j]:.2f}", ha="center", va="center", fontsize=8)
+    ax.set_xticks(range(len(xs)), [str(x) for x in xs], fontsize=8)
+    ax.set_yticks(range(len(ys)), [str(y) for y in ys], fontsize=8)
+    ax.set_xlabel(x_axis)
+    ax.set_ylabel(y_axis)
+    fig.colorbar(image, label=f"log2(J_{numerator} / J_{denominator})")
+    ax.set_title(f"{spec.name}: J_{numerator} / J_{denominator} (< 1: {numerator} better)",
+                 fontsize=10)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def save_plots(spec, rows: list[dict], out: Path) -> list[Path]:
+    written = [distribution(spec, rows, out / "J_distribution.png")]
+    for numerator in [c for c in spec.controllers if c != "pd"]:
+        path = ratio_map(spec, rows, out / f"J_{numerator}_over_pd.png", numerator)
+        if path is not None:
+            written.append(path)
+    return written

@@ -1,0 +1,134 @@
+"""Ensembles: the sweep file, the task, Dask execution, resuming, failures, outputs."""
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import pyarrow.parquet as pq
+import pytest
+
+from cosim import sweep
+from cosim.master import Master
+from cosim.report import cost
+from cosim.run import SCENARIO_DIR
+from cosim.seastate import model_scale
+from cosim.ssd import read_ssd
+
+EXAMPLE = Path(__file__).resolve().parent.parent / "docs" / "sweeps" / "example.toml"
+
+
+def write_spec(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "spec.toml"
+    path.write_text(text)
+    return path
+
+
+SMALL = """
+name = "small"
+stop_time = 20
+[axes]
+wave_seed = [1, 2]
+sea_state = [2]
+"ship.delta_rate_max" = [0.349]
+[plots]
+map = ["wave_seed", "ship.delta_rate_max"]
+"""
+
+
+def test_example_spec_expands_to_every_combination():
+    spec = sweep.Spec.read(EXAMPLE)
+    runs = spec.runs()
+    assert len(runs) == 2 * 3 * 3 == len({r["run_id"] for r in runs})
+    assert sweep.Spec.read(EXAMPLE).runs() == runs            # stable run ids
+
+
+def test_settings_map_axes_to_fmu_parameters(tmp_path):
+    spec = sweep.Spec.read(write_spec(tmp_path, """
+        [controllers]
+        smc = { scenario = "waves_smc", set = { "autopilot.eta_h" = 5.0 } }
+        [axes]
+        sea_state = [4]
+        route = ["0,0;10,0"]
+        psi_w = [1.0]
+        "autopilot.zeta" = [0.7]
+    """))
+    scenario, overrides = spec.settings(spec.runs()[0])
+    Hs, T0 = model_scale(4)
+    assert scenario == "waves_smc"
+    assert overrides == {"autopilot": {"eta_h": 5.0, "zeta": 0.7},
+                         "ship": {"Hs": Hs, "T0": T0, "psi_w": 1.0},
+                         "guidance": {"waypoints": "0,0;10,0"}}
+    assert Hs == pytest.approx(1.875 / 70) and T0 == pytest.approx(8.8 / 70 ** 0.5)
+
+
+@pytest.mark.parametrize("text, fragment", [
+    ("[axes]\nwind = [1]", "axis 'wind'"),
+    ("[axes]\nsea_state = [9]", "WMO code"),
+    ("[axes]\nHs = []", "non-empty"),
+    ("[controllers]\npd = { scenario = 'nope' }", "scenario 'nope'"),
+    ("[axes]\nHs = [0.0]\n[plots]\nmap = ['T0', 'Hs']", "'T0', which is not an axis"),
+    ("name = ", "cannot read"),
+])
+def test_bad_spec_is_refused_by_name(tmp_path, text, fragment):
+    with pytest.raises(ValueError, match=fragment):
+        sweep.Spec.read(write_spec(tmp_path, text))
+
+
+def test_task_equals_a_direct_run_and_reuses_its_fmus(fmu_paths, tmp_path):
+    spec = sweep.Spec.read(write_spec(tmp_path, SMALL))
+    first, again = spec.runs()[0], spec.runs()[0]
+    row = sweep.run_one(spec, first)
+    master_before = dict(sweep._masters)
+    assert sweep.run_one(spec, again)["J"] == row["J"]        # after fmi2Reset, bit for bit
+    assert dict(sweep._masters) == master_before              # same instances, reused
+    master = Master(read_ssd(SCENARIO_DIR / "waves_pd.ssd"),
+                    overrides={"ship": {"wave_seed": 1, "Hs": model_scale(2)[0],
+                                        "T0": model_scale(2)[1], "delta_rate_max": 0.349}})
+    try:
+        assert row["J"] == cost(master.run(20.0)).J
+    finally:
+        master.free()
+    assert row["status"] == "ok" and set(sweep.METRICS) <= set(row)
+    sweep.free_masters()
+
+
+def test_task_records_a_failed_run_with_its_message(fmu_paths, tmp_path):
+    spec = sweep.Spec.read(write_spec(tmp_path, '[axes]\nHs = [-1.0]\n'))
+    row = sweep.run_one(spec, spec.runs()[0])
+    assert row["status"] == "failed" and "parameter Hs must be >= 0" in row["error"]
+    assert math.isnan(row["J"])
+    sweep.free_masters()
+
+
+def test_dask_sweep_writes_resumes_and_plots(fmu_paths, tmp_path):
+    spec = sweep.Spec.read(write_spec(tmp_path, SMALL))
+    out = tmp_path / "out"
+    out.mkdir()
+    rows = sweep.execute(spec, out, workers=2, progress=False)
+    assert [r["status"] for r in rows] == ["ok"] * 4
+    journal = (out / "runs.jsonl").read_text().splitlines()
+    assert len(journal) == 4
+    # An interrupted sweep: drop one finished row, run again, only that run is redone.
+    (out / "runs.jsonl").write_text("\n".join(journal[1:]) + "\n")
+    lost = json.loads(journal[0])["run_id"]
+    again = sweep.execute(spec, out, workers=1, progress=False)
+    assert [r["J"] for r in again] == [r["J"] for r in rows]
+    assert len((out / "runs.jsonl").read_text().splitlines()) == 4
+    assert json.loads((out / "runs.jsonl").read_text().splitlines()[-1])["run_id"] == lost
+    written = sweep.write_tables(again, out, csv=True)
+    table = pq.read_table(written[0])
+    assert table.num_rows == 4 and {"controller", "wave_seed", "J", "status"} <= set(
+        table.column_names)
+    from cosim.sweep_plots import save_plots
+    assert all(p.stat().st_size > 5000 for p in save_plots(spec, again, out))
+
+
+def test_a_worker_killed_on_every_retry_is_recorded_as_failed(fmu_paths, tmp_path):
+    from sweep_faults import killing_task
+    spec = sweep.Spec.read(write_spec(tmp_path, 'stop_time = 5\n[axes]\nwave_seed = [1, 2]\n'))
+    rows = sweep.execute(spec, tmp_path, workers=1, progress=False, task=killing_task)
+    by_seed = {(r["controller"], r["wave_seed"]): r for r in rows}
+    assert by_seed[("pd", 1)]["status"] == "ok"
+    assert by_seed[("pd", 2)]["status"] == "failed"
+    assert "KilledWorker" in by_seed[("pd", 2)]["error"]
