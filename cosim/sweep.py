@@ -30,8 +30,8 @@ Each Dask task is one whole co-simulation with our master. A worker extracts the
 FMUs once per scenario and thread and resets them (fmi2Reset) between tasks.
 Results: results/sweeps/<name>/runs.jsonl gets each row as it completes (flushed),
 so an interrupted sweep resumes where it stopped; results.parquet (and
-results.csv with --csv) hold the table at the end; a summary is printed and two
-figures are written. A task whose worker dies is retried twice, then recorded
+results.csv with --csv) hold the table at the end; a summary is printed, two
+figures are written, and comparison.md pairs every controller with pd seed by seed. A task whose worker dies is retried twice, then recorded
 as failed; an FMU error is recorded as failed at once, with its message.
 """
 from __future__ import annotations
@@ -324,6 +324,45 @@ def summary(spec: Spec, rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
+def comparison(spec: Spec, rows: list[dict], baseline: str = "pd",
+               monte_carlo: str = "wave_seed") -> str:
+    """Markdown table: per setting of the other axes, median J and wins against the baseline.
+
+    Runs are paired by the Monte Carlo axis (the same sea for both controllers); a
+    controller wins a pair when its J is lower. The share of wins and the median J
+    ratio are given for every controller other than the baseline.
+    """
+    others = [c for c in spec.controllers if c != baseline]
+    axes = [a for a in spec.axes if a != monte_carlo]
+    ok = {(r["controller"], *(json.dumps(r[a]) for a in spec.axes)): r
+          for r in rows if r["status"] == "ok"}
+    header = [*axes, f"J {baseline}", *(f"J {c}" for c in others),
+              *(f"{c} wins" for c in others), *(f"J {c} / J {baseline}" for c in others)]
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    for setting in itertools.product(*(spec.axes[a] for a in axes)):
+        where = dict(zip(axes, setting))
+        seeds = spec.axes.get(monte_carlo, [None])
+
+        def J(controller: str) -> np.ndarray:
+            keys = [(controller, *(json.dumps(where.get(a, seed)) for a in spec.axes))
+                    for seed in seeds]
+            return np.array([ok[k]["J"] if k in ok else np.nan for k in keys])
+
+        base = J(baseline)
+        cells = [str(v) for v in setting] + [f"{np.nanmedian(base):.1f}"]
+        wins, ratios = [], []
+        for controller in others:
+            J_c = J(controller)
+            cells.append(f"{np.nanmedian(J_c):.1f}")
+            decided = np.isfinite(J_c) & np.isfinite(base) & (J_c != base)
+            wins.append(f"{int(np.sum(J_c[decided] < base[decided]))}/{int(decided.sum())}")
+            defined = np.isfinite(J_c) & (base > 1e-9)
+            ratios.append(f"{np.median(J_c[defined] / base[defined]):.2f}" if defined.any()
+                          else "-")
+        lines.append("| " + " | ".join(cells + wins + ratios) + " |")
+    return "\n".join(lines)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m cosim.sweep",
                                      description=__doc__.split("\n\n")[0],
@@ -347,6 +386,9 @@ def main(argv: list[str] | None = None) -> int:
     written = write_tables(rows, out, args.csv)
     from .sweep_plots import save_plots
     written += save_plots(spec, rows, out)
+    if "pd" in spec.controllers and len(spec.controllers) > 1:
+        (out / "comparison.md").write_text(comparison(spec, rows) + "\n")
+        written.append(out / "comparison.md")
     print(summary(spec, rows))
     print(f"wrote {', '.join(str(p) for p in written)}")
     return 0 if all(r["status"] == "ok" for r in rows) else 1
