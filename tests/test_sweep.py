@@ -122,6 +122,11 @@ def test_dask_sweep_writes_resumes_and_plots(fmu_paths, tmp_path):
         table.column_names)
     from cosim.sweep_plots import save_plots
     assert all(p.stat().st_size > 5000 for p in save_plots(spec, again, out))
+    header, rule, *settings = sweep.comparison(spec, again).splitlines()
+    assert "smc wins" in header and len(settings) == 1          # one setting, two seeds
+    J = {(r["controller"], r["wave_seed"]): r["J"] for r in again}
+    wins = sum(J[("smc", s)] < J[("pd", s)] for s in (1, 2))
+    assert f"| {wins}/2 |" in settings[0]
 
 
 def test_a_worker_killed_on_every_retry_is_recorded_as_failed(fmu_paths, tmp_path):
