@@ -9,7 +9,8 @@ from typing import Any
 from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
-                       fmi2CallbackFunctions, fmi2CallbackLoggerTYPE)
+                       fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, fmi2Integer, fmi2Real,
+                       fmi2True, fmi2ValueReference)
 from fmpy.fmi1 import calloc, free
 
 from .instance import Instance
@@ -88,6 +89,56 @@ class FmuInstance(Instance):
 
     def reset(self) -> None:
         self.call("reset", self.slave.reset)
+
+    # Prepared calls: the raw FMI functions on preallocated ctypes arrays, without
+    # fmpy's per-call wrapping, which costs more than the call itself.
+    def _status(self, what: str, status: int, before: int, time: float | None = None) -> None:
+        if status > 1:                      # discard, error, fatal
+            fresh = list(self.log)[before:] if len(self.log) > before else list(self.log)[-3:]
+            raise FmuCallError(self.name, what, time, STATUS[status], fresh)
+
+    def reader(self, vrs: list[int]):
+        return self._getter("fmi2GetReal", fmi2Real, vrs)
+
+    def integer_reader(self, vrs: list[int]):
+        return self._getter("fmi2GetInteger", fmi2Integer, vrs)
+
+    def _getter(self, function: str, ctype, vrs: list[int]):
+        get, component, log = self.slave._functions[function], self.slave.component, self.log
+        n = len(vrs)
+        refs, values = (fmi2ValueReference * n)(*vrs), (ctype * n)()
+        what = function.removeprefix("fmi2")
+
+        def read() -> list:
+            before = len(log)
+            status = get(component, refs, n, values)
+            if status:
+                self._status(what, status, before)
+            return values[:]
+        return read
+
+    def writer(self, vrs: list[int]):
+        set_, component, log = self.slave._functions["fmi2SetReal"], self.slave.component, self.log
+        n = len(vrs)
+        refs, values = (fmi2ValueReference * n)(*vrs), (fmi2Real * n)()
+
+        def write(new: list[float]) -> None:
+            values[:] = new
+            before = len(log)
+            status = set_(component, refs, n, values)
+            if status:
+                self._status("setReal", status, before)
+        return write
+
+    def stepper(self):
+        do_step, component, log = self.slave._functions["fmi2DoStep"], self.slave.component, self.log
+
+        def step(t: float, h: float) -> None:
+            before = len(log)
+            status = do_step(component, t, h, fmi2True)
+            if status:
+                self._status("doStep", status, before, t)
+        return step
 
     def free(self) -> None:
         """Terminate, free the instance and remove the extracted files."""

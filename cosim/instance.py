@@ -87,3 +87,19 @@ class Instance:
 
     def set_real(self, vrs: list[int], values: list[float]) -> None:
         self.call("setReal", self.fmi("setReal"), vrs, values)
+
+    # Prepared calls for a fixed list of value references: what the master's loop uses.
+    # A backend may override them with something faster.
+    def reader(self, vrs: list[int]) -> Callable[[], list[float]]:
+        """A function returning the current Real values of ``vrs``."""
+        return lambda: self.get_real(vrs)
+
+    def integer_reader(self, vrs: list[int]) -> Callable[[], list[int]]:
+        return lambda: self.get_integer(vrs)
+
+    def writer(self, vrs: list[int]) -> Callable[[list[float]], None]:
+        """A function setting the Real inputs ``vrs``."""
+        return lambda values: self.set_real(vrs, values)
+
+    def stepper(self) -> Callable[[float, float], None]:
+        return self.do_step

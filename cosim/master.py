@@ -25,6 +25,8 @@ the rows recorded up to then are kept.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from operator import itemgetter
+from pathlib import Path
 from graphlib import CycleError, TopologicalSorter
 from typing import Any, Callable
 
@@ -62,29 +64,56 @@ class Recording:
     def t(self) -> np.ndarray:
         return self.time[:self.rows]
 
+    path: Path | None = None            # where the rows went, if streamed to CSV
+
     def write_csv(self, path) -> None:
         """All complete rows, a header of column names; floats in their shortest exact form."""
-        table = np.column_stack([self.t, self.data[:self.rows]]).tolist()
-        with open(path, "w") as f:
-            f.write(",".join(["time", *self.columns]) + "\n")
-            f.writelines(",".join(map(repr, row)) + "\n" for row in table)
+        sink = _CsvSink(path, self.columns)
+        sink.write(self.t, self.data[:self.rows])
+        sink.close()
+
+
+class _CsvSink:
+    """Rows appended to a CSV file as they come, in the shortest exact float form."""
+
+    def __init__(self, path: str | Path, columns: list[str]):
+        self.path, self.rows = Path(path), 0
+        self.file = open(self.path, "w")
+        self.file.write(",".join(["time", *columns]) + "\n")
+
+    def write(self, times: np.ndarray, data: np.ndarray) -> None:
+        table = np.column_stack([times, data]).tolist()
+        self.file.writelines(",".join(map(repr, row)) + "\n" for row in table)
+        self.file.flush()
+        self.rows += len(table)
+
+    def close(self) -> None:
+        self.file.close()
 
 
 @dataclass
 class _Node:
-    """One component as the loop sees it."""
+    """One component as the loop sees it: column blocks and prepared FMI calls."""
 
     name: str
     instance: Any
-    state_out: list[int]                # value references: outputs without feedthrough
-    state_cols: list[int]               # their columns
-    ft_out: list[int]                   # outputs with feedthrough
-    ft_cols: list[int]
-    int_out: list[int]                  # Integer outputs (evaluated with the feedthrough)
-    int_cols: list[int]
-    in_vrs: list[int]                   # connected inputs
-    in_cols: list[int]
-    in_sources: list[int]               # column of the output each input is connected to
+    state: slice = field(default_factory=lambda: slice(0, 0))        # Real outputs, no feedthrough
+    feedthrough: slice = field(default_factory=lambda: slice(0, 0))  # Real, with feedthrough
+    integers: slice = field(default_factory=lambda: slice(0, 0))     # Integer outputs
+    inputs: slice = field(default_factory=lambda: slice(0, 0))       # connected inputs
+    sources: list[int] = field(default_factory=list)   # output column of each input
+    read_state: Callable | None = None
+    read_feedthrough: Callable | None = None
+    read_outputs: Callable | None = None               # state and feedthrough in one call
+    read_integers: Callable | None = None
+    write_inputs: Callable | None = None
+    read_inputs: Callable | None = None
+    gather: Callable | None = None                     # values -> this node's inputs
+    step: Callable | None = None
+
+    @property
+    def outputs(self) -> slice:
+        return slice(self.state.start, self.feedthrough.stop)
 
 
 class Master:
@@ -139,29 +168,42 @@ class Master:
                                f"{' -> '.join(error.args[1])}") from None
 
     def _layout(self) -> None:
+        """Columns in contiguous blocks per component; the prepared calls of the loop."""
         columns: list[str] = []
         nodes = {}
+
+        def block(names: list[str]) -> slice:
+            start = len(columns)
+            columns.extend(names)
+            return slice(start, len(columns))
+
         for name, instance in self.instances.items():
             outputs = [v for v in instance.variables.values() if v.causality == "output"]
-            reals = [v for v in outputs if v.type == "Real"]
+            state = [v for v in outputs if v.type == "Real" and not instance.feedthrough.get(v.name)]
+            ft = [v for v in outputs if v.type == "Real" and instance.feedthrough.get(v.name)]
             ints = [v for v in outputs if v.type == "Integer"]
-            state = [v for v in reals if not instance.feedthrough.get(v.name)]
-            ft = [v for v in reals if instance.feedthrough.get(v.name)]
-            node = _Node(name, instance, [], [], [], [], [], [], [], [], [])
-            for group, vrs, cols in ((state, node.state_out, node.state_cols),
-                                     (ft, node.ft_out, node.ft_cols),
-                                     (ints, node.int_out, node.int_cols)):
-                for v in group:
-                    vrs.append(v.valueReference)
-                    cols.append(len(columns))
-                    columns.append(f"{name}.{v.name}")
+            node = _Node(name, instance, step=instance.stepper())
+            node.state = block([f"{name}.{v.name}" for v in state])
+            node.feedthrough = block([f"{name}.{v.name}" for v in ft])
+            node.integers = block([f"{name}.{v.name}" for v in ints])
+            vrs = [v.valueReference for v in state + ft]
+            node.read_state = instance.reader(vrs[:len(state)]) if state else None
+            node.read_feedthrough = instance.reader(vrs[len(state):]) if ft else None
+            node.read_outputs = instance.reader(vrs) if vrs else None
+            node.read_integers = (instance.integer_reader([v.valueReference for v in ints])
+                                  if ints else None)
             nodes[name] = node
-        for c in self.system.connections:
-            node = nodes[c.end_element]
-            node.in_vrs.append(self.instances[c.end_element].vr(c.end_connector))
-            node.in_cols.append(len(columns))
-            node.in_sources.append(columns.index(f"{c.start_element}.{c.start_connector}"))
-            columns.append(f"{c.end_element}.{c.end_connector}")
+        for name, node in nodes.items():
+            incoming = [c for c in self.system.connections if c.end_element == name]
+            node.inputs = block([f"{name}.{c.end_connector}" for c in incoming])
+            if incoming:
+                vrs = [self.instances[name].vr(c.end_connector) for c in incoming]
+                node.sources = [columns.index(f"{c.start_element}.{c.start_connector}")
+                                for c in incoming]
+                node.write_inputs = self.instances[name].writer(vrs)
+                node.read_inputs = self.instances[name].reader(vrs)
+                node.gather = itemgetter(*node.sources) if len(node.sources) > 1 else \
+                    (lambda values, i=node.sources[0]: (values[i],))
         self.columns = columns
         self.nodes = [nodes[name] for name in (self.order if self.coupling == "gauss-seidel"
                                                else self.instances)]
@@ -191,29 +233,27 @@ class Master:
         values = [0.0] * len(self.columns)
         for _ in self.instances:          # enough passes for any acyclic chain
             for node in self.nodes:
-                self._read(node, values, node.state_out + node.ft_out,
-                           node.state_cols + node.ft_cols)
+                if node.read_outputs:
+                    values[node.outputs] = node.read_outputs()
                 self._apply_inputs(node, values)
         for instance in self.instances.values():
             instance.exit_initialization(t0)
 
-    def _read(self, node: _Node, values: list[float], vrs: list[int], cols: list[int]) -> None:
-        if vrs:
-            for col, value in zip(cols, node.instance.get_real(vrs)):
-                values[col] = value
-
     def _apply_inputs(self, node: _Node, values: list[float]) -> None:
-        if node.in_vrs:
-            inputs = [values[src] for src in node.in_sources]
-            node.instance.set_real(node.in_vrs, inputs)
-            if self.verify_inputs:
-                inputs = node.instance.get_real(node.in_vrs)
-            for col, value in zip(node.in_cols, inputs):
-                values[col] = value
+        if node.write_inputs:
+            inputs = node.gather(values)
+            node.write_inputs(inputs)
+            values[node.inputs] = node.read_inputs() if self.verify_inputs else inputs
 
     def run(self, stop_time: float | None = None,
-            progress: Callable[[int, int], None] | None = None) -> Recording:
-        """Simulate to stop_time (default: the system's); never raises on an FMU error."""
+            progress: Callable[[int, int], None] | None = None,
+            csv_path: str | Path | None = None, chunk_rows: int = 10_000) -> Recording:
+        """Simulate to stop_time (default: the system's); never raises on an FMU error.
+
+        With ``csv_path`` the rows go to that CSV file in chunks of ``chunk_rows`` as
+        the run proceeds, and memory stays flat however long the run; the returned
+        recording then holds no rows (``rows`` counts those written).
+        """
         system = self.system
         t0, h = system.start_time, seconds(nanoseconds(system.step_size))
         stop = system.stop_time if stop_time is None else stop_time
@@ -221,51 +261,67 @@ class Master:
         if remainder or n_steps < 1:
             raise ValueError(f"stop time {stop} s is not a whole number of {h} s steps "
                              f"after {t0} s")
-        times = np.array([communication_point(t0, k, h) for k in range(n_steps + 1)])
-        recording = Recording(self.columns, times,
-                              np.full((n_steps + 1, len(self.columns)), np.nan),
+        chunk = n_steps + 1 if csv_path is None else min(chunk_rows, n_steps + 1)
+        recording = Recording(self.columns, np.empty(chunk), np.full((chunk, len(self.columns)),
+                                                                    np.nan),
                               meta={"system": system.name, "coupling": self.coupling,
                                     "step_size": h})
+        sink = _CsvSink(csv_path, self.columns) if csv_path is not None else None
+        times, data = recording.time, recording.data
         values = [0.0] * len(self.columns)
+        nodes = self.nodes
         gauss_seidel = self.coupling == "gauss-seidel"
-        k, t = 0, t0
+        k, t, row = 0, t0, 0
         try:
             self.initialize()
             for k in range(n_steps + 1):
-                t = float(times[k])
+                t = communication_point(t0, k, h)
+                last = k == n_steps
                 if gauss_seidel:
-                    for node in self.nodes:
-                        self._read(node, values, node.state_out, node.state_cols)
-                    for node in self.nodes:
-                        self._apply_inputs(node, values)
-                        self._read(node, values, node.ft_out, node.ft_cols)
-                        self._read_int(node, values)
-                        if k < n_steps:
-                            node.instance.do_step(t, h)
-                    recording.data[k] = values
+                    for node in nodes:
+                        if node.read_state:
+                            values[node.state] = node.read_state()
+                    for node in nodes:
+                        if node.write_inputs:
+                            self._apply_inputs(node, values)
+                        if node.read_feedthrough:
+                            values[node.feedthrough] = node.read_feedthrough()
+                        if node.read_integers:
+                            values[node.integers] = node.read_integers()
+                        if not last:
+                            node.step(t, h)
+                    times[row], data[row] = t, values
                 else:
-                    for node in self.nodes:
-                        self._read(node, values, node.state_out + node.ft_out,
-                                   node.state_cols + node.ft_cols)
-                        self._read_int(node, values)
-                    for node in self.nodes:
-                        self._apply_inputs(node, values)
-                    recording.data[k] = values
-                    if k < n_steps:
-                        for node in self.nodes:
-                            node.instance.do_step(t, h)
-                recording.rows = k + 1
+                    for node in nodes:
+                        if node.read_outputs:
+                            values[node.outputs] = node.read_outputs()
+                        if node.read_integers:
+                            values[node.integers] = node.read_integers()
+                    for node in nodes:
+                        if node.write_inputs:
+                            self._apply_inputs(node, values)
+                    times[row], data[row] = t, values
+                    if not last:
+                        for node in nodes:
+                            node.step(t, h)
+                row += 1
+                recording.rows = row
+                if sink is not None and (row == chunk or last):
+                    sink.write(times[:row], data[:row])
+                    row = 0
                 if progress is not None and k % 100 == 0:
                     progress(k, n_steps)
         except FmuCallError as error:
             recording.error = f"{error}\n  (run stopped at step {k}, t = {t:.6g} s; " \
-                              f"{recording.rows} rows recorded)"
+                              f"{(sink.rows if sink else 0) + row} rows recorded)"
+            if sink is not None:
+                sink.write(times[:row], data[:row])
+        finally:
+            if sink is not None:
+                sink.close()
+                recording.rows, recording.path = 0, sink.path
+                recording.meta["rows_written"] = sink.rows
         return recording
-
-    def _read_int(self, node: _Node, values: list[float]) -> None:
-        if node.int_out:
-            for col, value in zip(node.int_cols, node.instance.get_integer(node.int_out)):
-                values[col] = value
 
     def free(self) -> None:
         for instance in self.instances.values():

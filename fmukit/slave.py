@@ -36,6 +36,7 @@ import ctypes
 import functools
 import json
 import math
+import operator
 import os
 import sys
 from dataclasses import dataclass
@@ -133,18 +134,27 @@ class ModelSlave(Fmi2Slave):
         self.phase = "instantiated"
         self._model = None
         self._by_vr: dict[int, Var] = {}
+        self._real_getters: dict[int, Callable[[], float]] = {}   # getReal's fast path
+        self._model_attributes: dict[int, str] = {}  # outputs that are attributes of the model
+        self._reads: dict[tuple[int, ...], Callable[[], list[float]]] = {}
+        self._writes: dict[tuple[int, ...], tuple[str, ...]] = {}
+        self._int_getters: dict[int, Callable[[], int]] = {}
+        self._real_inputs: dict[int, str] = {}                   # setReal's fast path
         for var in self.variables:
             self._register(var)
 
     def _register(self, var: Var) -> None:
         kind = _PYTHONFMU_TYPE[var.kind]
         if var.causality == "output":
-            get = var.get or (lambda slave, name=var.name: getattr(slave.model, name))
+            get = var.get or (lambda slave, name=var.name: getattr(slave._model, name))
+
+            def getter(get=get, undefined=math.nan if var.is_real else 0) -> Any:
+                return self._output(get, undefined)
             sv = kind(var.name, causality=Fmi2Causality.output,
                       variability=(Fmi2Variability.continuous if var.is_real
                                    else Fmi2Variability.discrete),
                       initial=Fmi2Initial.calculated, description=var.description,
-                      getter=lambda: self._output(get, var))
+                      getter=getter)
         else:
             setattr(self, var.name, var.start)
             variability = (Fmi2Variability.fixed if var.causality == "parameter"
@@ -153,6 +163,14 @@ class ModelSlave(Fmi2Slave):
                       variability=variability, description=var.description)
         self.register_variable(sv)
         self._by_vr[sv.value_reference] = var
+        if var.is_real:
+            self._real_getters[sv.value_reference] = sv.getter
+            if var.causality == "input":
+                self._real_inputs[sv.value_reference] = var.name
+            elif var.causality == "output" and var.get is None:
+                self._model_attributes[sv.value_reference] = var.name
+        elif var.kind is int:
+            self._int_getters[sv.value_reference] = sv.getter
 
     # -- model ---------------------------------------------------------------
     def build_model(self) -> Any:
@@ -163,7 +181,7 @@ class ModelSlave(Fmi2Slave):
         """Advance the model from t to t + h with the current inputs."""
         raise NotImplementedError
 
-    def _output(self, get: Callable[[Any], Any], var: Var) -> Any:
+    def _output(self, get: Callable[[Any], Any], undefined: Any) -> Any:
         """An output's value, or NaN (0 if Integer) when it cannot be evaluated.
 
         A read never fails: a failed getReal aborts some hosts (libcosim throws
@@ -178,7 +196,7 @@ class ModelSlave(Fmi2Slave):
                 self._model = self.build_model()
             return get(self)
         except ValueError:
-            return math.nan if var.is_real else 0
+            return undefined
 
     @property
     def model(self) -> Any:
@@ -249,7 +267,17 @@ class ModelSlave(Fmi2Slave):
 
     @_fmi_entry
     def set_real(self, vrs: list[int], values: list[float]) -> None:
-        self._set(vrs, values, float)
+        key = tuple(vrs)
+        names = self._writes.get(key)
+        if names is None:           # inputs only: always settable until terminate
+            inputs = self._real_inputs
+            names = self._writes[key] = (tuple(inputs[vr] for vr in vrs)
+                                         if all(vr in inputs for vr in vrs) else ())
+        if names and self.phase != "terminated":
+            for name, value in zip(names, values):
+                setattr(self, name, float(value))
+        else:
+            self._set(vrs, values, float)
 
     @_fmi_entry
     def set_integer(self, vrs: list[int], values: list[int]) -> None:
@@ -299,11 +327,37 @@ class ModelSlave(Fmi2Slave):
 
     @_fmi_entry
     def get_real(self, vrs: list[int]) -> list[float]:
-        return super().get_real(vrs)
+        read = self._reads.get(tuple(vrs))
+        if read is None:
+            read = self._reads[tuple(vrs)] = self._compile_read(vrs)
+        return read()
+
+    def _compile_read(self, vrs: list[int]) -> Callable[[], list[float]]:
+        """The fastest correct way to read these value references, built once."""
+        if not all(vr in self._real_getters for vr in vrs):
+            return lambda: Fmi2Slave.get_real(self, vrs)   # pythonfmu names the problem
+        getters = [self._real_getters[vr] for vr in vrs]
+
+        def each() -> list[float]:
+            return [float(get()) for get in getters]
+        if not all(vr in self._model_attributes for vr in vrs):
+            return each
+        attributes = operator.attrgetter(*(self._model_attributes[vr] for vr in vrs))
+
+        def model_attributes() -> list[float]:     # the ship's states: one C-level call
+            model = self._model
+            if model is None:
+                return each()
+            values = attributes(model)
+            return list(values) if len(vrs) > 1 else [values]
+        return model_attributes
 
     @_fmi_entry
     def get_integer(self, vrs: list[int]) -> list[int]:
-        return super().get_integer(vrs)
+        getters = self._int_getters
+        if all(vr in getters for vr in vrs):
+            return [int(getters[vr]()) for vr in vrs]
+        return super().get_integer(vrs)         # pythonfmu names the problem
 
     @_fmi_entry
     def get_string(self, vrs: list[int]) -> list[str]:

@@ -21,6 +21,8 @@ commands a negative rudder to increase the heading.
 """
 from __future__ import annotations
 
+from typing import Callable
+
 from .data import Actuators
 
 
@@ -29,33 +31,38 @@ def thrust(n: float, k_p: float, k_n: float) -> float:
     return k_p * n * n if n >= 0.0 else k_n * abs(n) * n
 
 
-def rudder_lift(act: Actuators, T: float, n: float, delta: float) -> float:
-    """Rudder lift in the slipstream of a propeller with thrust T, eq (9)."""
-    if n < 0.0:
-        return 0.0
-    return T * (1.0 + act.k_Ln * n) * (act.k_Ld1 + act.k_Ld2 * abs(delta)) * delta
+def actuator_model(act: Actuators, n1: float, n2: float,
+                   n3: float) -> Callable[[float], tuple[float, float, float]]:
+    """tau_th as a function of the rudder angle, at fixed shaft speeds, eqs (8)-(13).
 
+    What depends on the shaft speeds only (thrust, and the slipstream factors
+    T_i (1 + k_Ln n_i), T_i (1 + k_Dn n_i) of eqs (9)-(10)) is computed here once;
+    the returned function adds the rudder's part. Both rudders take the angle delta;
+    a propeller turning astern (n_i < 0) gives its rudder no lift or drag.
+    """
+    T1 = thrust(n1, act.k_Tp, act.k_Tn)
+    T2 = thrust(n2, act.k_Tp, act.k_Tn)
+    T3 = thrust(n3, act.k_T3p, act.k_T3n)
+    lift1, drag1 = (T1 * (1.0 + act.k_Ln * n1), T1 * (1.0 + act.k_Dn * n1)) if n1 >= 0.0 \
+        else (0.0, 0.0)
+    lift2, drag2 = (T2 * (1.0 + act.k_Ln * n2), T2 * (1.0 + act.k_Dn * n2)) if n2 >= 0.0 \
+        else (0.0, 0.0)
+    k_Ld1, k_Ld2, k_Dd1, k_Dd2 = act.k_Ld1, act.k_Ld2, act.k_Dd1, act.k_Dd2
+    l_yT, l_xT3, l_xR = act.l_yT, act.l_xT3, act.l_xR
 
-def rudder_drag(act: Actuators, T: float, n: float, delta: float) -> float:
-    """Rudder drag in the slipstream of a propeller with thrust T, eq (10)."""
-    if n < 0.0:
-        return 0.0
-    a = abs(delta)
-    return T * (1.0 + act.k_Dn * n) * (act.k_Dd1 * a + act.k_Dd2 * a * a)
+    def forces(delta: float) -> tuple[float, float, float]:
+        a = abs(delta)
+        lift = k_Ld1 + k_Ld2 * a                 # eq (9):  L_i = lift_i (k_Ld1 + k_Ld2 |d|) d
+        drag = k_Dd1 * a + k_Dd2 * a * a         # eq (10): D_i = drag_i (k_Dd1 |d| + k_Dd2 d^2)
+        L1, L2 = lift1 * lift * delta, lift2 * lift * delta
+        F1, F2 = T1 - drag1 * drag, T2 - drag2 * drag
+        return (F1 + F2,                                             # eqs (11)-(13)
+                T3 + L1 + L2,
+                l_yT * (F1 - F2) + l_xT3 * T3 - l_xR * (L1 + L2))
+    return forces
 
 
 def actuator_forces(act: Actuators, n1: float, n2: float, n3: float,
                     delta: float) -> tuple[float, float, float]:
-    """tau_th = T u for both rudders at angle delta, eqs (11)-(13)."""
-    T1 = thrust(n1, act.k_Tp, act.k_Tn)
-    T2 = thrust(n2, act.k_Tp, act.k_Tn)
-    T3 = thrust(n3, act.k_T3p, act.k_T3n)
-    L1 = rudder_lift(act, T1, n1, delta)
-    L2 = rudder_lift(act, T2, n2, delta)
-    F1 = T1 - rudder_drag(act, T1, n1, delta)
-    F2 = T2 - rudder_drag(act, T2, n2, delta)
-    return (
-        F1 + F2,
-        T3 + L1 + L2,
-        act.l_yT * (F1 - F2) + act.l_xT3 * T3 - act.l_xR * (L1 + L2),
-    )
+    """tau_th = T u for both rudders at angle delta, eqs (8)-(13)."""
+    return actuator_model(act, n1, n2, n3)(delta)

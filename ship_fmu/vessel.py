@@ -18,8 +18,11 @@ from dataclasses import dataclass, fields
 from .data import Actuators, Hull
 from .hull import coriolis_forces, damping_forces, kinematics, mass_matrix
 from .steering_gear import DELTA_MAX, DELTA_RATE_MAX, rudder_angle
-from .thrusters import actuator_forces
+from .thrusters import actuator_model
 from .waves import WaveComponents, WaveLoads
+
+State = tuple[float, float, float, float, float, float, float]
+"""(x, y, psi, u, v, r, xi): what RK4 integrates."""
 
 N_PROPELLER = 8.13
 """Main propeller speed of the paper's runs, rev/s: 0.3 m/s in calm water."""
@@ -92,13 +95,15 @@ class Vessel:
     def _wave_loads(self, t: float, xi: float, psi: float) -> tuple[float, float, float]:
         return (0.0, 0.0, 0.0) if self.waves is None else self.waves(t, xi, psi)
 
-    def rates(self, t: float, state: tuple[float, ...], delta: float,
-              n1: float, n2: float, n3: float) -> tuple[float, ...]:
-        """Time derivative of (x, y, psi, u, v, r, xi), eqs (1)-(17)."""
+    def rates(self, t: float, state: State, tau_th: tuple[float, float, float]) -> State:
+        """Time derivative of (x, y, psi, u, v, r, xi), eqs (1)-(17).
+
+        tau_th: the actuator forces, from ``thrusters.actuator_model``.
+        """
         _, _, psi, u, v, r, xi = state
         cX, cY, cN = coriolis_forces(self.hull, u, v, r)
         dX, dY, dN = damping_forces(self.hull, u, v, r)
-        tX, tY, tN = actuator_forces(self.actuators, n1, n2, n3, delta)
+        tX, tY, tN = tau_th
         wX, wY, wN = self._wave_loads(t, xi, psi)
         fX = tX + wX - cX - dX
         fY = tY + wY - cY - dY
@@ -112,13 +117,18 @@ class Vessel:
     def step(self, t: float, h: float, delta_c: float,
              n1: float = N_PROPELLER, n2: float = N_PROPELLER, n3: float = 0.0) -> None:
         """Advance from communication point t to t + h with the inputs held."""
-        for name, value in (("delta_c", delta_c), ("n1", n1), ("n2", n2), ("n3", n3)):
-            if not math.isfinite(value):
-                raise ValueError(f"input {name} = {value} is not finite")
+        if not (math.isfinite(delta_c) and math.isfinite(n1) and math.isfinite(n2)
+                and math.isfinite(n3)):
+            for name, value in (("delta_c", delta_c), ("n1", n1), ("n2", n2), ("n3", n3)):
+                if not math.isfinite(value):
+                    raise ValueError(f"input {name} = {value} is not finite")
         p = self.params
         n_sub = max(1, math.ceil(h / p.h_max - 1e-9))
         hs = h / n_sub
+        hh, c = 0.5 * hs, hs / 6.0
         delta0 = self.delta
+        forces = actuator_model(self.actuators, n1, n2, n3)
+        rates = self.rates
 
         def gear(s: float) -> float:
             return rudder_angle(delta0, delta_c, s, p.delta_max, p.delta_rate_max)
@@ -127,14 +137,12 @@ class Vessel:
         for j in range(n_sub):
             s = j * hs
             ts = t + s
-            d0, d1, d2 = gear(s), gear(s + 0.5 * hs), gear(s + hs)
-            k1 = self.rates(ts, y, d0, n1, n2, n3)
-            k2 = self.rates(ts + 0.5 * hs, _axpy(0.5 * hs, k1, y), d1, n1, n2, n3)
-            k3 = self.rates(ts + 0.5 * hs, _axpy(0.5 * hs, k2, y), d1, n1, n2, n3)
-            k4 = self.rates(ts + hs, _axpy(hs, k3, y), d2, n1, n2, n3)
-            c = hs / 6.0
-            y = tuple(yi + c * (a + 2.0 * b + 2.0 * e + f)
-                      for yi, a, b, e, f in zip(y, k1, k2, k3, k4))
+            tau0, tau1, tau2 = forces(gear(s)), forces(gear(s + hh)), forces(gear(s + hs))
+            k1 = rates(ts, y, tau0)
+            k2 = rates(ts + hh, _axpy(hh, k1, y), tau1)
+            k3 = rates(ts + hh, _axpy(hh, k2, y), tau1)
+            k4 = rates(ts + hs, _axpy(hs, k3, y), tau2)
+            y = _rk4(c, y, k1, k2, k3, k4)
         self.x, self.y, self.psi, self.u, self.v, self.r, self.xi = y
         self.delta = gear(h)
         self.t = t + h
@@ -151,6 +159,18 @@ class Vessel:
         self.X_w, self.Y_w, self.N_w = self._wave_loads(self.t, self.xi, self.psi)
 
 
-def _axpy(a: float, x: tuple[float, ...], y: tuple[float, ...]) -> tuple[float, ...]:
-    """y + a x, elementwise."""
-    return tuple(yi + a * xi for xi, yi in zip(x, y))
+def _axpy(a: float, x: State, y: State) -> State:
+    """y + a x for the 7 states, written out: it runs three times a step."""
+    return (y[0] + a * x[0], y[1] + a * x[1], y[2] + a * x[2], y[3] + a * x[3],
+            y[4] + a * x[4], y[5] + a * x[5], y[6] + a * x[6])
+
+
+def _rk4(c: float, y: State, k1: State, k2: State, k3: State, k4: State) -> State:
+    """The RK4 update y + h/6 (k1 + 2 k2 + 2 k3 + k4), with c = h/6."""
+    return (y[0] + c * (k1[0] + 2.0 * k2[0] + 2.0 * k3[0] + k4[0]),
+            y[1] + c * (k1[1] + 2.0 * k2[1] + 2.0 * k3[1] + k4[1]),
+            y[2] + c * (k1[2] + 2.0 * k2[2] + 2.0 * k3[2] + k4[2]),
+            y[3] + c * (k1[3] + 2.0 * k2[3] + 2.0 * k3[3] + k4[3]),
+            y[4] + c * (k1[4] + 2.0 * k2[4] + 2.0 * k3[4] + k4[4]),
+            y[5] + c * (k1[5] + 2.0 * k2[5] + 2.0 * k3[5] + k4[5]),
+            y[6] + c * (k1[6] + 2.0 * k2[6] + 2.0 * k3[6] + k4[6]))

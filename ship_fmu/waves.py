@@ -99,13 +99,31 @@ class WaveLoads:
         self._slope_amplitude = components.amplitude * components.k
         self._c_force = rho * G * h.B * h.L * h.T
         self._c_moment = rho * G * h.B * h.L * (h.L ** 2 - h.B ** 2) / 24.0
+        self._s = np.empty_like(components.omega)       # work arrays: no allocation per call
+        self._kxi = np.empty_like(components.omega)
+        self._last: tuple = (None, None)
 
     def __call__(self, t: float, xi: float, psi: float) -> tuple[float, float, float]:
-        """(X_w, Y_w, N_w) at time t, travel xi and heading psi."""
-        s = self._slope_amplitude * np.sin(self.components.phases(t, xi))
+        """(X_w, Y_w, N_w) at time t, travel xi and heading psi.
+
+        The last result is kept: the loads at the end of a step are those of the
+        next step's first RK4 stage.
+        """
+        key, loads = self._last
+        if key == (t, xi, psi):
+            return loads
+        w, s = self.components, self._s
+        np.multiply(w.omega, t, out=s)                  # theta = omega t - k xi + phi
+        np.multiply(w.k, xi, out=self._kxi)
+        np.subtract(s, self._kxi, out=s)
+        np.add(s, w.phase, out=s)
+        np.sin(s, out=s)
+        np.multiply(self._slope_amplitude, s, out=s)    # s_i = A_i k_i sin(theta_i)
         beta = self.psi_w - psi
         sum_s = float(s.sum())
         force = self._c_force * sum_s
-        return (force * math.cos(beta),
-                force * math.sin(beta),
-                self._c_moment * math.sin(2.0 * beta) * float(s @ s))
+        loads = (force * math.cos(beta),
+                 force * math.sin(beta),
+                 self._c_moment * math.sin(2.0 * beta) * float(s @ s))
+        self._last = ((t, xi, psi), loads)
+        return loads
