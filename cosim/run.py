@@ -76,19 +76,26 @@ class _Progress:
 
 
 def run_scenario(name: str, out: Path, overrides: dict, coupling: str, stop_time: float | None,
-                 lam: float, plot: bool = True, backend: str = "fmi") -> tuple[int, object]:
+                 lam: float, plot: bool = True, backend: str = "fmi",
+                 stream: bool = False) -> tuple[int, object]:
     """Simulate one scenario, write its CSV and figure, print its report."""
     system = read_ssd(SCENARIO_DIR / f"{name}.ssd")
     master = Master(system, coupling=coupling, overrides=overrides, backend=backend)
     progress = _Progress(name)
+    csv_path = out / f"{name}.csv"
     try:
-        recording = master.run(stop_time, progress=progress)
+        recording = master.run(stop_time, progress=progress,
+                               csv_path=csv_path if stream else None)
     finally:
         progress.close()
         master.free()
-    csv_path = out / f"{name}.csv"
-    recording.write_csv(csv_path)
+    if not stream:
+        recording.write_csv(csv_path)
     print(f"{name}: {system.description}")
+    if stream and not recording.error:
+        print(f"  {recording.meta['rows_written']} rows streamed to {csv_path} "
+              "(no report or figure in --stream mode)")
+        return 0, None
     if recording.error:
         print(f"error: {recording.error}", file=sys.stderr)
         print(f"  the {recording.rows} rows recorded before the error are in {csv_path}",
@@ -130,6 +137,9 @@ def main(argv: list[str] | None = None) -> int:
                         help="fmi: load the FMUs from fmus/ (default); inprocess: call the "
                              "FMUs' Python classes directly, without FMI")
     parser.add_argument("--no-plot", action="store_true", help="skip the figure")
+    parser.add_argument("--stream", action="store_true",
+                        help="write rows to the CSV in chunks as the run goes: flat memory "
+                             "for long runs (--stop-time 86400); no report or figure")
     args = parser.parse_args(argv)
 
     if args.all == bool(args.scenario):
@@ -150,7 +160,8 @@ def main(argv: list[str] | None = None) -> int:
         writable_folder(out)
         try:
             code, result = run_scenario(name, out, overrides, args.coupling, args.stop_time,
-                                        args.lam, plot=not args.no_plot, backend=args.backend)
+                                        args.lam, plot=not args.no_plot, backend=args.backend,
+                                        stream=args.stream)
         except (ValueError, FileNotFoundError) as error:
             print(f"error: {error}", file=sys.stderr)
             return 2

@@ -227,3 +227,17 @@ def test_fmu_error_mid_run_names_fmu_call_and_time_and_keeps_the_rows(tmp_path, 
     assert "FMU 'ship': doStep at t = 50 s" in err and "injected fault" in err
     header, *rows = (tmp_path / "calm_pd.csv").read_text().splitlines()
     assert len(rows) == 500 and rows[-1].startswith("49.9")
+
+
+def test_streamed_rows_equal_the_in_memory_recording(tmp_path):
+    """Rows written in chunks as the run goes are the rows a whole recording writes."""
+    master = Master(system("waves_smc"))
+    try:
+        whole = master.run(30.0)
+        master.reset()
+        streamed = master.run(30.0, csv_path=tmp_path / "streamed.csv", chunk_rows=64)
+    finally:
+        master.free()
+    whole.write_csv(tmp_path / "whole.csv")
+    assert streamed.meta["rows_written"] == 301 and streamed.rows == 0
+    assert (tmp_path / "streamed.csv").read_text() == (tmp_path / "whole.csv").read_text()
