@@ -23,7 +23,8 @@ class GuidanceSlave(ModelSlave):
                    get=lambda s: s.model.wp_index(s.x, s.y)),
         Var.parameter("waypoints", PAPER_ROUTE,
                       description="route 'x0,y0;x1,y1;...' in m, north and east"),
-        Var.parameter("R_accept", 2.0 * SHIP_LENGTH, "m", "radius of the circle of acceptance"),
+        Var.parameter("R_accept", 2.0 * SHIP_LENGTH, "m", "radius of the circle of acceptance, "
+                      "> 0", 0.0, 1e6),
     )
 
     def build_model(self) -> WaypointGuidance:

@@ -19,7 +19,7 @@ class SMCAutopilotSlave(ModelSlave):
                    "(Tomera 2010, eqs 33-44), design computed from the linear model")
     variables = (
         Var.input("psi", 0.0, "rad", "ship heading"),
-        Var.input("r", 0.0, "rad/s", "ship yaw rate"),
+        Var.input("r", 0.0, "rad/s", "ship yaw rate", -100.0, 100.0),
         Var.input("psi_d", 0.0, "rad", "desired course"),
         Var.output("delta_c", "rad", "commanded rudder angle, eq (43)",
                    depends=("psi", "r", "psi_d") + _LAW,
@@ -28,13 +28,17 @@ class SMCAutopilotSlave(ModelSlave):
         Var.output("r_z", "rad/s", "reference yaw rate, eq (44)", initial_depends=("r",)),
         Var.output("sigma", "1", "sliding surface, eq (37)", depends=("psi", "r") + _DESIGN,
                    get=lambda s: s.model.sigma(s.psi, s.r)),
-        Var.parameter("lambda1", -0.0005, "1/s", "closed-loop eigenvalue of smaller magnitude"),
-        Var.parameter("lambda2", -7.8128, "1/s", "closed-loop eigenvalue of larger magnitude"),
-        Var.parameter("eta_h", 10.0, "rad", "switching gain"),
-        Var.parameter("phi_h", 0.3, "rad", "boundary layer thickness, > 0"),
-        Var.parameter("omega_n", 0.1, "rad/s", "reference model natural frequency, > 0"),
-        Var.parameter("zeta", 0.85, "1", "reference model relative damping, > 0"),
-        Var.parameter("u0", 0.3, "m/s", "design surge speed (design_model 'ship')"),
+        Var.parameter("lambda1", -0.0005, "1/s", "closed-loop eigenvalue of smaller magnitude, "
+                      "< 0", -1e3, 0.0),
+        Var.parameter("lambda2", -7.8128, "1/s", "closed-loop eigenvalue of larger magnitude, "
+                      "< 0", -1e3, 0.0),
+        Var.parameter("eta_h", 10.0, "rad", "switching gain", 0.0, 1e3),
+        Var.parameter("phi_h", 0.3, "rad", "boundary layer thickness, > 0", 0.0, 1e3),
+        Var.parameter("omega_n", 0.1, "rad/s", "reference model natural frequency, > 0",
+                      0.0, 10.0),
+        Var.parameter("zeta", 0.85, "1", "reference model relative damping, > 0", 0.0, 10.0),
+        Var.parameter("u0", 0.3, "m/s", "design surge speed (design_model 'ship'), > 0",
+                      0.0, 5.0),
         Var.parameter("design_model", "paper", description=(
             "linear design model: 'paper' = eq (45) as printed, 'ship' = this ship "
             "model linearised at u0")),

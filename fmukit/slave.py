@@ -52,6 +52,9 @@ from .timebase import nanoseconds, seconds
 from .units import DISPLAY_UNIT, unit_definitions
 
 _PYTHONFMU_TYPE = {float: Real, int: Integer, str: String}
+_AFTER = {"instantiated": "fmi2Instantiate or fmi2Reset",
+          "initialization": "fmi2EnterInitializationMode",
+          "step": "fmi2ExitInitializationMode", "terminated": "fmi2Terminate"}
 _RELEASES_ON_EXCEPTION = PYTHONFMU_VERSION == "0.7.0"
 
 
@@ -92,17 +95,32 @@ class Var:
     depends: tuple[str, ...] = ()     # outputs: inputs and parameters they depend on
     initial_depends: tuple[str, ...] = ()     # outputs: further knowns, at initialisation only
     get: Callable[[Any], Any] | None = None   # outputs: value from the slave
+    min: float = -math.inf            # inputs and parameters: the valid range, written to
+    max: float = math.inf             # modelDescription.xml and enforced (NaN is never valid)
 
     @classmethod
     def parameter(cls, name: str, start: float | int | str, unit: str = "1",
-                  description: str = "") -> Var:
+                  description: str = "", min: float = -math.inf,
+                  max: float = math.inf) -> Var:
         """A fixed parameter; its Python type (float, int, str) sets the FMI type."""
-        return cls(name, "parameter", unit, description, start, type(start))
+        return cls(name, "parameter", unit, description, start, type(start), min=min, max=max)
 
     @classmethod
-    def input(cls, name: str, start: float, unit: str = "1", description: str = "") -> Var:
+    def input(cls, name: str, start: float, unit: str = "1", description: str = "",
+              min: float = -math.inf, max: float = math.inf) -> Var:
         """A continuous Real input."""
-        return cls(name, "input", unit, description, float(start))
+        return cls(name, "input", unit, description, float(start), min=min, max=max)
+
+    def check(self, value: Any) -> None:
+        """ValueError naming this variable if a number is NaN, infinite or out of range."""
+        if self.kind is str:
+            return
+        kind = "input" if self.causality == "input" else "parameter"
+        if not math.isfinite(value):
+            raise ValueError(f"{kind} {self.name} = {value} is not finite")
+        if not self.min <= value <= self.max:
+            raise ValueError(f"{kind} {self.name} = {value} is outside its range "
+                             f"[{self.min:g}, {self.max:g}]")
 
     @classmethod
     def output(cls, name: str, unit: str = "1", description: str = "",
@@ -142,6 +160,8 @@ class ModelSlave(Fmi2Slave):
         self._real_inputs: dict[int, str] = {}                   # setReal's fast path
         for var in self.variables:
             self._register(var)
+        self._checked = [v for v in self.variables if v.causality != "output"]
+        self._checked_inputs = [v for v in self._checked if v.causality == "input"]
 
     def _register(self, var: Var) -> None:
         kind = _PYTHONFMU_TYPE[var.kind]
@@ -206,17 +226,28 @@ class ModelSlave(Fmi2Slave):
         return self._model
 
     # -- FMI call sequence -----------------------------------------------------
+    def _require_phase(self, call: str, *phases: str) -> None:
+        if self.phase not in phases:
+            raise ValueError(f"{call} is not allowed in phase '{self.phase}' (FMI 2.0 allows "
+                             f"it after {' or '.join(_AFTER[p] for p in phases)})")
+
     @_fmi_entry
     def enter_initialization_mode(self) -> None:
+        self._require_phase("fmi2EnterInitializationMode", "instantiated")
         self.phase = "initialization"
 
     @_fmi_entry
     def exit_initialization_mode(self) -> None:
+        self._require_phase("fmi2ExitInitializationMode", "initialization")
+        for var in self._checked:             # the declared ranges, then the model's own rules
+            if var.causality == "parameter":
+                var.check(getattr(self, var.name))
         self._model = self.build_model()      # ValueError names a bad parameter
         self.phase = "step"
 
     @_fmi_entry
     def terminate(self) -> None:
+        self._require_phase("fmi2Terminate", "step")
         self.phase = "terminated"
 
     @_fmi_entry
@@ -228,6 +259,8 @@ class ModelSlave(Fmi2Slave):
             return self._refuse(f"doStep at t = {current_time} with communication step "
                                 f"{step_size}: the step must be finite and at least 1 ns")
         try:
+            for var in self._checked_inputs:
+                var.check(getattr(self, var.name))
             # The time base of fmukit.timebase: whole nanoseconds, whatever the master.
             self.step_model(seconds(nanoseconds(current_time)), seconds(nanoseconds(step_size)))
         except ValueError as error:
@@ -323,7 +356,7 @@ class ModelSlave(Fmi2Slave):
     @_fmi_entry
     def setup_experiment(self, start_time: float, stop_time: float | None = None,
                          tolerance: float | None = None) -> None:
-        pass
+        self._require_phase("fmi2SetupExperiment", "instantiated")
 
     @_fmi_entry
     def get_real(self, vrs: list[int]) -> list[float]:
@@ -381,6 +414,13 @@ class ModelSlave(Fmi2Slave):
                 if var.start is not None:
                     real.set("start", repr(float(var.start)))   # shortest exact form
                 real.set("unit", var.unit)
+                for bound in ("min", "max"):
+                    if math.isfinite(getattr(var, bound)):
+                        real.set(bound, repr(float(getattr(var, bound))))
+            elif var.kind is int:
+                for bound in ("min", "max"):
+                    if math.isfinite(getattr(var, bound)):
+                        element.find("Integer").set(bound, str(int(getattr(var, bound))))
                 if var.unit in DISPLAY_UNIT:
                     real.set("displayUnit", DISPLAY_UNIT[var.unit])
         used = {v.unit for v in self.variables if v.is_real}

@@ -25,9 +25,11 @@ class ManoeuvreSlave(ModelSlave):
         Var.output("reversals", description="rudder reversals so far", kind=int,
                    depends=("psi", "psi_switch"),
                    get=lambda s: s.model.reversals_at(s.psi)),
-        Var.parameter("delta", math.radians(20.0), "rad", "rudder angle executed at t = 0"),
+        Var.parameter("delta", math.radians(20.0), "rad", "rudder angle executed at t = 0",
+                      0.0, math.pi / 2),
         Var.parameter("psi_switch", math.radians(20.0), "rad",
-                      "heading deviation that reverses the rudder; 0 holds it (turning circle)"),
+                      "heading deviation that reverses the rudder; 0 holds it (turning circle)",
+                      0.0, math.pi),
     )
 
     def build_model(self) -> RudderProgram:

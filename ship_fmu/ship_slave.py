@@ -4,12 +4,15 @@ Inputs are held over each communication step. No output depends on an input at
 the same instant (the rudder acts through the steering gear and the hull's
 inertia), so the model structure declares no direct feedthrough.
 """
+import math
 from dataclasses import fields
 
 from fmukit.slave import ModelSlave, Var
 from ship_fmu.vessel import N_PROPELLER, Vessel, VesselParameters
 
 _P = VesselParameters()
+N_MAX = 50.0
+"""Largest shaft speed an input may ask for, rev/s (8.13 gives 0.3 m/s)."""
 _SEA = ("Hs", "T0", "psi_w", "wave_seed", "wave_components", "psi0")
 
 
@@ -21,9 +24,9 @@ class ShipSlave(ModelSlave):
     variables = (
         Var.input("delta_c", 0.0, "rad", "commanded rudder angle, both rudders; "
                   "positive turns the ship to port"),
-        Var.input("n1", N_PROPELLER, "rev/s", "main propeller 1 shaft speed"),
-        Var.input("n2", N_PROPELLER, "rev/s", "main propeller 2 shaft speed"),
-        Var.input("n3", 0.0, "rev/s", "bow thruster shaft speed"),
+        Var.input("n1", N_PROPELLER, "rev/s", "main propeller 1 shaft speed", -N_MAX, N_MAX),
+        Var.input("n2", N_PROPELLER, "rev/s", "main propeller 2 shaft speed", -N_MAX, N_MAX),
+        Var.input("n3", 0.0, "rev/s", "bow thruster shaft speed", -N_MAX, N_MAX),
         Var.output("x", "m", "north position", depends=("x0",)),
         Var.output("y", "m", "east position", depends=("y0",)),
         Var.output("psi", "rad", "heading, continuous (not wrapped)", depends=("psi0",)),
@@ -37,20 +40,22 @@ class ShipSlave(ModelSlave):
         Var.parameter("x0", _P.x0, "m", "initial north position"),
         Var.parameter("y0", _P.y0, "m", "initial east position"),
         Var.parameter("psi0", _P.psi0, "rad", "initial heading"),
-        Var.parameter("u0", _P.u0, "m/s", "initial surge velocity"),
-        Var.parameter("v0", _P.v0, "m/s", "initial sway velocity"),
-        Var.parameter("r0", _P.r0, "rad/s", "initial yaw rate"),
-        Var.parameter("delta_max", _P.delta_max, "rad", "rudder stops, > 0"),
+        Var.parameter("u0", _P.u0, "m/s", "initial surge velocity", -5.0, 5.0),
+        Var.parameter("v0", _P.v0, "m/s", "initial sway velocity", -5.0, 5.0),
+        Var.parameter("r0", _P.r0, "rad/s", "initial yaw rate", -5.0, 5.0),
+        Var.parameter("delta_max", _P.delta_max, "rad", "rudder stops, > 0", 0.0, math.pi / 2),
         Var.parameter("delta_rate_max", _P.delta_rate_max, "rad/s",
-                      "steering gear rate limit, > 0"),
-        Var.parameter("Hs", _P.Hs, "m", "significant wave height; 0 = calm water"),
-        Var.parameter("T0", _P.T0, "s", "modal period of the wave spectrum, > 0"),
+                      "steering gear rate limit, > 0", 0.0, 10.0),
+        Var.parameter("Hs", _P.Hs, "m", "significant wave height; 0 = calm water (0.1 m is "
+                      "7 m at full scale)", 0.0, 0.1),
+        Var.parameter("T0", _P.T0, "s", "modal period of the wave spectrum", 0.1, 10.0),
         Var.parameter("psi_w", _P.psi_w, "rad", "wave direction"),
-        Var.parameter("wave_seed", _P.wave_seed, description="seed of the wave realisation"),
+        Var.parameter("wave_seed", _P.wave_seed, description="seed of the wave realisation",
+                      min=0, max=2**31 - 1),
         Var.parameter("wave_components", _P.wave_components,
-                      description="number of regular wave components, >= 1"),
+                      description="number of regular wave components", min=1, max=5000),
         Var.parameter("h_max", _P.h_max, "s", "largest RK4 step; a communication step is "
-                      "cut into equal sub-steps no longer than this"),
+                      "cut into equal sub-steps no longer than this", 1e-4, 1.0),
     )
 
     def build_model(self) -> Vessel:

@@ -106,10 +106,10 @@ def test_non_finite_inputs_are_refused_at_the_step_by_name(open_fmu, name, input
     ("guidance", "waypoints", "0,0;10,0;10,0", "consecutive"),
     ("guidance", "R_accept", 0.0, "> 0"),
     ("smc_autopilot", "omega_n", 0.0, "> 0"),
-    ("smc_autopilot", "zeta", -0.1, "> 0"),
+    ("smc_autopilot", "zeta", -0.1, "outside its range [0, 10]"),
     ("smc_autopilot", "phi_h", 0.0, "> 0"),
     ("smc_autopilot", "design_model", "eq46", "'paper'"),
-    ("smc_autopilot", "lambda1", 0.5, "< 0"),
+    ("smc_autopilot", "lambda1", 0.5, "outside its range [-1000, 0]"),
     ("pd_autopilot", "Kp", math.inf, "not finite"),
 ])
 def test_bad_parameters_are_refused_at_initialisation_by_name(open_fmu, name, parameter,
