@@ -26,3 +26,10 @@ class PDAutopilot:
     def command(self, psi: float, r: float, psi_d: float) -> float:
         """Commanded rudder angle delta_c, rad."""
         return self.Kp * wrap(psi - psi_d) + self.Kd * r
+
+    def snapshot(self) -> dict:
+        """The dynamic state: none, the law is memoryless."""
+        return {}
+
+    def restore(self, snapshot: dict) -> None:
+        """Nothing to restore."""

@@ -50,6 +50,7 @@ H_MAX = 0.1
 """Largest RK4 step of the reference model, s (shorter for a faster reference model)."""
 
 EQUIVALENT_CONTROLS = ("paper", "tracking")
+MAX_SUBSTEPS = 100_000
 
 
 @dataclass(frozen=True)
@@ -140,6 +141,9 @@ class SlidingModeAutopilot:
         """Advance the reference model from t to t + h with psi_d held (RK4)."""
         require_finite(psi_d=psi_d)
         n = max(1, math.ceil(h / self._h_max - 1e-9))
+        if n > MAX_SUBSTEPS:
+            raise ValueError(f"a communication step of {h} s needs {n} RK4 steps of the "
+                             f"reference model; at most {MAX_SUBSTEPS} are taken per step")
         hs = h / n
         psi_z, r_z = self.psi_z, self.r_z
         for _ in range(n):

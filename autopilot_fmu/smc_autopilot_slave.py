@@ -51,8 +51,11 @@ class SMCAutopilotSlave(ModelSlave):
         design = SlidingModeDesign.from_model(design_model(self.design_model, self.u0),
                                               self.lambda1, self.lambda2)
         return SlidingModeAutopilot(design, self.eta_h, self.phi_h, self.omega_n, self.zeta,
-                                    psi_z=self.psi, r_z=self.r,
                                     equivalent_control=self.equivalent_control)
+
+    def start_model(self, model: SlidingModeAutopilot) -> None:
+        require_finite(psi=self.psi, r=self.r)
+        model.psi_z, model.r_z = self.psi, self.r
 
     def step_model(self, t: float, h: float) -> None:
         require_finite(psi=self.psi, r=self.r, psi_d=self.psi_d)

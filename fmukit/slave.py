@@ -48,7 +48,7 @@ from pythonfmu import Integer, Real, String
 from pythonfmu import __version__ as PYTHONFMU_VERSION
 from pythonfmu.enums import Fmi2Status
 
-from .timebase import nanoseconds, seconds
+from .timebase import MAX_TIME, nanoseconds, seconds
 from .units import DISPLAY_UNIT, unit_definitions
 
 _PYTHONFMU_TYPE = {float: Real, int: Integer, str: String}
@@ -201,6 +201,18 @@ class ModelSlave(Fmi2Slave):
         """Advance the model from t to t + h with the current inputs."""
         raise NotImplementedError
 
+    def start_model(self, model: Any) -> None:
+        """Set a model's initial state from the inputs seen at initialisation (default: none).
+
+        Kept apart from build_model, which depends on parameters only: restoring a saved
+        state rebuilds the model, and must not depend on the inputs of the moment.
+        """
+
+    def _started_model(self) -> Any:
+        model = self.build_model()
+        self.start_model(model)
+        return model
+
     def _output(self, get: Callable[[Any], Any], undefined: Any) -> Any:
         """An output's value, or NaN (0 if Integer) when it cannot be evaluated.
 
@@ -213,16 +225,16 @@ class ModelSlave(Fmi2Slave):
         """
         try:
             if self._model is None:
-                self._model = self.build_model()
+                self._model = self._started_model()
             return get(self)
-        except ValueError:
+        except (ValueError, ArithmeticError):
             return undefined
 
     @property
     def model(self) -> Any:
         """The model; before initialisation, built from the parameters as they are."""
         if self._model is None:
-            self._model = self.build_model()
+            self._model = self._started_model()
         return self._model
 
     # -- FMI call sequence -----------------------------------------------------
@@ -242,7 +254,7 @@ class ModelSlave(Fmi2Slave):
         for var in self._checked:             # the declared ranges, then the model's own rules
             if var.causality == "parameter":
                 var.check(getattr(self, var.name))
-        self._model = self.build_model()      # ValueError names a bad parameter
+        self._model = self._started_model()   # ValueError names a bad parameter or input
         self.phase = "step"
 
     @_fmi_entry
@@ -255,9 +267,10 @@ class ModelSlave(Fmi2Slave):
         if self.phase != "step":
             return self._refuse(f"doStep called in phase '{self.phase}': "
                                 "call exitInitializationMode first, and not after terminate")
-        if not (step_size >= 1e-9 and math.isfinite(step_size) and math.isfinite(current_time)):
+        if not (1e-9 <= step_size <= MAX_TIME and abs(current_time) <= MAX_TIME):
             return self._refuse(f"doStep at t = {current_time} with communication step "
-                                f"{step_size}: the step must be finite and at least 1 ns")
+                                f"{step_size}: the step must be at least 1 ns, and both within "
+                                f"+-{MAX_TIME:g} s")
         try:
             for var in self._checked_inputs:
                 var.check(getattr(self, var.name))
@@ -339,7 +352,8 @@ class ModelSlave(Fmi2Slave):
         self.phase = state["phase"]
         self._model = None
         if state["model"] is not None:
-            self.model.restore(state["model"])
+            self._model = self.build_model()
+            self._model.restore(state["model"])
 
     @staticmethod
     def _fmu_state_from_bytes(state: bytes) -> dict[str, Any]:

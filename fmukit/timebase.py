@@ -9,6 +9,8 @@ the master computes t_k = (t_0 + k h) in integer nanoseconds: any two masters th
 agree on the time to within half a nanosecond drive the FMUs bit for bit alike.
 """
 NANOSECONDS = 1_000_000_000
+MAX_TIME = 1e15
+"""Largest |t| an FMU accepts, s: 30 million years, and far from overflow in nanoseconds."""
 
 
 def nanoseconds(t: float) -> int:

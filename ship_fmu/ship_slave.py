@@ -55,7 +55,8 @@ class ShipSlave(ModelSlave):
         Var.parameter("wave_components", _P.wave_components,
                       description="number of regular wave components", min=1, max=5000),
         Var.parameter("h_max", _P.h_max, "s", "largest RK4 step; a communication step is "
-                      "cut into equal sub-steps no longer than this", 1e-4, 1.0),
+                      "cut into equal sub-steps no longer than this (RK4 diverges in "
+                      "the steepest valid seas beyond about 0.4 s)", 1e-4, 0.2),
     )
 
     def build_model(self) -> Vessel:

@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields
 
-from .data import Actuators, Hull
+from .data import G, Actuators, Hull
 from .hull import coriolis_forces, damping_forces, kinematics, mass_matrix
 from .steering_gear import DELTA_MAX, DELTA_RATE_MAX, rudder_angle
 from .thrusters import actuator_model
@@ -23,6 +23,12 @@ from .waves import WaveComponents, WaveLoads
 
 State = tuple[float, float, float, float, float, float, float]
 """(x, y, psi, u, v, r, xi): what RK4 integrates."""
+
+MAX_STEEPNESS = 7.0
+"""Waves break beyond Hs / lambda_p = 1/7."""
+
+MAX_SUBSTEPS = 100_000
+"""Most RK4 steps one communication step may take: a longer one is refused, not hung on."""
 
 N_PROPELLER = 8.13
 """Main propeller speed of the paper's runs, rev/s: 0.3 m/s in calm water."""
@@ -63,6 +69,13 @@ class VesselParameters:
         ):
             if not ok:
                 raise ValueError(f"parameter {name} must be {rule}, got {getattr(self, name)}")
+        # Waves steeper than Hs / lambda_p = 1/7 break (Stokes' limit); the block model's
+        # loads, which grow with the slope, are meaningless there and diverge.
+        peak_wavelength = G * self.T0 * self.T0 / (2.0 * math.pi)
+        if self.Hs > peak_wavelength / MAX_STEEPNESS:
+            raise ValueError(f"parameter Hs = {self.Hs} m with T0 = {self.T0} s: steepness "
+                             f"Hs / lambda_p = {self.Hs / peak_wavelength:.3g} exceeds 1/"
+                             f"{MAX_STEEPNESS:g}, steeper than waves can be")
 
 
 class Vessel:
@@ -124,6 +137,9 @@ class Vessel:
                     raise ValueError(f"input {name} = {value} is not finite")
         p = self.params
         n_sub = max(1, math.ceil(h / p.h_max - 1e-9))
+        if n_sub > MAX_SUBSTEPS:
+            raise ValueError(f"a communication step of {h} s needs {n_sub} RK4 steps of at most "
+                             f"h_max = {p.h_max} s; at most {MAX_SUBSTEPS} are taken per step")
         hs = h / n_sub
         hh, c = 0.5 * hs, hs / 6.0
         delta0 = self.delta

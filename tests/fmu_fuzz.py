@@ -1,0 +1,314 @@
+"""Property-based fuzzing of one FMU through fmpy: random call sequences and values.
+
+    python tests/fmu_fuzz.py ship --examples 2000       # prints counts as JSON
+    python tests/fmu_fuzz.py --all --examples 10000     # the long run (docs/robustness.md)
+
+Each example is a random program of FMI calls on a fresh instance: setupExperiment,
+enter/exitInitializationMode, terminate, reset, set (any variable, any value: in
+range, out of range, extreme, NaN, infinite, of the wrong type), doStep (any step
+size, including 0, negative, non-finite and huge, at any time), get, and a
+get/serialize/deserialize/set state round trip. A reference model of the FMI 2.0
+call sequence and of the declared variable ranges predicts which calls must be
+refused; the FMU must then return discard or fatal with a log message that names
+the cause, must accept every call that is valid, and must give finite outputs
+after every accepted step. Crashes and hangs are caught by the caller
+(tests/test_fuzz.py runs this in a child process with a time limit).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import time
+from collections import Counter
+from pathlib import Path
+
+from fmpy import extract, read_model_description
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from cosim.fmu import FmuCallError, FmuInstance  # noqa: E402
+from fmukit.timebase import MAX_TIME  # noqa: E402
+
+FMUS = ["ship", "pd_autopilot", "smc_autopilot", "guidance", "manoeuvre"]
+STEP_SIZES = [0.1, 0.1, 0.1, 0.05, 0.25, 1.0, 7.3, 1e-9, 0.0, -0.1, math.nan, math.inf, 1e-12,
+              2e4, 1e9]
+EXTREMES = [0.0, -0.0, 1e-300, -1e-300, 1e300, -1e300, 1.7976931348623157e308, math.pi, 1e6]
+
+
+class Expectation:
+    """What a correct FMU does: the FMI 2.0 phase machine and the declared ranges."""
+
+    def __init__(self, md):
+        self.vars = {v.name: v for v in md.modelVariables}
+        self.reset()
+
+    def reset(self) -> None:
+        self.phase = "instantiated"
+        self.values = {n: _start(v) for n, v in self.vars.items() if v.causality != "output"}
+        self.defaults = True
+
+    def valid(self, name: str) -> bool:
+        v, value = self.vars[name], self.values[name]
+        if v.type == "String":
+            return True
+        if not math.isfinite(value):
+            return False
+        low = float(v.min) if v.min is not None else -math.inf
+        high = float(v.max) if v.max is not None else math.inf
+        return low <= value <= high
+
+
+def _start(v):
+    if v.start is None:
+        return None
+    if v.type == "Real":
+        return float(v.start)
+    if v.type == "Integer":
+        return int(v.start)
+    return v.start
+
+
+def values_for(v) -> st.SearchStrategy:
+    """Any value a master might send to variable v, valid or not, of its type or not."""
+    if v.type == "String":
+        return st.one_of(st.text(max_size=40), st.just(v.start),
+                         st.just("0,0;10,0;10,10"), st.just("1,1"), st.just("0,0;0,0"))
+    if v.type == "Integer":
+        return st.one_of(st.integers(-2**31, 2**31 - 1), st.integers(-3, 60))
+    low = float(v.min) if v.min is not None else -1e6
+    high = float(v.max) if v.max is not None else 1e6
+    return st.one_of(st.floats(low, high), st.floats(low, high), st.floats(),
+                     st.sampled_from(EXTREMES + [math.nan, math.inf, -math.inf]),
+                     st.just(float(v.start) if v.start is not None else 0.0))
+
+
+def in_range(v) -> st.SearchStrategy:
+    """A valid value of a Real input: within its declared range."""
+    low = float(v.min) if v.min is not None else -1e6
+    high = float(v.max) if v.max is not None else 1e6
+    return st.floats(low, high)
+
+
+def programs(md) -> st.SearchStrategy:
+    variables = [v for v in md.modelVariables]
+    inputs = [v for v in variables if v.causality == "input"]
+    sets = st.one_of(*[st.tuples(st.just("set"), st.just(v.name), values_for(v))
+                       for v in variables])
+    wrong_type = st.tuples(st.just("set_wrong_type"), st.sampled_from([v.name for v in variables]))
+    steps = st.tuples(st.just("step"), st.sampled_from(STEP_SIZES),
+                      st.sampled_from(["clock", "clock", "clock", "zero", "huge", "negative"]))
+    calls = st.sampled_from([("setup",), ("enter",), ("exit",), ("terminate",), ("reset",),
+                             ("get",), ("state",)])
+    anything = st.lists(st.one_of(sets, wrong_type, steps, calls), max_size=25)
+    input_sets = (st.one_of(*[st.tuples(st.just("set"), st.just(v.name), values_for(v))
+                              for v in inputs]) if inputs else st.nothing())
+    valid_input_sets = (st.one_of(*[st.tuples(st.just("set"), st.just(v.name), in_range(v))
+                                    for v in inputs]) if inputs else st.nothing())
+    # Mostly a well-formed run with random values, sometimes random calls after it.
+    valid_steps = st.tuples(st.just("step"), st.sampled_from([0.1, 0.1, 0.05, 0.3, 2.0]),
+                            st.just("clock"))
+    running = st.lists(st.one_of(valid_input_sets, valid_input_sets, input_sets, valid_steps,
+                                 valid_steps, steps, st.just(("get",)), st.just(("state",))),
+                       max_size=40)
+    parameters = st.lists(st.one_of(*[st.tuples(st.just("set"), st.just(v.name), values_for(v))
+                                      for v in variables if v.causality == "parameter"]),
+                          max_size=3)
+    well_formed = st.builds(lambda p, r, a: [("setup",), ("enter",), *p, ("exit",), *r, *a],
+                            parameters, running, anything)
+    return st.one_of(well_formed, well_formed, anything)
+
+
+def run_program(fmu: FmuInstance, expected: Expectation, program: list, counts: Counter) -> None:
+    clock = 0.0
+    for op in program:
+        kind = op[0]
+        counts["calls"] += 1
+        must, names = _predict(op, expected, fmu, clock)
+        try:
+            _execute(op, fmu, clock)
+            status, messages = "ok", []
+        except FmuCallError as error:
+            status, messages = error.status, error.messages
+        counts[f"{kind} {status}"] += 1
+        where = f"{op!r} in phase {expected.phase}"
+        if status == "ok":
+            assert must != "refuse", f"accepted an invalid call: {where}"
+        else:
+            assert must != "accept", f"refused a valid call: {where}: {messages}"
+            assert status in ("discard", "error", "fatal"), where
+            text = " ".join(messages)
+            assert messages and any(n in text for n in names), \
+                f"refusal does not name {names}: {where}: {messages}"
+        _advance(op, status, expected, fmu)
+        if kind == "step" and status == "ok":
+            clock = _clock(op, clock) + op[1]
+            outputs = [v.name for v in fmu.description.modelVariables
+                       if v.causality == "output" and v.type == "Real"]
+            values = fmu.get(outputs)
+            bad = {n: x for n, x in values.items() if not math.isfinite(x)}
+            assert not bad, f"non-finite outputs after an accepted {where}: {bad}"
+            counts["valid steps"] += 1
+
+
+def _clock(op, clock: float) -> float:
+    return {"clock": clock, "zero": 0.0, "huge": 2 * MAX_TIME, "negative": -5.0}[op[2]]
+
+
+def _predict(op, e: Expectation, fmu: FmuInstance, clock: float) -> tuple[str, list[str]]:
+    """('accept' | 'refuse' | 'either', words one of which a refusal must contain)."""
+    kind = op[0]
+    phase_words = ["not allowed in phase"]
+    if kind in ("setup", "enter"):
+        return ("accept" if e.phase == "instantiated" else "refuse"), phase_words
+    if kind == "exit":
+        if e.phase != "initialization":
+            return "refuse", phase_words
+        params = [n for n, v in e.vars.items() if v.causality == "parameter"]
+        if any(not e.valid(n) for n in params):
+            return "refuse", ["parameter"]
+        return ("accept" if e.defaults else "either"), ["parameter"]
+    if kind == "terminate":
+        return ("accept" if e.phase == "step" else "refuse"), phase_words
+    if kind in ("reset", "get"):
+        return "accept", []
+    if kind == "state":
+        return "accept", []
+    if kind == "set_wrong_type":
+        return "refuse", [op[1], "type"]
+    if kind == "set":
+        v = e.vars[op[1]]
+        if v.causality == "output":
+            return "refuse", [op[1]]
+        if e.phase == "terminated" or (v.causality == "parameter" and e.phase == "step"):
+            return "refuse", [op[1]]
+        return "accept", []
+    if kind == "step":
+        h, t = op[1], _clock(op, clock)
+        if e.phase != "step":
+            return "refuse", ["phase"]
+        if not (1e-9 <= h <= MAX_TIME and abs(t) <= MAX_TIME):
+            return "refuse", ["communication step"]
+        bad = [n for n, v in e.vars.items() if v.causality == "input" and not e.valid(n)]
+        if bad:
+            return "refuse", bad
+        if math.ceil(h / _largest_internal_step(e) - 1e-9) > 100_000:
+            return "refuse", ["RK4 steps"]
+        return "accept", []
+    raise AssertionError(op)
+
+
+def _largest_internal_step(e: Expectation) -> float:
+    """The FMU's largest integration step: h_max (ship), the reference model's (SMC)."""
+    if "h_max" in e.values:
+        return e.values["h_max"]
+    if "omega_n" in e.values:
+        w, z = e.values["omega_n"], e.values["zeta"]
+        return min(0.1, 1.0 / (w * (z + math.sqrt(max(z * z - 1.0, 0.0)))))
+    return math.inf
+
+
+def _execute(op, fmu: FmuInstance, clock: float) -> None:
+    kind, slave = op[0], fmu.slave
+    if kind == "setup":
+        fmu.call("setupExperiment", slave.setupExperiment, startTime=0.0)
+    elif kind == "enter":
+        fmu.call("enterInitializationMode", slave.enterInitializationMode)
+    elif kind == "exit":
+        fmu.call("exitInitializationMode", slave.exitInitializationMode)
+    elif kind == "terminate":
+        fmu.call("terminate", slave.terminate)
+    elif kind == "reset":
+        fmu.reset()
+    elif kind == "get":
+        fmu.get([v.name for v in fmu.description.modelVariables])
+    elif kind == "set":
+        fmu.set({op[1]: op[2]})
+    elif kind == "set_wrong_type":
+        v = fmu.variable(op[1])
+        setter, value = ((slave.setInteger, 1) if v.type == "Real" else (slave.setReal, 1.0))
+        fmu.call(f"set {op[1]} with the wrong type", setter, [v.valueReference], [value])
+    elif kind == "step":
+        fmu.do_step(_clock(op, clock), op[1])
+    elif kind == "state":
+        names = [v.name for v in fmu.description.modelVariables]
+        before = fmu.get(names)
+        state = fmu.call("getFMUstate", slave.getFMUstate)
+        data = fmu.call("serializeFMUstate", slave.serializeFMUstate, state)
+        again = fmu.call("deSerializeFMUstate", slave.deSerializeFMUstate, data)
+        fmu.call("setFMUstate", slave.setFMUstate, again)
+        assert fmu.call("serializeFMUstate", slave.serializeFMUstate, again) == data
+        after = fmu.get(names)
+        same = all(a == b or (a != a and b != b) for a, b in zip(before.values(), after.values()))
+        assert same, f"state round trip changed values: {before} -> {after}"
+        fmu.call("freeFMUstate", slave.freeFMUstate, state)
+        fmu.call("freeFMUstate", slave.freeFMUstate, again)
+
+
+def _advance(op, status: str, e: Expectation, fmu: FmuInstance) -> None:
+    kind = op[0]
+    if status != "ok":
+        return
+    if kind == "enter":
+        e.phase = "initialization"
+    elif kind == "exit":
+        e.phase = "step"
+    elif kind == "terminate":
+        e.phase = "terminated"
+    elif kind == "reset":
+        e.reset()
+    elif kind == "set":
+        v = e.vars[op[1]]
+        e.values[op[1]] = _convert(v, op[2])
+        if v.causality == "parameter" and e.values[op[1]] != _start(v):
+            e.defaults = False
+
+
+def _convert(v, value):
+    if v.type == "Integer":
+        return int(value)
+    if v.type == "String":
+        return str(value)
+    return float(value)
+
+
+def fuzz(name: str, examples: int, seed: int | None = None) -> dict:
+    fmu_path = ROOT / "fmus" / f"{name}.fmu"
+    md = read_model_description(str(fmu_path))
+    unzipped = extract(str(fmu_path))
+    counts: Counter = Counter()
+
+    @settings(max_examples=examples, deadline=None, database=None, derandomize=seed is None,
+              suppress_health_check=list(HealthCheck))
+    @given(programs(md))
+    def check(program):
+        counts["examples"] += 1
+        fmu = FmuInstance(fmu_path, name, unzip_dir=unzipped)
+        try:
+            run_program(fmu, Expectation(md), program, counts)
+        finally:
+            fmu.free()
+
+    started = time.perf_counter()
+    check()
+    return {"fmu": name, "seconds": round(time.perf_counter() - started, 1),
+            **dict(sorted(counts.items()))}
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("names", nargs="*", choices=[[], *FMUS], metavar="FMU")
+    parser.add_argument("--all", action="store_true")
+    parser.add_argument("--examples", type=int, default=2000)
+    args = parser.parse_args(argv)
+    for name in (FMUS if args.all or not args.names else args.names):
+        print(json.dumps(fuzz(name, args.examples)), flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
