@@ -4,8 +4,9 @@ Engines: ``libcosim`` (OSP, through libcosimpy), ``ecos`` (through ecospy) and
 ``fmpy`` (fmpy's own SSP runner). Each returns the signals it recorded with the
 time each value belongs to:
 
-- libcosim and ecos: t_k = k h for k = 0 .. N, read after every step (their
-  coupling is Jacobi: every FMU steps on the previous step's outputs);
+- ecos: t_k = k h for k = 0 .. N, read after every step (its coupling is Jacobi:
+  every FMU steps on the previous step's outputs); libcosim likewise, but from t_1,
+  because it initialises the FMUs at its first step and has nothing to observe before;
 - fmpy's runner records after each step but labels the row with the time the step
   started, so its values belong to t_1, t_2, ...; and it accumulates time as a
   float, stepping while the sum is below the stop time. Where the sum falls short
@@ -78,12 +79,12 @@ def _libcosim(ssp: Path, signals: tuple[str, ...]) -> dict[str, np.ndarray]:
     def sample() -> list[float]:
         return [observer.last_real_values(index, [vr])[0] for index, vr in reads]
 
-    rows = [sample()]
+    rows = []
     for k in range(n_steps):
         if not execution.step():
             raise EngineError(f"libcosim failed at step {k + 1}")
         rows.append(sample())
-    times = system.start_time + system.step_size * np.arange(n_steps + 1)
+    times = system.start_time + system.step_size * np.arange(1, n_steps + 1)
     return {"time": times, **dict(zip(signals, np.array(rows).T))}
 
 

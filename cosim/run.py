@@ -75,11 +75,19 @@ class _Progress:
             self.bar.close()
 
 
+def scenario_path(scenario: str) -> Path:
+    """A scenario's .ssd: a name in cosim/scenarios, or a path to a .ssd file."""
+    if scenario.endswith(".ssd"):
+        return Path(scenario)
+    return SCENARIO_DIR / f"{scenario}.ssd"
+
+
 def run_scenario(name: str, out: Path, overrides: dict, coupling: str, stop_time: float | None,
                  lam: float, plot: bool = True, backend: str = "fmi",
                  stream: bool = False) -> tuple[int, object]:
     """Simulate one scenario, write its CSV and figure, print its report."""
-    system = read_ssd(SCENARIO_DIR / f"{name}.ssd")
+    system = read_ssd(scenario_path(name))
+    name = Path(name).stem
     master = Master(system, coupling=coupling, overrides=overrides, backend=backend)
     progress = _Progress(name)
     csv_path = out / f"{name}.csv"
@@ -116,7 +124,8 @@ def main(argv: list[str] | None = None) -> int:
         prog="python -m cosim.run", description=__doc__.split("\n\n")[0],
         epilog="\n\n".join(__doc__.split("\n\n")[1:]),
         formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("scenario", nargs="?", help=f"one of: {', '.join(scenarios())}")
+    parser.add_argument("scenario", nargs="?",
+                        help=f"one of: {', '.join(scenarios())}; or a path to a .ssd file")
     parser.add_argument("--all", action="store_true",
                         help="run the paper's four scenarios and print Tables 1-2 beside the "
                              "paper's")
@@ -146,7 +155,10 @@ def main(argv: list[str] | None = None) -> int:
         parser.error("give one SCENARIO or --all")
     names = PAPER_SCENARIOS if args.all else [args.scenario]
     for name in names:
-        if name not in scenarios():
+        if name.endswith(".ssd"):
+            if not Path(name).is_file():
+                parser.error(f"no system structure file {name}")
+        elif name not in scenarios():
             parser.error(f"unknown scenario {name!r}; valid scenarios: {', '.join(scenarios())}")
     overrides: dict[str, dict] = {}
     for component, variable, value in args.set:
@@ -154,7 +166,7 @@ def main(argv: list[str] | None = None) -> int:
 
     status, costs = 0, {}
     for name in names:
-        out = args.out or Path("results") / name
+        out = args.out or Path("results") / Path(name).stem
         if args.all and args.out:
             out = args.out / name
         writable_folder(out)

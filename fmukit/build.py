@@ -34,21 +34,27 @@ RUNTIME_REQUIREMENTS = "numpy\n"
 
 
 def build(name: str, dest: Path = FMU_DIR) -> Path:
-    """Build one FMU to dest/name.fmu, validate it, and return its path."""
+    """Build one FMU of this project to dest/name.fmu, validate it, and return its path."""
+    script, packages = FMUS[name]
+    return build_script(ROOT / script, packages, dest / f"{name}.fmu")
+
+
+def build_script(script: Path, packages: tuple[str, ...], fmu_path: Path) -> Path:
+    """Build the slave in ``script`` with this project's ``packages`` into ``fmu_path``."""
     from fmpy.validation import validate_fmu
     from pythonfmu import FmuBuilder
 
-    script, packages = FMUS[name]
+    name, dest = fmu_path.stem, fmu_path.parent
     dest.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix=f"build_{name}_") as tmp:
         stage = Path(tmp)
-        shutil.copy2(ROOT / script, stage)
+        shutil.copy2(script, stage)
         for package in packages:
             shutil.copytree(ROOT / package, stage / package,
                             ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
         (stage / "requirements.txt").write_text(RUNTIME_REQUIREMENTS)
         fmu = FmuBuilder.build_FMU(
-            stage / Path(script).name, dest=dest / f"{name}.fmu",
+            stage / Path(script).name, dest=fmu_path,
             project_files=[stage / p for p in packages] + [stage / "requirements.txt"],
             canGetAndSetFMUstate=True, canSerializeFMUstate=True)
     problems = validate_fmu(str(fmu))
