@@ -79,9 +79,12 @@ class WaveComponents:
         return cls(omega=omega, k=omega ** 2 / G,
                    amplitude=np.sqrt(2.0 * m0_bins), phase=phase)
 
-    def phases(self, t: float, xi: float) -> np.ndarray:
-        """theta_i(t) = omega_i t - k_i xi + phi_i."""
-        return self.omega * t - self.k * xi + self.phase
+    def phases(self, t: float, xi: float, out: np.ndarray | None = None,
+               work: np.ndarray | None = None) -> np.ndarray:
+        """theta_i(t) = omega_i t - k_i xi + phi_i (into ``out``, with ``work``, if given)."""
+        out = np.multiply(self.omega, t, out=out)
+        np.subtract(out, np.multiply(self.k, xi, out=work), out=out)
+        return np.add(out, self.phase, out=out)
 
     def elevation(self, t: float, xi: float) -> float:
         """Wave elevation at the ship, m."""
@@ -112,11 +115,7 @@ class WaveLoads:
         key, loads = self._last
         if key == (t, xi, psi):
             return loads
-        w, s = self.components, self._s
-        np.multiply(w.omega, t, out=s)                  # theta = omega t - k xi + phi
-        np.multiply(w.k, xi, out=self._kxi)
-        np.subtract(s, self._kxi, out=s)
-        np.add(s, w.phase, out=s)
+        s = self.components.phases(t, xi, out=self._s, work=self._kxi)
         np.sin(s, out=s)
         np.multiply(self._slope_amplitude, s, out=s)    # s_i = A_i k_i sin(theta_i)
         beta = self.psi_w - psi
