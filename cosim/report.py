@@ -6,7 +6,7 @@ scenario's name.
 The weight lambda of eq (19): the paper only says it brings the heading and rudder
 terms to the same level (its Table 1 has psi_E ~ delta_E). It is calibrated once,
 on calm_pd, so that psi_E = lambda * sum(delta^2) there, and held fixed for every
-other run; ``tests/test_cosim_run.py`` recomputes it and fails if the model no
+other run; ``tests/test_cosim.py`` recomputes it and fails if the model no
 longer gives this value (recalibrate by setting it to psi_E / sum(delta^2) of calm_pd).
 """
 from __future__ import annotations

@@ -1,15 +1,19 @@
 """A thin, declarative layer over pythonfmu's Fmi2Slave.
 
 An FMU class lists its variables once, as ``Var`` entries with unit, causality,
-start value and, for outputs, the variables they depend on. From that list this
-base class
+start value, valid range and, for outputs, the variables they depend on. From
+that list this base class
 
 - registers the variables with pythonfmu (parameters and inputs live as
   attributes of the slave, outputs are read from its model);
 - writes a complete modelDescription.xml: unit definitions with degree display
-  units, ``initial="calculated"`` outputs, output ``dependencies`` (so masters
-  see which outputs are not direct feedthrough) and ``InitialUnknowns``;
+  units, ``min``/``max``, ``initial="calculated"`` outputs, output
+  ``dependencies`` (so masters see which outputs are not direct feedthrough) and
+  ``InitialUnknowns``;
 - follows the FMI 2.0 call sequence and refuses what breaks it;
+- checks every parameter (at exitInitializationMode) and input (at each doStep)
+  against its range, and rounds the time it is given to whole nanoseconds
+  (``fmukit.timebase``);
 - saves and restores the whole state (fmi2Get/SetFMUstate, serialisable).
 
 Errors. pythonfmu 0.7 turns every Python exception into fmi2Fatal, and a False
@@ -19,16 +23,20 @@ use-after-free that crashes the host later. Every FMI entry point here therefore
 passes through ``_fmi_entry``, which takes one extra reference on those three
 objects before an exception leaves Python, so the host survives. With that:
 
-- invalid parameters: the model raises ValueError at exitInitializationMode,
-  reported as fmi2Fatal with the message naming the parameter;
+- invalid parameters: the range check or the model raises ValueError at
+  exitInitializationMode, reported as fmi2Fatal with the message naming the
+  parameter;
 - invalid inputs, step sizes, or doStep out of sequence: the step is refused with
   fmi2Discard and an error log naming the cause; the state is left as it was,
   so a master may correct the input and retry;
-- setting an output, or a fixed parameter after initialisation: fmi2Fatal with
-  a message naming the variable; the value is not applied.
+- other calls out of sequence, setting an output, or a fixed parameter after
+  initialisation: fmi2Fatal with a message naming the call or variable; nothing
+  is applied;
+- reading an output never fails: what cannot be evaluated reads NaN.
 
-The subclass supplies ``build_model`` (a model object from the parameter
-attributes) and ``step_model``; the model supplies ``snapshot``/``restore``.
+The subclass supplies ``build_model`` (a model from the parameter attributes
+alone), ``step_model`` and, if the initial state depends on inputs,
+``start_model``; the model supplies ``snapshot``/``restore``.
 """
 from __future__ import annotations
 
