@@ -431,20 +431,19 @@ class ModelSlave(Fmi2Slave):
         root = super().to_xml(model_options)
         index = {v.name: i + 1 for i, v in enumerate(self.variables)}
         for element, var in zip(root.find("ModelVariables"), self.variables):
+            if var.kind is str:
+                continue
+            typed = element.find("Real" if var.is_real else "Integer")
             if var.is_real:
-                real = element.find("Real")
                 if var.start is not None:
-                    real.set("start", repr(float(var.start)))   # shortest exact form
-                real.set("unit", var.unit)
-                for bound in ("min", "max"):
-                    if math.isfinite(getattr(var, bound)):
-                        real.set(bound, repr(float(getattr(var, bound))))
-            elif var.kind is int:
-                for bound in ("min", "max"):
-                    if math.isfinite(getattr(var, bound)):
-                        element.find("Integer").set(bound, str(int(getattr(var, bound))))
+                    typed.set("start", repr(float(var.start)))   # shortest exact form
+                typed.set("unit", var.unit)
                 if var.unit in DISPLAY_UNIT:
-                    real.set("displayUnit", DISPLAY_UNIT[var.unit])
+                    typed.set("displayUnit", DISPLAY_UNIT[var.unit])
+            for bound in ("min", "max"):
+                value = getattr(var, bound)
+                if math.isfinite(value):
+                    typed.set(bound, repr(var.kind(value)))
         used = {v.unit for v in self.variables if v.is_real}
         root.insert(list(root).index(root.find("CoSimulation")) + 1, unit_definitions(used))
 

@@ -38,6 +38,7 @@ def test_model_description_validates_with_units_and_dependencies(fmu_paths):
     for v in md.modelVariables:
         if v.type == "Real":
             assert v.unit in units, v.name
+            assert v.displayUnit == {"rad": "deg", "rad/s": "deg/s"}.get(v.unit), v.name
     assert {o.variable.name for o in md.outputs} == set(OUTPUTS)
     assert all(o.dependencies == [] for o in md.outputs), "no direct feedthrough"
     assert md.coSimulation.canGetAndSetFMUstate and md.coSimulation.canSerializeFMUstate
