@@ -53,9 +53,10 @@ class Recording:
     columns: list[str]
     time: np.ndarray
     data: np.ndarray
-    rows: int = 0                       # complete rows
+    rows: int = 0                       # complete rows held in memory
     error: str | None = None            # why the run stopped early, if it did
     meta: dict[str, Any] = field(default_factory=dict)
+    path: Path | None = None            # where the rows went, if streamed to CSV
 
     def __getitem__(self, column: str) -> np.ndarray:
         return self.data[:self.rows, self.columns.index(column)]
@@ -64,7 +65,10 @@ class Recording:
     def t(self) -> np.ndarray:
         return self.time[:self.rows]
 
-    path: Path | None = None            # where the rows went, if streamed to CSV
+    @property
+    def recorded(self) -> int:
+        """Rows the run recorded: held in memory, or written to ``path`` if streamed."""
+        return self.meta.get("rows_written", self.rows)
 
     def write_csv(self, path) -> None:
         """All complete rows, a header of column names; floats in their shortest exact form."""

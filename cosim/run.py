@@ -100,15 +100,15 @@ def run_scenario(name: str, out: Path, overrides: dict, coupling: str, stop_time
     if not stream:
         recording.write_csv(csv_path)
     print(f"{name}: {system.description}")
-    if stream and not recording.error:
-        print(f"  {recording.meta['rows_written']} rows streamed to {csv_path} "
-              "(no report or figure in --stream mode)")
-        return 0, None
     if recording.error:
         print(f"error: {recording.error}", file=sys.stderr)
-        print(f"  the {recording.rows} rows recorded before the error are in {csv_path}",
+        print(f"  the {recording.recorded} rows recorded before the error are in {csv_path}",
               file=sys.stderr)
         return 1, None
+    if stream:
+        print(f"  {recording.recorded} rows streamed to {csv_path} "
+              "(no report or figure in --stream mode)")
+        return 0, None
     for line in REPORTS[system.report](recording, lam=lam, parameters=master.parameters):
         print(f"  {line}")
     written = [csv_path]

@@ -211,8 +211,9 @@ def test_unwritable_output_folder_is_refused_before_simulating(tmp_path, monkeyp
         cli.main(["calm_pd", "--out", str(blocker / "results")])
 
 
+@pytest.mark.parametrize("stream", [[], ["--stream"]])
 def test_fmu_error_mid_run_names_fmu_call_and_time_and_keeps_the_rows(tmp_path, monkeypatch,
-                                                                      capsys):
+                                                                      capsys, stream):
     from ship_fmu.vessel import Vessel
     step = Vessel.step
 
@@ -221,10 +222,11 @@ def test_fmu_error_mid_run_names_fmu_call_and_time_and_keeps_the_rows(tmp_path, 
             raise ValueError("injected fault")
         return step(self, t, h, delta_c, *args)
     monkeypatch.setattr(Vessel, "step", failing_step)
-    code = cli.main(["calm_pd", "--out", str(tmp_path), "--backend", "inprocess"])
+    code = cli.main(["calm_pd", "--out", str(tmp_path), "--backend", "inprocess", *stream])
     assert code == 1
     err = capsys.readouterr().err
     assert "FMU 'ship': doStep at t = 50 s" in err and "injected fault" in err
+    assert "the 500 rows recorded before the error" in err
     header, *rows = (tmp_path / "calm_pd.csv").read_text().splitlines()
     assert len(rows) == 500 and rows[-1].startswith("49.9")
 
