@@ -4,14 +4,13 @@ from __future__ import annotations
 import shutil
 from collections import deque
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterable
 
 from fmpy import extract, read_model_description
-from fmpy.fmi1 import FMICallException
+from fmpy.fmi1 import FMICallException, calloc, free
 from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
                        fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, fmi2Integer, fmi2Real,
                        fmi2True, fmi2ValueReference)
-from fmpy.fmi1 import calloc, free
 
 from .instance import Instance
 
@@ -77,8 +76,16 @@ class FmuInstance(Instance):
             return function(*args, **kwargs)
         except FMICallException as error:
             status = str(error).rsplit("(", 1)[-1].rstrip(").")
-            fresh = list(self.log)[before:] if len(self.log) > before else list(self.log)[-3:]
-            raise FmuCallError(self.name, what, time, status, fresh) from error
+            raise FmuCallError(self.name, what, time, status, self._since(before)) from error
+
+    def _since(self, before: int) -> list[str]:
+        """The log messages of the call that began with ``before`` messages logged.
+
+        The log keeps the last 50; once full, its length no longer moves, and the
+        last three messages stand in for the call's own.
+        """
+        log = list(self.log)
+        return log[before:] if len(log) > before else log[-3:]
 
     def fmi(self, name: str):
         return getattr(self.slave, name)
@@ -94,8 +101,7 @@ class FmuInstance(Instance):
     # fmpy's per-call wrapping, which costs more than the call itself.
     def _status(self, what: str, status: int, before: int, time: float | None = None) -> None:
         if status > 1:                      # discard, error, fatal
-            fresh = list(self.log)[before:] if len(self.log) > before else list(self.log)[-3:]
-            raise FmuCallError(self.name, what, time, STATUS[status], fresh)
+            raise FmuCallError(self.name, what, time, STATUS[status], self._since(before))
 
     def reader(self, vrs: list[int]):
         return self._getter("fmi2GetReal", fmi2Real, vrs)
