@@ -58,5 +58,4 @@ class SMCAutopilotSlave(ModelSlave):
         model.psi_z, model.r_z = self.psi, self.r
 
     def step_model(self, t: float, h: float) -> None:
-        require_finite(psi=self.psi, r=self.r, psi_d=self.psi_d)
         self.model.step(t, h, self.psi_d)
