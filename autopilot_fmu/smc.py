@@ -106,7 +106,7 @@ class SlidingModeAutopilot:
         if equivalent_control not in EQUIVALENT_CONTROLS:
             raise ValueError(f"parameter equivalent_control must be 'paper' (eq 39) or "
                              f"'tracking' (-K^T (x - x_z)), got {equivalent_control!r}")
-        require_finite(psi=psi_z, r=r_z)
+        require_finite(psi_z=psi_z, r_z=r_z)
         self.design = design
         self.tracking = equivalent_control == "tracking"
         self.eta_h, self.phi_h, self.omega_n, self.zeta = eta_h, phi_h, omega_n, zeta
