@@ -52,7 +52,7 @@ from typing import Any
 import numpy as np
 from distributed import WorkerPlugin
 
-from .metrics import heading_error, sign_reversals_per_minute
+from .metrics import sign_reversals_per_minute
 from .report import LAMBDA, cost
 from .run import SCENARIO_DIR, scenarios, writable_folder
 from .seastate import model_scale
@@ -178,11 +178,16 @@ def free_masters() -> None:
         master.free()
 
 
+def _row(run: dict[str, Any], error: str = "") -> dict[str, Any]:
+    """A result row for ``run``: failed with ``error`` if given, metrics still undefined."""
+    return {**run, "status": "failed" if error else "ok", "error": error,
+            **{m: math.nan for m in METRICS}, "seconds": math.nan}
+
+
 def run_one(spec: Spec, run: dict[str, Any]) -> dict[str, Any]:
     """One whole co-simulation; never raises for a failed run, records it."""
     started = time.perf_counter()
-    row = {**run, "status": "ok", "error": ""}
-    row.update({m: math.nan for m in METRICS})
+    row = _row(run)
     scenario = spec.controllers[run["controller"]]["scenario"]
     try:
         scenario, overrides = spec.settings(run)
@@ -191,11 +196,11 @@ def run_one(spec: Spec, run: dict[str, Any]) -> dict[str, Any]:
         recording = master.run(spec.stop_time)
     except Exception as error:              # a bad setting: not worth retrying
         _drop_master(scenario)
-        row.update(status="failed", error=f"{type(error).__name__}: {error}")
+        row = _row(run, f"{type(error).__name__}: {error}")
     else:
         if recording.error:
             _drop_master(scenario)          # its FMUs may be in an error state
-            row.update(status="failed", error=recording.error)
+            row = _row(run, recording.error)
         else:
             row.update(_metrics(recording))
     row["seconds"] = time.perf_counter() - started
@@ -204,10 +209,9 @@ def run_one(spec: Spec, run: dict[str, Any]) -> dict[str, Any]:
 
 def _metrics(recording) -> dict[str, float]:
     c = cost(recording)
-    error = heading_error(recording["guidance.psi_d"], recording["ship.psi"])
     delta = recording["ship.delta"]
     return {"psi_E": c.psi_E, "sum_delta2": c.sum_delta2, "J": c.J,
-            "rms_heading_error": float(np.sqrt(np.mean(error ** 2))),
+            "rms_heading_error": math.sqrt(c.psi_E / recording.rows),   # psi_E: sum of squares
             "reversals_per_min": sign_reversals_per_minute(recording.t, delta),
             "max_delta": float(np.abs(delta).max())}
 
@@ -281,9 +285,7 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
                 try:
                     row = future.result()
                 except Exception as error:          # the worker died on every retry
-                    row = {**futures[future], "status": "failed",
-                           "error": f"{type(error).__name__}: {error}", "seconds": math.nan,
-                           **{m: math.nan for m in METRICS}}
+                    row = _row(futures[future], f"{type(error).__name__}: {error}")
                 journal.add(row)
                 if bar is not None:
                     bar.update()
