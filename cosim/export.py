@@ -16,6 +16,7 @@ import tempfile
 import zipfile
 from pathlib import Path
 
+from .fmu import BUILD_HINT
 from .run import PAPER_SCENARIOS, SCENARIO_DIR, scenarios, writable_folder
 from .ssd import read_ssd, write_ssd
 
@@ -30,8 +31,7 @@ def export(name: str, out: Path, overrides: dict[str, dict] | None = None) -> Pa
     fmus = {c: system.fmu_path(c) for c in system.components}
     for component, path in fmus.items():
         if not path.is_file():
-            raise FileNotFoundError(f"FMU for '{component}' not found: {path}; build the FMUs "
-                                    "with: python -m fmukit.build")
+            raise FileNotFoundError(f"FMU for '{component}' not found: {path}; {BUILD_HINT}")
     sources = {c: f"resources/{path.name}" for c, path in fmus.items()}
     target = out / f"{name}.ssp"
     with tempfile.TemporaryDirectory() as tmp:
