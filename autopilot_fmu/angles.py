@@ -7,9 +7,3 @@ def wrap(angle: float) -> float:
     wrapped = math.remainder(angle, 2.0 * math.pi)
     return math.pi if wrapped == -math.pi else wrapped
 
-
-def require_finite(**values: float) -> None:
-    """Raise ValueError naming the first input that is NaN or infinite."""
-    for name, value in values.items():
-        if not math.isfinite(value):
-            raise ValueError(f"input {name} = {value} is not finite")

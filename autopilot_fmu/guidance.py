@@ -19,12 +19,14 @@ from __future__ import annotations
 
 import math
 
-from .angles import require_finite
+from fmukit.numerics import require_finite
+from ship_fmu.data import Hull
 
 PAPER_ROUTE = "0,0;30,0;60,25;90,25"
 """The reproduction route, m: the paper gives no waypoints (see docs/reproduction.md)."""
 
-SHIP_LENGTH = 1.255
+R_ACCEPT = 2.0 * Hull.L
+"""Radius of the circle of acceptance, m: two ship lengths."""
 
 
 def parse_waypoints(text: str) -> list[tuple[float, float]]:
@@ -54,9 +56,7 @@ def parse_waypoints(text: str) -> list[tuple[float, float]]:
 class WaypointGuidance:
     """Desired course along a route of waypoints."""
 
-    STATE = ("leg",)
-
-    def __init__(self, waypoints: str = PAPER_ROUTE, R_accept: float = 2.0 * SHIP_LENGTH):
+    def __init__(self, waypoints: str = PAPER_ROUTE, R_accept: float = R_ACCEPT):
         if not (math.isfinite(R_accept) and R_accept > 0.0):
             raise ValueError(f"parameter R_accept must be finite and > 0, got {R_accept}")
         self.points = parse_waypoints(waypoints)

@@ -3,7 +3,7 @@
 psi_d and wp_index are direct feedthrough from the position: evaluated when read,
 with the leg switch committed at the end of each step.
 """
-from autopilot_fmu.guidance import PAPER_ROUTE, SHIP_LENGTH, WaypointGuidance
+from autopilot_fmu.guidance import PAPER_ROUTE, R_ACCEPT, WaypointGuidance
 from fmukit.slave import ModelSlave, Var
 
 
@@ -23,7 +23,7 @@ class GuidanceSlave(ModelSlave):
                    get=lambda s: s.model.wp_index(s.x, s.y)),
         Var.parameter("waypoints", PAPER_ROUTE,
                       description="route 'x0,y0;x1,y1;...' in m, north and east"),
-        Var.parameter("R_accept", 2.0 * SHIP_LENGTH, "m", "radius of the circle of acceptance, "
+        Var.parameter("R_accept", R_ACCEPT, "m", "radius of the circle of acceptance, "
                       "> 0", 0.0, 1e6),
     )
 

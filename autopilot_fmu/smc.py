@@ -43,14 +43,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .angles import require_finite, wrap
+from fmukit.numerics import require_finite, substeps
+
+from .angles import wrap
 from .design import NomotoModel, SwayYawModel
 
 H_MAX = 0.1
 """Largest RK4 step of the reference model, s (shorter for a faster reference model)."""
 
 EQUIVALENT_CONTROLS = ("paper", "tracking")
-MAX_SUBSTEPS = 100_000
 
 
 @dataclass(frozen=True)
@@ -91,8 +92,6 @@ class SlidingModeDesign:
 
 class SlidingModeAutopilot:
     """Reference model (44) as state, control law (37)-(43) as output."""
-
-    STATE = ("psi_z", "r_z")
 
     def __init__(self, design: SlidingModeDesign, eta_h: float = 10.0, phi_h: float = 0.3,
                  omega_n: float = 0.1, zeta: float = 0.85, psi_z: float = 0.0,
@@ -140,10 +139,7 @@ class SlidingModeAutopilot:
     def step(self, t: float, h: float, psi_d: float) -> None:
         """Advance the reference model from t to t + h with psi_d held (RK4)."""
         require_finite(psi_d=psi_d)
-        n = max(1, math.ceil(h / self._h_max - 1e-9))
-        if n > MAX_SUBSTEPS:
-            raise ValueError(f"a communication step of {h} s needs {n} RK4 steps of the "
-                             f"reference model; at most {MAX_SUBSTEPS} are taken per step")
+        n = substeps(h, self._h_max, "of the reference model")
         hs = h / n
         psi_z, r_z = self.psi_z, self.r_z
         for _ in range(n):

@@ -4,9 +4,9 @@ The reference model (44) is the FMU's state; it starts at the heading and yaw
 rate the FMU sees at initialisation. delta_c and sigma are direct feedthrough
 from the inputs and are evaluated when read; psi_z and r_z are states.
 """
-from autopilot_fmu.angles import require_finite
 from autopilot_fmu.design import design_model
 from autopilot_fmu.smc import SlidingModeAutopilot, SlidingModeDesign
+from fmukit.numerics import require_finite
 from fmukit.slave import ModelSlave, Var
 
 _DESIGN = ("lambda1", "lambda2", "u0", "design_model")

@@ -1,7 +1,7 @@
 """The master's in-process backend: the FMUs' Python classes, called without FMI.
 
 An ``InProcessInstance`` has the same interface as ``cosim.fmu.FmuInstance`` but
-instantiates the slave class an FMU was built from (``fmukit.build.FMUS``) in this
+instantiates the slave class an FMU was built from (``fmukit.packaging.FMUS``) in this
 process and calls its methods directly. A run on this backend differs from a
 co-simulation only by the FMI layer (C wrapper, fmpy, ctypes), which is what the
 equality tests compare.
@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from fmukit.build import FMUS
+from fmukit.packaging import FMUS
 from fmukit.slave import ModelSlave
 
 from .fmu import FmuCallError
@@ -50,13 +50,12 @@ class InProcessInstance(Instance):
         self.path, self.name = Path(path), name
         self.slave = slave_class(self.path.stem)(instance_name=name)
         self.variables = {}
-        for vr, var in self.slave._by_vr.items():
+        for vr, var in self.slave.registry.by_vr.items():
             self.variables[var.name] = VariableInfo(var.name, vr, _FMI_TYPE[var.kind],
                                                     var.causality)
         inputs = {v.name for v in self.slave.variables if v.causality == "input"}
         self.feedthrough = {v.name: frozenset(v.depends) & inputs
                             for v in self.slave.variables if v.causality == "output"}
-        self.log: list[str] = []
 
     def call(self, what: str, function, *args, time: float | None = None) -> Any:
         """Call a slave method; an exception or a refused step becomes FmuCallError."""
@@ -73,7 +72,6 @@ class InProcessInstance(Instance):
     def _drain(self) -> list[str]:
         messages = [f"[{m.status.name}] {m.msg}" for m in self.slave.log_queue]
         self.slave.log_queue.clear()
-        self.log.extend(messages)
         return messages
 
     def fmi(self, name: str):

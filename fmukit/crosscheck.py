@@ -18,7 +18,7 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from .build import FMU_DIR
+from .packaging import FMU_DIR
 
 TOOL, VERSION = "ship_autopilot_cosim", "0.1.0"
 CROSSCHECK_DIR = FMU_DIR / "crosscheck" / "2.0" / "cs" / "linux64" / TOOL / VERSION

@@ -26,3 +26,18 @@ def seconds(ns: int) -> float:
 def communication_point(t0: float, k: int, h: float) -> float:
     """t_k = t_0 + k h, computed in integer nanoseconds."""
     return seconds(nanoseconds(t0) + k * nanoseconds(h))
+
+
+def step_count(start: float, stop: float, step: float) -> int:
+    """Communication steps of ``step`` from start to stop; ValueError unless a whole number >= 1."""
+    h = nanoseconds(step)
+    if h <= 0:
+        raise ValueError(f"step size {step} s is not positive (at least 1 ns)")
+    span = nanoseconds(stop) - nanoseconds(start)
+    if span <= 0:
+        raise ValueError(f"stop time {stop} s is not after the start time {start} s")
+    n, remainder = divmod(span, h)
+    if remainder:
+        raise ValueError(f"stop time {stop} s is not a whole number of {seconds(h)} s steps "
+                         f"after {start} s")
+    return n

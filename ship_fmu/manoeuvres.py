@@ -12,6 +12,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from fmukit.timebase import step_count
+
 from .vessel import Vessel, VesselParameters
 
 DT = 0.1
@@ -40,8 +42,6 @@ class RudderProgram:
     psi_switch = 0 it is held (a turning circle). ``command`` evaluates the rule at
     a heading without committing it; ``update`` commits it.
     """
-
-    STATE = ("sign", "reversals")
 
     def __init__(self, delta: float = math.radians(20.0),
                  psi_switch: float = math.radians(20.0)):
@@ -109,7 +109,7 @@ def zigzag_figures(psi, reversals, psi_switch: float) -> ZigZagResult:
 def _run(program: RudderProgram, t_end: float, params: VesselParameters) -> dict[str, list]:
     vessel = Vessel(replace(params, x0=0.0, y0=0.0, psi0=0.0))
     track = {name: [] for name in ("x", "y", "psi", "u", "v", "r", "reversals")}
-    for k in range(round(t_end / DT)):
+    for k in range(step_count(0.0, t_end, DT)):
         delta_c = program.command(vessel.psi)
         program.update(vessel.psi)
         for name in track:

@@ -15,6 +15,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields
 
+from fmukit.numerics import require_finite, substeps
+
 from .data import G, Actuators, Hull
 from .hull import coriolis_forces, damping_forces, kinematics, mass_matrix
 from .steering_gear import DELTA_MAX, DELTA_RATE_MAX, rudder_angle
@@ -26,9 +28,6 @@ State = tuple[float, float, float, float, float, float, float]
 
 MAX_STEEPNESS = 7.0
 """Waves break beyond Hs / lambda_p = 1/7."""
-
-MAX_SUBSTEPS = 100_000
-"""Most RK4 steps one communication step may take: a longer one is refused, not hung on."""
 
 N_PROPELLER = 8.13
 """Main propeller speed of the paper's runs, rev/s: 0.3 m/s in calm water."""
@@ -132,14 +131,9 @@ class Vessel:
         """Advance from communication point t to t + h with the inputs held."""
         if not (math.isfinite(delta_c) and math.isfinite(n1) and math.isfinite(n2)
                 and math.isfinite(n3)):
-            for name, value in (("delta_c", delta_c), ("n1", n1), ("n2", n2), ("n3", n3)):
-                if not math.isfinite(value):
-                    raise ValueError(f"input {name} = {value} is not finite")
+            require_finite(delta_c=delta_c, n1=n1, n2=n2, n3=n3)
         p = self.params
-        n_sub = max(1, math.ceil(h / p.h_max - 1e-9))
-        if n_sub > MAX_SUBSTEPS:
-            raise ValueError(f"a communication step of {h} s needs {n_sub} RK4 steps of at most "
-                             f"h_max = {p.h_max} s; at most {MAX_SUBSTEPS} are taken per step")
+        n_sub = substeps(h, p.h_max, f"of at most h_max = {p.h_max} s")
         hs = h / n_sub
         hh, c = 0.5 * hs, hs / 6.0
         delta0 = self.delta

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from fmukit.build import FMU_DIR, FMUS, ROOT, build
+from fmukit.packaging import FMU_DIR, FMUS, ROOT, build
 
 
 def _stale(name: str) -> bool:

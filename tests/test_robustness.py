@@ -17,7 +17,7 @@ from cosim.fmu import FmuInstance
 from cosim.master import Master
 from cosim.run import SCENARIO_DIR
 from cosim.ssd import Component, Connection, SystemDescription, read_ssd, write_ssd
-from fmukit.build import ROOT, build_script
+from fmukit.packaging import ROOT, build_script
 from fmukit.timebase import communication_point
 
 # Inputs that drive each FMU through something worth restoring, by step k.

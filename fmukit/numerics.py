@@ -1,0 +1,32 @@
+"""Numerical rules every model here follows: finite inputs, bounded sub-stepping.
+
+Plain modules (``ship_fmu``, ``autopilot_fmu``) use these as much as the FMUs do:
+a model refuses a non-finite input by name, and a communication step is cut into
+equal integration steps no longer than the model's largest, with a bound on how
+many, so that a huge step is refused instead of hanging the host.
+"""
+from __future__ import annotations
+
+import math
+
+MAX_SUBSTEPS = 100_000
+"""Most integration steps one communication step may take."""
+
+
+def require_finite(**values: float) -> None:
+    """Raise ValueError naming the first input that is NaN or infinite."""
+    for name, value in values.items():
+        if not math.isfinite(value):
+            raise ValueError(f"input {name} = {value} is not finite")
+
+
+def substeps(h: float, h_max: float, what: str) -> int:
+    """Equal integration steps that cut a communication step h into pieces <= h_max.
+
+    ``what`` names the steps in the error, e.g. "of at most h_max = 0.1 s".
+    """
+    n = max(1, math.ceil(h / h_max - 1e-9))
+    if n > MAX_SUBSTEPS:
+        raise ValueError(f"a communication step of {h} s needs {n} RK4 steps {what}; "
+                         f"at most {MAX_SUBSTEPS} are taken per step")
+    return n

@@ -1,0 +1,68 @@
+"""FMU variables, declared once: ``Var`` with unit, causality, start, valid range, dependencies.
+
+A variable's declaration is the single source for its pythonfmu registration
+(``fmukit.registry``), its entry in modelDescription.xml (``fmukit.model_description``)
+and the range check its values must pass (``Var.check``).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Callable
+
+
+@dataclass(frozen=True)
+class Var:
+    """One FMU variable, declared once. Build it with the class methods."""
+
+    name: str
+    causality: str                    # "parameter" | "input" | "output"
+    unit: str = "1"                   # key of fmukit.units.UNITS (Real only)
+    description: str = ""
+    start: float | int | str | None = None
+    kind: type = float                # float (Real), int (Integer) or str (String)
+    depends: tuple[str, ...] = ()     # outputs: inputs and parameters they depend on
+    initial_depends: tuple[str, ...] = ()     # outputs: further knowns, at initialisation only
+    get: Callable[[Any], Any] | None = None   # outputs: value from the slave
+    min: float = -math.inf            # inputs and parameters: the valid range, written to
+    max: float = math.inf             # modelDescription.xml and enforced (NaN is never valid)
+
+    @classmethod
+    def parameter(cls, name: str, start: float | int | str, unit: str = "1",
+                  description: str = "", min: float = -math.inf,
+                  max: float = math.inf) -> Var:
+        """A fixed parameter; its Python type (float, int, str) sets the FMI type."""
+        return cls(name, "parameter", unit, description, start, type(start), min=min, max=max)
+
+    @classmethod
+    def input(cls, name: str, start: float, unit: str = "1", description: str = "",
+              min: float = -math.inf, max: float = math.inf) -> Var:
+        """A continuous Real input."""
+        return cls(name, "input", unit, description, float(start), min=min, max=max)
+
+    @classmethod
+    def output(cls, name: str, unit: str = "1", description: str = "",
+               depends: tuple[str, ...] = (), initial_depends: tuple[str, ...] = (),
+               get: Callable[[Any], Any] | None = None, kind: type = float) -> Var:
+        """An output read from the slave by ``get`` (default: the model's attribute).
+
+        ``depends``: the inputs (direct feedthrough) and parameters it depends on;
+        ``initial_depends``: inputs it depends on only at initialisation.
+        """
+        return cls(name, "output", unit, description, None, kind, depends, initial_depends,
+                   get)
+
+    def check(self, value: Any) -> None:
+        """ValueError naming this variable if a number is NaN, infinite or out of range."""
+        if self.kind is str:
+            return
+        kind = "input" if self.causality == "input" else "parameter"
+        if not math.isfinite(value):
+            raise ValueError(f"{kind} {self.name} = {value} is not finite")
+        if not self.min <= value <= self.max:
+            raise ValueError(f"{kind} {self.name} = {value} is outside its range "
+                             f"[{self.min:g}, {self.max:g}]")
+
+    @property
+    def is_real(self) -> bool:
+        return self.kind is float
