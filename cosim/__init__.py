@@ -1,0 +1,19 @@
+"""Ship-autopilot co-simulation: the master, the paper's scenarios, and what is built on them.
+
+Layers, each a sub-package whose docstring says more:
+
+- ``cosim.core``: the co-simulation core. Component backends (FMUs through fmpy, their
+  Python classes in-process, a null backend), SSP system descriptions, wiring and
+  ordering, the Gauss-Seidel and Jacobi couplings, recording, and the ``Master``.
+- ``cosim.scenarios``: the scenarios as .ssd files, and their registry.
+- ``cosim.analysis``: what is computed from a recorded run: metrics, eq (19), reports,
+  figures, sea states.
+- ``cosim.interop``: other FMI tools: SSP packages, libcosim, ecos, fmpy's SSP runner.
+- ``cosim.studies``: studies built on the above: ensembles on Dask, benchmarks, the
+  in-process reference.
+
+The modules directly in ``cosim/`` are the commands (``python -m cosim.run``,
+``cosim.sweep``, ``cosim.export``, ``cosim.bench``, ``cosim.engines``); they parse
+options and print, and nothing else imports them. A module imports only from the
+sub-packages listed before its own (the core from none); nothing imports a command.
+"""

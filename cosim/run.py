@@ -14,22 +14,19 @@ folder, and prints the cost of eq (19) (or the manoeuvre's figures).
 from __future__ import annotations
 
 import argparse
-import os
 import sys
-import tempfile
 from pathlib import Path
 
-from .master import BACKENDS, COUPLINGS, Master
-from .plots import save_figure
-from .report import LAMBDA, PAPER, REPORTS, cost, tables
-from .ssd import read_ssd
+from . import scenarios
+from ._cli import Progress, chosen_scenarios, writable_folder
+from .analysis.cost import LAMBDA, Cost, cost
+from .analysis.figures import save_figure
+from .analysis.kinds import analysis
+from .analysis.reports import tables
+from .core.coupling import COUPLINGS
+from .core.master import BACKENDS, Master
 
-SCENARIO_DIR = Path(__file__).resolve().parent / "scenarios"
-PAPER_SCENARIOS = list(PAPER)
-
-
-def scenarios() -> list[str]:
-    return sorted(p.stem for p in SCENARIO_DIR.glob("*.ssd"))
+RUN_BACKENDS = [b for b in BACKENDS if b != "null"]     # null runs measure the master only
 
 
 def parse_setting(text: str) -> tuple[str, str, int | float | str]:
@@ -46,50 +43,15 @@ def parse_setting(text: str) -> tuple[str, str, int | float | str]:
     return component, variable, raw
 
 
-def writable_folder(path: Path) -> Path:
-    """Create the folder and prove it is writable, before anything is simulated."""
-    try:
-        path.mkdir(parents=True, exist_ok=True)
-        with tempfile.NamedTemporaryFile(dir=path):
-            pass
-    except OSError as error:
-        raise SystemExit(f"error: output folder {path} is not writable ({error.strerror})")
-    return path
-
-
-class _Progress:
-    """A progress bar that appears only for runs longer than a second."""
-
-    def __init__(self, label: str):
-        self.label, self.bar = label, None
-
-    def __call__(self, k: int, n: int) -> None:
-        if self.bar is None:
-            from tqdm import tqdm
-            self.bar = tqdm(total=n, desc=self.label, unit="step", delay=1.0, leave=False,
-                            file=sys.stderr)
-        self.bar.update(k - self.bar.n)
-
-    def close(self) -> None:
-        if self.bar is not None:
-            self.bar.close()
-
-
-def scenario_path(scenario: str) -> Path:
-    """A scenario's .ssd: a name in cosim/scenarios, or a path to a .ssd file."""
-    if scenario.endswith(".ssd"):
-        return Path(scenario)
-    return SCENARIO_DIR / f"{scenario}.ssd"
-
-
 def run_scenario(name: str, out: Path, overrides: dict, coupling: str, stop_time: float | None,
                  lam: float, plot: bool = True, backend: str = "fmi",
-                 stream: bool = False) -> tuple[int, object]:
+                 stream: bool = False) -> tuple[int, Cost | None]:
     """Simulate one scenario, write its CSV and figure, print its report."""
-    system = read_ssd(scenario_path(name))
+    system = scenarios.load(name)
+    kind = analysis(system.report)
     name = Path(name).stem
     master = Master(system, coupling=coupling, overrides=overrides, backend=backend)
-    progress = _Progress(name)
+    progress = Progress(name)
     csv_path = out / f"{name}.csv"
     try:
         recording = master.run(stop_time, progress=progress,
@@ -102,19 +64,19 @@ def run_scenario(name: str, out: Path, overrides: dict, coupling: str, stop_time
     print(f"{name}: {system.description}")
     if recording.error:
         print(f"error: {recording.error}", file=sys.stderr)
-        print(f"  the {recording.recorded} rows recorded before the error are in {csv_path}",
+        print(f"  the {recording.rows} rows recorded before the error are in {csv_path}",
               file=sys.stderr)
         return 1, None
     if stream:
-        print(f"  {recording.recorded} rows streamed to {csv_path} "
+        print(f"  {recording.rows} rows streamed to {csv_path} "
               "(no report or figure in --stream mode)")
         return 0, None
-    for line in REPORTS[system.report](recording, lam=lam, parameters=master.parameters):
+    for line in kind.report(recording, lam=lam, parameters=master.parameters):
         print(f"  {line}")
     written = [csv_path]
-    if plot and save_figure(recording, system.report, out / f"{name}.png",
-                            f"{name}: {system.description}"):
-        written.append(out / f"{name}.png")
+    if plot and kind.figure is not None:
+        written.append(save_figure(recording, kind.figure, out / f"{name}.png",
+                                   f"{name}: {system.description}"))
     print(f"  wrote {', '.join(str(p) for p in written)}")
     return 0, cost(recording, lam) if system.report == "course_keeping" else None
 
@@ -125,7 +87,7 @@ def main(argv: list[str] | None = None) -> int:
         epilog="\n\n".join(__doc__.split("\n\n")[1:]),
         formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("scenario", nargs="?",
-                        help=f"one of: {', '.join(scenarios())}; or a path to a .ssd file")
+                        help=f"one of: {', '.join(scenarios.names())}; or a path to a .ssd file")
     parser.add_argument("--all", action="store_true",
                         help="run the paper's four scenarios and print Tables 1-2 beside the "
                              "paper's")
@@ -142,7 +104,7 @@ def main(argv: list[str] | None = None) -> int:
                              "model (default); jacobi: all FMUs on the previous step's outputs")
     parser.add_argument("--lambda", dest="lam", type=float, default=LAMBDA,
                         help=f"weight of eq (19) (default {LAMBDA:.4f}, calibrated on calm_pd)")
-    parser.add_argument("--backend", choices=BACKENDS, default="fmi",
+    parser.add_argument("--backend", choices=RUN_BACKENDS, default="fmi",
                         help="fmi: load the FMUs from fmus/ (default); inprocess: call the "
                              "FMUs' Python classes directly, without FMI")
     parser.add_argument("--no-plot", action="store_true", help="skip the figure")
@@ -150,16 +112,7 @@ def main(argv: list[str] | None = None) -> int:
                         help="write rows to the CSV in chunks as the run goes: flat memory "
                              "for long runs (--stop-time 86400); no report or figure")
     args = parser.parse_args(argv)
-
-    if args.all == bool(args.scenario):
-        parser.error("give one SCENARIO or --all")
-    names = PAPER_SCENARIOS if args.all else [args.scenario]
-    for name in names:
-        if name.endswith(".ssd"):
-            if not Path(name).is_file():
-                parser.error(f"no system structure file {name}")
-        elif name not in scenarios():
-            parser.error(f"unknown scenario {name!r}; valid scenarios: {', '.join(scenarios())}")
+    names = chosen_scenarios(parser, args.scenario, args.all)
     overrides: dict[str, dict] = {}
     for component, variable, value in args.set:
         overrides.setdefault(component, {})[variable] = value

@@ -1,378 +1,21 @@
-"""Ensembles of co-simulations on Dask: Monte Carlo over seeds, sea states and settings.
-
-    python -m cosim.sweep docs/sweeps/smc_vs_pd.toml             # local cluster, 1 worker/core
-    python -m cosim.sweep SPEC --scheduler tcp://host:8786       # an existing Dask cluster
-    python -m cosim.sweep SPEC --workers 2 --csv --out results/sweeps
-
-SPEC is a TOML file (see docs/sweeps/example.toml):
-
-    name = "example"                       # output folder results/sweeps/<name>/
-    stop_time = 400                        # s, optional (default: the scenario's)
-
-    [controllers]                          # the controller axis: base scenario and settings
-    pd = { scenario = "waves_pd" }
-    smc = { scenario = "waves_smc", set = { "autopilot.eta_h" = 10.0 } }
-
-    [axes]                                 # every combination is run
-    wave_seed = { start = 1, count = 20 }  # or a list
-    sea_state = [0, 2, 3]                  # WMO codes -> Hs, T0 at 1:70 (cosim.seastate)
-    Hs = [0.005]                           # m (instead of sea_state); T0 likewise
-    psi_w = [3.14159]                      # rad, wave direction
-    route = ["0,0;30,0;60,25;90,25"]       # guidance waypoints
-    "ship.delta_rate_max" = [0.0873, 0.349] # any FMU parameter, component.variable
-
-    [plots]
-    map = ["sea_state", "ship.delta_rate_max"]   # axes of the J_SMC / J_PD map
-
-Without [controllers], pd and smc run on waves_pd and waves_smc.
-
-Each Dask task is one whole co-simulation with our master. A worker extracts the
-FMUs once per scenario and thread and resets them (fmi2Reset) between tasks.
-Results: results/sweeps/<name>/runs.jsonl gets each row as it completes (flushed),
-so an interrupted sweep resumes where it stopped; results.parquet (and
-results.csv with --csv) hold the table at the end; a summary is printed, two
-figures are written, and comparison.md pairs every controller with pd seed by seed. A task whose worker dies is retried twice, then recorded
-as failed; an FMU error is recorded as failed at once, with its message.
-"""
+"""The command line of ``cosim.studies.sweep``: python -m cosim.sweep SPEC [options]."""
 from __future__ import annotations
 
 import argparse
-import hashlib
-import itertools
-import json
-import math
 import sys
-import threading
-import time
-import tomllib
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
-import numpy as np
-from distributed import WorkerPlugin
-
-from .metrics import sign_reversals_per_minute
-from .report import LAMBDA, cost
-from .run import SCENARIO_DIR, scenarios, writable_folder
-from .seastate import model_scale
+from ._cli import writable_folder
+from .studies import sweep
+from .studies.sweep_figures import save_figures
 
 RESULTS = Path("results/sweeps")
-DEFAULT_CONTROLLERS = {"pd": {"scenario": "waves_pd"}, "smc": {"scenario": "waves_smc"}}
-# Axis shorthands: name -> the FMU parameter it sets.
-SHORTHANDS = {"wave_seed": "ship.wave_seed", "Hs": "ship.Hs", "T0": "ship.T0",
-              "psi_w": "ship.psi_w", "route": "guidance.waypoints"}
-METRICS = ("psi_E", "sum_delta2", "J", "rms_heading_error", "reversals_per_min", "max_delta")
-
-
-@dataclass
-class Spec:
-    name: str
-    controllers: dict[str, dict[str, Any]]
-    axes: dict[str, list]
-    stop_time: float | None = None
-    map_axes: list[str] = field(default_factory=list)
-
-    @classmethod
-    def read(cls, path: str | Path) -> Spec:
-        """Parse a sweep file; ValueError naming the file and the problem."""
-        path = Path(path)
-        try:
-            data = tomllib.loads(path.read_text())
-        except (OSError, tomllib.TOMLDecodeError) as error:
-            raise ValueError(f"cannot read sweep spec {path}: {error}") from None
-        controllers = data.get("controllers", DEFAULT_CONTROLLERS)
-        for name, entry in controllers.items():
-            if entry.get("scenario") not in scenarios():
-                raise ValueError(f"{path}: controller {name!r} names scenario "
-                                 f"{entry.get('scenario')!r}; valid: {', '.join(scenarios())}")
-        axes = {}
-        for name, values in data.get("axes", {}).items():
-            if isinstance(values, dict):
-                values = list(range(values["start"], values["start"] + values["count"]))
-            if not isinstance(values, list) or not values:
-                raise ValueError(f"{path}: axis {name!r} needs a non-empty list of values")
-            if name not in SHORTHANDS and name != "sea_state" and "." not in name:
-                raise ValueError(f"{path}: axis {name!r} is neither one of "
-                                 f"{', '.join(['sea_state', *SHORTHANDS])} nor component.variable")
-            if name == "sea_state":
-                for code in values:
-                    model_scale(code)            # ValueError for codes outside 0-6
-            axes[name] = values
-        plots = data.get("plots", {})
-        map_axes = plots.get("map", [])
-        for axis in map_axes:
-            if axis not in axes:
-                raise ValueError(f"{path}: [plots] map names {axis!r}, which is not an axis")
-        return cls(name=data.get("name", path.stem), controllers=controllers, axes=axes,
-                   stop_time=data.get("stop_time"), map_axes=map_axes)
-
-    def runs(self) -> list[dict[str, Any]]:
-        """Every combination of controller and axis values, with a stable run id."""
-        names = list(self.axes)
-        runs = []
-        for controller in self.controllers:
-            for values in itertools.product(*(self.axes[n] for n in names)):
-                point = {"controller": controller, **dict(zip(names, values))}
-                key = json.dumps(point, sort_keys=True)
-                point["run_id"] = hashlib.sha1(key.encode()).hexdigest()[:12]
-                runs.append(point)
-        return runs
-
-    def settings(self, run: dict[str, Any]) -> tuple[str, dict[str, dict[str, Any]]]:
-        """(scenario, overrides by component) of one run."""
-        controller = self.controllers[run["controller"]]
-        overrides: dict[str, dict[str, Any]] = {}
-
-        def put(target: str, value: Any) -> None:
-            component, _, variable = target.partition(".")
-            overrides.setdefault(component, {})[variable] = value
-
-        for target, value in controller.get("set", {}).items():
-            put(target, value)
-        for axis in self.axes:
-            value = run[axis]
-            if axis == "sea_state":
-                Hs, T0 = model_scale(value)
-                put("ship.Hs", Hs)
-                put("ship.T0", T0)
-            else:
-                put(SHORTHANDS.get(axis, axis), value)
-        return controller["scenario"], overrides
-
-
-# -- the task, on a worker ------------------------------------------------------------
-_masters: dict[tuple[int, str], Any] = {}       # (thread, scenario) -> Master
-_masters_lock = threading.Lock()
-
-
-def _master(scenario: str):
-    from .master import Master
-    from .ssd import read_ssd
-
-    key = (threading.get_ident(), scenario)
-    with _masters_lock:
-        master = _masters.get(key)
-    if master is None:
-        master = Master(read_ssd(SCENARIO_DIR / f"{scenario}.ssd"))
-        with _masters_lock:
-            _masters[key] = master
-    else:
-        master.reset()
-    return master
-
-
-def _drop_master(scenario: str) -> None:
-    with _masters_lock:
-        master = _masters.pop((threading.get_ident(), scenario), None)
-    if master is not None:
-        master.free()
-
-
-def free_masters() -> None:
-    """Free every cached master of this process (worker teardown)."""
-    with _masters_lock:
-        masters = list(_masters.values())
-        _masters.clear()
-    for master in masters:
-        master.free()
-
-
-def _row(run: dict[str, Any], error: str = "") -> dict[str, Any]:
-    """A result row for ``run``: failed with ``error`` if given, metrics still undefined."""
-    return {**run, "status": "failed" if error else "ok", "error": error,
-            **{m: math.nan for m in METRICS}, "seconds": math.nan}
-
-
-def run_one(spec: Spec, run: dict[str, Any]) -> dict[str, Any]:
-    """One whole co-simulation; never raises for a failed run, records it."""
-    started = time.perf_counter()
-    row = _row(run)
-    scenario = spec.controllers[run["controller"]]["scenario"]
-    try:
-        scenario, overrides = spec.settings(run)
-        master = _master(scenario)
-        master.configure(overrides)
-        recording = master.run(spec.stop_time)
-    except Exception as error:              # a bad setting: not worth retrying
-        _drop_master(scenario)
-        row = _row(run, f"{type(error).__name__}: {error}")
-    else:
-        if recording.error:
-            _drop_master(scenario)          # its FMUs may be in an error state
-            row = _row(run, recording.error)
-        else:
-            row.update(_metrics(recording))
-    row["seconds"] = time.perf_counter() - started
-    return row
-
-
-def _metrics(recording) -> dict[str, float]:
-    c = cost(recording)
-    delta = recording["ship.delta"]
-    return {"psi_E": c.psi_E, "sum_delta2": c.sum_delta2, "J": c.J,
-            "rms_heading_error": math.sqrt(c.psi_E / recording.rows),   # psi_E: sum of squares
-            "reversals_per_min": sign_reversals_per_minute(recording.t, delta),
-            "max_delta": float(np.abs(delta).max())}
-
-
-# -- the client side --------------------------------------------------------------------
-class Journal:
-    """Rows appended and flushed as they complete: a sweep resumes from it."""
-
-    def __init__(self, path: Path):
-        self.path = path
-        self.rows: dict[str, dict] = {}
-        if path.exists():
-            for line in path.read_text().splitlines():
-                if line.strip():
-                    row = json.loads(line)
-                    self.rows[row["run_id"]] = row
-
-    def add(self, row: dict) -> None:
-        with open(self.path, "a") as f:
-            f.write(json.dumps(row) + "\n")
-            f.flush()
-        self.rows[row["run_id"]] = row
-
-
-def _client(scheduler: str | None, workers: int | None):
-    import logging
-
-    import dask
-    from dask.distributed import Client, LocalCluster
-
-    if scheduler:
-        return Client(scheduler), None
-    # One task in flight per worker thread: when a run kills its worker, no queued
-    # neighbour is counted as having died with it (and failed after three deaths).
-    with dask.config.set({"distributed.scheduler.worker-saturation": 1.0}):
-        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                               dashboard_address=None, silence_logs=logging.ERROR)
-    return Client(cluster), cluster
-
-
-class _Teardown(WorkerPlugin):
-    """Free a worker's cached FMUs (and their temporary folders) at shutdown."""
-
-    name = "cosim-sweep-teardown"
-
-    def teardown(self, worker) -> None:
-        free_masters()
-
-
-def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | None = None,
-            progress: bool = True, task=None) -> list[dict]:
-    """Run the runs not yet in the journal; return every row of the sweep.
-
-    ``task(spec, run) -> row`` is what each run executes (default ``run_one``).
-    """
-    from dask.distributed import as_completed
-
-    journal = Journal(out / "runs.jsonl")
-    todo = [r for r in spec.runs() if r["run_id"] not in journal.rows]
-    if todo:
-        client, cluster = _client(scheduler, workers)
-        try:
-            client.register_plugin(_Teardown())
-            futures = {client.submit(task or run_one, spec, run, retries=2, pure=False,
-                                     key=f"run-{run['run_id']}"): run for run in todo}
-            bar = None
-            if progress:
-                from tqdm import tqdm
-                bar = tqdm(total=len(todo), desc=spec.name, unit="run", file=sys.stderr)
-            for future in as_completed(futures):
-                try:
-                    row = future.result()
-                except Exception as error:          # the worker died on every retry
-                    row = _row(futures[future], f"{type(error).__name__}: {error}")
-                journal.add(row)
-                if bar is not None:
-                    bar.update()
-            if bar is not None:
-                bar.close()
-        finally:
-            client.close()
-            if cluster is not None:
-                cluster.close()
-    return [journal.rows[r["run_id"]] for r in spec.runs()]
-
-
-def write_tables(rows: list[dict], out: Path, csv: bool) -> list[Path]:
-    import pyarrow as pa
-    import pyarrow.csv as pacsv
-    import pyarrow.parquet as pq
-
-    table = pa.Table.from_pylist([{k: (json.dumps(v) if isinstance(v, (list, dict)) else v)
-                                   for k, v in row.items()} for row in rows])
-    written = [out / "results.parquet"]
-    pq.write_table(table, written[0])
-    if csv:
-        written.append(out / "results.csv")
-        pacsv.write_csv(table, written[1])
-    return written
-
-
-def summary(spec: Spec, rows: list[dict]) -> str:
-    ok = [r for r in rows if r["status"] == "ok"]
-    lines = [f"{spec.name}: {len(rows)} runs, {len(ok)} ok, {len(rows) - len(ok)} failed"]
-    for controller in spec.controllers:
-        J = np.array([r["J"] for r in ok if r["controller"] == controller])
-        if J.size:
-            lines.append(f"  {controller:>14}: J median {np.median(J):9.2f}, mean {J.mean():9.2f}"
-                         f", 5-95 % {np.percentile(J, 5):9.2f} - {np.percentile(J, 95):9.2f}"
-                         f" ({J.size} runs)")
-    for r in rows:
-        if r["status"] != "ok":
-            lines.append(f"  failed {r['run_id']} {r['controller']}: "
-                         f"{r['error'].splitlines()[0][:160]}")
-            break
-    return "\n".join(lines)
-
-
-def comparison(spec: Spec, rows: list[dict], baseline: str = "pd",
-               monte_carlo: str = "wave_seed") -> str:
-    """Markdown table: per setting of the other axes, median J and wins against the baseline.
-
-    Runs are paired by the Monte Carlo axis (the same sea for both controllers); a
-    controller wins a pair when its J is lower. The share of wins and the median J
-    ratio are given for every controller other than the baseline.
-    """
-    others = [c for c in spec.controllers if c != baseline]
-    axes = [a for a in spec.axes if a != monte_carlo]
-    ok = {(r["controller"], *(json.dumps(r[a]) for a in spec.axes)): r
-          for r in rows if r["status"] == "ok"}
-    header = [*axes, f"J {baseline}", *(f"J {c}" for c in others),
-              *(f"{c} wins" for c in others), *(f"J {c} / J {baseline}" for c in others)]
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    for setting in itertools.product(*(spec.axes[a] for a in axes)):
-        where = dict(zip(axes, setting))
-        seeds = spec.axes.get(monte_carlo, [None])
-
-        def J(controller: str) -> np.ndarray:
-            keys = [(controller, *(json.dumps(where.get(a, seed)) for a in spec.axes))
-                    for seed in seeds]
-            return np.array([ok[k]["J"] if k in ok else np.nan for k in keys])
-
-        base = J(baseline)
-        cells = [str(v) for v in setting] + [f"{np.nanmedian(base):.1f}"]
-        wins, ratios = [], []
-        for controller in others:
-            J_c = J(controller)
-            cells.append(f"{np.nanmedian(J_c):.1f}")
-            decided = np.isfinite(J_c) & np.isfinite(base) & (J_c != base)
-            wins.append(f"{int(np.sum(J_c[decided] < base[decided]))}/{int(decided.sum())}")
-            defined = np.isfinite(J_c) & (base > 1e-9)
-            ratios.append(f"{np.median(J_c[defined] / base[defined]):.2f}" if defined.any()
-                          else "-")
-        lines.append("| " + " | ".join(cells + wins + ratios) + " |")
-    return "\n".join(lines)
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m cosim.sweep",
-                                     description=__doc__.split("\n\n")[0],
-                                     epilog="\n\n".join(__doc__.split("\n\n")[1:]),
+                                     description=sweep.__doc__.split("\n\n")[0],
+                                     epilog="\n\n".join(sweep.__doc__.split("\n\n")[1:]),
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("spec", type=Path, help="sweep file (TOML)")
     parser.add_argument("--scheduler", metavar="ADDRESS",
@@ -383,24 +26,21 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--no-progress", action="store_true")
     args = parser.parse_args(argv)
     try:
-        spec = Spec.read(args.spec)
+        spec = sweep.Spec.read(args.spec)
     except ValueError as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
     out = writable_folder(args.out / spec.name)
-    rows = execute(spec, out, args.scheduler, args.workers, progress=not args.no_progress)
-    written = write_tables(rows, out, args.csv)
-    from .sweep_plots import save_plots
-    written += save_plots(spec, rows, out)
+    rows = sweep.execute(spec, out, args.scheduler, args.workers, progress=not args.no_progress)
+    written = sweep.write_tables(rows, out, args.csv)
+    written += save_figures(spec, rows, out)
     if "pd" in spec.controllers and len(spec.controllers) > 1:
-        (out / "comparison.md").write_text(comparison(spec, rows) + "\n")
+        (out / "comparison.md").write_text(sweep.comparison(spec, rows) + "\n")
         written.append(out / "comparison.md")
-    print(summary(spec, rows))
+    print(sweep.summary(spec, rows))
     print(f"wrote {', '.join(str(p) for p in written)}")
     return 0 if all(r["status"] == "ok" for r in rows) else 1
 
 
 if __name__ == "__main__":
-    # Dask pickles tasks by reference to their module: run them as cosim.sweep, not __main__.
-    from cosim.sweep import main as _main
-    sys.exit(_main())
+    sys.exit(main())

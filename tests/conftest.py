@@ -30,7 +30,7 @@ def fmu_paths() -> dict[str, Path]:
 @pytest.fixture
 def open_fmu(fmu_paths):
     """Factory of FmuInstance objects, freed (and garbage-collected) after the test."""
-    from cosim.fmu import FmuInstance
+    from cosim.core.fmi import FmuInstance
 
     opened = []
 

@@ -31,7 +31,8 @@ from hypothesis import strategies as st
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from cosim.fmu import FmuCallError, FmuInstance  # noqa: E402
+from cosim.core.fmi import FmuInstance  # noqa: E402
+from cosim.core.instance import FmuCallError  # noqa: E402
 from fmukit.timebase import MAX_TIME  # noqa: E402
 
 FMUS = ["ship", "pd_autopilot", "smc_autopilot", "guidance", "manoeuvre"]

@@ -1,7 +1,7 @@
 """A sweep task that kills its worker process for one run: the retry path."""
 import os
 
-from cosim.sweep import run_one
+from cosim.studies.sweep import run_one
 
 
 def killing_task(spec, run):

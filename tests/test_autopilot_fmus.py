@@ -11,7 +11,7 @@ from autopilot_fmu.design import PAPER_EQ45
 from autopilot_fmu.guidance import WaypointGuidance
 from autopilot_fmu.pd import PDAutopilot
 from autopilot_fmu.smc import SlidingModeAutopilot, SlidingModeDesign
-from cosim.fmu import FmuCallError
+from cosim.core.instance import FmuCallError
 from helpers import fmpy_cli, read_csv
 
 NAMES = ["pd_autopilot", "smc_autopilot", "guidance"]

@@ -11,7 +11,7 @@ from autopilot_fmu.design import PAPER_EQ45, NomotoModel, design_model, linearis
 from autopilot_fmu.guidance import WaypointGuidance, parse_waypoints
 from autopilot_fmu.pd import PDAutopilot
 from autopilot_fmu.smc import SlidingModeAutopilot, SlidingModeDesign
-from cosim.metrics import overshoot, settling_time, sign_reversals_per_minute
+from cosim.analysis.metrics import overshoot, settling_time, sign_reversals_per_minute
 from ship_fmu.vessel import Vessel
 
 DT = 0.1

@@ -11,13 +11,15 @@ import pytest
 from autopilot_fmu.guidance import parse_waypoints
 from autopilot_fmu.pd import PDAutopilot
 from cosim import run as cli
-from cosim.direct import SIGNALS, run_direct
-from cosim.master import Master, WiringError
-from cosim.metrics import cost_terms
-from cosim.report import LAMBDA
-from cosim.ssd import read_ssd, write_ssd
+from cosim import scenarios
+from cosim.analysis.cost import LAMBDA
+from cosim.analysis.metrics import cost_terms
+from cosim.core.master import Master
+from cosim.core.ssd import read_ssd, write_ssd
+from cosim.core.wiring import WiringError
+from cosim.studies.direct import SIGNALS, run_direct
 
-SCENARIOS = Path(cli.__file__).parent / "scenarios"
+SCENARIOS = scenarios.SCENARIO_DIR
 PAPER = ["calm_pd", "calm_smc", "waves_pd", "waves_smc"]
 _cache: dict = {}
 
@@ -241,5 +243,7 @@ def test_streamed_rows_equal_the_in_memory_recording(tmp_path):
     finally:
         master.free()
     whole.write_csv(tmp_path / "whole.csv")
-    assert streamed.meta["rows_written"] == 301 and streamed.rows == 0
+    assert streamed.rows == 301 and streamed.path == tmp_path / "streamed.csv"
+    with pytest.raises(ValueError, match="streamed to"):
+        streamed["ship.psi"]                # the rows are in the file, not in memory
     assert (tmp_path / "streamed.csv").read_text() == (tmp_path / "whole.csv").read_text()

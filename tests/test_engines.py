@@ -11,11 +11,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cosim.engines import SIGNALS, EngineError, run
-from cosim.export import export
-from cosim.master import Master
-from cosim.run import SCENARIO_DIR
-from cosim.ssd import read_ssd
+from cosim import scenarios
+from cosim.core.master import Master
+from cosim.interop.engines import SIGNALS, EngineError, run
+from cosim.interop.ssp import export
 from fmukit.timebase import nanoseconds
 
 PAPER = ["calm_pd", "calm_smc", "waves_pd", "waves_smc"]
@@ -44,7 +43,7 @@ _ours: dict = {}
 
 def ours(name: str):
     if name not in _ours:
-        master = Master(read_ssd(SCENARIO_DIR / f"{name}.ssd"), coupling="jacobi")
+        master = Master(scenarios.load(name), coupling="jacobi")
         try:
             _ours[name] = master.run()
         finally:

@@ -11,12 +11,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cosim.engines import run as run_engine
-from cosim.export import export
-from cosim.fmu import FmuInstance
-from cosim.master import Master
-from cosim.run import SCENARIO_DIR
-from cosim.ssd import Component, Connection, SystemDescription, read_ssd, write_ssd
+from cosim import scenarios
+from cosim.core.fmi import FmuInstance
+from cosim.core.master import Master
+from cosim.core.ssd import Component, Connection, SystemDescription, write_ssd
+from cosim.interop.engines import run as run_engine
+from cosim.interop.ssp import export
 from fmukit.packaging import ROOT, build_script
 from fmukit.timebase import communication_point
 
@@ -65,7 +65,7 @@ def test_a_restored_state_continues_bit_for_bit(open_fmu, name):
 
 
 def _scenario_csv(tmp_path: Path, name: str) -> str:
-    master = Master(read_ssd(SCENARIO_DIR / f"{name}.ssd"))
+    master = Master(scenarios.load(name))
     try:
         master.run().write_csv(tmp_path / "inprocess.csv")
     finally:
@@ -87,7 +87,7 @@ def test_same_scenario_same_bits_across_runs_and_processes(fmu_paths, tmp_path):
 
 
 def test_same_bits_in_our_master_and_in_libcosim(fmu_paths, tmp_path):
-    master = Master(read_ssd(SCENARIO_DIR / "waves_smc.ssd"), coupling="jacobi")
+    master = Master(scenarios.load("waves_smc"), coupling="jacobi")
     try:
         ours = master.run()
     finally:
@@ -147,8 +147,8 @@ def test_a_failing_fmu_stops_the_run_cleanly(fmu_paths, fault_fmu, tmp_path, kin
 
 def test_24_hours_in_waves_stay_finite_bounded_and_phase_accurate(fmu_paths):
     """A day at sea under the PD autopilot, in-process; the wave phases at t = 86400 s."""
-    from cosim.direct import build_models
-    system = read_ssd(SCENARIO_DIR / "waves_pd.ssd")
+    from cosim.studies.direct import build_models
+    system = scenarios.load("waves_pd")
     system.components["guidance"].parameters["waypoints"] = "0,0;1e6,1e6"  # 45 deg to the waves
     models = build_models(system)
     ship, pd, guidance = models["ship"], models["autopilot"], models["guidance"]
@@ -176,7 +176,7 @@ def test_24_hours_in_waves_stay_finite_bounded_and_phase_accurate(fmu_paths):
 
 
 def test_the_fmi_call_sequence_is_enforced_by_name(open_fmu):
-    from cosim.fmu import FmuCallError
+    from cosim.core.instance import FmuCallError
     fmu = open_fmu("ship")
     slave = fmu.slave
 

@@ -11,7 +11,8 @@ import pytest
 from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 
-from cosim.fmu import FmuCallError, FmuInstance
+from cosim.core.fmi import FmuInstance
+from cosim.core.instance import FmuCallError
 from fmukit.timebase import communication_point
 from helpers import fmpy_cli, read_csv
 from ship_fmu.vessel import Vessel, VesselParameters

@@ -8,12 +8,11 @@ from pathlib import Path
 import pyarrow.parquet as pq
 import pytest
 
-from cosim import sweep
-from cosim.master import Master
-from cosim.report import cost
-from cosim.run import SCENARIO_DIR
-from cosim.seastate import model_scale
-from cosim.ssd import read_ssd
+from cosim import scenarios
+from cosim.analysis.cost import cost
+from cosim.analysis.seastate import model_scale
+from cosim.core.master import Master
+from cosim.studies import sweep
 
 EXAMPLE = Path(__file__).resolve().parent.parent / "docs" / "sweeps" / "example.toml"
 
@@ -82,7 +81,7 @@ def test_task_equals_a_direct_run_and_reuses_its_fmus(fmu_paths, tmp_path):
     master_before = dict(sweep._masters)
     assert sweep.run_one(spec, again)["J"] == row["J"]        # after fmi2Reset, bit for bit
     assert dict(sweep._masters) == master_before              # same instances, reused
-    master = Master(read_ssd(SCENARIO_DIR / "waves_pd.ssd"),
+    master = Master(scenarios.load("waves_pd"),
                     overrides={"ship": {"wave_seed": 1, "Hs": model_scale(2)[0],
                                         "T0": model_scale(2)[1], "delta_rate_max": 0.349}})
     try:
@@ -120,8 +119,8 @@ def test_dask_sweep_writes_resumes_and_plots(fmu_paths, tmp_path):
     table = pq.read_table(written[0])
     assert table.num_rows == 4 and {"controller", "wave_seed", "J", "status"} <= set(
         table.column_names)
-    from cosim.sweep_plots import save_plots
-    assert all(p.stat().st_size > 5000 for p in save_plots(spec, again, out))
+    from cosim.studies.sweep_figures import save_figures
+    assert all(p.stat().st_size > 5000 for p in save_figures(spec, again, out))
     header, rule, *settings = sweep.comparison(spec, again).splitlines()
     assert "smc wins" in header and len(settings) == 1          # one setting, two seeds
     J = {(r["controller"], r["wave_seed"]): r["J"] for r in again}

@@ -1,6 +1,6 @@
 """The master's in-process backend: the FMUs' Python classes, called without FMI.
 
-An ``InProcessInstance`` has the same interface as ``cosim.fmu.FmuInstance`` but
+An ``InProcessInstance`` has the same interface as ``cosim.core.fmi.FmuInstance`` but
 instantiates the slave class an FMU was built from (``fmukit.packaging.FMUS``) in this
 process and calls its methods directly. A run on this backend differs from a
 co-simulation only by the FMI layer (C wrapper, fmpy, ctypes), which is what the
@@ -18,8 +18,7 @@ from typing import Any
 from fmukit.packaging import FMUS
 from fmukit.slave import ModelSlave
 
-from .fmu import FmuCallError
-from .instance import Instance
+from .instance import FmuCallError, Instance
 
 _FMI_TYPE = {float: "Real", int: "Integer", str: "String"}
 

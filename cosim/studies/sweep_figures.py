@@ -76,7 +76,7 @@ def ratio_map(spec, rows: list[dict], path: Path, numerator: str = "smc",
     return path
 
 
-def save_plots(spec, rows: list[dict], out: Path) -> list[Path]:
+def save_figures(spec, rows: list[dict], out: Path) -> list[Path]:
     written = [distribution(spec, rows, out / "J_distribution.png")]
     for numerator in [c for c in spec.controllers if c != "pd"]:
         path = ratio_map(spec, rows, out / f"J_{numerator}_over_pd.png", numerator)

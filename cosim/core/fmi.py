@@ -1,33 +1,41 @@
-"""One FMU instance driven through fmpy: variables by name, captured log, clear errors."""
+"""The master's FMI backend: one FMU instance driven through fmpy, its log captured, clear errors."""
 from __future__ import annotations
 
 import shutil
 from collections import deque
 from pathlib import Path
-from typing import Any, Iterable
+from typing import Any
 
 from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException, calloc, free
 from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
                        fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, fmi2Integer, fmi2Real,
                        fmi2True, fmi2ValueReference)
+from fmpy.model_description import ModelDescription
 
-from .instance import Instance
+from .instance import FmuCallError, Instance
 
 STATUS = ("ok", "warning", "discard", "error", "fatal", "pending")
 BUILD_HINT = "build the FMUs with: python -m fmukit.build"
 
 
-class FmuCallError(RuntimeError):
-    """An FMI call returned discard, error or fatal; carries the FMU's own log."""
+def read_description(path: Path, name: str) -> ModelDescription:
+    """An FMU's model description; FileNotFoundError or ValueError naming the file and
+    how to build it when the FMU is missing or not a readable FMU."""
+    if not path.is_file():
+        raise FileNotFoundError(f"FMU for '{name}' not found: {path}; {BUILD_HINT}")
+    try:
+        return read_model_description(str(path))
+    except Exception as error:
+        raise ValueError(f"{path} is not a readable FMU ({error}); {BUILD_HINT}") from error
 
-    def __init__(self, instance: str, call: str, time: float | None, status: str,
-                 messages: Iterable[str]):
-        self.instance, self.call, self.time, self.status = instance, call, time, status
-        self.messages = list(messages)
-        at = "" if time is None else f" at t = {time:.6g} s"
-        log = "".join(f"\n  {instance} log: {m}" for m in self.messages)
-        super().__init__(f"FMU '{instance}': {call}{at} returned {status}{log}")
+
+def feedthrough(description: ModelDescription) -> dict[str, frozenset[str]]:
+    """Each output's inputs, from the model structure (all inputs where it declares none)."""
+    inputs = frozenset(v.name for v in description.modelVariables if v.causality == "input")
+    return {o.variable.name: (frozenset(d.name for d in o.dependencies)
+                              if o.dependencies is not None else inputs)
+            for o in description.outputs}
 
 
 class FmuInstance(Instance):
@@ -39,21 +47,11 @@ class FmuInstance(Instance):
 
     def __init__(self, path: str | Path, name: str, unzip_dir: str | Path | None = None):
         self.path, self.name = Path(path), name
-        if not self.path.is_file():
-            raise FileNotFoundError(f"FMU for '{name}' not found: {self.path}; {BUILD_HINT}")
-        try:
-            self.description = read_model_description(str(self.path))
-        except Exception as error:
-            raise ValueError(f"{self.path} is not a readable FMU ({error}); {BUILD_HINT}") \
-                from error
+        self.description = read_description(self.path, name)
         self._owns_unzip_dir = unzip_dir is None
         self.unzip_dir = str(unzip_dir) if unzip_dir else extract(str(self.path))
         self.variables = {v.name: v for v in self.description.modelVariables}
-        self.feedthrough = {o.variable.name: frozenset(d.name for d in o.dependencies)
-                            if o.dependencies is not None else frozenset(
-                                v.name for v in self.description.modelVariables
-                                if v.causality == "input")
-                            for o in self.description.outputs}
+        self.feedthrough = feedthrough(self.description)
         self.log: deque[str] = deque(maxlen=50)
         self._callbacks = fmi2CallbackFunctions()
         self._callbacks.logger = fmi2CallbackLoggerTYPE(self._on_log)

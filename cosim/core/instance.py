@@ -2,7 +2,9 @@
 
 A backend supplies ``call`` (run a function, turning failure into FmuCallError),
 ``fmi(name)`` (the function behind an FMI 2.0 call name such as "setReal"),
-``enter_initialization`` and ``free``; everything else is shared here.
+``enter_initialization``, ``reset`` and ``free``, and may replace the prepared
+calls (``reader``, ``integer_reader``, ``writer``, ``stepper``) that the master's
+loop uses with faster ones; everything else is shared here.
 """
 from __future__ import annotations
 
@@ -11,11 +13,25 @@ from typing import Any, Callable, Iterable
 _CONVERT = {"Real": float, "Integer": int, "Boolean": bool, "String": str}
 
 
+class FmuCallError(RuntimeError):
+    """An FMI call returned discard, error or fatal; carries the FMU's own log."""
+
+    def __init__(self, instance: str, call: str, time: float | None, status: str,
+                 messages: Iterable[str]):
+        self.instance, self.call, self.time, self.status = instance, call, time, status
+        self.messages = list(messages)
+        at = "" if time is None else f" at t = {time:.6g} s"
+        log = "".join(f"\n  {instance} log: {m}" for m in self.messages)
+        super().__init__(f"FMU '{instance}': {call}{at} returned {status}{log}")
+
+
 class Instance:
+    """One instantiated component: its variables, its feedthrough, and FMI calls."""
+
     name: str
     path: Any
     variables: dict[str, Any]          # name: object with valueReference, type, causality
-    feedthrough: dict[str, frozenset[str]]
+    feedthrough: dict[str, frozenset[str]]   # output name: the inputs it depends on
 
     def call(self, what: str, function: Callable, *args, time: float | None = None) -> Any:
         raise NotImplementedError
@@ -78,28 +94,20 @@ class Instance:
     def do_step(self, t: float, h: float) -> None:
         self.call("doStep", self.fmi("doStep"), t, h, time=t)
 
-    # Batched calls by value reference, for the master's loop.
-    def get_real(self, vrs: list[int]) -> list[float]:
-        return self.call("getReal", self.fmi("getReal"), vrs)
-
-    def get_integer(self, vrs: list[int]) -> list[int]:
-        return self.call("getInteger", self.fmi("getInteger"), vrs)
-
-    def set_real(self, vrs: list[int], values: list[float]) -> None:
-        self.call("setReal", self.fmi("setReal"), vrs, values)
-
     # Prepared calls for a fixed list of value references: what the master's loop uses.
     # A backend may override them with something faster.
     def reader(self, vrs: list[int]) -> Callable[[], list[float]]:
         """A function returning the current Real values of ``vrs``."""
-        return lambda: self.get_real(vrs)
+        return lambda: self.call("getReal", self.fmi("getReal"), vrs)
 
     def integer_reader(self, vrs: list[int]) -> Callable[[], list[int]]:
-        return lambda: self.get_integer(vrs)
+        """A function returning the current Integer values of ``vrs``."""
+        return lambda: self.call("getInteger", self.fmi("getInteger"), vrs)
 
     def writer(self, vrs: list[int]) -> Callable[[list[float]], None]:
         """A function setting the Real inputs ``vrs``."""
-        return lambda values: self.set_real(vrs, values)
+        return lambda values: self.call("setReal", self.fmi("setReal"), vrs, values)
 
     def stepper(self) -> Callable[[float, float], None]:
+        """A function taking one communication step from t of length h."""
         return self.do_step

@@ -10,11 +10,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from fmukit.timebase import communication_point
+from fmukit.timebase import communication_point, step_count
 from ship_fmu.vessel import N_PROPELLER
 
-from .inprocess import InProcessInstance
-from .ssd import SystemDescription
+from ..core.inprocess import InProcessInstance
+from ..core.ssd import SystemDescription
 
 SIGNALS = ("guidance.psi_d", "autopilot.delta_c", "ship.x", "ship.y", "ship.psi", "ship.u",
            "ship.v", "ship.r", "ship.delta")
@@ -44,7 +44,7 @@ def run_direct(system: SystemDescription, stop_time: float | None = None) -> dic
                   for n in ("n1", "n2", "n3"))
     stepping_pilot = hasattr(autopilot, "step")
     h, t0 = system.step_size, system.start_time
-    n_steps = round(((system.stop_time if stop_time is None else stop_time) - t0) / h)
+    n_steps = step_count(t0, system.stop_time if stop_time is None else stop_time, h)
     out = np.empty((n_steps + 1, len(SIGNALS)))
     for k in range(n_steps + 1):
         t = communication_point(t0, k, h)

@@ -1,0 +1,38 @@
+"""The analyses a scenario can ask for, by the kind its .ssd names: what is printed and drawn.
+
+A scenario names its kind in its system description (``SystemDescription.report``,
+an annotation of this project that other tools ignore). Each kind has a report
+(lines of text) and, unless it has nothing to show, a figure.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Callable
+
+from ..core.recording import Recording
+from .figures import course_keeping_figure, manoeuvre_figure
+from .reports import course_keeping_report, turning_circle_report, zigzag_report
+
+
+@dataclass(frozen=True)
+class Analysis:
+    """What ``cosim.run`` prints (``report``) and draws (``figure``) for a kind of scenario."""
+
+    report: Callable[..., list[str]]
+    figure: Callable[[Recording, Any], None] | None = None
+
+
+ANALYSES = {
+    "course_keeping": Analysis(course_keeping_report, course_keeping_figure),
+    "turning_circle": Analysis(turning_circle_report, manoeuvre_figure),
+    "zigzag": Analysis(zigzag_report, manoeuvre_figure),
+    "none": Analysis(lambda recording, **_: []),
+}
+
+
+def analysis(kind: str) -> Analysis:
+    """The analysis of a kind; ValueError naming the known kinds."""
+    try:
+        return ANALYSES[kind]
+    except KeyError:
+        raise ValueError(f"unknown report kind {kind!r}; known: {', '.join(ANALYSES)}") from None

@@ -1,0 +1,15 @@
+"""The co-simulation core: components, system descriptions, the master and its parts.
+
+- ``instance``: what the master needs of a component (``Instance``, ``FmuCallError``),
+  with three backends: ``fmi`` (FMUs through fmpy), ``inprocess`` (the FMUs' Python
+  classes without FMI) and ``null`` (interfaces only, to measure the master);
+- ``ssd``: SSP system structure descriptions, read and written;
+- ``wiring``: connection checks, the Gauss-Seidel order, the column layout;
+- ``coupling``: the Gauss-Seidel and Jacobi steps;
+- ``recording``: the rows of a run, in memory or streamed to CSV;
+- ``master``: ``Master``, which wires, orders and delegates to the above.
+
+Nothing here knows the ship, the paper or the command line; studies, reports and
+interop with other engines are built on top (``cosim.analysis``, ``cosim.studies``,
+``cosim.interop``).
+"""

@@ -1,0 +1,131 @@
+"""The co-simulation master: FMUs wired by an SSP system description, stepped at a fixed step.
+
+Time is counted in integer steps, t_k = t_0 + k h computed in whole nanoseconds
+(``fmukit.timebase``, the FMUs' own time base), so no rounding accumulates and a
+400 s run at 0.1 s has exactly 4000 steps and 4001 recorded rows.
+
+The master wires and delegates: ``wiring`` checks the connections, derives the
+Gauss-Seidel order from the declared feedthrough and lays out the columns;
+``coupling`` exchanges the signals and steps the FMUs at each communication
+point (Gauss-Seidel or Jacobi); ``recording`` keeps the rows, in memory or
+streamed to CSV. Every FMU output and every connected input is recorded at every
+step (inputs as the master set them, or as read back from the FMU with
+``verify_inputs``). If a call fails, the run stops with an error naming the FMU,
+the call and the time; the rows recorded up to then are kept.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Callable
+
+from fmukit.timebase import communication_point, nanoseconds, seconds, step_count
+
+from .coupling import COUPLINGS
+from .fmi import FmuInstance
+from .inprocess import InProcessInstance
+from .instance import FmuCallError, Instance
+from .null import NullInstance
+from .recording import Recorder, Recording
+from .ssd import SystemDescription
+from .wiring import check_connections, feedthrough_order, layout
+
+BACKENDS: dict[str, type[Instance]] = {"fmi": FmuInstance, "inprocess": InProcessInstance,
+                                       "null": NullInstance}
+"""fmi: the FMUs through fmpy; inprocess: their Python classes without FMI; null: nothing
+but the FMUs' interfaces, to measure the master's own cost (``cosim.core.null``)."""
+
+
+class Master:
+    """Instantiate, initialise and step the components of a system description."""
+
+    def __init__(self, system: SystemDescription, coupling: str = "gauss-seidel",
+                 backend: str = "fmi", overrides: dict[str, dict[str, Any]] | None = None,
+                 verify_inputs: bool = False):
+        for what, value, known in (("coupling", coupling, COUPLINGS),
+                                   ("backend", backend, BACKENDS)):
+            if value not in known:
+                raise ValueError(f"{what} must be one of {', '.join(known)}, got {value!r}")
+        self.system, self.coupling = system, coupling
+        self.configure(overrides)
+        self.instances: dict[str, Instance] = {}
+        try:
+            for name in system.components:
+                self.instances[name] = BACKENDS[backend](system.fmu_path(name), name)
+            check_connections(system, self.instances)
+            self.order = feedthrough_order(system, self.instances)
+            self.columns, nodes = layout(self.instances, system.connections, verify_inputs)
+        except BaseException:
+            self.free()
+            raise
+        self.nodes = [nodes[name] for name in (self.order if coupling == "gauss-seidel"
+                                               else self.instances)]
+
+    def configure(self, overrides: dict[str, dict[str, Any]] | None = None) -> None:
+        """Parameters for the next run: the system's, updated by ``overrides``."""
+        parameters = {name: dict(c.parameters) for name, c in self.system.components.items()}
+        for component, values in (overrides or {}).items():
+            if component not in parameters:
+                raise ValueError(f"--set names the component '{component}'; the system has "
+                                 f"{', '.join(parameters)}")
+            parameters[component].update(values)
+        self.parameters = parameters
+
+    def reset(self) -> None:
+        """Return every FMU to its state after instantiation (fmi2Reset), for another run."""
+        for instance in self.instances.values():
+            instance.reset()
+
+    def initialize(self) -> None:
+        """Enter initialisation, set parameters, propagate initial outputs, exit."""
+        t0 = self.system.start_time
+        for name, instance in self.instances.items():
+            instance.enter_initialization(t0)
+            instance.set(self.parameters[name], time=t0)
+        values = [0.0] * len(self.columns)
+        for _ in self.instances:          # enough passes for any acyclic chain
+            for node in self.nodes:
+                if node.read_outputs:
+                    values[node.outputs] = node.read_outputs()
+                if node.apply_inputs:
+                    node.apply_inputs(values)
+        for instance in self.instances.values():
+            instance.exit_initialization(t0)
+
+    def run(self, stop_time: float | None = None,
+            progress: Callable[[int, int], None] | None = None,
+            csv_path: str | Path | None = None, chunk_rows: int = 10_000) -> Recording:
+        """Simulate to stop_time (default: the system's); never raises on an FMU error.
+
+        ValueError if the stop time is not a whole number of steps after the start.
+        With ``csv_path`` the rows go to that CSV file in chunks of ``chunk_rows`` as
+        the run proceeds, and memory stays flat however long the run; the returned
+        recording then holds no rows itself (``rows`` counts those written).
+        """
+        system = self.system
+        t0, h = system.start_time, seconds(nanoseconds(system.step_size))
+        n_steps = step_count(t0, system.stop_time if stop_time is None else stop_time, h)
+        recorder = Recorder(self.columns, n_steps + 1, csv_path, chunk_rows,
+                            meta={"system": system.name, "coupling": self.coupling,
+                                  "step_size": h})
+        exchange, nodes, values = COUPLINGS[self.coupling], self.nodes, [0.0] * len(self.columns)
+        k, t, error = 0, t0, None
+        try:
+            self.initialize()
+            for k in range(n_steps + 1):
+                t = communication_point(t0, k, h)
+                exchange(nodes, values, t, h, k < n_steps)
+                recorder.append(t, values)
+                if progress is not None and k % 100 == 0:
+                    progress(k, n_steps)
+        except FmuCallError as failure:
+            error = (f"{failure}\n  (run stopped at step {k}, t = {t:.6g} s; "
+                     f"{recorder.rows} rows recorded)")
+        finally:
+            recording = recorder.close(error)
+        return recording
+
+    def free(self) -> None:
+        """Terminate and free every FMU."""
+        for instance in self.instances.values():
+            instance.free()
+        self.instances = {}

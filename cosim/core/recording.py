@@ -1,0 +1,103 @@
+"""What a run records, row by row: held in memory, or streamed to a CSV file in chunks.
+
+Row k holds the time t_k and one value per column (every signal of the system at
+t_k). ``Recorder`` takes the rows as the master produces them; ``close`` hands
+back the ``Recording``. Streaming keeps memory flat however long the run: rows go
+to the CSV file in chunks, and the recording then holds none of them itself.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+
+@dataclass
+class Recording:
+    """What a run recorded: row k holds every signal at t_k."""
+
+    columns: list[str]
+    time: np.ndarray                    # the rows held in memory: time, and
+    data: np.ndarray                    # one column per signal
+    rows: int = 0                       # rows the run recorded: held, or written to ``path``
+    error: str | None = None            # why the run stopped early, if it did
+    meta: dict[str, Any] = field(default_factory=dict)
+    path: Path | None = None            # where the rows went, if streamed to CSV
+
+    def __getitem__(self, column: str) -> np.ndarray:
+        self._require_held()
+        return self.data[:, self.columns.index(column)]
+
+    @property
+    def t(self) -> np.ndarray:
+        self._require_held()
+        return self.time
+
+    def _require_held(self) -> None:
+        if len(self.time) < self.rows:
+            raise ValueError(f"the {self.rows} rows of this run were streamed to {self.path}; "
+                             "read them from there")
+
+    def write_csv(self, path: str | Path) -> None:
+        """All rows, a header of column names; floats in their shortest exact form."""
+        sink = CsvSink(path, self.columns)
+        sink.write(self.t, self.data)
+        sink.close()
+
+
+class CsvSink:
+    """Rows appended to a CSV file as they come, in the shortest exact float form."""
+
+    def __init__(self, path: str | Path, columns: list[str]):
+        self.path, self.rows = Path(path), 0
+        self.file = open(self.path, "w")
+        self.file.write(",".join(["time", *columns]) + "\n")
+
+    def write(self, times: np.ndarray, data: np.ndarray) -> None:
+        table = np.column_stack([times, data]).tolist()
+        self.file.writelines(",".join(map(repr, row)) + "\n" for row in table)
+        self.file.flush()
+        self.rows += len(table)
+
+    def close(self) -> None:
+        self.file.close()
+
+
+class Recorder:
+    """Takes a run's rows one at a time; with ``csv_path``, streams them in chunks."""
+
+    def __init__(self, columns: list[str], rows: int, csv_path: str | Path | None = None,
+                 chunk_rows: int = 10_000, meta: dict[str, Any] | None = None):
+        self.columns, self.meta = columns, meta or {}
+        self.sink = CsvSink(csv_path, columns) if csv_path is not None else None
+        size = rows if self.sink is None else min(chunk_rows, rows)
+        self.time, self.data = np.empty(size), np.full((size, len(columns)), np.nan)
+        self.held = 0                   # rows in the buffer, not yet written
+
+    @property
+    def rows(self) -> int:
+        """Rows recorded so far: written and held."""
+        return (self.sink.rows if self.sink else 0) + self.held
+
+    def append(self, t: float, values: list[float]) -> None:
+        row = self.held
+        self.time[row], self.data[row] = t, values
+        self.held = row + 1
+        if self.sink is not None and self.held == len(self.time):
+            self._flush()
+
+    def _flush(self) -> None:
+        self.sink.write(self.time[:self.held], self.data[:self.held])
+        self.held = 0
+
+    def close(self, error: str | None = None) -> Recording:
+        """The recording; a stream gets its last rows and is closed."""
+        if self.sink is None:
+            return Recording(self.columns, self.time[:self.held], self.data[:self.held],
+                             self.held, error, self.meta)
+        self._flush()
+        self.sink.close()
+        return Recording(self.columns, np.empty(0), np.empty((0, len(self.columns))),
+                         self.sink.rows, error, self.meta, self.sink.path)

@@ -1,0 +1,185 @@
+"""Run an exported SSP package (``cosim.export``) in another co-simulation engine.
+
+Engines: ``libcosim`` (OSP, through libcosimpy), ``ecos`` (through ecospy) and
+``fmpy`` (fmpy's own SSP runner). Each returns the signals it recorded with the
+time each value belongs to:
+
+- ecos: t_k = k h for k = 0 .. N, read after every step (its coupling is Jacobi:
+  every FMU steps on the previous step's outputs); libcosim likewise, but from t_1,
+  because it initialises the FMUs at its first step and has nothing to observe before;
+- fmpy's runner records after each step but labels the row with the time the step
+  started, so its values belong to t_1, t_2, ...; and it accumulates time as a
+  float, stepping while the sum is below the stop time. Where the sum falls short
+  it takes one step too many: 0.1 added 3000 times is 299.9999999999998, so a 300 s
+  run gets 3001 steps; added 4000 times it is 400.00000000002, so a 400 s run gets
+  exactly 4000. Compare by time, as ``tests/test_engines.py`` does.
+
+By default each run happens in a child process, because neither engine reports an
+FMU's error to its Python caller: libcosimpy 0.0.6 aborts the process
+(std::terminate from a worker thread) when an FMU fails during initialisation,
+and ecos 0.7.2 ignores FMI status codes and discards FMU log messages. The
+child runs with FMUKIT_LOG_STDERR=1, so our FMUs also write their errors to
+standard error; a crash, or outputs that are undefined (NaN, what our FMUs give
+after refusing their parameters), becomes an ``EngineError`` that carries that
+output.
+
+The command line: ``python -m cosim.engines ENGINE PACKAGE.ssp --out trace.npz``.
+"""
+from __future__ import annotations
+
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import zipfile
+from pathlib import Path
+
+import numpy as np
+
+from fmukit.timebase import step_count
+
+from .ssp import read_package
+
+ENGINES = ("libcosim", "ecos", "fmpy")
+SIGNALS = ("ship.psi", "ship.r", "ship.delta")
+
+
+class EngineError(RuntimeError):
+    """An engine failed or produced undefined values; the message holds its output."""
+
+
+def _split(signal: str) -> tuple[str, str]:
+    component, _, variable = signal.partition(".")
+    return component, variable
+
+
+def _libcosim(ssp: Path, signals: tuple[str, ...]) -> dict[str, np.ndarray]:
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimObserver import CosimObserver
+
+    log_output_level(CosimLogLevel.ERROR)
+    system = read_package(ssp)
+    n_steps = step_count(system.start_time, system.stop_time, system.step_size)
+    execution = CosimExecution.from_ssp_file(str(ssp))
+    slaves = {s.name.decode(): s.index for s in execution.slave_infos()}
+    references = {name: {v.name.decode(): v.reference for v in execution.slave_variables(i)}
+                  for name, i in slaves.items()}
+    observer = CosimObserver.create_last_value()
+    execution.add_observer(observer)
+    reads = [(slaves[c], references[c][v]) for c, v in map(_split, signals)]
+
+    def sample() -> list[float]:
+        return [observer.last_real_values(index, [vr])[0] for index, vr in reads]
+
+    rows = []
+    for k in range(n_steps):
+        if not execution.step():
+            raise EngineError(f"libcosim failed at step {k + 1}")
+        rows.append(sample())
+    times = system.start_time + system.step_size * np.arange(1, n_steps + 1)
+    return {"time": times, **dict(zip(signals, np.array(rows).T))}
+
+
+def _ecos(ssp: Path, signals: tuple[str, ...]) -> dict[str, np.ndarray]:
+    from ecospy import EcosLib, EcosSimulation
+
+    EcosLib.set_log_level("err")
+    system = read_package(ssp)
+    n_steps = step_count(system.start_time, system.stop_time, system.step_size)
+    simulation = EcosSimulation(step_size=system.step_size, ssp_path=str(ssp))
+    identifiers = [f"{c}::{v}" for c, v in map(_split, signals)]
+    try:
+        if not simulation.init(parameter_set="scenario"):
+            raise EngineError(f"ecos failed to initialise: {EcosLib.get_last_error()}")
+        rows = [[simulation.get_real(i) for i in identifiers]]
+        for k in range(n_steps):
+            if not all(map(math.isfinite, rows[-1])):   # ecos ignores refused calls
+                raise EngineError(f"ecos reported success, but {signals} are undefined "
+                                  f"at step {k}: an FMU refused to run")
+            simulation.step()
+            rows.append([simulation.get_real(i) for i in identifiers])
+    finally:
+        simulation.terminate()
+        simulation.free()
+    times = system.start_time + system.step_size * np.arange(n_steps + 1)
+    return {"time": times, **dict(zip(signals, np.array(rows).T))}
+
+
+def _fmpy(ssp: Path, signals: tuple[str, ...]) -> dict[str, np.ndarray]:
+    from fmpy import read_model_description
+    from fmpy.ssp.simulation import simulate_ssp
+    from fmpy.ssp.ssd import Parameter, ParameterSet
+
+    system = read_package(ssp)
+    # fmpy's runner applies no parameter bindings itself and cannot set Strings:
+    # pass the package's own values, fully qualified; a String must equal the FMU's
+    # default, or the run would not be the scenario.
+    parameters = ParameterSet()
+    with tempfile.TemporaryDirectory() as tmp:
+        with zipfile.ZipFile(ssp) as package:
+            package.extractall(tmp)
+        for name, component in system.components.items():
+            starts = {v.name: v.start for v in read_model_description(
+                str(Path(tmp) / component.source)).modelVariables}
+            for variable, value in component.parameters.items():
+                if isinstance(value, str):
+                    if value != starts[variable]:
+                        raise EngineError(f"fmpy's SSP runner cannot set the String "
+                                          f"{name}.{variable} = {value!r}")
+                    continue
+                parameters.parameters.append(Parameter(name=f"{name}.{variable}",
+                                                       type=type(value).__name__, value=value))
+    result = simulate_ssp(str(ssp), start_time=system.start_time, stop_time=system.stop_time,
+                          step_size=system.step_size, parameter_set=parameters)
+    times = np.array(result["time"]) + system.step_size   # rows hold values after each step
+    return {"time": times, **{s: np.asarray(result[s]) for s in signals}}
+
+
+RUNNERS = {"libcosim": _libcosim, "ecos": _ecos, "fmpy": _fmpy}
+
+
+def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = SIGNALS,
+        isolate: bool = True) -> dict[str, np.ndarray]:
+    """Run ``ssp`` in ``engine``; raise EngineError with the engine's output if it fails."""
+    if engine not in ENGINES:
+        raise ValueError(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
+    ssp = Path(ssp).resolve()
+    if not isolate:
+        result = RUNNERS[engine](ssp, tuple(signals))
+        _check_defined(engine, result, "")
+        return result
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "trace.npz"
+        child = subprocess.run(
+            [sys.executable, "-m", "cosim.engines", engine, str(ssp), "--out", str(out),
+             "--signals", *signals],
+            capture_output=True, text=True, timeout=600,
+            env={**os.environ, "FMUKIT_LOG_STDERR": "1"})
+        log = _summary(child.stdout + child.stderr)
+        if child.returncode != 0 or not out.exists():
+            raise EngineError(f"{engine} failed on {ssp.name} (exit status "
+                              f"{child.returncode}):\n{log}")
+        with np.load(out) as data:
+            result = {key: data[key] for key in data.files}
+    _check_defined(engine, result, log)
+    return result
+
+
+def _summary(log: str, head: int = 20, tail: int = 5) -> str:
+    """The first lines of a log (where the cause is) and its last ones."""
+    lines = [line for line in log.strip().splitlines() if line.strip()]
+    if len(lines) <= head + tail:
+        return "\n".join(lines)
+    return "\n".join(lines[:head] + [f"... ({len(lines) - head - tail} more lines) ..."]
+                     + lines[-tail:])
+
+
+def _check_defined(engine: str, result: dict[str, np.ndarray], log: str) -> None:
+    for signal, values in result.items():
+        bad = np.flatnonzero(~np.isfinite(values))
+        if bad.size:
+            raise EngineError(f"{engine} reported success, but {signal} is undefined from "
+                              f"t = {result['time'][bad[0]]:.6g} s: an FMU refused to run "
+                              f"and the engine did not stop.\n{log}")

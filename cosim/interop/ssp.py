@@ -1,0 +1,48 @@
+"""SSP packages for other FMI tools: a scenario exported as one self-contained .ssp file.
+
+The package is a zip holding SystemStructure.ssd (components, connections, the
+scenario's parameter values, the fixed step as an OSP annotation) and
+resources/<fmu>.fmu for every FMU it uses. OSP libcosim, ecos, fmpy and
+OMSimulator load it unchanged (see README, "Using the FMUs elsewhere").
+"""
+from __future__ import annotations
+
+import tempfile
+import zipfile
+from pathlib import Path
+
+from .. import scenarios
+from ..core.fmi import BUILD_HINT
+from ..core.ssd import SystemDescription, read_ssd, write_ssd
+
+SSD_NAME = "SystemStructure.ssd"
+
+
+def export(scenario: str, out: Path, overrides: dict[str, dict] | None = None) -> Path:
+    """Write out/<name>.ssp; ``overrides`` changes parameter values by component."""
+    system = scenarios.load(scenario)
+    name = Path(scenario).stem
+    for component, values in (overrides or {}).items():
+        system.components[component].parameters.update(values)
+    fmus = {c: system.fmu_path(c) for c in system.components}
+    for component, path in fmus.items():
+        if not path.is_file():
+            raise FileNotFoundError(f"FMU for '{component}' not found: {path}; {BUILD_HINT}")
+    sources = {c: f"resources/{path.name}" for c, path in fmus.items()}
+    target = out / f"{name}.ssp"
+    with tempfile.TemporaryDirectory() as tmp:
+        ssd = Path(tmp) / SSD_NAME
+        write_ssd(system, ssd, sources)
+        with zipfile.ZipFile(target, "w", zipfile.ZIP_DEFLATED) as package:
+            package.write(ssd, SSD_NAME)
+            for path in sorted(set(fmus.values())):
+                package.write(path, f"resources/{path.name}")
+    return target
+
+
+def read_package(ssp: Path) -> SystemDescription:
+    """The system description inside an SSP package."""
+    with tempfile.TemporaryDirectory() as tmp:
+        with zipfile.ZipFile(ssp) as package:
+            package.extract(SSD_NAME, tmp)
+        return read_ssd(Path(tmp) / SSD_NAME)

@@ -1,0 +1,40 @@
+"""The scenarios: one SSP system structure file (.ssd) each, and their registry.
+
+Every command that takes a scenario takes its name (a file here, e.g.
+``calm_pd``) or, where it says so, a path to a .ssd file. ``PAPER`` lists the
+paper's four runs, the ones behind its Tables 1-2.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..core.ssd import SystemDescription, read_ssd
+
+SCENARIO_DIR = Path(__file__).resolve().parent
+PAPER = ("calm_pd", "calm_smc", "waves_pd", "waves_smc")
+"""Tomera (2010), Tables 1-2 and Figs 2-3: PD and sliding mode, calm water and waves."""
+
+
+def names() -> list[str]:
+    """The scenarios of this package, sorted."""
+    return sorted(p.stem for p in SCENARIO_DIR.glob("*.ssd"))
+
+
+def path(scenario: str | Path) -> Path:
+    """A scenario's .ssd: a name of this package, or a path to a .ssd file.
+
+    ValueError listing the valid names for an unknown name; FileNotFoundError for
+    a .ssd path that is not a file.
+    """
+    if str(scenario).endswith(".ssd"):
+        if not Path(scenario).is_file():
+            raise FileNotFoundError(f"no system structure file {scenario}")
+        return Path(scenario)
+    if scenario not in names():
+        raise ValueError(f"unknown scenario {scenario!r}; valid scenarios: {', '.join(names())}")
+    return SCENARIO_DIR / f"{scenario}.ssd"
+
+
+def load(scenario: str | Path) -> SystemDescription:
+    """The system description of a scenario (a name or a .ssd path, as ``path``)."""
+    return read_ssd(path(scenario))
