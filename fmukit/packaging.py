@@ -3,13 +3,17 @@
 Each FMU carries in its resources the project packages it imports (Python
 sources only) and a requirements.txt, so a host needs only Python with numpy
 (``pythonfmu deploy -f fmus/ship.fmu`` installs it). After building, the
-modelDescription.xml is checked with fmpy's validator; a problem fails the build.
+binary gets ``fmukit.exit_fix`` (pythonfmu 0.7.0 corrupts its host's heap at
+exit) and the modelDescription.xml is checked with fmpy's validator; a problem
+fails the build.
 """
 from __future__ import annotations
 
 import shutil
 import tempfile
 from pathlib import Path
+
+from . import exit_fix
 
 ROOT = Path(__file__).resolve().parent.parent
 FMU_DIR = ROOT / "fmus"
@@ -53,6 +57,7 @@ def build_script(script: Path, packages: tuple[str, ...], fmu_path: Path) -> Pat
             stage / Path(script).name, dest=fmu_path,
             project_files=[stage / p for p in packages] + [stage / "requirements.txt"],
             canGetAndSetFMUstate=True, canSerializeFMUstate=True)
+    exit_fix.fix_fmu(Path(fmu))
     problems = validate_fmu(str(fmu))
     if problems:
         raise RuntimeError(f"{fmu} does not validate:\n" + "\n".join(problems))

@@ -1,10 +1,13 @@
-"""Failure behaviour: saved states, determinism, a failing FMU in the master, long runs."""
+"""Failure behaviour: saved states, determinism, a failing FMU in the master, long runs,
+and hosts that survive loading our FMUs."""
 from __future__ import annotations
 
 import math
 import os
+import signal
 import subprocess
 import sys
+import zipfile
 from fractions import Fraction
 from pathlib import Path
 
@@ -203,3 +206,50 @@ def test_the_fmi_call_sequence_is_enforced_by_name(open_fmu):
     fmu.reset()                                                # back to instantiated
     fmu.initialize()
     fmu.do_step(0.0, 0.1)
+
+
+@pytest.fixture(scope="module")
+def exit_heap_host(tmp_path_factory) -> tuple[Path, Path]:
+    """The exit-time host of tests/exit_heap and its late allocator library, compiled."""
+    folder = Path(__file__).parent / "exit_heap"
+    library = tmp_path_factory.mktemp("exit_heap") / "late_malloc.so"
+    subprocess.run(["gcc", "-shared", "-fPIC", "-o", str(library),
+                    str(folder / "late_malloc.c")], check=True)
+    return folder / "host.py", library
+
+
+def _host_exit_status(host: tuple[Path, Path], fmu: Path) -> tuple[int, str]:
+    child = subprocess.run([sys.executable, str(host[0]), str(fmu), str(host[1])],
+                           capture_output=True, text=True, timeout=120)
+    return child.returncode, child.stderr
+
+
+@pytest.mark.parametrize("name", list(PROGRAMS))
+def test_a_host_that_loaded_an_fmu_exits_with_its_heap_intact(fmu_paths, exit_heap_host,
+                                                              name):
+    status, err = _host_exit_status(exit_heap_host, fmu_paths[name])
+    assert status == 0, err
+
+
+def test_without_the_exit_fix_the_same_host_aborts(fmu_paths, exit_heap_host, tmp_path):
+    """The check above can fail: pythonfmu 0.7.0's own binary corrupts the heap at exit."""
+    from fmukit.exit_fix import KNOWN_BINARIES
+
+    offset, original, patched = next(iter(KNOWN_BINARIES.values()))
+    unfixed = tmp_path / "ship.fmu"
+    with zipfile.ZipFile(fmu_paths["ship"]) as fixed, zipfile.ZipFile(unfixed, "w") as out:
+        for info in fixed.infolist():
+            data = fixed.read(info)
+            if info.filename.startswith("binaries/linux64/"):
+                assert data[offset:offset + len(patched)] == patched
+                data = data[:offset] + original + data[offset + len(patched):]
+            out.writestr(info, data)
+    status, err = _host_exit_status(exit_heap_host, unfixed)
+    assert status == -signal.SIGABRT and "corrupted" in err
+
+
+def test_the_exit_fix_refuses_a_binary_it_does_not_know():
+    from fmukit.exit_fix import patch
+
+    with pytest.raises(RuntimeError, match="ship.so is not the pythonfmu 0.7.0 linux64 binary"):
+        patch(b"\x7fELF something else", "ship.fmu:binaries/linux64/ship.so")

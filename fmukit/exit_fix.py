@@ -1,0 +1,60 @@
+"""A fix for pythonfmu 0.7.0's linux64 binary, which corrupts its host's heap at process exit.
+
+The binary keeps its Python state in a global ``std::shared_ptr<PyState>``. At
+exit, the C++ static destructors destroy it first (freeing its control block);
+only afterwards, from ``.fini_array``, its ``__attribute__((destructor))``
+``onLibraryUnload`` assigns ``pyState = nullptr`` to the dead pointer, which
+decrements a counter inside the freed block, by then often one of malloc's
+free-list pointers. A later malloc or free at exit (numpy's libgfortran, the
+OpenBLAS thread) then aborts with "corrupted double-linked list". The library
+is never really unloaded before exit (its STB_GNU_UNIQUE symbols make it
+NODELETE), so every host process that loaded an FMU is exposed, Python or not:
+seen as an intermittent SIGABRT of ``fmpy simulate`` and of pytest at exit.
+
+The static destructor already shuts the Python state down, so the fix turns
+``onLibraryUnload`` into a plain return. It is applied to a built FMU's linux64
+binary only when that binary is the exact pythonfmu 0.7.0 build (by SHA-256) and
+the expected instructions are where the symbol table puts them; any other binary
+fails the build, so that a pythonfmu upgrade is looked at again. The upstream
+fix: drop ``onLibraryUnload``, or never destroy ``pyState``.
+"""
+from __future__ import annotations
+
+import hashlib
+import zipfile
+from pathlib import Path
+
+# SHA-256 of the binary: (file offset of onLibraryUnload, its code, the patched code).
+# endbr64; jmp finalizePythonInterpreter  ->  endbr64; ret
+KNOWN_BINARIES = {
+    "4be156a552c16f30eb4395805c59855d8d4086056d0f165442565f6c5fbac0c9":   # 0.7.0 linux64
+        (0x16F30, bytes.fromhex("f30f1efae937dcffff"), bytes.fromhex("f30f1efac337dcffff")),
+}
+
+
+def patch(binary: bytes, where: str) -> bytes:
+    """The binary with ``onLibraryUnload`` made a no-op; RuntimeError naming ``where`` if unknown."""
+    digest = hashlib.sha256(binary).hexdigest()
+    fix = KNOWN_BINARIES.get(digest)
+    if fix is None:
+        raise RuntimeError(f"{where} is not the pythonfmu 0.7.0 linux64 binary whose exit-time "
+                           f"heap corruption fmukit.exit_fix knows how to fix (SHA-256 "
+                           f"{digest}); check the new binary and extend KNOWN_BINARIES")
+    offset, code, patched = fix
+    if binary[offset:offset + len(code)] != code:
+        raise RuntimeError(f"{where}: unexpected code at onLibraryUnload")
+    return binary[:offset] + patched + binary[offset + len(code):]
+
+
+def fix_fmu(fmu_path: Path) -> None:
+    """Apply ``patch`` to every linux64 binary inside a freshly built FMU, in place."""
+    with zipfile.ZipFile(fmu_path) as fmu:
+        entries = [(info, fmu.read(info)) for info in fmu.infolist()]
+    entries = [(info, patch(data, f"{fmu_path}:{info.filename}")
+                if info.filename.startswith("binaries/linux64/") else data)
+               for info, data in entries]
+    tmp = fmu_path.with_name(fmu_path.name + ".tmp")
+    with zipfile.ZipFile(tmp, "w") as fmu:
+        for info, data in entries:
+            fmu.writestr(info, data)
+    tmp.replace(fmu_path)
