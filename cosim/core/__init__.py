@@ -9,7 +9,8 @@
 - ``recording``: the rows of a run, in memory or streamed to CSV;
 - ``master``: ``Master``, which wires, orders and delegates to the above.
 
-Nothing here knows the ship, the paper or the command line; studies, reports and
-interop with other engines are built on top (``cosim.analysis``, ``cosim.studies``,
+No code here depends on the ship, the paper or the command line (the docstrings use
+the paper's diagram as their example); studies, reports and interop with other
+engines are built on top (``cosim.analysis``, ``cosim.studies``,
 ``cosim.interop``).
 """

@@ -4,7 +4,8 @@ The subset used here is the one OSP libcosim, ecos and fmpy all read: one system
 FMU components with connectors, inline parameter sets (ssv:Real, Integer, Boolean,
 String), connections, and a DefaultExperiment whose OSP annotation gives the fixed
 step. This project adds one annotation of its own (type ``REPORT_ANNOTATION``)
-naming the analysis ``cosim.run`` prints; other tools ignore it.
+naming the kind of analysis a run of the system gets (``cosim.analysis.kinds``);
+other tools ignore it.
 """
 from __future__ import annotations
 
