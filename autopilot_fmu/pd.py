@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .angles import wrap
+from fmukit.numerics import wrap
 
 
 @dataclass(frozen=True)

@@ -43,9 +43,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fmukit.numerics import require_finite, substeps
+from fmukit.numerics import require_finite, substeps, wrap
 
-from .angles import wrap
 from .design import NomotoModel, SwayYawModel
 
 H_MAX = 0.1

@@ -5,6 +5,7 @@ Examples:
   python -m cosim.run waves_smc --out /tmp/w   the sliding-mode autopilot in waves
   python -m cosim.run calm_pd --set ship.Hs=0.003 --set autopilot.Kd=30
   python -m cosim.run --all                    the paper's four runs, Tables 1-2
+  python -m cosim.run waves_pd --autopilot my.fmu   your own autopilot in waves_pd's place
 
 Each scenario is an SSP system structure file in cosim/scenarios/ (the FMUs, their
 parameters and connections). A run writes every signal at every 0.1 s step to
@@ -16,6 +17,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import NamedTuple
 
 from . import scenarios
 from ._cli import Progress, chosen_scenarios, writable_folder
@@ -24,7 +26,10 @@ from .analysis.figures import save_figure
 from .analysis.kinds import analysis
 from .analysis.reports import tables
 from .core.coupling import COUPLINGS
+from .core.instance import FmuCallError
 from .core.master import BACKENDS, Master
+from .core.ssd import SystemDescription
+from .scenarios.autopilot import COMPONENT, AutopilotError, check_autopilot
 
 RUN_BACKENDS = [b for b in BACKENDS if b != "null"]     # null runs measure the master only
 
@@ -43,16 +48,23 @@ def parse_setting(text: str) -> tuple[str, str, int | float | str]:
     return component, variable, raw
 
 
-def run_scenario(name: str, out: Path, overrides: dict, coupling: str, stop_time: float | None,
-                 lam: float, plot: bool = True, backend: str = "fmi",
-                 stream: bool = False) -> tuple[int, Cost | None]:
-    """Simulate one scenario, write its CSV and figure, print its report."""
-    system = scenarios.load(name)
+def parse_port_map(text: str) -> tuple[str, str]:
+    """'psi=heading' -> ('psi', 'heading')."""
+    port, sep, name = text.partition("=")
+    if not (sep and port and name):
+        raise argparse.ArgumentTypeError(f"--map expects PORT=NAME, e.g. psi=heading; "
+                                         f"got {text!r}")
+    return port, name
+
+
+def run_scenario(system: SystemDescription, label: str, out: Path, overrides: dict,
+                 coupling: str, stop_time: float | None, lam: float, plot: bool = True,
+                 backend: str = "fmi", stream: bool = False) -> tuple[int, Cost | None]:
+    """Simulate one system, write its CSV and figure as ``label``, print its report."""
     kind = analysis(system.report)
-    name = Path(name).stem
     master = Master(system, coupling=coupling, overrides=overrides, backend=backend)
-    progress = Progress(name)
-    csv_path = out / f"{name}.csv"
+    progress = Progress(label)
+    csv_path = out / f"{label}.csv"
     try:
         recording = master.run(stop_time, progress=progress,
                                csv_path=csv_path if stream else None)
@@ -61,7 +73,7 @@ def run_scenario(name: str, out: Path, overrides: dict, coupling: str, stop_time
         master.free()
     if not stream:
         recording.write_csv(csv_path)
-    print(f"{name}: {system.description}")
+    print(f"{label}: {system.description}")
     if recording.error:
         print(f"error: {recording.error}", file=sys.stderr)
         print(f"  the {recording.rows} rows recorded before the error are in {csv_path}",
@@ -75,10 +87,32 @@ def run_scenario(name: str, out: Path, overrides: dict, coupling: str, stop_time
         print(f"  {line}")
     written = [csv_path]
     if plot and kind.figure is not None:
-        written.append(save_figure(recording, kind.figure, out / f"{name}.png",
-                                   f"{name}: {system.description}"))
+        written.append(save_figure(recording, kind.figure, out / f"{label}.png",
+                                   f"{label}: {system.description}"))
     print(f"  wrote {', '.join(str(p) for p in written)}")
     return 0, cost(recording, lam) if system.report == "course_keeping" else None
+
+
+class Run(NamedTuple):
+    scenario: str                       # a name or a .ssd path
+    label: str                          # names the output files
+    autopilot: Path | None              # a user's autopilot in place of the scenario's
+    table_row: tuple[str, str] | None   # (sea, controller) in Tables 1-2
+
+
+def runs_asked(names: list[str], paper: bool, autopilot: Path | None,
+               name: str | None) -> list[Run]:
+    """Every run of the command line. With --all and --autopilot, the user's autopilot also
+    runs in calm_pd's and waves_pd's place: same route, ship and sea, another controller."""
+    name = name or (autopilot.stem if autopilot else None)
+    if not paper:
+        stem = Path(names[0]).stem
+        return [Run(names[0], f"{stem}-{name}" if autopilot else stem, autopilot, None)]
+    runs = [Run(scenario, scenario, None, tuple(scenario.split("_"))) for scenario in names]
+    if autopilot is not None:
+        runs += [Run(scenario, f"{scenario}-{name}", autopilot, (scenario.split("_")[0], name))
+                 for scenario in ("calm_pd", "waves_pd")]
+    return runs
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -107,32 +141,57 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--backend", choices=RUN_BACKENDS, default="fmi",
                         help="fmi: load the FMUs from fmus/ (default); inprocess: call the "
                              "FMUs' Python classes directly, without FMI")
+    parser.add_argument("--autopilot", type=Path, metavar="FMU",
+                        help="your own autopilot, an FMI 2.0 co-simulation FMU with inputs psi "
+                             "(rad), r (rad/s), psi_d (rad) and output delta_c (rad), in place "
+                             "of the scenario's; with --all it also runs in calm_pd's and "
+                             "waves_pd's place, as an extra row of Tables 1-2 (see "
+                             "docs/own_autopilot.md)")
+    parser.add_argument("--map", action="append", default=[], type=parse_port_map,
+                        metavar="PORT=NAME",
+                        help="the FMU's name of an autopilot port, e.g. psi=heading; repeatable")
+    parser.add_argument("--name", help="the autopilot's name in file names and tables "
+                                       "(default: the FMU's file name)")
     parser.add_argument("--no-plot", action="store_true", help="skip the figure")
     parser.add_argument("--stream", action="store_true",
                         help="write rows to the CSV in chunks as the run goes: flat memory "
                              "for long runs (--stop-time 86400); no report or figure")
     args = parser.parse_args(argv)
     names = chosen_scenarios(parser, args.scenario, args.all)
+    if args.autopilot is None and (args.map or args.name):
+        parser.error("--map and --name describe an --autopilot FMU; give one")
+    if args.autopilot is not None:
+        try:
+            check_autopilot(args.autopilot, dict(args.map))   # before anything is run
+        except AutopilotError as error:
+            print(f"error: {error}", file=sys.stderr)
+            return 2
     overrides: dict[str, dict] = {}
     for component, variable, value in args.set:
         overrides.setdefault(component, {})[variable] = value
+    # With --all, autopilot.* settings are for the user's autopilot, not the paper's.
+    paper_overrides = {c: v for c, v in overrides.items()
+                       if c != COMPONENT or args.autopilot is None}
 
     status, costs = 0, {}
-    for name in names:
-        out = args.out or Path("results") / Path(name).stem
+    for run in runs_asked(names, args.all, args.autopilot, args.name):
+        out = args.out or Path("results") / run.label
         if args.all and args.out:
-            out = args.out / name
+            out = args.out / run.label
         writable_folder(out)
         try:
-            code, result = run_scenario(name, out, overrides, args.coupling, args.stop_time,
-                                        args.lam, plot=not args.no_plot, backend=args.backend,
-                                        stream=args.stream)
-        except (ValueError, FileNotFoundError) as error:
+            system = scenarios.load(run.scenario, run.autopilot, dict(args.map), args.name)
+            code, result = run_scenario(system, run.label, out,
+                                        overrides if run.autopilot else paper_overrides,
+                                        args.coupling,
+                                        args.stop_time, args.lam, plot=not args.no_plot,
+                                        backend=args.backend, stream=args.stream)
+        except (ValueError, FileNotFoundError, FmuCallError) as error:
             print(f"error: {error}", file=sys.stderr)
             return 2
         status = max(status, code)
-        if result is not None:
-            costs[name] = result
+        if result is not None and run.table_row is not None:
+            costs[run.table_row] = result
     if args.all and costs:
         print()
         print(tables(costs))

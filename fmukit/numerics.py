@@ -1,9 +1,10 @@
-"""Numerical rules every model here follows: finite inputs, bounded sub-stepping.
+"""Numerical rules every model here follows: finite inputs, bounded sub-stepping, wrapped angles.
 
-Plain modules (``ship_fmu``, ``autopilot_fmu``) use these as much as the FMUs do:
-a model refuses a non-finite input by name, and a communication step is cut into
-equal integration steps no longer than the model's largest, with a bound on how
-many, so that a huge step is refused instead of hanging the host.
+Plain modules (``ship_fmu``, ``autopilot_fmu``) and your own autopilot use these as
+much as the FMUs do: a model refuses a non-finite input by name; a communication
+step is cut into equal integration steps no longer than the model's largest, with
+a bound on how many, so that a huge step is refused instead of hanging the host;
+angle differences are wrapped to (-pi, pi], the short way round.
 """
 from __future__ import annotations
 
@@ -11,6 +12,12 @@ import math
 
 MAX_SUBSTEPS = 100_000
 """Most integration steps one communication step may take."""
+
+
+def wrap(angle: float) -> float:
+    """The angle mod 2 pi in (-pi, pi]: the short way round."""
+    wrapped = math.remainder(angle, 2.0 * math.pi)
+    return math.pi if wrapped == -math.pi else wrapped
 
 
 def require_finite(**values: float) -> None:

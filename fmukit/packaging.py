@@ -28,9 +28,12 @@ FMUS: dict[str, tuple[str, tuple[str, ...]]] = {
     "smc_autopilot": ("autopilot_fmu/smc_autopilot_slave.py",
                       ("fmukit", "autopilot_fmu", "ship_fmu")),
     "guidance": ("autopilot_fmu/guidance_slave.py", ("fmukit", "autopilot_fmu", "ship_fmu")),
+    # Written as a user's own autopilot is (docs/own_autopilot.md): one file and fmukit.
+    "pid_autopilot": ("autopilot_fmu/pid_autopilot_slave.py", ("fmukit",)),
 }
 
 RUNTIME_REQUIREMENTS = "numpy\n"
+BUILD_HINT = "build the FMUs with: python -m fmukit.build"
 
 
 def build(name: str, dest: Path = FMU_DIR) -> Path:

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from autopilot_fmu.angles import wrap
+from fmukit.numerics import wrap
 from autopilot_fmu.design import PAPER_EQ45, NomotoModel, design_model, linearised_ship
 from autopilot_fmu.guidance import WaypointGuidance, parse_waypoints
 from autopilot_fmu.pd import PDAutopilot

@@ -15,6 +15,7 @@ from cosim import scenarios
 from cosim.analysis.cost import LAMBDA
 from cosim.analysis.metrics import cost_terms
 from cosim.core.master import Master
+from cosim.core import ssd
 from cosim.core.ssd import read_ssd, write_ssd
 from cosim.core.wiring import WiringError
 from cosim.studies.direct import SIGNALS, run_direct
@@ -178,11 +179,30 @@ def _variant(tmp_path: Path, name: str, edit) -> Path:
     return path
 
 
-def test_missing_fmu_says_how_to_build_it(tmp_path):
+def test_missing_fmu_names_the_paths_tried_and_says_how_to_build_it(tmp_path, monkeypatch):
+    monkeypatch.setattr(ssd, "FMU_SEARCH_PATH", [tmp_path / "empty"])
+
     def edit(d):
         d.components["ship"].source = str(tmp_path / "nowhere" / "ship.fmu")
-    with pytest.raises(FileNotFoundError, match="python -m fmukit.build"):
+    with pytest.raises(FileNotFoundError, match="python -m fmukit.build") as missing:
         Master(read_ssd(_variant(tmp_path, "calm_pd", edit)))
+    assert f"tried {tmp_path / 'nowhere' / 'ship.fmu'}, {tmp_path / 'empty' / 'ship.fmu'}" \
+        in str(missing.value)
+
+
+def test_a_missing_fmu_of_the_user_is_not_a_build_problem(tmp_path):
+    def edit(d):
+        d.components["autopilot"].source = "my_pilot.fmu"
+    with pytest.raises(FileNotFoundError, match="check the source of component 'autopilot'"):
+        Master(read_ssd(_variant(tmp_path, "calm_pd", edit)))
+
+
+def test_a_scenario_copied_anywhere_finds_the_project_fmus(tmp_path):
+    copy = tmp_path / "elsewhere" / "my_calm_pd.ssd"
+    copy.parent.mkdir()
+    shutil.copy(SCENARIOS / "calm_pd.ssd", copy)      # sources still say ../../fmus/*.fmu
+    assert cli.main([str(copy), "--out", str(tmp_path), "--no-plot", "--stop-time", "10"]) == 0
+    assert len((tmp_path / "my_calm_pd.csv").read_text().splitlines()) == 102
 
 
 def test_corrupt_fmu_says_how_to_build_it(tmp_path):

@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 
-from autopilot_fmu.angles import wrap
+from fmukit.numerics import wrap
 
 
 def heading_error(psi_d: np.ndarray, psi: np.ndarray) -> np.ndarray:

@@ -40,19 +40,25 @@ def zigzag_report(recording: Recording, parameters: dict, **_) -> list[str]:
             f"{math.degrees(zz.second_overshoot):.2f} deg"]
 
 
-def tables(costs: dict[str, Cost]) -> str:
-    """Tables 1 and 2 of the paper next to ours."""
+def tables(costs: dict[tuple[str, str], Cost]) -> str:
+    """Tables 1 and 2 of the paper next to ours; ``costs`` by (sea, controller).
+
+    The sea is "calm" or "waves"; the controllers "pd" and "smc" are the paper's and
+    get its values beside ours, any other (a user's autopilot) gets a row of its own.
+    """
     lines = []
     for title, sea in (("Table 1, calm water", "calm"), ("Table 2, waves", "waves")):
         lines += [f"{title}:", f"  {'':16}{'psi_E':>9}{'delta_E':>9}{'J':>9}   |"
                   f"{'paper psi_E':>12}{'delta_E':>9}{'J':>9}"]
-        for controller in ("pd", "smc"):
-            name = f"{sea}_{controller}"
-            if name in costs:
-                c, (p_psi, p_delta, p_J) = costs[name], PAPER_TABLES[name]
-                lines.append(f"  {controller.upper() + ' controller':16}{c.psi_E:9.2f}"
-                             f"{c.delta_E:9.2f}{c.J:9.2f}   |{p_psi:12.2f}{p_delta:9.2f}"
-                             f"{p_J:9.2f}")
+        for (row_sea, controller), c in costs.items():
+            if row_sea != sea:
+                continue
+            paper = PAPER_TABLES.get(f"{sea}_{controller}")
+            label = controller.upper() if paper else controller
+            theirs = (f"{paper[0]:12.2f}{paper[1]:9.2f}{paper[2]:9.2f}" if paper
+                      else f"{'-':>12}{'-':>9}{'-':>9}")
+            lines.append(f"  {label + ' controller':16}{c.psi_E:9.2f}{c.delta_E:9.2f}"
+                         f"{c.J:9.2f}   |{theirs}")
     lam = next(iter(costs.values())).lam if costs else LAMBDA
     lines.append(f"  (lambda = {lam:.4f}, delta_E = lambda * sum delta^2; sums over the "
                  "0.1 s samples, rad^2)")

@@ -13,10 +13,11 @@ from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFr
                        fmi2True, fmi2ValueReference)
 from fmpy.model_description import ModelDescription
 
+from fmukit.packaging import BUILD_HINT
+
 from .instance import FmuCallError, Instance
 
 STATUS = ("ok", "warning", "discard", "error", "fatal", "pending")
-BUILD_HINT = "build the FMUs with: python -m fmukit.build"
 
 
 def read_description(path: Path, name: str) -> ModelDescription:
@@ -25,9 +26,12 @@ def read_description(path: Path, name: str) -> ModelDescription:
     if not path.is_file():
         raise FileNotFoundError(f"FMU for '{name}' not found: {path}; {BUILD_HINT}")
     try:
-        return read_model_description(str(path))
+        description = read_model_description(str(path))
     except Exception as error:
         raise ValueError(f"{path} is not a readable FMU ({error}); {BUILD_HINT}") from error
+    if description.coSimulation is None:
+        raise ValueError(f"{path} is not a co-simulation FMU (model exchange only)")
+    return description
 
 
 def feedthrough(description: ModelDescription) -> dict[str, frozenset[str]]:
@@ -42,7 +46,8 @@ class FmuInstance(Instance):
     """An instantiated co-simulation FMU.
 
     Raises FileNotFoundError or ValueError, naming the file and how to build it,
-    when the FMU is missing or not a readable FMU.
+    when the FMU is missing or not a readable co-simulation FMU, and FmuCallError
+    when it cannot be instantiated (its extracted files are removed).
     """
 
     def __init__(self, path: str | Path, name: str, unzip_dir: str | Path | None = None):
@@ -57,11 +62,18 @@ class FmuInstance(Instance):
         self._callbacks.logger = fmi2CallbackLoggerTYPE(self._on_log)
         self._callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
         self._callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-        self.slave = FMU2Slave(guid=self.description.guid, unzipDirectory=self.unzip_dir,
-                               modelIdentifier=self.description.coSimulation.modelIdentifier,
-                               instanceName=name)
-        self.call("instantiate", self.slave.instantiate, callbacks=self._callbacks,
-                  loggingOn=True)
+        try:
+            self.slave = FMU2Slave(guid=self.description.guid, unzipDirectory=self.unzip_dir,
+                                   modelIdentifier=self.description.coSimulation.modelIdentifier,
+                                   instanceName=name)
+            self.call("instantiate", self.slave.instantiate, callbacks=self._callbacks,
+                      loggingOn=True)
+        except Exception as error:        # fmpy raises a plain Exception when it gets NULL
+            self._remove_unzip_dir()
+            if isinstance(error, FmuCallError):
+                raise
+            raise FmuCallError(name, f"instantiate ({self.path.name})", None, "failure",
+                               [*self.log, f"{type(error).__name__}: {error}"]) from error
 
     def _on_log(self, env, instance, status, category, message) -> None:
         self.log.append(f"[{STATUS[status] if status < len(STATUS) else status}] "
@@ -151,5 +163,8 @@ class FmuInstance(Instance):
         except FMICallException:
             pass
         self.slave.freeInstance()
+        self._remove_unzip_dir()
+
+    def _remove_unzip_dir(self) -> None:
         if self._owns_unzip_dir:
             shutil.rmtree(self.unzip_dir, ignore_errors=True)

@@ -86,4 +86,6 @@ class InProcessInstance(Instance):
         self.slave = type(self.slave)(instance_name=self.name)
 
     def free(self) -> None:
-        self.slave.terminate()
+        """Terminate, if the slave was initialised (as fmi2FreeInstance may follow any call)."""
+        if self.slave.sequence.phase == "step":
+            self.slave.terminate()

@@ -13,6 +13,8 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from fmukit.packaging import BUILD_HINT, FMU_DIR, FMUS
+
 NS = {
     "ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",
     "ssc": "http://ssp-standard.org/SSP1/SystemStructureCommon",
@@ -25,6 +27,10 @@ REPORT_ANNOTATION = "org.ship-autopilot-cosim"
 PARAMETER_SET = "scenario"
 _TYPES = {"Real": float, "Integer": int, "Boolean": lambda s: s.strip().lower() in ("true", "1"),
           "String": str}
+
+FMU_SEARCH_PATH = [FMU_DIR]
+"""Folders searched, by file name, for an FMU not found where its .ssd points: the
+project's fmus/, so that a scenario copied anywhere still finds the project's FMUs."""
 
 for _prefix, _uri in NS.items():
     ET.register_namespace(_prefix, _uri)
@@ -62,10 +68,25 @@ class SystemDescription:
     description: str = ""
     path: Path | None = None                     # the .ssd this was read from
 
-    def fmu_path(self, component: str) -> Path:
-        """Absolute path of a component's FMU."""
+    def fmu_candidates(self, component: str) -> list[Path]:
+        """Where a component's FMU may be: its source relative to the .ssd (or the current
+        folder), then a file of that name in each of ``FMU_SEARCH_PATH``."""
+        source = Path(self.components[component].source)
         base = self.path.parent if self.path else Path.cwd()
-        return (base / self.components[component].source).resolve()
+        candidates = [(base / source).resolve(), *(d / source.name for d in FMU_SEARCH_PATH)]
+        return list(dict.fromkeys(candidates))
+
+    def fmu_path(self, component: str) -> Path:
+        """The first of ``fmu_candidates`` that exists; FileNotFoundError naming all tried."""
+        candidates = self.fmu_candidates(component)
+        for path in candidates:
+            if path.is_file():
+                return path
+        source = Path(self.components[component].source)
+        hint = (BUILD_HINT if source.stem in FMUS
+                else f"check the source of component '{component}' in {self.path or 'the system'}")
+        raise FileNotFoundError(f"FMU for '{component}' not found; tried "
+                                f"{', '.join(map(str, candidates))}; {hint}")
 
 
 def _q(prefix: str, tag: str) -> str:

@@ -12,7 +12,6 @@ import zipfile
 from pathlib import Path
 
 from .. import scenarios
-from ..core.fmi import BUILD_HINT
 from ..core.ssd import SystemDescription, read_ssd, write_ssd
 
 SSD_NAME = "SystemStructure.ssd"
@@ -24,10 +23,7 @@ def export(scenario: str, out: Path, overrides: dict[str, dict] | None = None) -
     name = Path(scenario).stem
     for component, values in (overrides or {}).items():
         system.components[component].parameters.update(values)
-    fmus = {c: system.fmu_path(c) for c in system.components}
-    for component, path in fmus.items():
-        if not path.is_file():
-            raise FileNotFoundError(f"FMU for '{component}' not found: {path}; {BUILD_HINT}")
+    fmus = {c: system.fmu_path(c) for c in system.components}     # FileNotFoundError
     sources = {c: f"resources/{path.name}" for c, path in fmus.items()}
     target = out / f"{name}.ssp"
     with tempfile.TemporaryDirectory() as tmp:

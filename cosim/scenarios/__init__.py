@@ -1,14 +1,16 @@
 """The scenarios: one SSP system structure file (.ssd) each, and their registry.
 
 Every command that takes a scenario takes its name (a file here, e.g.
-``calm_pd``) or, where it says so, a path to a .ssd file. ``PAPER`` lists the
-paper's four runs, the ones behind its Tables 1-2.
+``calm_pd``) or a path to a .ssd file. ``PAPER`` lists the paper's four runs, the
+ones behind its Tables 1-2. ``autopilot`` puts a user's autopilot FMU into a
+course-keeping scenario.
 """
 from __future__ import annotations
 
 from pathlib import Path
 
 from ..core.ssd import SystemDescription, read_ssd
+from .autopilot import with_autopilot
 
 SCENARIO_DIR = Path(__file__).resolve().parent
 PAPER = ("calm_pd", "calm_smc", "waves_pd", "waves_smc")
@@ -35,6 +37,9 @@ def path(scenario: str | Path) -> Path:
     return SCENARIO_DIR / f"{scenario}.ssd"
 
 
-def load(scenario: str | Path) -> SystemDescription:
-    """The system description of a scenario (a name or a .ssd path, as ``path``)."""
-    return read_ssd(path(scenario))
+def load(scenario: str | Path, autopilot: str | Path | None = None,
+         port_map: dict[str, str] | None = None, name: str | None = None) -> SystemDescription:
+    """The system description of a scenario (a name or a .ssd path, as ``path``), with
+    ``autopilot``, an FMU, in place of its own (``cosim.scenarios.autopilot``)."""
+    system = read_ssd(path(scenario))
+    return system if autopilot is None else with_autopilot(system, autopilot, port_map, name)

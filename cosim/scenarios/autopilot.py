@@ -1,0 +1,117 @@
+"""Your own autopilot in the paper's scenarios: the port contract, checked, and the substitution.
+
+An autopilot is any FMI 2.0 co-simulation FMU with these ports (SI units, radians):
+
+| port | causality | unit | meaning |
+|---|---|---|---|
+| ``psi`` | input | rad | ship heading |
+| ``r`` | input | rad/s | ship yaw rate |
+| ``psi_d`` | input | rad | desired heading, from the guidance |
+| ``delta_c`` | output | rad | commanded rudder angle; positive turns the ship to port |
+
+An FMU whose ports have other names maps them with ``port_map`` (contract name ->
+the FMU's name, ``--map psi=heading`` on the command line). A port's unit, where
+the FMU declares one, must be the contract's: a heading in degrees is refused,
+not converted, so that a run never rests on a guess about what a number means.
+``with_autopilot`` puts such an FMU in place of the ``autopilot`` component of a
+course-keeping scenario; its parameters keep the FMU's defaults unless set.
+"""
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import fmpy
+from fmpy import read_model_description
+from fmpy.model_description import ModelDescription
+
+from ..core.ssd import Connection, SystemDescription
+
+COMPONENT = "autopilot"
+PORTS = {"psi": ("input", "rad"), "r": ("input", "rad/s"), "psi_d": ("input", "rad"),
+         "delta_c": ("output", "rad")}
+
+
+class AutopilotError(ValueError):
+    """An FMU that cannot serve as an autopilot; the message names the file and the port."""
+
+
+def _listing(description: ModelDescription) -> str:
+    kinds = {}
+    for v in description.modelVariables:
+        kinds.setdefault(v.causality, []).append(f"{v.name} ({v.type}"
+                                                 + (f", {v.unit})" if v.unit else ")"))
+    return "; ".join(f"{k}s: {', '.join(names)}" for k, names in kinds.items()
+                     if k in ("input", "output", "parameter"))
+
+
+def check_autopilot(fmu: str | Path, port_map: dict[str, str] | None = None) -> ModelDescription:
+    """The FMU's model description if it keeps the port contract; AutopilotError if not."""
+    fmu, port_map = Path(fmu), port_map or {}
+    if not fmu.is_file():
+        raise AutopilotError(f"autopilot FMU {fmu} not found")
+    try:
+        description = read_model_description(str(fmu))
+    except Exception as error:
+        raise AutopilotError(f"{fmu} is not an FMU ({error})") from None
+    if description.fmiVersion != "2.0":
+        raise AutopilotError(f"{fmu} is an FMI {description.fmiVersion} FMU; an autopilot "
+                             "must be an FMI 2.0 co-simulation FMU")
+    if description.coSimulation is None:
+        raise AutopilotError(f"{fmu} is a model-exchange FMU only; an autopilot must be an "
+                             "FMI 2.0 co-simulation FMU")
+    platforms = [p for p in fmpy.supported_platforms(str(fmu)) if p != "c-code"]
+    if fmpy.platform not in platforms:
+        raise AutopilotError(f"{fmu} has no binary for this platform ({fmpy.platform}); it has "
+                             f"{', '.join(platforms) or 'none'}")
+    unknown = sorted(set(port_map) - set(PORTS))
+    if unknown:
+        raise AutopilotError(f"--map names {', '.join(map(repr, unknown))}, which is not a port "
+                             f"of an autopilot ({', '.join(PORTS)})")
+    variables = {v.name: v for v in description.modelVariables}
+    for port, (causality, unit) in PORTS.items():
+        name = port_map.get(port, port)
+        variable = variables.get(name)
+        mapped = f"'{name}' (for {port})" if name != port else f"'{port}'"
+        if variable is None:
+            raise AutopilotError(f"{fmu} has no port {mapped}; an autopilot needs Real inputs "
+                                 f"psi, r, psi_d and a Real output delta_c (map other names "
+                                 f"with --map PORT=NAME). It has {_listing(description)}")
+        if variable.causality != causality or variable.type != "Real":
+            raise AutopilotError(f"{fmu}: port {mapped} is a {variable.type} "
+                                 f"{variable.causality}; it must be a Real {causality}. It has "
+                                 f"{_listing(description)}")
+        declared = variable.unit or (variable.declaredType.unit if variable.declaredType
+                                     else None)
+        if declared and declared != unit:
+            raise AutopilotError(f"{fmu}: port {mapped} is in {declared}; the autopilot "
+                                 f"contract is in {unit} (units are not converted)")
+    return description
+
+
+def with_autopilot(system: SystemDescription, fmu: str | Path,
+                   port_map: dict[str, str] | None = None,
+                   name: str | None = None) -> SystemDescription:
+    """A copy of a course-keeping system with ``fmu`` as its autopilot; AutopilotError if the
+    FMU breaks the contract or the system has no autopilot to replace."""
+    fmu, port_map = Path(fmu).resolve(), port_map or {}
+    if COMPONENT not in system.components or system.report != "course_keeping":
+        raise AutopilotError(f"scenario {system.name!r} has no autopilot to replace; "
+                             "--autopilot works with the course-keeping scenarios")
+    check_autopilot(fmu, port_map)
+    name = name or fmu.stem
+    new = copy.deepcopy(system)
+    autopilot = new.components[COMPONENT]
+    autopilot.source, autopilot.parameters = str(fmu), {}
+    autopilot.connectors = {port_map.get(p, p): (causality, "Real")
+                            for p, (causality, _) in PORTS.items()}
+
+    def port(element: str, connector: str) -> str:
+        return port_map.get(connector, connector) if element == COMPONENT else connector
+    new.connections = [Connection(c.start_element, port(c.start_element, c.start_connector),
+                                  c.end_element, port(c.end_element, c.end_connector))
+                       for c in system.connections]
+    new.name = f"{system.name}-{name}"
+    new.description = (f"autopilot {name} ({fmu.name}) in the {system.name} scenario "
+                       f"(its route, ship and sea)")
+    return new
