@@ -1,4 +1,5 @@
-"""What the command-line modules share: scenario arguments, output folders, the progress bar.
+"""What the command-line modules share: scenario and autopilot arguments, output folders,
+the progress bar.
 
 Only the commands (``cosim.run``, ``cosim.sweep``, ``cosim.export``, ...) import this.
 """
@@ -10,6 +11,7 @@ import tempfile
 from pathlib import Path
 
 from . import scenarios
+from .scenarios.autopilot import AutopilotError, check_autopilot
 
 
 def chosen_scenarios(parser: argparse.ArgumentParser, scenario: str | None,
@@ -25,6 +27,43 @@ def chosen_scenarios(parser: argparse.ArgumentParser, scenario: str | None,
         except (ValueError, FileNotFoundError) as error:
             parser.error(str(error))
     return names
+
+
+def parse_port_map(text: str) -> tuple[str, str]:
+    """'psi=heading' -> ('psi', 'heading')."""
+    port, sep, name = text.partition("=")
+    if not (sep and port and name):
+        raise argparse.ArgumentTypeError(f"--map expects PORT=NAME, e.g. psi=heading; "
+                                         f"got {text!r}")
+    return port, name
+
+
+def add_autopilot_options(parser: argparse.ArgumentParser, also: str) -> None:
+    """--autopilot FMU, --map PORT=NAME, --name NAME; ``also`` says what --all does with it."""
+    parser.add_argument("--autopilot", type=Path, metavar="FMU",
+                        help="your own autopilot, an FMI 2.0 co-simulation FMU with inputs psi "
+                             "(rad), r (rad/s), psi_d (rad) and output delta_c (rad), in place "
+                             f"of the scenario's; {also} (see docs/own_autopilot.md)")
+    parser.add_argument("--map", action="append", default=[], type=parse_port_map,
+                        metavar="PORT=NAME",
+                        help="the FMU's name of an autopilot port, e.g. psi=heading; repeatable")
+    parser.add_argument("--name", help="the autopilot's name in file names and tables "
+                                       "(default: the FMU's file name)")
+
+
+def checked_autopilot(parser: argparse.ArgumentParser, args: argparse.Namespace) -> bool:
+    """Check --autopilot against the port contract before anything runs; False (and the
+    reason on standard error) if it fails."""
+    if args.autopilot is None:
+        if args.map or args.name:
+            parser.error("--map and --name describe an --autopilot FMU; give one")
+        return True
+    try:
+        check_autopilot(args.autopilot, dict(args.map), trial=True)
+    except AutopilotError as error:
+        print(f"error: {error}", file=sys.stderr)
+        return False
+    return True
 
 
 def writable_folder(path: Path) -> Path:

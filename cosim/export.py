@@ -2,6 +2,7 @@
 
     python -m cosim.export calm_pd                 -> results/ssp/calm_pd.ssp
     python -m cosim.export --all --out DIR         -> the paper's four scenarios
+    python -m cosim.export waves_pd --autopilot my.fmu   -> results/ssp/waves_pd-my.ssp
 
 The package is a zip holding SystemStructure.ssd (components, connections, the
 scenario's parameter values, the fixed step as an OSP annotation) and
@@ -15,7 +16,7 @@ import sys
 from pathlib import Path
 
 from . import scenarios
-from ._cli import chosen_scenarios, writable_folder
+from ._cli import add_autopilot_options, checked_autopilot, chosen_scenarios, writable_folder
 from .interop.ssp import export
 
 
@@ -25,13 +26,17 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("scenario", nargs="?", help=f"one of: {', '.join(scenarios.names())}")
     parser.add_argument("--all", action="store_true", help="the paper's four scenarios")
     parser.add_argument("--out", type=Path, default=Path("results/ssp"), help="output folder")
+    add_autopilot_options(parser, "the package carries the FMU; with --all, in each of the "
+                                  "four scenarios")
     args = parser.parse_args(argv)
     names = chosen_scenarios(parser, args.scenario, args.all)
+    if not checked_autopilot(parser, args):
+        return 2
     writable_folder(args.out)
     for name in names:
         try:
-            print(f"wrote {export(name, args.out)}")
-        except FileNotFoundError as error:
+            print(f"wrote {export(name, args.out, None, args.autopilot, dict(args.map), args.name)}")
+        except (ValueError, FileNotFoundError) as error:
             print(f"error: {error}", file=sys.stderr)
             return 2
     return 0

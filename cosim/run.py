@@ -20,7 +20,8 @@ from pathlib import Path
 from typing import NamedTuple
 
 from . import scenarios
-from ._cli import Progress, chosen_scenarios, writable_folder
+from ._cli import (Progress, add_autopilot_options, checked_autopilot, chosen_scenarios,
+                   writable_folder)
 from .analysis.cost import LAMBDA, Cost, cost
 from .analysis.figures import save_figure
 from .analysis.kinds import analysis
@@ -29,7 +30,7 @@ from .core.coupling import COUPLINGS
 from .core.instance import FmuCallError
 from .core.master import BACKENDS, Master
 from .core.ssd import SystemDescription
-from .scenarios.autopilot import COMPONENT, AutopilotError, check_autopilot
+from .scenarios.autopilot import COMPONENT
 
 RUN_BACKENDS = [b for b in BACKENDS if b != "null"]     # null runs measure the master only
 
@@ -46,15 +47,6 @@ def parse_setting(text: str) -> tuple[str, str, int | float | str]:
         except ValueError:
             pass
     return component, variable, raw
-
-
-def parse_port_map(text: str) -> tuple[str, str]:
-    """'psi=heading' -> ('psi', 'heading')."""
-    port, sep, name = text.partition("=")
-    if not (sep and port and name):
-        raise argparse.ArgumentTypeError(f"--map expects PORT=NAME, e.g. psi=heading; "
-                                         f"got {text!r}")
-    return port, name
 
 
 def run_scenario(system: SystemDescription, label: str, out: Path, overrides: dict,
@@ -104,13 +96,12 @@ def runs_asked(names: list[str], paper: bool, autopilot: Path | None,
                name: str | None) -> list[Run]:
     """Every run of the command line. With --all and --autopilot, the user's autopilot also
     runs in calm_pd's and waves_pd's place: same route, ship and sea, another controller."""
-    name = name or (autopilot.stem if autopilot else None)
     if not paper:
-        stem = Path(names[0]).stem
-        return [Run(names[0], f"{stem}-{name}" if autopilot else stem, autopilot, None)]
+        return [Run(names[0], scenarios.label(names[0], autopilot, name), autopilot, None)]
     runs = [Run(scenario, scenario, None, tuple(scenario.split("_"))) for scenario in names]
     if autopilot is not None:
-        runs += [Run(scenario, f"{scenario}-{name}", autopilot, (scenario.split("_")[0], name))
+        runs += [Run(scenario, scenarios.label(scenario, autopilot, name), autopilot,
+                     (scenario.split("_")[0], name or autopilot.stem))
                  for scenario in ("calm_pd", "waves_pd")]
     return runs
 
@@ -141,31 +132,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--backend", choices=RUN_BACKENDS, default="fmi",
                         help="fmi: load the FMUs from fmus/ (default); inprocess: call the "
                              "FMUs' Python classes directly, without FMI")
-    parser.add_argument("--autopilot", type=Path, metavar="FMU",
-                        help="your own autopilot, an FMI 2.0 co-simulation FMU with inputs psi "
-                             "(rad), r (rad/s), psi_d (rad) and output delta_c (rad), in place "
-                             "of the scenario's; with --all it also runs in calm_pd's and "
-                             "waves_pd's place, as an extra row of Tables 1-2 (see "
-                             "docs/own_autopilot.md)")
-    parser.add_argument("--map", action="append", default=[], type=parse_port_map,
-                        metavar="PORT=NAME",
-                        help="the FMU's name of an autopilot port, e.g. psi=heading; repeatable")
-    parser.add_argument("--name", help="the autopilot's name in file names and tables "
-                                       "(default: the FMU's file name)")
+    add_autopilot_options(parser, "with --all it also runs in calm_pd's and waves_pd's "
+                                  "place, as an extra row of Tables 1-2")
     parser.add_argument("--no-plot", action="store_true", help="skip the figure")
     parser.add_argument("--stream", action="store_true",
                         help="write rows to the CSV in chunks as the run goes: flat memory "
                              "for long runs (--stop-time 86400); no report or figure")
     args = parser.parse_args(argv)
     names = chosen_scenarios(parser, args.scenario, args.all)
-    if args.autopilot is None and (args.map or args.name):
-        parser.error("--map and --name describe an --autopilot FMU; give one")
-    if args.autopilot is not None:
-        try:
-            check_autopilot(args.autopilot, dict(args.map))   # before anything is run
-        except AutopilotError as error:
-            print(f"error: {error}", file=sys.stderr)
-            return 2
+    if not checked_autopilot(parser, args):
+        return 2
     overrides: dict[str, dict] = {}
     for component, variable, value in args.set:
         overrides.setdefault(component, {})[variable] = value

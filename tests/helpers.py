@@ -16,3 +16,19 @@ def fmpy_cli(*args: str, cwd: Path) -> None:
 def read_csv(path: Path) -> list[dict[str, float]]:
     with open(path) as f:
         return [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
+
+
+def fmu_variant(source: Path, dest: Path, xml=None, drop: tuple[str, ...] = ()) -> Path:
+    """A copy of an FMU with its modelDescription.xml passed through ``xml`` (text -> text)
+    and the members starting with any of ``drop`` left out."""
+    import zipfile
+
+    with zipfile.ZipFile(source) as original, zipfile.ZipFile(dest, "w") as copy:
+        for info in original.infolist():
+            if info.filename.startswith(drop):
+                continue
+            data = original.read(info)
+            if info.filename == "modelDescription.xml" and xml is not None:
+                data = xml(data.decode("utf-8")).encode("utf-8")
+            copy.writestr(info, data)
+    return dest

@@ -62,13 +62,7 @@ class Master:
 
     def configure(self, overrides: dict[str, dict[str, Any]] | None = None) -> None:
         """Parameters for the next run: the system's, updated by ``overrides``."""
-        parameters = {name: dict(c.parameters) for name, c in self.system.components.items()}
-        for component, values in (overrides or {}).items():
-            if component not in parameters:
-                raise ValueError(f"--set names the component '{component}'; the system has "
-                                 f"{', '.join(parameters)}")
-            parameters[component].update(values)
-        self.parameters = parameters
+        self.parameters = self.system.parameters(overrides)
 
     def reset(self) -> None:
         """Return every FMU to its state after instantiation (fmi2Reset), for another run."""

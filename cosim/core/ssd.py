@@ -12,6 +12,7 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from fmukit.packaging import BUILD_HINT, FMU_DIR, FMUS
 
@@ -67,6 +68,18 @@ class SystemDescription:
     report: str = "none"
     description: str = ""
     path: Path | None = None                     # the .ssd this was read from
+
+    def parameters(self, overrides: dict[str, dict[str, Any]] | None = None
+                   ) -> dict[str, dict[str, Any]]:
+        """Each component's parameter values, updated by ``overrides`` (by component);
+        ValueError naming a component the system does not have."""
+        parameters = {name: dict(c.parameters) for name, c in self.components.items()}
+        for component, values in (overrides or {}).items():
+            if component not in parameters:
+                raise ValueError(f"--set names the component '{component}'; the system has "
+                                 f"{', '.join(parameters)}")
+            parameters[component].update(values)
+        return parameters
 
     def fmu_candidates(self, component: str) -> list[Path]:
         """Where a component's FMU may be: its source relative to the .ssd (or the current

@@ -17,15 +17,22 @@ from ..core.ssd import SystemDescription, read_ssd, write_ssd
 SSD_NAME = "SystemStructure.ssd"
 
 
-def export(scenario: str, out: Path, overrides: dict[str, dict] | None = None) -> Path:
-    """Write out/<name>.ssp; ``overrides`` changes parameter values by component."""
-    system = scenarios.load(scenario)
-    name = Path(scenario).stem
-    for component, values in (overrides or {}).items():
-        system.components[component].parameters.update(values)
+def export(scenario: str | Path, out: Path, overrides: dict[str, dict] | None = None,
+           autopilot: str | Path | None = None, port_map: dict[str, str] | None = None,
+           name: str | None = None) -> Path:
+    """Write out/<label>.ssp (``scenarios.label``): the scenario, with ``autopilot`` in
+    place of its own if given, and ``overrides`` changing parameter values by component."""
+    system = scenarios.load(scenario, autopilot, port_map, name)
+    for component, values in system.parameters(overrides).items():
+        system.components[component].parameters = values
     fmus = {c: system.fmu_path(c) for c in system.components}     # FileNotFoundError
+    by_name: dict[str, Path] = {}
+    for component, path in fmus.items():
+        if by_name.setdefault(path.name, path) != path:
+            raise ValueError(f"two FMUs named {path.name} ({by_name[path.name]} and {path}) "
+                             "cannot both go into resources/; rename one")
     sources = {c: f"resources/{path.name}" for c, path in fmus.items()}
-    target = out / f"{name}.ssp"
+    target = out / f"{scenarios.label(scenario, autopilot, name)}.ssp"
     with tempfile.TemporaryDirectory() as tmp:
         ssd = Path(tmp) / SSD_NAME
         write_ssd(system, ssd, sources)

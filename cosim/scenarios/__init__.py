@@ -37,6 +37,14 @@ def path(scenario: str | Path) -> Path:
     return SCENARIO_DIR / f"{scenario}.ssd"
 
 
+def label(scenario: str | Path, autopilot: str | Path | None = None,
+          name: str | None = None) -> str:
+    """What a run of the scenario is called in file names: the scenario's name, and the
+    autopilot's (``name``, or the FMU's file name) when it replaces the scenario's."""
+    stem = Path(scenario).stem
+    return f"{stem}-{name or Path(autopilot).stem}" if autopilot is not None else stem
+
+
 def load(scenario: str | Path, autopilot: str | Path | None = None,
          port_map: dict[str, str] | None = None, name: str | None = None) -> SystemDescription:
     """The system description of a scenario (a name or a .ssd path, as ``path``), with

@@ -25,6 +25,7 @@ import fmpy
 from fmpy import read_model_description
 from fmpy.model_description import ModelDescription
 
+from ..core.fmi import trial_instantiation
 from ..core.ssd import Connection, SystemDescription
 
 COMPONENT = "autopilot"
@@ -45,15 +46,25 @@ def _listing(description: ModelDescription) -> str:
                      if k in ("input", "output", "parameter"))
 
 
-def check_autopilot(fmu: str | Path, port_map: dict[str, str] | None = None) -> ModelDescription:
-    """The FMU's model description if it keeps the port contract; AutopilotError if not."""
+def _mapped(port: str, port_map: dict[str, str]) -> str:
+    name = port_map.get(port, port)
+    return f"'{name}' (for {port})" if name != port else f"'{port}'"
+
+
+def check_autopilot(fmu: str | Path, port_map: dict[str, str] | None = None,
+                    trial: bool = False) -> ModelDescription:
+    """The FMU's model description if it keeps the port contract; AutopilotError if not.
+
+    ``trial`` also instantiates it once in a child process (``trial_instantiation``).
+    """
     fmu, port_map = Path(fmu), port_map or {}
     if not fmu.is_file():
         raise AutopilotError(f"autopilot FMU {fmu} not found")
     try:
         description = read_model_description(str(fmu))
     except Exception as error:
-        raise AutopilotError(f"{fmu} is not an FMU ({error})") from None
+        raise AutopilotError(f"{fmu} is not an FMU, or not a readable one "
+                             f"({type(error).__name__}: {error})") from None
     if description.fmiVersion != "2.0":
         raise AutopilotError(f"{fmu} is an FMI {description.fmiVersion} FMU; an autopilot "
                              "must be an FMI 2.0 co-simulation FMU")
@@ -66,26 +77,34 @@ def check_autopilot(fmu: str | Path, port_map: dict[str, str] | None = None) -> 
                              f"{', '.join(platforms) or 'none'}")
     unknown = sorted(set(port_map) - set(PORTS))
     if unknown:
-        raise AutopilotError(f"--map names {', '.join(map(repr, unknown))}, which is not a port "
-                             f"of an autopilot ({', '.join(PORTS)})")
+        raise AutopilotError(f"{fmu}: --map names {', '.join(map(repr, unknown))}, which is "
+                             f"not a port of an autopilot ({', '.join(PORTS)})")
     variables = {v.name: v for v in description.modelVariables}
     for port, (causality, unit) in PORTS.items():
-        name = port_map.get(port, port)
-        variable = variables.get(name)
-        mapped = f"'{name}' (for {port})" if name != port else f"'{port}'"
+        variable = variables.get(port_map.get(port, port))
+        mapped = _mapped(port, port_map)
         if variable is None:
             raise AutopilotError(f"{fmu} has no port {mapped}; an autopilot needs Real inputs "
                                  f"psi, r, psi_d and a Real output delta_c (map other names "
                                  f"with --map PORT=NAME). It has {_listing(description)}")
         if variable.causality != causality or variable.type != "Real":
-            raise AutopilotError(f"{fmu}: port {mapped} is a {variable.type} "
-                                 f"{variable.causality}; it must be a Real {causality}. It has "
+            article = "an" if variable.causality[0] in "aeiou" else "a"
+            raise AutopilotError(f"{fmu}: port {mapped} is {article} {variable.causality} of "
+                                 f"type {variable.type}; it must be a Real {causality}. It has "
                                  f"{_listing(description)}")
+    for port, (_, unit) in PORTS.items():          # the structure first, then the units
+        variable = variables[port_map.get(port, port)]
         declared = variable.unit or (variable.declaredType.unit if variable.declaredType
                                      else None)
         if declared and declared != unit:
-            raise AutopilotError(f"{fmu}: port {mapped} is in {declared}; the autopilot "
-                                 f"contract is in {unit} (units are not converted)")
+            raise AutopilotError(f"{fmu}: port {_mapped(port, port_map)} is in {declared}; "
+                                 f"the autopilot contract is in {unit} (units are not "
+                                 "converted)")
+    if trial:
+        try:
+            trial_instantiation(fmu)
+        except ValueError as error:
+            raise AutopilotError(str(error)) from None
     return description
 
 

@@ -12,6 +12,8 @@ SPEC is a TOML file (see docs/sweeps/example.toml):
     [controllers]                          # the controller axis: base scenario and settings
     pd = { scenario = "waves_pd" }
     smc = { scenario = "waves_smc", set = { "autopilot.eta_h" = 10.0 } }
+    mine = { autopilot = "my.fmu", map = { psi = "heading" } }   # your own, in waves_pd
+    other = "path/to/other.ssd"            # or a scenario, or an autopilot FMU, alone
 
     [axes]                                 # every combination is run
     wave_seed = { start = 1, count = 20 }  # or a list
@@ -24,7 +26,9 @@ SPEC is a TOML file (see docs/sweeps/example.toml):
     [plots]
     map = ["sea_state", "ship.delta_rate_max"]   # axes of the J_SMC / J_PD map
 
-Without [controllers], pd and smc run on waves_pd and waves_smc.
+Without [controllers], pd and smc run on waves_pd and waves_smc. Paths are relative
+to the sweep file; an autopilot FMU must keep the port contract of
+``cosim.scenarios.autopilot``.
 
 Each Dask task is one whole co-simulation with our master. A worker extracts the
 FMUs once per scenario and thread and resets them (fmi2Reset) between tasks.
@@ -55,6 +59,7 @@ from .. import scenarios
 from ..analysis.cost import cost
 from ..analysis.metrics import sign_reversals_per_minute
 from ..analysis.seastate import model_scale
+from ..scenarios.autopilot import check_autopilot
 from .cluster import connect
 
 DEFAULT_CONTROLLERS = {"pd": {"scenario": "waves_pd"}, "smc": {"scenario": "waves_smc"}}
@@ -80,12 +85,8 @@ class Spec:
             data = tomllib.loads(path.read_text())
         except (OSError, tomllib.TOMLDecodeError) as error:
             raise ValueError(f"cannot read sweep spec {path}: {error}") from None
-        controllers = data.get("controllers", DEFAULT_CONTROLLERS)
-        for name, entry in controllers.items():
-            if entry.get("scenario") not in scenarios.names():
-                raise ValueError(f"{path}: controller {name!r} names scenario "
-                                 f"{entry.get('scenario')!r}; valid: "
-                                 f"{', '.join(scenarios.names())}")
+        controllers = {name: _controller(entry, path, name)
+                       for name, entry in data.get("controllers", DEFAULT_CONTROLLERS).items()}
         axes = {}
         for name, values in data.get("axes", {}).items():
             if isinstance(values, dict):
@@ -141,19 +142,55 @@ class Spec:
         return controller["scenario"], overrides
 
 
+def _controller(entry: str | dict[str, Any], spec: Path, name: str) -> dict[str, Any]:
+    """A controller entry, checked, with its paths made absolute (relative to the spec file).
+
+    An entry is a scenario (a name or a .ssd path), an autopilot FMU (run in waves_pd's
+    place), or a table: scenario, autopilot, map (autopilot port -> the FMU's name), set.
+    """
+    if isinstance(entry, str):
+        entry = {"autopilot": entry} if entry.endswith(".fmu") else {"scenario": entry}
+    unknown = set(entry) - {"scenario", "autopilot", "map", "set"}
+    if unknown:
+        raise ValueError(f"{spec}: controller {name!r} has {', '.join(sorted(unknown))}; a "
+                         "controller has scenario, autopilot, map and set")
+
+    def beside_spec(value: str) -> str:
+        return str((spec.parent / value).resolve()) if value.endswith((".ssd", ".fmu")) \
+            else value
+    scenario = beside_spec(entry.get("scenario", "waves_pd" if "autopilot" in entry else ""))
+    try:
+        scenarios.path(scenario)
+        autopilot = entry.get("autopilot")
+        if autopilot is not None:
+            autopilot = beside_spec(autopilot)
+            check_autopilot(autopilot, entry.get("map"), trial=True)
+            scenarios.load(scenario, autopilot, entry.get("map"))
+    except (ValueError, FileNotFoundError) as error:
+        raise ValueError(f"{spec}: controller {name!r}: {error}") from None
+    return {"scenario": scenario, "autopilot": autopilot, "map": dict(entry.get("map", {})),
+            "set": dict(entry.get("set", {}))}
+
+
 # -- the task, on a worker ------------------------------------------------------------
-_masters: dict[tuple[int, str], Any] = {}       # (thread, scenario) -> Master
+_masters: dict[tuple[int, str], Any] = {}       # (thread, controller) -> Master
 _masters_lock = threading.Lock()
 
 
-def _master(scenario: str):
+def _key(controller: dict[str, Any]) -> tuple[int, str]:
+    system = {k: controller[k] for k in ("scenario", "autopilot", "map")}
+    return threading.get_ident(), json.dumps(system, sort_keys=True)
+
+
+def _master(controller: dict[str, Any]):
     from ..core.master import Master
 
-    key = (threading.get_ident(), scenario)
+    key = _key(controller)
     with _masters_lock:
         master = _masters.get(key)
     if master is None:
-        master = Master(scenarios.load(scenario))
+        master = Master(scenarios.load(controller["scenario"], controller["autopilot"],
+                                       controller["map"]))
         with _masters_lock:
             _masters[key] = master
     else:
@@ -161,9 +198,9 @@ def _master(scenario: str):
     return master
 
 
-def _drop_master(scenario: str) -> None:
+def _drop_master(controller: dict[str, Any]) -> None:
     with _masters_lock:
-        master = _masters.pop((threading.get_ident(), scenario), None)
+        master = _masters.pop(_key(controller), None)
     if master is not None:
         master.free()
 
@@ -187,18 +224,18 @@ def run_one(spec: Spec, run: dict[str, Any]) -> dict[str, Any]:
     """One whole co-simulation; never raises for a failed run, records it."""
     started = time.perf_counter()
     row = _row(run)
-    scenario = spec.controllers[run["controller"]]["scenario"]
+    controller = spec.controllers[run["controller"]]
     try:
-        scenario, overrides = spec.settings(run)
-        master = _master(scenario)
+        _, overrides = spec.settings(run)
+        master = _master(controller)
         master.configure(overrides)
         recording = master.run(spec.stop_time)
     except Exception as error:              # a bad setting: not worth retrying
-        _drop_master(scenario)
+        _drop_master(controller)
         row = _row(run, f"{type(error).__name__}: {error}")
     else:
         if recording.error:
-            _drop_master(scenario)          # its FMUs may be in an error state
+            _drop_master(controller)        # its FMUs may be in an error state
             row = _row(run, recording.error)
         else:
             row.update(_metrics(recording))
