@@ -3,6 +3,7 @@
 delta_c is direct feedthrough from psi, r and psi_d: it is evaluated when read.
 """
 from autopilot_fmu.pd import PDAutopilot
+from fmukit.autopilot import INPUTS, rudder_command
 from fmukit.slave import ModelSlave, Var
 
 _P = PDAutopilot()
@@ -12,12 +13,9 @@ class PDAutopilotSlave(ModelSlave):
     model_name = "pd_autopilot"
     description = "PD heading autopilot, delta_c = Kp (psi - psi_d) + Kd r (Tomera 2010, eq 20)"
     variables = (
-        Var.input("psi", 0.0, "rad", "ship heading"),
-        Var.input("r", 0.0, "rad/s", "ship yaw rate", -100.0, 100.0),
-        Var.input("psi_d", 0.0, "rad", "desired course"),
-        Var.output("delta_c", "rad", "commanded rudder angle; positive turns the ship to port",
-                   depends=("psi", "r", "psi_d", "Kp", "Kd"),
-                   get=lambda s: s.model.command(s.psi, s.r, s.psi_d)),
+        *INPUTS,
+        rudder_command(depends=("psi", "r", "psi_d", "Kp", "Kd"),
+                       get=lambda s: s.model.command(s.psi, s.r, s.psi_d)),
         Var.parameter("Kp", _P.Kp, "1", "heading error gain, rad of rudder per rad", -1e4, 1e4),
         Var.parameter("Kd", _P.Kd, "s", "yaw rate gain, rad of rudder per rad/s", -1e4, 1e4),
     )

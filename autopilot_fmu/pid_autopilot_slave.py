@@ -13,6 +13,7 @@ Written as your own autopilot would be: one file, nothing but fmukit
 import math
 from dataclasses import dataclass
 
+from fmukit.autopilot import INPUTS, rudder_command
 from fmukit.numerics import require_finite, wrap
 from fmukit.slave import ModelSlave, Var
 
@@ -51,12 +52,9 @@ class PIDAutopilotSlave(ModelSlave):
     model_name = "pid_autopilot"
     description = "PID heading autopilot with anti-windup: eq (20) with integral action"
     variables = (
-        Var.input("psi", 0.0, "rad", "ship heading"),
-        Var.input("r", 0.0, "rad/s", "ship yaw rate", -100.0, 100.0),
-        Var.input("psi_d", 0.0, "rad", "desired course"),
-        Var.output("delta_c", "rad", "commanded rudder angle; positive turns the ship to port",
-                   depends=("psi", "r", "psi_d", "Kp", "Ki", "Kd"),
-                   get=lambda s: s.model.command(s.psi, s.r, s.psi_d)),
+        *INPUTS,
+        rudder_command(depends=("psi", "r", "psi_d", "Kp", "Ki", "Kd"),
+                       get=lambda s: s.model.command(s.psi, s.r, s.psi_d)),
         Var.output("z", "rad.s", "integrated heading error"),
         Var.parameter("Kp", _P.Kp, "1", "heading error gain", -1e4, 1e4),
         Var.parameter("Ki", _P.Ki, "1/s", "integral gain", -1e4, 1e4),

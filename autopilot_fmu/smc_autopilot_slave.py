@@ -6,6 +6,7 @@ from the inputs and are evaluated when read; psi_z and r_z are states.
 """
 from autopilot_fmu.design import design_model
 from autopilot_fmu.smc import SlidingModeAutopilot, SlidingModeDesign
+from fmukit.autopilot import INPUTS, rudder_command
 from fmukit.numerics import require_finite
 from fmukit.slave import ModelSlave, Var
 
@@ -18,12 +19,10 @@ class SMCAutopilotSlave(ModelSlave):
     description = ("Sliding-mode heading autopilot with reference model "
                    "(Tomera 2010, eqs 33-44), design computed from the linear model")
     variables = (
-        Var.input("psi", 0.0, "rad", "ship heading"),
-        Var.input("r", 0.0, "rad/s", "ship yaw rate", -100.0, 100.0),
-        Var.input("psi_d", 0.0, "rad", "desired course"),
-        Var.output("delta_c", "rad", "commanded rudder angle, eq (43)",
-                   depends=("psi", "r", "psi_d") + _LAW,
-                   get=lambda s: s.model.command(s.psi, s.r, s.psi_d)),
+        *INPUTS,
+        rudder_command(depends=("psi", "r", "psi_d") + _LAW,
+                       get=lambda s: s.model.command(s.psi, s.r, s.psi_d),
+                       description="commanded rudder angle, eq (43)"),
         Var.output("psi_z", "rad", "reference heading, eq (44)", initial_depends=("psi",)),
         Var.output("r_z", "rad/s", "reference yaw rate, eq (44)", initial_depends=("r",)),
         Var.output("sigma", "1", "sliding surface, eq (37)", depends=("psi", "r") + _DESIGN,

@@ -22,6 +22,7 @@ import copy
 from pathlib import Path
 
 import fmpy
+import fmukit.autopilot
 from fmpy import read_model_description
 from fmpy.model_description import ModelDescription
 
@@ -29,8 +30,7 @@ from ..core.fmi import trial_instantiation
 from ..core.ssd import Connection, SystemDescription
 
 COMPONENT = "autopilot"
-PORTS = {"psi": ("input", "rad"), "r": ("input", "rad/s"), "psi_d": ("input", "rad"),
-         "delta_c": ("output", "rad")}
+PORTS = {v.name: (v.causality, v.unit) for v in fmukit.autopilot.PORTS}
 
 
 class AutopilotError(ValueError):
