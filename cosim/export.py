@@ -23,7 +23,8 @@ from .interop.ssp import export
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m cosim.export",
                                      description=__doc__.split("\n\n")[0])
-    parser.add_argument("scenario", nargs="?", help=f"one of: {', '.join(scenarios.names())}")
+    parser.add_argument("scenario", nargs="?",
+                        help=f"one of: {', '.join(scenarios.names())}; or a path to a .ssd file")
     parser.add_argument("--all", action="store_true", help="the paper's four scenarios")
     parser.add_argument("--out", type=Path, default=Path("results/ssp"), help="output folder")
     add_autopilot_options(parser, "the package carries the FMU; with --all, in each of the "

@@ -23,7 +23,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--workers", type=int, help="local worker processes (default: cores)")
     parser.add_argument("--out", type=Path, default=RESULTS, help="parent folder of the results")
     parser.add_argument("--csv", action="store_true", help="also write results.csv")
-    parser.add_argument("--no-progress", action="store_true")
+    parser.add_argument("--no-progress", action="store_true",
+                        help="no progress bar (for logs)")
     args = parser.parse_args(argv)
     try:
         spec = sweep.Spec.read(args.spec)

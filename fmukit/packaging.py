@@ -9,7 +9,9 @@ fails the build.
 """
 from __future__ import annotations
 
+import contextlib
 import shutil
+import sys
 import tempfile
 from pathlib import Path
 
@@ -42,26 +44,63 @@ def build(name: str, dest: Path = FMU_DIR) -> Path:
     return build_script(ROOT / script, packages, dest / f"{name}.fmu")
 
 
-def build_script(script: Path, packages: tuple[str, ...], fmu_path: Path) -> Path:
-    """Build the slave in ``script`` with this project's ``packages`` into ``fmu_path``."""
+def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path) -> Path:
+    """Build the slave in ``script`` into ``dest`` (a .fmu path, or a folder where the FMU
+    is named after the slave's model_name), carrying ``packages``: this project's package
+    names, or paths of a user's modules and packages. Returns the FMU's path.
+
+    ValueError naming the script if it cannot be built (no ModelSlave in it, or it
+    does not import); RuntimeError if the result does not validate.
+    """
     from fmpy.validation import validate_fmu
     from pythonfmu import FmuBuilder
 
-    name, dest = fmu_path.stem, fmu_path.parent
-    dest.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(prefix=f"build_{name}_") as tmp:
+    script, dest = Path(script), Path(dest)
+    if not (script.is_file() and script.suffix == ".py"):
+        raise ValueError(f"{script} is not a Python script (.py) to build an FMU from")
+    sources = [ROOT / p if isinstance(p, str) else Path(p) for p in packages]
+    for source in sources:
+        if not source.exists():
+            raise ValueError(f"{source}, to be carried by {script.name}'s FMU, does not exist")
+    (dest.parent if dest.suffix == ".fmu" else dest).mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix=f"build_{script.stem}_") as tmp, \
+            _imports_undone(tmp):
         stage = Path(tmp)
         shutil.copy2(script, stage)
-        for package in packages:
-            shutil.copytree(ROOT / package, stage / package,
-                            ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+        for source in sources:
+            if source.is_dir():
+                shutil.copytree(source, stage / source.name,
+                                ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+            else:
+                shutil.copy2(source, stage)
         (stage / "requirements.txt").write_text(RUNTIME_REQUIREMENTS)
-        fmu = FmuBuilder.build_FMU(
-            stage / Path(script).name, dest=fmu_path,
-            project_files=[stage / p for p in packages] + [stage / "requirements.txt"],
-            canGetAndSetFMUstate=True, canSerializeFMUstate=True)
-    exit_fix.fix_fmu(Path(fmu))
+        try:
+            fmu = Path(FmuBuilder.build_FMU(
+                stage / script.name, dest=dest,
+                project_files=[stage / s.name for s in sources] + [stage / "requirements.txt"],
+                canGetAndSetFMUstate=True, canSerializeFMUstate=True))
+        except Exception as error:      # the script's own import errors included
+            why = str(error).replace(str(stage / script.name), str(script))
+            raise ValueError(f"cannot build an FMU from {script}: "
+                             f"{type(error).__name__}: {why}") from error
+    exit_fix.fix_fmu(fmu)
     problems = validate_fmu(str(fmu))
     if problems:
         raise RuntimeError(f"{fmu} does not validate:\n" + "\n".join(problems))
-    return Path(fmu)
+    return fmu
+
+
+@contextlib.contextmanager
+def _imports_undone(stage: str):
+    """Forget what building imported from ``stage``: pythonfmu imports the script and the
+    packages it carries from the temporary folder, and leaves that on sys.path. Left
+    there, the next build in this process (or an in-process run) would find those stale
+    modules. Modules imported from elsewhere (numpy, say) stay: they cannot be reloaded."""
+    path, modules = list(sys.path), set(sys.modules)
+    try:
+        yield
+    finally:
+        sys.path[:] = path
+        for name in set(sys.modules) - modules:
+            if str(getattr(sys.modules[name], "__file__", None) or "").startswith(stage):
+                del sys.modules[name]

@@ -30,6 +30,9 @@ def communication_point(t0: float, k: int, h: float) -> float:
 
 def step_count(start: float, stop: float, step: float) -> int:
     """Communication steps of ``step`` from start to stop; ValueError unless a whole number >= 1."""
+    for name, value in (("start time", start), ("stop time", stop), ("step size", step)):
+        if not abs(value) <= MAX_TIME:
+            raise ValueError(f"{name} {value} s is not a finite time within +-{MAX_TIME:g} s")
     h = nanoseconds(step)
     if h <= 0:
         raise ValueError(f"step size {step} s is not positive (at least 1 ns)")

@@ -6,25 +6,38 @@ from pathlib import Path
 
 import pytest
 
+from fmukit.cbuild import C_FMUS, build_c, c_compiler
 from fmukit.packaging import FMU_DIR, FMUS, ROOT, build
 
 
-def _stale(name: str) -> bool:
+def _stale(name: str, sources: list[Path]) -> bool:
     fmu = FMU_DIR / f"{name}.fmu"
-    if not fmu.exists():
-        return True
-    sources = [ROOT / FMUS[name][0]] + [p for pkg in FMUS[name][1]
-                                        for p in (ROOT / pkg).rglob("*.py")]
-    return max(p.stat().st_mtime for p in sources) > fmu.stat().st_mtime
+    return not fmu.exists() or max(p.stat().st_mtime for p in sources) > fmu.stat().st_mtime
 
 
 @pytest.fixture(scope="session")
 def fmu_paths() -> dict[str, Path]:
-    """Every FMU in fmus/, rebuilt first if missing or older than its sources."""
-    for name in FMUS:
-        if _stale(name):
+    """Every FMU in fmus/, rebuilt first if missing or older than its sources (the C FMU
+    only where there is a C compiler)."""
+    for name, (script, packages) in FMUS.items():
+        if _stale(name, [ROOT / script] + [p for pkg in packages
+                                           for p in (ROOT / pkg).rglob("*.py")]):
             build(name)
-    return {name: FMU_DIR / f"{name}.fmu" for name in FMUS}
+    built = list(FMUS)
+    if c_compiler() is not None:
+        for name, folder in C_FMUS.items():
+            if _stale(name, list((ROOT / folder).iterdir())):
+                build_c(name)
+        built += list(C_FMUS)
+    return {name: FMU_DIR / f"{name}.fmu" for name in built}
+
+
+@pytest.fixture
+def c_autopilot(fmu_paths) -> Path:
+    """The autopilot in C; the test is skipped, saying why, on a machine without a compiler."""
+    if "pd_autopilot_c" not in fmu_paths:
+        pytest.skip("no C compiler on this machine (set CC or install gcc)")
+    return fmu_paths["pd_autopilot_c"]
 
 
 @pytest.fixture
@@ -43,4 +56,3 @@ def open_fmu(fmu_paths):
     for instance in opened:
         instance.free()
     gc.collect()            # a host corrupted by an FMU would crash here, inside the test
-

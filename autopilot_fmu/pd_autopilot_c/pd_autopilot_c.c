@@ -1,0 +1,276 @@
+/* The PD autopilot of eq (20) as an FMI 2.0 co-simulation FMU written in C.
+
+       delta_c = Kp wrap(psi - psi_d) + Kd r,   wrap: to (-pi, pi]
+
+   The same law as autopilot_fmu/pd.py, to show that an autopilot in any language that
+   can export the FMI 2.0 C API drops into the co-simulation (docs/own_autopilot.md).
+   Built by fmukit.cbuild against the FMI 2.0 headers fmpy ships in fmpy/c-code.
+
+   Value references: 0 psi, 1 r, 2 psi_d (inputs), 3 delta_c (output), 4 Kp, 5 Kd. */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fmi2Functions.h"
+
+enum { PSI, R, PSI_D, DELTA_C, KP, KD, N_VARIABLES };
+enum Phase { INSTANTIATED, INITIALIZATION, STEP, TERMINATED };
+
+typedef struct {
+    fmi2Real value[N_VARIABLES];
+    enum Phase phase;
+    fmi2CallbackFunctions callbacks;
+    char *name;
+    fmi2Boolean logging;
+} Instance;
+
+static const fmi2Real START[N_VARIABLES] = {0.0, 0.0, 0.0, 0.0, 2.0, 50.0};
+
+static void say(Instance *c, fmi2Status status, const char *category, const char *format, ...) {
+    char message[512];
+    va_list args;
+    if (status < fmi2Error && !c->logging) return;
+    va_start(args, format);
+    vsnprintf(message, sizeof message, format, args);
+    va_end(args);
+    /* Passed as the format, without arguments: hosts that cannot take variadic
+       callbacks (fmpy's ctypes logger) show the format. No message here holds a '%'. */
+    if (c->callbacks.logger)
+        c->callbacks.logger(c->callbacks.componentEnvironment, c->name, status, category,
+                            message);
+}
+
+/* Log an error (always) and return the status the call ends with. */
+#define REFUSE(c, status, ...) (say((c), (status), "logStatusError", __VA_ARGS__), (status))
+
+static const fmi2Real PI = 3.141592653589793;      /* the double nearest pi, as math.pi */
+
+static fmi2Real wrap(fmi2Real angle) {              /* the short way round, (-pi, pi] */
+    fmi2Real wrapped = remainder(angle, 2.0 * PI);
+    return wrapped == -PI ? PI : wrapped;
+}
+
+static fmi2Real rudder_command(const Instance *c) {  /* eq (20) */
+    const fmi2Real *v = c->value;
+    return v[KP] * wrap(v[PSI] - v[PSI_D]) + v[KD] * v[R];
+}
+
+const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
+const char *fmi2GetVersion(void) { return fmi2Version; }
+
+fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid,
+                              fmi2String resources, const fmi2CallbackFunctions *callbacks,
+                              fmi2Boolean visible, fmi2Boolean loggingOn) {
+    Instance *c;
+    (void)resources; (void)visible;
+    if (type != fmi2CoSimulation || !name || !guid
+            || strcmp(guid, "{5d0b1c4e-9a51-4b9c-8f57-3f0b5a3d2e71}") != 0)
+        return NULL;
+    c = calloc(1, sizeof *c);
+    if (!c) return NULL;
+    c->name = malloc(strlen(name) + 1);
+    if (!c->name) { free(c); return NULL; }
+    strcpy(c->name, name);
+    if (callbacks) c->callbacks = *callbacks;
+    c->logging = loggingOn;
+    memcpy(c->value, START, sizeof START);
+    c->phase = INSTANTIATED;
+    return c;
+}
+
+void fmi2FreeInstance(fmi2Component component) {
+    Instance *c = component;
+    if (!c) return;
+    free(c->name);
+    free(c);
+}
+
+fmi2Status fmi2SetDebugLogging(fmi2Component component, fmi2Boolean loggingOn,
+                               size_t nCategories, const fmi2String categories[]) {
+    (void)nCategories; (void)categories;
+    ((Instance *)component)->logging = loggingOn;
+    return fmi2OK;
+}
+
+fmi2Status fmi2SetupExperiment(fmi2Component component, fmi2Boolean toleranceDefined,
+                               fmi2Real tolerance, fmi2Real startTime,
+                               fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
+    Instance *c = component;
+    (void)toleranceDefined; (void)tolerance; (void)startTime; (void)stopTimeDefined;
+    (void)stopTime;
+    if (c->phase != INSTANTIATED)
+        return REFUSE(c, fmi2Error, "%s is only allowed after fmi2Instantiate",
+                      "fmi2SetupExperiment");
+    return fmi2OK;
+}
+
+fmi2Status fmi2EnterInitializationMode(fmi2Component component) {
+    Instance *c = component;
+    if (c->phase != INSTANTIATED)
+        return REFUSE(c, fmi2Error, "%s is only allowed after fmi2Instantiate",
+                      "fmi2EnterInitializationMode");
+    c->phase = INITIALIZATION;
+    return fmi2OK;
+}
+
+fmi2Status fmi2ExitInitializationMode(fmi2Component component) {
+    Instance *c = component;
+    if (c->phase != INITIALIZATION)
+        return REFUSE(c, fmi2Error, "%s is only allowed in initialization mode",
+                      "fmi2ExitInitializationMode");
+    if (!isfinite(c->value[KP]) || !isfinite(c->value[KD]))
+        return REFUSE(c, fmi2Error, "parameter %s is not finite",
+                      isfinite(c->value[KP]) ? "Kd" : "Kp");
+    c->phase = STEP;
+    return fmi2OK;
+}
+
+fmi2Status fmi2Terminate(fmi2Component component) {
+    Instance *c = component;
+    if (c->phase != STEP)
+        return REFUSE(c, fmi2Error, "%s is only allowed after initialization",
+                      "fmi2Terminate");
+    c->phase = TERMINATED;
+    return fmi2OK;
+}
+
+fmi2Status fmi2Reset(fmi2Component component) {
+    Instance *c = component;
+    memcpy(c->value, START, sizeof START);
+    c->phase = INSTANTIATED;
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetReal(fmi2Component component, const fmi2ValueReference vr[], size_t nvr,
+                       fmi2Real value[]) {
+    Instance *c = component;
+    size_t i;
+    for (i = 0; i < nvr; i++) {
+        if (vr[i] >= N_VARIABLES)
+            return REFUSE(c, fmi2Error, "no Real variable has value reference %u", vr[i]);
+        value[i] = vr[i] == DELTA_C ? rudder_command(c) : c->value[vr[i]];
+    }
+    return fmi2OK;
+}
+
+fmi2Status fmi2SetReal(fmi2Component component, const fmi2ValueReference vr[], size_t nvr,
+                       const fmi2Real value[]) {
+    Instance *c = component;
+    size_t i;
+    for (i = 0; i < nvr; i++) {
+        if (vr[i] >= N_VARIABLES || vr[i] == DELTA_C)
+            return REFUSE(c, fmi2Error, "value reference %u is not an input or parameter",
+                          vr[i]);
+        if (vr[i] >= KP && c->phase != INSTANTIATED && c->phase != INITIALIZATION)
+            return REFUSE(c, fmi2Error, "parameter %s is fixed after initialization",
+                          vr[i] == KP ? "Kp" : "Kd");
+    }
+    for (i = 0; i < nvr; i++) c->value[vr[i]] = value[i];
+    return fmi2OK;
+}
+
+fmi2Status fmi2DoStep(fmi2Component component, fmi2Real t, fmi2Real h,
+                      fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
+    static const char *const input[] = {"psi", "r", "psi_d"};
+    Instance *c = component;
+    int i;
+    (void)t; (void)noSetFMUStatePriorToCurrentPoint;
+    if (c->phase != STEP)
+        return REFUSE(c, fmi2Error, "%s is only allowed after initialization", "fmi2DoStep");
+    if (!(h > 0.0))
+        return REFUSE(c, fmi2Discard, "doStep with a communication step of %g s", h);
+    for (i = PSI; i <= PSI_D; i++)
+        if (!isfinite(c->value[i]))
+            return REFUSE(c, fmi2Discard, "input %s is not finite; step refused", input[i]);
+    return fmi2OK;                                /* memoryless: nothing to advance */
+}
+
+/* What this FMU does not do. */
+static fmi2Status unsupported(fmi2Component component, const char *call) {
+    return REFUSE((Instance *)component, fmi2Error, "%s is not supported by this FMU", call);
+}
+fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                          fmi2Integer value[]) {
+    (void)vr; (void)value;
+    return nvr ? unsupported(c, "fmi2GetInteger") : fmi2OK;
+}
+fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                          fmi2Boolean value[]) {
+    (void)vr; (void)value;
+    return nvr ? unsupported(c, "fmi2GetBoolean") : fmi2OK;
+}
+fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                         fmi2String value[]) {
+    (void)vr; (void)value;
+    return nvr ? unsupported(c, "fmi2GetString") : fmi2OK;
+}
+fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                          const fmi2Integer value[]) {
+    (void)vr; (void)value;
+    return nvr ? unsupported(c, "fmi2SetInteger") : fmi2OK;
+}
+fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                          const fmi2Boolean value[]) {
+    (void)vr; (void)value;
+    return nvr ? unsupported(c, "fmi2SetBoolean") : fmi2OK;
+}
+fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                         const fmi2String value[]) {
+    (void)vr; (void)value;
+    return nvr ? unsupported(c, "fmi2SetString") : fmi2OK;
+}
+fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *s) {
+    (void)s; return unsupported(c, "fmi2GetFMUstate");
+}
+fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate s) {
+    (void)s; return unsupported(c, "fmi2SetFMUstate");
+}
+fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *s) {
+    (void)s; return unsupported(c, "fmi2FreeFMUstate");
+}
+fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate s, size_t *n) {
+    (void)s; (void)n; return unsupported(c, "fmi2SerializedFMUstateSize");
+}
+fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate s, fmi2Byte b[], size_t n) {
+    (void)s; (void)b; (void)n; return unsupported(c, "fmi2SerializeFMUstate");
+}
+fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte b[], size_t n,
+                                   fmi2FMUstate *s) {
+    (void)b; (void)n; (void)s; return unsupported(c, "fmi2DeSerializeFMUstate");
+}
+fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[],
+                                        size_t nu, const fmi2ValueReference z[], size_t nz,
+                                        const fmi2Real dv[], fmi2Real dz[]) {
+    (void)u; (void)nu; (void)z; (void)nz; (void)dv; (void)dz;
+    return unsupported(c, "fmi2GetDirectionalDerivative");
+}
+fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[],
+                                       size_t nvr, const fmi2Integer order[],
+                                       const fmi2Real value[]) {
+    (void)vr; (void)nvr; (void)order; (void)value;
+    return unsupported(c, "fmi2SetRealInputDerivatives");
+}
+fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[],
+                                        size_t nvr, const fmi2Integer order[],
+                                        fmi2Real value[]) {
+    (void)vr; (void)nvr; (void)order; (void)value;
+    return unsupported(c, "fmi2GetRealOutputDerivatives");
+}
+fmi2Status fmi2CancelStep(fmi2Component c) { return unsupported(c, "fmi2CancelStep"); }
+fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *v) {
+    (void)s; (void)v; return unsupported(c, "fmi2GetStatus");
+}
+fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *v) {
+    (void)s; (void)v; return unsupported(c, "fmi2GetRealStatus");
+}
+fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *v) {
+    (void)s; (void)v; return unsupported(c, "fmi2GetIntegerStatus");
+}
+fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *v) {
+    (void)s; (void)v; return unsupported(c, "fmi2GetBooleanStatus");
+}
+fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *v) {
+    (void)s; (void)v; return unsupported(c, "fmi2GetStringStatus");
+}
