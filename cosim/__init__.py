@@ -12,8 +12,13 @@ Layers, each a sub-package whose docstring says more:
 - ``cosim.studies``: studies built on the above: ensembles on Dask, benchmarks, the
   in-process reference.
 
-The modules directly in ``cosim/`` are the commands (``python -m cosim.run``,
-``cosim.sweep``, ``cosim.export``, ``cosim.bench``, ``cosim.engines``); they parse
-options and print, and nothing else imports them. A module imports only from the
-sub-packages listed before its own (the core from none); nothing imports a command.
+On top of them, directly in ``cosim/``: the Python entry point ``cosim.simulate``
+(``api.py``), the pytest plugin (``testing.py``), and the commands (``python -m
+cosim.run``, ``cosim.sweep``, ``cosim.export``, ``cosim.bench``, ``cosim.engines``,
+``cosim.score``), which parse options and print; ``_cli.py`` is what they share. A
+module imports only from the sub-packages listed before its own (the core from
+none); nothing imports a command.
 """
+from .api import SimulationError, simulate
+
+__all__ = ["simulate", "SimulationError"]

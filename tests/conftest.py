@@ -9,6 +9,8 @@ import pytest
 from fmukit.cbuild import C_FMUS, build_c, c_compiler
 from fmukit.packaging import FMU_DIR, FMUS, ROOT, build
 
+pytest_plugins = ["pytester"]       # to run the example test file for each autopilot
+
 
 def _stale(name: str, sources: list[Path]) -> bool:
     fmu = FMU_DIR / f"{name}.fmu"

@@ -29,6 +29,7 @@ class VariableInfo:
     valueReference: int
     type: str
     causality: str
+    unit: str
 
 
 def slave_class(fmu_name: str) -> type[ModelSlave]:
@@ -51,7 +52,8 @@ class InProcessInstance(Instance):
         self.variables = {}
         for vr, var in self.slave.registry.by_vr.items():
             self.variables[var.name] = VariableInfo(var.name, vr, _FMI_TYPE[var.kind],
-                                                    var.causality)
+                                                    var.causality,
+                                                    var.unit if var.is_real else "")
         inputs = {v.name for v in self.slave.variables if v.causality == "input"}
         self.feedthrough = {v.name: frozenset(v.depends) & inputs
                             for v in self.slave.variables if v.causality == "output"}

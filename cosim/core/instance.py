@@ -60,6 +60,12 @@ class Instance:
     def vr(self, name: str) -> int:
         return self.variable(name).valueReference
 
+    def unit(self, name: str) -> str:
+        """The unit a variable declares (its own or its type's), "" if none."""
+        variable = self.variable(name)
+        declared = getattr(variable, "declaredType", None)
+        return getattr(variable, "unit", None) or getattr(declared, "unit", None) or ""
+
     def set(self, values: dict[str, Any], time: float | None = None) -> None:
         """Set variables by name, each with the FMI type of its declaration."""
         for name, value in values.items():

@@ -59,6 +59,9 @@ class Master:
             raise
         self.nodes = [nodes[name] for name in (self.order if coupling == "gauss-seidel"
                                                else self.instances)]
+        self.units = {column: self.instances[component].unit(variable)
+                      for column in self.columns
+                      for component, variable in [column.split(".", 1)]}
 
     def configure(self, overrides: dict[str, dict[str, Any]] | None = None) -> None:
         """Parameters for the next run: the system's, updated by ``overrides``."""
@@ -100,7 +103,7 @@ class Master:
         n_steps = step_count(t0, system.stop_time if stop_time is None else stop_time, h)
         recorder = Recorder(self.columns, n_steps + 1, csv_path, chunk_rows,
                             meta={"system": system.name, "coupling": self.coupling,
-                                  "step_size": h})
+                                  "step_size": h}, units=self.units)
         exchange, nodes, values = COUPLINGS[self.coupling], self.nodes, [0.0] * len(self.columns)
         k, t, error = 0, t0, None
         try:

@@ -25,6 +25,7 @@ class Recording:
     error: str | None = None            # why the run stopped early, if it did
     meta: dict[str, Any] = field(default_factory=dict)
     path: Path | None = None            # where the rows went, if streamed to CSV
+    units: dict[str, str] = field(default_factory=dict)   # column: unit ("" if none)
 
     def __getitem__(self, column: str) -> np.ndarray:
         self._require_held()
@@ -69,8 +70,9 @@ class Recorder:
     """Takes a run's rows one at a time; with ``csv_path``, streams them in chunks."""
 
     def __init__(self, columns: list[str], rows: int, csv_path: str | Path | None = None,
-                 chunk_rows: int = 10_000, meta: dict[str, Any] | None = None):
-        self.columns, self.meta = columns, meta or {}
+                 chunk_rows: int = 10_000, meta: dict[str, Any] | None = None,
+                 units: dict[str, str] | None = None):
+        self.columns, self.meta, self.units = columns, meta or {}, units or {}
         self.sink = CsvSink(csv_path, columns) if csv_path is not None else None
         size = rows if self.sink is None else min(chunk_rows, rows)
         self.time, self.data = np.empty(size), np.full((size, len(columns)), np.nan)
@@ -96,8 +98,8 @@ class Recorder:
         """The recording; a stream gets its last rows and is closed."""
         if self.sink is None:
             return Recording(self.columns, self.time[:self.held], self.data[:self.held],
-                             self.held, error, self.meta)
+                             self.held, error, self.meta, units=self.units)
         self._flush()
         self.sink.close()
         return Recording(self.columns, np.empty(0), np.empty((0, len(self.columns))),
-                         self.sink.rows, error, self.meta, self.sink.path)
+                         self.sink.rows, error, self.meta, self.sink.path, self.units)

@@ -1,0 +1,55 @@
+"""The Python entry point: one call runs a scenario, with your autopilot if you have one.
+
+    from cosim import simulate
+    run = simulate("waves_pd", autopilot="my.fmu", set={"ship.Hs": 0.01}, stop_time=200)
+    run["ship.psi"], run.t, run.units["ship.psi"]        # heading (rad) at every 0.1 s
+
+The recording holds every exchanged signal by ``component.variable`` (every FMU
+output and every connected input) at every communication point, and the unit of
+each. ``cosim.testing`` turns this into pytest checks.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from . import scenarios
+from .core.master import Master
+from .core.recording import Recording
+
+
+class SimulationError(RuntimeError):
+    """An FMU failed during the run; ``recording`` holds the rows up to the failure."""
+
+    def __init__(self, message: str, recording: Recording):
+        super().__init__(message)
+        self.recording = recording
+
+
+def simulate(scenario: str | Path, autopilot: str | Path | None = None,
+             set: dict[str, Any] | None = None, stop_time: float | None = None,
+             coupling: str = "gauss-seidel", backend: str = "fmi",
+             port_map: dict[str, str] | None = None) -> Recording:
+    """Run a scenario (a name or a .ssd path) and return its recording.
+
+    ``autopilot``: an FMU in place of the scenario's (``cosim.scenarios.autopilot``),
+    its ports renamed by ``port_map``; ``set``: parameter values by
+    ``"component.variable"`` (SI units, radians); ``stop_time`` in s (default: the
+    scenario's). ValueError or FileNotFoundError for bad input, naming it;
+    SimulationError if an FMU fails during the run.
+    """
+    overrides: dict[str, dict[str, Any]] = {}
+    for target, value in (set or {}).items():
+        component, dot, variable = target.partition(".")
+        if not (dot and component and variable):
+            raise ValueError(f"set: {target!r} is not 'component.variable'")
+        overrides.setdefault(component, {})[variable] = value
+    master = Master(scenarios.load(scenario, autopilot, port_map), coupling=coupling,
+                    backend=backend, overrides=overrides)
+    try:
+        recording = master.run(stop_time)
+    finally:
+        master.free()
+    if recording.error:
+        raise SimulationError(recording.error, recording)
+    return recording
