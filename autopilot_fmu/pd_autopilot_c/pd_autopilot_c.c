@@ -94,32 +94,36 @@ fmi2Status fmi2SetDebugLogging(fmi2Component component, fmi2Boolean loggingOn,
     return fmi2OK;
 }
 
+/* fmi2OK if the instance is in ``phase``; else an error naming the call. */
+static fmi2Status require(Instance *c, enum Phase phase, const char *call) {
+    static const char *const after[] = {"fmi2Instantiate", "fmi2EnterInitializationMode",
+                                        "fmi2ExitInitializationMode", "fmi2Terminate"};
+    if (c->phase == phase) return fmi2OK;
+    return REFUSE(c, fmi2Error, "%s is only allowed after %s", call, after[phase]);
+}
+
 fmi2Status fmi2SetupExperiment(fmi2Component component, fmi2Boolean toleranceDefined,
                                fmi2Real tolerance, fmi2Real startTime,
                                fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
-    Instance *c = component;
     (void)toleranceDefined; (void)tolerance; (void)startTime; (void)stopTimeDefined;
     (void)stopTime;
-    if (c->phase != INSTANTIATED)
-        return REFUSE(c, fmi2Error, "%s is only allowed after fmi2Instantiate",
-                      "fmi2SetupExperiment");
-    return fmi2OK;
+    return require(component, INSTANTIATED, "fmi2SetupExperiment");
+}
+
+/* From phase ``from`` to ``to``, or an error naming the call. */
+static fmi2Status advance(Instance *c, enum Phase from, enum Phase to, const char *call) {
+    fmi2Status status = require(c, from, call);
+    if (status == fmi2OK) c->phase = to;
+    return status;
 }
 
 fmi2Status fmi2EnterInitializationMode(fmi2Component component) {
-    Instance *c = component;
-    if (c->phase != INSTANTIATED)
-        return REFUSE(c, fmi2Error, "%s is only allowed after fmi2Instantiate",
-                      "fmi2EnterInitializationMode");
-    c->phase = INITIALIZATION;
-    return fmi2OK;
+    return advance(component, INSTANTIATED, INITIALIZATION, "fmi2EnterInitializationMode");
 }
 
 fmi2Status fmi2ExitInitializationMode(fmi2Component component) {
     Instance *c = component;
-    if (c->phase != INITIALIZATION)
-        return REFUSE(c, fmi2Error, "%s is only allowed in initialization mode",
-                      "fmi2ExitInitializationMode");
+    if (require(c, INITIALIZATION, "fmi2ExitInitializationMode") != fmi2OK) return fmi2Error;
     if (!isfinite(c->value[KP]) || !isfinite(c->value[KD]))
         return REFUSE(c, fmi2Error, "parameter %s is not finite",
                       isfinite(c->value[KP]) ? "Kd" : "Kp");
@@ -128,12 +132,7 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component component) {
 }
 
 fmi2Status fmi2Terminate(fmi2Component component) {
-    Instance *c = component;
-    if (c->phase != STEP)
-        return REFUSE(c, fmi2Error, "%s is only allowed after initialization",
-                      "fmi2Terminate");
-    c->phase = TERMINATED;
-    return fmi2OK;
+    return advance(component, STEP, TERMINATED, "fmi2Terminate");
 }
 
 fmi2Status fmi2Reset(fmi2Component component) {
@@ -177,8 +176,7 @@ fmi2Status fmi2DoStep(fmi2Component component, fmi2Real t, fmi2Real h,
     Instance *c = component;
     int i;
     (void)t; (void)noSetFMUStatePriorToCurrentPoint;
-    if (c->phase != STEP)
-        return REFUSE(c, fmi2Error, "%s is only allowed after initialization", "fmi2DoStep");
+    if (require(c, STEP, "fmi2DoStep") != fmi2OK) return fmi2Error;
     if (!(h > 0.0))
         return REFUSE(c, fmi2Discard, "doStep with a communication step of %g s", h);
     for (i = PSI; i <= PSI_D; i++)
