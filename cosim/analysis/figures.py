@@ -58,3 +58,31 @@ def save_figure(recording: Recording, draw: Callable[[Recording, Any], None], pa
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return path
+
+
+def comparison_figure(runs: dict[str, Recording], path: Path, title: str) -> Path:
+    """Several controllers on one scenario: their tracks, headings and rudders, overlaid."""
+    fig = plt.figure(figsize=(11, 6), constrained_layout=True)
+    grid = fig.add_gridspec(2, 2, width_ratios=(1, 1.3))
+    track, heading, rudder = (fig.add_subplot(grid[:, 0]), fig.add_subplot(grid[0, 1]),
+                              fig.add_subplot(grid[1, 1]))
+    first = next(iter(runs.values()))
+    heading.plot(first.t, np.degrees(first["guidance.psi_d"]), "--", color="0.4",
+                 label="psi_d")
+    for label, run in runs.items():
+        line, = track.plot(run["ship.y"], run["ship.x"], label=label)
+        heading.plot(run.t, np.degrees(run["ship.psi"]), color=line.get_color(), label=label)
+        rudder.plot(run.t, np.degrees(run["ship.delta"]), color=line.get_color(),
+                    linewidth=0.7)
+    track.set(xlabel="east y (m)", ylabel="north x (m)")
+    track.set_aspect("equal", adjustable="datalim")
+    track.legend(loc="best", fontsize=8)
+    heading.set(ylabel="heading psi (deg)")
+    heading.legend(loc="best", fontsize=8)
+    rudder.set(xlabel="time (s)", ylabel="rudder delta (deg)")
+    for a in (track, heading, rudder):
+        a.grid(alpha=0.3)
+    fig.suptitle(title, fontsize=10)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path

@@ -85,7 +85,7 @@ class Spec:
             data = tomllib.loads(path.read_text())
         except (OSError, tomllib.TOMLDecodeError) as error:
             raise ValueError(f"cannot read sweep spec {path}: {error}") from None
-        controllers = {name: _controller(entry, path, name)
+        controllers = {name: controller_entry(entry, path, name)
                        for name, entry in data.get("controllers", DEFAULT_CONTROLLERS).items()}
         axes = {}
         for name, values in data.get("axes", {}).items():
@@ -142,7 +142,7 @@ class Spec:
         return controller["scenario"], overrides
 
 
-def _controller(entry: str | dict[str, Any], spec: Path, name: str) -> dict[str, Any]:
+def controller_entry(entry: str | dict[str, Any], spec: Path, name: str) -> dict[str, Any]:
     """A controller entry, checked, with its paths made absolute (relative to the spec file).
 
     An entry is a scenario (a name or a .ssd path), an autopilot FMU (run in waves_pd's

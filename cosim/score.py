@@ -1,0 +1,71 @@
+"""Score your autopilot against the paper's PD and sliding-mode autopilots and the PID.
+
+    python -m cosim.score my.fmu [--name NAME] [--seeds N] [--map PORT=NAME] [--out DIR]
+
+Runs the paper's route in calm water and waves, a 40 deg course change, and an
+N-seed wave ensemble on a local Dask cluster (or --scheduler), for your FMU and the
+three project autopilots; writes scorecard.md and its figures to
+results/score/NAME/ and prints the tables (``cosim.studies.scorecard``).
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from ._cli import checked_autopilot, parse_port_map, writable_folder
+from .api import SimulationError
+from .studies.scorecard import score
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m cosim.score",
+                                     description=__doc__.split("\n\n")[0],
+                                     epilog="\n\n".join(__doc__.split("\n\n")[1:]),
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("autopilot", type=Path, metavar="FMU",
+                        help="your autopilot: FMI 2.0 co-simulation, inputs psi (rad), r "
+                             "(rad/s), psi_d (rad), output delta_c (rad)")
+    parser.add_argument("--name", help="its name in the tables (default: the file name)")
+    parser.add_argument("--map", action="append", default=[], type=parse_port_map,
+                        metavar="PORT=NAME",
+                        help="the FMU's name of an autopilot port, e.g. psi=heading; repeatable")
+    parser.add_argument("--seeds", type=int, default=20, help="wave seeds of the ensemble "
+                                                              "(default 20)")
+    parser.add_argument("--workers", type=int, help="local Dask worker processes "
+                                                    "(default: one per core)")
+    parser.add_argument("--out", type=Path, help="output folder (default: results/score/NAME)")
+    args = parser.parse_args(argv)
+    if args.seeds < 1:
+        parser.error(f"--seeds must be at least 1, got {args.seeds}")
+    if args.workers is not None and args.workers < 1:
+        parser.error(f"--workers must be at least 1, got {args.workers}")
+    if not checked_autopilot(parser, args):
+        return 2
+    name = args.name or args.autopilot.stem
+    out = writable_folder(args.out or Path("results") / "score" / name)
+    started = time.perf_counter()
+    steps = 4 * 2 + 4 + 1
+
+    from tqdm import tqdm
+    with tqdm(total=steps, desc="scorecard", unit="step", file=sys.stderr,
+              bar_format="{desc}: {n}/{total} {bar} {elapsed} {postfix}") as bar:
+        def progress(step: str) -> None:
+            if bar.n or step != "calm water, PD":
+                bar.update()
+            bar.set_postfix_str(step)
+        try:
+            text = score(args.autopilot.resolve(), name, out, args.seeds, dict(args.map),
+                         args.workers, progress)
+        except (ValueError, FileNotFoundError, SimulationError) as error:
+            print(f"error: {error}", file=sys.stderr)
+            return 1
+        bar.update()
+    print(text)
+    print(f"wrote {out / 'scorecard.md'} and its figures in {time.perf_counter() - started:.0f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,42 @@
+"""The scorecard: your autopilot beside PD, SMC and PID, in tables and figures."""
+from __future__ import annotations
+
+import re
+
+from cosim import score as cli
+
+
+def _rows(text: str, heading: str) -> dict[str, list[str]]:
+    """The rows of the first markdown table after ``heading``, by their first cell."""
+    table = text[text.index(heading):].split("\n\n")[1].splitlines()[2:]
+    return {cells[0]: cells[1:] for cells in
+            ([c.strip() for c in row.strip("|").split("|")] for row in table)}
+
+
+def test_the_scorecard_ranks_an_autopilot_beside_the_three_baselines(fmu_paths, tmp_path,
+                                                                     capsys):
+    out = tmp_path / "score"
+    assert cli.main([str(fmu_paths["pid_autopilot"]), "--name", "mine", "--seeds", "2",
+                     "--workers", "1", "--out", str(out)]) == 0
+    text = (out / "scorecard.md").read_text()
+    assert text in capsys.readouterr().out
+    route = _rows(text, "## The paper's route")
+    change = _rows(text, "## A 40 deg course change")
+    waves = _rows(text, "## Wave ensemble")
+    for table in (route, change, waves):
+        assert list(table) == ["PD", "SMC", "PID", "mine"]
+        assert table["mine"][:4] == table["PID"][:4]        # the same FMU, the same numbers
+    assert route["PD"][-1] == "256.9 / 520.8" and route["mine"][-1] == "-"
+    assert float(change["PD"][0]) < float(change["SMC"][0])  # the PD settles faster
+    assert waves["mine"][-1] == "2/2"
+    for figure in ("route_calm", "route_waves", "course_change", "J_distribution"):
+        assert (out / f"{figure}.png").stat().st_size > 10_000
+        assert f"({figure}.png)" in text
+
+
+def test_the_scorecard_refuses_a_file_that_is_not_an_autopilot(tmp_path, capsys):
+    junk = tmp_path / "junk.fmu"
+    junk.write_text("no")
+    assert cli.main([str(junk), "--out", str(tmp_path / "score")]) == 2
+    assert re.search(r"junk\.fmu is not an FMU", capsys.readouterr().err)
+    assert not (tmp_path / "score").exists()
