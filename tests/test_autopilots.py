@@ -6,12 +6,13 @@ import math
 import numpy as np
 import pytest
 
-from fmukit.numerics import wrap
 from autopilot_fmu.design import PAPER_EQ45, NomotoModel, design_model, linearised_ship
 from autopilot_fmu.guidance import WaypointGuidance, parse_waypoints
 from autopilot_fmu.pd import PDAutopilot
 from autopilot_fmu.smc import SlidingModeAutopilot, SlidingModeDesign
-from cosim.analysis.metrics import overshoot, settling_time, sign_reversals_per_minute
+from cosim.analysis.metrics import (heading_error, overshoot, settling_time,
+                                   sign_reversals_per_minute)
+from fmukit.numerics import wrap
 from ship_fmu.vessel import Vessel
 
 DT = 0.1
@@ -152,3 +153,19 @@ def test_40_deg_course_change_settles(name):
         assert settle < 100.0 and chatter < 5.0
     else:
         assert chatter > 20.0           # k2 ~ -2000 against a rate-limited gear: chattering
+
+
+def test_the_pid_removes_the_pds_steady_heading_offset_in_oblique_waves():
+    """One long leg at the route's second course (39.8 deg), waves from 180 deg: the mean
+    wave yaw moment needs a steady rudder, which the PD buys with a heading offset."""
+    from cosim import simulate
+
+    offsets = {}
+    for scenario in ("waves_pd", "waves_pid"):
+        run = simulate(scenario, set={"guidance.waypoints": "0,0;300,251"}, backend="inprocess")
+        late = run.t > 200.0
+        offsets[scenario] = heading_error(run["guidance.psi_d"], run["ship.psi"])[late].mean()
+        print(f"{scenario}: mean heading error after 200 s {math.degrees(offsets[scenario]):.3f}"
+              f" deg, mean rudder {math.degrees(run['ship.delta'][late].mean()):.2f} deg")
+    assert math.degrees(offsets["waves_pd"]) > 2.0
+    assert abs(math.degrees(offsets["waves_pid"])) < 0.05

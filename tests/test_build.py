@@ -111,3 +111,9 @@ def test_the_c_autopilot_refuses_a_nan_input_at_the_step(c_autopilot, tmp_path):
             raise AssertionError("a NaN input was accepted")
     finally:
         fmu.free()
+
+
+def test_the_walkthrough_shows_the_pid_exactly_as_it_is_built():
+    doc = (ROOT / "docs" / "own_autopilot.md").read_text()
+    shown = doc.split("```python\n", 1)[1].split("```", 1)[0]
+    assert shown == (ROOT / "autopilot_fmu" / "pid_autopilot_slave.py").read_text()
