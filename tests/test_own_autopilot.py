@@ -157,3 +157,23 @@ def test_check_autopilot_accepts_every_autopilot_of_the_project(fmu_paths):
         assert check_autopilot(fmu_paths[name]).coSimulation is not None
     with pytest.raises(AutopilotError, match="has no port 'psi'"):
         check_autopilot(fmu_paths["guidance"])
+
+
+@pytest.mark.parametrize("setting, fragment", [
+    ("autopilot.Kp=1e9", "parameter Kp = 1000000000.0 is outside its range [-10000, 10000]"),
+    ("autopilot.Ki=nan", "parameter Ki = nan is not finite"),
+])
+def test_a_bad_parameter_of_the_autopilot_is_named(fmu_paths, tmp_path, capsys, setting,
+                                                   fragment):
+    assert _run(tmp_path, "calm_pd", "--autopilot", str(fmu_paths["pid_autopilot"]),
+                "--set", setting) == 1
+    err = capsys.readouterr().err
+    assert "FMU 'autopilot': exitInitializationMode" in err and fragment in err
+
+
+def test_the_in_process_backend_says_it_cannot_run_a_foreign_fmu(foreign, tmp_path, capsys):
+    assert _run(tmp_path, "calm_pd", "--autopilot", str(foreign["renamed"]), *MAP,
+                "--backend", "inprocess") == 2
+    err = capsys.readouterr().err
+    assert "no FMU named 'heading_pilot' is built by this project" in err
+    assert "fmi2Terminate" not in err
