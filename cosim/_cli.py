@@ -78,7 +78,7 @@ def writable_folder(path: Path) -> Path:
 
 
 class Progress:
-    """A progress bar on standard error that appears only for runs longer than a second."""
+    """A progress bar on standard error, for runs longer than a second, on a terminal only."""
 
     def __init__(self, label: str):
         self.label, self.bar = label, None
@@ -87,7 +87,7 @@ class Progress:
         if self.bar is None:
             from tqdm import tqdm
             self.bar = tqdm(total=n, desc=self.label, unit="step", delay=1.0, leave=False,
-                            file=sys.stderr)
+                            file=sys.stderr, disable=None)      # None: only on a terminal
         self.bar.update(k - self.bar.n)
 
     def close(self) -> None:

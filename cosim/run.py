@@ -16,19 +16,23 @@ from __future__ import annotations
 
 import argparse
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 from typing import NamedTuple
 
 from . import scenarios
 from ._cli import (Progress, add_autopilot_options, checked_autopilot, chosen_scenarios,
                    writable_folder)
+from .analysis.animation import animate, require_track, video_format
 from .analysis.cost import LAMBDA, Cost, cost
+from .analysis.describe import conditions
 from .analysis.figures import save_figure
 from .analysis.kinds import analysis
 from .analysis.reports import tables
 from .core.coupling import COUPLINGS
 from .core.instance import FmuCallError
 from .core.master import BACKENDS, Master
+from .core.provenance import write_metadata
 from .core.ssd import SystemDescription
 from .scenarios.autopilot import COMPONENT
 
@@ -49,40 +53,64 @@ def parse_setting(text: str) -> tuple[str, str, int | float | str]:
     return component, variable, raw
 
 
+@dataclass(frozen=True)
+class Options:
+    """How to run and what to write, from the command line."""
+
+    coupling: str = "gauss-seidel"
+    stop_time: float | None = None
+    lam: float = LAMBDA
+    backend: str = "fmi"
+    plot: bool = True
+    formats: tuple[str, ...] = ("png",)
+    stream: bool = False
+    animate: str | None = None          # "gif" or "mp4"
+
+
 def run_scenario(system: SystemDescription, label: str, out: Path, overrides: dict,
-                 coupling: str, stop_time: float | None, lam: float, plot: bool = True,
-                 backend: str = "fmi", stream: bool = False) -> tuple[int, Cost | None]:
-    """Simulate one system, write its CSV and figure as ``label``, print its report."""
+                 options: Options) -> tuple[int, Cost | None]:
+    """Simulate one system; write its CSV, its metadata and its figure as ``label``; print
+    what it was and its report."""
     kind = analysis(system.report)
-    master = Master(system, coupling=coupling, overrides=overrides, backend=backend)
+    master = Master(system, coupling=options.coupling, overrides=overrides,
+                    backend=options.backend)
+    if options.animate:
+        try:
+            require_track(master.columns)
+        except ValueError:
+            master.free()
+            raise
     progress = Progress(label)
     csv_path = out / f"{label}.csv"
     try:
-        recording = master.run(stop_time, progress=progress,
-                               csv_path=csv_path if stream else None)
+        recording = master.run(options.stop_time, progress=progress,
+                               csv_path=csv_path if options.stream else None)
     finally:
         progress.close()
         master.free()
-    if not stream:
+    if not options.stream:
         recording.write_csv(csv_path)
+    written = [csv_path, write_metadata(recording, out / f"{label}.json")]
     print(f"{label}: {system.description}")
+    for line in conditions(recording.meta):
+        print(f"  {line}")
     if recording.error:
         print(f"error: {recording.error}", file=sys.stderr)
         print(f"  the {recording.rows} rows recorded before the error are in {csv_path}",
               file=sys.stderr)
         return 1, None
-    if stream:
+    if options.stream:
         print(f"  {recording.rows} rows streamed to {csv_path} "
               "(no report or figure in --stream mode)")
         return 0, None
-    for line in kind.report(recording, lam=lam, parameters=master.parameters):
+    for line in kind.report(recording, lam=options.lam, parameters=master.parameters):
         print(f"  {line}")
-    written = [csv_path]
-    if plot and kind.figure is not None:
-        written.append(save_figure(recording, kind.figure, out / f"{label}.png",
-                                   f"{label}: {system.description}"))
+    if options.plot and kind.figure is not None:
+        written += save_figure(recording, kind.figure, out / label, label, options.formats)
+    if options.animate:
+        written.append(animate(recording, out / label, label, options.animate))
     print(f"  wrote {', '.join(str(p) for p in written)}")
-    return 0, cost(recording, lam) if system.report == "course_keeping" else None
+    return 0, cost(recording, options.lam) if system.report == "course_keeping" else None
 
 
 class Run(NamedTuple):
@@ -135,6 +163,12 @@ def main(argv: list[str] | None = None) -> int:
     add_autopilot_options(parser, "with --all it also runs in calm_pd's and waves_pd's "
                                   "place, as an extra row of Tables 1-2")
     parser.add_argument("--no-plot", action="store_true", help="skip the figure")
+    parser.add_argument("--figure-format", action="append", default=[], choices=("svg", "pdf"),
+                        help="also write the figure as SVG or PDF (for papers); repeatable")
+    parser.add_argument("--animate", nargs="?", const=video_format(), choices=("gif", "mp4"),
+                        help="also write an animation of the ship along its track: "
+                             f"SCENARIO.gif, or .mp4 where ffmpeg is installed (here: "
+                             f"{video_format()})")
     parser.add_argument("--stream", action="store_true",
                         help="write rows to the CSV in chunks as the run goes: flat memory "
                              "for long runs (--stop-time 86400); no report or figure")
@@ -149,6 +183,12 @@ def main(argv: list[str] | None = None) -> int:
     paper_overrides = {c: v for c, v in overrides.items()
                        if c != COMPONENT or args.autopilot is None}
 
+    if args.animate and args.stream:
+        parser.error("--animate needs the run in memory; it cannot be combined with --stream")
+    if args.animate == "mp4" and video_format() != "mp4":
+        parser.error("--animate mp4 needs ffmpeg, which is not installed here; use gif")
+    options = Options(args.coupling, args.stop_time, args.lam, args.backend,
+                      not args.no_plot, ("png", *args.figure_format), args.stream, args.animate)
     status, costs = 0, {}
     for run in runs_asked(names, args.all, args.autopilot, args.name):
         out = args.out or Path("results") / run.label
@@ -159,9 +199,7 @@ def main(argv: list[str] | None = None) -> int:
             system = scenarios.load(run.scenario, run.autopilot, dict(args.map), args.name)
             code, result = run_scenario(system, run.label, out,
                                         overrides if run.autopilot else paper_overrides,
-                                        args.coupling,
-                                        args.stop_time, args.lam, plot=not args.no_plot,
-                                        backend=args.backend, stream=args.stream)
+                                        options)
         except (ValueError, FileNotFoundError, FmuCallError) as error:
             print(f"error: {error}", file=sys.stderr)
             return 2

@@ -49,7 +49,7 @@ def main(argv: list[str] | None = None) -> int:
     steps = 4 * 2 + 4 + 1
 
     from tqdm import tqdm
-    with tqdm(total=steps, desc="scorecard", unit="step", file=sys.stderr,
+    with tqdm(total=steps, desc="scorecard", unit="step", file=sys.stderr, disable=None,
               bar_format="{desc}: {n}/{total} {bar} {elapsed} {postfix}") as bar:
         def progress(step: str) -> None:
             if bar.n or step != "calm water, PD":

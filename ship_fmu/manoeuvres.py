@@ -30,8 +30,14 @@ class TurningCircle:
 
 @dataclass(frozen=True)
 class ZigZagResult:
-    first_overshoot: float       # rad
-    second_overshoot: float      # rad
+    first_overshoot: float       # rad; NaN if the turn was never checked (no second reversal)
+    second_overshoot: float      # rad; NaN if there was no third reversal
+    reversals: int               # rudder reversals the test reached
+
+    @property
+    def checked(self) -> bool:
+        """Whether the ship checked its turns: three reversals, both overshoots defined."""
+        return self.reversals >= 3
 
 
 class RudderProgram:
@@ -75,7 +81,7 @@ class RudderProgram:
         self.sign, self.reversals = int(snapshot["sign"]), int(snapshot["reversals"])
 
 
-def _crossing(x: np.ndarray, y: np.ndarray, psi: np.ndarray,
+def crossing(x: np.ndarray, y: np.ndarray, psi: np.ndarray,
               target: float) -> tuple[float, float]:
     """(x, y) where |psi| first reaches target, linearly interpolated."""
     heading = np.abs(psi)
@@ -89,8 +95,8 @@ def _crossing(x: np.ndarray, y: np.ndarray, psi: np.ndarray,
 def turning_circle_figures(x, y, psi, u, v, r) -> TurningCircle:
     """Turning-circle figures of a run that starts along x at psi = 0."""
     x, y, psi = map(np.asarray, (x, y, psi))
-    advance, transfer = _crossing(x, y, psi, math.pi / 2)
-    _, across = _crossing(x, y, psi, math.pi)
+    advance, transfer = crossing(x, y, psi, math.pi / 2)
+    _, across = crossing(x, y, psi, math.pi)
     return TurningCircle(advance=float(advance), transfer=float(abs(transfer)),
                          tactical_diameter=float(abs(across)),
                          steady_yaw_rate=float(r[-1]),
@@ -98,12 +104,18 @@ def turning_circle_figures(x, y, psi, u, v, r) -> TurningCircle:
 
 
 def zigzag_figures(psi, reversals, psi_switch: float) -> ZigZagResult:
-    """Overshoot angles after the first and second rudder reversal."""
+    """Overshoot angles after the first and second rudder reversal.
+
+    An overshoot is measured once the next reversal shows the turn was checked; a
+    ship that never checks its turn (a straight-line unstable one, with too little
+    rudder) leaves it NaN.
+    """
     psi, reversals = np.abs(np.asarray(psi)), np.asarray(reversals)
-    if reversals.max() < 3:
-        raise ValueError("zig-zag did not complete three rudder reversals")
-    return ZigZagResult(first_overshoot=float(psi[reversals == 1].max() - psi_switch),
-                        second_overshoot=float(psi[reversals == 2].max() - psi_switch))
+    reached = int(reversals.max())
+
+    def overshoot(n: int) -> float:
+        return float(psi[reversals == n].max() - psi_switch) if reached > n else math.nan
+    return ZigZagResult(overshoot(1), overshoot(2), reached)
 
 
 def _run(program: RudderProgram, t_end: float, params: VesselParameters) -> dict[str, list]:

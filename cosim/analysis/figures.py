@@ -1,72 +1,254 @@
-"""Figures of a run, in degrees for display: the layout of the paper's Figs 2-3."""
+"""Figures of a run, in degrees for display: where the ship went, and how it got there.
+
+Every course-keeping and manoeuvre figure has a track panel, north up and east
+right at equal scale: the track, the route with its circles of acceptance, where
+each leg switched, the ship's outline to scale at regular times, and the direction
+the waves travel to. Beside it, the signals over time. The figures take what they
+show from the recording: its columns, and the parameter values the run used
+(``Recording.meta``), never from what a scenario is supposed to be.
+"""
 from __future__ import annotations
 
-import textwrap
+import contextlib
+import math
+import os
+import tempfile
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, Iterator
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
+from matplotlib.patches import Circle, Polygon  # noqa: E402
+
+from autopilot_fmu.guidance import parse_waypoints  # noqa: E402
+from ship_fmu.data import Hull  # noqa: E402
+from ship_fmu.manoeuvres import crossing, turning_circle_figures, zigzag_figures  # noqa: E402
 
 from ..core.recording import Recording  # noqa: E402
+from .describe import title  # noqa: E402
+from .metrics import heading_error  # noqa: E402
+
+FORMATS = ("png", "svg", "pdf")
+OUTLINES = 12
+"""Ship outlines drawn along a track, about."""
 
 
-def course_keeping_figure(recording: Recording, ax: Any) -> None:
-    """Surge speed, heading against the desired course, rudder; over time."""
-    t = recording.t
-    ax[0].plot(t, recording["ship.u"], color="k")
-    ax[0].set_ylabel("surge speed u (m/s)")
-    ax[1].plot(t, np.degrees(recording["ship.psi"]), color="k", label="psi")
-    ax[1].plot(t, np.degrees(recording["guidance.psi_d"]), "--", color="tab:red", label="psi_d")
-    if "autopilot.psi_z" in recording.columns:
-        ax[1].plot(t, np.degrees(recording["autopilot.psi_z"]), ":", color="tab:blue",
-                   label="psi_z")
-    ax[1].set_ylabel("heading (deg)")
-    ax[1].legend(loc="best")
-    ax[2].plot(t, np.degrees(recording["ship.delta"]), color="k", linewidth=0.7)
-    ax[2].set_ylabel("rudder delta (deg)")
-    for a in ax:
-        a.set_xlabel("time (s)")
+def hull_outline(x: float, y: float, psi: float) -> np.ndarray:
+    """The ship's waterline to scale, pointed bow, as (east, north) corners at (x, y, psi)."""
+    L, B = Hull.L, Hull.B
+    body = np.array([(L / 2, 0.0), (L / 4, B / 2), (-L / 2, B / 2), (-L / 2, -B / 2),
+                     (L / 4, -B / 2)])                  # x forward, y starboard
+    c, s = math.cos(psi), math.sin(psi)
+    north = x + body[:, 0] * c - body[:, 1] * s
+    east = y + body[:, 0] * s + body[:, 1] * c
+    return np.column_stack([east, north])
 
 
-def manoeuvre_figure(recording: Recording, ax: Any) -> None:
-    """The track (north up), heading and rudder over time."""
-    t = recording.t
-    ax[0].plot(recording["ship.y"], recording["ship.x"], color="k")
-    ax[0].set_xlabel("east y (m)")
-    ax[0].set_ylabel("north x (m)")
-    ax[0].set_aspect("equal", adjustable="datalim")
-    ax[1].plot(t, np.degrees(recording["ship.psi"]), color="k")
-    ax[1].set_ylabel("heading (deg)")
-    ax[2].plot(t, np.degrees(recording["ship.delta"]), color="k")
-    ax[2].set_ylabel("rudder delta (deg)")
-    for a in ax[1:]:
-        a.set_xlabel("time (s)")
+def track_panel(ax: Any, run: Recording, ship: bool = True) -> None:
+    """The route with its circles of acceptance, the wave direction and, with ``ship``, the
+    track, where each leg switched and the ship's outline to scale at regular times."""
+    p = run.meta.get("parameters", {})
+    x, y, psi, t = run["ship.x"], run["ship.y"], run["ship.psi"], run.t
+    if ship:
+        ax.plot(y, x, color="k", linewidth=1.0, label="track", zorder=3)
+    if "guidance" in p:
+        points = np.array(parse_waypoints(p["guidance"]["waypoints"]))
+        ax.plot(points[:, 1], points[:, 0], "--o", color="tab:blue", linewidth=0.8,
+                markersize=4, label="route", zorder=2)
+        for north, east in points[1:]:
+            ax.add_patch(Circle((east, north), p["guidance"]["R_accept"], fill=False,
+                                linestyle=":", color="tab:blue", zorder=2))
+        if ship:
+            switched = np.flatnonzero(np.diff(run["guidance.wp_index"])) + 1
+            ax.plot(y[switched], x[switched], "x", color="tab:red", markersize=8, mew=2,
+                    label="leg switched", zorder=4)
+    if ship:
+        every = max(1.0, round((t[-1] - t[0]) / OUTLINES / 10.0) * 10.0)
+        stride = max(1, round(every / run.meta.get("step_size", t[1] - t[0])))
+        drawn: list[tuple[float, float]] = []
+        for k in range(0, len(t), stride):      # not on top of one drawn a lap earlier
+            if all(math.hypot(x[k] - a, y[k] - b) > Hull.L for a, b in drawn):
+                drawn.append((x[k], y[k]))
+                ax.add_patch(Polygon(hull_outline(x[k], y[k], psi[k]), closed=True,
+                                     color="tab:gray", alpha=0.7, zorder=3))
+        ax.plot([], [], "s", color="tab:gray", alpha=0.7,
+                label=f"ship to scale, every {every:g} s")
+    sea = p.get("ship", {})
+    if sea.get("Hs", 0.0) > 0.0:
+        direction = sea["psi_w"]
+        ax.annotate("", xy=(0.9 + 0.07 * math.sin(direction), 0.88 + 0.07 * math.cos(direction)),
+                    xytext=(0.9 - 0.07 * math.sin(direction), 0.88 - 0.07 * math.cos(direction)),
+                    xycoords="axes fraction", arrowprops=dict(arrowstyle="->", color="tab:cyan",
+                                                              linewidth=2))
+        ax.text(0.9, 0.77, "waves", transform=ax.transAxes, ha="center", fontsize=8,
+                color="tab:cyan")
+    ax.set(xlabel="east y (m)", ylabel="north x (m)")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.legend(loc="best", fontsize=7)
 
 
-def save_figure(recording: Recording, draw: Callable[[Recording, Any], None], path: Path,
-                title: str) -> Path:
-    """Three panels drawn by ``draw``, titled, written to ``path``."""
-    fig, ax = plt.subplots(3, 1, figsize=(7, 8), constrained_layout=True)
-    draw(recording, ax)
-    for a in ax:
+def _layout(panels: int) -> tuple[Figure, Any, list[Any]]:
+    """A track panel on the left, ``panels`` time panels sharing the time axis on the right."""
+    fig = plt.figure(figsize=(13, 8), constrained_layout=True)
+    grid = fig.add_gridspec(panels, 2, width_ratios=(1.0, 1.25))
+    track = fig.add_subplot(grid[:, 0])
+    right = [fig.add_subplot(grid[0, 1])]
+    right += [fig.add_subplot(grid[i, 1], sharex=right[0]) for i in range(1, panels)]
+    for a in right[:-1]:
+        a.tick_params(labelbottom=False)
+    right[-1].set_xlabel("time (s)")
+    for a in (track, *right):
         a.grid(alpha=0.3)
-    fig.suptitle("\n".join(textwrap.wrap(title, 80)), fontsize=9)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return fig, track, right
+
+
+def _rudder(ax: Any, run: Recording, commanded: str) -> None:
+    ax.plot(run.t, np.degrees(run[commanded]), color="tab:orange", linewidth=0.7,
+            label="commanded delta_c")
+    ax.plot(run.t, np.degrees(run["ship.delta"]), color="k", linewidth=0.9, label="actual delta")
+    ax.set_ylabel("rudder (deg)")
+    ax.legend(loc="best", fontsize=7)
+
+
+def course_keeping_figure(run: Recording) -> Figure:
+    """Track; surge speed, heading, heading error, yaw rate, commanded and actual rudder."""
+    fig, track, (u, heading, error, r, rudder) = _layout(5)
+    track_panel(track, run)
+    t = run.t
+    u.plot(t, run["ship.u"], color="k")
+    u.set_ylabel("surge u (m/s)")
+    heading.plot(t, np.degrees(run["ship.psi"]), color="k", label="psi")
+    heading.plot(t, np.degrees(run["guidance.psi_d"]), "--", color="tab:red", label="psi_d")
+    if "autopilot.psi_z" in run.columns:
+        heading.plot(t, np.degrees(run["autopilot.psi_z"]), ":", color="tab:blue",
+                     label="psi_z")
+    heading.set_ylabel("heading (deg)")
+    heading.legend(loc="best", fontsize=7)
+    error.plot(t, np.degrees(heading_error(run["guidance.psi_d"], run["ship.psi"])), color="k")
+    error.set_ylabel("psi_d - psi (deg)")
+    r.plot(t, np.degrees(run["ship.r"]), color="k")
+    r.set_ylabel("yaw rate r (deg/s)")
+    _rudder(rudder, run, "ship.delta_c")
+    return fig
+
+
+def turning_circle_figure(run: Recording) -> Figure:
+    """Track with advance, transfer and tactical diameter marked; heading, yaw rate, rudder."""
+    fig, track, (heading, r, rudder) = _layout(3)
+    track_panel(track, run)
+    x, y, psi = run["ship.x"], run["ship.y"], run["ship.psi"]
+    tc = turning_circle_figures(*(run[f"ship.{n}"] for n in ("x", "y", "psi", "u", "v", "r")))
+    x90, y90 = crossing(x, y, psi, math.pi / 2)
+    x180, y180 = crossing(x, y, psi, math.pi)
+    x0, y0 = x[0], y[0]
+    track.plot([y0, y0], [x0, x90], color="tab:green", linewidth=2)
+    track.plot([y0, y90], [x90, x90], color="tab:purple", linewidth=2)
+    track.plot([y0, y180], [x180, x180], color="tab:brown", linewidth=2)
+    box = dict(boxstyle="round", facecolor="white", alpha=0.8, edgecolor="none")
+    track.annotate(f"advance {tc.advance:.2f} m", (y0, (x0 + x90) / 2), fontsize=8,
+                   color="tab:green", xytext=(8, 0), textcoords="offset points", bbox=box)
+    track.annotate(f"transfer {tc.transfer:.2f} m\n(at 90 deg)", (y90, x90), fontsize=8,
+                   color="tab:purple", xytext=(8, 8), textcoords="offset points", bbox=box)
+    track.annotate(f"tactical diameter {tc.tactical_diameter:.2f} m (at 180 deg)",
+                   ((y0 + y180) / 2, x180), fontsize=8, color="tab:brown", ha="center",
+                   xytext=(0, 8), textcoords="offset points", bbox=box)
+    heading.plot(run.t, np.degrees(psi), color="k")
+    heading.set_ylabel("heading (deg)")
+    r.plot(run.t, np.degrees(run["ship.r"]), color="k")
+    r.axhline(math.degrees(tc.steady_yaw_rate), linestyle=":", color="tab:gray")
+    r.set_ylabel("yaw rate r (deg/s)")
+    _rudder(rudder, run, "ship.delta_c")
+    return fig
+
+
+def zigzag_figure(run: Recording) -> Figure:
+    """Track; heading with the switching angles, the execute points and both overshoots."""
+    fig, track, (heading, r, rudder) = _layout(3)
+    track_panel(track, run)
+    t, psi = run.t, np.degrees(run["ship.psi"])
+    switch = run.meta["parameters"]["program"]["psi_switch"]
+    zz = zigzag_figures(run["ship.psi"], run["program.reversals"], switch)
+    reversals = run["program.reversals"]
+    heading.plot(t, psi, color="k", label="psi")
+    for level in (-math.degrees(switch), math.degrees(switch)):
+        heading.axhline(level, linestyle=":", color="tab:gray")
+    executed = [0, *(np.flatnonzero(np.diff(reversals)) + 1)]
+    heading.plot(t[executed], psi[executed], "v", color="tab:red",
+                 label="rudder executed, reversed")
+    for n, overshoot in ((1, zz.first_overshoot), (2, zz.second_overshoot)):
+        if math.isnan(overshoot):
+            heading.text(0.02, 0.05, f"no reversal {n + 1}: the turn was never checked",
+                         transform=heading.transAxes, fontsize=9, color="tab:red")
+            break
+        k = np.flatnonzero(reversals == n)[np.argmax(np.abs(psi[reversals == n]))]
+        level = math.copysign(math.degrees(switch), psi[k])
+        heading.annotate("", xy=(t[k], psi[k]), xytext=(t[k], level),
+                         arrowprops=dict(arrowstyle="<->", color="tab:red"))
+        heading.annotate(f"overshoot {n}: {math.degrees(overshoot):.1f} deg",
+                         (t[k], (psi[k] + level) / 2), xytext=(6, 0),
+                         textcoords="offset points", va="center", fontsize=8,
+                         color="tab:red",
+                         bbox=dict(boxstyle="round", facecolor="white", alpha=0.8,
+                                   edgecolor="none"))
+    heading.set_ylabel("heading (deg)")
+    heading.legend(loc="best", fontsize=7)
+    r.plot(t, np.degrees(run["ship.r"]), color="k")
+    r.set_ylabel("yaw rate r (deg/s)")
+    _rudder(rudder, run, "ship.delta_c")
+    return fig
+
+
+@contextlib.contextmanager
+def whole_file(target: Path) -> Iterator[str]:
+    """A temporary name beside ``target`` to write to; renamed to ``target`` if the writing
+    succeeds, removed if it fails: a reader never finds half a file."""
+    handle, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.stem}.",
+                                   suffix=target.suffix)
+    os.close(handle)
+    try:
+        yield tmp
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)       # as a file opened for writing would be
+        os.replace(tmp, target)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+
+
+def save(fig: Figure, path: Path, formats: tuple[str, ...] = ("png",)) -> list[Path]:
+    """Write the figure in each format (path with that suffix), each file whole or not at all."""
+    written = []
+    try:
+        for fmt in formats:
+            if fmt not in FORMATS:
+                raise ValueError(f"figure format {fmt!r}: one of {', '.join(FORMATS)}")
+            target = path.with_suffix(f".{fmt}")
+            with whole_file(target) as tmp:
+                fig.savefig(tmp, dpi=120, format=fmt)
+            written.append(target)
+    finally:
+        plt.close(fig)
+    return written
+
+
+def save_figure(run: Recording, draw: Callable[[Recording], Figure], path: Path, label: str,
+                formats: tuple[str, ...] = ("png",)) -> list[Path]:
+    """Draw a run's figure, title it from what the run used, write it in each format."""
+    fig = draw(run)
+    fig.suptitle(title(label, run.meta), fontsize=8)
+    return save(fig, path, formats)
 
 
 def comparison_figure(runs: dict[str, Recording], path: Path, title: str) -> Path:
     """Several controllers on one scenario: their tracks, headings and rudders, overlaid."""
-    fig = plt.figure(figsize=(11, 6), constrained_layout=True)
-    grid = fig.add_gridspec(2, 2, width_ratios=(1, 1.3))
-    track, heading, rudder = (fig.add_subplot(grid[:, 0]), fig.add_subplot(grid[0, 1]),
-                              fig.add_subplot(grid[1, 1]))
+    fig, track, (heading, rudder) = _layout(2)
     first = next(iter(runs.values()))
+    track_panel(track, first, ship=False)       # the route and the waves
     heading.plot(first.t, np.degrees(first["guidance.psi_d"]), "--", color="0.4",
                  label="psi_d")
     for label, run in runs.items():
@@ -74,15 +256,9 @@ def comparison_figure(runs: dict[str, Recording], path: Path, title: str) -> Pat
         heading.plot(run.t, np.degrees(run["ship.psi"]), color=line.get_color(), label=label)
         rudder.plot(run.t, np.degrees(run["ship.delta"]), color=line.get_color(),
                     linewidth=0.7)
-    track.set(xlabel="east y (m)", ylabel="north x (m)")
-    track.set_aspect("equal", adjustable="datalim")
-    track.legend(loc="best", fontsize=8)
+    track.legend(loc="best", fontsize=7)
     heading.set(ylabel="heading psi (deg)")
-    heading.legend(loc="best", fontsize=8)
-    rudder.set(xlabel="time (s)", ylabel="rudder delta (deg)")
-    for a in (track, heading, rudder):
-        a.grid(alpha=0.3)
+    heading.legend(loc="best", fontsize=7)
+    rudder.set(ylabel="rudder delta (deg)")
     fig.suptitle(title, fontsize=10)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save(fig, path)[0]

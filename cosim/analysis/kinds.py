@@ -7,10 +7,12 @@ an annotation of this project that other tools ignore). Each kind has a report
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Callable
+
+from matplotlib.figure import Figure
 
 from ..core.recording import Recording
-from .figures import course_keeping_figure, manoeuvre_figure
+from .figures import course_keeping_figure, turning_circle_figure, zigzag_figure
 from .reports import course_keeping_report, turning_circle_report, zigzag_report
 
 
@@ -19,13 +21,13 @@ class Analysis:
     """What ``cosim.run`` prints (``report``) and draws (``figure``) for a kind of scenario."""
 
     report: Callable[..., list[str]]
-    figure: Callable[[Recording, Any], None] | None = None
+    figure: Callable[[Recording], Figure] | None = None
 
 
 ANALYSES = {
     "course_keeping": Analysis(course_keeping_report, course_keeping_figure),
-    "turning_circle": Analysis(turning_circle_report, manoeuvre_figure),
-    "zigzag": Analysis(zigzag_report, manoeuvre_figure),
+    "turning_circle": Analysis(turning_circle_report, turning_circle_figure),
+    "zigzag": Analysis(zigzag_report, zigzag_figure),
     "none": Analysis(lambda recording, **_: []),
 }
 

@@ -21,6 +21,8 @@ def course_keeping_report(recording: Recording, lam: float = LAMBDA, **_) -> lis
     t, delta = recording.t, recording["ship.delta"]
     return [f"psi_E = {c.psi_E:.2f} rad^2   sum delta^2 = {c.sum_delta2:.3f} rad^2   "
             f"lambda = {c.lam:.4f}   delta_E = {c.delta_E:.2f}   J = {c.J:.2f}",
+            "(eq 19: J = psi_E + delta_E; psi_E sums the squared heading errors, delta_E = "
+            "lambda sum delta^2, lambda making them equal on calm_pd; over the 0.1 s samples)",
             f"rudder: max |delta| = {math.degrees(abs(delta).max()):.1f} deg, "
             f"{sign_reversals_per_minute(t, delta):.1f} sign reversals per minute"]
 
@@ -34,8 +36,15 @@ def turning_circle_report(recording: Recording, **_) -> list[str]:
 
 
 def zigzag_report(recording: Recording, parameters: dict, **_) -> list[str]:
+    program = parameters["program"]
     zz = zigzag_figures(recording["ship.psi"], recording["program.reversals"],
-                        parameters["program"]["psi_switch"])
+                        program["psi_switch"])
+    if not zz.checked:
+        psi = recording["ship.psi"]
+        return [f"the turn was never checked: {zz.reversals} rudder reversal(s) of 3, heading "
+                f"{math.degrees(psi[-1]):.0f} deg at t = {recording.t[-1]:.0f} s; with "
+                f"{math.degrees(program['delta']):.0f} deg of counter-rudder this straight-line "
+                "unstable ship keeps turning"]
     return [f"first overshoot {math.degrees(zz.first_overshoot):.2f} deg, second overshoot "
             f"{math.degrees(zz.second_overshoot):.2f} deg"]
 

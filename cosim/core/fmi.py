@@ -97,6 +97,10 @@ class FmuInstance(Instance):
             raise FmuCallError(name, f"instantiate ({self.path.name})", None, "failure",
                                [*self.log, f"{type(error).__name__}: {error}"]) from error
 
+    @property
+    def guid(self) -> str:
+        return self.description.guid
+
     def _on_log(self, env, instance, status, category, message) -> None:
         self.log.append(f"[{STATUS[status] if status < len(STATUS) else status}] "
                         f"{message.decode('utf-8', 'replace')}")

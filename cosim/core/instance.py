@@ -87,6 +87,10 @@ class Instance:
             out[name] = value.decode("utf-8") if isinstance(value, bytes) else value
         return out
 
+    def parameter_values(self) -> dict[str, Any]:
+        """Every parameter's value as the FMU holds it: defaults and what was set."""
+        return self.get([n for n, v in self.variables.items() if v.causality == "parameter"])
+
     def initialize(self, parameters: dict[str, Any] | None = None,
                    start_time: float = 0.0) -> None:
         """setupExperiment, enter initialisation, parameters, exit initialisation."""

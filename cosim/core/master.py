@@ -15,6 +15,7 @@ the call and the time; the rows recorded up to then are kept.
 """
 from __future__ import annotations
 
+import time
 from pathlib import Path
 from typing import Any, Callable
 
@@ -66,6 +67,7 @@ class Master:
     def configure(self, overrides: dict[str, dict[str, Any]] | None = None) -> None:
         """Parameters for the next run: the system's, updated by ``overrides``."""
         self.parameters = self.system.parameters(overrides)
+        self.overrides = {c: dict(v) for c, v in (overrides or {}).items()}
 
     def reset(self) -> None:
         """Return every FMU to its state after instantiation (fmi2Reset), for another run."""
@@ -101,13 +103,22 @@ class Master:
         system = self.system
         t0, h = system.start_time, seconds(nanoseconds(system.step_size))
         n_steps = step_count(t0, system.stop_time if stop_time is None else stop_time, h)
-        recorder = Recorder(self.columns, n_steps + 1, csv_path, chunk_rows,
-                            meta={"system": system.name, "coupling": self.coupling,
-                                  "step_size": h}, units=self.units)
+        meta = {"system": system.name, "description": system.description,
+                "coupling": self.coupling, "start_time": t0, "step_size": h,
+                "stop_time": communication_point(t0, n_steps, h), "overrides": self.overrides,
+                "fmus": {name: {"file": str(i.path), "guid": getattr(i, "guid", None)}
+                         for name, i in self.instances.items()}}
+        recorder = Recorder(self.columns, n_steps + 1, csv_path, chunk_rows, meta=meta,
+                            units=self.units)
         exchange, nodes, values = COUPLINGS[self.coupling], self.nodes, [0.0] * len(self.columns)
-        k, t, error = 0, t0, None
+        k, t, error, started = 0, t0, None, time.perf_counter()
         try:
             self.initialize()
+            meta["parameters"] = {name: instance.parameter_values()
+                                  for name, instance in self.instances.items()}
+            meta["parameter_units"] = {
+                name: {p: instance.unit(p) for p in meta["parameters"][name]}
+                for name, instance in self.instances.items()}
             for k in range(n_steps + 1):
                 t = communication_point(t0, k, h)
                 exchange(nodes, values, t, h, k < n_steps)
@@ -118,6 +129,7 @@ class Master:
             error = (f"{failure}\n  (run stopped at step {k}, t = {t:.6g} s; "
                      f"{recorder.rows} rows recorded)")
         finally:
+            meta["wall_time_s"] = time.perf_counter() - started
             recording = recorder.close(error)
         return recording
 

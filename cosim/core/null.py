@@ -10,7 +10,7 @@ results mean nothing.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, Iterable
 
 from .fmi import feedthrough, read_description
 from .instance import Instance
@@ -22,6 +22,7 @@ class NullInstance(Instance):
     def __init__(self, path: str | Path, name: str):
         self.path, self.name = Path(path), name
         description = read_description(self.path, name)
+        self.guid = description.guid
         self.variables = {v.name: v for v in description.modelVariables}
         self.feedthrough = feedthrough(description)
 
@@ -39,6 +40,10 @@ class NullInstance(Instance):
 
     def free(self) -> None:
         pass
+
+    def get(self, names: Iterable[str]) -> dict[str, Any]:
+        """The start values of the model description: a null instance holds nothing else."""
+        return {name: self.variable(name).start for name in names}
 
     def reader(self, vrs: list[int]) -> Callable[[], list[float]]:
         values = [0.0] * len(vrs)

@@ -300,7 +300,8 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
             bar = None
             if progress:
                 from tqdm import tqdm
-                bar = tqdm(total=len(todo), desc=spec.name, unit="run", file=sys.stderr)
+                bar = tqdm(total=len(todo), desc=spec.name, unit="run", file=sys.stderr,
+                           disable=None)                # None: only on a terminal
             for future in as_completed(futures):
                 try:
                     row = future.result()

@@ -1,0 +1,156 @@
+"""An animation of a run: the ship moving along its track, its heading, rudder and leg.
+
+A GIF (Pillow, which comes with matplotlib), or an MP4 where ffmpeg is installed.
+The run plays at a speed that fits it into about 25 s of video at 10 frames per
+second (a 400 s run: 16 times real time, 250 frames). The route, the circles of
+acceptance and the wave direction are drawn once; each frame moves the ship's
+outline (to scale), extends its wake, highlights the active leg and moves the
+time cursor on the heading and rudder panels: only those are redrawn, on top of
+a background rendered once, which keeps a 400 s run to a few seconds of work.
+"""
+from __future__ import annotations
+
+import math
+import shutil
+import subprocess
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.patches import Polygon  # noqa: E402
+
+from autopilot_fmu.guidance import parse_waypoints  # noqa: E402
+
+from ..core.recording import Recording  # noqa: E402
+from .describe import title  # noqa: E402
+from .figures import hull_outline, track_panel, whole_file  # noqa: E402
+
+FPS = 10
+VIDEO_SECONDS = 25.0
+NEEDS = ("ship.x", "ship.y", "ship.psi", "ship.delta")
+
+
+def video_format() -> str:
+    """'mp4' where ffmpeg is installed, else 'gif'."""
+    return "mp4" if shutil.which("ffmpeg") else "gif"
+
+
+def require_track(columns: list[str]) -> None:
+    """ValueError naming what is missing if these columns hold no track to animate."""
+    missing = [c for c in NEEDS if c not in columns]
+    if missing:
+        raise ValueError(f"--animate needs the ship's track; this system records no "
+                         f"{', '.join(missing)}")
+
+
+def frame_times(t: np.ndarray, fps: int = FPS, seconds: float = VIDEO_SECONDS) -> np.ndarray:
+    """Indices of the rows shown, one per frame, evenly spaced over the run."""
+    frames = max(2, min(len(t), round(seconds * fps)))
+    return np.unique(np.round(np.linspace(0, len(t) - 1, frames)).astype(int))
+
+
+def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> Path:
+    """Write the animation of a run to ``path`` with the suffix of ``fmt``; its path.
+
+    ValueError naming what is missing if the run has no track to show. The file is
+    written whole or not at all.
+    """
+    require_track(run.columns)
+    fmt = fmt or video_format()
+    rows = frame_times(run.t)
+    x, y, psi, delta, t = (run["ship.x"], run["ship.y"], run["ship.psi"], run["ship.delta"],
+                           run.t)
+    fig = plt.figure(figsize=(10, 5.6), dpi=90, constrained_layout=True)
+    grid = fig.add_gridspec(2, 2, width_ratios=(1.0, 1.1))
+    track, heading, rudder = (fig.add_subplot(grid[:, 0]), fig.add_subplot(grid[0, 1]),
+                              fig.add_subplot(grid[1, 1]))
+    track_panel(track, run, ship=False)
+    track.plot(y, x, color="0.8", linewidth=0.8, zorder=1)            # the whole track, faint
+    wake, = track.plot([], [], color="k", linewidth=1.2, zorder=3)
+    hull = track.add_patch(Polygon(hull_outline(x[0], y[0], psi[0]), closed=True,
+                                   color="tab:red", zorder=5))
+    marker, = track.plot([], [], color="tab:red", alpha=0.35, markersize=14, zorder=4,
+                         linestyle="none")          # the ship to scale is small: mark it
+    legs = run.meta.get("parameters", {}).get("guidance")
+    points = np.array(parse_waypoints(legs["waypoints"])) if legs else None
+    active, = track.plot([], [], color="tab:green", linewidth=3, alpha=0.6, zorder=2,
+                         label="active leg")
+    track.legend(loc="best", fontsize=7)
+    heading.plot(t, np.degrees(psi), color="k", linewidth=0.8, label="psi")
+    if "guidance.psi_d" in run.columns:
+        heading.plot(t, np.degrees(run["guidance.psi_d"]), "--", color="tab:red",
+                     linewidth=0.8, label="psi_d")
+    heading.set(ylabel="heading (deg)")
+    heading.legend(loc="best", fontsize=7)
+    rudder.plot(t, np.degrees(delta), color="k", linewidth=0.8)
+    rudder.set(xlabel="time (s)", ylabel="rudder delta (deg)")
+    cursors = [a.axvline(t[0], color="tab:red", linewidth=1) for a in (heading, rudder)]
+    for a in (heading, rudder):
+        a.grid(alpha=0.3)
+    readout = track.text(0.02, 0.02, "", transform=track.transAxes, fontsize=8, va="bottom",
+                         bbox=dict(boxstyle="round", facecolor="white", alpha=0.85))
+    fig.suptitle(title(label, run.meta), fontsize=7)
+    leg = run["guidance.wp_index"].astype(int) if "guidance.wp_index" in run.columns else None
+
+    def draw(k: int) -> None:
+        wake.set_data(y[:k + 1], x[:k + 1])
+        hull.set_xy(hull_outline(x[k], y[k], psi[k]))
+        marker.set_data([y[k]], [x[k]])
+        marker.set_marker((3, 0, -math.degrees(psi[k])))     # a triangle along the heading
+        for cursor in cursors:
+            cursor.set_xdata([t[k], t[k]])
+        text = (f"t = {t[k]:.0f} s\nheading {math.degrees(psi[k]):.1f} deg\n"
+                f"rudder {math.degrees(delta[k]):+.1f} deg")
+        if leg is not None and points is not None:
+            to = min(leg[k], len(points) - 1)
+            active.set_data(points[to - 1:to + 1, 1], points[to - 1:to + 1, 0])
+            text += f"\nleg to waypoint {to} ({points[to][0]:g}, {points[to][1]:g}) m"
+        readout.set_text(text)
+
+    dynamic = [wake, marker, hull, active, readout, *cursors]
+    for artist in dynamic:
+        artist.set_animated(True)           # left out of the background drawn once
+    fig.canvas.draw()
+    fig.set_layout_engine("none")           # the layout is fixed from here on
+    background = fig.canvas.copy_from_bbox(fig.bbox)
+    width, height = fig.canvas.get_width_height()
+    target = path.with_suffix(f".{fmt}")
+    try:
+        frames = []
+        for k in rows:
+            draw(k)
+            fig.canvas.restore_region(background)
+            for artist in dynamic:
+                artist.axes.draw_artist(artist)
+            frames.append(np.asarray(fig.canvas.buffer_rgba())[:, :, :3].copy())
+        with whole_file(target) as tmp:
+            _write(frames, tmp, fmt, width, height)
+    finally:
+        plt.close(fig)
+    return target
+
+
+def _write(frames: list[np.ndarray], path: str, fmt: str, width: int, height: int) -> None:
+    """RGB frames to a GIF (Pillow) or to an MP4 (ffmpeg, fed raw frames on a pipe)."""
+    if fmt == "gif":
+        from PIL import Image
+
+        images = [Image.fromarray(frame).quantize(colors=64, method=Image.Quantize.FASTOCTREE)
+                  for frame in frames]
+        images[0].save(path, save_all=True, append_images=images[1:],
+                       duration=round(1000 / FPS), loop=0)
+        return
+    ffmpeg = shutil.which("ffmpeg")
+    if ffmpeg is None:
+        raise ValueError("an MP4 needs ffmpeg, which is not installed; write a GIF")
+    encode = subprocess.run(
+        [ffmpeg, "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt", "rgb24",
+         "-s", f"{width}x{height}", "-r", str(FPS), "-i", "-", "-vf",
+         "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-pix_fmt", "yuv420p", "-f", "mp4", path],
+        input=b"".join(frame.tobytes() for frame in frames), capture_output=True)
+    if encode.returncode != 0:
+        raise RuntimeError(f"ffmpeg could not encode the animation: "
+                           f"{encode.stderr.decode(errors='replace').strip()}")

@@ -1,0 +1,78 @@
+"""Words for a run, made from the parameter values it used: titles and printed headers.
+
+Nothing here is typed in per scenario: the sea state, the route, the steering gear,
+the autopilot's gains and the settings given on the command line are read from
+what the FMUs held (``Recording.meta``), so a label cannot describe a run that was
+not made. Angles are shown in degrees.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from autopilot_fmu.guidance import parse_waypoints
+
+_DISPLAY = {"rad": (math.degrees(1.0), "deg"), "rad/s": (math.degrees(1.0), "deg/s"),
+            "m": (1.0, "m"), "s": (1.0, "s"), "1/s": (1.0, "1/s"), "m/s": (1.0, "m/s")}
+
+
+def value(x: Any, unit: str = "") -> str:
+    """A parameter value for people: 4 significant digits, angles in degrees."""
+    if isinstance(x, str) or isinstance(x, bool) or x is None:
+        return str(x)
+    factor, shown = _DISPLAY.get(unit, (1.0, "" if unit in ("", "1") else unit))
+    text = f"{x * factor:.4g}" if isinstance(x, float) else str(x)
+    return f"{text} {shown}".strip()
+
+
+def sea(ship: dict[str, Any]) -> str:
+    """'calm water', or the sea state: Hs, T0, the direction the waves travel to, the seed."""
+    if ship.get("Hs", 0.0) == 0.0:
+        return "calm water"
+    return (f"waves Hs {ship['Hs'] * 1000:.3g} mm, T0 {ship['T0']:.3g} s, travelling to "
+            f"{math.degrees(ship['psi_w']) % 360:.0f} deg, seed {ship['wave_seed']}")
+
+
+def route(guidance: dict[str, Any]) -> str:
+    points = " ".join(f"({x:g},{y:g})" for x, y in parse_waypoints(guidance["waypoints"]))
+    return f"route {points} m, acceptance radius {guidance['R_accept']:.3g} m"
+
+
+def gear(ship: dict[str, Any]) -> str:
+    return (f"rudder within +-{math.degrees(ship['delta_max']):.3g} deg at up to "
+            f"{math.degrees(ship['delta_rate_max']):.3g} deg/s")
+
+
+def settings(parameters: dict[str, Any], units: dict[str, str]) -> str:
+    """'name = value unit, ...' of one component's parameters."""
+    return ", ".join(f"{name} = {value(x, units.get(name, ''))}" for name, x in parameters.items())
+
+
+def overrides(meta: dict[str, Any]) -> str:
+    """The settings given on top of the scenario, as the --set options that give them."""
+    return " ".join(f"--set {c}.{n}={x}" for c, values in meta.get("overrides", {}).items()
+                    for n, x in values.items())
+
+
+def conditions(meta: dict[str, Any]) -> list[str]:
+    """What a run was, line by line: route, sea and gear, controller or rudder program, settings."""
+    p, units = meta.get("parameters", {}), meta.get("parameter_units", {})
+    lines = []
+    if "guidance" in p:
+        lines.append(route(p["guidance"]))
+    if "ship" in p:
+        lines.append(f"{sea(p['ship'])}; {gear(p['ship'])}; starting at "
+                     f"{p['ship']['u0']:.3g} m/s")
+    for component in ("autopilot", "program"):
+        if component in p:
+            fmu = meta.get("fmus", {}).get(component, {}).get("file", "")
+            lines.append(f"{component} {fmu.rsplit('/', 1)[-1]}: "
+                         f"{settings(p[component], units.get(component, {}))}")
+    if meta.get("overrides"):
+        lines.append(f"set: {overrides(meta)}")
+    return lines
+
+
+def title(label: str, meta: dict[str, Any]) -> str:
+    """A figure title: the run's label and description, then what it was."""
+    return "\n".join([f"{label}: {meta.get('description', '')}", *conditions(meta)])
