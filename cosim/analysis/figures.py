@@ -106,6 +106,12 @@ def _layout(panels: int) -> tuple[Figure, Any, list[Any]]:
     return fig, track, right
 
 
+def _degrees(ax: Any, run: Recording, column: str, label: str) -> None:
+    """One signal over time, in degrees, black, labelled."""
+    ax.plot(run.t, np.degrees(run[column]), color="k")
+    ax.set_ylabel(label)
+
+
 def _rudder(ax: Any, run: Recording, commanded: str) -> None:
     ax.plot(run.t, np.degrees(run[commanded]), color="tab:orange", linewidth=0.7,
             label="commanded delta_c")
@@ -130,8 +136,7 @@ def course_keeping_figure(run: Recording) -> Figure:
     heading.legend(loc="best", fontsize=7)
     error.plot(t, np.degrees(heading_error(run["guidance.psi_d"], run["ship.psi"])), color="k")
     error.set_ylabel("psi_d - psi (deg)")
-    r.plot(t, np.degrees(run["ship.r"]), color="k")
-    r.set_ylabel("yaw rate r (deg/s)")
+    _degrees(r, run, "ship.r", "yaw rate r (deg/s)")
     _rudder(rudder, run, "ship.delta_c")
     return fig
 
@@ -156,11 +161,9 @@ def turning_circle_figure(run: Recording) -> Figure:
     track.annotate(f"tactical diameter {tc.tactical_diameter:.2f} m (at 180 deg)",
                    ((y0 + y180) / 2, x180), fontsize=8, color="tab:brown", ha="center",
                    xytext=(0, 8), textcoords="offset points", bbox=box)
-    heading.plot(run.t, np.degrees(psi), color="k")
-    heading.set_ylabel("heading (deg)")
-    r.plot(run.t, np.degrees(run["ship.r"]), color="k")
+    _degrees(heading, run, "ship.psi", "heading (deg)")
+    _degrees(r, run, "ship.r", "yaw rate r (deg/s)")
     r.axhline(math.degrees(tc.steady_yaw_rate), linestyle=":", color="tab:gray")
-    r.set_ylabel("yaw rate r (deg/s)")
     _rudder(rudder, run, "ship.delta_c")
     return fig
 
@@ -196,8 +199,7 @@ def zigzag_figure(run: Recording) -> Figure:
                                    edgecolor="none"))
     heading.set_ylabel("heading (deg)")
     heading.legend(loc="best", fontsize=7)
-    r.plot(t, np.degrees(run["ship.r"]), color="k")
-    r.set_ylabel("yaw rate r (deg/s)")
+    _degrees(r, run, "ship.r", "yaw rate r (deg/s)")
     _rudder(rudder, run, "ship.delta_c")
     return fig
 
