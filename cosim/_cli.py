@@ -11,6 +11,7 @@ import tempfile
 from pathlib import Path
 
 from . import scenarios
+from .api import parse_setting
 from .scenarios.autopilot import AutopilotError, check_autopilot
 
 
@@ -29,6 +30,14 @@ def chosen_scenarios(parser: argparse.ArgumentParser, scenario: str | None,
     return names
 
 
+def setting_option(text: str) -> tuple[str, int | float | str]:
+    """--set COMPONENT.VARIABLE=VALUE, for argparse."""
+    try:
+        return parse_setting(text)
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
+
+
 def parse_port_map(text: str) -> tuple[str, str]:
     """'psi=heading' -> ('psi', 'heading')."""
     port, sep, name = text.partition("=")
@@ -44,6 +53,11 @@ def add_autopilot_options(parser: argparse.ArgumentParser, also: str) -> None:
                         help="your own autopilot, an FMI 2.0 co-simulation FMU with inputs psi "
                              "(rad), r (rad/s), psi_d (rad) and output delta_c (rad), in place "
                              f"of the scenario's; {also} (see docs/own_autopilot.md)")
+    add_port_options(parser)
+
+
+def add_port_options(parser: argparse.ArgumentParser) -> None:
+    """--map PORT=NAME and --name NAME, which describe an autopilot FMU."""
     parser.add_argument("--map", action="append", default=[], type=parse_port_map,
                         metavar="PORT=NAME",
                         help="the FMU's name of an autopilot port, e.g. psi=heading; repeatable")

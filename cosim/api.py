@@ -26,6 +26,32 @@ class SimulationError(RuntimeError):
         self.recording = recording
 
 
+def parse_setting(text: str) -> tuple[str, int | float | str]:
+    """'component.variable=value' -> ('component.variable', value); numbers become int or
+    float. ValueError naming the text if it is not of that form."""
+    target, sep, raw = text.partition("=")
+    component, dot, variable = target.partition(".")
+    if not (sep and dot and component and variable):
+        raise ValueError(f"--set expects COMPONENT.VARIABLE=VALUE, got {text!r}")
+    for convert in (int, float):
+        try:
+            return target, convert(raw)
+        except ValueError:
+            pass
+    return target, raw
+
+
+def overrides_of(settings: dict[str, Any]) -> dict[str, dict[str, Any]]:
+    """{'ship.Hs': 0.01} -> {'ship': {'Hs': 0.01}}; ValueError for a key without a dot."""
+    overrides: dict[str, dict[str, Any]] = {}
+    for target, value in settings.items():
+        component, dot, variable = target.partition(".")
+        if not (dot and component and variable):
+            raise ValueError(f"set: {target!r} is not 'component.variable'")
+        overrides.setdefault(component, {})[variable] = value
+    return overrides
+
+
 def simulate(scenario: str | Path, autopilot: str | Path | None = None,
              set: dict[str, Any] | None = None, stop_time: float | None = None,
              coupling: str = "gauss-seidel", backend: str = "fmi",
@@ -38,14 +64,8 @@ def simulate(scenario: str | Path, autopilot: str | Path | None = None,
     scenario's). ValueError or FileNotFoundError for bad input, naming it;
     SimulationError if an FMU fails during the run.
     """
-    overrides: dict[str, dict[str, Any]] = {}
-    for target, value in (set or {}).items():
-        component, dot, variable = target.partition(".")
-        if not (dot and component and variable):
-            raise ValueError(f"set: {target!r} is not 'component.variable'")
-        overrides.setdefault(component, {})[variable] = value
     master = Master(scenarios.load(scenario, autopilot, port_map), coupling=coupling,
-                    backend=backend, overrides=overrides)
+                    backend=backend, overrides=overrides_of(set or {}))
     try:
         recording = master.run(stop_time)
     finally:

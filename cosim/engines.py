@@ -32,6 +32,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: {type(error).__name__}: {error}", file=sys.stderr)
         return 1
     np.savez(args.out, **result)
+    print(f"wrote {args.out}: {', '.join(args.signals)} at {len(result['time'])} times")
     return 0
 
 

@@ -22,13 +22,14 @@ from typing import NamedTuple
 
 from . import scenarios
 from ._cli import (Progress, add_autopilot_options, checked_autopilot, chosen_scenarios,
-                   writable_folder)
+                   setting_option, writable_folder)
 from .analysis.animation import animate, require_track, video_format
 from .analysis.cost import LAMBDA, Cost, cost
 from .analysis.describe import conditions
 from .analysis.figures import save_figure
 from .analysis.kinds import analysis
 from .analysis.reports import tables
+from .api import overrides_of
 from .core.coupling import COUPLINGS
 from .core.instance import FmuCallError
 from .core.master import BACKENDS, Master
@@ -38,19 +39,6 @@ from .scenarios.autopilot import COMPONENT
 
 RUN_BACKENDS = [b for b in BACKENDS if b != "null"]     # null runs measure the master only
 
-
-def parse_setting(text: str) -> tuple[str, str, int | float | str]:
-    """'fmu.var=value' -> (fmu, var, value); numbers become int or float."""
-    target, sep, raw = text.partition("=")
-    component, dot, variable = target.partition(".")
-    if not (sep and dot and component and variable):
-        raise argparse.ArgumentTypeError(f"--set expects FMU.VARIABLE=VALUE, got {text!r}")
-    for convert in (int, float):
-        try:
-            return component, variable, convert(raw)
-        except ValueError:
-            pass
-    return component, variable, raw
 
 
 @dataclass(frozen=True)
@@ -80,6 +68,9 @@ def run_scenario(system: SystemDescription, label: str, out: Path, overrides: di
         except ValueError:
             master.free()
             raise
+    for old in out.glob(f"{label}.*"):         # a previous run's outputs would mislead
+        if old.suffix in (".csv", ".json", ".png", ".svg", ".pdf", ".gif", ".mp4"):
+            old.unlink()
     progress = Progress(label)
     csv_path = out / f"{label}.csv"
     try:
@@ -148,7 +139,7 @@ def main(argv: list[str] | None = None) -> int:
                         help="output folder (default: results/SCENARIO, or results/ with --all)")
     parser.add_argument("--stop-time", type=float, metavar="T",
                         help="end of the run in s (default: the scenario's, 400 s)")
-    parser.add_argument("--set", action="append", default=[], type=parse_setting,
+    parser.add_argument("--set", action="append", default=[], type=setting_option,
                         metavar="FMU.VAR=VALUE",
                         help="override a parameter, e.g. ship.Hs=0.01 (SI units, radians); "
                              "repeatable")
@@ -176,9 +167,7 @@ def main(argv: list[str] | None = None) -> int:
     names = chosen_scenarios(parser, args.scenario, args.all)
     if not checked_autopilot(parser, args):
         return 2
-    overrides: dict[str, dict] = {}
-    for component, variable, value in args.set:
-        overrides.setdefault(component, {})[variable] = value
+    overrides = overrides_of(dict(args.set))
     # With --all, autopilot.* settings are for the user's autopilot, not the paper's.
     paper_overrides = {c: v for c, v in overrides.items()
                        if c != COMPONENT or args.autopilot is None}

@@ -1,6 +1,6 @@
 """Score your autopilot against the paper's PD and sliding-mode autopilots and the PID.
 
-    python -m cosim.score my.fmu [--name NAME] [--seeds N] [--map PORT=NAME] [--out DIR]
+    python -m cosim.score my.fmu [--name NAME] [--seeds N] [--map PORT=NAME] [--set ...]
 
 Runs the paper's route in calm water and waves, a 40 deg course change, and an
 N-seed wave ensemble on a local Dask cluster (or --scheduler), for your FMU and the
@@ -14,8 +14,7 @@ import sys
 import time
 from pathlib import Path
 
-from ._cli import checked_autopilot, parse_port_map, writable_folder
-from .api import SimulationError
+from ._cli import add_port_options, checked_autopilot, setting_option, writable_folder
 from .studies.scorecard import score
 
 
@@ -27,12 +26,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("autopilot", type=Path, metavar="FMU",
                         help="your autopilot: FMI 2.0 co-simulation, inputs psi (rad), r "
                              "(rad/s), psi_d (rad), output delta_c (rad)")
-    parser.add_argument("--name", help="its name in the tables (default: the file name)")
-    parser.add_argument("--map", action="append", default=[], type=parse_port_map,
-                        metavar="PORT=NAME",
-                        help="the FMU's name of an autopilot port, e.g. psi=heading; repeatable")
+    add_port_options(parser)
+    parser.add_argument("--set", action="append", default=[], type=setting_option,
+                        metavar="COMPONENT.VAR=VALUE",
+                        help="a parameter value for your autopilot's runs, e.g. "
+                             "autopilot.Kp=1.5; repeatable")
     parser.add_argument("--seeds", type=int, default=20, help="wave seeds of the ensemble "
                                                               "(default 20)")
+    parser.add_argument("--scheduler", metavar="ADDRESS",
+                        help="run the ensemble on this Dask scheduler (default: a local "
+                             "cluster)")
     parser.add_argument("--workers", type=int, help="local Dask worker processes "
                                                     "(default: one per core)")
     parser.add_argument("--out", type=Path, help="output folder (default: results/score/NAME)")
@@ -49,19 +52,22 @@ def main(argv: list[str] | None = None) -> int:
     steps = 4 * 2 + 4 + 1
 
     from tqdm import tqdm
-    with tqdm(total=steps, desc="scorecard", unit="step", file=sys.stderr, disable=None,
-              bar_format="{desc}: {n}/{total} {bar} {elapsed} {postfix}") as bar:
-        def progress(step: str) -> None:
-            if bar.n or step != "calm water, PD":
-                bar.update()
-            bar.set_postfix_str(step)
-        try:
-            text = score(args.autopilot.resolve(), name, out, args.seeds, dict(args.map),
-                         args.workers, progress)
-        except (ValueError, FileNotFoundError, SimulationError) as error:
-            print(f"error: {error}", file=sys.stderr)
-            return 1
+    bar = tqdm(total=steps, desc="scorecard", unit="step", file=sys.stderr, disable=None,
+               bar_format="{desc}: {n}/{total} {bar} {elapsed} {postfix}")
+
+    def progress(step: str) -> None:
+        if bar.n or step != "calm water, PD":
+            bar.update()
+        bar.set_postfix_str(step)
+    try:
+        text = score(args.autopilot.resolve(), name, out, args.seeds, dict(args.map),
+                     dict(args.set), args.workers, args.scheduler, progress)
         bar.update()
+    except (ValueError, FileNotFoundError) as error:
+        bar.close()
+        print(f"error: {error}", file=sys.stderr)
+        return 1
+    bar.close()
     print(text)
     print(f"wrote {out / 'scorecard.md'} and its figures in {time.perf_counter() - started:.0f} s")
     return 0

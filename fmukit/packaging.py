@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import shutil
+import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -56,8 +57,10 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path) -> 
     from pythonfmu import FmuBuilder
 
     script, dest = Path(script), Path(dest)
-    if not (script.is_file() and script.suffix == ".py"):
+    if script.suffix != ".py":
         raise ValueError(f"{script} is not a Python script (.py) to build an FMU from")
+    if not script.is_file():
+        raise ValueError(f"{script} does not exist")
     sources = [ROOT / p if isinstance(p, str) else Path(p) for p in packages]
     for source in sources:
         if not source.exists():
@@ -87,7 +90,43 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path) -> 
     problems = validate_fmu(str(fmu))
     if problems:
         raise RuntimeError(f"{fmu} does not validate:\n" + "\n".join(problems))
+    try:
+        check_instantiates(fmu)
+    except RuntimeError:
+        fmu.unlink()
+        raise
     return fmu
+
+
+_TRIAL = """
+import sys
+sys.path = [p for p in sys.path if p not in ("", {root!r})]
+sys.meta_path = [f for f in sys.meta_path if "editable" not in repr(f).lower()]
+from fmpy import extract, read_model_description
+from fmpy.fmi2 import FMU2Slave
+description = read_model_description(sys.argv[1])
+slave = FMU2Slave(guid=description.guid, unzipDirectory=extract(sys.argv[1]),
+                  modelIdentifier=description.coSimulation.modelIdentifier,
+                  instanceName="trial")
+slave.instantiate(loggingOn=True)     # pythonfmu 0.7 logs only then
+slave.freeInstance()
+"""
+
+
+def check_instantiates(fmu: Path) -> None:
+    """Instantiate the FMU once in a fresh interpreter that cannot import this checkout:
+    RuntimeError with its last words if it fails, as it would on a host without the
+    modules the FMU forgot to carry."""
+    with tempfile.TemporaryDirectory() as elsewhere:
+        child = subprocess.run([sys.executable, "-c", _TRIAL.format(root=str(ROOT)), str(fmu)],
+                               cwd=elsewhere, capture_output=True, text=True, timeout=120)
+    if child.returncode != 0:
+        log = [line for line in child.stdout.splitlines() if line.strip()][-3:]  # the FMU's
+        words = log or [line for line in child.stderr.splitlines() if line.strip()][-3:]
+        raise RuntimeError(f"{fmu.name} was built but does not instantiate without this "
+                           "checkout, so it was removed; a module it imports is probably "
+                           "missing from it (carry it with --include):\n  "
+                           + "\n  ".join(words))
 
 
 @contextlib.contextmanager

@@ -19,6 +19,8 @@ UNITS: dict[str, tuple[dict[str, int], float, dict[str, float]]] = {
     "rad/s": ({"rad": 1, "s": -1}, 1.0, {"deg/s": 180.0 / math.pi}),
     "rad/s2": ({"rad": 1, "s": -2}, 1.0, {"deg/s2": 180.0 / math.pi}),
     "rad.s": ({"rad": 1, "s": 1}, 1.0, {"deg.s": 180.0 / math.pi}),
+    "deg": ({"rad": 1}, math.pi / 180.0, {}),
+    "deg/s": ({"rad": 1, "s": -1}, math.pi / 180.0, {}),
     "rev/s": ({"rad": 1, "s": -1}, 2.0 * math.pi, {"rpm": 60.0}),
     "N": ({"kg": 1, "m": 1, "s": -2}, 1.0, {}),
     "N.m": ({"kg": 1, "m": 2, "s": -2}, 1.0, {}),

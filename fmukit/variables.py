@@ -10,6 +10,8 @@ import math
 from dataclasses import dataclass
 from typing import Any, Callable
 
+from .units import UNITS
+
 
 @dataclass(frozen=True)
 class Var:
@@ -26,6 +28,11 @@ class Var:
     get: Callable[[Any], Any] | None = None   # outputs: value from the slave
     min: float = -math.inf            # inputs and parameters: the valid range, written to
     max: float = math.inf             # modelDescription.xml and enforced (NaN is never valid)
+
+    def __post_init__(self) -> None:
+        if self.kind is float and self.unit not in UNITS:
+            raise ValueError(f"variable {self.name}: unit {self.unit!r} is not one of "
+                             f"{', '.join(UNITS)} (fmukit/units.py)")
 
     @classmethod
     def parameter(cls, name: str, start: float | int | str, unit: str = "1",

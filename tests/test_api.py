@@ -44,19 +44,27 @@ def test_simulate_refuses_bad_input_by_name(fmu_paths, kwargs, error, fragment):
         simulate("calm_pd", **kwargs)
 
 
-@pytest.mark.parametrize("name, options", [
-    ("pd_autopilot", []), ("pid_autopilot", []), ("pd_autopilot_c", []),
-    # The SMC as printed turns slowly (eq 39, k2 = -2000; docs/reproduction.md): 25.7 deg
-    # off course 60 s after the first turn. It is held to what it does, not to the PD's.
-    ("smc_autopilot", ["--heading-bound", "30"]),
-])
-def test_the_example_test_file_passes_for_each_autopilot_of_the_project(
-        fmu_paths, pytester, name, options):
+@pytest.mark.parametrize("name", ["pd_autopilot", "pid_autopilot", "pd_autopilot_c"])
+def test_the_example_test_file_passes_for_the_pd_the_pid_and_the_c_autopilot(
+        fmu_paths, pytester, name):
     if name not in fmu_paths:
         pytest.skip("no C compiler on this machine (set CC or install gcc)")
     result = pytester.runpytest_subprocess(str(EXAMPLE), "--autopilot", str(fmu_paths[name]),
-                                           *options, "-p", "no:cacheprovider")
+                                           "-p", "no:cacheprovider")
     result.assert_outcomes(passed=8)
+
+
+def test_the_example_test_file_tells_what_the_smc_as_printed_does(fmu_paths, pytester):
+    """It turns slowly (eq 39, k2 = -2000; docs/reproduction.md): 25.7 deg off course 60 s
+    after the first turn, held here to 30 deg. And it asks for rudder it cannot have, and
+    keeps the gear at its rate limit: those checks fail, saying so."""
+    result = pytester.runpytest_subprocess(str(EXAMPLE), "--autopilot",
+                                           str(fmu_paths["smc_autopilot"]), "--heading-bound",
+                                           "30", "-p", "no:cacheprovider")
+    result.assert_outcomes(passed=4, failed=4)
+    result.stdout.fnmatch_lines([
+        "*commanded rudder 874.6 deg at t = 161.2 s, 60 s or more after a course change*",
+        "*the rudder moved at the gear's limit of 20.0 deg/s for 76.8 % of the run*"])
 
 
 def test_the_example_test_file_fails_an_autopilot_that_does_not_steer(fmu_paths, pytester,
@@ -72,8 +80,10 @@ def test_the_example_test_file_fails_an_autopilot_that_does_not_steer(fmu_paths,
 def test_the_plugin_checks_say_what_is_wrong_and_when(fmu_paths):
     from cosim.testing import check_rudder_rate, check_rudder_within_stops
 
-    run = simulate("calm_pd", stop_time=120)
-    with pytest.raises(AssertionError, match=r"rudder at 24\.\d\d deg at t = 9\d\.\d s, beyond"):
-        check_rudder_within_stops(run, delta_max=math.radians(20))
-    with pytest.raises(AssertionError, match=r"rudder moving at 20\.00 deg/s at t = .* faster"):
-        check_rudder_rate(run, delta_rate_max=math.radians(10))
+    run = simulate("calm_pd", set={"ship.delta_max": math.radians(2.0)})   # cannot turn
+    with pytest.raises(AssertionError, match=r"commanded rudder \d+\.\d deg at t = \d+\.\d s, "
+                                             r"60 s or more .* stops are at \+-2\.0 deg"):
+        check_rudder_within_stops(run)
+    with pytest.raises(AssertionError, match=r"gear's limit of 20\.0 deg/s for 1\.8 % of the "
+                                             r"run \(allowed 1 %\)"):
+        check_rudder_rate(simulate("calm_pd"), share=0.01)

@@ -40,3 +40,20 @@ def test_the_scorecard_refuses_a_file_that_is_not_an_autopilot(tmp_path, capsys)
     assert cli.main([str(junk), "--out", str(tmp_path / "score")]) == 2
     assert re.search(r"junk\.fmu is not an FMU", capsys.readouterr().err)
     assert not (tmp_path / "score").exists()
+
+
+def test_an_autopilot_that_fails_is_scored_as_failed_and_the_rest_goes_on(tmp_path, capsys):
+    from fmukit.packaging import ROOT, build_script
+
+    failing = build_script(ROOT / "tests" / "faulty" / "idle_pilot_slave.py", ("fmukit",),
+                           tmp_path / "idle_pilot.fmu")
+    out = tmp_path / "score"
+    assert cli.main([str(failing), "--set", "autopilot.fail_time=150", "--seeds", "1",
+                     "--workers", "1", "--out", str(out)]) == 0
+    text = (out / "scorecard.md").read_text()
+    assert _rows(text, "## The paper's route")["idle_pilot"][:6] == ["failed"] * 6
+    assert _rows(text, "## A 40 deg course change")["idle_pilot"] == ["failed"] * 4
+    assert _rows(text, "## Wave ensemble")["idle_pilot"][-1] == "0/1"
+    assert "- idle_pilot, calm water: `FMU 'autopilot': doStep at t = 150 s returned " \
+           "fatal`" in text
+    assert _rows(text, "## The paper's route")["PD"][2] == "200.3"   # the others still run

@@ -18,7 +18,7 @@ import math
 import shutil
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 
@@ -26,7 +26,7 @@ from ..analysis.cost import Cost, cost
 from ..analysis.figures import comparison_figure
 from ..analysis.metrics import heading_error, overshoot, settling_time, sign_reversals_per_minute
 from ..analysis.reports import PAPER_TABLES
-from ..api import simulate
+from ..api import SimulationError, simulate
 from ..core.recording import Recording
 from .sweep import Spec, comparison, controller_entry, execute
 from .sweep_figures import distribution
@@ -48,10 +48,15 @@ class Contender:
     suffix: str = "pd"                   # scenarios <sea>_<suffix>
     fmu: Path | None = None              # in place of that scenario's autopilot
     port_map: dict[str, str] | None = None
+    settings: dict[str, Any] | None = None   # --set values, for the user's autopilot only
 
-    def run(self, sea: str, **kwargs) -> Recording:
+    def run(self, sea: str, stop_time: float | None = None,
+            route: str | None = None) -> Recording:
+        settings = dict(self.settings or {})
+        if route is not None:
+            settings["guidance.waypoints"] = route
         return simulate(f"{sea}_{self.suffix}", autopilot=self.fmu, port_map=self.port_map,
-                        **kwargs)
+                        set=settings, stop_time=stop_time)
 
 
 @dataclass(frozen=True)
@@ -72,26 +77,37 @@ def course_change(run: Recording) -> CourseChange:
 
 
 def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | None = None,
-          workers: int | None = None, progress: Callable[[str], None] = lambda step: None
-          ) -> str:
-    """Run the scorecard of ``fmu`` (called ``name``), write out/scorecard.md and figures."""
+          settings: dict[str, Any] | None = None, workers: int | None = None,
+          scheduler: str | None = None,
+          progress: Callable[[str], None] = lambda step: None) -> str:
+    """Run the scorecard of ``fmu`` (called ``name``), write out/scorecard.md and figures.
+
+    A run that fails (an FMU error) is reported in the tables as failed, with its message,
+    and the scorecard goes on.
+    """
     contenders = [*(Contender(label, suffix) for label, suffix in BASELINES.items()),
-                  Contender(name, fmu=fmu, port_map=port_map)]
+                  Contender(name, fmu=fmu, port_map=port_map, settings=settings)]
+    failures: dict[tuple[str, str], str] = {}
+
+    def attempt(contender: Contender, test: str, **kwargs) -> Recording | None:
+        progress(f"{test}, {contender.name}")
+        try:
+            return contender.run(**kwargs)
+        except SimulationError as error:
+            failures[contender.name, test] = str(error).splitlines()[0]
+            return None
+
     paper: dict[tuple[str, str], Cost] = {}
     for sea in ("calm", "waves"):
-        runs = {}
-        for contender in contenders:
-            progress(f"{sea} water, {contender.name}")
-            runs[contender.name] = contender.run(sea)
-            paper[contender.name, sea] = cost(runs[contender.name])
+        runs = {c.name: attempt(c, f"{sea} water", sea=sea) for c in contenders}
+        runs = {n: r for n, r in runs.items() if r is not None}
+        paper.update({(n, sea): cost(r) for n, r in runs.items()})
         comparison_figure(runs, out / f"route_{sea}.png",
                           f"The paper's route in {'calm water' if sea == 'calm' else 'waves'}")
-    changes, runs = {}, {}
-    for contender in contenders:
-        progress(f"course change, {contender.name}")
-        runs[contender.name] = contender.run("calm", stop_time=COURSE_CHANGE_TIME,
-                                             set={"guidance.waypoints": COURSE_CHANGE_ROUTE})
-        changes[contender.name] = course_change(runs[contender.name])
+    runs = {c.name: attempt(c, "course change", sea="calm", stop_time=COURSE_CHANGE_TIME,
+                            route=COURSE_CHANGE_ROUTE) for c in contenders}
+    runs = {n: r for n, r in runs.items() if r is not None}
+    changes = {n: course_change(r) for n, r in runs.items()}
     comparison_figure(runs, out / "course_change.png",
                       "40 deg course change from straight running, calm water")
     progress(f"wave ensemble, {seeds} seeds on Dask")
@@ -99,21 +115,22 @@ def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | Non
     shutil.rmtree(ensemble, ignore_errors=True)          # a fresh ensemble every time
     ensemble.mkdir(parents=True)
     entries = {c.name: ({"scenario": f"waves_{c.suffix}"} if c.fmu is None else
-                        {"autopilot": str(c.fmu), "map": c.port_map or {}})
+                        {"autopilot": str(c.fmu), "map": c.port_map or {},
+                         "set": c.settings or {}})
                for c in contenders}
     spec = Spec(name="ensemble", axes={"wave_seed": list(range(1, seeds + 1))},
                 controllers={n: controller_entry(e, out / "scorecard", n)
                              for n, e in entries.items()})
-    rows = execute(spec, ensemble, workers=workers, progress=False)
+    rows = execute(spec, ensemble, scheduler=scheduler, workers=workers, progress=False)
     distribution(spec, rows, out / "J_distribution.png")
-    text = _markdown(fmu, name, seeds, contenders, paper, changes, spec, rows)
+    text = _markdown(fmu, name, seeds, contenders, paper, changes, failures, spec, rows)
     (out / "scorecard.md").write_text(text)
     return text
 
 
 def _markdown(fmu: Path, name: str, seeds: int, contenders: list[Contender],
               paper: dict[tuple[str, str], Cost], changes: dict[str, CourseChange],
-              spec: Spec, rows: list[dict]) -> str:
+              failures: dict[tuple[str, str], str], spec: Spec, rows: list[dict]) -> str:
     lines = [f"# Scorecard: {name}", "",
              f"Autopilot `{fmu}` beside the paper's PD and sliding-mode (SMC) autopilots and "
              "the project's PID, on CyberShip II (docs/own_autopilot.md says how each is run).",
@@ -121,18 +138,24 @@ def _markdown(fmu: Path, name: str, seeds: int, contenders: list[Contender],
              "| controller | calm psi_E | calm delta_E | calm J | waves psi_E | waves delta_E "
              "| waves J | paper J calm / waves |", "|---|---|---|---|---|---|---|---|"]
     for c in contenders:
-        calm, waves = paper[c.name, "calm"], paper[c.name, "waves"]
+        cells = []
+        for sea in ("calm", "waves"):
+            r = paper.get((c.name, sea))
+            cells += ([f"{r.psi_E:.1f}", f"{r.delta_E:.1f}", f"{r.J:.1f}"] if r
+                      else ["failed"] * 3)
         theirs = (f"{PAPER_TABLES[f'calm_{c.suffix}'][2]:.1f} / "
                   f"{PAPER_TABLES[f'waves_{c.suffix}'][2]:.1f}"
                   if c.fmu is None and f"calm_{c.suffix}" in PAPER_TABLES else "-")
-        lines.append(f"| {c.name} | {calm.psi_E:.1f} | {calm.delta_E:.1f} | {calm.J:.1f} | "
-                     f"{waves.psi_E:.1f} | {waves.delta_E:.1f} | {waves.J:.1f} | {theirs} |")
+        lines.append(f"| {c.name} | {' | '.join(cells)} | {theirs} |")
     lines += ["", "![route in calm water](route_calm.png)", "![route in waves](route_waves.png)",
               "", f"## A 40 deg course change, calm water, {COURSE_CHANGE_TIME:.0f} s", "",
               "| controller | settling time to 2 % (s) | overshoot (deg) | rudder reversals "
               "per min | max rudder (deg) |", "|---|---|---|---|---|"]
     for c in contenders:
-        r = changes[c.name]
+        r = changes.get(c.name)
+        if r is None:
+            lines.append(f"| {c.name} | failed | failed | failed | failed |")
+            continue
         settled = f"{r.settling_time:.1f}" if math.isfinite(r.settling_time) else \
             f"> {COURSE_CHANGE_TIME:.0f}"
         lines.append(f"| {c.name} | {settled} | {math.degrees(r.overshoot):.2f} | "
@@ -148,8 +171,12 @@ def _markdown(fmu: Path, name: str, seeds: int, contenders: list[Contender],
         lines.append(f"| {c.name} | {spread} | {J.size}/{seeds} |")
     failed = [r for r in rows if r["status"] != "ok"]
     if failed:
-        lines += ["", f"{len(failed)} runs failed; the first: "
+        lines += ["", f"{len(failed)} runs of the ensemble failed; the first: "
                       f"`{failed[0]['error'].splitlines()[0][:200]}`"]
+    if failures:
+        lines += ["", "Runs that failed:", ""]
+        lines += [f"- {name}, {test}: `{message[:200]}`"
+                  for (name, test), message in failures.items()]
     lines += ["", "Seed-paired against the PD (a win: lower J on the same sea):", "",
               comparison(spec, rows, baseline="PD"), "",
               "![J per controller](J_distribution.png)", ""]

@@ -375,12 +375,15 @@ def comparison(spec: Spec, rows: list[dict], baseline: str = "pd",
                     for seed in seeds]
             return np.array([ok[k]["J"] if k in ok else np.nan for k in keys])
 
+        def median(values: np.ndarray) -> str:
+            return f"{np.nanmedian(values):.1f}" if np.isfinite(values).any() else "-"
+
         base = J(baseline)
-        cells = [str(v) for v in setting] + [f"{np.nanmedian(base):.1f}"]
+        cells = [str(v) for v in setting] + [median(base)]
         wins, ratios = [], []
         for controller in others:
             J_c = J(controller)
-            cells.append(f"{np.nanmedian(J_c):.1f}")
+            cells.append(median(J_c))
             decided = np.isfinite(J_c) & np.isfinite(base) & (J_c != base)
             wins.append(f"{int(np.sum(J_c[decided] < base[decided]))}/{int(decided.sum())}")
             defined = np.isfinite(J_c) & (base > 1e-9)

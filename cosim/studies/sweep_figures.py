@@ -33,8 +33,12 @@ def distribution(spec, rows: list[dict], path: Path) -> Path:
             labels.append(f"{controller}\n{sea} {group}" if sea else controller)
     ax.boxplot(data, positions=positions, widths=0.7)
     ax.set_xticks(positions, labels, fontsize=8)
-    ax.set_yscale("log")
-    ax.set_ylabel("J of eq (19)")
+    values = [j for J in data for j in J if np.isfinite(j)]
+    if not values:
+        ax.text(0.5, 0.5, "no run succeeded", transform=ax.transAxes, ha="center")
+    elif min(values) > 0 and max(values) > 10 * min(values):
+        ax.set_yscale("log")            # J spans decades across sea states and controllers
+    ax.set_ylabel("J of eq (19) (rad^2)")
     ax.set_title(f"{spec.name}: J per controller" + (f" and {sea}" if sea else ""), fontsize=10)
     ax.grid(alpha=0.3, axis="y")
     fig.savefig(path, dpi=120)

@@ -1,6 +1,9 @@
-"""An autopilot that keeps the rudder amidships: it has the ports, and does not steer."""
+"""An autopilot that keeps the rudder amidships: it has the ports, and does not steer.
+
+With ``fail_time`` set it fails every step from then on (an exception: fmi2Fatal).
+"""
 from fmukit.autopilot import INPUTS, rudder_command
-from fmukit.slave import ModelSlave
+from fmukit.slave import ModelSlave, Var
 
 
 class Idle:
@@ -14,10 +17,12 @@ class Idle:
 class IdlePilotSlave(ModelSlave):
     model_name = "idle_pilot"
     description = "holds the rudder amidships"
-    variables = (*INPUTS, rudder_command(depends=(), get=lambda slave: 0.0))
+    variables = (*INPUTS, rudder_command(depends=(), get=lambda slave: 0.0),
+                 Var.parameter("fail_time", 1e9, "s", "fail every step from then on"))
 
     def build_model(self) -> Idle:
         return Idle()
 
     def step_model(self, t: float, h: float) -> None:
-        pass
+        if t >= self.fail_time:
+            raise RuntimeError(f"injected failure at t = {t}")
