@@ -16,11 +16,12 @@ _DISPLAY = {"rad": (math.degrees(1.0), "deg"), "rad/s": (math.degrees(1.0), "deg
             "m": (1.0, "m"), "s": (1.0, "s"), "1/s": (1.0, "1/s"), "m/s": (1.0, "m/s")}
 
 
-def value(x: Any, unit: str = "") -> str:
-    """A parameter value for people: 4 significant digits, angles in degrees."""
+def value(x: Any, unit: str = "", degrees: bool = True) -> str:
+    """A parameter value for people: 4 significant digits; angles in degrees if ``degrees``."""
     if isinstance(x, str) or isinstance(x, bool) or x is None:
         return str(x)
-    factor, shown = _DISPLAY.get(unit, (1.0, "" if unit in ("", "1") else unit))
+    factor, shown = _DISPLAY.get(unit, (1.0, unit)) if degrees else (1.0, unit)
+    shown = "" if shown in ("", "1") else shown
     text = f"{x * factor:.4g}" if isinstance(x, float) else str(x)
     return f"{text} {shown}".strip()
 
@@ -43,9 +44,10 @@ def gear(ship: dict[str, Any]) -> str:
             f"{math.degrees(ship['delta_rate_max']):.3g} deg/s")
 
 
-def settings(parameters: dict[str, Any], units: dict[str, str]) -> str:
+def settings(parameters: dict[str, Any], units: dict[str, str], degrees: bool = True) -> str:
     """'name = value unit, ...' of one component's parameters."""
-    return ", ".join(f"{name} = {value(x, units.get(name, ''))}" for name, x in parameters.items())
+    return ", ".join(f"{name} = {value(x, units.get(name, ''), degrees)}"
+                     for name, x in parameters.items())
 
 
 def overrides(meta: dict[str, Any]) -> str:
@@ -63,11 +65,13 @@ def conditions(meta: dict[str, Any]) -> list[str]:
     if "ship" in p:
         lines.append(f"{sea(p['ship'])}; {gear(p['ship'])}; starting at "
                      f"{p['ship']['u0']:.3g} m/s")
-    for component in ("autopilot", "program"):
+    # An autopilot's gains stay in the units it declares (eta_h = 10 rad, not 573 deg);
+    # a rudder program's angles read in degrees.
+    for component, degrees in (("autopilot", False), ("program", True)):
         if component in p:
             fmu = meta.get("fmus", {}).get(component, {}).get("file", "")
             lines.append(f"{component} {fmu.rsplit('/', 1)[-1]}: "
-                         f"{settings(p[component], units.get(component, {}))}")
+                         f"{settings(p[component], units.get(component, {}), degrees)}")
     if meta.get("overrides"):
         lines.append(f"set: {overrides(meta)}")
     return lines

@@ -113,11 +113,19 @@ def _degrees(ax: Any, run: Recording, column: str, label: str) -> None:
 
 
 def _rudder(ax: Any, run: Recording, commanded: str) -> None:
-    ax.plot(run.t, np.degrees(run[commanded]), color="tab:orange", linewidth=0.7,
-            label="commanded delta_c")
+    """Commanded and actual rudder; the scale is the stops', a larger command is clipped."""
+    command = np.degrees(run[commanded])
+    ax.plot(run.t, command, color="tab:orange", linewidth=0.7, label="commanded delta_c")
     ax.plot(run.t, np.degrees(run["ship.delta"]), color="k", linewidth=0.9, label="actual delta")
+    stops = math.degrees(run.meta.get("parameters", {}).get("ship", {}).get("delta_max", math.pi))
+    if np.abs(command).max() > 1.15 * stops:
+        ax.set_ylim(-1.15 * stops, 1.15 * stops)
+        ax.text(0.01, 0.03, f"commanded up to {np.abs(command).max():.0f} deg, beyond the "
+                f"stops at +-{stops:.0f} deg (clipped here)", transform=ax.transAxes,
+                fontsize=7, color="tab:orange", zorder=5,
+                bbox=dict(boxstyle="round", facecolor="white", alpha=0.9, edgecolor="none"))
     ax.set_ylabel("rudder (deg)")
-    ax.legend(loc="best", fontsize=7)
+    ax.legend(loc="upper right", fontsize=7)
 
 
 def course_keeping_figure(run: Recording) -> Figure:

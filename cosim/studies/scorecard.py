@@ -29,7 +29,7 @@ from ..analysis.reports import PAPER_TABLES
 from ..api import SimulationError, simulate
 from ..core.recording import Recording
 from .sweep import Spec, comparison, controller_entry, execute
-from .sweep_figures import distribution
+from .sweep_figures import distribution, tracks
 
 BASELINES = {"PD": "pd", "SMC": "smc", "PID": "pid"}
 """The project's autopilots by display name: scenarios <sea>_<suffix>."""
@@ -120,9 +120,10 @@ def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | Non
                for c in contenders}
     spec = Spec(name="ensemble", axes={"wave_seed": list(range(1, seeds + 1))},
                 controllers={n: controller_entry(e, out / "scorecard", n)
-                             for n, e in entries.items()})
+                             for n, e in entries.items()}, tracks={})   # every track
     rows = execute(spec, ensemble, scheduler=scheduler, workers=workers, progress=False)
     distribution(spec, rows, out / "J_distribution.png")
+    tracks(spec, rows, out / "tracks_waves.png")
     text = _markdown(fmu, name, seeds, contenders, paper, changes, failures, spec, rows)
     (out / "scorecard.md").write_text(text)
     return text
@@ -179,5 +180,6 @@ def _markdown(fmu: Path, name: str, seeds: int, contenders: list[Contender],
                   for (name, test), message in failures.items()]
     lines += ["", "Seed-paired against the PD (a win: lower J on the same sea):", "",
               comparison(spec, rows, baseline="PD"), "",
-              "![J per controller](J_distribution.png)", ""]
+              "![J per controller](J_distribution.png)",
+              "![tracks of every seed](tracks_waves.png)", ""]
     return "\n".join(lines)

@@ -25,6 +25,7 @@ SPEC is a TOML file (see docs/sweeps/example.toml):
 
     [plots]
     map = ["sea_state", "ship.delta_rate_max"]   # axes of the J_SMC / J_PD map
+    tracks = { sea_state = 3 }             # overlay the tracks of these runs (all seeds)
 
 Without [controllers], pd and smc run on waves_pd and waves_smc. Paths are relative
 to the sweep file; an autopilot FMU must keep the port contract of
@@ -66,7 +67,9 @@ DEFAULT_CONTROLLERS = {"pd": {"scenario": "waves_pd"}, "smc": {"scenario": "wave
 # Axis shorthands: name -> the FMU parameter it sets.
 SHORTHANDS = {"wave_seed": "ship.wave_seed", "Hs": "ship.Hs", "T0": "ship.T0",
               "psi_w": "ship.psi_w", "route": "guidance.waypoints"}
-METRICS = ("psi_E", "sum_delta2", "J", "rms_heading_error", "reversals_per_min", "max_delta")
+METRICS = {"psi_E": "rad^2", "sum_delta2": "rad^2", "J": "rad^2",
+           "rms_heading_error_deg": "deg", "reversals_per_min": "1/min", "max_delta_deg": "deg"}
+"""The figures of merit of a run and their units, as ``cosim.run`` prints them."""
 
 
 @dataclass
@@ -76,6 +79,11 @@ class Spec:
     axes: dict[str, list]
     stop_time: float | None = None
     map_axes: list[str] = field(default_factory=list)
+    tracks: dict[str, Any] | None = None      # which runs record their track: axis values
+
+    def wants_track(self, run: dict[str, Any]) -> bool:
+        """Whether ``run`` is one of the runs whose tracks are drawn ([plots] tracks)."""
+        return self.tracks is not None and all(run.get(k) == v for k, v in self.tracks.items())
 
     @classmethod
     def read(cls, path: str | Path) -> Spec:
@@ -105,8 +113,14 @@ class Spec:
         for axis in map_axes:
             if axis not in axes:
                 raise ValueError(f"{path}: [plots] map names {axis!r}, which is not an axis")
+        tracks = plots.get("tracks")
+        for key, value in (tracks or {}).items():
+            known = list(controllers) if key == "controller" else axes.get(key)
+            if known is None or value not in known:
+                raise ValueError(f"{path}: [plots] tracks selects {key} = {value!r}; "
+                                 f"select by controller or an axis, with one of its values")
         return cls(name=data.get("name", path.stem), controllers=controllers, axes=axes,
-                   stop_time=data.get("stop_time"), map_axes=map_axes)
+                   stop_time=data.get("stop_time"), map_axes=map_axes, tracks=tracks)
 
     def runs(self) -> list[dict[str, Any]]:
         """Every combination of controller and axis values, with a stable run id."""
@@ -239,17 +253,27 @@ def run_one(spec: Spec, run: dict[str, Any]) -> dict[str, Any]:
             row = _row(run, recording.error)
         else:
             row.update(_metrics(recording))
+            if spec.wants_track(run):
+                row["track"] = _track(recording, master.parameters)
     row["seconds"] = time.perf_counter() - started
     return row
+
+
+def _track(recording, parameters: dict[str, dict[str, Any]], every: float = 1.0) -> dict:
+    """The run's track every ``every`` s, and its route, for the tracks figure."""
+    stride = max(1, round(every / recording.meta["step_size"]))
+    return {"x": recording["ship.x"][::stride].tolist(),
+            "y": recording["ship.y"][::stride].tolist(),
+            "route": parameters.get("guidance", {}).get("waypoints")}
 
 
 def _metrics(recording) -> dict[str, float]:
     c = cost(recording)
     delta = recording["ship.delta"]
     return {"psi_E": c.psi_E, "sum_delta2": c.sum_delta2, "J": c.J,
-            "rms_heading_error": math.sqrt(c.psi_E / recording.rows),   # psi_E: sum of squares
+            "rms_heading_error_deg": math.degrees(math.sqrt(c.psi_E / recording.rows)),
             "reversals_per_min": sign_reversals_per_minute(recording.t, delta),
-            "max_delta": float(np.abs(delta).max())}
+            "max_delta_deg": math.degrees(float(np.abs(delta).max()))}
 
 
 # -- the client side --------------------------------------------------------------------
@@ -320,17 +344,24 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
 
 
 def write_tables(rows: list[dict], out: Path, csv: bool) -> list[Path]:
+    """results.parquet (each metric's unit in its field metadata), results.csv with ``csv``,
+    and results.json: the unit of every column."""
     import pyarrow as pa
     import pyarrow.csv as pacsv
     import pyarrow.parquet as pq
 
     table = pa.Table.from_pylist([{k: (json.dumps(v) if isinstance(v, (list, dict)) else v)
-                                   for k, v in row.items()} for row in rows])
-    written = [out / "results.parquet"]
+                                   for k, v in row.items() if k != "track"} for row in rows])
+    units = {name: METRICS.get(name, "s" if name == "seconds" else "")
+             for name in table.column_names}
+    table = table.cast(pa.schema([field.with_metadata({"unit": units[field.name]})
+                                  for field in table.schema]))
+    written = [out / "results.parquet", out / "results.json"]
     pq.write_table(table, written[0])
+    written[1].write_text(json.dumps({"units": units}, indent=1) + "\n")
     if csv:
         written.append(out / "results.csv")
-        pacsv.write_csv(table, written[1])
+        pacsv.write_csv(table, written[2])
     return written
 
 

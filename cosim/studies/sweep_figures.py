@@ -9,6 +9,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from autopilot_fmu.guidance import parse_waypoints  # noqa: E402
+
 SEA_AXES = ("sea_state", "Hs")
 
 
@@ -80,8 +82,40 @@ def ratio_map(spec, rows: list[dict], path: Path, numerator: str = "smc",
     return path
 
 
+def tracks(spec, rows: list[dict], path: Path) -> Path | None:
+    """The tracks of the runs [plots] tracks selects, overlaid, one colour per controller:
+    every run a thin line, so the spread over seeds shows; the route dashed."""
+    chosen = [r for r in rows if r.get("track")]
+    if not chosen:
+        return None
+    fig, ax = plt.subplots(figsize=(6.5, 7), constrained_layout=True)
+    for controller, color in zip(spec.controllers, plt.rcParams["axes.prop_cycle"].by_key()
+                                 ["color"]):
+        mine = [r["track"] for r in chosen if r["controller"] == controller]
+        for i, track in enumerate(mine):
+            ax.plot(track["y"], track["x"], color=color, linewidth=0.8, alpha=0.45,
+                    label=f"{controller} ({len(mine)} runs)" if i == 0 else None)
+    route = chosen[0]["track"].get("route")
+    if route:
+        points = np.array(parse_waypoints(route))
+        ax.plot(points[:, 1], points[:, 0], "--o", color="0.3", linewidth=0.8, markersize=3,
+                label="route")
+    ax.set(xlabel="east y (m)", ylabel="north x (m)")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.grid(alpha=0.3)
+    ax.legend(loc="best", fontsize=8)
+    where = ", ".join(f"{k} {v}" for k, v in spec.tracks.items()) or "every run"
+    ax.set_title(f"{spec.name}: tracks ({where})", fontsize=10)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
 def save_figures(spec, rows: list[dict], out: Path) -> list[Path]:
     written = [distribution(spec, rows, out / "J_distribution.png")]
+    overlay = tracks(spec, rows, out / "tracks.png")
+    if overlay is not None:
+        written.append(overlay)
     for numerator in [c for c in spec.controllers if c != "pd"]:
         path = ratio_map(spec, rows, out / f"J_{numerator}_over_pd.png", numerator)
         if path is not None:
