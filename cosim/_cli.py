@@ -6,9 +6,11 @@ Only the commands (``cosim.run``, ``cosim.sweep``, ``cosim.export``, ...) import
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 import tempfile
 from pathlib import Path
+from typing import Callable
 
 from . import scenarios
 from .api import parse_setting
@@ -78,6 +80,13 @@ def checked_autopilot(parser: argparse.ArgumentParser, args: argparse.Namespace)
         print(f"error: {error}", file=sys.stderr)
         return False
     return True
+
+
+def entry(main: Callable[[], int]) -> int:
+    """Run a command's main; when its output pipe closes (``| head``), end quietly as other
+    Unix tools do, instead of with a BrokenPipeError."""
+    signal.signal(signal.SIGPIPE, signal.SIG_DFL)
+    return main()
 
 
 def writable_folder(path: Path) -> Path:

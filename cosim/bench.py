@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from ._cli import entry
 from .studies import bench
 
 
@@ -39,4 +40,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(entry(main))

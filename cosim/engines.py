@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ._cli import entry
 from .interop.engines import ENGINES, RUNNERS, SIGNALS
 
 
@@ -37,4 +38,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(entry(main))

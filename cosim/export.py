@@ -16,7 +16,8 @@ import sys
 from pathlib import Path
 
 from . import scenarios
-from ._cli import add_autopilot_options, checked_autopilot, chosen_scenarios, writable_folder
+from ._cli import (add_autopilot_options, checked_autopilot, chosen_scenarios, entry,
+                   writable_folder)
 from .interop.ssp import export
 
 
@@ -44,4 +45,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(entry(main))

@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import NamedTuple
 
 from . import scenarios
-from ._cli import (Progress, add_autopilot_options, checked_autopilot, chosen_scenarios,
+from ._cli import (Progress, add_autopilot_options, checked_autopilot, chosen_scenarios, entry,
                    setting_option, writable_folder)
 from .analysis.animation import animate, require_track, video_format
 from .analysis.cost import LAMBDA, Cost, cost
@@ -183,6 +183,7 @@ def main(argv: list[str] | None = None) -> int:
         out = args.out or Path("results") / run.label
         if args.all and args.out:
             out = args.out / run.label
+        created = not out.exists()
         writable_folder(out)
         try:
             system = scenarios.load(run.scenario, run.autopilot, dict(args.map), args.name)
@@ -191,6 +192,8 @@ def main(argv: list[str] | None = None) -> int:
                                         options)
         except (ValueError, FileNotFoundError, FmuCallError) as error:
             print(f"error: {error}", file=sys.stderr)
+            if created and not any(out.iterdir()):
+                out.rmdir()                     # nothing was run: leave nothing behind
             return 2
         status = max(status, code)
         if result is not None and run.table_row is not None:
@@ -202,4 +205,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(entry(main))

@@ -14,7 +14,7 @@ import sys
 import time
 from pathlib import Path
 
-from ._cli import add_port_options, checked_autopilot, setting_option, writable_folder
+from ._cli import add_port_options, checked_autopilot, entry, setting_option, writable_folder
 from .studies.scorecard import score
 
 
@@ -74,4 +74,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(entry(main))

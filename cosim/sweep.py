@@ -5,7 +5,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ._cli import writable_folder
+from ._cli import entry, writable_folder
 from .studies import sweep
 from .studies.sweep_figures import save_figures
 
@@ -44,4 +44,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(entry(main))

@@ -67,6 +67,7 @@ def test_the_title_and_the_header_describe_the_run_that_was_made(fmu_paths, tmp_
     assert "set: --set ship.Hs=0.01 --set ship.psi_w=1.5708 --set autopilot.Kd=30" in out
     assert "5 mm" not in out and "180 deg" not in out
     assert "lambda making them equal on calm_pd" in out          # what delta_E is
+    assert "60 s in steps of 0.1 s, gauss-seidel coupling, fmi backend" in out
 
 
 def test_next_to_every_csv_a_json_with_what_it_takes_to_reproduce_the_run(fmu_paths,
@@ -74,7 +75,7 @@ def test_next_to_every_csv_a_json_with_what_it_takes_to_reproduce_the_run(fmu_pa
     assert cli.main(["calm_smc", "--set", "autopilot.eta_h=5.0", "--stop-time", "20",
                      "--no-plot", "--out", str(tmp_path)]) == 0
     meta = json.loads((tmp_path / "calm_smc.json").read_text())
-    header = (tmp_path / "calm_smc.csv").read_text().splitlines()[0].split(",")[1:]
+    header = (tmp_path / "calm_smc.csv").read_text().splitlines()[0].split(",")
     assert list(meta["columns"]) == header
     assert meta["columns"]["ship.psi"] == "rad" and meta["columns"]["autopilot.sigma"] == "1"
     assert meta["parameters"]["autopilot"]["eta_h"] == 5.0                # as set
@@ -88,13 +89,18 @@ def test_next_to_every_csv_a_json_with_what_it_takes_to_reproduce_the_run(fmu_pa
     assert (meta["coupling"], meta["step_size"], meta["stop_time"], meta["rows"]) == \
         ("gauss-seidel", 0.1, 20.0, 201)
     assert meta["wall_time_s"] > 0 and meta["versions"]["ship-autopilot-cosim"] == "0.1.0"
-    assert meta["error"] is None
+    assert meta["error"] is None and meta["backend"] == "fmi"
+    assert meta["columns"]["time"] == "s" and meta["settings"]["ship"]["n1"] == 8.13
+    assert meta["scenario_sha256"] == hashlib.sha256(
+        open(meta["scenario_file"], "rb").read()).hexdigest()
 
 
 def test_the_turning_circle_figure_marks_advance_transfer_and_tactical_diameter(fmu_paths):
-    texts = _texts(turning_circle_figure(simulate("turning_circle")).axes[0])
-    assert "advance 4.42 m" in texts and "transfer 0.13 m" in texts
-    assert "tactical diameter 3.70 m" in texts
+    track = turning_circle_figure(simulate("turning_circle")).axes[0]
+    legend = " | ".join(t.get_text() for t in track.get_legend().get_texts())
+    assert "advance 4.42 m (at 90 deg)" in legend and "transfer 0.13 m (at 90 deg)" in legend
+    assert "tactical diameter 3.70 m (at 180 deg)" in legend
+    assert "steady turn: drift angle 59 deg, diameter 2U/|r| = 5.17 m" in _texts(track)
 
 
 def test_the_zigzag_figure_marks_execute_points_and_both_overshoots(fmu_paths):
@@ -159,7 +165,7 @@ def test_animate_refuses_a_system_without_a_track_before_running(fmu_paths, tmp_
                      str(tmp_path / "out")]) == 2
     assert "--animate needs the ship's track; this system records no ship.x" in \
         capsys.readouterr().err
-    assert not list((tmp_path / "out").iterdir())
+    assert not (tmp_path / "out").exists()                  # nothing ran, nothing left
 
 
 def test_a_figure_that_cannot_be_written_leaves_nothing_behind(waves, tmp_path):
@@ -200,3 +206,18 @@ def test_a_sweep_says_its_units_as_the_command_line_does(fmu_paths, tmp_path):
     row = table.to_pylist()[0]
     assert row["max_delta_deg"] == pytest.approx(math.degrees(np.abs(run["ship.delta"]).max()))
     assert (out / "tracks.png").stat().st_size > 20_000
+
+
+def test_the_metadata_is_strict_json_when_a_value_is_not_finite(fmu_paths, tmp_path):
+    assert cli.main(["calm_pd", "--set", "ship.Hs=nan", "--no-plot", "--out",
+                     str(tmp_path)]) == 1
+    text = (tmp_path / "calm_pd.json").read_text()
+    meta = json.loads(text, parse_constant=lambda token: pytest.fail(f"{token} in JSON"))
+    assert meta["parameters"]["ship"]["Hs"] == "nan"     # read before the FMU refused it
+    assert "parameter Hs = nan is not finite" in meta["error"]
+
+
+def test_a_run_that_loses_the_ship_says_so(fmu_paths, tmp_path, capsys):
+    assert cli.main(["waves_pd", "--set", "ship.Hs=0.01", "--set", "ship.psi_w=1.5708",
+                     "--no-plot", "--out", str(tmp_path)]) == 0
+    assert "warning: the rudder was at its stops for" in capsys.readouterr().out

@@ -26,7 +26,7 @@ from autopilot_fmu.guidance import parse_waypoints  # noqa: E402
 
 from ..core.recording import Recording  # noqa: E402
 from .describe import title  # noqa: E402
-from .figures import hull_outline, track_panel, whole_file  # noqa: E402
+from .figures import legend_if_any, hull_outline, track_panel, whole_file  # noqa: E402
 
 FPS = 10
 VIDEO_SECONDS = 25.0
@@ -73,24 +73,25 @@ def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> P
     hull = track.add_patch(Polygon(hull_outline(x[0], y[0], psi[0]), closed=True,
                                    color="tab:red", zorder=5))
     marker, = track.plot([], [], color="tab:red", alpha=0.35, markersize=14, zorder=4,
-                         linestyle="none")          # the ship to scale is small: mark it
+                         linestyle="none", marker=(3, 0, 0),   # the ship to scale is small
+                         label="ship (outline to scale, marker enlarged)")
     legs = run.meta.get("parameters", {}).get("guidance")
     points = np.array(parse_waypoints(legs["waypoints"])) if legs else None
     active, = track.plot([], [], color="tab:green", linewidth=3, alpha=0.6, zorder=2,
-                         label="active leg")
-    track.legend(loc="best", fontsize=7)
+                         label="active leg" if points is not None else None)
+    legend_if_any(track)
     heading.plot(t, np.degrees(psi), color="k", linewidth=0.8, label="psi")
     if "guidance.psi_d" in run.columns:
         heading.plot(t, np.degrees(run["guidance.psi_d"]), "--", color="tab:red",
                      linewidth=0.8, label="psi_d")
     heading.set(ylabel="heading (deg)")
-    heading.legend(loc="best", fontsize=7)
+    legend_if_any(heading)
     rudder.plot(t, np.degrees(delta), color="k", linewidth=0.8)
     rudder.set(xlabel="time (s)", ylabel="rudder delta (deg)")
     cursors = [a.axvline(t[0], color="tab:red", linewidth=1) for a in (heading, rudder)]
     for a in (heading, rudder):
         a.grid(alpha=0.3)
-    readout = track.text(0.02, 0.02, "", transform=track.transAxes, fontsize=8, va="bottom",
+    readout = track.text(0.02, 0.98, "", transform=track.transAxes, fontsize=8, va="top",
                          bbox=dict(boxstyle="round", facecolor="white", alpha=0.85))
     fig.suptitle(title(label, run.meta), fontsize=7)
     leg = run["guidance.wp_index"].astype(int) if "guidance.wp_index" in run.columns else None
@@ -107,7 +108,8 @@ def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> P
         if leg is not None and points is not None:
             to = min(leg[k], len(points) - 1)
             active.set_data(points[to - 1:to + 1, 1], points[to - 1:to + 1, 0])
-            text += f"\nleg to waypoint {to} ({points[to][0]:g}, {points[to][1]:g}) m"
+            text += (f"\nleg to waypoint {to} ({points[to][0]:g}, {points[to][1]:g}) m"
+                     if leg[k] < len(points) else "\npast the last waypoint: holding its course")
         readout.set_text(text)
 
     dynamic = [wake, marker, hull, active, readout, *cursors]

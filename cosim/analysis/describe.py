@@ -60,6 +60,10 @@ def conditions(meta: dict[str, Any]) -> list[str]:
     """What a run was, line by line: route, sea and gear, controller or rudder program, settings."""
     p, units = meta.get("parameters", {}), meta.get("parameter_units", {})
     lines = []
+    if "stop_time" in meta:
+        lines.append(f"{meta['stop_time'] - meta['start_time']:g} s in steps of "
+                     f"{meta['step_size']:g} s, {meta['coupling']} coupling, "
+                     f"{meta['backend']} backend")
     if "guidance" in p:
         lines.append(route(p["guidance"]))
     if "ship" in p:

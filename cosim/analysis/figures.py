@@ -74,21 +74,28 @@ def track_panel(ax: Any, run: Recording, ship: bool = True) -> None:
             if all(math.hypot(x[k] - a, y[k] - b) > Hull.L for a, b in drawn):
                 drawn.append((x[k], y[k]))
                 ax.add_patch(Polygon(hull_outline(x[k], y[k], psi[k]), closed=True,
-                                     color="tab:gray", alpha=0.7, zorder=3))
-        ax.plot([], [], "s", color="tab:gray", alpha=0.7,
+                                     facecolor="0.55", edgecolor="k", linewidth=0.6,
+                                     zorder=3))
+        ax.plot([], [], "s", color="0.55", markeredgecolor="k",
                 label=f"ship to scale, every {every:g} s")
     sea = p.get("ship", {})
     if sea.get("Hs", 0.0) > 0.0:
         direction = sea["psi_w"]
-        ax.annotate("", xy=(0.9 + 0.07 * math.sin(direction), 0.88 + 0.07 * math.cos(direction)),
-                    xytext=(0.9 - 0.07 * math.sin(direction), 0.88 - 0.07 * math.cos(direction)),
-                    xycoords="axes fraction", arrowprops=dict(arrowstyle="->", color="tab:cyan",
-                                                              linewidth=2))
-        ax.text(0.9, 0.77, "waves", transform=ax.transAxes, ha="center", fontsize=8,
+        tail = (0.9 - 0.07 * math.sin(direction), 0.86 - 0.07 * math.cos(direction))
+        ax.annotate("", xy=(0.9 + 0.07 * math.sin(direction), 0.86 + 0.07 * math.cos(direction)),
+                    xytext=tail, xycoords="axes fraction",
+                    arrowprops=dict(arrowstyle="->", color="tab:cyan", linewidth=2))
+        ax.text(*tail, "waves ", transform=ax.transAxes, ha="right", va="center", fontsize=8,
                 color="tab:cyan")
     ax.set(xlabel="east y (m)", ylabel="north x (m)")
     ax.set_aspect("equal", adjustable="datalim")
-    ax.legend(loc="best", fontsize=7)
+    legend_if_any(ax)
+
+
+def legend_if_any(ax: Any, **kwargs: Any) -> None:
+    """A legend, if anything in the axes has a label to show."""
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(**{"loc": "best", "fontsize": 7, "framealpha": 0.9, **kwargs})
 
 
 def _layout(panels: int) -> tuple[Figure, Any, list[Any]]:
@@ -125,7 +132,7 @@ def _rudder(ax: Any, run: Recording, commanded: str) -> None:
                 fontsize=7, color="tab:orange", zorder=5,
                 bbox=dict(boxstyle="round", facecolor="white", alpha=0.9, edgecolor="none"))
     ax.set_ylabel("rudder (deg)")
-    ax.legend(loc="upper right", fontsize=7)
+    legend_if_any(ax, loc="upper right")
 
 
 def course_keeping_figure(run: Recording) -> Figure:
@@ -141,7 +148,7 @@ def course_keeping_figure(run: Recording) -> Figure:
         heading.plot(t, np.degrees(run["autopilot.psi_z"]), ":", color="tab:blue",
                      label="psi_z")
     heading.set_ylabel("heading (deg)")
-    heading.legend(loc="best", fontsize=7)
+    legend_if_any(heading)
     error.plot(t, np.degrees(heading_error(run["guidance.psi_d"], run["ship.psi"])), color="k")
     error.set_ylabel("psi_d - psi (deg)")
     _degrees(r, run, "ship.r", "yaw rate r (deg/s)")
@@ -158,17 +165,21 @@ def turning_circle_figure(run: Recording) -> Figure:
     x90, y90 = crossing(x, y, psi, math.pi / 2)
     x180, y180 = crossing(x, y, psi, math.pi)
     x0, y0 = x[0], y[0]
-    track.plot([y0, y0], [x0, x90], color="tab:green", linewidth=2)
-    track.plot([y0, y90], [x90, x90], color="tab:purple", linewidth=2)
-    track.plot([y0, y180], [x180, x180], color="tab:brown", linewidth=2)
-    box = dict(boxstyle="round", facecolor="white", alpha=0.8, edgecolor="none")
-    track.annotate(f"advance {tc.advance:.2f} m", (y0, (x0 + x90) / 2), fontsize=8,
-                   color="tab:green", xytext=(8, 0), textcoords="offset points", bbox=box)
-    track.annotate(f"transfer {tc.transfer:.2f} m\n(at 90 deg)", (y90, x90), fontsize=8,
-                   color="tab:purple", xytext=(8, 8), textcoords="offset points", bbox=box)
-    track.annotate(f"tactical diameter {tc.tactical_diameter:.2f} m (at 180 deg)",
-                   ((y0 + y180) / 2, x180), fontsize=8, color="tab:brown", ha="center",
-                   xytext=(0, 8), textcoords="offset points", bbox=box)
+    u_end, v_end, r_end = (run[f"ship.{n}"][-1] for n in ("u", "v", "r"))
+    track.plot([y0, y0], [x0, x90], color="tab:green", linewidth=2.5,
+               label=f"advance {tc.advance:.2f} m (at 90 deg)")
+    track.plot([y0, y90], [x90, x90], color="tab:purple", linewidth=2.5,
+               label=f"transfer {tc.transfer:.2f} m (at 90 deg)")
+    track.plot([y0, y180], [x180, x180], color="tab:brown", linewidth=2.5,
+               label=f"tactical diameter {tc.tactical_diameter:.2f} m (at 180 deg)")
+    # IMO measures these at heading changes; with a large drift angle the heading leads the
+    # velocity, so the steady circle is wider than the tactical diameter: say so.
+    track.text(0.02, 0.02, f"steady turn: drift angle "
+               f"{math.degrees(math.atan2(v_end, u_end)):.0f} deg, diameter 2U/|r| = "
+               f"{2 * math.hypot(u_end, v_end) / abs(r_end):.2f} m",
+               transform=track.transAxes, fontsize=8,
+               bbox=dict(boxstyle="round", facecolor="white", alpha=0.9, edgecolor="none"))
+    legend_if_any(track)
     _degrees(heading, run, "ship.psi", "heading (deg)")
     _degrees(r, run, "ship.r", "yaw rate r (deg/s)")
     r.axhline(math.degrees(tc.steady_yaw_rate), linestyle=":", color="tab:gray")
@@ -190,23 +201,23 @@ def zigzag_figure(run: Recording) -> Figure:
     executed = [0, *(np.flatnonzero(np.diff(reversals)) + 1)]
     heading.plot(t[executed], psi[executed], "v", color="tab:red",
                  label="rudder executed, reversed")
+    words = []
     for n, overshoot in ((1, zz.first_overshoot), (2, zz.second_overshoot)):
         if math.isnan(overshoot):
-            heading.text(0.02, 0.05, f"no reversal {n + 1}: the turn was never checked",
-                         transform=heading.transAxes, fontsize=9, color="tab:red")
+            words.append(f"no reversal {n + 1}: the turn was never checked")
             break
         k = np.flatnonzero(reversals == n)[np.argmax(np.abs(psi[reversals == n]))]
         level = math.copysign(math.degrees(switch), psi[k])
         heading.annotate("", xy=(t[k], psi[k]), xytext=(t[k], level),
                          arrowprops=dict(arrowstyle="<->", color="tab:red"))
-        heading.annotate(f"overshoot {n}: {math.degrees(overshoot):.1f} deg",
-                         (t[k], (psi[k] + level) / 2), xytext=(6, 0),
-                         textcoords="offset points", va="center", fontsize=8,
-                         color="tab:red",
-                         bbox=dict(boxstyle="round", facecolor="white", alpha=0.8,
-                                   edgecolor="none"))
+        heading.text(t[k], psi[k], f" {n}", color="tab:red", fontsize=8,
+                     va="top" if psi[k] < 0 else "bottom")
+        words.append(f"overshoot {n}: {math.degrees(overshoot):.1f} deg")
+    heading.text(0.99, 0.03, "\n".join(words), transform=heading.transAxes, ha="right",
+                 fontsize=8, color="tab:red",
+                 bbox=dict(boxstyle="round", facecolor="white", alpha=0.9, edgecolor="none"))
     heading.set_ylabel("heading (deg)")
-    heading.legend(loc="best", fontsize=7)
+    legend_if_any(heading)
     _degrees(r, run, "ship.r", "yaw rate r (deg/s)")
     _rudder(rudder, run, "ship.delta_c")
     return fig
@@ -266,9 +277,9 @@ def comparison_figure(runs: dict[str, Recording], path: Path, title: str) -> Pat
         heading.plot(run.t, np.degrees(run["ship.psi"]), color=line.get_color(), label=label)
         rudder.plot(run.t, np.degrees(run["ship.delta"]), color=line.get_color(),
                     linewidth=0.7)
-    track.legend(loc="best", fontsize=7)
+    legend_if_any(track)
     heading.set(ylabel="heading psi (deg)")
-    heading.legend(loc="best", fontsize=7)
+    legend_if_any(heading)
     rudder.set(ylabel="rudder delta (deg)")
     fig.suptitle(title, fontsize=10)
     return save(fig, path)[0]

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from ship_fmu.manoeuvres import turning_circle_figures, zigzag_figures
 
 from ..core.recording import Recording
@@ -19,7 +21,12 @@ PAPER_TABLES = {   # Tomera (2010), Tables 1 and 2: psi_E, delta_E, J
 def course_keeping_report(recording: Recording, lam: float = LAMBDA, **_) -> list[str]:
     c = cost(recording, lam)
     t, delta = recording.t, recording["ship.delta"]
-    return [f"psi_E = {c.psi_E:.2f} rad^2   sum delta^2 = {c.sum_delta2:.3f} rad^2   "
+    stops = recording.meta.get("parameters", {}).get("ship", {}).get("delta_max", math.inf)
+    pinned = np.abs(delta) >= stops * (1 - 1e-9)
+    warning = ([f"warning: the rudder was at its stops for {100 * pinned.mean():.0f} % of the "
+                f"run (from t = {t[pinned][0]:.0f} s): the autopilot could not hold the course"]
+               if pinned.mean() > 0.1 else [])
+    return warning + [f"psi_E = {c.psi_E:.2f} rad^2   sum delta^2 = {c.sum_delta2:.3f} rad^2   "
             f"lambda = {c.lam:.4f}   delta_E = {c.delta_E:.2f}   J = {c.J:.2f}",
             "(eq 19: J = psi_E + delta_E; psi_E sums the squared heading errors, delta_E = "
             "lambda sum delta^2, lambda making them equal on calm_pd; over the 0.1 s samples)",

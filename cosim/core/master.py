@@ -46,7 +46,7 @@ class Master:
                                    ("backend", backend, BACKENDS)):
             if value not in known:
                 raise ValueError(f"{what} must be one of {', '.join(known)}, got {value!r}")
-        self.system, self.coupling = system, coupling
+        self.system, self.coupling, self.backend = system, coupling, backend
         self.configure(overrides)
         self.instances: dict[str, Instance] = {}
         try:
@@ -75,11 +75,17 @@ class Master:
             instance.reset()
 
     def initialize(self) -> None:
-        """Enter initialisation, set parameters, propagate initial outputs, exit."""
+        """Enter initialisation, set parameters, propagate initial outputs, exit.
+
+        ``parameter_values`` then holds every parameter as the FMUs hold it (defaults and
+        what was set), read before the FMUs judge them.
+        """
         t0 = self.system.start_time
         for name, instance in self.instances.items():
             instance.enter_initialization(t0)
             instance.set(self.parameters[name], time=t0)
+        self.parameter_values = {name: instance.parameter_values()
+                                 for name, instance in self.instances.items()}
         values = [0.0] * len(self.columns)
         for _ in self.instances:          # enough passes for any acyclic chain
             for node in self.nodes:
@@ -104,21 +110,22 @@ class Master:
         t0, h = system.start_time, seconds(nanoseconds(system.step_size))
         n_steps = step_count(t0, system.stop_time if stop_time is None else stop_time, h)
         meta = {"system": system.name, "description": system.description,
-                "coupling": self.coupling, "start_time": t0, "step_size": h,
-                "stop_time": communication_point(t0, n_steps, h), "overrides": self.overrides,
+                "scenario_file": str(system.path) if system.path else None,
+                "backend": self.backend, "coupling": self.coupling, "start_time": t0,
+                "step_size": h, "stop_time": communication_point(t0, n_steps, h),
+                "settings": self.parameters, "overrides": self.overrides,
                 "fmus": {name: {"file": str(i.path), "guid": getattr(i, "guid", None)}
                          for name, i in self.instances.items()}}
         recorder = Recorder(self.columns, n_steps + 1, csv_path, chunk_rows, meta=meta,
                             units=self.units)
         exchange, nodes, values = COUPLINGS[self.coupling], self.nodes, [0.0] * len(self.columns)
         k, t, error, started = 0, t0, None, time.perf_counter()
+        meta["parameter_units"] = {
+            name: {n: i.unit(n) for n, v in i.variables.items() if v.causality == "parameter"}
+            for name, i in self.instances.items()}
+        self.parameter_values = {}
         try:
             self.initialize()
-            meta["parameters"] = {name: instance.parameter_values()
-                                  for name, instance in self.instances.items()}
-            meta["parameter_units"] = {
-                name: {p: instance.unit(p) for p in meta["parameters"][name]}
-                for name, instance in self.instances.items()}
             for k in range(n_steps + 1):
                 t = communication_point(t0, k, h)
                 exchange(nodes, values, t, h, k < n_steps)
@@ -129,6 +136,8 @@ class Master:
             error = (f"{failure}\n  (run stopped at step {k}, t = {t:.6g} s; "
                      f"{recorder.rows} rows recorded)")
         finally:
+            if self.parameter_values:
+                meta["parameters"] = self.parameter_values
             meta["wall_time_s"] = time.perf_counter() - started
             recording = recorder.close(error)
         return recording

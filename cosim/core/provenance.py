@@ -1,15 +1,19 @@
 """What it takes to reproduce a run, written as JSON next to its CSV.
 
 The unit of every column, every parameter value the FMUs held (defaults and what
-was set) with its unit, the settings given on top of the scenario, each FMU's
-file, GUID and SHA-256, the coupling, step and times, the wall time, and the
-versions of this package, Python, fmpy and pythonfmu.
+was set) with its unit, the values the scenario sets (inputs such as propeller
+speeds included) and those given on top of it, the scenario file and its SHA-256,
+each FMU's file, GUID and SHA-256, the backend, coupling, step and times, the wall
+time, the command, and the versions of this package (with its git commit), Python,
+numpy, fmpy and pythonfmu. Strict JSON: a non-finite number is written as a string.
 """
 from __future__ import annotations
 
 import hashlib
 import json
+import math
 import platform
+import subprocess
 import sys
 from datetime import datetime, timezone
 from importlib import metadata
@@ -35,27 +39,58 @@ def _sha256(path: str) -> str | None:
         return None
 
 
+def _commit() -> str | None:
+    """The git commit of this checkout, with '+changes' if it has uncommitted ones."""
+    root = Path(__file__).resolve().parents[2]
+    try:
+        head = subprocess.run(["git", "-C", str(root), "rev-parse", "HEAD"], capture_output=True,
+                              text=True, timeout=10)
+        dirty = subprocess.run(["git", "-C", str(root), "status", "--porcelain",
+                                "--untracked-files=no"], capture_output=True, text=True,
+                               timeout=10)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    if head.returncode != 0:
+        return None
+    return head.stdout.strip() + ("+changes" if dirty.stdout.strip() else "")
+
+
+def _strict(value: Any) -> Any:
+    """JSON without NaN or Infinity tokens: a non-finite number becomes its name, a string."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return repr(value)
+    if isinstance(value, dict):
+        return {k: _strict(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_strict(v) for v in value]
+    return value
+
+
 def run_metadata(recording: Recording, command: list[str] | None = None) -> dict[str, Any]:
-    """The metadata of a run, as plain JSON-able values."""
+    """The metadata of a run, as plain JSON values (non-finite numbers as strings)."""
     meta = dict(recording.meta)
     meta["fmus"] = {name: {**fmu, "sha256": _sha256(fmu["file"])}
                     for name, fmu in meta.get("fmus", {}).items()}
-    return {
+    if meta.get("scenario_file"):
+        meta["scenario_sha256"] = _sha256(meta["scenario_file"])
+    return _strict({
         **meta,
         "rows": recording.rows,
         "error": recording.error,
-        "columns": {column: recording.units.get(column, "") for column in recording.columns},
-        "command": command if command is not None else sys.argv,
+        "columns": {"time": "s", **{column: recording.units.get(column, "")
+                                    for column in recording.columns}},
+        "command": command if command is not None else getattr(sys, "orig_argv", sys.argv),
         "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
-        "versions": {PACKAGE: _version(PACKAGE), "python": platform.python_version(),
+        "versions": {PACKAGE: _version(PACKAGE), "commit": _commit(),
+                     "python": platform.python_version(), "numpy": _version("numpy"),
                      "fmpy": _version("fmpy"), "pythonfmu": _version("pythonfmu")},
-    }
+    })
 
 
 def write_metadata(recording: Recording, path: str | Path,
                    command: list[str] | None = None) -> Path:
-    """Write ``run_metadata`` to ``path`` (JSON); returns the path."""
+    """Write ``run_metadata`` to ``path`` as strict JSON; returns the path."""
     path = Path(path)
-    path.write_text(json.dumps(run_metadata(recording, command), indent=1, allow_nan=True)
+    path.write_text(json.dumps(run_metadata(recording, command), indent=1, allow_nan=False)
                     + "\n")
     return path

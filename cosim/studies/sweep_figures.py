@@ -11,6 +11,8 @@ import numpy as np  # noqa: E402
 
 from autopilot_fmu.guidance import parse_waypoints  # noqa: E402
 
+from ..analysis.seastate import model_scale  # noqa: E402
+
 SEA_AXES = ("sea_state", "Hs")
 
 
@@ -105,6 +107,9 @@ def tracks(spec, rows: list[dict], path: Path) -> Path | None:
     ax.grid(alpha=0.3)
     ax.legend(loc="best", fontsize=8)
     where = ", ".join(f"{k} {v}" for k, v in spec.tracks.items()) or "every run"
+    if "sea_state" in spec.tracks:
+        Hs, T0 = model_scale(spec.tracks["sea_state"])
+        where += f" (Hs {Hs * 1000:.3g} mm, T0 {T0:.2g} s)"
     ax.set_title(f"{spec.name}: tracks ({where})", fontsize=10)
     fig.savefig(path, dpi=120)
     plt.close(fig)
