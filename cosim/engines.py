@@ -2,8 +2,9 @@
 
     python -m cosim.engines libcosim results/ssp/calm_pd.ssp --out trace.npz
 
-Runs in this process and saves the recorded signals; ``cosim.interop.engines.run``
-calls this command in a child process and checks what it recorded.
+Runs the engine in a child process (an engine that aborts does not take this
+command with it), checks what it recorded, and saves the signals; a failure is
+exit status 1 with the engine's and the FMU's messages.
 """
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ._cli import entry
-from .interop.engines import ENGINES, RUNNERS, SIGNALS
+from .interop.engines import ENGINES, SIGNALS, EngineError, run
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -28,9 +29,9 @@ def main(argv: list[str] | None = None) -> int:
                         help="component.variable names to record (Real)")
     args = parser.parse_args(argv)
     try:
-        result = RUNNERS[args.engine](args.ssp.resolve(), tuple(args.signals))
-    except Exception as error:          # the engine's own exceptions, with their message
-        print(f"error: {type(error).__name__}: {error}", file=sys.stderr)
+        result = run(args.engine, args.ssp, tuple(args.signals))
+    except EngineError as error:        # the engine's failure, with the FMU's message
+        print(f"error: {error}", file=sys.stderr)
         return 1
     np.savez(args.out, **result)
     print(f"wrote {args.out}: {', '.join(args.signals)} at {len(result['time'])} times")

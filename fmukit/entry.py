@@ -3,28 +3,30 @@
 pythonfmu 0.7 turns every Python exception into fmi2Fatal. Its C++ layer also
 releases the instance, its class and its log queue once per exception and again
 at fmi2FreeInstance, a use-after-free that crashes the host later. ``fmi_entry``
-takes one extra reference on those three objects before an exception leaves
-Python, so the host survives; and it echoes the error to standard error when
-FMUKIT_LOG_STDERR is set, for hosts that drop FMU log messages (ecos 0.7
-installs a no-op logger).
+takes one extra reference on those three objects before any exception leaves
+Python (a KeyboardInterrupt or SystemExit raised in FMU code included: those used
+to end in a segmentation fault), so the host survives; and it tells the user
+why, through the host's logger or on standard error (``fmukit.hostlog``).
 """
 from __future__ import annotations
 
 import ctypes
 import functools
-import os
-import sys
-from typing import Any, Callable
+from typing import Callable
 
 from pythonfmu import __version__ as PYTHONFMU_VERSION
 
 _RELEASES_ON_EXCEPTION = PYTHONFMU_VERSION == "0.7.0"
 
 
-def echo(slave: Any, message: str) -> None:
-    """Also write an error to standard error if FMUKIT_LOG_STDERR is set."""
-    if os.environ.get("FMUKIT_LOG_STDERR"):
-        print(f"[{slave.instance_name}] {message}", file=sys.stderr, flush=True)
+class Refused(ValueError):
+    """A call the FMU refuses; pythonfmu reports it as fmi2Fatal, with this message."""
+
+
+def explain(error: BaseException) -> str:
+    """What went wrong, for the user: a refusal's own message, or the exception's type and
+    message."""
+    return str(error) if isinstance(error, Refused) else f"{type(error).__name__}: {error}"
 
 
 def fmi_entry(method: Callable) -> Callable:
@@ -33,8 +35,9 @@ def fmi_entry(method: Callable) -> Callable:
     def entry(self, *args):
         try:
             return method(self, *args)
-        except Exception as error:
-            echo(self, f"{method.__name__}: {error!r}")
+        except BaseException as error:
+            self.host_log.tell(self.instance_name, explain(error) if isinstance(error, Refused)
+                               else f"{method.__name__}: {explain(error)}")
             if _RELEASES_ON_EXCEPTION:
                 for obj in (self, type(self), self.log_queue):
                     ctypes.pythonapi.Py_IncRef(ctypes.py_object(obj))

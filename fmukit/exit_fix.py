@@ -22,14 +22,29 @@ from __future__ import annotations
 
 import hashlib
 import zipfile
+from dataclasses import dataclass
 from pathlib import Path
 
-# SHA-256 of the binary: (file offset of onLibraryUnload, its code, the patched code).
-# endbr64; jmp finalizePythonInterpreter  ->  endbr64; ret
+@dataclass(frozen=True)
+class Binary:
+    """A pythonfmu binary fmukit knows inside out."""
+
+    offset: int                 # file offset of onLibraryUnload
+    code: bytes                 # its first instructions
+    patched: bytes              # what they become
+    fixed_sha256: str           # the binary once patched
+    debug_flag_offset: int      # of PyLogger::debugLogging_, from the logger's address
+
+
+# endbr64; jmp finalizePythonInterpreter  ->  endbr64; ret. PyLogger::log tests
+# ``cmpb $0x0, 0x8(%rdi)``: the debug-logging flag sits 8 bytes into the logger.
 KNOWN_BINARIES = {
-    "4be156a552c16f30eb4395805c59855d8d4086056d0f165442565f6c5fbac0c9":   # 0.7.0 linux64
-        (0x16F30, bytes.fromhex("f30f1efae937dcffff"), bytes.fromhex("f30f1efac337dcffff")),
+    "4be156a552c16f30eb4395805c59855d8d4086056d0f165442565f6c5fbac0c9": Binary(  # 0.7.0
+        0x16F30, bytes.fromhex("f30f1efae937dcffff"), bytes.fromhex("f30f1efac337dcffff"),
+        "7b771dc338b6e8ecc6a7c658f8a409e30e14e4031b61d1cfc682f3b61451ed3e", 8),
 }
+FIXED = {b.fixed_sha256: b for b in KNOWN_BINARIES.values()}
+"""The binaries as fmukit builds them, by their SHA-256."""
 
 
 def patch(binary: bytes, where: str) -> bytes:
@@ -40,10 +55,13 @@ def patch(binary: bytes, where: str) -> bytes:
         raise RuntimeError(f"{where} is not the pythonfmu 0.7.0 linux64 binary whose exit-time "
                            f"heap corruption fmukit.exit_fix knows how to fix (SHA-256 "
                            f"{digest}); check the new binary and extend KNOWN_BINARIES")
-    offset, code, patched = fix
+    offset, code = fix.offset, fix.code
     if binary[offset:offset + len(code)] != code:
         raise RuntimeError(f"{where}: unexpected code at onLibraryUnload")
-    return binary[:offset] + patched + binary[offset + len(code):]
+    fixed = binary[:offset] + fix.patched + binary[offset + len(code):]
+    if hashlib.sha256(fixed).hexdigest() != fix.fixed_sha256:
+        raise RuntimeError(f"{where}: the patched binary is not the one fmukit expects")
+    return fixed
 
 
 def fix_fmu(fmu_path: Path) -> None:

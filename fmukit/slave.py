@@ -16,39 +16,49 @@ attributes alone), ``step_model`` and, if the initial state depends on inputs,
 - ``fmukit.model_description``: a complete modelDescription.xml;
 - ``fmukit.entry``: every FMI entry point made safe against pythonfmu 0.7's error path.
 
-What a host sees, with pythonfmu 0.7 (which turns every Python exception into
-fmi2Fatal, and a False return of do_step into fmi2Discard):
+What a host sees. pythonfmu 0.7 can return fmi2OK, fmi2Fatal (any Python
+exception) and fmi2Discard with fmi2Terminated true (do_step returning False),
+which hosts such as fmpy take for the model's normal end: a refused step would
+pass for a short, successful run. So every refusal raises, and is fmi2Fatal, the
+only failure status there is to give (docs/robustness.md argues it):
 
-- invalid parameters: the range check or the model raises ValueError at
-  exitInitializationMode, reported as fmi2Fatal with the message naming the
-  parameter;
-- invalid inputs, step sizes, or doStep out of sequence: the step is refused with
-  fmi2Discard and an error log naming the cause; the state is left as it was,
-  so a master may correct the input and retry;
-- other calls out of sequence, setting an output, or a fixed parameter after
-  initialisation: fmi2Fatal with a message naming the call or variable; nothing
-  is applied;
+- invalid parameters: fmi2ExitInitializationMode reports them (an error
+  message naming the parameter) and the FMU has failed; the first fmi2DoStep
+  then fails with that message. Not fmi2ExitInitializationMode itself: OSP
+  libcosim terminates its host process when that call fails;
+- invalid inputs or step sizes, or an exception in the model: fmi2DoStep fails
+  naming the cause, and the FMU has failed;
+- once failed, every output reads NaN and every step is refused with the first
+  reason, until fmi2Reset, so that a host that ignores statuses (ecos) still
+  cannot pass the rest of the run off as results;
+- calls out of sequence (fmi2DoStep included), setting an output or a fixed
+  parameter after initialisation: fmi2Fatal naming the call or variable; nothing
+  is applied, and the FMU goes on as before;
 - reading an output never fails: what cannot be evaluated reads NaN.
+
+The reason reaches the user through the host's logger when it listens, and on
+standard error when it does not (``fmukit.hostlog``).
 
 Time is rounded to whole nanoseconds before the model sees it (``fmukit.timebase``).
 """
 from __future__ import annotations
 
-from typing import Any, Callable, ClassVar
+from typing import Any, Callable, ClassVar, NoReturn
 from xml.etree.ElementTree import Element
 
 from pythonfmu import DefaultExperiment, Fmi2Slave
 from pythonfmu.enums import Fmi2Status
 
 from . import model_description, state
-from .entry import echo, fmi_entry
+from .entry import Refused, fmi_entry
 from .fastpath import FastPaths
+from .hostlog import HostLog
 from .registry import Registry
 from .sequence import CallSequence
 from .timebase import MAX_TIME, nanoseconds, seconds
 from .variables import Var
 
-__all__ = ["ModelSlave", "Var"]
+__all__ = ["ModelSlave", "Refused", "Var"]
 
 
 class ModelSlave(Fmi2Slave):
@@ -62,6 +72,9 @@ class ModelSlave(Fmi2Slave):
         super().__init__(**kwargs)
         self.modelName = self.model_name
         self.sequence = CallSequence()
+        self.host_log = HostLog(kwargs.get("logger"), kwargs.get("resources"),
+                                in_process="logger" not in kwargs)
+        self.failure: str | None = None       # why the FMU failed; until fmi2Reset
         self._model = None
         self.registry = Registry(self, self.variables, self._output)
         self._fast = FastPaths(self, self.registry)
@@ -90,7 +103,8 @@ class ModelSlave(Fmi2Slave):
         return model
 
     def _output(self, get: Callable[[Any], Any], undefined: Any) -> Any:
-        """An output's value, or NaN (0 if Integer) when it cannot be evaluated.
+        """An output's value, or NaN (0 if Integer) when it cannot be evaluated or the FMU
+        has failed.
 
         A read never fails: a failed getReal aborts some hosts (libcosim throws
         from a worker thread). Masters read outputs during initialisation, when
@@ -99,6 +113,8 @@ class ModelSlave(Fmi2Slave):
         that commits (exitInitializationMode, doStep) refuses with a message. A
         master that ignores those statuses still sees NaN outputs.
         """
+        if self.failure:
+            return undefined
         try:
             if self._model is None:
                 self._model = self._started_model()
@@ -127,39 +143,49 @@ class ModelSlave(Fmi2Slave):
     @fmi_entry
     def exit_initialization_mode(self) -> None:
         self.sequence.require("fmi2ExitInitializationMode", "initialization")
-        for var in self._parameters:          # the declared ranges, then the model's own rules
-            var.check(getattr(self, var.name))
-        self._model = self._started_model()   # ValueError names a bad parameter or input
         self.sequence.phase = "step"
+        try:
+            for var in self._parameters:      # the declared ranges, then the model's own rules
+                var.check(getattr(self, var.name))
+            self._model = self._started_model()   # ValueError names a bad parameter or input
+        except Exception as error:            # reported now, refused at the first step
+            self.failure = f"exitInitializationMode: {error}; the FMU has failed"
+            self.log(self.failure, Fmi2Status.error)
+            self.host_log.tell(self.instance_name, self.failure)
 
     @fmi_entry
     def terminate(self) -> None:
-        self.sequence.require("fmi2Terminate", "step")
+        if not self.failure:                  # a failed FMU may be terminated in any phase
+            self.sequence.require("fmi2Terminate", "step")
         self.sequence.phase = "terminated"
 
     @fmi_entry
     def do_step(self, current_time: float, step_size: float) -> bool:
+        if self.failure:
+            raise Refused(self.failure)
         refusal = self.sequence.step_refusal()
-        if refusal:
-            return self._refuse(refusal)
+        if refusal:                           # like any call out of sequence: nothing done
+            raise Refused(refusal)
         if not (1e-9 <= step_size <= MAX_TIME and abs(current_time) <= MAX_TIME):
-            return self._refuse(f"doStep at t = {current_time} with communication step "
-                                f"{step_size}: the step must be at least 1 ns, and both within "
-                                f"+-{MAX_TIME:g} s")
+            self._fail(f"doStep at t = {current_time} with communication step {step_size}: the "
+                       f"step must be at least 1 ns, and both within +-{MAX_TIME:g} s")
         try:
             for var in self._inputs:
                 var.check(getattr(self, var.name))
             # The time base of fmukit.timebase: whole nanoseconds, whatever the master.
             self.step_model(seconds(nanoseconds(current_time)), seconds(nanoseconds(step_size)))
         except ValueError as error:
-            return self._refuse(f"doStep at t = {current_time}: {error}; step refused, "
-                                "state unchanged")
+            self._fail(f"doStep at t = {current_time}: {error}; the FMU has failed (its "
+                       "outputs read NaN until fmi2Reset)")
+        except BaseException as error:        # the model's own exception, or an interrupt
+            self.failure = f"doStep at t = {current_time}: {type(error).__name__}: {error}"
+            raise
         return True
 
-    def _refuse(self, message: str) -> bool:
-        self.log(message, Fmi2Status.error)
-        echo(self, message)
-        return False
+    def _fail(self, reason: str) -> NoReturn:
+        """Fail the FMU for ``reason``: refuse this call and every step until fmi2Reset."""
+        self.failure = reason
+        raise Refused(reason)
 
     # -- setters: refuse what the standard does not allow ----------------------
     def _set(self, vrs: list[int], values: list, convert: type) -> None:
@@ -198,7 +224,12 @@ class ModelSlave(Fmi2Slave):
     @fmi_entry
     def get_real(self, vrs: list[int]) -> list[float]:
         read = self._fast.real_reader(vrs)
-        return read() if read is not None else super().get_real(vrs)  # pythonfmu names it
+        if read is None:
+            return super().get_real(vrs)        # pythonfmu names the problem
+        if self.failure:                        # outputs read NaN: through their getters
+            getters = self.registry.real_getters
+            return [float(getters[vr]()) for vr in vrs]
+        return read()
 
     @fmi_entry
     def get_integer(self, vrs: list[int]) -> list[int]:

@@ -1,8 +1,8 @@
 """Saved FMU states: fmi2GetFMUstate, fmi2SetFMUstate and their serialised form.
 
 A state is a plain dict that pythonfmu serialises as JSON: the phase of the call
-sequence, the value of every parameter and input, and the model's own
-``snapshot()`` (None while there is no model). Restoring rebuilds the model from
+sequence, the value of every parameter and input, the model's own ``snapshot()``
+(None while there is no model), and why the FMU failed, if it has. Restoring rebuilds the model from
 the restored parameters and hands it the snapshot, so a restored run continues
 bit for bit.
 """
@@ -21,6 +21,7 @@ def capture(slave: Any) -> dict[str, Any]:
         "values": {v.name: getattr(slave, v.name) for v in slave.variables
                    if v.causality != "output"},
         "model": slave._model.snapshot() if slave._model is not None else None,
+        "failure": slave.failure,
     }
 
 
@@ -31,6 +32,7 @@ def restore(slave: Any, state: dict[str, Any]) -> None:
     for name, value in state["values"].items():
         setattr(slave, name, value)
     slave.sequence.phase = state["phase"]
+    slave.failure = state.get("failure")
     slave._model = None
     if state["model"] is not None:
         slave._model = slave.build_model()

@@ -8,11 +8,15 @@ enter/exitInitializationMode, terminate, reset, set (any variable, any value: in
 range, out of range, extreme, NaN, infinite, of the wrong type), doStep (any step
 size, including 0, negative, non-finite and huge, at any time), get, and a
 get/serialize/deserialize/set state round trip. A reference model of the FMI 2.0
-call sequence and of the declared variable ranges predicts which calls must be
-refused; the FMU must then return discard or fatal with a log message that names
-the cause, must accept every call that is valid, and must give finite outputs
-after every accepted step. Crashes and hangs are caught by the caller
-(tests/test_fuzz.py runs this in a child process with a time limit).
+call sequence, of the declared variable ranges and of fmukit's failed state
+(docs/robustness.md) predicts which calls must be refused; the FMU must then
+return fatal with a log message that names the cause, must accept every call that
+is valid, must give finite outputs after every accepted step and NaN outputs once
+it has failed. Invalid parameters are accepted at exitInitializationMode with an
+error logged, and fail the FMU; a refused step fails it; every step of a failed
+FMU is refused naming the first cause, until reset. Crashes and hangs are caught
+by the caller (tests/test_fuzz.py runs this in a child process with a time
+limit).
 """
 from __future__ import annotations
 
@@ -50,6 +54,7 @@ class Expectation:
 
     def reset(self) -> None:
         self.phase = "instantiated"
+        self.failure: list[str] | None = None      # words naming why the FMU failed
         self.values = {n: _start(v) for n, v in self.vars.items() if v.causality != "output"}
         self.defaults = True
 
@@ -129,7 +134,7 @@ def run_program(fmu: FmuInstance, expected: Expectation, program: list, counts: 
     for op in program:
         kind = op[0]
         counts["calls"] += 1
-        must, names = _predict(op, expected, fmu, clock)
+        must, names = _predict(op, expected, clock)
         try:
             _execute(op, fmu, clock)
             status, messages = "ok", []
@@ -141,15 +146,20 @@ def run_program(fmu: FmuInstance, expected: Expectation, program: list, counts: 
             assert must != "refuse", f"accepted an invalid call: {where}"
         else:
             assert must != "accept", f"refused a valid call: {where}: {messages}"
-            assert status in ("discard", "error", "fatal"), where
+            assert status == (FAILED_AT_EXIT if kind == "exit" and expected.phase ==
+                              "initialization" else "fatal"), f"{status}: {where}"
             text = " ".join(messages)
             assert messages and any(n in text for n in names), \
                 f"refusal does not name {names}: {where}: {messages}"
-        _advance(op, status, expected, fmu)
-        if kind == "step" and status == "ok":
+        _advance(op, status, expected, names)
+        outputs = [v.name for v in fmu.description.modelVariables
+                   if v.causality == "output" and v.type == "Real"]
+        if expected.failure and kind in ("step", "get"):
+            values = fmu.get(outputs)
+            assert all(math.isnan(x) for x in values.values()), \
+                f"outputs of a failed FMU after {where}: {values}"
+        elif kind == "step" and status == "ok":
             clock = _clock(op, clock) + op[1]
-            outputs = [v.name for v in fmu.description.modelVariables
-                       if v.causality == "output" and v.type == "Real"]
             values = fmu.get(outputs)
             bad = {n: x for n, x in values.items() if not math.isfinite(x)}
             assert not bad, f"non-finite outputs after an accepted {where}: {bad}"
@@ -160,7 +170,11 @@ def _clock(op, clock: float) -> float:
     return {"clock": clock, "zero": 0.0, "huge": 2 * MAX_TIME, "negative": -5.0}[op[2]]
 
 
-def _predict(op, e: Expectation, fmu: FmuInstance, clock: float) -> tuple[str, list[str]]:
+FAILED_AT_EXIT = "OK but logged an error"
+"""How the master reports invalid parameters: exitInitializationMode returns OK, logs."""
+
+
+def _predict(op, e: Expectation, clock: float) -> tuple[str, list[str]]:
     """('accept' | 'refuse' | 'either', words one of which a refusal must contain)."""
     kind = op[0]
     phase_words = ["not allowed in phase"]
@@ -170,11 +184,11 @@ def _predict(op, e: Expectation, fmu: FmuInstance, clock: float) -> tuple[str, l
         if e.phase != "initialization":
             return "refuse", phase_words
         params = [n for n, v in e.vars.items() if v.causality == "parameter"]
-        if any(not e.valid(n) for n in params):
+        if any(not e.valid(n) for n in params):  # reported, and the FMU has failed
             return "refuse", ["parameter"]
         return ("accept" if e.defaults else "either"), ["parameter"]
     if kind == "terminate":
-        return ("accept" if e.phase == "step" else "refuse"), phase_words
+        return ("accept" if e.phase == "step" or e.failure else "refuse"), phase_words
     if kind in ("reset", "get"):
         return "accept", []
     if kind == "state":
@@ -190,6 +204,8 @@ def _predict(op, e: Expectation, fmu: FmuInstance, clock: float) -> tuple[str, l
         return "accept", []
     if kind == "step":
         h, t = op[1], _clock(op, clock)
+        if e.failure:
+            return "refuse", e.failure
         if e.phase != "step":
             return "refuse", ["phase"]
         if not (1e-9 <= h <= MAX_TIME and abs(t) <= MAX_TIME):
@@ -220,7 +236,7 @@ def _execute(op, fmu: FmuInstance, clock: float) -> None:
     elif kind == "enter":
         fmu.call("enterInitializationMode", slave.enterInitializationMode)
     elif kind == "exit":
-        fmu.call("exitInitializationMode", slave.exitInitializationMode)
+        fmu.exit_initialization()
     elif kind == "terminate":
         fmu.call("terminate", slave.terminate)
     elif kind == "reset":
@@ -250,8 +266,12 @@ def _execute(op, fmu: FmuInstance, clock: float) -> None:
         fmu.call("freeFMUstate", slave.freeFMUstate, again)
 
 
-def _advance(op, status: str, e: Expectation, fmu: FmuInstance) -> None:
+def _advance(op, status: str, e: Expectation, names: list[str]) -> None:
     kind = op[0]
+    if status == FAILED_AT_EXIT:
+        e.phase, e.failure = "step", names
+    elif kind == "step" and status != "ok" and e.phase == "step" and not e.failure:
+        e.failure = names
     if status != "ok":
         return
     if kind == "enter":

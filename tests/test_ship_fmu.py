@@ -105,29 +105,42 @@ def test_saved_state_reproduces_the_run_bit_for_bit(ship, open_fmu):
 
 @pytest.mark.parametrize("name", ["delta_c", "n1", "n2", "n3"])
 @pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf])
-def test_non_finite_inputs_are_refused_by_name(ship, name, bad):
+def test_a_non_finite_input_fails_the_fmu_by_name_until_reset(ship, name, bad):
+    ship.initialize()
+    first = _run(ship, 0, 10)
+    ship.reset()
     ship.initialize()
     _run(ship, 0, 5)
-    before = ship.get(OUTPUTS)
     ship.set({name: bad})
     with pytest.raises(FmuCallError) as refused:
         ship.do_step(5 * DT, DT)
-    assert refused.value.status == "discard"
-    assert any(name in m and "not finite" in m for m in refused.value.messages)
-    assert ship.get(OUTPUTS) == before
+    assert refused.value.status == "fatal"
+    assert any(f"input {name} = {bad}" in m and "not finite" in m
+               for m in refused.value.messages), refused.value.messages
+    assert all(math.isnan(value) for value in ship.get(OUTPUTS).values())
     ship.set({name: 1.0 if name != "delta_c" else 0.0})
-    ship.do_step(5 * DT, DT)                   # recovers once the input is valid
+    with pytest.raises(FmuCallError) as again:  # failed: a valid input does not revive it
+        ship.do_step(5 * DT, DT)
+    assert any(f"input {name} = {bad}" in m for m in again.value.messages)
+    ship.reset()
+    ship.initialize()
+    assert _run(ship, 0, 10) == first
 
 
 @pytest.mark.parametrize("name, value", [
     ("Hs", -0.01), ("T0", 0.0), ("T0", -1.0), ("wave_components", 0),
     ("delta_max", 0.0), ("delta_rate_max", 0.0), ("delta_rate_max", -1.0), ("u0", math.nan),
 ])
-def test_invalid_parameters_are_refused_by_name(ship, name, value):
-    with pytest.raises(FmuCallError) as refused:
+def test_invalid_parameters_are_reported_by_name_and_fail_the_first_step(ship, name, value):
+    with pytest.raises(FmuCallError) as reported:
         ship.initialize({name: value})
-    assert refused.value.call == "exitInitializationMode"
-    assert refused.value.status in ("error", "fatal")
+    error = reported.value
+    assert (error.call, error.status) == ("exitInitializationMode", "OK but logged an error")
+    assert any(m.startswith("[error]") and f"parameter {name}" in m for m in error.messages)
+    assert all(math.isnan(v) for v in ship.get(OUTPUTS).values())
+    with pytest.raises(FmuCallError) as refused:
+        ship.do_step(0.0, DT)
+    assert refused.value.status == "fatal"
     assert any(f"parameter {name}" in m for m in refused.value.messages)
 
 
@@ -136,7 +149,7 @@ def test_bad_communication_steps_are_refused(ship, h):
     ship.initialize()
     with pytest.raises(FmuCallError) as refused:
         ship.do_step(0.0, h)
-    assert refused.value.status == "discard"
+    assert refused.value.status == "fatal"
     assert any("communication step" in m for m in refused.value.messages)
 
 
@@ -174,7 +187,7 @@ def test_setting_an_output_or_a_fixed_parameter_late_is_refused(ship):
 def test_step_before_initialisation_is_refused(ship):
     with pytest.raises(FmuCallError) as refused:
         ship.do_step(0.0, DT)
-    assert refused.value.status == "discard"
+    assert refused.value.status == "fatal"
     assert any("exitInitializationMode" in m for m in refused.value.messages)
 
 

@@ -6,7 +6,11 @@
    can export the FMI 2.0 C API drops into the co-simulation (docs/own_autopilot.md).
    Built by fmukit.cbuild against the FMI 2.0 headers fmpy ships in fmpy/c-code.
 
-   Value references: 0 psi, 1 r, 2 psi_d (inputs), 3 delta_c (output), 4 Kp, 5 Kd. */
+   Value references: 0 psi, 1 r, 2 psi_d (inputs), 3 delta_c (output), 4 Kp, 5 Kd.
+
+   As the project's Python FMUs do (docs/robustness.md): a step with an input that is
+   not finite fails the FMU, fmi2Error; from then on delta_c reads NaN and every step
+   fails with the same reason, until fmi2Reset. */
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -24,6 +28,7 @@ typedef struct {
     fmi2CallbackFunctions callbacks;
     char *name;
     fmi2Boolean logging;
+    char failure[128];                            /* why the FMU failed; "" if it has not */
 } Instance;
 
 static const fmi2Real START[N_VARIABLES] = {0.0, 0.0, 0.0, 0.0, 2.0, 50.0};
@@ -132,13 +137,19 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component component) {
 }
 
 fmi2Status fmi2Terminate(fmi2Component component) {
-    return advance(component, STEP, TERMINATED, "fmi2Terminate");
+    Instance *c = component;
+    if (c->failure[0]) {                          /* a failed FMU may end in any phase */
+        c->phase = TERMINATED;
+        return fmi2OK;
+    }
+    return advance(c, STEP, TERMINATED, "fmi2Terminate");
 }
 
 fmi2Status fmi2Reset(fmi2Component component) {
     Instance *c = component;
     memcpy(c->value, START, sizeof START);
     c->phase = INSTANTIATED;
+    c->failure[0] = '\0';
     return fmi2OK;
 }
 
@@ -149,7 +160,7 @@ fmi2Status fmi2GetReal(fmi2Component component, const fmi2ValueReference vr[], s
     for (i = 0; i < nvr; i++) {
         if (vr[i] >= N_VARIABLES)
             return REFUSE(c, fmi2Error, "no Real variable has value reference %u", vr[i]);
-        value[i] = vr[i] == DELTA_C ? rudder_command(c) : c->value[vr[i]];
+        value[i] = vr[i] != DELTA_C ? c->value[vr[i]] : c->failure[0] ? NAN : rudder_command(c);
     }
     return fmi2OK;
 }
@@ -175,13 +186,18 @@ fmi2Status fmi2DoStep(fmi2Component component, fmi2Real t, fmi2Real h,
     static const char *const input[] = {"psi", "r", "psi_d"};
     Instance *c = component;
     int i;
-    (void)t; (void)noSetFMUStatePriorToCurrentPoint;
+    (void)noSetFMUStatePriorToCurrentPoint;
+    if (c->failure[0]) return REFUSE(c, fmi2Error, "%s", c->failure);
     if (require(c, STEP, "fmi2DoStep") != fmi2OK) return fmi2Error;
     if (!(h > 0.0))
-        return REFUSE(c, fmi2Discard, "doStep with a communication step of %g s", h);
+        return REFUSE(c, fmi2Error, "doStep with a communication step of %g s", h);
     for (i = PSI; i <= PSI_D; i++)
-        if (!isfinite(c->value[i]))
-            return REFUSE(c, fmi2Discard, "input %s is not finite; step refused", input[i]);
+        if (!isfinite(c->value[i])) {
+            snprintf(c->failure, sizeof c->failure, "doStep at t = %g: input %s is not "
+                     "finite; the FMU has failed (delta_c reads NaN until fmi2Reset)", t,
+                     input[i]);
+            return REFUSE(c, fmi2Error, "%s", c->failure);
+        }
     return fmi2OK;                                /* memoryless: nothing to advance */
 }
 

@@ -1,6 +1,8 @@
 """The master's FMI backend: one FMU instance driven through fmpy, its log captured, clear errors."""
 from __future__ import annotations
 
+import ast
+import re
 import shutil
 import signal
 import subprocess
@@ -16,9 +18,10 @@ from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFr
                        fmi2True, fmi2ValueReference)
 from fmpy.model_description import ModelDescription
 
+from fmukit.entry import Refused
 from fmukit.packaging import BUILD_HINT
 
-from .instance import FmuCallError, Instance
+from .instance import FmuCallError, Instance, logged_error
 
 STATUS = ("ok", "warning", "discard", "error", "fatal", "pending")
 
@@ -56,6 +59,25 @@ def trial_instantiation(path: str | Path, timeout: float = 120.0) -> None:
                          + "".join(f"\n  {line}" for line in last))
 
 
+_PYTHONFMU_FATAL = re.compile(r"Fatal py exception encountered: \[[^]]*\] \w+\s*\n?"
+                             r"(\w+)\((.*)\)\s*$", re.S)
+
+
+def python_error(message: str) -> str:
+    """pythonfmu's 'Fatal py exception encountered: [doStep] PyObject_CallMethod
+    ValueError('why')' as 'ValueError: why' (a refusal as 'why'); other messages as they
+    are."""
+    match = _PYTHONFMU_FATAL.match(message.strip())
+    if match is None:
+        return message
+    try:
+        args = ast.literal_eval(f"({match.group(2)},)")
+    except (ValueError, SyntaxError):
+        return message
+    kind, text = match.group(1), args[0] if len(args) == 1 else args
+    return str(text) if kind == Refused.__name__ else f"{kind}: {text}"
+
+
 def feedthrough(description: ModelDescription) -> dict[str, frozenset[str]]:
     """Each output's inputs, from the model structure (all inputs where it declares none)."""
     inputs = frozenset(v.name for v in description.modelVariables if v.causality == "input")
@@ -79,7 +101,8 @@ class FmuInstance(Instance):
         self.unzip_dir = str(unzip_dir) if unzip_dir else extract(str(self.path))
         self.variables = {v.name: v for v in self.description.modelVariables}
         self.feedthrough = feedthrough(self.description)
-        self.log: deque[str] = deque(maxlen=50)
+        self.log: deque[str] = deque(maxlen=50)     # the last messages
+        self.logged = 0                              # how many there have been
         self._callbacks = fmi2CallbackFunctions()
         self._callbacks.logger = fmi2CallbackLoggerTYPE(self._on_log)
         self._callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
@@ -102,26 +125,30 @@ class FmuInstance(Instance):
         return self.description.guid
 
     def _on_log(self, env, instance, status, category, message) -> None:
+        self.logged += 1
         self.log.append(f"[{STATUS[status] if status < len(STATUS) else status}] "
-                        f"{message.decode('utf-8', 'replace')}")
+                        f"{python_error(message.decode('utf-8', 'replace'))}")
 
-    def call(self, what: str, function, *args, time: float | None = None, **kwargs) -> Any:
-        """Call an fmpy function; turn a failed status into FmuCallError."""
-        before = len(self.log)
+    def call(self, what: str, function, *args, time: float | None = None, strict: bool = False,
+             **kwargs) -> Any:
+        """Call an fmpy function; turn a failed status (or, ``strict``, an error logged) into
+        FmuCallError."""
+        before = self.logged
         try:
-            return function(*args, **kwargs)
+            result = function(*args, **kwargs)
         except FMICallException as error:
             status = str(error).rsplit("(", 1)[-1].rstrip(").")
             raise FmuCallError(self.name, what, time, status, self._since(before)) from error
+        if strict and logged_error(self._since(before)):
+            raise FmuCallError(self.name, what, time, "OK but logged an error",
+                               self._since(before))
+        return result
 
     def _since(self, before: int) -> list[str]:
-        """The log messages of the call that began with ``before`` messages logged.
-
-        The log keeps the last 50; once full, its length no longer moves, and the
-        last three messages stand in for the call's own.
-        """
-        log = list(self.log)
-        return log[before:] if len(log) > before else log[-3:]
+        """The log messages of the call that began when ``before`` had been logged (the
+        last 50 of them, as the log keeps no more)."""
+        new = self.logged - before
+        return list(self.log)[-new:] if new else []
 
     def fmi(self, name: str):
         return getattr(self.slave, name)
@@ -146,13 +173,13 @@ class FmuInstance(Instance):
         return self._getter("fmi2GetInteger", fmi2Integer, vrs)
 
     def _getter(self, function: str, ctype, vrs: list[int]):
-        get, component, log = self.slave._functions[function], self.slave.component, self.log
+        get, component = self.slave._functions[function], self.slave.component
         n = len(vrs)
         refs, values = (fmi2ValueReference * n)(*vrs), (ctype * n)()
         what = function.removeprefix("fmi2")
 
         def read() -> list:
-            before = len(log)
+            before = self.logged
             status = get(component, refs, n, values)
             if status:
                 self._status(what, status, before)
@@ -160,23 +187,23 @@ class FmuInstance(Instance):
         return read
 
     def writer(self, vrs: list[int]):
-        set_, component, log = self.slave._functions["fmi2SetReal"], self.slave.component, self.log
+        set_, component = self.slave._functions["fmi2SetReal"], self.slave.component
         n = len(vrs)
         refs, values = (fmi2ValueReference * n)(*vrs), (fmi2Real * n)()
 
         def write(new: list[float]) -> None:
             values[:] = new
-            before = len(log)
+            before = self.logged
             status = set_(component, refs, n, values)
             if status:
                 self._status("setReal", status, before)
         return write
 
     def stepper(self):
-        do_step, component, log = self.slave._functions["fmi2DoStep"], self.slave.component, self.log
+        do_step, component = self.slave._functions["fmi2DoStep"], self.slave.component
 
         def step(t: float, h: float) -> None:
-            before = len(log)
+            before = self.logged
             status = do_step(component, t, h, fmi2True)
             if status:
                 self._status("doStep", status, before, t)

@@ -15,10 +15,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from fmukit.entry import explain
 from fmukit.packaging import FMUS
 from fmukit.slave import ModelSlave
 
-from .instance import FmuCallError, Instance
+from .instance import FmuCallError, Instance, logged_error
 
 _FMI_TYPE = {float: "Real", int: "Integer", str: "String"}
 
@@ -58,16 +59,20 @@ class InProcessInstance(Instance):
         self.feedthrough = {v.name: frozenset(v.depends) & inputs
                             for v in self.slave.variables if v.causality == "output"}
 
-    def call(self, what: str, function, *args, time: float | None = None) -> Any:
-        """Call a slave method; an exception or a refused step becomes FmuCallError."""
+    def call(self, what: str, function, *args, time: float | None = None,
+             strict: bool = False) -> Any:
+        """Call a slave method; an exception, a refused step or (``strict``) an error logged
+        becomes FmuCallError."""
         try:
             result = function(*args)
         except Exception as error:
-            raise FmuCallError(self.name, what, time, "fatal", [*self._drain(), repr(error)]) \
-                from error
+            raise FmuCallError(self.name, what, time, "fatal",
+                               [*self._drain(), explain(error)]) from error
         if result is False:
             raise FmuCallError(self.name, what, time, "discard", self._drain())
-        self._drain()
+        messages = self._drain()
+        if strict and logged_error(messages):
+            raise FmuCallError(self.name, what, time, "OK but logged an error", messages)
         return result
 
     def _drain(self) -> list[str]:

@@ -25,6 +25,11 @@ class FmuCallError(RuntimeError):
         super().__init__(f"FMU '{instance}': {call}{at} returned {status}{log}")
 
 
+def logged_error(messages: Iterable[str]) -> bool:
+    """Whether a call's log messages include an error (``[error]`` or ``[fatal]``)."""
+    return any(m.startswith(("[error]", "[fatal]")) for m in messages)
+
+
 class Instance:
     """One instantiated component: its variables, its feedthrough, and FMI calls."""
 
@@ -33,7 +38,10 @@ class Instance:
     variables: dict[str, Any]          # name: object with valueReference, type, causality
     feedthrough: dict[str, frozenset[str]]   # output name: the inputs it depends on
 
-    def call(self, what: str, function: Callable, *args, time: float | None = None) -> Any:
+    def call(self, what: str, function: Callable, *args, time: float | None = None,
+             strict: bool = False) -> Any:
+        """Run ``function``; FmuCallError if it fails, or, ``strict``, if it returns OK but
+        logs an error."""
         raise NotImplementedError
 
     def fmi(self, name: str) -> Callable:
@@ -99,7 +107,10 @@ class Instance:
         self.exit_initialization(start_time)
 
     def exit_initialization(self, start_time: float = 0.0) -> None:
-        self.call("exitInitializationMode", self.fmi("exitInitializationMode"), time=start_time)
+        """exitInitializationMode; strict, as our FMUs report invalid parameters in their log
+        here and fail at the first step (``fmukit.slave``)."""
+        self.call("exitInitializationMode", self.fmi("exitInitializationMode"), time=start_time,
+                  strict=True)
 
     def do_step(self, t: float, h: float) -> None:
         self.call("doStep", self.fmi("doStep"), t, h, time=t)

@@ -14,21 +14,21 @@ time each value belongs to:
   run gets 3001 steps; added 4000 times it is 400.00000000002, so a 400 s run gets
   exactly 4000. Compare by time, as ``tests/test_engines.py`` does.
 
-By default each run happens in a child process, because neither engine reports an
-FMU's error to its Python caller: libcosimpy 0.0.6 aborts the process
-(std::terminate from a worker thread) when an FMU fails during initialisation,
-and ecos 0.7.2 ignores FMI status codes and discards FMU log messages. The
-child runs with FMUKIT_LOG_STDERR=1, so our FMUs also write their errors to
-standard error; a crash, or outputs that are undefined (NaN, what our FMUs give
-after refusing their parameters), becomes an ``EngineError`` that carries that
-output.
+By default each run happens in a child process, because neither engine can be
+trusted with its caller: libcosimpy 0.0.6 aborts the process (std::terminate
+from a worker thread) when an FMU call fails during initialisation, and ecos
+0.7.2 ignores FMI status codes and discards FMU log messages. Our FMUs write an
+error to standard error when the host does not listen (``fmukit.hostlog``) and
+read NaN once they have failed; a crash, a failed step, or outputs that read NaN
+becomes an ``EngineError`` that carries the child's output, with the FMU's
+message and the time. A package is checked first (``check_package``).
 
 The command line: ``python -m cosim.engines ENGINE PACKAGE.ssp --out trace.npz``.
 """
 from __future__ import annotations
 
 import math
-import os
+import signal
 import subprocess
 import sys
 import tempfile
@@ -37,7 +37,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fmukit.timebase import step_count
+from fmukit.timebase import communication_point, step_count
 
 from .ssp import read_package
 
@@ -76,7 +76,9 @@ def _libcosim(ssp: Path, signals: tuple[str, ...]) -> dict[str, np.ndarray]:
     rows = []
     for k in range(n_steps):
         if not execution.step():
-            raise EngineError(f"libcosim failed at step {k + 1}")
+            raise EngineError(f"libcosim failed in the step from t = "
+                              f"{communication_point(system.start_time, k, system.step_size):g}"
+                              " s (the FMU's message is above)")
         rows.append(sample())
     times = system.start_time + system.step_size * np.arange(1, n_steps + 1)
     return {"time": times, **dict(zip(signals, np.array(rows).T))}
@@ -96,8 +98,10 @@ def _ecos(ssp: Path, signals: tuple[str, ...]) -> dict[str, np.ndarray]:
         rows = [[simulation.get_real(i) for i in identifiers]]
         for k in range(n_steps):
             if not all(map(math.isfinite, rows[-1])):   # ecos ignores refused calls
-                raise EngineError(f"ecos reported success, but {signals} are undefined "
-                                  f"at step {k}: an FMU refused to run")
+                raise EngineError(
+                    f"ecos went on, but {', '.join(signals)} read NaN from t = "
+                    f"{communication_point(system.start_time, k, system.step_size):g} s: an FMU "
+                    "failed (its message is above)")
             simulation.step()
             rows.append([simulation.get_real(i) for i in identifiers])
     finally:
@@ -140,31 +144,66 @@ def _fmpy(ssp: Path, signals: tuple[str, ...]) -> dict[str, np.ndarray]:
 RUNNERS = {"libcosim": _libcosim, "ecos": _ecos, "fmpy": _fmpy}
 
 
+def check_package(ssp: Path) -> None:
+    """EngineError naming the file or the parameter if the package cannot be run as it is:
+    not an SSP package, or a parameter value that is not finite (which engines reject with
+    messages of their own, such as libcosim's 'Unable to create execution from path')."""
+    try:
+        system = read_package(ssp)
+    except (OSError, KeyError, ValueError, zipfile.BadZipFile) as error:
+        raise EngineError(f"{ssp} is not an SSP package this project can run ({error})") \
+            from None
+    for name, component in system.components.items():
+        for variable, value in component.parameters.items():
+            if isinstance(value, float) and not math.isfinite(value):
+                raise EngineError(f"{ssp.name}: parameter {name}.{variable} = {value} is not "
+                                  "finite")
+
+
 def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = SIGNALS,
         isolate: bool = True) -> dict[str, np.ndarray]:
-    """Run ``ssp`` in ``engine``; raise EngineError with the engine's output if it fails."""
+    """Run ``ssp`` in ``engine``; raise EngineError with the engine's output if it fails.
+
+    With ``isolate`` (the default) the engine runs in a child process, which may die
+    (libcosim aborts its host on some FMU failures) without taking this one with it.
+    """
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
     ssp = Path(ssp).resolve()
+    check_package(ssp)
     if not isolate:
         result = RUNNERS[engine](ssp, tuple(signals))
         _check_defined(engine, result, "")
         return result
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "trace.npz"
-        child = subprocess.run(
-            [sys.executable, "-m", "cosim.engines", engine, str(ssp), "--out", str(out),
-             "--signals", *signals],
-            capture_output=True, text=True, timeout=600,
-            env={**os.environ, "FMUKIT_LOG_STDERR": "1"})
+        child = subprocess.run([sys.executable, "-c", _CHILD, engine, str(ssp), str(out),
+                                *signals], capture_output=True, text=True, timeout=600)
         log = _summary(child.stdout + child.stderr)
         if child.returncode != 0 or not out.exists():
-            raise EngineError(f"{engine} failed on {ssp.name} (exit status "
-                              f"{child.returncode}):\n{log}")
+            how = (f"killed by {signal.Signals(-child.returncode).name}"
+                   if child.returncode < 0 else f"exit status {child.returncode}")
+            raise EngineError(f"{engine} failed on {ssp.name} ({how}):\n{log}")
         with np.load(out) as data:
             result = {key: data[key] for key in data.files}
     _check_defined(engine, result, log)
     return result
+
+
+_CHILD = ("import sys\nfrom cosim.interop.engines import record\n"
+          "sys.exit(record(sys.argv[1], sys.argv[2], sys.argv[3], tuple(sys.argv[4:])))\n")
+
+
+def record(engine: str, ssp: str, out: str, signals: tuple[str, ...]) -> int:
+    """Run an engine in this process and save what it recorded to ``out`` (.npz): the
+    child's side of ``run``. 1, and the reason on standard error, if the engine fails."""
+    try:
+        result = RUNNERS[engine](Path(ssp), signals)
+    except Exception as error:          # the engine's own exceptions, with their message
+        print(f"error: {type(error).__name__}: {error}", file=sys.stderr)
+        return 1
+    np.savez(out, **result)
+    return 0
 
 
 def _summary(log: str, head: int = 20, tail: int = 5) -> str:

@@ -1,41 +1,54 @@
-"""A rudder program that fails on purpose, to test how masters handle a failing FMU."""
+"""Fault injection for the fault matrix: a rudder program whose outputs or model go wrong.
+
+Until ``fault_time`` it commands a constant rudder and full ahead; from then on, by
+``fault`` (an Integer, which every engine can set): 1 'nan' (the rudder command is
+NaN), 2 'range' (the propeller command n1 is 100 rev/s, outside the ship's +-50),
+3 'raise' (its own step raises: an exception inside a model), 0 'none'.
+"""
 from fmukit.slave import ModelSlave, Var
+
+KINDS = ("none", "nan", "range", "raise")
 
 
 class Fault:
-    """Commands a constant rudder until fault_time, then fails every step."""
+    def __init__(self, fault_time: float, fault: int):
+        self.fault_time, self.fault_kind, self.t = fault_time, KINDS[fault], 0.0
 
-    def __init__(self, fault_time: float, fault_kind: str):
-        if fault_kind not in ("discard", "raise"):
-            raise ValueError(f"parameter fault_kind must be 'discard' or 'raise', "
-                             f"got {fault_kind!r}")
-        self.fault_time, self.fault_kind = fault_time, fault_kind
+    def faulty(self, kind: str) -> bool:
+        return self.fault_kind == kind and self.t >= self.fault_time
+
+    def delta_c(self) -> float:
+        return float("nan") if self.faulty("nan") else 0.1
+
+    def n1(self) -> float:
+        return 100.0 if self.faulty("range") else 8.13
 
     def step(self, t: float, h: float) -> None:
-        if t >= self.fault_time:
-            if self.fault_kind == "raise":          # an exception: fmi2Fatal
-                raise RuntimeError(f"injected fault at t = {t}")
-            raise ValueError(f"injected fault at t = {t}")     # refused step: fmi2Discard
+        if self.fault_kind == "raise" and t >= self.fault_time:
+            raise RuntimeError(f"injected fault at t = {t}")
+        self.t = t + h
 
     def snapshot(self) -> dict:
-        return {}
+        return {"t": self.t}
 
     def restore(self, snapshot: dict) -> None:
-        pass
+        self.t = float(snapshot["t"])
 
 
 class FaultSlave(ModelSlave):
     model_name = "fault"
-    description = "Test FMU: a constant rudder command that fails from fault_time on"
+    description = "Test FMU: a rudder program that goes wrong at fault_time, as fault_kind says"
     variables = (
         Var.input("psi", 0.0, "rad", "heading (unused)"),
-        Var.output("delta_c", "rad", "commanded rudder angle", get=lambda s: 0.1),
-        Var.parameter("fault_time", 50.0, "s", "time from which every step fails"),
-        Var.parameter("fault_kind", "discard", description="'discard' or 'raise'"),
+        Var.output("delta_c", "rad", "commanded rudder angle", get=lambda s: s.model.delta_c()),
+        Var.output("n1", "rev/s", "propeller command", get=lambda s: s.model.n1()),
+        Var.parameter("fault_time", 50.0, "s", "time of the fault"),
+        Var.parameter("fault", 3, description="0 none, 1 nan, 2 range, 3 raise",
+                      min=0, max=3),
     )
 
     def build_model(self) -> Fault:
-        return Fault(self.fault_time, self.fault_kind)
+        return Fault(self.fault_time, self.fault)
 
     def step_model(self, t: float, h: float) -> None:
         self.model.step(t, h)
