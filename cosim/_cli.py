@@ -14,6 +14,7 @@ from typing import Callable
 
 from . import scenarios
 from .api import parse_setting
+from .core.interrupt import Interrupted, raise_on_signals
 from .scenarios.autopilot import AutopilotError, check_autopilot
 
 
@@ -83,10 +84,16 @@ def checked_autopilot(parser: argparse.ArgumentParser, args: argparse.Namespace)
 
 
 def entry(main: Callable[[], int]) -> int:
-    """Run a command's main; when its output pipe closes (``| head``), end quietly as other
-    Unix tools do, instead of with a BrokenPipeError."""
+    """Run a command's main as Unix tools end: quietly when its output pipe closes
+    (``| head``); on Ctrl-C or SIGTERM with "interrupted" and status 130 or 143, not a
+    traceback. (A run in progress takes these signals itself: ``cosim.core.interrupt``.)"""
     signal.signal(signal.SIGPIPE, signal.SIG_DFL)
-    return main()
+    try:
+        with raise_on_signals():
+            return main()
+    except Interrupted as interrupted:
+        print(interrupted, file=sys.stderr)
+        return interrupted.exit_status
 
 
 def writable_folder(path: Path) -> Path:

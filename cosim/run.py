@@ -32,6 +32,7 @@ from .analysis.reports import tables
 from .api import overrides_of
 from .core.coupling import COUPLINGS
 from .core.instance import FmuCallError
+from .core.interrupt import StopSignals
 from .core.master import BACKENDS, Master
 from .core.provenance import write_metadata
 from .core.ssd import SystemDescription
@@ -58,33 +59,34 @@ class Options:
 def run_scenario(system: SystemDescription, label: str, out: Path, overrides: dict,
                  options: Options) -> tuple[int, Cost | None]:
     """Simulate one system; write its CSV, its metadata and its figure as ``label``; print
-    what it was and its report."""
+    what it was and its report. The status is 0, 1 if an FMU failed, or 130 / 143 if
+    Ctrl-C or SIGTERM stopped the run (its rows are written all the same)."""
     kind = analysis(system.report)
-    master = Master(system, coupling=options.coupling, overrides=overrides,
-                    backend=options.backend)
-    if options.animate:
+    with StopSignals() as stop:           # from here on, a signal stops between steps
+        master = Master(system, coupling=options.coupling, overrides=overrides,
+                        backend=options.backend)
+        progress = Progress(label)
+        csv_path = out / f"{label}.csv"
         try:
-            require_track(master.columns)
-        except ValueError:
+            if options.animate:
+                require_track(master.columns)
+            for old in out.glob(f"{label}.*"):     # a previous run's outputs would mislead
+                if old.suffix in (".csv", ".json", ".png", ".svg", ".pdf", ".gif", ".mp4"):
+                    old.unlink()
+            recording = master.run(options.stop_time, progress=progress,
+                                   csv_path=csv_path if options.stream else None, stop=stop)
+        finally:
+            progress.close()
             master.free()
-            raise
-    for old in out.glob(f"{label}.*"):         # a previous run's outputs would mislead
-        if old.suffix in (".csv", ".json", ".png", ".svg", ".pdf", ".gif", ".mp4"):
-            old.unlink()
-    progress = Progress(label)
-    csv_path = out / f"{label}.csv"
-    try:
-        recording = master.run(options.stop_time, progress=progress,
-                               csv_path=csv_path if options.stream else None)
-    finally:
-        progress.close()
-        master.free()
     if not options.stream:
         recording.write_csv(csv_path)
     written = [csv_path, write_metadata(recording, out / f"{label}.json")]
     print(f"{label}: {system.description}")
     for line in conditions(recording.meta):
         print(f"  {line}")
+    if recording.interrupted:
+        print(f"{recording.error}; written to {csv_path}", file=sys.stderr)
+        return stop.exit_status, None
     if recording.error:
         print(f"error: {recording.error}", file=sys.stderr)
         print(f"  the {recording.rows} rows recorded before the error are in {csv_path}",
@@ -196,6 +198,8 @@ def main(argv: list[str] | None = None) -> int:
                 out.rmdir()                     # nothing was run: leave nothing behind
             return 2
         status = max(status, code)
+        if code > 128:                          # interrupted: no further run
+            return code
         if result is not None and run.table_row is not None:
             costs[run.table_row] = result
     if args.all and costs:

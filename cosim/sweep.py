@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 
 from ._cli import entry, writable_folder
+from .core.interrupt import Interrupted
 from .studies import sweep
 from .studies.sweep_figures import save_figures
 
@@ -32,7 +33,16 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: {error}", file=sys.stderr)
         return 2
     out = writable_folder(args.out / spec.name)
-    rows = sweep.execute(spec, out, args.scheduler, args.workers, progress=not args.no_progress)
+    try:
+        rows = sweep.execute(spec, out, args.scheduler, args.workers,
+                             progress=not args.no_progress)
+    except Interrupted as interrupted:
+        rows = sweep.completed(spec, out)
+        written = sweep.write_tables(rows, out, args.csv) if rows else []
+        print(f"{interrupted}: {len(rows)} of {len(spec.runs())} runs done, kept in "
+              f"{out / 'runs.jsonl'}{''.join(f', {p}' for p in written)}; the same command "
+              "resumes the sweep", file=sys.stderr)
+        return interrupted.exit_status
     written = sweep.write_tables(rows, out, args.csv)
     written += save_figures(spec, rows, out)
     if "pd" in spec.controllers and len(spec.controllers) > 1:

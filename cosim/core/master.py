@@ -11,7 +11,8 @@ point (Gauss-Seidel or Jacobi); ``recording`` keeps the rows, in memory or
 streamed to CSV. Every FMU output and every connected input is recorded at every
 step (inputs as the master set them, or as read back from the FMU with
 ``verify_inputs``). If a call fails, the run stops with an error naming the FMU,
-the call and the time; the rows recorded up to then are kept.
+the call and the time; the rows recorded up to then are kept. So does a run asked
+to stop (``cosim.core.interrupt``: Ctrl-C, SIGTERM), between two steps.
 """
 from __future__ import annotations
 
@@ -25,6 +26,7 @@ from .coupling import COUPLINGS
 from .fmi import FmuInstance
 from .inprocess import InProcessInstance
 from .instance import FmuCallError, Instance
+from .interrupt import StopSignals
 from .null import NullInstance
 from .recording import Recorder, Recording
 from .ssd import SystemDescription
@@ -98,13 +100,16 @@ class Master:
 
     def run(self, stop_time: float | None = None,
             progress: Callable[[int, int], None] | None = None,
-            csv_path: str | Path | None = None, chunk_rows: int = 10_000) -> Recording:
+            csv_path: str | Path | None = None, chunk_rows: int = 10_000,
+            stop: StopSignals | None = None) -> Recording:
         """Simulate to stop_time (default: the system's); never raises on an FMU error.
 
-        ValueError if the stop time is not a whole number of steps after the start.
-        With ``csv_path`` the rows go to that CSV file in chunks of ``chunk_rows`` as
-        the run proceeds, and memory stays flat however long the run; the returned
-        recording then holds no rows itself (``rows`` counts those written).
+        ValueError if the stop time is not a whole number of steps after the start, or
+        if the rows would not fit in memory. With ``csv_path`` the rows go to that CSV
+        file in chunks of ``chunk_rows`` as the run proceeds, and memory stays flat
+        however long the run; the returned recording then holds no rows itself
+        (``rows`` counts those written). Once ``stop`` has received a signal, the run
+        ends before the next step (``Recording.interrupted``).
         """
         system = self.system
         t0, h = system.start_time, seconds(nanoseconds(system.step_size))
@@ -128,6 +133,11 @@ class Master:
             self.initialize()
             for k in range(n_steps + 1):
                 t = communication_point(t0, k, h)
+                if stop is not None and stop.received:
+                    recorder.interrupted = stop.received.name
+                    t = communication_point(t0, k - 1, h) if k else t0
+                    error = f"interrupted at t = {t:.6g} s, {recorder.rows} rows kept"
+                    break
                 exchange(nodes, values, t, h, k < n_steps)
                 recorder.append(t, values)
                 if progress is not None and k % 100 == 0:

@@ -7,6 +7,7 @@ to the CSV file in chunks, and the recording then holds none of them itself.
 """
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -23,6 +24,7 @@ class Recording:
     data: np.ndarray                    # one column per signal
     rows: int = 0                       # rows the run recorded: held, or written to ``path``
     error: str | None = None            # why the run stopped early, if it did
+    interrupted: str | None = None      # the signal that stopped it, if one did
     meta: dict[str, Any] = field(default_factory=dict)
     path: Path | None = None            # where the rows went, if streamed to CSV
     units: dict[str, str] = field(default_factory=dict)   # column: unit ("" if none)
@@ -73,10 +75,13 @@ class Recorder:
                  chunk_rows: int = 10_000, meta: dict[str, Any] | None = None,
                  units: dict[str, str] | None = None):
         self.columns, self.meta, self.units = columns, meta or {}, units or {}
+        size = rows if csv_path is None else min(chunk_rows, rows)
+        if csv_path is None:
+            require_memory(size, len(columns) + 1)
         self.sink = CsvSink(csv_path, columns) if csv_path is not None else None
-        size = rows if self.sink is None else min(chunk_rows, rows)
         self.time, self.data = np.empty(size), np.full((size, len(columns)), np.nan)
         self.held = 0                   # rows in the buffer, not yet written
+        self.interrupted: str | None = None
 
     @property
     def rows(self) -> int:
@@ -98,8 +103,31 @@ class Recorder:
         """The recording; a stream gets its last rows and is closed."""
         if self.sink is None:
             return Recording(self.columns, self.time[:self.held], self.data[:self.held],
-                             self.held, error, self.meta, units=self.units)
+                             self.held, error, self.interrupted, self.meta, units=self.units)
         self._flush()
         self.sink.close()
         return Recording(self.columns, np.empty(0), np.empty((0, len(self.columns))),
-                         self.sink.rows, error, self.meta, self.sink.path, self.units)
+                         self.sink.rows, error, self.interrupted, self.meta, self.sink.path,
+                         self.units)
+
+
+def available_memory() -> int:
+    """Bytes of memory available to a new allocation (Linux's MemAvailable; else all RAM)."""
+    try:
+        with open("/proc/meminfo") as meminfo:
+            for line in meminfo:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+
+
+def require_memory(rows: int, columns: int) -> None:
+    """ValueError if ``rows`` x ``columns`` floats would not fit in the memory available."""
+    needed, available = rows * columns * 8, available_memory()
+    if needed > 0.8 * available:
+        raise ValueError(f"the run would hold {rows} rows of {columns} values in memory, "
+                         f"{needed / 2**30:,.1f} GiB, more than the {available / 2**30:,.1f} GiB "
+                         "available: stream the rows to a CSV file as the run goes "
+                         "(cosim.run --stream; Master.run(csv_path=...))")

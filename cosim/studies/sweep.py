@@ -309,7 +309,10 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
             progress: bool = True, task=None) -> list[dict]:
     """Run the runs not yet in the journal; return every row of the sweep.
 
-    ``task(spec, run) -> row`` is what each run executes (default ``run_one``).
+    ``task(spec, run) -> row`` is what each run executes (default ``run_one``). On
+    Ctrl-C or SIGTERM (``Interrupted``, raised again once the cluster is closed) the
+    runs completed so far stay in the journal (``completed``) and runs in progress
+    are lost; the same call then resumes.
     """
     from dask.distributed import as_completed
 
@@ -340,7 +343,13 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
             client.close()
             if cluster is not None:
                 cluster.close()
-    return [journal.rows[r["run_id"]] for r in spec.runs()]
+    return completed(spec, out)
+
+
+def completed(spec: Spec, out: Path) -> list[dict]:
+    """The rows of ``spec``'s runs in its journal, in the order of ``spec.runs()``."""
+    rows = Journal(out / "runs.jsonl").rows
+    return [rows[r["run_id"]] for r in spec.runs() if r["run_id"] in rows]
 
 
 def write_tables(rows: list[dict], out: Path, csv: bool) -> list[Path]:

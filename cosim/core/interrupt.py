@@ -1,0 +1,77 @@
+"""Ctrl-C and SIGTERM: a request to stop between steps, or an exception where no FMU runs.
+
+Our FMUs' Python code runs in the master's own interpreter, so Python's default
+KeyboardInterrupt would be raised inside an FMU's call and turn into an FMU
+failure. Within ``StopSignals`` a SIGINT or SIGTERM only records itself; the
+master checks between steps, stops, and keeps every row computed
+(``Master.run``'s ``stop``). Within ``raise_on_signals`` either signal raises
+``Interrupted`` wherever the program is: for code that runs no FMU, such as a
+sweep's client, or a command outside its runs.
+"""
+from __future__ import annotations
+
+import signal
+import threading
+from contextlib import contextmanager
+from typing import Iterator
+
+SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+class StopSignals:
+    """``with StopSignals() as stop``: ``stop.received`` is the first SIGINT or SIGTERM that
+    arrived, or None. Only the main thread can take signals; elsewhere this does nothing."""
+
+    def __init__(self) -> None:
+        self.received: signal.Signals | None = None
+        self._previous: dict[signal.Signals, object] = {}
+
+    def __enter__(self) -> StopSignals:
+        if threading.current_thread() is threading.main_thread():
+            for number in SIGNALS:
+                self._previous[number] = signal.signal(number, self._handle)
+        return self
+
+    def _handle(self, number: int, frame) -> None:
+        if self.received is None:
+            self.received = signal.Signals(number)
+
+    def __exit__(self, *exc) -> None:
+        for number, handler in self._previous.items():
+            signal.signal(number, handler)
+        self._previous = {}
+
+    @property
+    def exit_status(self) -> int:
+        """The shell's status for a command ended by the signal received: 130, 143."""
+        return 128 + self.received if self.received else 0
+
+
+class Interrupted(BaseException):
+    """A SIGINT or SIGTERM arrived (a BaseException, as KeyboardInterrupt is)."""
+
+    def __init__(self, number: int):
+        self.signal = signal.Signals(number)
+        super().__init__(f"interrupted by {self.signal.name}")
+
+    @property
+    def exit_status(self) -> int:
+        return 128 + self.signal
+
+
+def _raise(number: int, frame) -> None:
+    raise Interrupted(number)
+
+
+@contextmanager
+def raise_on_signals() -> Iterator[None]:
+    """Within: SIGINT and SIGTERM raise ``Interrupted`` (main thread only)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {number: signal.signal(number, _raise) for number in SIGNALS}
+    try:
+        yield
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, handler)
