@@ -75,6 +75,7 @@ class ModelSlave(Fmi2Slave):
         self.host_log = HostLog(kwargs.get("logger"), kwargs.get("resources"),
                                 in_process="logger" not in kwargs)
         self.failure: str | None = None       # why the FMU failed; until fmi2Reset
+        self.start_time = 0.0                 # of the experiment, for messages
         self._model = None
         self.registry = Registry(self, self.variables, self._output)
         self._fast = FastPaths(self, self.registry)
@@ -134,6 +135,7 @@ class ModelSlave(Fmi2Slave):
     def setup_experiment(self, start_time: float, stop_time: float | None = None,
                          tolerance: float | None = None) -> None:
         self.sequence.require("fmi2SetupExperiment", "instantiated")
+        self.start_time = start_time
 
     @fmi_entry
     def enter_initialization_mode(self) -> None:
@@ -149,7 +151,8 @@ class ModelSlave(Fmi2Slave):
                 var.check(getattr(self, var.name))
             self._model = self._started_model()   # ValueError names a bad parameter or input
         except Exception as error:            # reported now, refused at the first step
-            self.failure = f"exitInitializationMode: {error}; the FMU has failed"
+            self.failure = (f"exitInitializationMode at t = {self.start_time}: {error}; the FMU "
+                            "has failed")
             self.log(self.failure, Fmi2Status.error)
             self.host_log.tell(self.instance_name, self.failure)
 
