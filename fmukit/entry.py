@@ -4,9 +4,10 @@ pythonfmu 0.7 turns every Python exception into fmi2Fatal. Its C++ layer also
 releases the instance, its class and its log queue once per exception and again
 at fmi2FreeInstance, a use-after-free that crashes the host later. ``fmi_entry``
 takes one extra reference on those three objects before any exception leaves
-Python (a KeyboardInterrupt or SystemExit raised in FMU code included: those used
-to end in a segmentation fault), so the host survives; and it tells the user
-why, through the host's logger or on standard error (``fmukit.hostlog``).
+Python, so the host survives; and it tells the user why, through the host's
+logger or on standard error (``fmukit.hostlog``). A KeyboardInterrupt (or any
+other BaseException) raised in FMU code fails the FMU like a refusal does
+(``ModelSlave.interrupted``).
 """
 from __future__ import annotations
 
@@ -36,10 +37,13 @@ def fmi_entry(method: Callable) -> Callable:
         try:
             return method(self, *args)
         except BaseException as error:
+            if not isinstance(error, Exception):  # Ctrl-C or the like: the FMU has failed
+                error = self.interrupted(method.__name__, error)
             self.host_log.tell(self.instance_name, explain(error) if isinstance(error, Refused)
                                else f"{method.__name__}: {explain(error)}")
             if _RELEASES_ON_EXCEPTION:
                 for obj in (self, type(self), self.log_queue):
                     ctypes.pythonapi.Py_IncRef(ctypes.py_object(obj))
-            raise
+            raise error
     return entry
+

@@ -53,5 +53,6 @@ class HostLog:
         """Write an error to standard error if the host will not hear it; once, not again
         for each following call that fails for the same reason."""
         if not self.hears() and message != self._told:
-            print(f"[{instance_name}] {message}", file=sys.stderr, flush=True)
+            sys.stderr.write(f"[{instance_name}] {message}\n")   # one write: hosts step
+            sys.stderr.flush()                                   # FMUs in parallel threads
             self._told = message

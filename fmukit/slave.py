@@ -50,7 +50,8 @@ from pythonfmu import DefaultExperiment, Fmi2Slave
 from pythonfmu.enums import Fmi2Status
 
 from . import model_description, state
-from .entry import Refused, fmi_entry
+from . import signals
+from .entry import Refused, explain, fmi_entry
 from .fastpath import FastPaths
 from .hostlog import HostLog
 from .registry import Registry
@@ -76,6 +77,7 @@ class ModelSlave(Fmi2Slave):
                                 in_process="logger" not in kwargs)
         self.failure: str | None = None       # why the FMU failed; until fmi2Reset
         self.start_time = 0.0                 # of the experiment, for messages
+        signals.defer_host_handlers()
         self._model = None
         self.registry = Registry(self, self.variables, self._output)
         self._fast = FastPaths(self, self.registry)
@@ -180,10 +182,21 @@ class ModelSlave(Fmi2Slave):
         except ValueError as error:
             self._fail(f"doStep at t = {current_time}: {error}; the FMU has failed (its "
                        "outputs read NaN until fmi2Reset)")
-        except BaseException as error:        # the model's own exception, or an interrupt
-            self.failure = f"doStep at t = {current_time}: {type(error).__name__}: {error}"
+        except Exception as error:            # the model's own exception
+            self.failure = f"doStep at t = {current_time}: {explain(error)}"
             raise
+        except BaseException as error:        # Ctrl-C or the like, raised in this FMU's code
+            raise self.interrupted(f"doStep at t = {current_time}", error) from None
         return True
+
+    def interrupted(self, where: str, error: BaseException) -> Refused:
+        """Fail the FMU for a KeyboardInterrupt (or any BaseException) raised in its code
+        while the host called ``where``, and return the refusal to raise. (Rare: the
+        host's signal handlers wait until FMU code returns, ``fmukit.signals``.)"""
+        number = signals.interrupt_signal(error)
+        cause = f"interrupted by {number.name}" if number else explain(error)
+        self.failure = self.failure or f"{where}: {cause}; the FMU has failed"
+        return Refused(self.failure)
 
     def _fail(self, reason: str) -> NoReturn:
         """Fail the FMU for ``reason``: refuse this call and every step until fmi2Reset."""

@@ -1,0 +1,107 @@
+"""Ctrl-C while an FMU computes: the host's signal handler runs in the host's code, not ours.
+
+A pythonfmu FMU runs in its host's Python interpreter, and Python runs a signal
+handler in the main thread at the next bytecode it executes: inside the FMU, if
+the host called it from the main thread (fmpy, ecospy, our master). The
+KeyboardInterrupt would surface in FMU code, where it can only fail the FMU (a
+host that ignores statuses, ecos, would step on), or, raised at the first
+instruction of an FMI entry point before any ``try``, escape to pythonfmu's C++
+layer, which loses it and releases the instance once too often
+(``fmukit.entry``).
+
+So FMU code is a critical section for the host's Python handlers of SIGINT and
+SIGTERM. ``defer_host_handlers`` wraps each (once per process, from the main
+thread): a signal that arrives while FMU code runs is kept pending and
+signalled again each millisecond, from a helper thread, until the main thread
+runs host code, where the host's own handler takes it as if no FMU had been
+there: fmpy and ecospy scripts get their KeyboardInterrupt between two FMI
+calls, our master its request to stop between steps.
+
+A C or C++ host (the ``ecos`` program) has no Python code of its own; pythonfmu
+starts Python in a thread of its own, which becomes Python's main thread and
+never runs Python again, so Python's SIGINT handler would never run and Ctrl-C
+would not stop the host. There SIGINT gets its default action back.
+"""
+from __future__ import annotations
+
+import _thread
+import ctypes
+import os
+import signal
+import sys
+import threading
+import time
+from types import FrameType
+from typing import Callable
+
+SIGNALS = (signal.SIGINT, signal.SIGTERM)
+_ENTRY_FILE = os.path.join("fmukit", "entry.py")   # where fmi_entry's wrapper runs
+
+_pending: set[signal.Signals] = set()   # arrived while FMU code ran; not yet handled
+
+
+def _in_fmu_code(frame: FrameType | None) -> bool:
+    """Whether ``frame`` runs inside an FMI entry point of a ModelSlave."""
+    while frame is not None:
+        code = frame.f_code
+        if code.co_name == "entry" and code.co_filename.endswith(_ENTRY_FILE):
+            return True
+        frame = frame.f_back
+    return False
+
+
+class _DeferringHandler:
+    """The host's handler, run only outside FMU code."""
+
+    def __init__(self, host_handler: Callable):
+        self.host_handler = host_handler
+
+    def __call__(self, number: int, frame: FrameType | None) -> object:
+        if _in_fmu_code(frame):
+            first = not _pending
+            _pending.add(signal.Signals(number))
+            if first:
+                threading.Thread(target=_signal_again, name="fmukit-signals", daemon=True).start()
+            return None
+        _pending.discard(signal.Signals(number))
+        return self.host_handler(number, frame)
+
+
+def _signal_again() -> None:
+    """Signal the main thread again, each millisecond, until its handler has run in host
+    code. (Signalled from the handler itself, the handler would run again at once,
+    inside itself.)"""
+    while _pending:
+        time.sleep(0.001)
+        for number in tuple(_pending):
+            _thread.interrupt_main(number)
+
+
+def defer_host_handlers() -> None:
+    """Wrap the host's Python handlers of SIGINT and SIGTERM (see the module docstring);
+    in a host that is not Python, give SIGINT its default action back."""
+    if not sys.orig_argv:                     # Python embedded by pythonfmu itself
+        _restore_default_sigint()
+    elif threading.current_thread() is threading.main_thread():
+        for number in SIGNALS:
+            handler = signal.getsignal(number)
+            if callable(handler) and not isinstance(handler, _DeferringHandler):
+                signal.signal(number, _DeferringHandler(handler))
+
+
+def _restore_default_sigint() -> None:
+    """Undo Python's start-up SIGINT handler at the operating-system level (Python's own
+    record of it stays as it was)."""
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        libc = ctypes.CDLL(None)
+        libc.signal.argtypes = (ctypes.c_int, ctypes.c_void_p)
+        libc.signal.restype = ctypes.c_void_p
+        libc.signal(signal.SIGINT, None)      # SIG_DFL
+
+
+def interrupt_signal(error: BaseException) -> signal.Signals | None:
+    """The signal behind an interrupt: SIGINT for KeyboardInterrupt, an exception's own
+    ``signal`` attribute (``cosim.core.interrupt.Interrupted``), else None."""
+    number = getattr(error, "signal", signal.SIGINT if isinstance(error, KeyboardInterrupt)
+                     else None)
+    return None if number is None else signal.Signals(number)
