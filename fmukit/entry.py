@@ -39,11 +39,24 @@ def fmi_entry(method: Callable) -> Callable:
         except BaseException as error:
             if not isinstance(error, Exception):  # Ctrl-C or the like: the FMU has failed
                 error = self.interrupted(method.__name__, error)
-            self.host_log.tell(self.instance_name, explain(error) if isinstance(error, Refused)
-                               else f"{method.__name__}: {explain(error)}")
+            text = (explain(error) if isinstance(error, Refused)
+                    else f"{method.__name__}: {explain(error)}")
+            self.host_log.tell(self.instance_name, text)
             if _RELEASES_ON_EXCEPTION:
                 for obj in (self, type(self), self.log_queue):
                     ctypes.pythonapi.Py_IncRef(ctypes.py_object(obj))
-            raise error
+            raise Refused(naming(self.instance_name, text)) from error
     return entry
+
+
+def naming(instance_name: str, text: str) -> str:
+    """A message as it leaves the FMU: naming the FMU, for hosts whose logs do not
+    (libcosim's log shows neither the instance nor the call)."""
+    return f"{instance_name}: {text}"
+
+
+def unnamed(instance_name: str, message: str) -> str:
+    """A message without the FMU's name in front, for a host that shows the name itself."""
+    prefix = f"{instance_name}: "
+    return message[len(prefix):] if message.startswith(prefix) else message
 

@@ -17,6 +17,7 @@ import hashlib
 import sys
 from pathlib import Path
 
+from .entry import naming
 from .exit_fix import FIXED
 
 
@@ -53,6 +54,6 @@ class HostLog:
         """Write an error to standard error if the host will not hear it; once, not again
         for each following call that fails for the same reason."""
         if not self.hears() and message != self._told:
-            sys.stderr.write(f"[{instance_name}] {message}\n")   # one write: hosts step
-            sys.stderr.flush()                                   # FMUs in parallel threads
+            sys.stderr.write(naming(instance_name, message) + "\n")   # one write: hosts
+            sys.stderr.flush()                              # step FMUs in parallel threads
             self._told = message

@@ -51,7 +51,7 @@ from pythonfmu.enums import Fmi2Status
 
 from . import model_description, state
 from . import signals
-from .entry import Refused, explain, fmi_entry
+from .entry import Refused, explain, fmi_entry, naming
 from .fastpath import FastPaths
 from .hostlog import HostLog
 from .registry import Registry
@@ -155,7 +155,7 @@ class ModelSlave(Fmi2Slave):
         except Exception as error:            # reported now, refused at the first step
             self.failure = (f"exitInitializationMode at t = {self.start_time}: {error}; the FMU "
                             "has failed")
-            self.log(self.failure, Fmi2Status.error)
+            self.log(naming(self.instance_name, self.failure), Fmi2Status.error)
             self.host_log.tell(self.instance_name, self.failure)
 
     @fmi_entry

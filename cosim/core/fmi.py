@@ -18,7 +18,7 @@ from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFr
                        fmi2True, fmi2ValueReference)
 from fmpy.model_description import ModelDescription
 
-from fmukit.entry import Refused
+from fmukit.entry import Refused, unnamed
 from fmukit.packaging import BUILD_HINT
 
 from .instance import FmuCallError, Instance, logged_error
@@ -127,7 +127,7 @@ class FmuInstance(Instance):
     def _on_log(self, env, instance, status, category, message) -> None:
         self.logged += 1
         self.log.append(f"[{STATUS[status] if status < len(STATUS) else status}] "
-                        f"{python_error(message.decode('utf-8', 'replace'))}")
+                        + unnamed(self.name, python_error(message.decode("utf-8", "replace"))))
 
     def call(self, what: str, function, *args, time: float | None = None, strict: bool = False,
              **kwargs) -> Any:

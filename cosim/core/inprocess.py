@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from fmukit.entry import explain
+from fmukit.entry import explain, unnamed
 from fmukit.packaging import FMUS
 from fmukit.slave import ModelSlave
 
@@ -67,7 +67,7 @@ class InProcessInstance(Instance):
             result = function(*args)
         except Exception as error:
             raise FmuCallError(self.name, what, time, "fatal",
-                               [*self._drain(), explain(error)]) from error
+                               [*self._drain(), unnamed(self.name, explain(error))]) from error
         if result is False:
             raise FmuCallError(self.name, what, time, "discard", self._drain())
         messages = self._drain()
@@ -76,7 +76,8 @@ class InProcessInstance(Instance):
         return result
 
     def _drain(self) -> list[str]:
-        messages = [f"[{m.status.name}] {m.msg}" for m in self.slave.log_queue]
+        messages = [f"[{m.status.name}] {unnamed(self.name, m.msg)}"
+                    for m in self.slave.log_queue]
         self.slave.log_queue.clear()
         return messages
 

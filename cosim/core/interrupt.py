@@ -46,6 +46,11 @@ class StopSignals:
         """The shell's status for a command ended by the signal received: 130, 143."""
         return 128 + self.received if self.received else 0
 
+    def check(self) -> None:
+        """Raise ``Interrupted`` if a signal has arrived: a loop's way to stop between steps."""
+        if self.received is not None:
+            raise Interrupted(self.received)
+
 
 class Interrupted(BaseException):
     """A SIGINT or SIGTERM arrived (a BaseException, as KeyboardInterrupt is)."""

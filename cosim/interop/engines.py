@@ -39,6 +39,8 @@ import numpy as np
 
 from fmukit.timebase import communication_point, step_count
 
+from ..core.interrupt import SIGNALS as SIGNALS_TO_STOP, Interrupted, StopSignals
+
 from .ssp import read_package
 
 ENGINES = ("libcosim", "ecos", "fmpy")
@@ -54,7 +56,7 @@ def _split(signal: str) -> tuple[str, str]:
     return component, variable
 
 
-def _libcosim(ssp: Path, signals: tuple[str, ...]) -> dict[str, np.ndarray]:
+def _libcosim(ssp: Path, signals: tuple[str, ...], stop: StopSignals) -> dict[str, np.ndarray]:
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimObserver import CosimObserver
@@ -75,6 +77,7 @@ def _libcosim(ssp: Path, signals: tuple[str, ...]) -> dict[str, np.ndarray]:
 
     rows = []
     for k in range(n_steps):
+        stop.check()
         if not execution.step():
             raise EngineError(f"libcosim failed in the step from t = "
                               f"{communication_point(system.start_time, k, system.step_size):g}"
@@ -84,7 +87,7 @@ def _libcosim(ssp: Path, signals: tuple[str, ...]) -> dict[str, np.ndarray]:
     return {"time": times, **dict(zip(signals, np.array(rows).T))}
 
 
-def _ecos(ssp: Path, signals: tuple[str, ...]) -> dict[str, np.ndarray]:
+def _ecos(ssp: Path, signals: tuple[str, ...], stop: StopSignals) -> dict[str, np.ndarray]:
     from ecospy import EcosLib, EcosSimulation
 
     EcosLib.set_log_level("err")
@@ -97,6 +100,7 @@ def _ecos(ssp: Path, signals: tuple[str, ...]) -> dict[str, np.ndarray]:
             raise EngineError(f"ecos failed to initialise: {EcosLib.get_last_error()}")
         rows = [[simulation.get_real(i) for i in identifiers]]
         for k in range(n_steps):
+            stop.check()
             if not all(map(math.isfinite, rows[-1])):   # ecos ignores refused calls
                 raise EngineError(
                     f"ecos went on, but {', '.join(signals)} read NaN from t = "
@@ -111,7 +115,7 @@ def _ecos(ssp: Path, signals: tuple[str, ...]) -> dict[str, np.ndarray]:
     return {"time": times, **dict(zip(signals, np.array(rows).T))}
 
 
-def _fmpy(ssp: Path, signals: tuple[str, ...]) -> dict[str, np.ndarray]:
+def _fmpy(ssp: Path, signals: tuple[str, ...], stop: StopSignals) -> dict[str, np.ndarray]:
     from fmpy import read_model_description
     from fmpy.ssp.simulation import simulate_ssp
     from fmpy.ssp.ssd import Parameter, ParameterSet
@@ -137,6 +141,7 @@ def _fmpy(ssp: Path, signals: tuple[str, ...]) -> dict[str, np.ndarray]:
                                                        type=type(value).__name__, value=value))
     result = simulate_ssp(str(ssp), start_time=system.start_time, stop_time=system.stop_time,
                           step_size=system.step_size, parameter_set=parameters)
+    stop.check()                        # fmpy's runner cannot be stopped before its end
     times = np.array(result["time"]) + system.step_size   # rows hold values after each step
     return {"time": times, **{s: np.asarray(result[s]) for s in signals}}
 
@@ -165,14 +170,16 @@ def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = SIGNALS,
     """Run ``ssp`` in ``engine``; raise EngineError with the engine's output if it fails.
 
     With ``isolate`` (the default) the engine runs in a child process, which may die
-    (libcosim aborts its host on some FMU failures) without taking this one with it.
+    (libcosim aborts its host on some FMU failures) without taking this one with it;
+    a child ended by SIGINT or SIGTERM raises ``Interrupted`` here.
     """
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
     ssp = Path(ssp).resolve()
     check_package(ssp)
     if not isolate:
-        result = RUNNERS[engine](ssp, tuple(signals))
+        with StopSignals() as stop:
+            result = RUNNERS[engine](ssp, tuple(signals), stop)
         _check_defined(engine, result, "")
         return result
     with tempfile.TemporaryDirectory() as tmp:
@@ -180,6 +187,9 @@ def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = SIGNALS,
         child = subprocess.run([sys.executable, "-c", _CHILD, engine, str(ssp), str(out),
                                 *signals], capture_output=True, text=True, timeout=600)
         log = _summary(child.stdout + child.stderr)
+        number = -child.returncode if child.returncode < 0 else child.returncode - 128
+        if number in SIGNALS_TO_STOP:       # Ctrl-C or a kill: not the engine's fault
+            raise Interrupted(number)
         if child.returncode != 0 or not out.exists():
             how = (f"killed by {signal.Signals(-child.returncode).name}"
                    if child.returncode < 0 else f"exit status {child.returncode}")
@@ -196,9 +206,15 @@ _CHILD = ("import sys\nfrom cosim.interop.engines import record\n"
 
 def record(engine: str, ssp: str, out: str, signals: tuple[str, ...]) -> int:
     """Run an engine in this process and save what it recorded to ``out`` (.npz): the
-    child's side of ``run``. 1, and the reason on standard error, if the engine fails."""
+    child's side of ``run``. 1, and the reason on standard error, if the engine fails;
+    130 or 143 if SIGINT or SIGTERM stopped it (between steps: the engines' own clean-up
+    is not safe against a KeyboardInterrupt)."""
     try:
-        result = RUNNERS[engine](Path(ssp), signals)
+        with StopSignals() as stop:
+            result = RUNNERS[engine](Path(ssp), signals, stop)
+    except Interrupted as interrupted:
+        print(interrupted, file=sys.stderr)
+        return interrupted.exit_status
     except Exception as error:          # the engine's own exceptions, with their message
         print(f"error: {type(error).__name__}: {error}", file=sys.stderr)
         return 1

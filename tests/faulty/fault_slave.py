@@ -3,16 +3,22 @@
 Until ``fault_time`` it commands a constant rudder and full ahead; from then on, by
 ``fault`` (an Integer, which every engine can set): 1 'nan' (the rudder command is
 NaN), 2 'range' (the propeller command n1 is 100 rev/s, outside the ship's +-50),
-3 'raise' (its own step raises: an exception inside a model), 0 'none'.
+3 'raise' (its own step raises: an exception inside a model), 4 'sigint' and
+5 'sigterm' (its step sends that signal to its own process, once: Ctrl-C or a
+kill arriving while FMU code runs), 0 'none'.
 """
+import os
+import signal
+
 from fmukit.slave import ModelSlave, Var
 
-KINDS = ("none", "nan", "range", "raise")
+KINDS = ("none", "nan", "range", "raise", "sigint", "sigterm")
 
 
 class Fault:
     def __init__(self, fault_time: float, fault: int):
         self.fault_time, self.fault_kind, self.t = fault_time, KINDS[fault], 0.0
+        self.signalled = False
 
     def faulty(self, kind: str) -> bool:
         return self.fault_kind == kind and self.t >= self.fault_time
@@ -26,6 +32,9 @@ class Fault:
     def step(self, t: float, h: float) -> None:
         if self.fault_kind == "raise" and t >= self.fault_time:
             raise RuntimeError(f"injected fault at t = {t}")
+        if self.fault_kind.startswith("sig") and t >= self.fault_time and not self.signalled:
+            self.signalled = True
+            os.kill(os.getpid(), getattr(signal, self.fault_kind.upper()))
         self.t = t + h
 
     def snapshot(self) -> dict:
@@ -43,8 +52,8 @@ class FaultSlave(ModelSlave):
         Var.output("delta_c", "rad", "commanded rudder angle", get=lambda s: s.model.delta_c()),
         Var.output("n1", "rev/s", "propeller command", get=lambda s: s.model.n1()),
         Var.parameter("fault_time", 50.0, "s", "time of the fault"),
-        Var.parameter("fault", 3, description="0 none, 1 nan, 2 range, 3 raise",
-                      min=0, max=3),
+        Var.parameter("fault", 3, description="0 none, 1 nan, 2 range, 3 raise, 4 sigint, "
+                      "5 sigterm", min=0, max=5),
     )
 
     def build_model(self) -> Fault:

@@ -1,0 +1,337 @@
+"""The fault matrix: every fault, in every host, ends in a failure the user is told of.
+
+Faults, from 5 s of a 10 s run (1000 s for signals, so that a host that ignored one
+would be seen finishing; the fault FMU, ``tests/faulty/fault_slave.py``, as
+component "fault", drives the ship's rudder and propeller): a NaN input, an input
+out of its range, an invalid parameter (the ship's Hs = -1, at t = 0), an exception
+in a model, SIGINT and SIGTERM arriving while FMU code runs (the fault FMU signals
+its own process), and a corrupt (truncated) FMU or package.
+
+Hosts: our master (FMI and in-process backends), fmpy's command line, its Python
+API and its SSP runner, libcosim (a libcosimpy script, and ``cosim.engines``), ecos
+(an ecospy script, ``cosim.engines``, and the ``ecos`` program with LD_PRELOAD as
+README says).
+
+What every cell must show, without any flag or environment variable set: no crash
+(no SIGSEGV, SIGABRT...) and no hang; a non-success (exit status, exception, or a
+failed libcosim step), except where the host ignores FMI statuses (an ecospy
+script, the ``ecos`` program), whose trace must then read NaN; a message naming the
+FMU, the variable (or the model's error) and the time. A signal ends the host as
+that signal does: our commands with 130 or 143 and "interrupted", other hosts
+killed by it (or, Python's way, by the KeyboardInterrupt). A corrupt file is the
+host's own error, naming the file where the host does. docs/robustness.md has the
+table. Each cell is a child process with a time limit; the selected cells run two
+at a time, once per session (``outcomes``).
+"""
+from __future__ import annotations
+
+import json
+import os
+import re
+import signal
+import subprocess
+import sys
+import sysconfig
+import time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import pytest
+
+from cosim.core.ssd import Component, Connection, SystemDescription, write_ssd
+from cosim.interop.ssp import export
+from fmukit.packaging import ROOT, build_script
+
+FAULTS = ("nan", "range", "parameter", "exception", "sigint", "sigterm", "corrupt")
+HOSTS = ("master-fmi", "master-inprocess", "fmpy-cli", "fmpy-api", "fmpy-ssp",
+         "libcosim-script", "libcosim-cli", "ecos-script", "ecos-cli", "ecos-program")
+OURS = ("master-fmi", "master-inprocess", "libcosim-cli", "ecos-cli")
+IGNORES_STATUS = ("ecos-script", "ecos-program")
+NOT_APPLICABLE = {   # the in-process backend runs this project's own FMU classes only
+    ("master-inprocess", "exception"): "runs only this project's FMU classes",
+    ("master-inprocess", "corrupt"): "loads no FMU file",
+}
+CELLS = [(h, f) for h in HOSTS for f in FAULTS if (h, f) not in NOT_APPLICABLE]
+KIND = {"nan": 1, "range": 2, "parameter": 0, "exception": 3, "sigint": 4, "sigterm": 5}
+CRASHES = {signal.SIGSEGV, signal.SIGABRT, signal.SIGBUS, signal.SIGILL, signal.SIGFPE}
+FAULT_TIME = 5.0
+T5 = r"t = (5(\.0*)?|4\.9999\d*)( s)?\b"       # ecos's time is a sum of floats
+T0 = r"t = 0(\.0*)?( s)?\b"
+# What the message must name, on one line: the FMU, the variable or error, the time.
+NAMES = {"nan": ("ship", "delta_c", T5), "range": ("ship", "n1", T5),
+         "parameter": ("ship", "Hs", T0), "exception": ("fault", "injected fault", T5)}
+INPROCESS_SET = {"nan": "ship.n3=nan", "range": "ship.n1=100", "parameter": "ship.Hs=-1"}
+INPROCESS_NAMES = {"nan": ("ship", "n3", T0), "range": ("ship", "n1", T0),
+                   "parameter": ("ship", "Hs", T0)}
+TIME_LIMIT = 120.0
+PY = sys.executable
+
+FMPY_API = """import sys, json, numpy as np
+from fmpy import simulate_fmu
+fmu, options = sys.argv[1], json.loads(sys.argv[2])
+if "input" in options:
+    options["input"] = np.genfromtxt(options["input"], delimiter=",", names=True)
+result = simulate_fmu(fmu, stop_time=float(sys.argv[3]), **options)
+print("last row:", result[-1])
+"""
+FMPY_SSP = """import sys, json
+from fmpy.ssp.simulation import simulate_ssp
+from fmpy.ssp.ssd import Parameter, ParameterSet
+parameters = ParameterSet()
+for name, value in json.loads(sys.argv[2]).items():
+    parameters.parameters.append(Parameter(name=name, type=type(value).__name__, value=value))
+result = simulate_ssp(sys.argv[1], stop_time=float(sys.argv[3]), step_size=0.1,
+                      parameter_set=parameters)
+print("last row:", result[-1])
+"""
+LIBCOSIM = """import sys
+from libcosimpy.CosimExecution import CosimExecution
+execution = CosimExecution.from_ssp_file(sys.argv[1])
+for k in range(round(float(sys.argv[2]) * 10)):
+    if not execution.step():
+        sys.exit(f"libcosim: the step from t = {k / 10} s failed")
+print("done")
+"""
+ECOS = """import sys
+from ecospy import EcosSimulation
+sim = EcosSimulation(step_size=0.1, ssp_path=sys.argv[1])
+sim.init(parameter_set="scenario")
+for _ in range(round(float(sys.argv[2]) * 10)):
+    sim.step()
+print("ship psi =", sim.get_real("ship::psi"))
+"""
+
+
+@dataclass
+class Cell:
+    """One child process: its command, and when to signal it (for the in-process cells)."""
+    argv: list[str]
+    cwd: Path
+    env: dict[str, str] = field(default_factory=dict)
+    signal_after: Callable[[], bool] | None = None    # send the fault's signal once true
+    fault_signal: signal.Signals | None = None
+
+
+@dataclass
+class Outcome:
+    returncode: int
+    output: str             # standard output and error
+    files: str              # the CSV files the host wrote, for NaN
+
+
+@dataclass
+class Files:
+    """What the cells run: a system per fault, as .ssd and as package, and fmpy inputs."""
+    root: Path
+    fmus: dict[str, Path]
+
+    def ssd(self, fault: str) -> Path:
+        return self.root / f"{fault}.ssd"
+
+    def package(self, fault: str) -> Path:
+        return self.root / "packages" / f"{fault}.ssp"
+
+
+def _system(ship: Path, fault_fmu: Path, fault: str) -> SystemDescription:
+    ship_parameters = {"Hs": -1.0} if fault == "parameter" else {}
+    return SystemDescription(
+        fault, {"fault": Component("fault", str(fault_fmu),
+                                   {"psi": ("input", "Real"), "delta_c": ("output", "Real"),
+                                    "n1": ("output", "Real")},
+                                   {"fault_time": FAULT_TIME, "fault": KIND[fault]}),
+                "ship": Component("ship", str(ship),
+                                  {"delta_c": ("input", "Real"), "n1": ("input", "Real"),
+                                   "psi": ("output", "Real")}, ship_parameters)},
+        [Connection("ship", "psi", "fault", "psi"),
+         Connection("fault", "delta_c", "ship", "delta_c"),
+         Connection("fault", "n1", "ship", "n1")],
+        stop_time=_stop_time(fault), report="none", description=f"fault matrix: {fault}")
+
+
+def _stop_time(fault: str) -> float:
+    return 1000.0 if fault.startswith("sig") else 10.0
+
+
+def _truncated(source: Path, target: Path) -> Path:
+    data = source.read_bytes()
+    target.write_bytes(data[: len(data) // 2])
+    return target
+
+
+@pytest.fixture(scope="session")
+def files(fmu_paths, tmp_path_factory) -> Files:
+    root = tmp_path_factory.mktemp("fault_matrix")
+    fault_fmu = build_script(Path(__file__).parent / "faulty" / "fault_slave.py", ("fmukit",),
+                             root / "fault.fmu")
+    ship = fmu_paths["ship"]
+    (root / "packages").mkdir()
+    for fault in KIND:
+        write_ssd(_system(ship, fault_fmu, fault), root / f"{fault}.ssd")
+        export(root / f"{fault}.ssd", root / "packages")
+    corrupt_ship = _truncated(ship, root / "corrupt_ship.fmu")
+    write_ssd(_system(corrupt_ship, fault_fmu, "exception"), root / "corrupt.ssd")
+    _truncated(root / "packages" / "exception.ssp", root / "packages" / "corrupt.ssp")
+    for fault, column, value in (("nan", "delta_c", "nan"), ("range", "n1", "100")):
+        row = {"delta_c": "0.1", "n1": "8.13"}
+        lines = ["time,delta_c,n1"]
+        for t in (0.0, FAULT_TIME - 0.01):
+            lines.append(f"{t},{row['delta_c']},{row['n1']}")
+        row[column] = value
+        for t in (FAULT_TIME, 10.0):
+            lines.append(f"{t},{row['delta_c']},{row['n1']}")
+        (root / f"{fault}.csv").write_text("\n".join(lines) + "\n")
+    return Files(root, {"ship": ship, "fault": fault_fmu, "corrupt": corrupt_ship})
+
+
+def _libpython() -> str:
+    return os.path.join(sysconfig.get_config_var("LIBDIR"), sysconfig.get_config_var("LDLIBRARY"))
+
+
+def _ecos_program() -> Path:
+    import ecospy
+    return Path(ecospy.__file__).parent / "binaries" / "ecos"
+
+
+def _fmu_and_options(files: Files, fault: str) -> tuple[Path, dict]:
+    """What a single-FMU host (fmpy) runs for a fault: the FMU and its options."""
+    if fault in ("nan", "range"):
+        return files.fmus["ship"], {"input": str(files.root / f"{fault}.csv")}
+    if fault == "parameter":
+        return files.fmus["ship"], {"start_values": {"Hs": -1.0}}
+    if fault == "corrupt":
+        return files.fmus["corrupt"], {}
+    return files.fmus["fault"], {"start_values": {"fault": KIND[fault],
+                                                  "fault_time": FAULT_TIME}}
+
+
+def _parameters(fault: str) -> dict:
+    """fmpy's SSP runner applies no bindings of its own: the package's values."""
+    values = {"fault.fault": KIND.get(fault, 0), "fault.fault_time": FAULT_TIME}
+    return {**values, "ship.Hs": -1.0} if fault == "parameter" else values
+
+
+def cell(host: str, fault: str, files: Files, out: Path) -> Cell:
+    """The command a user of ``host`` would run, for ``fault``."""
+    package, stop = files.package(fault), f"{_stop_time(fault):g}"
+    if host == "master-fmi":
+        ssd = files.root / ("corrupt.ssd" if fault == "corrupt" else f"{fault}.ssd")
+        return Cell([PY, "-m", "cosim.run", str(ssd), "--out", str(out), "--no-plot"], ROOT)
+    if host == "master-inprocess":
+        argv = [PY, "-m", "cosim.run", "calm_pd", "--backend", "inprocess", "--out", str(out),
+                "--no-plot"]
+        if fault in INPROCESS_SET:
+            return Cell(argv + ["--stop-time", "10", "--set", INPROCESS_SET[fault]], ROOT)
+        csv = out / "calm_pd.csv"      # a signal from outside, once rows are being written
+        return Cell(argv + ["--stop-time", "100000", "--stream"], ROOT,
+                    signal_after=lambda: csv.exists() and csv.stat().st_size > 2000,
+                    fault_signal=signal.Signals[f"SIG{fault[3:].upper()}"])
+    if host in ("fmpy-cli", "fmpy-api"):
+        fmu, options = _fmu_and_options(files, fault)
+        if host == "fmpy-api":
+            return Cell([PY, "-c", FMPY_API, str(fmu), json.dumps(options), stop], out)
+        argv = [str(Path(PY).parent / "fmpy"), "simulate", str(fmu), "--stop-time", stop,
+                "--output-file", str(out / "result.csv")]
+        if "input" in options:
+            argv += ["--input-file", options["input"]]
+        if "start_values" in options:
+            argv += ["--start-values", *(str(x) for item in options["start_values"].items()
+                                         for x in item)]
+        return Cell(argv, out)
+    if host == "fmpy-ssp":
+        return Cell([PY, "-c", FMPY_SSP, str(package), json.dumps(_parameters(fault)), stop],
+                    out)
+    if host == "libcosim-script":
+        return Cell([PY, "-c", LIBCOSIM, str(package), stop], out)
+    if host == "ecos-script":
+        return Cell([PY, "-c", ECOS, str(package), stop], out)
+    if host in ("libcosim-cli", "ecos-cli"):
+        return Cell([PY, "-m", "cosim.engines", host.split("-")[0], str(package), "--out",
+                     str(out / "trace.npz")], ROOT)
+    if host == "ecos-program":
+        site = sysconfig.get_paths()["purelib"]
+        return Cell([str(_ecos_program()), "simulate", "--path", str(package), "--stepSize",
+                     "0.1", "--stopTime", stop, "--parameterSet", "scenario"], out,
+                    env={"LD_PRELOAD": _libpython(), "PYTHONPATH": site})
+    raise ValueError(f"unknown host {host!r}")
+
+
+def run_cell(spec: Cell) -> Outcome:
+    """Run one cell in a child process, within TIME_LIMIT; what it printed and wrote."""
+    spec.cwd.mkdir(parents=True, exist_ok=True)
+    env = {**os.environ, **spec.env}
+    with subprocess.Popen(spec.argv, cwd=spec.cwd, env=env, stdout=subprocess.PIPE,
+                          stderr=subprocess.STDOUT, text=True,
+                          start_new_session=True) as child:
+        deadline = time.monotonic() + TIME_LIMIT
+        if spec.signal_after is not None:
+            while not spec.signal_after() and child.poll() is None \
+                    and time.monotonic() < deadline:
+                time.sleep(0.05)
+            child.send_signal(spec.fault_signal)
+        try:
+            output, _ = child.communicate(timeout=max(1.0, deadline - time.monotonic()))
+        except subprocess.TimeoutExpired:
+            os.killpg(child.pid, signal.SIGKILL)
+            output, _ = child.communicate()
+            pytest.fail(f"{spec.argv[:4]}... still running after {TIME_LIMIT:g} s:\n{output}")
+    written = "".join(p.read_text(errors="replace") for p in spec.cwd.glob("*.csv"))
+    return Outcome(child.returncode, output, written)
+
+
+def _cells(session: pytest.Session) -> list[tuple[str, str]]:
+    """The (host, fault) cells this session runs."""
+    chosen = []
+    for item in session.items:
+        if item.originalname == "test_fault_matrix" and hasattr(item, "callspec"):
+            chosen.append((item.callspec.params["host"], item.callspec.params["fault"]))
+    return chosen
+
+
+@pytest.fixture(scope="session")
+def outcomes(request, files, tmp_path_factory) -> dict[tuple[str, str], Outcome]:
+    """Every selected cell, run two at a time (each is a child process)."""
+    cells = _cells(request.session)
+    specs = {c: cell(*c, files, tmp_path_factory.mktemp(f"{c[0]}-{c[1]}")) for c in cells}
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        futures = {c: pool.submit(run_cell, spec) for c, spec in specs.items()}
+        return {c: future.result() for c, future in futures.items()}
+
+
+def _status(returncode: int) -> str:
+    return (f"killed by {signal.Signals(-returncode).name}" if returncode < 0
+            else f"exit status {returncode}")
+
+
+def _named(output: str, fmu: str, what: str, when: str) -> bool:
+    """Whether one line of the output names the FMU, the variable or error, and the time."""
+    return any(fmu in line and what in line and re.search(when, line)
+               for line in output.splitlines())
+
+
+@pytest.mark.parametrize("host, fault", CELLS, ids=[f"{h}-{f}" for h, f in CELLS])
+def test_fault_matrix(host, fault, outcomes):
+    result = outcomes[(host, fault)]
+    said = f"{host} / {fault}: {_status(result.returncode)}\n{result.output[-3000:]}"
+    code = result.returncode
+    assert -code not in CRASHES and code - 128 not in CRASHES, said
+    if fault.startswith("sig"):
+        number = signal.Signals[f"SIG{fault[3:].upper()}"]
+        if host in OURS:
+            assert code == 128 + number and "interrupted" in result.output, said
+            if host.startswith("master"):
+                assert re.search(r"interrupted at t = [\d.]+ s, \d+ rows kept", result.output)
+        else:                              # Python re-raises an uncaught KeyboardInterrupt
+            assert code == -number, said
+        return
+    if host in IGNORES_STATUS and code == 0:
+        assert "nan" in (result.output + result.files).lower(), said
+    else:
+        assert code != 0, said
+    if fault == "corrupt":
+        if host in OURS:
+            assert "corrupt" in result.output, said
+        return
+    fmu, what, when = (INPROCESS_NAMES if host == "master-inprocess" else NAMES)[fault]
+    assert _named(result.output, fmu, what, when), said
