@@ -184,7 +184,7 @@ class ModelSlave(Fmi2Slave):
                        "outputs read NaN until fmi2Reset)")
         except Exception as error:            # the model's own exception
             self.failure = f"doStep at t = {current_time}: {explain(error)}"
-            raise
+            raise Refused(self.failure) from error
         except BaseException as error:        # Ctrl-C or the like, raised in this FMU's code
             raise self.interrupted(f"doStep at t = {current_time}", error) from None
         return True

@@ -19,7 +19,7 @@ from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFr
 from fmpy.model_description import ModelDescription
 
 from fmukit.entry import Refused, unnamed
-from fmukit.packaging import BUILD_HINT
+from fmukit.packaging import BUILD_HINT, FMU_DIR
 
 from .instance import FmuCallError, Instance, logged_error
 
@@ -27,14 +27,15 @@ STATUS = ("ok", "warning", "discard", "error", "fatal", "pending")
 
 
 def read_description(path: Path, name: str) -> ModelDescription:
-    """An FMU's model description; FileNotFoundError or ValueError naming the file and
-    how to build it when the FMU is missing or not a readable FMU."""
+    """An FMU's model description; FileNotFoundError or ValueError naming the file (and,
+    for one of ours in fmus/, how to build it) when the FMU is missing or not readable."""
+    hint = f"; {BUILD_HINT}" if path.parent.resolve() == FMU_DIR.resolve() else ""
     if not path.is_file():
-        raise FileNotFoundError(f"FMU for '{name}' not found: {path}; {BUILD_HINT}")
+        raise FileNotFoundError(f"FMU for '{name}' not found: {path}{hint}")
     try:
         description = read_model_description(str(path))
     except Exception as error:
-        raise ValueError(f"{path} is not a readable FMU ({error}); {BUILD_HINT}") from error
+        raise ValueError(f"{path} is not a readable FMU ({error}){hint}") from error
     if description.coSimulation is None:
         raise ValueError(f"{path} is not a co-simulation FMU (model exchange only)")
     return description
