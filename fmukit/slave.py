@@ -14,7 +14,8 @@ attributes alone), ``step_model`` and, if the initial state depends on inputs,
   value references;
 - ``fmukit.state``: saving and restoring the whole state (serialisable);
 - ``fmukit.model_description``: a complete modelDescription.xml;
-- ``fmukit.entry``: every FMI entry point made safe against pythonfmu 0.7's error path.
+- ``fmukit.entry``: every FMI entry point made safe against pythonfmu 0.7's error path;
+- ``fmukit.signals``: the host's Ctrl-C handled in the host's code, not inside the FMU.
 
 What a host sees. pythonfmu 0.7 can return fmi2OK, fmi2Fatal (any Python
 exception) and fmi2Discard with fmi2Terminated true (do_step returning False),
@@ -36,8 +37,9 @@ only failure status there is to give (docs/robustness.md argues it):
   is applied, and the FMU goes on as before;
 - reading an output never fails: what cannot be evaluated reads NaN.
 
-The reason reaches the user through the host's logger when it listens, and on
-standard error when it does not (``fmukit.hostlog``).
+The reason, beginning with the FMU's instance name, reaches the user through the
+host's logger when it listens, and on standard error when it does not
+(``fmukit.hostlog``).
 
 Time is rounded to whole nanoseconds before the model sees it (``fmukit.timebase``).
 """
