@@ -108,10 +108,10 @@ def test_a_nan_input_fails_the_c_autopilot_until_reset(c_autopilot, tmp_path):
         with pytest.raises(FmuCallError) as failed:
             fmu.do_step(0.0, 0.1)
         assert failed.value.status == "error"
-        assert "at t = 0: input psi is not finite" in str(failed.value)
+        assert "at t = 0: input psi = nan is not finite" in str(failed.value)
         assert math.isnan(fmu.get(["delta_c"])["delta_c"])
         fmu.set({"psi": 0.0})
-        with pytest.raises(FmuCallError, match="input psi is not finite"):
+        with pytest.raises(FmuCallError, match="input psi = nan is not finite"):
             fmu.do_step(0.0, 0.1)                # a valid input does not revive it
         fmu.reset()
         fmu.initialize()

@@ -35,10 +35,14 @@ static const fmi2Real START[N_VARIABLES] = {0.0, 0.0, 0.0, 0.0, 2.0, 50.0};
 
 static void say(Instance *c, fmi2Status status, const char *category, const char *format, ...) {
     char message[512];
+    int named;
     va_list args;
     if (status < fmi2Error && !c->logging) return;
+    /* Named, as every FMU of this project names itself: some hosts' logs do not. */
+    named = snprintf(message, sizeof message, "%s: ", c->name);
+    if (named < 0 || (size_t)named >= sizeof message) named = 0;
     va_start(args, format);
-    vsnprintf(message, sizeof message, format, args);
+    vsnprintf(message + named, sizeof message - (size_t)named, format, args);
     va_end(args);
     /* Passed as the format, without arguments: hosts that cannot take variadic
        callbacks (fmpy's ctypes logger) show the format. No message here holds a '%'. */
@@ -193,9 +197,9 @@ fmi2Status fmi2DoStep(fmi2Component component, fmi2Real t, fmi2Real h,
         return REFUSE(c, fmi2Error, "doStep with a communication step of %g s", h);
     for (i = PSI; i <= PSI_D; i++)
         if (!isfinite(c->value[i])) {
-            snprintf(c->failure, sizeof c->failure, "doStep at t = %g: input %s is not "
+            snprintf(c->failure, sizeof c->failure, "doStep at t = %g: input %s = %g is not "
                      "finite; the FMU has failed (delta_c reads NaN until fmi2Reset)", t,
-                     input[i]);
+                     input[i], c->value[i]);
             return REFUSE(c, fmi2Error, "%s", c->failure);
         }
     return fmi2OK;                                /* memoryless: nothing to advance */
