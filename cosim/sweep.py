@@ -20,8 +20,12 @@ def main(argv: list[str] | None = None) -> int:
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("spec", type=Path, help="sweep file (TOML)")
     parser.add_argument("--scheduler", metavar="ADDRESS",
-                        help="an existing Dask scheduler (default: a local cluster)")
-    parser.add_argument("--workers", type=int, help="local worker processes (default: cores)")
+                        help="an existing Dask scheduler (default: DASK_SCHEDULER_ADDRESS, "
+                             "else a local cluster)")
+    parser.add_argument("--scheduler-file", metavar="FILE",
+                        help="an existing Dask scheduler, from its --scheduler-file")
+    parser.add_argument("--workers", type=int,
+                        help="worker processes of the local cluster (default: cores)")
     parser.add_argument("--out", type=Path, default=RESULTS, help="parent folder of the results")
     parser.add_argument("--csv", action="store_true", help="also write results.csv")
     parser.add_argument("--no-progress", action="store_true",
@@ -35,7 +39,10 @@ def main(argv: list[str] | None = None) -> int:
     out = writable_folder(args.out / spec.name)
     try:
         rows = sweep.execute(spec, out, args.scheduler, args.workers,
-                             progress=not args.no_progress)
+                             progress=not args.no_progress, scheduler_file=args.scheduler_file)
+    except (sweep.SweepError, ValueError) as error:
+        print(f"error: {error}", file=sys.stderr)
+        return 2
     except Interrupted as interrupted:
         rows = sweep.completed(spec, out)
         written = sweep.write_tables(rows, out, args.csv) if rows else []
@@ -44,7 +51,10 @@ def main(argv: list[str] | None = None) -> int:
               "resumes the sweep", file=sys.stderr)
         return interrupted.exit_status
     written = sweep.write_tables(rows, out, args.csv)
-    written += save_figures(spec, rows, out)
+    if any(r["status"] == "ok" for r in rows):
+        written += save_figures(spec, rows, out)
+    else:
+        print("no run succeeded: no figures drawn", file=sys.stderr)
     if "pd" in spec.controllers and len(spec.controllers) > 1:
         (out / "comparison.md").write_text(sweep.comparison(spec, rows) + "\n")
         written.append(out / "comparison.md")

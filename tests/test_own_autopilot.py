@@ -14,7 +14,7 @@ from cosim.core.master import Master
 from cosim.interop.engines import run as run_engine
 from cosim.interop.ssp import export
 from cosim.scenarios.autopilot import AutopilotError, check_autopilot
-from cosim.studies import sweep
+from cosim.studies import sweep, sweep_task
 from helpers import fmu_variant
 
 RENAMED = {"psi": "heading", "r": "yaw_rate", "psi_d": "course", "delta_c": "rudder"}
@@ -123,8 +123,8 @@ def test_sweep_takes_an_autopilot_fmu_and_an_ssd_path(fmu_paths, foreign, tmp_pa
         wave_seed = [3]
     """.replace("'", '"').replace(":", " ="))
     spec = sweep.Spec.read(spec_path)
-    rows = {r["controller"]: sweep.run_one(spec, r) for r in spec.runs()}
-    sweep.free_masters()
+    rows = {r["controller"]: sweep.run_locally(spec, r) for r in spec.runs()}
+    sweep_task.free_masters()
     assert rows["ssd"]["status"] == rows["fmu"]["status"] == "ok"
     assert rows["ssd"]["J"] == rows["fmu"]["J"]          # the same PID, the same sea
 

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 from pathlib import Path
 
 import pyarrow.parquet as pq
@@ -12,7 +13,9 @@ from cosim import scenarios
 from cosim.analysis.cost import cost
 from cosim.analysis.seastate import model_scale
 from cosim.core.master import Master
-from cosim.studies import sweep
+from cosim.core.ssd import write_ssd
+from cosim.studies import sweep, sweep_task
+from cosim.studies.journal import Journal
 
 EXAMPLE = Path(__file__).resolve().parent.parent / "docs" / "sweeps" / "example.toml"
 
@@ -68,19 +71,48 @@ def test_settings_map_axes_to_fmu_parameters(tmp_path):
     ("[controllers]\npd = { scenario = 'nope' }", "scenario 'nope'"),
     ("[axes]\nHs = [0.0]\n[plots]\nmap = ['T0', 'Hs']", "'T0', which is not an axis"),
     ("name = ", "cannot read"),
+    ("[axes]\nwave_seed = { start = 1, count = 'three' }", "axis 'wave_seed' = .*a range is"),
+    ("stop_time = 'long'", "stop_time = 'long': give a number"),
+    ("stop = 400", "unknown key stop"),
+    ("[controllers]\npd = 3", "controller 'pd' = 3: give a scenario"),
+    ("[plots]\nmap = 'Hs'", "\\[plots\\] map = 'Hs': give a list"),
 ])
 def test_bad_spec_is_refused_by_name(tmp_path, text, fragment):
     with pytest.raises(ValueError, match=fragment):
         sweep.Spec.read(write_spec(tmp_path, text))
 
 
+def test_a_run_id_changes_with_everything_that_changes_its_result(fmu_paths, tmp_path):
+    base = '[controllers]\npd = { scenario = "%s" }\nsmc = { scenario = "waves_smc" }\n' \
+           '[axes]\nwave_seed = [1]\n'
+    def ids(text: str) -> dict[str, str]:
+        return {r["controller"]: r["run_id"] for r in sweep.Spec.read(
+            write_spec(tmp_path, text)).runs()}
+    first = ids(base % "waves_pd")
+    assert ids(base % "waves_pd") == first                              # stable
+    assert set(ids("stop_time = 100\n" + base % "waves_pd").values()).isdisjoint(first.values())
+    changed = ids(base.replace('"waves_smc" }', '"waves_smc", set = { "autopilot.eta_h" = 9.0 } }')
+                  % "waves_pd")
+    assert changed["pd"] == first["pd"] and changed["smc"] != first["smc"]
+    system = scenarios.load("waves_pd")                   # the same scenario, one value changed
+    system.components["autopilot"].parameters["Kd"] = 51.0
+    write_ssd(system, tmp_path / "edited.ssd")
+    assert ids(base % (tmp_path / "edited.ssd"))["pd"] != first["pd"]
+    own = tmp_path / "mine.fmu"                          # an autopilot FMU: by content
+    mine = '[controllers]\nmine = { autopilot = "mine.fmu" }\n[axes]\nwave_seed = [1]\n'
+    own.write_bytes(fmu_paths["pd_autopilot"].read_bytes())
+    before = ids(mine)
+    own.write_bytes(fmu_paths["pid_autopilot"].read_bytes())
+    assert ids(mine) != before
+
+
 def test_task_equals_a_direct_run_and_reuses_its_fmus(fmu_paths, tmp_path):
     spec = sweep.Spec.read(write_spec(tmp_path, SMALL))
     first, again = spec.runs()[0], spec.runs()[0]
-    row = sweep.run_one(spec, first)
-    master_before = dict(sweep._masters)
-    assert sweep.run_one(spec, again)["J"] == row["J"]        # after fmi2Reset, bit for bit
-    assert dict(sweep._masters) == master_before              # same instances, reused
+    row = sweep.run_locally(spec, first)
+    master_before = dict(sweep_task._masters)
+    assert sweep.run_locally(spec, again)["J"] == row["J"]        # after fmi2Reset, bit for bit
+    assert dict(sweep_task._masters) == master_before              # same instances, reused
     master = Master(scenarios.load("waves_pd"),
                     overrides={"ship": {"wave_seed": 1, "Hs": model_scale(2)[0],
                                         "T0": model_scale(2)[1], "delta_rate_max": 0.349}})
@@ -89,18 +121,18 @@ def test_task_equals_a_direct_run_and_reuses_its_fmus(fmu_paths, tmp_path):
     finally:
         master.free()
     assert row["status"] == "ok" and set(sweep.METRICS) <= set(row)
-    sweep.free_masters()
+    sweep_task.free_masters()
 
 
 def test_task_records_a_failed_run_with_its_message(fmu_paths, tmp_path):
     spec = sweep.Spec.read(write_spec(tmp_path, '[axes]\nHs = [-1.0]\n'))
-    row = sweep.run_one(spec, spec.runs()[0])
+    row = sweep.run_locally(spec, spec.runs()[0])
     assert row["status"] == "failed" and "parameter Hs = -1.0 is outside its range" in row["error"]
     assert math.isnan(row["J"])
-    sweep.free_masters()
+    sweep_task.free_masters()
 
 
-def test_dask_sweep_writes_resumes_and_plots(fmu_paths, tmp_path):
+def test_dask_sweep_writes_resumes_and_plots(fmu_paths, tmp_path, capsys):
     spec = sweep.Spec.read(write_spec(tmp_path, SMALL))
     out = tmp_path / "out"
     out.mkdir()
@@ -108,13 +140,17 @@ def test_dask_sweep_writes_resumes_and_plots(fmu_paths, tmp_path):
     assert [r["status"] for r in rows] == ["ok"] * 4
     journal = (out / "runs.jsonl").read_text().splitlines()
     assert len(journal) == 4
-    # An interrupted sweep: drop one finished row, run again, only that run is redone.
-    (out / "runs.jsonl").write_text("\n".join(journal[1:]) + "\n")
-    lost = json.loads(journal[0])["run_id"]
+    # Resume: a failed row and a torn last line (a write cut by a kill) are run again;
+    # nothing else is.
+    failed = {**json.loads(journal[0]), "status": "failed", "error": "a worker was lost"}
+    torn = journal[3][: len(journal[3]) // 2]
+    (out / "runs.jsonl").write_text("\n".join([json.dumps(failed), *journal[1:3], torn]))
     again = sweep.execute(spec, out, workers=1, progress=False)
+    assert "is not a whole journal row" in capsys.readouterr().err
     assert [r["J"] for r in again] == [r["J"] for r in rows]
-    assert len((out / "runs.jsonl").read_text().splitlines()) == 4
-    assert json.loads((out / "runs.jsonl").read_text().splitlines()[-1])["run_id"] == lost
+    redone = [json.loads(line)["run_id"] for line in
+              (out / "runs.jsonl").read_text().splitlines()[4:]]
+    assert sorted(redone) == sorted(json.loads(journal[i])["run_id"] for i in (0, 3))
     written = sweep.write_tables(again, out, csv=True)
     table = pq.read_table(written[0])
     assert table.num_rows == 4 and {"controller", "wave_seed", "J", "status"} <= set(
@@ -126,6 +162,13 @@ def test_dask_sweep_writes_resumes_and_plots(fmu_paths, tmp_path):
     J = {(r["controller"], r["wave_seed"]): r["J"] for r in again}
     wins = sum(J[("smc", s)] < J[("pd", s)] for s in (1, 2))
     assert f"| {wins}/2 |" in settings[0]
+
+
+def test_a_journal_has_one_writer(fmu_paths, tmp_path):
+    spec = sweep.Spec.read(write_spec(tmp_path, SMALL))
+    with Journal(tmp_path / "runs.jsonl"):
+        with pytest.raises(sweep.SweepError, match=f"being written by process {os.getpid()} on"):
+            sweep.execute(spec, tmp_path, workers=1, progress=False)
 
 
 def test_a_worker_killed_on_every_retry_is_recorded_as_failed(fmu_paths, tmp_path):

@@ -9,7 +9,9 @@ numpy, fmpy and pythonfmu. Strict JSON: a non-finite number is written as a stri
 """
 from __future__ import annotations
 
+import functools
 import hashlib
+import importlib.util
 import json
 import math
 import platform
@@ -23,6 +25,7 @@ from typing import Any
 from .recording import Recording
 
 PACKAGE = "ship-autopilot-cosim"
+CODE_PACKAGES = ("cosim", "fmukit", "ship_fmu", "autopilot_fmu")
 
 
 def _version(distribution: str) -> str | None:
@@ -53,6 +56,19 @@ def _commit() -> str | None:
     if head.returncode != 0:
         return None
     return head.stdout.strip() + ("+changes" if dirty.stdout.strip() else "")
+
+
+@functools.lru_cache(maxsize=1)
+def code_version() -> str:
+    """This package's version and a SHA-256 of its Python sources (12 digits): two
+    environments with the same string run the same code, from a checkout or a wheel."""
+    digest = hashlib.sha256()
+    for package in CODE_PACKAGES:
+        root = Path(importlib.util.find_spec(package).submodule_search_locations[0])
+        for path in sorted(root.rglob("*.py")):
+            digest.update(f"{package}/{path.relative_to(root).as_posix()}\n".encode())
+            digest.update(path.read_bytes())
+    return f"{_version(PACKAGE)} (code {digest.hexdigest()[:12]})"
 
 
 def _strict(value: Any) -> Any:

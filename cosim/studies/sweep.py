@@ -44,32 +44,29 @@ from __future__ import annotations
 import hashlib
 import itertools
 import json
-import math
 import sys
-import threading
-import time
 import tomllib
+import uuid
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-from distributed import WorkerPlugin
 
 from .. import scenarios
-from ..analysis.cost import cost
-from ..analysis.metrics import sign_reversals_per_minute
 from ..analysis.seastate import model_scale
+from ..core.provenance import PACKAGE, code_version
 from ..scenarios.autopilot import check_autopilot
+from .bundle import Bundle, bundle
 from .cluster import connect
+from .journal import Journal, JournalLocked, read_rows, write_atomically
+from .sweep_task import (METRICS, Job, SweepTeardown, blank_row, fmu_bytes, run_one,
+                         worker_facts)
 
 DEFAULT_CONTROLLERS = {"pd": {"scenario": "waves_pd"}, "smc": {"scenario": "waves_smc"}}
 # Axis shorthands: name -> the FMU parameter it sets.
 SHORTHANDS = {"wave_seed": "ship.wave_seed", "Hs": "ship.Hs", "T0": "ship.T0",
               "psi_w": "ship.psi_w", "route": "guidance.waypoints"}
-METRICS = {"psi_E": "rad^2", "sum_delta2": "rad^2", "J": "rad^2",
-           "rms_heading_error_deg": "deg", "reversals_per_min": "1/min", "max_delta_deg": "deg"}
-"""The figures of merit of a run and their units, as ``cosim.run`` prints them."""
 
 
 @dataclass
@@ -80,6 +77,8 @@ class Spec:
     stop_time: float | None = None
     map_axes: list[str] = field(default_factory=list)
     tracks: dict[str, Any] | None = None      # which runs record their track: axis values
+    _bundles: dict[str, Bundle] | None = field(default=None, repr=False, compare=False)
+    _files: dict[str, Path] = field(default_factory=dict, repr=False, compare=False)
 
     def wants_track(self, run: dict[str, Any]) -> bool:
         """Whether ``run`` is one of the runs whose tracks are drawn ([plots] tracks)."""
@@ -87,52 +86,79 @@ class Spec:
 
     @classmethod
     def read(cls, path: str | Path) -> Spec:
-        """Parse a sweep file; ValueError naming the file and the problem."""
+        """Parse a sweep file; ValueError naming the file, the key and the problem."""
         path = Path(path)
         try:
             data = tomllib.loads(path.read_text())
         except (OSError, tomllib.TOMLDecodeError) as error:
             raise ValueError(f"cannot read sweep spec {path}: {error}") from None
+        unknown = set(data) - {"name", "stop_time", "controllers", "axes", "plots"}
+        if unknown:
+            raise ValueError(f"{path}: unknown key {', '.join(sorted(unknown))}; a sweep file "
+                             "has name, stop_time, [controllers], [axes] and [plots]")
+        name = _typed(path, "name", data.get("name", path.stem), str, "a string")
+        stop_time = data.get("stop_time")
+        if stop_time is not None and (isinstance(stop_time, bool)
+                                      or not isinstance(stop_time, (int, float))
+                                      or not stop_time > 0):
+            raise ValueError(f"{path}: stop_time = {stop_time!r}: give a number of seconds > 0")
+        entries = _typed(path, "[controllers]", data.get("controllers", DEFAULT_CONTROLLERS),
+                         dict, "a table")
         controllers = {name: controller_entry(entry, path, name)
-                       for name, entry in data.get("controllers", DEFAULT_CONTROLLERS).items()}
-        axes = {}
-        for name, values in data.get("axes", {}).items():
-            if isinstance(values, dict):
-                values = list(range(values["start"], values["start"] + values["count"]))
-            if not isinstance(values, list) or not values:
-                raise ValueError(f"{path}: axis {name!r} needs a non-empty list of values")
-            if name not in SHORTHANDS and name != "sea_state" and "." not in name:
-                raise ValueError(f"{path}: axis {name!r} is neither one of "
-                                 f"{', '.join(['sea_state', *SHORTHANDS])} nor component.variable")
-            if name == "sea_state":
-                for code in values:
-                    model_scale(code)            # ValueError for codes outside 0-6
-            axes[name] = values
-        plots = data.get("plots", {})
-        map_axes = plots.get("map", [])
+                       for name, entry in entries.items()}
+        axes = {name: _axis(path, name, values)
+                for name, values in _typed(path, "[axes]", data.get("axes", {}), dict,
+                                           "a table").items()}
+        plots = _typed(path, "[plots]", data.get("plots", {}), dict, "a table")
+        map_axes = _typed(path, "[plots] map", plots.get("map", []), list, "a list of axes")
         for axis in map_axes:
             if axis not in axes:
                 raise ValueError(f"{path}: [plots] map names {axis!r}, which is not an axis")
-        tracks = plots.get("tracks")
+        tracks = _typed(path, "[plots] tracks", plots.get("tracks", {}), dict,
+                        "a table of axis = value") or None
         for key, value in (tracks or {}).items():
             known = list(controllers) if key == "controller" else axes.get(key)
             if known is None or value not in known:
                 raise ValueError(f"{path}: [plots] tracks selects {key} = {value!r}; "
                                  f"select by controller or an axis, with one of its values")
-        return cls(name=data.get("name", path.stem), controllers=controllers, axes=axes,
-                   stop_time=data.get("stop_time"), map_axes=map_axes, tracks=tracks)
+        return cls(name=name, controllers=controllers, axes=axes, stop_time=stop_time,
+                   map_axes=map_axes, tracks=tracks)
+
+    def bundles(self) -> dict[str, Bundle]:
+        """Each controller's system with its FMUs named by content (read once)."""
+        if self._bundles is None:
+            self._bundles, self._files = {}, {}
+            for name, controller in self.controllers.items():
+                self._bundles[name], files = bundle(controller)
+                self._files.update(files)
+        return self._bundles
+
+    def files(self) -> dict[str, Path]:
+        """Every FMU the sweep uses, by SHA-256."""
+        self.bundles()
+        return self._files
 
     def runs(self) -> list[dict[str, Any]]:
-        """Every combination of controller and axis values, with a stable run id."""
+        """Every combination of controller and axis values, with its run id: a hash of
+        everything that determines the result (the system and its FMUs' contents, the
+        settings, the stop time, the axis values)."""
         names = list(self.axes)
         runs = []
-        for controller in self.controllers:
+        for controller, shipped in self.bundles().items():
             for values in itertools.product(*(self.axes[n] for n in names)):
                 point = {"controller": controller, **dict(zip(names, values))}
-                key = json.dumps(point, sort_keys=True)
-                point["run_id"] = hashlib.sha1(key.encode()).hexdigest()[:12]
+                identity = {"system": shipped.digest, "settings": self.settings(point)[1],
+                            "stop_time": self.stop_time, "point": point}
+                key = json.dumps(identity, sort_keys=True, default=str)
+                point["run_id"] = hashlib.sha256(key.encode()).hexdigest()[:16]
                 runs.append(point)
         return runs
+
+    def job(self, run: dict[str, Any], sweep: str) -> Job:
+        """What a worker needs for ``run`` (of the sweep with token ``sweep``)."""
+        return Job(sweep=sweep, run=run, bundle=self.bundles()[run["controller"]],
+                   overrides=self.settings(run)[1], stop_time=self.stop_time,
+                   track=self.wants_track(run), code=code_version())
 
     def settings(self, run: dict[str, Any]) -> tuple[str, dict[str, dict[str, Any]]]:
         """(scenario, overrides by component) of one run."""
@@ -156,6 +182,36 @@ class Spec:
         return controller["scenario"], overrides
 
 
+def _typed(path: Path, key: str, value: Any, kind: type, what: str) -> Any:
+    if not isinstance(value, kind):
+        raise ValueError(f"{path}: {key} = {value!r}: give {what}")
+    return value
+
+
+def _axis(path: Path, name: str, values: Any) -> list:
+    """An axis's values: a non-empty list, or a range { start = integer, count = integer }."""
+    if name not in SHORTHANDS and name != "sea_state" and "." not in name:
+        raise ValueError(f"{path}: axis {name!r} is neither one of "
+                         f"{', '.join(['sea_state', *SHORTHANDS])} nor component.variable")
+    if isinstance(values, dict):
+        start, count = values.get("start"), values.get("count")
+        if set(values) != {"start", "count"} or not all(
+                isinstance(v, int) and not isinstance(v, bool) for v in (start, count)) \
+                or count < 1:
+            raise ValueError(f"{path}: axis {name!r} = {values!r}: a range is "
+                             "{ start = <integer>, count = <integer >= 1> }")
+        values = list(range(start, start + count))
+    if not isinstance(values, list) or not values:
+        raise ValueError(f"{path}: axis {name!r} needs a non-empty list of values")
+    if name == "sea_state":
+        for code in values:
+            try:
+                model_scale(code)
+            except ValueError as error:
+                raise ValueError(f"{path}: axis 'sea_state': {error}") from None
+    return values
+
+
 def controller_entry(entry: str | dict[str, Any], spec: Path, name: str) -> dict[str, Any]:
     """A controller entry, checked, with its paths made absolute (relative to the spec file).
 
@@ -164,6 +220,9 @@ def controller_entry(entry: str | dict[str, Any], spec: Path, name: str) -> dict
     """
     if isinstance(entry, str):
         entry = {"autopilot": entry} if entry.endswith(".fmu") else {"scenario": entry}
+    if not isinstance(entry, dict):
+        raise ValueError(f"{spec}: controller {name!r} = {entry!r}: give a scenario, an "
+                         "autopilot FMU, or a table of scenario, autopilot, map and set")
     unknown = set(entry) - {"scenario", "autopilot", "map", "set"}
     if unknown:
         raise ValueError(f"{spec}: controller {name!r} has {', '.join(sorted(unknown))}; a "
@@ -186,169 +245,140 @@ def controller_entry(entry: str | dict[str, Any], spec: Path, name: str) -> dict
             "set": dict(entry.get("set", {}))}
 
 
-# -- the task, on a worker ------------------------------------------------------------
-_masters: dict[tuple[int, str], Any] = {}       # (thread, controller) -> Master
-_masters_lock = threading.Lock()
-
-
-def _key(controller: dict[str, Any]) -> tuple[int, str]:
-    system = {k: controller[k] for k in ("scenario", "autopilot", "map")}
-    return threading.get_ident(), json.dumps(system, sort_keys=True)
-
-
-def _master(controller: dict[str, Any]):
-    from ..core.master import Master
-
-    key = _key(controller)
-    with _masters_lock:
-        master = _masters.get(key)
-    if master is None:
-        master = Master(scenarios.load(controller["scenario"], controller["autopilot"],
-                                       controller["map"]))
-        with _masters_lock:
-            _masters[key] = master
-    else:
-        master.reset()
-    return master
-
-
-def _drop_master(controller: dict[str, Any]) -> None:
-    with _masters_lock:
-        master = _masters.pop(_key(controller), None)
-    if master is not None:
-        master.free()
-
-
-def free_masters() -> None:
-    """Free every cached master of this process (worker teardown)."""
-    with _masters_lock:
-        masters = list(_masters.values())
-        _masters.clear()
-    for master in masters:
-        master.free()
-
-
-def _row(run: dict[str, Any], error: str = "") -> dict[str, Any]:
-    """A result row for ``run``: failed with ``error`` if given, metrics still undefined."""
-    return {**run, "status": "failed" if error else "ok", "error": error,
-            **{m: math.nan for m in METRICS}, "seconds": math.nan}
-
-
-def run_one(spec: Spec, run: dict[str, Any]) -> dict[str, Any]:
-    """One whole co-simulation; never raises for a failed run, records it."""
-    started = time.perf_counter()
-    row = _row(run)
-    controller = spec.controllers[run["controller"]]
-    try:
-        _, overrides = spec.settings(run)
-        master = _master(controller)
-        master.configure(overrides)
-        recording = master.run(spec.stop_time)
-    except Exception as error:              # a bad setting: not worth retrying
-        _drop_master(controller)
-        row = _row(run, f"{type(error).__name__}: {error}")
-    else:
-        if recording.error:
-            _drop_master(controller)        # its FMUs may be in an error state
-            row = _row(run, recording.error)
-        else:
-            row.update(_metrics(recording))
-            if spec.wants_track(run):
-                row["track"] = _track(recording, master.parameters)
-    row["seconds"] = time.perf_counter() - started
-    return row
-
-
-def _track(recording, parameters: dict[str, dict[str, Any]], every: float = 1.0) -> dict:
-    """The run's track every ``every`` s, and its route, for the tracks figure."""
-    stride = max(1, round(every / recording.meta["step_size"]))
-    return {"x": recording["ship.x"][::stride].tolist(),
-            "y": recording["ship.y"][::stride].tolist(),
-            "route": parameters.get("guidance", {}).get("waypoints")}
-
-
-def _metrics(recording) -> dict[str, float]:
-    c = cost(recording)
-    delta = recording["ship.delta"]
-    return {"psi_E": c.psi_E, "sum_delta2": c.sum_delta2, "J": c.J,
-            "rms_heading_error_deg": math.degrees(math.sqrt(c.psi_E / recording.rows)),
-            "reversals_per_min": sign_reversals_per_minute(recording.t, delta),
-            "max_delta_deg": math.degrees(float(np.abs(delta).max()))}
-
-
 # -- the client side --------------------------------------------------------------------
-class Journal:
-    """Rows appended and flushed as they complete: a sweep resumes from it."""
-
-    def __init__(self, path: Path):
-        self.path = path
-        self.rows: dict[str, dict] = {}
-        if path.exists():
-            for line in path.read_text().splitlines():
-                if line.strip():
-                    row = json.loads(line)
-                    self.rows[row["run_id"]] = row
-
-    def add(self, row: dict) -> None:
-        with open(self.path, "a") as f:
-            f.write(json.dumps(row) + "\n")
-            f.flush()
-        self.rows[row["run_id"]] = row
+class SweepError(RuntimeError):
+    """The sweep cannot start: a worker runs other code, or another sweep holds the journal."""
 
 
-class _Teardown(WorkerPlugin):
-    """Free a worker's cached FMUs (and their temporary folders) at shutdown."""
+def _say(message: str) -> None:
+    print(message, file=sys.stderr, flush=True)
 
-    name = "cosim-sweep-teardown"
 
-    def teardown(self, worker) -> None:
-        free_masters()
+def run_locally(spec: Spec, run: dict[str, Any]) -> dict[str, Any]:
+    """One run of ``spec`` in this process, as a worker would do it."""
+    job = spec.job(run, "local")
+    return run_one(job, {sha: spec.files()[sha].read_bytes() for sha in job.bundle.fmu_hashes()})
+
+
+def check_workers(client) -> None:
+    """SweepError naming each worker that runs other code than this client (or none of
+    it); a warning for workers with more than one thread, or a scheduler that queues
+    more than one run per thread."""
+    mine = code_version()
+    try:
+        facts = client.run(worker_facts, on_error="return")
+    except Exception as error:              # e.g. no worker can import cosim at all
+        raise SweepError(f"cannot ask the workers what they run ({error})") from None
+    wrong = []
+    for address, fact in sorted(facts.items()):
+        theirs = fact["code"] if isinstance(fact, dict) else f"none ({type(fact).__name__}: {fact})"
+        if theirs != mine:
+            wrong.append(f"  {address} runs {PACKAGE} {theirs}")
+    if wrong:
+        raise SweepError(f"workers run other code than this client ({PACKAGE} {mine}):\n"
+                         + "\n".join(wrong) + "\ninstall the client's version on every worker "
+                         "(a wheel: pip wheel --no-deps -w dist . ; pip install dist/*.whl)")
+    threaded = {a: n for a, n in client.nthreads().items() if n > 1}
+    if threaded:
+        _say(f"warning: {', '.join(f'{a} has {n} threads' for a, n in threaded.items())}; a "
+             "run holds the GIL from start to end, so threads of one worker take turns: start "
+             "workers with --nthreads 1 and more processes (--nworkers)")
+    saturation = client.run_on_scheduler(_worker_saturation)
+    if saturation != 1.0:
+        _say(f"warning: the scheduler's worker-saturation is {saturation}: it queues more than "
+             "one run per worker thread, and a worker killed by one run takes the queued ones "
+             "with it; start the scheduler with DASK_DISTRIBUTED__SCHEDULER__WORKER_SATURATION=1.0")
+
+
+def _has_dashboard(dask_scheduler=None) -> bool:
+    """Whether the scheduler serves its dashboard (which needs bokeh where it runs)."""
+    import importlib.util
+    return ("dashboard" in dask_scheduler.services
+            and importlib.util.find_spec("bokeh") is not None)
+
+
+def _worker_saturation(dask_scheduler=None) -> float:
+    """The running scheduler's worker-saturation (read at its start from Dask's config)."""
+    return float(dask_scheduler.WORKER_SATURATION)
 
 
 def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | None = None,
-            progress: bool = True, task=None) -> list[dict]:
-    """Run the runs not yet in the journal; return every row of the sweep.
+            progress: bool = True, task=None, scheduler_file: str | None = None) -> list[dict]:
+    """Run every run of ``spec`` without an ok row in the journal (failed rows are run
+    again); return every row of the sweep.
 
-    ``task(spec, run) -> row`` is what each run executes (default ``run_one``). On
-    Ctrl-C or SIGTERM (``Interrupted``, raised again once the cluster is closed) the
-    runs completed so far stay in the journal (``completed``) and runs in progress
-    are lost; the same call then resumes.
+    ``task(job, blobs) -> row`` is what each run executes (default ``run_one``). Each
+    distinct FMU goes to the cluster once (``cosim.studies.bundle``); each run's future
+    is released as soon as its row is journaled, so a lost worker costs only the runs
+    it had in flight. On Ctrl-C or SIGTERM (``Interrupted``, raised again once the
+    cluster is closed) the runs completed so far stay in the journal (``completed``);
+    the same call then resumes. SweepError if a worker runs other code than the client
+    or another sweep writes the journal.
     """
+    try:
+        with Journal(out / "runs.jsonl") as journal:
+            todo = [r for r in spec.runs()
+                    if journal.rows.get(r["run_id"], {}).get("status") != "ok"]
+            if todo:
+                _run_on_cluster(spec, todo, journal, connect(scheduler, workers, scheduler_file),
+                                progress, task or run_one)
+    except JournalLocked as locked:
+        raise SweepError(str(locked)) from None
+    return completed(spec, out)
+
+
+def _run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, progress: bool,
+                    task) -> None:
     from dask.distributed import as_completed
 
-    journal = Journal(out / "runs.jsonl")
-    todo = [r for r in spec.runs() if r["run_id"] not in journal.rows]
-    if todo:
-        client, cluster = connect(scheduler, workers)
-        try:
-            client.register_plugin(_Teardown())
-            futures = {client.submit(task or run_one, spec, run, retries=2, pure=False,
-                                     key=f"run-{run['run_id']}"): run for run in todo}
-            bar = None
-            if progress:
-                from tqdm import tqdm
-                bar = tqdm(total=len(todo), desc=spec.name, unit="run", file=sys.stderr,
-                           disable=None)                # None: only on a terminal
-            for future in as_completed(futures):
-                try:
-                    row = future.result()
-                except Exception as error:          # the worker died on every retry
-                    row = _row(futures[future], f"{type(error).__name__}: {error}")
-                journal.add(row)
-                if bar is not None:
-                    bar.update()
+    client, cluster = connection
+    token = uuid.uuid4().hex[:12]
+    teardown = SweepTeardown(token)
+    try:
+        if client.run_on_scheduler(_has_dashboard):
+            _say(f"dashboard: {client.dashboard_link}")
+        check_workers(client)
+        client.register_plugin(teardown)
+        # Each FMU as a task holding its bytes, not scattered data: a task's result lost with
+        # its worker is computed again, scattered data is gone, and every run with it.
+        shipped = {sha: client.submit(fmu_bytes, path.read_bytes(), key=f"fmu-{sha}", pure=False)
+                   for sha, path in spec.files().items()}
+        futures = {}
+        for run in todo:
+            job = spec.job(run, token)
+            blobs = {sha: shipped[sha] for sha in job.bundle.fmu_hashes()}
+            futures[client.submit(task, job, blobs, retries=2, pure=False,
+                                  key=f"run-{token}-{run['run_id']}")] = run
+        bar = None
+        if progress:
+            from tqdm import tqdm
+            bar = tqdm(total=len(todo), desc=spec.name, unit="run", file=sys.stderr,
+                       disable=None)                # None: only on a terminal
+        for future in as_completed(futures):
+            run = futures.pop(future)
+            try:
+                row = future.result()
+            except Exception as error:          # the worker died on every retry
+                row = blank_row(run, f"{type(error).__name__}: {error}")
+            journal.add(row)
+            future.release()                    # done: nothing to recompute if a worker dies
             if bar is not None:
-                bar.close()
-        finally:
-            client.close()
-            if cluster is not None:
-                cluster.close()
-    return completed(spec, out)
+                bar.update()
+        if bar is not None:
+            bar.close()
+    finally:
+        try:
+            client.unregister_worker_plugin(teardown.name)   # frees this sweep's FMUs
+        except Exception:                       # the cluster may be gone (Ctrl-C)
+            pass
+        client.close()
+        if cluster is not None:
+            cluster.close()
 
 
 def completed(spec: Spec, out: Path) -> list[dict]:
     """The rows of ``spec``'s runs in its journal, in the order of ``spec.runs()``."""
-    rows = Journal(out / "runs.jsonl").rows
+    rows = read_rows(out / "runs.jsonl", quiet=True)
     return [rows[r["run_id"]] for r in spec.runs() if r["run_id"] in rows]
 
 
@@ -365,16 +395,17 @@ def write_tables(rows: list[dict], out: Path, csv: bool) -> list[Path]:
              for name in table.column_names}
     table = table.cast(pa.schema([field.with_metadata({"unit": units[field.name]})
                                   for field in table.schema]))
-    written = [out / "results.parquet", out / "results.json"]
-    pq.write_table(table, written[0])
-    written[1].write_text(json.dumps({"units": units}, indent=1) + "\n")
+    written = [write_atomically(out / "results.parquet", lambda p: pq.write_table(table, p)),
+               write_atomically(out / "results.json", lambda p: p.write_text(
+                   json.dumps({"units": units}, indent=1) + "\n"))]
     if csv:
-        written.append(out / "results.csv")
-        pacsv.write_csv(table, written[2])
+        written.append(write_atomically(out / "results.csv",
+                                        lambda p: pacsv.write_csv(table, p)))
     return written
 
 
-def summary(spec: Spec, rows: list[dict]) -> str:
+def summary(spec: Spec, rows: list[dict], shown_failures: int = 10) -> str:
+    """Runs, ok and failed; J by controller; each failed run with its message."""
     ok = [r for r in rows if r["status"] == "ok"]
     lines = [f"{spec.name}: {len(rows)} runs, {len(ok)} ok, {len(rows) - len(ok)} failed"]
     for controller in spec.controllers:
@@ -383,11 +414,14 @@ def summary(spec: Spec, rows: list[dict]) -> str:
             lines.append(f"  {controller:>14}: J median {np.median(J):9.2f}, mean {J.mean():9.2f}"
                          f", 5-95 % {np.percentile(J, 5):9.2f} - {np.percentile(J, 95):9.2f}"
                          f" ({J.size} runs)")
-    for r in rows:
-        if r["status"] != "ok":
-            lines.append(f"  failed {r['run_id']} {r['controller']}: "
-                         f"{r['error'].splitlines()[0][:160]}")
-            break
+    failed = [r for r in rows if r["status"] != "ok"]
+    for r in failed[:shown_failures]:
+        axes = ", ".join(f"{a} = {r[a]}" for a in spec.axes)
+        lines.append(f"  failed {r['controller']} ({axes}): "
+                     f"{(r['error'].splitlines() or [''])[0][:200]}")
+    if len(failed) > shown_failures:
+        lines.append(f"  ... and {len(failed) - shown_failures} more failed runs (results.parquet "
+                     "has every message)")
     return "\n".join(lines)
 
 

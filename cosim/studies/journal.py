@@ -1,0 +1,106 @@
+"""A sweep's journal: one JSON row per finished run, appended and flushed as runs complete.
+
+The journal is what a sweep resumes from, so it must survive what ends a process
+mid-write: a torn last line (a write cut by a kill) is skipped with a warning, and
+its run is done again. One sweep writes a journal at a time: a second writer is
+refused with a message naming the holder of the lock (process, host, since when).
+Tables derived from it are written atomically (``write_atomically``).
+"""
+from __future__ import annotations
+
+import fcntl
+import json
+import os
+import socket
+import sys
+import time
+from pathlib import Path
+from typing import Callable, TextIO
+
+
+class JournalLocked(RuntimeError):
+    """Another process writes this journal."""
+
+
+def read_rows(path: Path, quiet: bool = False) -> dict[str, dict]:
+    """The rows of a journal by run id; lines that are not whole rows are skipped, with a
+    warning naming the file and line (a later row for the same run replaces an earlier)."""
+    rows: dict[str, dict] = {}
+    if not path.exists():
+        return rows
+    for number, line in enumerate(path.read_text().splitlines(), 1):
+        if not line.strip():
+            continue
+        try:
+            row = json.loads(line)
+            rows[row["run_id"]] = row
+        except (ValueError, KeyError, TypeError):
+            if not quiet:
+                print(f"warning: {path}:{number} is not a whole journal row (a write cut "
+                      "short?); skipped, its run is done again", file=sys.stderr)
+    return rows
+
+
+class Journal:
+    """The journal of one sweep, locked for writing while open (``with Journal(path)``)."""
+
+    def __init__(self, path: Path):
+        self.path = path
+        self.rows = read_rows(path)
+        self._lock_file: TextIO | None = None
+
+    def __enter__(self) -> Journal:
+        lock = self.path.with_name(self.path.name + ".lock")
+        handle = open(lock, "a+")
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            handle.seek(0)
+            holder = handle.read().strip() or "another process"
+            handle.close()
+            raise JournalLocked(f"{self.path} is being written by {holder}; wait for that "
+                                "sweep to end, or give this one another --out") from None
+        handle.seek(0)
+        handle.truncate()
+        handle.write(f"process {os.getpid()} on {socket.gethostname()} since "
+                     f"{time.strftime('%Y-%m-%d %H:%M:%S')}\n")
+        handle.flush()
+        self._lock_file = handle
+        self._repair_tail()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self._lock_file is not None:
+            fcntl.flock(self._lock_file, fcntl.LOCK_UN)
+            self._lock_file.close()
+            self._lock_file = None
+
+    def _repair_tail(self) -> None:
+        """End the file with a newline, so that a torn last line stays a line of its own."""
+        if self.path.exists() and self.path.stat().st_size:
+            with open(self.path, "rb+") as f:
+                f.seek(-1, os.SEEK_END)
+                if f.read(1) != b"\n":
+                    f.write(b"\n")
+
+    def add(self, row: dict) -> None:
+        """Append a row and flush it to the file."""
+        if self._lock_file is None:
+            raise RuntimeError("a Journal is written within 'with', which locks it")
+        with open(self.path, "a") as f:
+            f.write(json.dumps(row) + "\n")
+            f.flush()
+            os.fsync(f.fileno())
+        self.rows[row["run_id"]] = row
+
+
+def write_atomically(target: Path, write: Callable[[Path], None]) -> Path:
+    """``write(path)`` to a temporary path beside ``target``, then rename it to ``target``:
+    a reader sees the old file or the new one, never half of one."""
+    temporary = target.with_name(f".{target.name}.{os.getpid()}.tmp")
+    try:
+        write(temporary)
+        os.replace(temporary, target)
+    finally:
+        temporary.unlink(missing_ok=True)
+    return target

@@ -1,0 +1,147 @@
+"""A sweep's task, on a worker: one whole co-simulation, from a ``Job`` and the FMUs' bytes.
+
+A worker keeps one master per sweep, thread and system (``Bundle.digest``) and resets
+it (fmi2Reset) between tasks. Each sweep registers its own ``SweepTeardown`` worker
+plugin, named after the sweep's token: when the sweep ends (or the worker closes) it
+frees that sweep's masters only, so two sweeps on one cluster do not free each
+other's FMUs.
+"""
+from __future__ import annotations
+
+import math
+import threading
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from distributed import WorkerPlugin
+
+from ..analysis.cost import cost
+from ..analysis.metrics import sign_reversals_per_minute
+from ..core.provenance import code_version
+from .bundle import Bundle, materialise
+
+METRICS = {"psi_E": "rad^2", "sum_delta2": "rad^2", "J": "rad^2",
+           "rms_heading_error_deg": "deg", "reversals_per_min": "1/min", "max_delta_deg": "deg"}
+"""The figures of merit of a run and their units, as ``cosim.run`` prints them."""
+
+
+@dataclass(frozen=True)
+class Job:
+    """One run as a worker receives it: nothing is read from the client's disk."""
+    sweep: str                          # the sweep's token: whose masters these are
+    run: dict[str, Any]                 # run_id, controller and axis values
+    bundle: Bundle
+    overrides: dict[str, dict[str, Any]]
+    stop_time: float | None
+    track: bool                         # record the track for the tracks figure
+    code: str                           # the client's code_version(): the worker's must match
+
+
+_masters: dict[tuple[str, int, str], Any] = {}      # (sweep, thread, digest) -> Master
+_masters_lock = threading.Lock()
+
+
+def _master(job: Job, blobs: dict[str, bytes]):
+    from ..core.master import Master
+
+    key = (job.sweep, threading.get_ident(), job.bundle.digest)
+    with _masters_lock:
+        master = _masters.get(key)
+    if master is None:
+        master = Master(materialise(job.bundle, blobs))
+        with _masters_lock:
+            _masters[key] = master
+    else:
+        master.reset()
+    return master
+
+
+def _drop_master(job: Job) -> None:
+    with _masters_lock:
+        master = _masters.pop((job.sweep, threading.get_ident(), job.bundle.digest), None)
+    if master is not None:
+        master.free()
+
+
+def free_masters(sweep: str | None = None) -> None:
+    """Free this process's cached masters: of one sweep, or all."""
+    with _masters_lock:
+        keys = [k for k in _masters if sweep is None or k[0] == sweep]
+        masters = [_masters.pop(k) for k in keys]
+    for master in masters:
+        master.free()
+
+
+class SweepTeardown(WorkerPlugin):
+    """Frees one sweep's masters (and their temporary folders) on a worker."""
+
+    def __init__(self, sweep: str):
+        self.sweep = sweep
+        self.name = f"cosim-sweep-{sweep}"
+
+    def teardown(self, worker) -> None:
+        free_masters(self.sweep)
+
+
+def worker_facts() -> dict[str, Any]:
+    """What the client checks of a worker before it sends work: the code it runs."""
+    return {"code": code_version()}
+
+
+def fmu_bytes(data: bytes) -> bytes:
+    """An FMU's file, as a task's result: what each run of its system depends on."""
+    return data
+
+
+def blank_row(run: dict[str, Any], error: str = "") -> dict[str, Any]:
+    """A result row for ``run``: failed with ``error`` if given, metrics still undefined."""
+    return {**run, "status": "failed" if error else "ok", "error": error,
+            **{m: math.nan for m in METRICS}, "seconds": math.nan, "sim_seconds": math.nan}
+
+
+def run_one(job: Job, blobs: dict[str, bytes]) -> dict[str, Any]:
+    """One whole co-simulation; never raises for a failed run, records it. ``seconds`` is
+    the task's wall time, ``sim_seconds`` the master's run alone."""
+    started = time.perf_counter()
+    row = blank_row(job.run)
+    if job.code != code_version():          # a worker that joined after the client's check
+        return blank_row(job.run, f"worker runs {code_version()}, the client {job.code}: "
+                                  "install the client's version on every worker")
+    try:
+        master = _master(job, blobs)
+        master.configure(job.overrides)
+        simulating = time.perf_counter()
+        recording = master.run(job.stop_time)
+        row["sim_seconds"] = time.perf_counter() - simulating
+    except Exception as error:              # a bad setting: not worth retrying
+        _drop_master(job)
+        row = blank_row(job.run, f"{type(error).__name__}: {error}")
+    else:
+        if recording.error:
+            _drop_master(job)               # its FMUs may be in an error state
+            row = blank_row(job.run, recording.error)
+        else:
+            row.update(_metrics(recording))
+            if job.track:
+                row["track"] = _track(recording, master.parameters)
+    row["seconds"] = time.perf_counter() - started
+    return row
+
+
+def _track(recording, parameters: dict[str, dict[str, Any]], every: float = 1.0) -> dict:
+    """The run's track every ``every`` s, and its route, for the tracks figure."""
+    stride = max(1, round(every / recording.meta["step_size"]))
+    return {"x": recording["ship.x"][::stride].tolist(),
+            "y": recording["ship.y"][::stride].tolist(),
+            "route": parameters.get("guidance", {}).get("waypoints")}
+
+
+def _metrics(recording) -> dict[str, float]:
+    c = cost(recording)
+    delta = recording["ship.delta"]
+    return {"psi_E": c.psi_E, "sum_delta2": c.sum_delta2, "J": c.J,
+            "rms_heading_error_deg": math.degrees(math.sqrt(c.psi_E / recording.rows)),
+            "reversals_per_min": sign_reversals_per_minute(recording.t, delta),
+            "max_delta_deg": math.degrees(float(np.abs(delta).max()))}
