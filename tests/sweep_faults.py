@@ -8,3 +8,4 @@ def killing_task(job, blobs):
     if job.run["wave_seed"] == 2:
         os._exit(3)                 # the worker dies; Dask retries, then gives up
     return run_one(job, blobs)
+

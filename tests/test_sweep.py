@@ -179,3 +179,26 @@ def test_a_worker_killed_on_every_retry_is_recorded_as_failed(fmu_paths, tmp_pat
     assert by_seed[("pd", 1)]["status"] == "ok"
     assert by_seed[("pd", 2)]["status"] == "failed"
     assert "KilledWorker" in by_seed[("pd", 2)]["error"]
+
+
+def test_two_sweeps_on_one_cluster_both_finish_with_every_row(fmu_paths, tmp_path):
+    """Each sweep frees only its own FMUs: the first to end must not free the other's."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from cosim.studies.cluster import local_cluster
+
+    for name in ("short", "long"):
+        (tmp_path / name).mkdir()
+    specs = [sweep.Spec.read(write_spec(tmp_path / name, text)) for name, text in (
+        ("short", 'name = "short"\nstop_time = 5\n[axes]\nwave_seed = [1, 2]\n'),
+        ("long", 'name = "long"\nstop_time = 60\n[axes]\nwave_seed = [1, 2, 3]\n'))]
+    cluster = local_cluster(2)
+    try:
+        with ThreadPoolExecutor(2) as pool:
+            done = list(pool.map(lambda spec: sweep.execute(
+                spec, tmp_path / spec.name, scheduler=cluster.scheduler_address,
+                progress=False), specs))
+    finally:
+        cluster.close()
+    assert [len(rows) for rows in done] == [4, 6]
+    assert all(r["status"] == "ok" for rows in done for r in rows), done
