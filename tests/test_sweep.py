@@ -202,3 +202,21 @@ def test_two_sweeps_on_one_cluster_both_finish_with_every_row(fmu_paths, tmp_pat
         cluster.close()
     assert [len(rows) for rows in done] == [4, 6]
     assert all(r["status"] == "ok" for rows in done for r in rows), done
+
+
+def test_when_every_run_fails_the_summary_still_names_each_failure(fmu_paths, tmp_path):
+    import subprocess
+    import sys
+
+    spec = write_spec(tmp_path, 'name = "bad"\nstop_time = 5\n[axes]\nHs = [-1.0]\n')
+    child = subprocess.run([sys.executable, "-m", "cosim.sweep", str(spec), "--workers", "1",
+                            "--out", str(tmp_path / "out"), "--no-progress"],
+                           capture_output=True, text=True, timeout=300)
+    assert child.returncode == 1, child.stderr
+    assert "bad: 2 runs, 0 ok, 2 failed" in child.stdout
+    for controller in ("pd", "smc"):
+        assert (f"failed {controller} (Hs = -1.0): FMU 'ship': exitInitializationMode at t = 0 s "
+                "returned OK but logged an error / ship log: [error] exitInitializationMode at "
+                "t = 0.0: parameter Hs = -1.0 is outside its range") in child.stdout, child.stdout
+    assert "no run succeeded: no figures drawn" in child.stderr
+    assert (tmp_path / "out" / "bad" / "results.parquet").exists()

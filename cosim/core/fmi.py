@@ -19,7 +19,7 @@ from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFr
 from fmpy.model_description import ModelDescription
 
 from fmukit.entry import Refused, unnamed
-from fmukit.packaging import BUILD_HINT, FMU_DIR
+from fmukit.packaging import BUILD_HINT, FMUS
 
 from .instance import FmuCallError, Instance, logged_error
 
@@ -28,8 +28,8 @@ STATUS = ("ok", "warning", "discard", "error", "fatal", "pending")
 
 def read_description(path: Path, name: str) -> ModelDescription:
     """An FMU's model description; FileNotFoundError or ValueError naming the file (and,
-    for one of ours in fmus/, how to build it) when the FMU is missing or not readable."""
-    hint = f"; {BUILD_HINT}" if path.parent.resolve() == FMU_DIR.resolve() else ""
+    for one named as ours, how to build it) when the FMU is missing or not readable."""
+    hint = f"; {BUILD_HINT}" if path.stem in FMUS else ""      # one of ours: build it
     if not path.is_file():
         raise FileNotFoundError(f"FMU for '{name}' not found: {path}{hint}")
     try:

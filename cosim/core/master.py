@@ -16,6 +16,7 @@ to stop (``cosim.core.interrupt``: Ctrl-C, SIGTERM), between two steps.
 """
 from __future__ import annotations
 
+import re
 import time
 from pathlib import Path
 from typing import Any, Callable
@@ -31,6 +32,9 @@ from .null import NullInstance
 from .recording import Recorder, Recording
 from .ssd import SystemDescription
 from .wiring import check_connections, feedthrough_order, layout
+
+# How our FMUs refuse a NaN input: at initialisation, the consequence of another FMU's failure.
+_NAN_INPUT = re.compile(r"input \w+ = nan is not finite")
 
 BACKENDS: dict[str, type[Instance]] = {"fmi": FmuInstance, "inprocess": InProcessInstance,
                                        "null": NullInstance}
@@ -95,8 +99,15 @@ class Master:
                     values[node.outputs] = node.read_outputs()
                 if node.apply_inputs:
                     node.apply_inputs(values)
+        failures = []
         for instance in self.instances.values():
-            instance.exit_initialization(t0)
+            try:
+                instance.exit_initialization(t0)
+            except FmuCallError as error:
+                failures.append(error)
+        if failures:                      # the cause, not an FMU that read its NaN outputs
+            raise next((f for f in failures if not any(map(_NAN_INPUT.search, f.messages))),
+                       failures[0])
 
     def run(self, stop_time: float | None = None,
             progress: Callable[[int, int], None] | None = None,

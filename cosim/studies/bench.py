@@ -167,7 +167,9 @@ def memory(hours: float) -> None:
 
 
 def sweep_throughput(runs: int, worker_counts: tuple[int, ...] = (1, 2)) -> None:
-    """Runs per second of a waves_pd/waves_smc seed sweep (400 s each) on a local cluster."""
+    """Runs per second of a waves_pd/waves_smc seed sweep (400 s each) on a local cluster,
+    the scaling from one worker to more, and the overhead per run: in the task (its wall
+    time minus the master's run) and outside it (worker time per run minus task time)."""
     from dask.distributed import Client
 
     from .cluster import local_cluster
@@ -175,6 +177,7 @@ def sweep_throughput(runs: int, worker_counts: tuple[int, ...] = (1, 2)) -> None
 
     print(f"sweep throughput: {runs} runs of 400 s (waves_pd and waves_smc, wave seeds), "
           f"on {machine()}")
+    rates = {}
     for workers in worker_counts:
         with tempfile.TemporaryDirectory() as tmp:
             spec_path = Path(tmp) / "bench.toml"
@@ -191,6 +194,20 @@ def sweep_throughput(runs: int, worker_counts: tuple[int, ...] = (1, 2)) -> None
             finally:
                 cluster.close()
             done = time.perf_counter()
-        ok = sum(r["status"] == "ok" for r in rows)
-        print(f"  {workers} worker{'s' if workers > 1 else ' '}: {ok / (done - ready):5.2f} runs/s "
-              f"({ok} runs in {done - ready:5.1f} s; cluster start-up {ready - started:4.1f} s)")
+        ok = [r for r in rows if r["status"] == "ok"]
+        wall = done - ready
+        rates[workers] = len(ok) / wall
+        simulated = sum(r["sim_seconds"] for r in ok) / len(ok)
+        in_task = sum(r["seconds"] - r["sim_seconds"] for r in ok) / len(ok)
+        outside = wall * workers / len(ok) - simulated - in_task
+        print(f"  {workers} worker{'s' if workers > 1 else ' '}: {rates[workers]:5.2f} runs/s "
+              f"({len(ok)} runs in {wall:5.1f} s; cluster start-up {ready - started:4.1f} s); "
+              f"per run: simulation {simulated:5.3f} s, overhead in the task {in_task:5.3f} s "
+              f"({in_task / simulated:4.1%}), outside it {outside:5.3f} s "
+              f"({outside / simulated:4.1%})")
+    base = min(worker_counts)
+    for workers in worker_counts:
+        if workers != base:
+            print(f"  scaling {base} -> {workers} workers: {rates[workers] / rates[base]:4.2f}x, "
+                  f"parallel efficiency {rates[workers] / rates[base] / (workers / base):4.2f} "
+                  "(1.00: each worker as fast as one alone)")

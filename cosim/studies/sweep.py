@@ -417,8 +417,8 @@ def summary(spec: Spec, rows: list[dict], shown_failures: int = 10) -> str:
     failed = [r for r in rows if r["status"] != "ok"]
     for r in failed[:shown_failures]:
         axes = ", ".join(f"{a} = {r[a]}" for a in spec.axes)
-        lines.append(f"  failed {r['controller']} ({axes}): "
-                     f"{(r['error'].splitlines() or [''])[0][:200]}")
+        said = [line.strip() for line in r["error"].splitlines()[:2]]   # the call, the FMU's words
+        lines.append(f"  failed {r['controller']} ({axes}): {' / '.join(said)[:300]}")
     if len(failed) > shown_failures:
         lines.append(f"  ... and {len(failed) - shown_failures} more failed runs (results.parquet "
                      "has every message)")
