@@ -7,15 +7,14 @@ workers of an existing cluster should be started the same way
 """
 from __future__ import annotations
 
-import importlib.util
 import logging
 
 from dask.distributed import Client, LocalCluster
 
 
 def local_cluster(workers: int | None = None) -> LocalCluster:
-    """``workers`` single-threaded worker processes (default: one per core), quiet; with a
-    dashboard where bokeh is installed.
+    """``workers`` single-threaded worker processes (default: one per core), quiet; its web
+    server on a free port (the dashboard, where bokeh is installed).
 
     One task in flight per worker thread (worker-saturation 1.0): when a run kills
     its worker, no queued neighbour is counted as having died with it (and failed
@@ -23,10 +22,9 @@ def local_cluster(workers: int | None = None) -> LocalCluster:
     """
     import dask
 
-    dashboard = ":0" if importlib.util.find_spec("bokeh") is not None else None
     with dask.config.set({"distributed.scheduler.worker-saturation": 1.0}):
         return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                            dashboard_address=dashboard, silence_logs=logging.ERROR)
+                            dashboard_address=":0", silence_logs=logging.ERROR)
 
 
 def connect(scheduler: str | None = None, workers: int | None = None,

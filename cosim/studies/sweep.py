@@ -367,12 +367,13 @@ def _run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, 
         if bar is not None:
             bar.close()
     finally:
-        try:
-            client.unregister_worker_plugin(teardown.name)   # frees this sweep's FMUs
-        except Exception:                       # the cluster may be gone (Ctrl-C)
-            pass
+        if cluster is None:                     # a shared cluster: free this sweep's FMUs
+            try:
+                client.unregister_worker_plugin(teardown.name)
+            except Exception:                   # workers gone with Ctrl-C
+                pass
         client.close()
-        if cluster is not None:
+        if cluster is not None:                 # closing its workers frees everything
             cluster.close()
 
 
