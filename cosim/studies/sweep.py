@@ -31,13 +31,20 @@ Without [controllers], pd and smc run on waves_pd and waves_smc. Paths are relat
 to the sweep file; an autopilot FMU must keep the port contract of
 ``cosim.scenarios.autopilot``.
 
-Each Dask task is one whole co-simulation with our master. A worker extracts the
-FMUs once per scenario and thread and resets them (fmi2Reset) between tasks.
-Results: results/sweeps/<name>/runs.jsonl gets each row as it completes (flushed),
-so an interrupted sweep resumes where it stopped; results.parquet (and
-results.csv with --csv) hold the table at the end; a summary is printed, two
-figures are written, and comparison.md pairs every controller with pd seed by seed. A task whose worker dies is retried twice, then recorded
-as failed; an FMU error is recorded as failed at once, with its message.
+Each Dask task is one whole co-simulation with our master (``sweep_task``). The
+client sends every FMU once, by content (``bundle``): a worker needs the project
+installed, nothing else, and runs the client's code or is refused. A worker keeps
+each system's FMUs per thread and resets them (fmi2Reset) between tasks.
+
+A run's id hashes everything that determines its result (the system and its FMUs'
+contents, the settings, the stop time, the axis values). results/sweeps/<name>/
+runs.jsonl gets each row as it completes (``journal``), so an interrupted sweep
+resumes where it stopped; failed runs are run again then (a deterministic failure
+fails again at once, one caused by a lost worker deserves its retry).
+results.parquet (and results.csv with --csv) hold the table at the end; a summary
+is printed, figures are written, and comparison.md pairs every controller with pd
+seed by seed. A task whose worker dies is retried twice, then recorded as failed;
+an FMU error is recorded as failed at once, with its message.
 """
 from __future__ import annotations
 
