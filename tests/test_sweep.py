@@ -195,9 +195,10 @@ def test_two_sweeps_on_one_cluster_both_finish_with_every_row(fmu_paths, tmp_pat
     cluster = local_cluster(2)
     try:
         with ThreadPoolExecutor(2) as pool:
-            done = list(pool.map(lambda spec: sweep.execute(
-                spec, tmp_path / spec.name, scheduler=cluster.scheduler_address,
-                progress=False), specs))
+            running = [pool.submit(sweep.execute, spec, tmp_path / spec.name,
+                                   scheduler=cluster.scheduler_address, progress=False)
+                       for spec in specs]
+            done = [future.result(timeout=240) for future in running]   # not stuck
     finally:
         cluster.close()
     assert [len(rows) for rows in done] == [4, 6]

@@ -347,8 +347,10 @@ def _run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, 
         check_workers(client)
         client.register_plugin(teardown)
         # Each FMU as a task holding its bytes, not scattered data: a task's result lost with
-        # its worker is computed again, scattered data is gone, and every run with it.
-        shipped = {sha: client.submit(fmu_bytes, path.read_bytes(), key=f"fmu-{sha}", pure=False)
+        # its worker is computed again, scattered data is gone, and every run with it. Keyed
+        # by sweep: another sweep's release of a shared key would strand this one's runs.
+        shipped = {sha: client.submit(fmu_bytes, path.read_bytes(), key=f"fmu-{token}-{sha}",
+                                      pure=False)
                    for sha, path in spec.files().items()}
         futures = {}
         for run in todo:
@@ -361,7 +363,9 @@ def _run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, 
             from tqdm import tqdm
             bar = tqdm(total=len(todo), desc=spec.name, unit="run", file=sys.stderr,
                        disable=None)                # None: only on a terminal
-        for future in as_completed(futures):
+        # On this client's loop: by default as_completed takes the newest client's, and a
+        # sweep beside another in this process would wait forever once that one closed.
+        for future in as_completed(futures, loop=client.loop):
             run = futures.pop(future)
             try:
                 row = future.result()
