@@ -22,3 +22,30 @@ def test_the_reference_is_100_times_more_accurate_than_what_it_measures(step_res
     finest = step_response["errors"][accuracy.H_MAX[-1]]
     for signal, own in step_response["reference_error"].items():
         assert own.max * 100 <= finest[signal].max, (signal, own, finest[signal])
+
+
+def test_cosimulation_converges_to_the_monolithic_model_as_the_step_shrinks():
+    """calm_smc over its first turn: J's distance from the monolithic value shrinks with
+    every halving of the communication step, for both couplings."""
+    from cosim import scenarios
+
+    reference = accuracy.figures(accuracy.monolithic(scenarios.load("calm_smc"), 120.0))
+    for rows in accuracy.convergence("calm_smc", reference, (0.1, 0.05, 0.025),
+                                     120.0).values():
+        errors = [row["J_error"] for row in rows]
+        assert errors[0] > errors[1] > errors[2], errors
+        assert errors[2] < 0.05
+
+
+def test_the_quick_study_prints_and_writes_its_tables(tmp_path):
+    import subprocess
+    import sys
+
+    child = subprocess.run([sys.executable, "-m", "cosim.accuracy", "--quick", "--out",
+                            str(tmp_path)], capture_output=True, text=True, timeout=600)
+    assert child.returncode == 0, child.stderr
+    report = (tmp_path / "accuracy.md").read_text()
+    for title in ("Integration error, open loop", "monolithic reference",
+                  "J against the communication step"):
+        assert title in report and title in child.stdout
+    assert (tmp_path / "convergence.png").stat().st_size > 10_000

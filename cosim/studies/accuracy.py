@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -122,6 +123,10 @@ def open_loop(program: str, t_end: float = 400.0) -> dict:
 
 
 # -- part 2: coupling error, closed loop --------------------------------------------------
+MAX_STEP = 1.0
+"""s: on a straight leg Radau's steps grow long enough to pass through a circle of
+acceptance (5 m across, 16 s at 0.3 m/s) without an endpoint inside it, and the
+event would be missed."""
 SERVO_GAIN = 1000.0
 """1/s: the steering gear as a stiff servo in the monolithic model (see ``monolithic``)."""
 
@@ -139,7 +144,8 @@ def monolithic(system, stop_time: float | None = None, servo_gain: float = SERVO
     lag of 1/k (1 ms, against the 50 ms mean delay of a 0.1 s zero-order hold); the stiff
     k is why the solver is implicit. The guidance's waypoint switching is an event (the
     circle of acceptance reached, or the leg's end passed): the solver stops there,
-    switches the leg, and restarts. The SMC's switching term is eq (43)'s tanh boundary
+    switches the leg, and restarts (steps of at most ``MAX_STEP``, so that no crossing is
+    stepped over). The SMC's switching term is eq (43)'s tanh boundary
     layer (phi_h), continuous: no event is needed.
     """
     from .direct import build_models
@@ -188,7 +194,8 @@ def monolithic(system, stop_time: float | None = None, servo_gain: float = SERVO
     while True:
         events = [] if finished else arrival(leg)
         solution = solve_ivp(rhs, (t, stop), Y, method="Radau", rtol=tolerance,
-                             atol=tolerance, dense_output=True, events=events, args=(leg,))
+                             atol=tolerance, dense_output=True, events=events, args=(leg,),
+                             max_step=MAX_STEP)
         end = solution.t[-1]
         for g in grid[(grid >= t) & (grid <= end)]:
             sampled.setdefault(float(g), (solution.sol(g), leg))
@@ -205,3 +212,135 @@ def monolithic(system, stop_time: float | None = None, servo_gain: float = SERVO
             "psi_d": np.array([guidance.course(sampled[g][1]) for g in times]),
             "psi": values[:, 2], "r": values[:, 5], "x": values[:, 0], "y": values[:, 1],
             "delta": values[:, 7]}
+
+
+PAPER_RUNS = ("calm_pd", "calm_smc", "waves_pd", "waves_smc")
+COUPLINGS = ("gauss-seidel", "jacobi")
+STEPS = (0.4, 0.2, 0.1, 0.05, 0.025, 0.0125)   # s, communication steps of part 3
+
+
+def cosimulation(name: str, step: float, coupling: str,
+                 stop_time: float | None = None) -> dict[str, np.ndarray]:
+    """Our master (the FMUs' classes in-process: the same code, without FMI's cost) at
+    communication step ``step``, sampled on the 0.1 s grid; a coarser step is sampled at
+    its own points, each standing for step / 0.1 samples of the grid (``weight``)."""
+    import dataclasses
+
+    from .. import scenarios
+    from ..core.master import Master
+
+    system = dataclasses.replace(scenarios.load(name), step_size=step)
+    master = Master(system, coupling=coupling, backend="inprocess")
+    try:
+        recording = master.run(stop_time)
+    finally:
+        master.free()
+    every = max(1, round(H / step))
+    return {"t": recording.t[::every], "psi_d": recording["guidance.psi_d"][::every],
+            "psi": recording["ship.psi"][::every], "delta": recording["ship.delta"][::every],
+            "weight": max(1.0, step / H)}
+
+
+def figures(run: dict[str, np.ndarray]) -> dict[str, float]:
+    """psi_E, sum delta^2 and J of eq (19) on the 0.1 s grid."""
+    from ..analysis.cost import LAMBDA
+    from ..analysis.metrics import cost_terms
+
+    psi_E, sum_delta2 = cost_terms(run["psi_d"], run["psi"], run["delta"])
+    weight = run.get("weight", 1.0)
+    psi_E, sum_delta2 = weight * psi_E, weight * sum_delta2
+    return {"psi_E": psi_E, "sum_delta2": sum_delta2, "J": psi_E + LAMBDA * sum_delta2}
+
+
+# -- the study: tables ----------------------------------------------------------------------
+def open_loop_table(results: list[dict]) -> str:
+    """Part 1 as a Markdown table."""
+    lines = ["| program | h_max (s) | " + " | ".join(f"max / RMS error {s}" for s in SIGNALS)
+             + " |", "|---|---:|" + "---:|" * len(SIGNALS)]
+    for result in results:
+        for h, e in result["errors"].items():
+            lines.append(f"| {result['program']} | {h:g} | " + " | ".join(
+                f"{e[s].max:.2e} / {e[s].rms:.2e}" for s in SIGNALS) + " |")
+        lines.append(f"| {result['program']} | order | " + " | ".join(
+            ", ".join(f"{o:.2f}" for o in result["orders"][s]) for s in SIGNALS) + " |")
+        lines.append(f"| {result['program']} | reference, tol / 2 | " + " | ".join(
+            f"{result['reference_error'][s].max:.1e}" for s in SIGNALS) + " |")
+    return "\n".join(lines)
+
+
+def closed_loop(name: str, stop_time: float | None = None) -> dict[str, dict]:
+    """Part 2 for one run: figures of the monolithic reference and of both couplings at
+    0.1 s, with the largest heading difference from the reference."""
+    from .. import scenarios
+
+    reference_run = monolithic(scenarios.load(name), stop_time)
+    out = {"monolithic": {**figures(reference_run), "max_dpsi": 0.0}}
+    for coupling in COUPLINGS:
+        run = cosimulation(name, H, coupling, stop_time)
+        out[coupling] = {**figures(run),
+                         "max_dpsi": float(np.abs(run["psi"] - reference_run["psi"]).max())}
+    out["_reference"] = reference_run
+    return out
+
+
+def closed_loop_table(results: dict[str, dict]) -> str:
+    lines = ["| run | model | psi_E (rad^2) | sum delta^2 (rad^2) | J | max abs(psi - psi_ref) (deg) |",
+             "|---|---|---:|---:|---:|---:|"]
+    for name, result in results.items():
+        for model in ("monolithic", *COUPLINGS):
+            f = result[model]
+            lines.append(f"| {name} | {model} | {f['psi_E']:.2f} | {f['sum_delta2']:.3f} | "
+                         f"{f['J']:.2f} | {math.degrees(f['max_dpsi']):.3f} |")
+    return "\n".join(lines)
+
+
+def convergence(name: str, reference_figures: dict[str, float], steps=STEPS,
+                stop_time: float | None = None) -> dict[str, list[dict]]:
+    """Part 3 for one run: J, psi_E and sum delta^2 at each communication step, each
+    coupling, and the relative distance of J from the monolithic value."""
+    out = {}
+    for coupling in COUPLINGS:
+        rows = []
+        for step in steps:
+            f = figures(cosimulation(name, step, coupling, stop_time))
+            f["J_error"] = abs(f["J"] - reference_figures["J"]) / reference_figures["J"]
+            rows.append({"step": step, **f})
+        out[coupling] = rows
+    return out
+
+
+def convergence_table(results: dict[str, dict], references: dict[str, dict]) -> str:
+    steps = [r["step"] for r in next(iter(next(iter(results.values())).values()))]
+    lines = ["| run | coupling | " + " | ".join(f"J at {s:g} s" for s in steps)
+             + " | order | J monolithic |", "|---|---|" + "---:|" * (len(steps) + 2)]
+    for name, by_coupling in results.items():
+        for coupling, rows in by_coupling.items():
+            errors = [r["J_error"] for r in rows]
+            order = [math.log2(a / b) for a, b in zip(errors, errors[1:]) if a > 0 and b > 0]
+            lines.append(f"| {name} | {coupling} | " + " | ".join(f"{r['J']:.2f}" for r in rows)
+                         + f" | {np.median(order) if order else math.nan:.2f} | "
+                           f"{references[name]['J']:.2f} |")
+    return "\n".join(lines)
+
+
+def convergence_figure(results: dict[str, dict], path: Path) -> Path:
+    """|J - J_monolithic| / J_monolithic against the communication step, log-log."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for name, by_coupling in results.items():
+        for coupling, rows in by_coupling.items():
+            ax.loglog([r["step"] for r in rows], [max(r["J_error"], 1e-12) for r in rows],
+                      "o-" if coupling == "gauss-seidel" else "s--",
+                      label=f"{name}, {coupling}")
+    ax.set_xlabel("communication step (s)")
+    ax.set_ylabel("|J - J monolithic| / J monolithic")
+    ax.set_title("Co-simulation converges to the monolithic model")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path

@@ -1,0 +1,55 @@
+"""The command line of ``cosim.studies.accuracy``: how large are the set-up's numerical errors?
+
+    python -m cosim.accuracy            # the full study, about 3-5 minutes on 2 cores
+    python -m cosim.accuracy --quick    # shorter runs and fewer steps (CI)
+
+Prints three tables (integration error open loop; co-simulation against the
+monolithic reference; convergence in the communication step) and writes them, with
+a convergence figure, to results/accuracy/.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from ._cli import entry, writable_folder
+from .studies import accuracy
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m cosim.accuracy",
+                                     description=__doc__.split("\n\n")[0])
+    parser.add_argument("--quick", action="store_true",
+                        help="60 s open loop, 120 s closed loop, steps 0.1-0.025 s, calm runs")
+    parser.add_argument("--out", type=Path, default=Path("results/accuracy"))
+    args = parser.parse_args(argv)
+    out = writable_folder(args.out)
+    started = time.perf_counter()
+    open_end, closed_end = (60.0, 120.0) if args.quick else (400.0, None)
+    runs = accuracy.PAPER_RUNS[:2] if args.quick else accuracy.PAPER_RUNS
+    steps = (0.1, 0.05, 0.025) if args.quick else accuracy.STEPS
+
+    tables = ["## Integration error, open loop (calm water)\n",
+              accuracy.open_loop_table([accuracy.open_loop(p, open_end)
+                                        for p in ("step", "sine", "zigzag")])]
+    print("".join(tables[-2:]), flush=True)
+    closed = {name: accuracy.closed_loop(name, closed_end) for name in runs}
+    tables += ["\n## Co-simulation at 0.1 s against the monolithic reference\n",
+               accuracy.closed_loop_table(closed)]
+    print("".join(tables[-2:]), flush=True)
+    references = {name: result["monolithic"] for name, result in closed.items()}
+    converging = {name: accuracy.convergence(name, references[name], steps, closed_end)
+                  for name in runs}
+    tables += ["\n## J against the communication step\n",
+               accuracy.convergence_table(converging, references)]
+    print("".join(tables[-2:]), flush=True)
+    (out / "accuracy.md").write_text("\n".join(tables) + "\n")
+    figure = accuracy.convergence_figure(converging, out / "convergence.png")
+    print(f"wrote {out / 'accuracy.md'}, {figure} ({time.perf_counter() - started:.0f} s)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(entry(main))
