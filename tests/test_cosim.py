@@ -267,3 +267,9 @@ def test_streamed_rows_equal_the_in_memory_recording(tmp_path):
     with pytest.raises(ValueError, match="streamed to"):
         streamed["ship.psi"]                # the rows are in the file, not in memory
     assert (tmp_path / "streamed.csv").read_text() == (tmp_path / "whole.csv").read_text()
+
+
+def test_the_null_backend_runs_a_scenario(fmu_paths):
+    """The benchmark's measure of the master's own cost: the master with no model behind."""
+    recording = Master(scenarios.load("calm_pd"), backend="null").run(1.0)
+    assert recording.error is None and recording.rows == 11

@@ -26,7 +26,8 @@ class NullInstance(Instance):
         self.variables = {v.name: v for v in description.modelVariables}
         self.feedthrough = feedthrough(description)
 
-    def call(self, what: str, function: Callable, *args, time: float | None = None) -> Any:
+    def call(self, what: str, function: Callable, *args, time: float | None = None,
+             strict: bool = False) -> Any:
         return None
 
     def fmi(self, name: str) -> Callable:
