@@ -1,11 +1,14 @@
-"""The command line of ``cosim.studies.accuracy``: how large are the set-up's numerical errors?
+"""How large are the set-up's own numerical errors? RK4 against DOP853, co-simulation
+against a monolithic model with the controller inside the solver.
 
     python -m cosim.accuracy            # the full study, about 3-5 minutes on 2 cores
     python -m cosim.accuracy --quick    # shorter runs and fewer steps (CI)
 
 Prints three tables (integration error open loop; co-simulation against the
 monolithic reference; convergence in the communication step) and writes them, with
-a convergence figure, to results/accuracy/.
+a convergence figure, to results/accuracy/. The quick mode's figures cover shorter
+runs in calm water only: they differ from docs/reproduction.md's, which are the full
+study's.
 """
 from __future__ import annotations
 
@@ -20,10 +23,14 @@ from .studies import accuracy
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m cosim.accuracy",
-                                     description=__doc__.split("\n\n")[0])
+                                     description=__doc__.split("\n\n")[0],
+                                     epilog=__doc__.split("\n\n", 1)[1],
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--quick", action="store_true",
                         help="60 s open loop, 120 s closed loop, steps 0.1-0.025 s, calm runs")
-    parser.add_argument("--out", type=Path, default=Path("results/accuracy"))
+    parser.add_argument("--out", type=Path, default=Path("results/accuracy"),
+                        help="folder for accuracy.md and convergence.png "
+                             "(default: results/accuracy)")
     args = parser.parse_args(argv)
     out = writable_folder(args.out)
     started = time.perf_counter()

@@ -148,7 +148,7 @@ def monolithic(system, stop_time: float | None = None, servo_gain: float = SERVO
     k is why the solver must handle stiffness. The guidance's waypoint switching is an event (the
     circle of acceptance reached, or the leg's end passed): the solver stops there,
     switches the leg, and restarts (steps of at most ``MAX_STEP``, so that no crossing is
-    stepped over). The SMC's switching term is eq (43)'s tanh boundary
+    stepped over). The SMC's switching term is eq (42)'s tanh boundary
     layer (phi_h), continuous: no event is needed.
     """
     from .direct import build_models
