@@ -1,7 +1,7 @@
 """Fuzzing every FMU through fmpy (tests/fmu_fuzz.py), each campaign in a child process.
 
 A crash of the host ends the child with a signal, a hang hits the time limit: both fail
-here instead of taking the test session down. 2,000 examples per FMU; the documented
+here instead of taking the test session down. 1,500 examples per FMU; the documented
 long run takes 10,000 (docs/robustness.md).
 """
 from __future__ import annotations
@@ -15,7 +15,7 @@ import pytest
 
 from fmu_fuzz import FMUS
 
-EXAMPLES = 2000
+EXAMPLES = 1500
 
 
 @pytest.mark.parametrize("name", FMUS)
