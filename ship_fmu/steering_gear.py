@@ -18,11 +18,16 @@ DELTA_MAX = math.radians(35.0)
 DELTA_RATE_MAX = math.radians(20.0)
 
 
+def rudder_target(delta_c: float, delta_max: float = DELTA_MAX) -> float:
+    """Where the rudder heads for: the command, within the stops."""
+    return min(max(delta_c, -delta_max), delta_max)
+
+
 def rudder_angle(delta0: float, delta_c: float, s: float,
                  delta_max: float = DELTA_MAX,
                  delta_rate_max: float = DELTA_RATE_MAX) -> float:
     """Rudder angle a time s >= 0 after it was delta0, with delta_c held."""
-    target = min(max(delta_c, -delta_max), delta_max)
+    target = rudder_target(delta_c, delta_max)
     travel = delta_rate_max * s
     error = target - delta0
     if error > travel:

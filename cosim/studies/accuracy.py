@@ -26,7 +26,7 @@ from scipy.integrate import solve_ivp
 
 from fmukit.timebase import communication_point, step_count
 from ship_fmu.manoeuvres import RudderProgram
-from ship_fmu.steering_gear import rudder_angle
+from ship_fmu.steering_gear import rudder_angle, rudder_target
 from ship_fmu.thrusters import actuator_model
 from ship_fmu.vessel import N_PROPELLER, Vessel, VesselParameters
 
@@ -79,7 +79,7 @@ def reference(delta_c: np.ndarray, tolerance: float = TOLERANCE) -> dict[str, np
     rows = [[y[2], y[5], y[0], y[1]]]
     for k, command in enumerate(delta_c):
         t, command = communication_point(0.0, k, H), float(command)
-        target = min(max(command, -p.delta_max), p.delta_max)
+        target = rudder_target(command, p.delta_max)
         reach = abs(target - delta) / p.delta_rate_max
         pieces = [(0.0, reach), (reach, H)] if 0.0 < reach < H else [(0.0, H)]
 
@@ -151,13 +151,11 @@ def monolithic(system, stop_time: float | None = None, servo_gain: float = SERVO
     stepped over). The SMC's switching term is eq (42)'s tanh boundary
     layer (phi_h), continuous: no event is needed.
     """
-    from .direct import build_models
+    from .direct import build_models, shaft_speeds
 
     models = build_models(system)
     guidance, autopilot, ship = (models[n] for n in ("guidance", "autopilot", "ship"))
-    inputs = system.components["ship"].parameters
-    forces = actuator_model(ship.actuators, *(inputs.get(n, N_PROPELLER if n != "n3" else 0.0)
-                                              for n in ("n1", "n2", "n3")))
+    forces = actuator_model(ship.actuators, *shaft_speeds(system))
     p = ship.params
     smc = hasattr(autopilot, "r_z_dot")
     stop = system.stop_time if stop_time is None else stop_time
@@ -168,7 +166,7 @@ def monolithic(system, stop_time: float | None = None, servo_gain: float = SERVO
         if smc:
             autopilot.psi_z, autopilot.r_z = Y[8], Y[9]
         delta_c = autopilot.command(Y[2], Y[5], psi_d)
-        target = min(max(delta_c, -p.delta_max), p.delta_max)
+        target = rudder_target(delta_c, p.delta_max)
         delta_dot = min(max(servo_gain * (target - Y[7]), -p.delta_rate_max), p.delta_rate_max)
         rates = [*ship.rates(t, tuple(Y[:7]), forces(Y[7])), delta_dot]
         if smc:

@@ -35,13 +35,17 @@ def build_models(system: SystemDescription) -> dict:
     return models
 
 
+def shaft_speeds(system: SystemDescription) -> tuple[float, float, float]:
+    """The ship's propeller and bow thruster speeds n1, n2, n3 as the system sets them."""
+    inputs = system.components["ship"].parameters
+    return tuple(inputs.get(n, N_PROPELLER if n != "n3" else 0.0) for n in ("n1", "n2", "n3"))
+
+
 def run_direct(system: SystemDescription, stop_time: float | None = None) -> dict[str, np.ndarray]:
     """Simulate; each signal sampled at t_k = k h, k = 0 .. N, like the master's rows."""
     models = build_models(system)
     guidance, autopilot, ship = (models[n] for n in ("guidance", "autopilot", "ship"))
-    ship_inputs = system.components["ship"].parameters
-    n1, n2, n3 = (ship_inputs.get(n, N_PROPELLER if n != "n3" else 0.0)
-                  for n in ("n1", "n2", "n3"))
+    n1, n2, n3 = shaft_speeds(system)
     stepping_pilot = hasattr(autopilot, "step")
     h, t0 = system.step_size, system.start_time
     n_steps = step_count(t0, system.stop_time if stop_time is None else stop_time, h)
