@@ -16,6 +16,7 @@ import math
 from dataclasses import dataclass, fields
 
 from fmukit.numerics import require_finite, substeps
+from fmukit.timebase import nanoseconds, seconds
 
 from .data import G, Actuators, Hull
 from .hull import coriolis_forces, damping_forces, kinematics, mass_matrix
@@ -93,19 +94,17 @@ class Vessel:
         self._m11_inv = 1.0 / M[0][0]
         self._minv = (M[2][2] / det, -M[1][2] / det, -M[2][1] / det, M[1][1] / det)
         self.waves = None
+        self._wave_loads = _calm_water
         if params.Hs > 0.0:
             components = WaveComponents.from_spectrum(
                 params.Hs, params.T0, params.wave_components, params.wave_seed)
-            self.waves = WaveLoads(components, hull, params.psi_w)
+            self.waves = self._wave_loads = WaveLoads(components, hull, params.psi_w)
         self.x, self.y, self.psi = params.x0, params.y0, params.psi0
         self.u, self.v, self.r = params.u0, params.v0, params.r0
         self.delta = 0.0
         self.xi = 0.0
         self.t = 0.0
         self.X_w, self.Y_w, self.N_w = self._wave_loads(self.t, self.xi, self.psi)
-
-    def _wave_loads(self, t: float, xi: float, psi: float) -> tuple[float, float, float]:
-        return (0.0, 0.0, 0.0) if self.waves is None else self.waves(t, xi, psi)
 
     def rates(self, t: float, state: State, tau_th: tuple[float, float, float]) -> State:
         """Time derivative of (x, y, psi, u, v, r, xi), eqs (1)-(17).
@@ -155,7 +154,7 @@ class Vessel:
             y = _rk4(c, y, k1, k2, k3, k4)
         self.x, self.y, self.psi, self.u, self.v, self.r, self.xi = y
         self.delta = gear(h)
-        self.t = t + h
+        self.t = seconds(nanoseconds(t) + nanoseconds(h))   # the next communication point
         self.X_w, self.Y_w, self.N_w = self._wave_loads(self.t, self.xi, self.psi)
 
     def snapshot(self) -> dict[str, float]:
@@ -167,6 +166,11 @@ class Vessel:
         for name in self.STATE:
             setattr(self, name, float(snapshot[name]))
         self.X_w, self.Y_w, self.N_w = self._wave_loads(self.t, self.xi, self.psi)
+
+
+def _calm_water(t: float, xi: float, psi: float) -> tuple[float, float, float]:
+    """The wave loads (X_w, Y_w, N_w) without waves."""
+    return (0.0, 0.0, 0.0)
 
 
 def _axpy(a: float, x: State, y: State) -> State:

@@ -64,7 +64,6 @@ class WaveComponents:
     k: np.ndarray           # rad/m
     amplitude: np.ndarray   # m
     phase: np.ndarray       # rad
-
     @classmethod
     def from_spectrum(cls, Hs: float, T0: float, n: int, seed: int,
                       band_fraction: float = 0.98) -> WaveComponents:
@@ -80,11 +79,16 @@ class WaveComponents:
                    amplitude=np.sqrt(2.0 * m0_bins), phase=phase)
 
     def phases(self, t: float, xi: float, out: np.ndarray | None = None,
-               work: np.ndarray | None = None) -> np.ndarray:
-        """theta_i(t) = omega_i t - k_i xi + phi_i (into ``out``, with ``work``, if given)."""
-        out = np.multiply(self.omega, t, out=out)
-        np.subtract(out, np.multiply(self.k, xi, out=work), out=out)
-        return np.add(out, self.phase, out=out)
+               omega_t: np.ndarray | None = None) -> np.ndarray:
+        """theta_i(t) = omega_i t - k_i xi + phi_i (into ``out``, if given).
+
+        ``omega_t``: omega_i t already computed for this t, to be used, not recomputed.
+        """
+        if omega_t is None:
+            omega_t = self.omega * t
+        out = np.multiply(self.k, xi, out)
+        np.subtract(omega_t, out, out)
+        return np.add(out, self.phase, out)
 
     def elevation(self, t: float, xi: float) -> float:
         """Wave elevation at the ship, m."""
@@ -92,37 +96,52 @@ class WaveComponents:
 
 
 class WaveLoads:
-    """First-order wave forces on a block-shaped hull, eqs (14)-(16)."""
+    """First-order wave forces on a block-shaped hull, eqs (14)-(16).
+
+    With s_i = A_i k_i sin(theta_i) and beta = psi_w - psi:
+    X_w = rho g B L T cos(beta) sum s_i, Y_w = rho g B L T sin(beta) sum s_i and
+    N_w = rho g B L (L^2 - B^2) / 24 sin(2 beta) sum s_i^2.
+
+    On 50 components numpy's cost is its calls, not its arithmetic, so an
+    evaluation makes as few as the exact phases allow: omega_i t once per time
+    (RK4's second and third stages share one, and the end of a step is the next
+    step's first stage), and both sums from one matrix-vector product [1; s] @ s,
+    which adds in a different order than a sum and a dot product would (the loads
+    differ from such by a few units in the last place).
+    """
 
     def __init__(self, components: WaveComponents, hull: Hull, psi_w: float,
                  rho: float = RHO_WATER):
-        h = hull
+        h, n = hull, len(components.omega)
         self.components = components
         self.psi_w = psi_w
-        self._slope_amplitude = components.amplitude * components.k
         self._c_force = rho * G * h.B * h.L * h.T
         self._c_moment = rho * G * h.B * h.L * (h.L ** 2 - h.B ** 2) / 24.0
-        self._s = np.empty_like(components.omega)       # work arrays: no allocation per call
-        self._kxi = np.empty_like(components.omega)
-        self._last: tuple = (None, None)
+        self._slope_amplitude = components.amplitude * components.k
+        # Work arrays, so that an evaluation allocates nothing.
+        self._omega_t, self._theta, self._sums = np.empty(n), np.empty(n), np.empty(2)
+        self._ones_s = np.ones((2, n))                # rows 1 and s: [1; s] @ s = both sums
+        self._s = self._ones_s[1]
+        self._t: float | None = None                  # the time of _omega_t
+        self._key: tuple = (None, None, None)         # the last evaluation's arguments,
+        self._loads = (0.0, 0.0, 0.0)                 # and its loads
 
     def __call__(self, t: float, xi: float, psi: float) -> tuple[float, float, float]:
-        """(X_w, Y_w, N_w) at time t, travel xi and heading psi.
-
-        The last result is kept: the loads at the end of a step are those of the
-        next step's first RK4 stage.
-        """
-        key, loads = self._last
-        if key == (t, xi, psi):
-            return loads
-        s = self.components.phases(t, xi, out=self._s, work=self._kxi)
-        np.sin(s, out=s)
-        np.multiply(self._slope_amplitude, s, out=s)    # s_i = A_i k_i sin(theta_i)
+        """(X_w, Y_w, N_w) at time t, travel xi and heading psi."""
+        if self._key == (t, xi, psi):
+            return self._loads
+        if t != self._t:
+            np.multiply(self.components.omega, t, self._omega_t)
+            self._t = t
+        theta, s, sums = self._theta, self._s, self._sums
+        self.components.phases(t, xi, theta, self._omega_t)
+        np.sin(theta, theta)
+        np.multiply(self._slope_amplitude, theta, s)      # s_i = A_i k_i sin(theta_i)
+        np.dot(self._ones_s, s, sums)
+        sum_s, sum_s2 = sums.tolist()
         beta = self.psi_w - psi
-        sum_s = float(s.sum())
         force = self._c_force * sum_s
-        loads = (force * math.cos(beta),
-                 force * math.sin(beta),
-                 self._c_moment * math.sin(2.0 * beta) * float(s @ s))
-        self._last = ((t, xi, psi), loads)
-        return loads
+        self._key = (t, xi, psi)
+        self._loads = (force * math.cos(beta), force * math.sin(beta),
+                       self._c_moment * math.sin(2.0 * beta) * sum_s2)
+        return self._loads
