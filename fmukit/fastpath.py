@@ -1,11 +1,20 @@
-"""Fast getReal, setReal and getInteger: the work of a call decided once per list of references.
+"""Plans for getReal, getInteger and setReal: the work of a call decided once per list of references.
 
 A master asks for the same value references at every step. The first call with a
-list works out how to serve it (which getters, whether every reference is a
-model attribute that one ``operator.attrgetter`` call can read, whether every
-reference is a Real input that can be set as an attribute) and caches that; the
-next calls only execute it. A list that is not of that kind gets ``None`` and the
-slave lets pythonfmu serve it (and name any problem).
+list works out how to serve it and caches that plan; the next calls only execute
+it. A plan is complete: it gives what the FMI call gives in every state of the
+slave (NaN outputs once it has failed or where an output cannot be evaluated), so
+the slave's getReal is its plan, and a host in the same process (cosim's
+in-process backend) may call the plan itself. A list that is not of the plan's
+kind gets ``None`` and the slave lets pythonfmu serve it (and name any problem).
+
+- Reals that are all model attributes (the ship's states): one
+  ``operator.attrgetter`` call on the model;
+- other Reals and Integers (feedthrough outputs, evaluated from the inputs; inputs and
+  parameters read back): each one's value read from the slave within one
+  ``try``; where one fails, every one is read again through its own getter,
+  which gives NaN for that one alone;
+- Real inputs: set as attributes of the slave.
 """
 from __future__ import annotations
 
@@ -13,6 +22,10 @@ import operator
 from typing import Any, Callable
 
 from .registry import Registry
+from .variables import Var
+
+Reader = Callable[[], list[float]]
+Writer = Callable[[list[float]], None]
 
 
 class FastPaths:
@@ -20,11 +33,12 @@ class FastPaths:
 
     def __init__(self, slave: Any, registry: Registry):
         self._slave, self._registry = slave, registry
-        self._reads: dict[tuple[int, ...], Callable[[], list[float]] | None] = {}
-        self._writes: dict[tuple[int, ...], tuple[str, ...]] = {}
+        self._reads: dict[tuple[int, ...], Reader | None] = {}
+        self._writes: dict[tuple[int, ...], Writer | None] = {}
+        self._integer_reads: dict[tuple[int, ...], Callable[[], list[int]] | None] = {}
 
-    def real_reader(self, vrs: list[int]) -> Callable[[], list[float]] | None:
-        """The fastest correct way to read these Reals, or None if one is not a Real."""
+    def real_reader(self, vrs: list[int]) -> Reader | None:
+        """The plan reading these Reals, or None if one is not a Real."""
         key = tuple(vrs)
         try:
             return self._reads[key]
@@ -32,41 +46,80 @@ class FastPaths:
             read = self._reads[key] = self._compile_read(key)
             return read
 
-    def _compile_read(self, vrs: tuple[int, ...]) -> Callable[[], list[float]] | None:
+    def _compile_read(self, vrs: tuple[int, ...]) -> Reader | None:
         getters = self._registry.real_getters
         if not all(vr in getters for vr in vrs):
             return None
-        each_getter = [getters[vr] for vr in vrs]
-
-        def each() -> list[float]:
-            return [float(get()) for get in each_getter]
         attributes_of = self._registry.model_attributes
         if not all(vr in attributes_of for vr in vrs):
-            return each
+            return self._evaluated(vrs, getters, float)
+        slave, each = self._slave, self._each(vrs, getters, float)
         attributes = operator.attrgetter(*(attributes_of[vr] for vr in vrs))
-        slave = self._slave
+        single = len(vrs) == 1
 
-        def model_attributes() -> list[float]:     # the ship's states: one C-level call
+        def model_attributes() -> list[float]:   # one C-level call
             model = slave._model
-            if model is None:
+            if model is None or slave.failure:
                 return each()
             values = attributes(model)
-            return list(values) if len(vrs) > 1 else [values]
+            return [values] if single else list(values)
         return model_attributes
 
-    def input_names(self, vrs: list[int]) -> tuple[str, ...]:
-        """The names of these Real inputs, or () if one is not a Real input."""
+    def integer_reader(self, vrs: list[int]) -> Callable[[], list[int]] | None:
+        """The plan reading these Integers, or None if one is not an Integer."""
         key = tuple(vrs)
-        names = self._writes.get(key)
-        if names is None:
-            inputs = self._registry.real_inputs
-            names = self._writes[key] = (tuple(inputs[vr] for vr in vrs)
-                                         if all(vr in inputs for vr in vrs) else ())
-        return names
+        try:
+            return self._integer_reads[key]
+        except KeyError:
+            getters = self._registry.integer_getters
+            read = self._integer_reads[key] = (self._evaluated(key, getters, int)
+                                               if all(vr in getters for vr in vrs) else None)
+            return read
 
-    def integers(self, vrs: list[int]) -> list[int] | None:
-        """The current values of these Integers, or None if one is not an Integer."""
-        getters = self._registry.integer_getters
-        if all(vr in getters for vr in vrs):
-            return [int(getters[vr]()) for vr in vrs]
-        return None
+    @staticmethod
+    def _each(vrs: tuple[int, ...], getters: dict[int, Callable[[], Any]],
+              convert: type) -> Callable[[], list]:
+        """Each value through its own getter: NaN (0) for each one that cannot be read."""
+        each_getter = [getters[vr] for vr in vrs]
+        return lambda: [convert(get()) for get in each_getter]
+
+    def _evaluated(self, vrs: tuple[int, ...], getters: dict[int, Callable[[], Any]],
+                   convert: type) -> Callable[[], list]:
+        slave, each = self._slave, self._each(vrs, getters, convert)
+        gets = [self._get(self._registry.by_vr[vr]) for vr in vrs]
+
+        def evaluated() -> list:
+            if slave._model is None or slave.failure:
+                return each()
+            try:
+                return [convert(get(slave)) for get in gets]
+            except (ValueError, ArithmeticError):
+                return each()
+        return evaluated
+
+    @staticmethod
+    def _get(var: Var) -> Callable[[Any], Any]:
+        """How a Real's value is read from the slave."""
+        if var.causality != "output":
+            return operator.attrgetter(var.name)
+        return var.get or operator.attrgetter(f"_model.{var.name}")
+
+    def input_writer(self, vrs: list[int]) -> Writer | None:
+        """The plan setting these Real inputs, or None if one is not a Real input."""
+        key = tuple(vrs)
+        try:
+            return self._writes[key]
+        except KeyError:
+            write = self._writes[key] = self._compile_write(key)
+            return write
+
+    def _compile_write(self, vrs: tuple[int, ...]) -> Writer | None:
+        inputs = self._registry.real_inputs
+        if not all(vr in inputs for vr in vrs):
+            return None
+        slave, names = self._slave, tuple(inputs[vr] for vr in vrs)
+
+        def write(values: list[float]) -> None:
+            for name, value in zip(names, values):
+                setattr(slave, name, float(value))
+        return write

@@ -11,7 +11,7 @@ attributes alone), ``step_model`` and, if the initial state depends on inputs,
 - ``fmukit.variables``: the range checks of every parameter (at
   exitInitializationMode) and input (at each doStep);
 - ``fmukit.fastpath``: getReal, setReal and getInteger planned once per list of
-  value references;
+  value references (``plans``, which a host in the same process may call);
 - ``fmukit.state``: saving and restoring the whole state (serialisable);
 - ``fmukit.model_description``: a complete modelDescription.xml;
 - ``fmukit.entry``: every FMI entry point made safe against pythonfmu 0.7's error path;
@@ -58,8 +58,8 @@ from .fastpath import FastPaths
 from .hostlog import HostLog
 from .registry import Registry
 from .sequence import CallSequence
-from .timebase import MAX_TIME, nanoseconds, seconds
-from .variables import Var
+from .timebase import MAX_TIME, on_time_base
+from .variables import Var, range_check
 
 __all__ = ["ModelSlave", "Refused", "Var"]
 
@@ -82,9 +82,10 @@ class ModelSlave(Fmi2Slave):
         signals.defer_host_handlers()
         self._model = None
         self.registry = Registry(self, self.variables, self._output)
-        self._fast = FastPaths(self, self.registry)
+        self.plans = FastPaths(self, self.registry)
         self._parameters = [v for v in self.variables if v.causality == "parameter"]
-        self._inputs = [v for v in self.variables if v.causality == "input"]
+        self._check_inputs = range_check(tuple(v for v in self.variables
+                                               if v.causality == "input"))
 
     # -- model ---------------------------------------------------------------
     def build_model(self) -> Any:
@@ -177,10 +178,9 @@ class ModelSlave(Fmi2Slave):
             self._fail(f"doStep at t = {current_time} with communication step {step_size}: the "
                        f"step must be at least 1 ns, and both within +-{MAX_TIME:g} s")
         try:
-            for var in self._inputs:
-                var.check(getattr(self, var.name))
+            self._check_inputs(self)
             # The time base of fmukit.timebase: whole nanoseconds, whatever the master.
-            self.step_model(seconds(nanoseconds(current_time)), seconds(nanoseconds(step_size)))
+            self.step_model(on_time_base(current_time), on_time_base(step_size))
         except ValueError as error:
             self._fail(f"doStep at t = {current_time}: {error}; the FMU has failed (its "
                        "outputs read NaN until fmi2Reset)")
@@ -219,10 +219,9 @@ class ModelSlave(Fmi2Slave):
 
     @fmi_entry
     def set_real(self, vrs: list[int], values: list[float]) -> None:
-        names = self._fast.input_names(vrs)   # inputs only: always settable until terminate
-        if names and self.sequence.phase != "terminated":
-            for name, value in zip(names, values):
-                setattr(self, name, float(value))
+        write = self.plans.input_writer(vrs)  # inputs only: always settable until terminate
+        if write is not None and self.sequence.phase != "terminated":
+            write(values)
         else:
             self._set(vrs, values, float)
 
@@ -241,18 +240,13 @@ class ModelSlave(Fmi2Slave):
     # -- getters ---------------------------------------------------------------------
     @fmi_entry
     def get_real(self, vrs: list[int]) -> list[float]:
-        read = self._fast.real_reader(vrs)
-        if read is None:
-            return super().get_real(vrs)        # pythonfmu names the problem
-        if self.failure:                        # outputs read NaN: through their getters
-            getters = self.registry.real_getters
-            return [float(getters[vr]()) for vr in vrs]
-        return read()
+        read = self.plans.real_reader(vrs)
+        return super().get_real(vrs) if read is None else read()   # pythonfmu names a problem
 
     @fmi_entry
     def get_integer(self, vrs: list[int]) -> list[int]:
-        values = self._fast.integers(vrs)
-        return values if values is not None else super().get_integer(vrs)
+        read = self.plans.integer_reader(vrs)
+        return super().get_integer(vrs) if read is None else read()
 
     @fmi_entry
     def get_string(self, vrs: list[int]) -> list[str]:

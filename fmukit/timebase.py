@@ -23,6 +23,11 @@ def seconds(ns: int) -> float:
     return ns / NANOSECONDS
 
 
+def on_time_base(t: float) -> float:
+    """t rounded to whole nanoseconds: ``seconds(nanoseconds(t))``."""
+    return round(t * NANOSECONDS) / NANOSECONDS
+
+
 def communication_point(t0: float, k: int, h: float) -> float:
     """t_k = t_0 + k h, computed in integer nanoseconds."""
     return seconds(nanoseconds(t0) + k * nanoseconds(h))

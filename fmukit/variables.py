@@ -7,6 +7,7 @@ and the range check its values must pass (``Var.check``).
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass
 from typing import Any, Callable
 
@@ -73,3 +74,24 @@ class Var:
     @property
     def is_real(self) -> bool:
         return self.kind is float
+
+
+def range_check(variables: tuple[Var, ...]) -> Callable[[Any], None]:
+    """A function checking the numeric ``variables`` as attributes of an object at once:
+    ValueError from the first one's ``Var.check`` that fails.
+
+    What every step checks of its inputs, so the test is compiled to one expression,
+    ``low <= obj.name <= high and ...``, each range clipped to the finite doubles,
+    which no NaN or infinity passes; only a failure goes through ``Var.check``.
+    """
+    tests = [f"{max(v.min, -sys.float_info.max)!r} <= obj.{v.name} <= "
+             f"{min(v.max, sys.float_info.max)!r}" for v in variables]
+    namespace: dict[str, Any] = {}
+    exec(f"def passes(obj):\n    return {' and '.join(tests) or 'True'}\n", namespace)
+    passes = namespace["passes"]
+
+    def check(obj: Any) -> None:
+        if not passes(obj):
+            for var in variables:
+                var.check(getattr(obj, var.name))
+    return check

@@ -115,8 +115,8 @@ class Instance:
     def do_step(self, t: float, h: float) -> None:
         self.call("doStep", self.fmi("doStep"), t, h, time=t)
 
-    # Prepared calls for a fixed list of value references: what the master's loop uses.
-    # A backend may override them with something faster.
+    # Prepared calls for a fixed list of value references: what the master's loop uses,
+    # valid until ``reset``. A backend may override them with something faster.
     def reader(self, vrs: list[int]) -> Callable[[], list[float]]:
         """A function returning the current Real values of ``vrs``."""
         return lambda: self.call("getReal", self.fmi("getReal"), vrs)

@@ -60,12 +60,11 @@ class Master:
                 self.instances[name] = BACKENDS[backend](system.fmu_path(name), name)
             check_connections(system, self.instances)
             self.order = feedthrough_order(system, self.instances)
-            self.columns, nodes = layout(self.instances, system.connections, verify_inputs)
+            self.verify_inputs = verify_inputs
+            self._prepare()
         except BaseException:
             self.free()
             raise
-        self.nodes = [nodes[name] for name in (self.order if coupling == "gauss-seidel"
-                                               else self.instances)]
         self.units = {column: self.instances[component].unit(variable)
                       for column in self.columns
                       for component, variable in [column.split(".", 1)]}
@@ -75,10 +74,18 @@ class Master:
         self.parameters = self.system.parameters(overrides)
         self.overrides = {c: dict(v) for c, v in (overrides or {}).items()}
 
+    def _prepare(self) -> None:
+        """Lay out the columns and prepare each component's calls for the loop."""
+        self.columns, nodes = layout(self.instances, self.system.connections,
+                                     self.verify_inputs)
+        self.nodes = [nodes[name] for name in (self.order if self.coupling == "gauss-seidel"
+                                               else self.instances)]
+
     def reset(self) -> None:
         """Return every FMU to its state after instantiation (fmi2Reset), for another run."""
         for instance in self.instances.values():
             instance.reset()
+        self._prepare()                   # a backend's prepared calls may not survive a reset
 
     def initialize(self) -> None:
         """Enter initialisation, set parameters, propagate initial outputs, exit.
