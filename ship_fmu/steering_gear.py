@@ -13,6 +13,7 @@ full-scale steering rate (SOLAS: 35 deg port to 30 deg starboard in 28 s, about
 from __future__ import annotations
 
 import math
+from typing import Callable
 
 DELTA_MAX = math.radians(35.0)
 DELTA_RATE_MAX = math.radians(20.0)
@@ -23,15 +24,25 @@ def rudder_target(delta_c: float, delta_max: float = DELTA_MAX) -> float:
     return min(max(delta_c, -delta_max), delta_max)
 
 
+def rudder_motion(delta0: float, delta_c: float, delta_max: float = DELTA_MAX,
+                 delta_rate_max: float = DELTA_RATE_MAX) -> Callable[[float], float]:
+    """The rudder angle as a function of the time s >= 0 since it was delta0, with
+    delta_c held: what a step needs at its RK4 stages."""
+    target = rudder_target(delta_c, delta_max)
+    error = target - delta0
+
+    def angle(s: float) -> float:
+        travel = delta_rate_max * s
+        if error > travel:
+            return delta0 + travel
+        if error < -travel:
+            return delta0 - travel
+        return target
+    return angle
+
+
 def rudder_angle(delta0: float, delta_c: float, s: float,
                  delta_max: float = DELTA_MAX,
                  delta_rate_max: float = DELTA_RATE_MAX) -> float:
     """Rudder angle a time s >= 0 after it was delta0, with delta_c held."""
-    target = rudder_target(delta_c, delta_max)
-    travel = delta_rate_max * s
-    error = target - delta0
-    if error > travel:
-        return delta0 + travel
-    if error < -travel:
-        return delta0 - travel
-    return target
+    return rudder_motion(delta0, delta_c, delta_max, delta_rate_max)(s)

@@ -20,7 +20,7 @@ from fmukit.timebase import nanoseconds, seconds
 
 from .data import G, Actuators, Hull
 from .hull import coriolis_forces, damping_forces, kinematics, mass_matrix
-from .steering_gear import DELTA_MAX, DELTA_RATE_MAX, rudder_angle
+from .steering_gear import DELTA_MAX, DELTA_RATE_MAX, rudder_motion
 from .thrusters import actuator_model
 from .waves import WaveComponents, WaveLoads
 
@@ -99,6 +99,8 @@ class Vessel:
             components = WaveComponents.from_spectrum(
                 params.Hs, params.T0, params.wave_components, params.wave_seed)
             self.waves = self._wave_loads = WaveLoads(components, hull, params.psi_w)
+        self._h, self._cut = None, (1, 0.0)          # the last step size and its cut
+        self._shaft_speeds, self._forces = None, None  # the last shaft speeds, their tau_th
         self.x, self.y, self.psi = params.x0, params.y0, params.psi0
         self.u, self.v, self.r = params.u0, params.v0, params.r0
         self.delta = 0.0
@@ -132,21 +134,25 @@ class Vessel:
                 and math.isfinite(n3)):
             require_finite(delta_c=delta_c, n1=n1, n2=n2, n3=n3)
         p = self.params
-        n_sub = substeps(h, p.h_max, f"of at most h_max = {p.h_max} s")
-        hs = h / n_sub
+        if h != self._h:                      # the same step, run after run: cut it once
+            n_sub = substeps(h, p.h_max, f"of at most h_max = {p.h_max} s")
+            self._h, self._cut = h, (n_sub, h / n_sub)
+        n_sub, hs = self._cut
         hh, c = 0.5 * hs, hs / 6.0
-        delta0 = self.delta
-        forces = actuator_model(self.actuators, n1, n2, n3)
-        rates = self.rates
-
-        def gear(s: float) -> float:
-            return rudder_angle(delta0, delta_c, s, p.delta_max, p.delta_rate_max)
+        if (n1, n2, n3) != self._shaft_speeds:
+            self._shaft_speeds, self._forces = (n1, n2, n3), actuator_model(
+                self.actuators, n1, n2, n3)
+        forces, rates = self._forces, self.rates
+        gear = rudder_motion(self.delta, delta_c, p.delta_max, p.delta_rate_max)
 
         y = (self.x, self.y, self.psi, self.u, self.v, self.r, self.xi)
         for j in range(n_sub):
             s = j * hs
             ts = t + s
-            tau0, tau1, tau2 = forces(gear(s)), forces(gear(s + hh)), forces(gear(s + hs))
+            delta0, delta1, delta2 = gear(s), gear(s + hh), gear(s + hs)
+            tau0 = forces(delta0)             # the rudder at rest: the same forces
+            tau1 = tau0 if delta1 == delta0 != 0.0 else forces(delta1)
+            tau2 = tau1 if delta2 == delta1 != 0.0 else forces(delta2)
             k1 = rates(ts, y, tau0)
             k2 = rates(ts + hh, _axpy(hh, k1, y), tau1)
             k3 = rates(ts + hh, _axpy(hh, k2, y), tau1)
