@@ -49,6 +49,12 @@ def fmi_entry(method: Callable) -> Callable:
     return entry
 
 
+def unguarded(entry_point: Callable) -> Callable:
+    """The bound method behind an ``fmi_entry``: for a host in the same process, which
+    handles exceptions itself (pythonfmu's C++ layer is not there)."""
+    return entry_point.__func__.__wrapped__.__get__(entry_point.__self__)
+
+
 def naming(instance_name: str, text: str) -> str:
     """A message as it leaves the FMU: naming the FMU, for hosts whose logs do not
     (libcosim's log shows neither the instance nor the call)."""

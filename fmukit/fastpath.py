@@ -14,7 +14,8 @@ kind gets ``None`` and the slave lets pythonfmu serve it (and name any problem).
   parameters read back): each one's value read from the slave within one
   ``try``; where one fails, every one is read again through its own getter,
   which gives NaN for that one alone;
-- Real inputs: set as attributes of the slave.
+- Real inputs: set as attributes of the slave (refused after fmi2Terminate, as
+  FMI 2.0 wants).
 """
 from __future__ import annotations
 
@@ -87,12 +88,14 @@ class FastPaths:
                    convert: type) -> Callable[[], list]:
         slave, each = self._slave, self._each(vrs, getters, convert)
         gets = [self._get(self._registry.by_vr[vr]) for vr in vrs]
+        first = gets[0] if len(gets) == 1 else None     # a feedthrough output, typically
 
         def evaluated() -> list:
             if slave._model is None or slave.failure:
                 return each()
             try:
-                return [convert(get(slave)) for get in gets]
+                return ([convert(first(slave))] if first
+                        else [convert(get(slave)) for get in gets])
             except (ValueError, ArithmeticError):
                 return each()
         return evaluated
@@ -118,8 +121,17 @@ class FastPaths:
         if not all(vr in inputs for vr in vrs):
             return None
         slave, names = self._slave, tuple(inputs[vr] for vr in vrs)
+        sequence, attributes = slave.sequence, vars(slave)
+        if any(hasattr(type(slave), name) for name in names):   # a property: set it
+            def assign(values: list[float]) -> None:
+                for name, value in zip(names, values):
+                    setattr(slave, name, float(value))
+        else:                                                    # plain attributes
+            def assign(values: list[float]) -> None:
+                attributes.update(zip(names, map(float, values)))
 
         def write(values: list[float]) -> None:
-            for name, value in zip(names, values):
-                setattr(slave, name, float(value))
+            if sequence.phase == "terminated":
+                slave._set(list(vrs), values, float)     # refused, naming the input
+            assign(values)
         return write

@@ -79,6 +79,7 @@ class ModelSlave(Fmi2Slave):
                                 in_process="logger" not in kwargs)
         self.failure: str | None = None       # why the FMU failed; until fmi2Reset
         self.start_time = 0.0                 # of the experiment, for messages
+        self._step_size = (None, None)        # the last step size given, on the time base
         signals.defer_host_handlers()
         self._model = None
         self.registry = Registry(self, self.variables, self._output)
@@ -180,7 +181,9 @@ class ModelSlave(Fmi2Slave):
         try:
             self._check_inputs(self)
             # The time base of fmukit.timebase: whole nanoseconds, whatever the master.
-            self.step_model(on_time_base(current_time), on_time_base(step_size))
+            if step_size != self._step_size[0]:
+                self._step_size = (step_size, on_time_base(step_size))
+            self.step_model(on_time_base(current_time), self._step_size[1])
         except ValueError as error:
             self._fail(f"doStep at t = {current_time}: {error}; the FMU has failed (its "
                        "outputs read NaN until fmi2Reset)")
@@ -220,10 +223,10 @@ class ModelSlave(Fmi2Slave):
     @fmi_entry
     def set_real(self, vrs: list[int], values: list[float]) -> None:
         write = self.plans.input_writer(vrs)  # inputs only: always settable until terminate
-        if write is not None and self.sequence.phase != "terminated":
-            write(values)
-        else:
+        if write is None:
             self._set(vrs, values, float)
+        else:
+            write(values)
 
     @fmi_entry
     def set_integer(self, vrs: list[int], values: list[int]) -> None:

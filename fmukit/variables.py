@@ -86,12 +86,11 @@ def range_check(variables: tuple[Var, ...]) -> Callable[[Any], None]:
     """
     tests = [f"{max(v.min, -sys.float_info.max)!r} <= obj.{v.name} <= "
              f"{min(v.max, sys.float_info.max)!r}" for v in variables]
-    namespace: dict[str, Any] = {}
-    exec(f"def passes(obj):\n    return {' and '.join(tests) or 'True'}\n", namespace)
-    passes = namespace["passes"]
 
-    def check(obj: Any) -> None:
-        if not passes(obj):
-            for var in variables:
-                var.check(getattr(obj, var.name))
-    return check
+    def name_the_failure(obj: Any) -> None:
+        for var in variables:
+            var.check(getattr(obj, var.name))
+    namespace: dict[str, Any] = {"name_the_failure": name_the_failure}
+    exec(f"def check(obj):\n    if not ({' and '.join(tests) or 'True'}):\n"
+         "        name_the_failure(obj)\n", namespace)
+    return namespace["check"]

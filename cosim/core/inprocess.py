@@ -25,7 +25,7 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
-from fmukit.entry import explain, unnamed
+from fmukit.entry import explain, unguarded, unnamed
 from fmukit.packaging import FMUS
 from fmukit.slave import ModelSlave
 
@@ -126,20 +126,11 @@ class InProcessInstance(Instance):
         return read
 
     def writer(self, vrs: list[int]):
-        write, slave = self.slave.plans.input_writer(vrs), self.slave
-        if write is None:
-            return super().writer(vrs)
-        slow = super().writer(vrs)
-
-        def fast(values: list[float]) -> None:
-            if slave.sequence.phase == "terminated":
-                slow(values)                  # refused as through FMI
-            else:
-                write(values)
-        return fast
+        write = self.slave.plans.input_writer(vrs)
+        return super().writer(vrs) if write is None else write
 
     def stepper(self):
-        do_step, queue = self.slave.do_step, self.slave.log_queue
+        do_step, queue = unguarded(self.slave.do_step), self.slave.log_queue
 
         def step(t: float, h: float) -> None:
             try:
