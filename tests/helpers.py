@@ -18,17 +18,20 @@ def read_csv(path: Path) -> list[dict[str, float]]:
         return [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
 
 
-def fmu_variant(source: Path, dest: Path, xml=None, drop: tuple[str, ...] = ()) -> Path:
-    """A copy of an FMU with its modelDescription.xml passed through ``xml`` (text -> text)
-    and the members starting with any of ``drop`` left out."""
+def fmu_variant(source: Path, dest: Path, xml=None, drop: tuple[str, ...] = (),
+                edit: dict | None = None) -> Path:
+    """A copy of an FMU with its modelDescription.xml passed through ``xml`` (text -> text),
+    the members starting with any of ``drop`` left out, and members named in ``edit``
+    passed through its function (text -> text)."""
     import zipfile
 
+    edit = {**(edit or {}), **({"modelDescription.xml": xml} if xml is not None else {})}
     with zipfile.ZipFile(source) as original, zipfile.ZipFile(dest, "w") as copy:
         for info in original.infolist():
             if info.filename.startswith(drop):
                 continue
             data = original.read(info)
-            if info.filename == "modelDescription.xml" and xml is not None:
-                data = xml(data.decode("utf-8")).encode("utf-8")
+            if info.filename in edit:
+                data = edit[info.filename](data.decode("utf-8")).encode("utf-8")
             copy.writestr(info, data)
     return dest

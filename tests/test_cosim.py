@@ -19,6 +19,7 @@ from cosim.core import ssd
 from cosim.core.ssd import read_ssd, write_ssd
 from cosim.core.wiring import WiringError
 from cosim.studies.direct import SIGNALS, run_direct
+from helpers import fmu_variant
 
 SCENARIOS = scenarios.SCENARIO_DIR
 PAPER = ["calm_pd", "calm_smc", "waves_pd", "waves_smc"]
@@ -101,6 +102,33 @@ def test_fmi_and_inprocess_backends_agree_bit_for_bit(name):
             c for i, c in enumerate(fmi.columns)
             if not np.array_equal(fmi.data[:, i], inprocess.data[:, i])]
         assert fmi.meta["parameters"] == inprocess.meta["parameters"]
+        assert set(inprocess.meta["backends"].values()) == {"inprocess"}, inprocess.meta["notes"]
+
+
+def test_only_our_fmus_as_built_from_this_checkout_run_in_process(fmu_paths, tmp_path):
+    from cosim.core.inprocess import in_process_refusal
+    ship = fmu_paths["ship"]
+    assert in_process_refusal(ship) is None
+    # by content, whatever the file's name (a sweep's worker names them by hash)
+    assert in_process_refusal(shutil.copy(ship, tmp_path / "0a1b2c.fmu")) is None
+    edited = fmu_variant(ship, tmp_path / "edited.fmu", edit={
+        "resources/ship_fmu/hull.py": lambda text: text + "\n# changed\n"})
+    assert "other sources than this process runs (ship_fmu/hull.py differs" in \
+        in_process_refusal(edited)
+    renamed = fmu_variant(ship, tmp_path / "renamed.fmu",
+                          lambda xml: xml.replace('name="delta_c"', 'name="rudder"'))
+    assert "its ModelVariables differ from those of this project's 'ship'" in \
+        in_process_refusal(renamed)
+    other = fmu_variant(ship, tmp_path / "other.fmu",
+                        lambda xml: xml.replace('modelName="ship"', 'modelName="tanker"'))
+    assert in_process_refusal(other) == "its model 'tanker' is not one of this project's " \
+                                        "Python FMUs"
+    master = Master(system("calm_pd"), backend="inprocess")
+    try:
+        assert master.backends == dict.fromkeys(["guidance", "autopilot", "ship"], "inprocess")
+        assert master.notes == []
+    finally:
+        master.free()
 
 
 @pytest.mark.parametrize("overrides", [

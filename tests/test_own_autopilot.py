@@ -1,6 +1,7 @@
 """Your own autopilot: the port contract, --autopilot and --map, sweeps and SSP packages."""
 from __future__ import annotations
 
+import json
 import re
 import zipfile
 from pathlib import Path
@@ -171,9 +172,13 @@ def test_a_bad_parameter_of_the_autopilot_is_named(fmu_paths, tmp_path, capsys, 
     assert "FMU 'autopilot': exitInitializationMode" in err and fragment in err
 
 
-def test_the_in_process_backend_says_it_cannot_run_a_foreign_fmu(foreign, tmp_path, capsys):
+def test_the_in_process_backend_runs_a_foreign_fmu_through_fmi_and_says_so(foreign, tmp_path,
+                                                                         capsys):
     assert _run(tmp_path, "calm_pd", "--autopilot", str(foreign["renamed"]), *MAP,
-                "--backend", "inprocess") == 2
+                "--backend", "inprocess", "--stop-time", "20") == 0
     err = capsys.readouterr().err
-    assert "no FMU named 'heading_pilot' is built by this project" in err
-    assert "fmi2Terminate" not in err
+    assert ("note: autopilot (heading_pilot.fmu) runs through FMI, not in-process: its "
+            "ModelVariables differ from those of this project's 'pid_autopilot'") in err
+    meta = json.loads(next(tmp_path.glob("*.json")).read_text())
+    assert meta["backends"] == {"guidance": "inprocess", "autopilot": "fmi",
+                                "ship": "inprocess"}

@@ -20,13 +20,15 @@ from __future__ import annotations
 import importlib
 import inspect
 import re
+import zipfile
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 from typing import Any
+from xml.etree import ElementTree
 
 from fmukit.entry import explain, unguarded, unnamed
-from fmukit.packaging import FMUS
+from fmukit.packaging import BUILD_HINT, FMUS, ROOT
 from fmukit.slave import ModelSlave
 
 from .instance import FmuCallError, Instance, logged_error
@@ -44,7 +46,7 @@ class VariableInfo:
 
 
 def slave_class(fmu_name: str) -> type[ModelSlave]:
-    """The ModelSlave subclass that ``fmus/<fmu_name>.fmu`` is built from."""
+    """The ModelSlave subclass that this project's FMU ``fmu_name`` is built from."""
     if fmu_name not in FMUS:
         raise ValueError(f"no FMU named '{fmu_name}' is built by this project "
                          f"(known: {', '.join(FMUS)})")
@@ -54,12 +56,79 @@ def slave_class(fmu_name: str) -> type[ModelSlave]:
                 if issubclass(cls, ModelSlave) and getattr(cls, "model_name", None) == fmu_name)
 
 
+def in_process_refusal(path: str | Path) -> str | None:
+    """Why the FMU at ``path`` cannot run in-process, or None if it can: it must be one
+    this project builds (by its modelName, whatever its file name), declare the
+    variables, units and dependencies its class declares, and carry the same Python
+    sources this process runs, so that both routes compute the same."""
+    path = Path(path)
+    stat = path.stat()
+    key = (path.resolve(), stat.st_size, stat.st_mtime_ns)
+    if key not in _refusals:
+        _refusals[key] = _refusal(path)
+    return _refusals[key]
+
+
+_refusals: dict[tuple, str | None] = {}
+
+
+def _refusal(path: Path) -> str | None:
+    try:
+        with zipfile.ZipFile(path) as fmu:
+            declared = ElementTree.fromstring(fmu.read("modelDescription.xml"))
+            name = declared.get("modelName")
+            if name not in FMUS:
+                return f"its model '{name}' is not one of this project's Python FMUs"
+            ours = slave_class(name)(instance_name=name).to_xml()
+            for section in _DECLARATIONS:
+                if _canonical(declared.find(section)) != _canonical(ours.find(section)):
+                    return (f"its {section} differ from those of this project's '{name}' "
+                            f"(another FMU of that name, or ours before a change: {BUILD_HINT})")
+            script = Path(FMUS[name][0])
+            carried = {n.removeprefix("resources/"): n for n in fmu.namelist()
+                       if n.startswith("resources/") and n.endswith(".py")}
+            for relative, entry in carried.items():
+                here = _source_here(relative, script)
+                if here is not None and (not here.is_file()
+                                         or here.read_bytes() != fmu.read(entry)):
+                    return (f"it was built from other sources than this process runs "
+                            f"({relative} differs: {BUILD_HINT})")
+    except (OSError, KeyError, zipfile.BadZipFile, ElementTree.ParseError) as error:
+        return f"it cannot be read as an FMU ({error})"
+    return None
+
+
+_DECLARATIONS = ("ModelVariables", "UnitDefinitions", "ModelStructure")
+
+
+def _canonical(element: ElementTree.Element | None) -> str:
+    return "" if element is None else ElementTree.canonicalize(ElementTree.tostring(element),
+                                                               strip_text=True)
+
+
+def _source_here(relative: str, script: Path) -> Path | None:
+    """This process's file for a source an FMU carries (None for one not of this project:
+    pythonfmu's own)."""
+    if relative == script.name:
+        return ROOT / script
+    package = relative.split("/", 1)[0]
+    return ROOT / relative if package in _PACKAGES else None
+
+
+_PACKAGES = {p for _, packages in FMUS.values() for p in packages}
+
+
 class InProcessInstance(Instance):
     """A slave class instantiated and driven in this process."""
 
     def __init__(self, path: str | Path, name: str):
         self.path, self.name = Path(path), name
-        self.slave = slave_class(self.path.stem)(instance_name=name)
+        refusal = in_process_refusal(self.path)
+        if refusal:
+            raise ValueError(f"FMU '{name}' ({self.path.name}) cannot run in-process: "
+                             f"{refusal}")
+        self.model_name = _model_name(self.path)
+        self.slave = slave_class(self.model_name)(instance_name=name)
         self.variables = {}
         for vr, var in self.slave.registry.by_vr.items():
             self.variables[var.name] = VariableInfo(var.name, vr, _FMI_TYPE[var.kind],
@@ -153,6 +222,11 @@ class InProcessInstance(Instance):
         """Terminate, if the slave was initialised (as fmi2FreeInstance may follow any call)."""
         if self.slave.sequence.phase == "step":
             self.slave.terminate()
+
+
+def _model_name(path: Path) -> str:
+    with zipfile.ZipFile(path) as fmu:
+        return ElementTree.fromstring(fmu.read("modelDescription.xml")).get("modelName")
 
 
 @cache

@@ -25,7 +25,7 @@ from fmukit.timebase import communication_point, nanoseconds, seconds, step_coun
 
 from .coupling import COUPLINGS
 from .fmi import FmuInstance
-from .inprocess import InProcessInstance
+from .inprocess import InProcessInstance, in_process_refusal
 from .instance import FmuCallError, Instance
 from .interrupt import StopSignals
 from .null import NullInstance
@@ -38,8 +38,10 @@ _NAN_INPUT = re.compile(r"input \w+ = nan is not finite")
 
 BACKENDS: dict[str, type[Instance]] = {"fmi": FmuInstance, "inprocess": InProcessInstance,
                                        "null": NullInstance}
-"""fmi: the FMUs through fmpy; inprocess: their Python classes without FMI; null: nothing
-but the FMUs' interfaces, to measure the master's own cost (``cosim.core.null``)."""
+"""fmi: the FMUs through fmpy; inprocess: their Python classes without FMI (an FMU this
+project does not build, or built from other sources, runs through FMI, with a note);
+null: nothing but the FMUs' interfaces, to measure the master's own cost
+(``cosim.core.null``)."""
 
 
 class Master:
@@ -55,9 +57,11 @@ class Master:
         self.system, self.coupling, self.backend = system, coupling, backend
         self.configure(overrides)
         self.instances: dict[str, Instance] = {}
+        self.notes: list[str] = []        # what the user should know about how this runs
+        self.backends: dict[str, str] = {}    # how each component runs
         try:
             for name in system.components:
-                self.instances[name] = BACKENDS[backend](system.fmu_path(name), name)
+                self.instances[name] = self._instantiate(system.fmu_path(name), name)
             check_connections(system, self.instances)
             self.order = feedthrough_order(system, self.instances)
             self.verify_inputs = verify_inputs
@@ -68,6 +72,17 @@ class Master:
         self.units = {column: self.instances[component].unit(variable)
                       for column in self.columns
                       for component, variable in [column.split(".", 1)]}
+
+    def _instantiate(self, path: Path, name: str) -> Instance:
+        backend = self.backend
+        if backend == "inprocess":
+            refusal = in_process_refusal(path)
+            if refusal:
+                backend = "fmi"
+                self.notes.append(f"{name} ({path.name}) runs through FMI, not in-process: "
+                                  f"{refusal}")
+        self.backends[name] = backend
+        return BACKENDS[backend](path, name)
 
     def configure(self, overrides: dict[str, dict[str, Any]] | None = None) -> None:
         """Parameters for the next run: the system's, updated by ``overrides``."""
@@ -134,7 +149,8 @@ class Master:
         n_steps = step_count(t0, system.stop_time if stop_time is None else stop_time, h)
         meta = {"system": system.name, "description": system.description,
                 "scenario_file": str(system.path) if system.path else None,
-                "backend": self.backend, "coupling": self.coupling, "start_time": t0,
+                "backend": self.backend, "backends": self.backends, "notes": self.notes,
+                "coupling": self.coupling, "start_time": t0,
                 "step_size": h, "stop_time": communication_point(t0, n_steps, h),
                 "settings": self.parameters, "overrides": self.overrides,
                 "fmus": {name: {"file": str(i.path), "guid": getattr(i, "guid", None)}
