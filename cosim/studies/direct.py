@@ -25,7 +25,7 @@ def build_models(system: SystemDescription) -> dict:
     ship_start = system.components["ship"].parameters
     models = {}
     for name, component in system.components.items():
-        instance = InProcessInstance(component.source, name)
+        instance = InProcessInstance(system.fmu_path(name), name)
         instance.enter_initialization(system.start_time)
         instance.set(component.parameters)
         if name == "autopilot":             # the reference model starts at the ship's state
