@@ -124,6 +124,17 @@ def test_task_equals_a_direct_run_and_reuses_its_fmus(fmu_paths, tmp_path):
     sweep_task.free_masters()
 
 
+def test_an_in_process_sweep_notes_each_fmu_that_runs_through_fmi(c_autopilot, tmp_path):
+    spec = sweep.Spec.read(write_spec(tmp_path, f'[controllers]\npd = "waves_pd"\n'
+                                                f'c = "{c_autopilot}"\n[axes]\nwave_seed = [1]\n'))
+    assert spec.backend_notes("fmi") == []
+    assert spec.backend_notes("inprocess") == [
+        "controller 'c': autopilot (pd_autopilot_c.fmu) runs through FMI, not in-process: its "
+        "model 'pd_autopilot_c' is not one of this project's Python FMUs"]
+    with pytest.raises(ValueError, match="backend must be fmi or inprocess, got 'null'"):
+        sweep.execute(spec, tmp_path, backend="null")
+
+
 def test_task_records_a_failed_run_with_its_message(fmu_paths, tmp_path):
     spec = sweep.Spec.read(write_spec(tmp_path, '[axes]\nHs = [-1.0]\n'))
     row = sweep.run_locally(spec, spec.runs()[0])
@@ -145,8 +156,10 @@ def test_dask_sweep_writes_resumes_and_plots(fmu_paths, tmp_path, capsys):
     failed = {**json.loads(journal[0]), "status": "failed", "error": "a worker was lost"}
     torn = journal[3][: len(journal[3]) // 2]
     (out / "runs.jsonl").write_text("\n".join([json.dumps(failed), *journal[1:3], torn]))
-    again = sweep.execute(spec, out, workers=1, progress=False)
-    assert "is not a whole journal row" in capsys.readouterr().err
+    # resumed in-process: the same rows, bit for bit (the backend is not part of a run's id)
+    again = sweep.execute(spec, out, workers=1, progress=False, backend="inprocess")
+    err = capsys.readouterr().err
+    assert "is not a whole journal row" in err and "runs through FMI" not in err
     assert [r["J"] for r in again] == [r["J"] for r in rows]
     redone = [json.loads(line)["run_id"] for line in
               (out / "runs.jsonl").read_text().splitlines()[4:]]

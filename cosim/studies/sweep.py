@@ -3,6 +3,7 @@
     python -m cosim.sweep docs/sweeps/smc_vs_pd.toml             # local cluster, 1 worker/core
     python -m cosim.sweep SPEC --scheduler tcp://host:8786       # an existing Dask cluster
     python -m cosim.sweep SPEC --workers 2 --csv --out results/sweeps
+    python -m cosim.sweep SPEC --backend inprocess               # our FMUs without FMI: faster
 
 SPEC is a TOML file (see docs/sweeps/example.toml):
 
@@ -62,6 +63,7 @@ import numpy as np
 
 from .. import scenarios
 from ..analysis.seastate import model_scale
+from ..core.inprocess import in_process_refusal
 from ..core.provenance import PACKAGE, code_version
 from ..scenarios.autopilot import check_autopilot
 from .bundle import Bundle, bundle
@@ -161,11 +163,26 @@ class Spec:
                 runs.append(point)
         return runs
 
-    def job(self, run: dict[str, Any], sweep: str) -> Job:
+    def job(self, run: dict[str, Any], sweep: str, backend: str = "fmi") -> Job:
         """What a worker needs for ``run`` (of the sweep with token ``sweep``)."""
         return Job(sweep=sweep, run=run, bundle=self.bundles()[run["controller"]],
                    overrides=self.settings(run)[1], stop_time=self.stop_time,
-                   track=self.wants_track(run), code=code_version())
+                   track=self.wants_track(run), code=code_version(), backend=backend)
+
+    def backend_notes(self, backend: str) -> list[str]:
+        """Which components of which controllers will run through FMI although ``backend``
+        is "inprocess" (an FMU not of this project, or not built from this checkout)."""
+        if backend != "inprocess":
+            return []
+        notes = []
+        for controller, shipped in self.bundles().items():
+            for name, component in shipped.system.components.items():
+                path = self.files()[Path(component.source).stem]
+                refusal = in_process_refusal(path)
+                if refusal:
+                    notes.append(f"controller {controller!r}: {name} ({path.name}) runs through "
+                                 f"FMI, not in-process: {refusal}")
+        return notes
 
     def settings(self, run: dict[str, Any]) -> tuple[str, dict[str, dict[str, Any]]]:
         """(scenario, overrides by component) of one run."""
@@ -310,9 +327,15 @@ def _worker_saturation(dask_scheduler=None) -> float:
 
 
 def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | None = None,
-            progress: bool = True, task=None, scheduler_file: str | None = None) -> list[dict]:
+            progress: bool = True, task=None, scheduler_file: str | None = None,
+            backend: str = "fmi") -> list[dict]:
     """Run every run of ``spec`` without an ok row in the journal (failed rows are run
     again); return every row of the sweep.
+
+    ``backend``: the master's, "fmi" or "inprocess" (this project's FMUs as Python
+    classes: the same results, several times faster; any other FMU runs through FMI,
+    and a note says so). The backend is not part of a run's identity: a sweep may be
+    resumed with the other.
 
     ``task(job, blobs) -> row`` is what each run executes (default ``run_one``). Each
     distinct FMU goes to the cluster once (``cosim.studies.bundle``); each run's future
@@ -322,20 +345,24 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
     the same call then resumes. SweepError if a worker runs other code than the client
     or another sweep writes the journal.
     """
+    if backend not in ("fmi", "inprocess"):
+        raise ValueError(f"backend must be fmi or inprocess, got {backend!r}")
     try:
         with Journal(out / "runs.jsonl") as journal:
             todo = [r for r in spec.runs()
                     if journal.rows.get(r["run_id"], {}).get("status") != "ok"]
             if todo:
+                for note in spec.backend_notes(backend):
+                    _say(f"note: {note}")
                 _run_on_cluster(spec, todo, journal, connect(scheduler, workers, scheduler_file),
-                                progress, task or run_one)
+                                progress, task or run_one, backend)
     except JournalLocked as locked:
         raise SweepError(str(locked)) from None
     return completed(spec, out)
 
 
 def _run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, progress: bool,
-                    task) -> None:
+                    task, backend: str) -> None:
     from dask.distributed import as_completed
 
     client, cluster = connection
@@ -354,7 +381,7 @@ def _run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, 
                    for sha, path in spec.files().items()}
         futures = {}
         for run in todo:
-            job = spec.job(run, token)
+            job = spec.job(run, token, backend)
             blobs = {sha: shipped[sha] for sha in job.bundle.fmu_hashes()}
             futures[client.submit(task, job, blobs, retries=2, pure=False,
                                   key=f"run-{token}-{run['run_id']}")] = run

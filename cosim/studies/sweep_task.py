@@ -1,7 +1,7 @@
 """A sweep's task, on a worker: one whole co-simulation, from a ``Job`` and the FMUs' bytes.
 
-A worker keeps one master per sweep, thread and system (``Bundle.digest``) and resets
-it (fmi2Reset) between tasks. Each sweep registers its own ``SweepTeardown`` worker
+A worker keeps one master per sweep, thread, system (``Bundle.digest``) and backend,
+and resets it (fmi2Reset) between tasks. Each sweep registers its own ``SweepTeardown`` worker
 plugin, named after the sweep's token: when the sweep ends (or the worker closes) it
 frees that sweep's masters only, so two sweeps on one cluster do not free each
 other's FMUs.
@@ -37,20 +37,21 @@ class Job:
     stop_time: float | None
     track: bool                         # record the track for the tracks figure
     code: str                           # the client's code_version(): the worker's must match
+    backend: str = "fmi"                # the master's: fmi, or inprocess for our FMUs
 
 
-_masters: dict[tuple[str, int, str], Any] = {}      # (sweep, thread, digest) -> Master
+_masters: dict[tuple[str, int, str, str], Any] = {}    # (sweep, thread, digest, backend)
 _masters_lock = threading.Lock()
 
 
 def _master(job: Job, blobs: dict[str, bytes]):
     from ..core.master import Master
 
-    key = (job.sweep, threading.get_ident(), job.bundle.digest)
+    key = _key(job)
     with _masters_lock:
         master = _masters.get(key)
     if master is None:
-        master = Master(materialise(job.bundle, blobs))
+        master = Master(materialise(job.bundle, blobs), backend=job.backend)
         with _masters_lock:
             _masters[key] = master
     else:
@@ -58,9 +59,13 @@ def _master(job: Job, blobs: dict[str, bytes]):
     return master
 
 
+def _key(job: Job) -> tuple[str, int, str, str]:
+    return job.sweep, threading.get_ident(), job.bundle.digest, job.backend
+
+
 def _drop_master(job: Job) -> None:
     with _masters_lock:
-        master = _masters.pop((job.sweep, threading.get_ident(), job.bundle.digest), None)
+        master = _masters.pop(_key(job), None)
     if master is not None:
         master.free()
 
