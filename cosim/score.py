@@ -1,6 +1,7 @@
 """Score your autopilot against the paper's PD and sliding-mode autopilots and the PID.
 
     python -m cosim.score my.fmu [--name NAME] [--seeds N] [--map PORT=NAME] [--set ...]
+                                 [--backend inprocess]
 
 Runs the paper's route in calm water and waves, a 40 deg course change, and an
 N-seed wave ensemble on a local Dask cluster (or --scheduler), for your FMU and the
@@ -15,6 +16,7 @@ import time
 from pathlib import Path
 
 from ._cli import add_port_options, checked_autopilot, entry, setting_option, writable_folder
+from .core.inprocess import in_process_refusal
 from .studies.scorecard import score
 
 
@@ -38,6 +40,10 @@ def main(argv: list[str] | None = None) -> int:
                              "cluster)")
     parser.add_argument("--workers", type=int, help="local Dask worker processes "
                                                     "(default: one per core)")
+    parser.add_argument("--backend", choices=("fmi", "inprocess"), default="fmi",
+                        help="fmi: every run through the FMUs (default); inprocess: this "
+                             "project's FMUs as Python classes, without FMI: the same results, "
+                             "faster (your FMU still runs through FMI, with a note)")
     parser.add_argument("--out", type=Path, help="output folder (default: results/score/NAME)")
     args = parser.parse_args(argv)
     if args.seeds < 1:
@@ -48,6 +54,10 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     name = args.name or args.autopilot.stem
     out = writable_folder(args.out or Path("results") / "score" / name)
+    refusal = in_process_refusal(args.autopilot) if args.backend == "inprocess" else None
+    if refusal:
+        print(f"note: {args.autopilot.name} runs through FMI, not in-process: {refusal}",
+              file=sys.stderr)
     started = time.perf_counter()
     steps = 4 * 2 + 4 + 1
 
@@ -61,7 +71,7 @@ def main(argv: list[str] | None = None) -> int:
         bar.set_postfix_str(step)
     try:
         text = score(args.autopilot.resolve(), name, out, args.seeds, dict(args.map),
-                     dict(args.set), args.workers, args.scheduler, progress)
+                     dict(args.set), args.workers, args.scheduler, progress, args.backend)
         bar.update()
     except (ValueError, FileNotFoundError) as error:
         bar.close()

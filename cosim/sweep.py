@@ -42,6 +42,8 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     out = writable_folder(args.out / spec.name)
     try:
+        for note in spec.backend_notes(args.backend):
+            print(f"note: {note}", file=sys.stderr)
         rows = sweep.execute(spec, out, args.scheduler, args.workers,
                              progress=not args.no_progress, scheduler_file=args.scheduler_file,
                              backend=args.backend)

@@ -334,8 +334,8 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
 
     ``backend``: the master's, "fmi" or "inprocess" (this project's FMUs as Python
     classes: the same results, several times faster; any other FMU runs through FMI,
-    and a note says so). The backend is not part of a run's identity: a sweep may be
-    resumed with the other.
+    ``Spec.backend_notes`` says which). The backend is not part of a run's identity: a
+    sweep may be resumed with the other.
 
     ``task(job, blobs) -> row`` is what each run executes (default ``run_one``). Each
     distinct FMU goes to the cluster once (``cosim.studies.bundle``); each run's future
@@ -352,8 +352,6 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
             todo = [r for r in spec.runs()
                     if journal.rows.get(r["run_id"], {}).get("status") != "ok"]
             if todo:
-                for note in spec.backend_notes(backend):
-                    _say(f"note: {note}")
                 _run_on_cluster(spec, todo, journal, connect(scheduler, workers, scheduler_file),
                                 progress, task or run_one, backend)
     except JournalLocked as locked:
