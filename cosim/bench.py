@@ -2,13 +2,15 @@
 
     python -m cosim.bench                 engines side by side, calm_pd and waves_pd, 400 s
     python -m cosim.bench memory          a 24 h run of calm_pd streamed to disk: peak memory
-    python -m cosim.bench sweep           runs per second of a sweep, 1 and 2 workers
+    python -m cosim.bench sweep           runs per second of a sweep: FMI and in-process
+                                          backends, 1 and 2 workers
 
 The default benchmark measures, for each scenario, (a) the plain Python modules
-wired by hand in-process (cosim.studies.direct), (b) our master through the FMUs, (c) OSP
-libcosim and (d) ecos on the exported SSP package of the same scenario, with the
-median wall time of several runs; and the cost per macro step of the ship FMU's
-doStep alone and of the master's own bookkeeping.
+wired by hand (cosim.studies.direct), our master (b) on its in-process backend and
+(c) through the FMUs, (d) OSP libcosim and (e) ecos on the exported SSP package of the
+same scenario, timed in turn round after round (the median of each), and (f) the
+floor of any FMI route: (a) plus the FMI calls per step times the measured cost of
+one call. One table per scenario, with the ratios.
 """
 from __future__ import annotations
 

@@ -1,12 +1,13 @@
 """Benchmarks that print figures (never timed assertions); ``python -m cosim.bench`` runs them.
 
 - ``engines``: calm_pd and waves_pd, 400 s, (a) the plain Python modules wired by
-  hand in-process (``cosim.studies.direct``), (b) our master through the FMUs, (c)
-  OSP libcosim and (d) ecos on the exported SSP package of the same scenario, each
-  the median wall time of several runs; and the cost per step of the ship FMU's
-  doStep alone and of the master's own work (the master on the null backend);
+  hand (``cosim.studies.direct``), our master (b) on its in-process backend and (c)
+  through the FMUs, (d) OSP libcosim and (e) ecos on the exported SSP package of the
+  same scenario, timed in turn round after round (median of each), and (f) the floor
+  of any FMI route: (a) plus the FMI calls a step makes times the measured cost of one;
 - ``memory``: a long calm_pd run streamed to CSV, peak memory against a 1 h run;
-- ``sweep_throughput``: runs per second of a seed sweep on a local cluster.
+- ``sweep_throughput``: runs per second of a seed sweep on a local cluster, for each
+  backend with 1 and 2 workers.
 """
 from __future__ import annotations
 
@@ -21,7 +22,6 @@ from pathlib import Path
 from typing import Callable
 
 STEPS = 4000
-TARGETS = {"waves_pd through the FMUs": "<= 0.3 s", "b/a": "<= 1.25", "c/b": ">= 3"}
 
 
 def machine() -> str:
@@ -38,15 +38,17 @@ def machine() -> str:
             f"{platform.system()} {platform.release()}")
 
 
-def median_time(run: Callable[[], object], repeats: int) -> float:
-    """Median wall time of ``repeats`` calls, after one warm-up call."""
-    run()
-    times = []
-    for _ in range(repeats):
-        started = time.perf_counter()
-        run()
-        times.append(time.perf_counter() - started)
-    return statistics.median(times)
+def side_by_side(runners: dict[str, Callable[[], object]], repeats: int) -> dict[str, float]:
+    """Median wall time of each runner, timed in turn, round after round (after one warm-up
+    round): on a shared machine, the alternatives see the same load."""
+    times: dict[str, list[float]] = {key: [] for key in runners}
+    for round_ in range(repeats + 1):
+        for key, run in runners.items():
+            started = time.perf_counter()
+            run()
+            if round_:
+                times[key].append(time.perf_counter() - started)
+    return {key: statistics.median(values) for key, values in times.items()}
 
 
 def _libcosim_runner(ssp: Path) -> Callable[[], None]:
@@ -76,71 +78,99 @@ def _ecos_runner(ssp: Path) -> Callable[[], None]:
     return run
 
 
-def engines(repeats: int) -> None:
+ROWS = {"direct": "(a) cosim.direct: the modules wired by hand",
+        "inprocess": "(b) our master, in-process backend",
+        "fmi": "(c) our master, FMUs via fmpy",
+        "libcosim": "(d) OSP libcosim, same SSP",
+        "ecos": "(e) ecos, same SSP",
+        "floor": "(f) FMI floor: a + calls x cost"}
+
+
+def engines(repeats: int) -> dict[str, dict[str, float]]:
+    """calm_pd and waves_pd, 400 s, every way at once; prints one table per scenario and the
+    ratios, returns the times by scenario and row."""
     from .. import scenarios
     from ..core.master import Master
     from ..interop.ssp import export
     from .direct import run_direct
 
     print(f"Engines on the same system, 400 s = {STEPS} macro steps of 0.1 s, median of "
-          f"{repeats} runs, on {machine()}")
-    rows = []
+          f"{repeats} runs taken in turn, on {machine()}")
+    results = {}
     with tempfile.TemporaryDirectory() as tmp:
         for name in ("calm_pd", "waves_pd"):
             system = scenarios.load(name)
             ssp = export(name, Path(tmp))
-            master = Master(system)
+            masters = {b: Master(system, backend=b) for b in ("inprocess", "fmi")}
             try:
-                def ours() -> None:
-                    master.reset()
-                    if master.run().error:
-                        raise RuntimeError("our master failed")
-                times = {"a": median_time(lambda: run_direct(system), repeats),
-                         "b": median_time(ours, repeats)}
-                ship = master.instances["ship"]
-                doStep = _ship_step_cost(ship)
+                runners = {"direct": lambda: run_direct(system),
+                           **{b: _master_runner(m) for b, m in masters.items()}}
+                for key, make in (("libcosim", _libcosim_runner), ("ecos", _ecos_runner)):
+                    try:
+                        runners[key] = make(ssp)
+                    except Exception as error:          # not installed here: say so
+                        print(f"  {key} unavailable: {type(error).__name__}: {error}")
+                times = side_by_side(runners, repeats)
+                calls, per_call = fmi_calls_per_step(masters["fmi"]), fmi_call_cost(masters["fmi"])
             finally:
-                master.free()
-            null = Master(system, backend="null")
-            own = median_time(null.run, repeats)
-            for key, runner in (("c", _libcosim_runner), ("d", _ecos_runner)):
-                try:
-                    times[key] = median_time(runner(ssp), repeats)
-                except Exception as error:          # not installed here: say so
-                    times[key] = None
-                    print(f"  ({key}) {'libcosim' if key == 'c' else 'ecos'} unavailable: "
-                          f"{type(error).__name__}: {error}")
-            rows.append((name, times, doStep, own))
-
-    labels = {"a": "(a) Python modules in-process, no FMI", "b": "(b) our master, FMUs via fmpy",
-              "c": "(c) OSP libcosim, same SSP", "d": "(d) ecos, same SSP"}
-    for name, times, doStep, own in rows:
-        print(f"\n{name}:")
-        print(f"  {'':40} {'wall s':>8} {'us/step':>9} {'RTF':>7}")
-        for key, label in labels.items():
-            if times.get(key) is not None:
-                t = times[key]
-                print(f"  {label:40} {t:8.3f} {t / STEPS * 1e6:9.1f} {400 / t:7.0f}")
-        b = times["b"]
-        print(f"  b/a = {b / times['a']:.2f}" + (f"   c/b = {times['c'] / b:.2f}"
-                                                 if times.get("c") else "")
-              + (f"   d/b = {times['d'] / b:.2f}" if times.get("d") else ""))
-        print(f"  ship FMU doStep alone: {doStep:.1f} us;  master's own cost (bookkeeping, "
-              f"no FMI): {own / STEPS * 1e6:.1f} us/step;  FMI calls and slave wrappers: "
-              f"{(b - times['a'] - own) / STEPS * 1e6:.1f} us/step")
-    waves_b = dict((n, t) for n, t, _, _ in rows)["waves_pd"]["b"]
-    print(f"\nTargets: waves_pd through the FMUs {waves_b:.3f} s (target "
-          f"{TARGETS['waves_pd through the FMUs']}); b/a (target {TARGETS['b/a']}); "
-          f"c/b (target {TARGETS['c/b']}) as above.")
+                for master in masters.values():
+                    master.free()
+            times["floor"] = times["direct"] + STEPS * calls * per_call
+            results[name] = times
+            _print_engines(name, times, calls, per_call)
+    calm, waves = results["calm_pd"], results["waves_pd"]
+    print(f"\nwaves_pd / calm_pd in-process: {waves['inprocess'] / calm['inprocess']:.2f} "
+          f"(cosim.direct: {waves['direct'] / calm['direct']:.2f})")
+    return results
 
 
-def _ship_step_cost(ship, steps: int = 2000) -> float:
-    """Microseconds per doStep of the ship FMU alone, as initialised by the master."""
-    step = ship.stepper()
+def _master_runner(master) -> Callable[[], None]:
+    def run() -> None:
+        master.reset()
+        if master.run().error:
+            raise RuntimeError(f"our master failed ({master.backend})")
+    return run
+
+
+def _print_engines(name: str, times: dict[str, float], calls: int, per_call: float) -> None:
+    print(f"\n{name}:")
+    print(f"  {'':44} {'wall s':>7} {'us/step':>8} {'RTF':>6} {'x (a)':>6}")
+    for key, label in ROWS.items():
+        if key in times:
+            t = times[key]
+            print(f"  {label:44} {t:7.3f} {t / STEPS * 1e6:8.1f} {400 / t:6.0f} "
+                  f"{t / times['direct']:6.2f}")
+    ratios = [f"b/a = {times['inprocess'] / times['direct']:.2f}",
+              f"c/b = {times['fmi'] / times['inprocess']:.2f}",
+              f"c/f = {times['fmi'] / times['floor']:.2f}"]
+    ratios += [f"{letter}/c = {times[k] / times['fmi']:.2f}"
+               for letter, k in (("d", "libcosim"), ("e", "ecos"))
+               if k in times]
+    print(f"  {'   '.join(ratios)}")
+    print(f"  (f): {calls} FMI calls per step x {per_call * 1e6:.1f} us per call (measured "
+          "on the PD FMU in the running loop) + the model compute (a)")
+
+
+def fmi_calls_per_step(master) -> int:
+    """FMI calls one Gauss-Seidel step of ``master`` makes (its prepared calls)."""
+    return sum(bool(call) for node in master.nodes
+               for call in (node.read_state, node.apply_inputs, node.read_feedthrough,
+                            node.read_integers, node.step))
+
+
+def fmi_call_cost(master, calls: int = 20_000) -> float:
+    """Seconds per FMI call of the cheapest kind a step makes, setReal and getReal of one
+    value on the autopilot FMU, as the master's loop makes them."""
+    master.reset()
+    master.initialize()
+    instance = master.instances["autopilot"]
+    write = instance.writer([instance.vr("psi_d")])
+    read = instance.reader([instance.vr("delta_c")])
     started = time.perf_counter()
-    for k in range(steps):
-        step(400.0 + 0.1 * k, 0.1)
-    return (time.perf_counter() - started) / steps * 1e6
+    for _ in range(calls // 2):
+        write([0.1])
+        read()
+    return (time.perf_counter() - started) / calls
 
 
 def memory(hours: float) -> None:
@@ -166,48 +196,65 @@ def memory(hours: float) -> None:
               f"CSV {size / 1e6:7.1f} MB, peak RSS {peak_kb / 1024:6.1f} MB")
 
 
-def sweep_throughput(runs: int, worker_counts: tuple[int, ...] = (1, 2)) -> None:
+def sweep_throughput(runs: int, worker_counts: tuple[int, ...] = (1, 2),
+                     backends: tuple[str, ...] = ("fmi", "inprocess")) -> dict:
     """Runs per second of a waves_pd/waves_smc seed sweep (400 s each) on a local cluster,
-    the scaling from one worker to more, and the overhead per run: in the task (its wall
-    time minus the master's run) and outside it (worker time per run minus task time)."""
+    for each backend and number of workers; the scaling from one worker to more, the
+    overhead per run (in the task: its wall time minus the master's run; outside it:
+    worker time per run minus task time), and each backend's throughput against FMI's."""
+    print(f"sweep throughput: {runs} runs of 400 s (waves_pd and waves_smc, wave seeds), "
+          f"on {machine()}")
+    rates = {}
+    for backend in backends:
+        for workers in worker_counts:
+            rates[backend, workers] = _sweep_rate(runs, workers, backend)
+    base = min(worker_counts)
+    for backend in backends:
+        for workers in worker_counts:
+            if workers != base:
+                gain = rates[backend, workers] / rates[backend, base]
+                print(f"  {backend:9}: scaling {base} -> {workers} workers: {gain:4.2f}x, parallel "
+                      f"efficiency {gain / (workers / base):4.2f} (1.00: each worker as fast "
+                      "as one alone)")
+    for backend in backends:
+        if backend != "fmi" and "fmi" in backends:
+            print("  " + ", ".join(f"{backend} / fmi with {w} worker{'s' if w > 1 else ''}: "
+                                   f"{rates[backend, w] / rates['fmi', w]:4.2f}x"
+                                   for w in worker_counts))
+    return rates
+
+
+def _sweep_rate(runs: int, workers: int, backend: str) -> float:
     from dask.distributed import Client
 
     from .cluster import local_cluster
     from .sweep import Spec, execute
 
-    print(f"sweep throughput: {runs} runs of 400 s (waves_pd and waves_smc, wave seeds), "
-          f"on {machine()}")
-    rates = {}
-    for workers in worker_counts:
-        with tempfile.TemporaryDirectory() as tmp:
-            spec_path = Path(tmp) / "bench.toml"
-            spec_path.write_text(f'name = "bench"\n[axes]\n'
-                                 f'wave_seed = {{ start = 1, count = {runs // 2} }}\n')
-            spec = Spec.read(spec_path)
-            started = time.perf_counter()
-            cluster = local_cluster(workers)
-            Client(cluster).close()
-            ready = time.perf_counter()
-            try:
-                rows = execute(spec, Path(tmp), scheduler=cluster.scheduler_address,
-                               progress=False)
-            finally:
-                cluster.close()
-            done = time.perf_counter()
-        ok = [r for r in rows if r["status"] == "ok"]
-        wall = done - ready
-        rates[workers] = len(ok) / wall
-        simulated = sum(r["sim_seconds"] for r in ok) / len(ok)
-        in_task = sum(r["seconds"] - r["sim_seconds"] for r in ok) / len(ok)
-        outside = wall * workers / len(ok) - simulated - in_task
-        print(f"  {workers} worker{'s' if workers > 1 else ' '}: {rates[workers]:5.2f} runs/s "
-              f"({len(ok)} runs in {wall:5.1f} s; cluster start-up {ready - started:4.1f} s); "
-              f"per run: simulation {simulated:5.3f} s, overhead in the task {in_task:5.3f} s "
-              f"({in_task / simulated:4.1%}), outside it {outside:5.3f} s "
-              f"({outside / simulated:4.1%})")
-    base = min(worker_counts)
-    for workers in worker_counts:
-        if workers != base:
-            print(f"  scaling {base} -> {workers} workers: {rates[workers] / rates[base]:4.2f}x, "
-                  f"parallel efficiency {rates[workers] / rates[base] / (workers / base):4.2f} "
-                  "(1.00: each worker as fast as one alone)")
+    with tempfile.TemporaryDirectory() as tmp:
+        spec_path = Path(tmp) / "bench.toml"
+        spec_path.write_text(f'name = "bench"\n[axes]\n'
+                             f'wave_seed = {{ start = 1, count = {runs // 2} }}\n')
+        spec = Spec.read(spec_path)
+        started = time.perf_counter()
+        cluster = local_cluster(workers)
+        Client(cluster).close()
+        ready = time.perf_counter()
+        try:
+            rows = execute(spec, Path(tmp), scheduler=cluster.scheduler_address,
+                           progress=False, backend=backend)
+        finally:
+            cluster.close()
+        done = time.perf_counter()
+    ok = [r for r in rows if r["status"] == "ok"]
+    if not ok:
+        raise RuntimeError(f"no run of the {backend} sweep succeeded: {rows[0]['error']}")
+    wall = done - ready
+    simulated = sum(r["sim_seconds"] for r in ok) / len(ok)
+    in_task = sum(r["seconds"] - r["sim_seconds"] for r in ok) / len(ok)
+    outside = wall * workers / len(ok) - simulated - in_task
+    print(f"  {backend:9} {workers} worker{'s' if workers > 1 else ' '}: {len(ok) / wall:5.2f} "
+          f"runs/s ({len(ok)} runs in {wall:5.1f} s; cluster start-up {ready - started:4.1f} s); "
+          f"per run: simulation {simulated:5.3f} s, overhead in the task {in_task:5.3f} s "
+          f"({in_task / simulated:4.1%}), outside it {outside:5.3f} s "
+          f"({outside / simulated:4.1%})")
+    return len(ok) / wall
