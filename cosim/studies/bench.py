@@ -173,13 +173,14 @@ def fmi_call_cost(master, calls: int = 20_000) -> float:
     return (time.perf_counter() - started) / calls
 
 
-def memory(hours: float) -> None:
-    """A long calm_pd run with rows streamed to disk; peak RSS against a short run."""
+def memory(hours: float, backends: tuple[str, ...] = ("fmi", "inprocess")) -> None:
+    """A long calm_pd run with rows streamed to disk; peak RSS against a short run, for each
+    backend."""
     print(f"Memory: calm_pd streamed to CSV in chunks of 10,000 rows, on {machine()}")
-    for duration in (3600.0, hours * 3600.0):
+    for backend, duration in ((b, d) for b in backends for d in (3600.0, hours * 3600.0)):
         code = ("import resource, time, tempfile, os\n"
                 "from cosim import scenarios\nfrom cosim.core.master import Master\n"
-                "m = Master(scenarios.load('calm_pd'))\n"
+                f"m = Master(scenarios.load('calm_pd'), backend={backend!r})\n"
                 "out = os.path.join(tempfile.mkdtemp(), 'run.csv')\n"
                 "t = time.perf_counter()\n"
                 f"rec = m.run({duration!r}, csv_path=out)\n"
@@ -192,7 +193,7 @@ def memory(hours: float) -> None:
         out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                              check=True).stdout.split()
         rows, wall, size, peak_kb = int(out[0]), float(out[1]), int(out[2]), int(out[3])
-        print(f"  {duration / 3600:5.1f} h simulated: {rows:>8} rows, {wall:6.1f} s wall, "
+        print(f"  {backend:9} {duration / 3600:5.1f} h simulated: {rows:>8} rows, {wall:6.1f} s wall, "
               f"CSV {size / 1e6:7.1f} MB, peak RSS {peak_kb / 1024:6.1f} MB")
 
 
