@@ -1,4 +1,4 @@
-"""Plans for getReal, getInteger and setReal: the work of a call decided once per list of references.
+"""Plans for getReal, getInteger and setReal: a call's work decided once per list of references.
 
 A master asks for the same value references at every step. The first call with a
 list works out how to serve it and caches that plan; the next calls only execute

@@ -193,8 +193,8 @@ def memory(hours: float, backends: tuple[str, ...] = ("fmi", "inprocess")) -> No
         out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                              check=True).stdout.split()
         rows, wall, size, peak_kb = int(out[0]), float(out[1]), int(out[2]), int(out[3])
-        print(f"  {backend:9} {duration / 3600:5.1f} h simulated: {rows:>8} rows, {wall:6.1f} s wall, "
-              f"CSV {size / 1e6:7.1f} MB, peak RSS {peak_kb / 1024:6.1f} MB")
+        print(f"  {backend:9} {duration / 3600:5.1f} h simulated: {rows:>8} rows, "
+              f"{wall:6.1f} s wall, CSV {size / 1e6:7.1f} MB, peak RSS {peak_kb / 1024:6.1f} MB")
 
 
 def sweep_throughput(runs: int, worker_counts: tuple[int, ...] = (1, 2),
