@@ -32,12 +32,16 @@ def main(argv: list[str] | None = None) -> int:
     sweep = commands.add_parser("sweep", help="runs per second of a sweep with 1 and 2 workers")
     sweep.add_argument("--runs", type=int, default=16, help="runs per measurement (even)")
     args = parser.parse_args(argv)
-    if args.command == "memory":
-        bench.memory(args.hours)
-    elif args.command == "sweep":
-        bench.sweep_throughput(args.runs)
-    else:
-        bench.engines(args.repeats)
+    try:
+        if args.command == "memory":
+            bench.memory(args.hours)
+        elif args.command == "sweep":
+            bench.sweep_throughput(args.runs)
+        else:
+            bench.engines(args.repeats)
+    except (RuntimeError, ValueError, FileNotFoundError) as error:   # e.g. stale FMUs
+        print(f"error: {error}", file=sys.stderr)
+        return 2
     return 0
 
 

@@ -25,6 +25,20 @@ def test_simulate_returns_every_exchanged_signal_with_its_unit(fmu_paths):
     np.testing.assert_array_equal(run["ship.psi"], pd["ship.psi"])          # Ki = 0: a PD
 
 
+def test_simulate_in_process_gives_the_same_run_and_warns_for_a_foreign_fmu(fmu_paths,
+                                                                           c_autopilot):
+    fmi = simulate("waves_pd", stop_time=30)
+    inprocess = simulate("waves_pd", stop_time=30, backend="inprocess")
+    assert inprocess.meta["backends"]["ship"] == "inprocess"
+    np.testing.assert_array_equal(fmi.data, inprocess.data)
+    with pytest.warns(UserWarning, match=r"autopilot \(pd_autopilot_c\.fmu\) runs through FMI, "
+                                         r"not in-process: its model 'pd_autopilot_c'"):
+        mixed = simulate("waves_pd", stop_time=30, backend="inprocess", autopilot=c_autopilot)
+    assert mixed.meta["backends"] == {"guidance": "inprocess", "autopilot": "fmi",
+                                      "ship": "inprocess"}
+    np.testing.assert_array_equal(mixed["ship.psi"], fmi["ship.psi"])   # the same PD law
+
+
 def test_simulate_equals_the_command_line_run(fmu_paths, tmp_path):
     from cosim import run as cli
 

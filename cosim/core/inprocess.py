@@ -121,10 +121,13 @@ _PACKAGES = {p for _, packages in FMUS.values() for p in packages}
 class InProcessInstance(Instance):
     """A slave class instantiated and driven in this process."""
 
-    def __init__(self, path: str | Path, name: str):
+    def __init__(self, path: str | Path, name: str, same_sources: bool = True):
+        """The class of the FMU at ``path``; ValueError if it cannot run in-process
+        (``in_process_refusal``), or, without ``same_sources``, only if it is not one of
+        ours (``cosim.studies.direct``: the modules as they are, whatever the FMU)."""
         self.path, self.name = Path(path), name
         refusal = in_process_refusal(self.path)
-        if refusal:
+        if refusal and (same_sources or _model_name(self.path) not in FMUS):
             raise ValueError(f"FMU '{name}' ({self.path.name}) cannot run in-process: "
                              f"{refusal}")
         self.model_name = _model_name(self.path)

@@ -103,6 +103,7 @@ def engines(repeats: int) -> dict[str, dict[str, float]]:
             ssp = export(name, Path(tmp))
             masters = {b: Master(system, backend=b) for b in ("inprocess", "fmi")}
             try:
+                _require_in_process(masters["inprocess"].notes)
                 runners = {"direct": lambda: run_direct(system),
                            **{b: _master_runner(m) for b, m in masters.items()}}
                 for key, make in (("libcosim", _libcosim_runner), ("ecos", _ecos_runner)):
@@ -122,6 +123,12 @@ def engines(repeats: int) -> dict[str, dict[str, float]]:
     print(f"\nwaves_pd / calm_pd in-process: {waves['inprocess'] / calm['inprocess']:.2f} "
           f"(cosim.direct: {waves['direct'] / calm['direct']:.2f})")
     return results
+
+
+def _require_in_process(notes: list[str]) -> None:
+    """RuntimeError if a component meant to run in-process would run through FMI."""
+    if notes:
+        raise RuntimeError("the in-process backend cannot be measured: " + "; ".join(notes))
 
 
 def _master_runner(master) -> Callable[[], None]:
@@ -236,6 +243,8 @@ def _sweep_rate(runs: int, workers: int, backend: str) -> float:
         spec_path.write_text(f'name = "bench"\n[axes]\n'
                              f'wave_seed = {{ start = 1, count = {runs // 2} }}\n')
         spec = Spec.read(spec_path)
+        if backend == "inprocess":
+            _require_in_process(spec.backend_notes(backend))
         started = time.perf_counter()
         cluster = local_cluster(workers)
         Client(cluster).close()

@@ -2,8 +2,9 @@
 
 guidance -> autopilot -> ship, in that order at every step, as in the paper's
 Simulink model and the master's Gauss-Seidel coupling. The models are built by
-the same ``build_model`` code the FMUs use, from the parameters of a course-keeping
-system description (components named guidance, autopilot and ship). This is the
+the same ``build_model`` code the FMUs use (as this checkout has it, whatever the FMUs
+were built from), from the parameters of a course-keeping system description
+(components named guidance, autopilot and ship). This is the
 in-process limit the benchmark measures and the reference the equality tests use.
 """
 from __future__ import annotations
@@ -25,7 +26,7 @@ def build_models(system: SystemDescription) -> dict:
     ship_start = system.components["ship"].parameters
     models = {}
     for name, component in system.components.items():
-        instance = InProcessInstance(system.fmu_path(name), name)
+        instance = InProcessInstance(system.fmu_path(name), name, same_sources=False)
         instance.enter_initialization(system.start_time)
         instance.set(component.parameters)
         if name == "autopilot":             # the reference model starts at the ship's state
