@@ -16,7 +16,6 @@ import math
 from dataclasses import dataclass, fields
 
 from fmukit.numerics import require_finite, substeps
-from fmukit.timebase import nanoseconds, seconds
 
 from .data import G, Actuators, Hull
 from .hull import coriolis_forces, damping_forces, kinematics, mass_matrix
@@ -160,7 +159,7 @@ class Vessel:
             y = _rk4(c, y, k1, k2, k3, k4)
         self.x, self.y, self.psi, self.u, self.v, self.r, self.xi = y
         self.delta = gear(h)
-        self.t = seconds(nanoseconds(t) + nanoseconds(h))   # the next communication point
+        self.t = t + h
         self.X_w, self.Y_w, self.N_w = self._wave_loads(self.t, self.xi, self.psi)
 
     def snapshot(self) -> dict[str, float]:

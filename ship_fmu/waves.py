@@ -103,11 +103,13 @@ class WaveLoads:
     N_w = rho g B L (L^2 - B^2) / 24 sin(2 beta) sum s_i^2.
 
     On 50 components numpy's cost is its calls, not its arithmetic, so an
-    evaluation makes as few as the exact phases allow: omega_i t once per time
-    (RK4's second and third stages share one, and the end of a step is the next
-    step's first stage), and both sums from one matrix-vector product [1; s] @ s,
-    which adds in a different order than a sum and a dot product would (the loads
-    differ from such by a few units in the last place).
+    evaluation makes no call it can share: omega_i t is computed once per time
+    (RK4's second and third stages share one), into arrays allocated once, and the
+    last evaluation is kept (the end of a step is usually the next one's first stage). The arithmetic of every value
+    is the one the equations write, in their order, so the results are those of
+    a plain evaluation to the bit. (Summing both sums in one matrix product, or
+    the phases in one, would save a call or three but add in another order, and the
+    chattering sliding-mode loop turns last bits into visibly different runs.)
     """
 
     def __init__(self, components: WaveComponents, hull: Hull, psi_w: float,
@@ -119,9 +121,7 @@ class WaveLoads:
         self._c_moment = rho * G * h.B * h.L * (h.L ** 2 - h.B ** 2) / 24.0
         self._slope_amplitude = components.amplitude * components.k
         # Work arrays, so that an evaluation allocates nothing.
-        self._omega_t, self._theta, self._sums = np.empty(n), np.empty(n), np.empty(2)
-        self._ones_s = np.ones((2, n))                # rows 1 and s: [1; s] @ s = both sums
-        self._s = self._ones_s[1]
+        self._omega_t, self._s = np.empty(n), np.empty(n)
         self._t: float | None = None                  # the time of _omega_t
         self._key: tuple = (None, None, None)         # the last evaluation's arguments,
         self._loads = (0.0, 0.0, 0.0)                 # and its loads
@@ -133,15 +133,12 @@ class WaveLoads:
         if t != self._t:
             np.multiply(self.components.omega, t, self._omega_t)
             self._t = t
-        theta, s, sums = self._theta, self._s, self._sums
-        self.components.phases(t, xi, theta, self._omega_t)
-        np.sin(theta, theta)
-        np.multiply(self._slope_amplitude, theta, s)      # s_i = A_i k_i sin(theta_i)
-        np.dot(self._ones_s, s, sums)
-        sum_s, sum_s2 = sums.tolist()
+        s = self.components.phases(t, xi, self._s, self._omega_t)
+        np.sin(s, s)
+        np.multiply(self._slope_amplitude, s, s)          # s_i = A_i k_i sin(theta_i)
         beta = self.psi_w - psi
-        force = self._c_force * sum_s
+        force = self._c_force * float(s.sum())
         self._key = (t, xi, psi)
         self._loads = (force * math.cos(beta), force * math.sin(beta),
-                       self._c_moment * math.sin(2.0 * beta) * sum_s2)
+                       self._c_moment * math.sin(2.0 * beta) * float(s @ s))
         return self._loads
