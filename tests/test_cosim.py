@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+import re
 import shutil
 from pathlib import Path
 
@@ -19,6 +20,7 @@ from cosim.core import ssd
 from cosim.core.ssd import read_ssd, write_ssd
 from cosim.core.wiring import WiringError
 from cosim.studies.direct import SIGNALS, run_direct
+from fmukit.packaging import ROOT
 from helpers import fmu_variant
 
 SCENARIOS = scenarios.SCENARIO_DIR
@@ -194,6 +196,12 @@ def test_all_prints_tables_1_and_2_beside_the_paper(tmp_path, capsys):
     assert "Table 1, calm water" in out and "Table 2, waves" in out
     assert "256.94" in out and "390.55" in out          # the paper's J for PD calm, SMC waves
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(PAPER)
+    # the published tables (docs/reproduction.md) are what the code computes today
+    published = re.findall(r"^\| (PD|SMC) controller \| ([\d.]+) \| ([\d.]+) \| ([\d.]+) \|",
+                           (ROOT / "docs" / "reproduction.md").read_text(), re.M)
+    printed = re.findall(r"^  (PD|SMC) controller +([\d.]+) +([\d.]+) +([\d.]+) +\|",
+                         out, re.M)
+    assert len(published) == 4 and published == printed
 
 
 def test_stop_time_and_set_reach_the_fmus(tmp_path):
