@@ -38,14 +38,19 @@ class FastPaths:
         self._writes: dict[tuple[int, ...], Writer | None] = {}
         self._integer_reads: dict[tuple[int, ...], Callable[[], list[int]] | None] = {}
 
-    def real_reader(self, vrs: list[int]) -> Reader | None:
-        """The plan reading these Reals, or None if one is not a Real."""
+    @staticmethod
+    def _planned(plans: dict, vrs: list[int], compile_plan: Callable) -> Any:
+        """The plan for ``vrs`` from ``plans``, compiled the first time."""
         key = tuple(vrs)
         try:
-            return self._reads[key]
+            return plans[key]
         except KeyError:
-            read = self._reads[key] = self._compile_read(key)
-            return read
+            plan = plans[key] = compile_plan(key)
+            return plan
+
+    def real_reader(self, vrs: list[int]) -> Reader | None:
+        """The plan reading these Reals, or None if one is not a Real."""
+        return self._planned(self._reads, vrs, self._compile_read)
 
     def _compile_read(self, vrs: tuple[int, ...]) -> Reader | None:
         getters = self._registry.real_getters
@@ -68,14 +73,11 @@ class FastPaths:
 
     def integer_reader(self, vrs: list[int]) -> Callable[[], list[int]] | None:
         """The plan reading these Integers, or None if one is not an Integer."""
-        key = tuple(vrs)
-        try:
-            return self._integer_reads[key]
-        except KeyError:
-            getters = self._registry.integer_getters
-            read = self._integer_reads[key] = (self._evaluated(key, getters, int)
-                                               if all(vr in getters for vr in vrs) else None)
-            return read
+        return self._planned(self._integer_reads, vrs, self._compile_integer_read)
+
+    def _compile_integer_read(self, vrs: tuple[int, ...]) -> Callable[[], list[int]] | None:
+        getters = self._registry.integer_getters
+        return self._evaluated(vrs, getters, int) if all(vr in getters for vr in vrs) else None
 
     @staticmethod
     def _each(vrs: tuple[int, ...], getters: dict[int, Callable[[], Any]],
@@ -109,12 +111,7 @@ class FastPaths:
 
     def input_writer(self, vrs: list[int]) -> Writer | None:
         """The plan setting these Real inputs, or None if one is not a Real input."""
-        key = tuple(vrs)
-        try:
-            return self._writes[key]
-        except KeyError:
-            write = self._writes[key] = self._compile_write(key)
-            return write
+        return self._planned(self._writes, vrs, self._compile_write)
 
     def _compile_write(self, vrs: tuple[int, ...]) -> Writer | None:
         inputs = self._registry.real_inputs

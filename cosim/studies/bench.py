@@ -212,6 +212,9 @@ def sweep_throughput(runs: int, worker_counts: tuple[int, ...] = (1, 2),
     worker time per run minus task time), and each backend's throughput against FMI's."""
     print(f"sweep throughput: {runs} runs of 400 s (waves_pd and waves_smc, wave seeds), "
           f"on {machine()}")
+    if "inprocess" in backends:                   # before minutes of measuring the others
+        with tempfile.TemporaryDirectory() as tmp:
+            _require_in_process(_bench_spec(runs, Path(tmp)).backend_notes("inprocess"))
     rates = {}
     for backend in backends:
         for workers in worker_counts:
@@ -232,19 +235,24 @@ def sweep_throughput(runs: int, worker_counts: tuple[int, ...] = (1, 2),
     return rates
 
 
+def _bench_spec(runs: int, folder: Path):
+    """The benchmark's sweep: waves_pd and waves_smc over runs / 2 wave seeds."""
+    from .sweep import Spec
+
+    spec_path = folder / "bench.toml"
+    spec_path.write_text('name = "bench"\n[axes]\n'
+                         f'wave_seed = {{ start = 1, count = {runs // 2} }}\n')
+    return Spec.read(spec_path)
+
+
 def _sweep_rate(runs: int, workers: int, backend: str) -> float:
     from dask.distributed import Client
 
     from .cluster import local_cluster
-    from .sweep import Spec, execute
+    from .sweep import execute
 
     with tempfile.TemporaryDirectory() as tmp:
-        spec_path = Path(tmp) / "bench.toml"
-        spec_path.write_text(f'name = "bench"\n[axes]\n'
-                             f'wave_seed = {{ start = 1, count = {runs // 2} }}\n')
-        spec = Spec.read(spec_path)
-        if backend == "inprocess":
-            _require_in_process(spec.backend_notes(backend))
+        spec = _bench_spec(runs, Path(tmp))
         started = time.perf_counter()
         cluster = local_cluster(workers)
         Client(cluster).close()
