@@ -216,8 +216,8 @@ def sweep_throughput(runs: int, worker_counts: tuple[int, ...] = (1, 2),
         with tempfile.TemporaryDirectory() as tmp:
             _require_in_process(_bench_spec(runs, Path(tmp)).backend_notes("inprocess"))
     rates = {}
-    for backend in backends:
-        for workers in worker_counts:
+    for workers in worker_counts:                 # backends side by side, under the same load
+        for backend in backends:
             rates[backend, workers] = _sweep_rate(runs, workers, backend)
     base = min(worker_counts)
     for backend in backends:
