@@ -137,8 +137,9 @@ class WaveLoads:
         np.sin(s, s)
         np.multiply(self._slope_amplitude, s, s)          # s_i = A_i k_i sin(theta_i)
         beta = self.psi_w - psi
-        force = self._c_force * float(s.sum())
+        # np.add.reduce and np.dot: what s.sum() and s @ s compute, without their wrappers
+        force = self._c_force * float(np.add.reduce(s))
         self._key = (t, xi, psi)
         self._loads = (force * math.cos(beta), force * math.sin(beta),
-                       self._c_moment * math.sin(2.0 * beta) * float(s @ s))
+                       self._c_moment * math.sin(2.0 * beta) * float(np.dot(s, s)))
         return self._loads
