@@ -4,6 +4,7 @@ from __future__ import annotations
 import math
 import re
 import shutil
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -125,6 +126,23 @@ def test_only_our_fmus_as_built_from_this_checkout_run_in_process(fmu_paths, tmp
                         lambda xml: xml.replace('modelName="ship"', 'modelName="tanker"'))
     assert in_process_refusal(other) == "its model 'tanker' is not one of this project's " \
                                         "Python FMUs"
+    # someone's copy of our slave script, keeping our model name (a user's own PID, say)
+    pid = fmu_paths["pid_autopilot"]
+    copied = tmp_path / "my_pid.fmu"
+    with zipfile.ZipFile(pid) as original, zipfile.ZipFile(copied, "w") as copy:
+        for info in original.infolist():
+            data = original.read(info)
+            if info.filename == "resources/slavemodule.txt":
+                data = b"my_pid"
+            copy.writestr(info.filename.replace("pid_autopilot_slave.py", "my_pid.py"), data)
+    assert in_process_refusal(copied) == ("its slave is my_pid.py, not this project's "
+                                          "pid_autopilot_slave.py (another FMU of the name "
+                                          "'pid_autopilot')")
+    extra = tmp_path / "extra.fmu"
+    shutil.copy(pid, extra)
+    with zipfile.ZipFile(extra, "a") as fmu:
+        fmu.writestr("resources/tuning.py", "GAIN = 0.5\n")
+    assert in_process_refusal(extra).startswith("it carries tuning.py, which this project's")
     master = Master(system("calm_pd"), backend="inprocess")
     try:
         assert master.backends == dict.fromkeys(["guidance", "autopilot", "ship"], "inprocess")

@@ -85,16 +85,25 @@ def _refusal(path: Path) -> str | None:
                     return (f"its {section} differ from those of this project's '{name}' "
                             f"(another FMU of that name, or ours before a change: {BUILD_HINT})")
             script = Path(FMUS[name][0])
-            carried = {n.removeprefix("resources/"): n for n in fmu.namelist()
-                       if n.startswith("resources/") and n.endswith(".py")}
-            for relative, entry in carried.items():
+            module = fmu.read("resources/slavemodule.txt").decode().strip()
+            if module != script.stem:
+                return (f"its slave is {module}.py, not this project's {script.name} "
+                        f"(another FMU of the name '{name}')")
+            for entry in fmu.namelist():
+                relative = entry.removeprefix("resources/")
+                if relative == entry or not relative.endswith(".py") \
+                        or relative.startswith("pythonfmu/"):     # pythonfmu's own
+                    continue
                 here = _source_here(relative, script)
-                if here is not None and (not here.is_file()
-                                         or here.read_bytes() != fmu.read(entry)):
+                if here is None:
+                    return (f"it carries {relative}, which this project's '{name}' does not "
+                            "(another FMU of that name)")
+                if not here.is_file() or here.read_bytes() != fmu.read(entry):
                     return (f"it was built from other sources than this process runs "
                             f"({relative} differs: {BUILD_HINT})")
-    except (OSError, KeyError, zipfile.BadZipFile, ElementTree.ParseError) as error:
-        return f"it cannot be read as an FMU ({error})"
+    except (OSError, KeyError, UnicodeDecodeError, zipfile.BadZipFile,
+            ElementTree.ParseError) as error:
+        return f"it cannot be read as an FMU ({type(error).__name__}: {error})"
     return None
 
 
@@ -107,12 +116,12 @@ def _canonical(element: ElementTree.Element | None) -> str:
 
 
 def _source_here(relative: str, script: Path) -> Path | None:
-    """This process's file for a source an FMU carries (None for one not of this project:
-    pythonfmu's own)."""
+    """This process's file for a Python source an FMU carries: its slave script, or a module
+    of this project's packages; None for anything else."""
     if relative == script.name:
         return ROOT / script
     package = relative.split("/", 1)[0]
-    return ROOT / relative if package in _PACKAGES else None
+    return ROOT / relative if "/" in relative and package in _PACKAGES else None
 
 
 _PACKAGES = {p for _, packages in FMUS.values() for p in packages}
@@ -127,10 +136,11 @@ class InProcessInstance(Instance):
         ours (``cosim.studies.direct``: the modules as they are, whatever the FMU)."""
         self.path, self.name = Path(path), name
         refusal = in_process_refusal(self.path)
-        if refusal and (same_sources or _model_name(self.path) not in FMUS):
+        if refusal and (same_sources or _description(self.path).get("modelName") not in FMUS):
             raise ValueError(f"FMU '{name}' ({self.path.name}) cannot run in-process: "
                              f"{refusal}")
-        self.model_name = _model_name(self.path)
+        description = _description(self.path)
+        self.model_name, self.guid = description.get("modelName"), description.get("guid")
         self.slave = slave_class(self.model_name)(instance_name=name)
         self.variables = {}
         for vr, var in self.slave.registry.by_vr.items():
@@ -227,9 +237,10 @@ class InProcessInstance(Instance):
             self.slave.terminate()
 
 
-def _model_name(path: Path) -> str:
+def _description(path: Path) -> ElementTree.Element:
+    """The root of an FMU's modelDescription.xml."""
     with zipfile.ZipFile(path) as fmu:
-        return ElementTree.fromstring(fmu.read("modelDescription.xml")).get("modelName")
+        return ElementTree.fromstring(fmu.read("modelDescription.xml"))
 
 
 @cache
