@@ -50,8 +50,10 @@ def test_an_autopilot_that_fails_is_scored_as_failed_and_the_rest_goes_on(tmp_pa
     out = tmp_path / "score"
     assert cli.main([str(failing), "--set", "autopilot.fail_time=150", "--seeds", "1",
                      "--workers", "1", "--out", str(out), "--backend", "inprocess"]) == 0
-    assert ("note: idle_pilot.fmu runs through FMI, not in-process: its model 'idle_pilot' is "
-            "not one of this project's Python FMUs") in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert ("note: controller 'idle_pilot': autopilot (idle_pilot.fmu) runs through FMI, not "
+            "in-process: its model 'idle_pilot' is not one of this project's Python FMUs") in err
+    assert err.count("note:") == 1
     text = (out / "scorecard.md").read_text()
     assert _rows(text, "## The paper's route")["idle_pilot"][:6] == ["failed"] * 6
     assert _rows(text, "## A 40 deg course change")["idle_pilot"] == ["failed"] * 4

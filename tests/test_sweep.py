@@ -159,8 +159,10 @@ def test_dask_sweep_writes_resumes_and_plots(fmu_paths, tmp_path, capsys):
     # resumed in-process: the same rows, bit for bit (the backend is not part of a run's id)
     assert spec.backend_notes("inprocess") == []
     again = sweep.execute(spec, out, workers=1, progress=False, backend="inprocess")
-    assert "is not a whole journal row" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "is not a whole journal row" in err and "2 of 4 runs already done in" in err
     assert [r["J"] for r in again] == [r["J"] for r in rows]
+    assert sorted(r["backend"] for r in again) == ["fmi", "fmi", "inprocess", "inprocess"]
     redone = [json.loads(line)["run_id"] for line in
               (out / "runs.jsonl").read_text().splitlines()[4:]]
     assert sorted(redone) == sorted(json.loads(journal[i])["run_id"] for i in (0, 3))

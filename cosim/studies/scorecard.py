@@ -91,8 +91,7 @@ def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | Non
     FMI (the same results, faster); ``fmu`` then still runs through FMI unless it is one
     of ours (``cosim.core.inprocess.in_process_refusal``).
     """
-    contenders = [*(Contender(label, suffix) for label, suffix in BASELINES.items()),
-                  Contender(name, fmu=fmu, port_map=port_map, settings=settings)]
+    contenders = _contenders(fmu, name, port_map, settings)
     failures: dict[tuple[str, str], str] = {}
 
     def attempt(contender: Contender, test: str, **kwargs) -> Recording | None:
@@ -120,13 +119,7 @@ def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | Non
     ensemble = out / "ensemble"
     shutil.rmtree(ensemble, ignore_errors=True)          # a fresh ensemble every time
     ensemble.mkdir(parents=True)
-    entries = {c.name: ({"scenario": f"waves_{c.suffix}"} if c.fmu is None else
-                        {"autopilot": str(c.fmu), "map": c.port_map or {},
-                         "set": c.settings or {}})
-               for c in contenders}
-    spec = Spec(name="ensemble", axes={"wave_seed": list(range(1, seeds + 1))},
-                controllers={n: controller_entry(e, out / "scorecard", n)
-                             for n, e in entries.items()}, tracks={})   # every track
+    spec = _ensemble(contenders, seeds, out)
     rows = execute(spec, ensemble, scheduler=scheduler, workers=workers, progress=False,
                    backend=backend)
     distribution(spec, rows, out / "J_distribution.png")
@@ -134,6 +127,30 @@ def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | Non
     text = _markdown(fmu, name, seeds, contenders, paper, changes, failures, spec, rows)
     (out / "scorecard.md").write_text(text)
     return text
+
+
+def _contenders(fmu: Path, name: str, port_map: dict | None,
+                settings: dict[str, Any] | None) -> list[Contender]:
+    return [*(Contender(label, suffix) for label, suffix in BASELINES.items()),
+            Contender(name, fmu=fmu, port_map=port_map, settings=settings)]
+
+
+def _ensemble(contenders: list[Contender], seeds: int, out: Path) -> Spec:
+    """The wave ensemble: every contender on the paper's route in waves, over ``seeds``."""
+    entries = {c.name: ({"scenario": f"waves_{c.suffix}"} if c.fmu is None else
+                        {"autopilot": str(c.fmu), "map": c.port_map or {},
+                         "set": c.settings or {}})
+               for c in contenders}
+    return Spec(name="ensemble", axes={"wave_seed": list(range(1, seeds + 1))},
+                controllers={n: controller_entry(e, out / "scorecard", n)
+                             for n, e in entries.items()}, tracks={})   # every track
+
+
+def backend_notes(fmu: Path, name: str, port_map: dict | None, backend: str) -> list[str]:
+    """Which FMUs of the scorecard (the project's and ``fmu``) run through FMI although
+    ``backend`` is "inprocess": the ensemble's systems hold every FMU the scorecard runs."""
+    return _ensemble(_contenders(fmu, name, port_map, None), 1, fmu.parent).backend_notes(
+        backend)
 
 
 def _markdown(fmu: Path, name: str, seeds: int, contenders: list[Contender],

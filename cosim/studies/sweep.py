@@ -333,7 +333,7 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
     again); return every row of the sweep.
 
     ``backend``: the master's, "fmi" or "inprocess" (this project's FMUs as Python
-    classes: the same results, several times faster; any other FMU runs through FMI,
+    classes: the same results, faster; any other FMU runs through FMI,
     ``Spec.backend_notes`` says which). The backend is not part of a run's identity: a
     sweep may be resumed with the other.
 
@@ -349,8 +349,11 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
         raise ValueError(f"backend must be fmi or inprocess, got {backend!r}")
     try:
         with Journal(out / "runs.jsonl") as journal:
-            todo = [r for r in spec.runs()
-                    if journal.rows.get(r["run_id"], {}).get("status") != "ok"]
+            runs = spec.runs()
+            todo = [r for r in runs if journal.rows.get(r["run_id"], {}).get("status") != "ok"]
+            if len(todo) < len(runs):
+                _say(f"{len(runs) - len(todo)} of {len(runs)} runs already done in "
+                     f"{journal.path}; {len(todo)} to run")
             if todo:
                 _run_on_cluster(spec, todo, journal, connect(scheduler, workers, scheduler_file),
                                 progress, task or run_one, backend)
@@ -395,7 +398,7 @@ def _run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, 
             try:
                 row = future.result()
             except Exception as error:          # the worker died on every retry
-                row = blank_row(run, f"{type(error).__name__}: {error}")
+                row = {**blank_row(run, f"{type(error).__name__}: {error}"), "backend": backend}
             journal.add(row)
             future.release()                    # done: nothing to recompute if a worker dies
             if bar is not None:

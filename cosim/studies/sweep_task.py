@@ -131,6 +131,7 @@ def run_one(job: Job, blobs: dict[str, bytes]) -> dict[str, Any]:
             row.update(_metrics(recording))
             if job.track:
                 row["track"] = _track(recording, master.parameters)
+    row["backend"] = job.backend            # how the row was computed (the same either way)
     row["seconds"] = time.perf_counter() - started
     return row
 
