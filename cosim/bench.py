@@ -1,6 +1,7 @@
 """Benchmarks that print figures (no timed assertions in the tests).
 
     python -m cosim.bench                 engines side by side, calm_pd and waves_pd, 400 s
+    python -m cosim.bench overhead        the masters' own work, with the ship's step idle
     python -m cosim.bench memory          a 24 h run of calm_pd streamed to disk: peak memory
     python -m cosim.bench sweep           runs per second of a sweep: FMI and in-process
                                           backends, 1 and 2 workers
@@ -27,6 +28,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repeats", type=int, default=5, help="runs per median (default 5)")
     commands = parser.add_subparsers(dest="command")
     commands.add_parser("engines", help="engines side by side (the default)")
+    commands.add_parser("overhead", help="what the routes do besides the models (the ship's "
+                                         "step doing nothing)")
     mem = commands.add_parser("memory", help="peak memory of a long run streamed to disk")
     mem.add_argument("--hours", type=float, default=24.0, help="simulated hours (default 24)")
     sweep = commands.add_parser("sweep", help="runs per second of a sweep with 1 and 2 workers")
@@ -37,6 +40,8 @@ def main(argv: list[str] | None = None) -> int:
             bench.memory(args.hours)
         elif args.command == "sweep":
             bench.sweep_throughput(args.runs)
+        elif args.command == "overhead":
+            bench.overhead(args.repeats)
         else:
             bench.engines(args.repeats)
     except (RuntimeError, ValueError, FileNotFoundError) as error:   # e.g. stale FMUs

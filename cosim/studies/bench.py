@@ -5,6 +5,7 @@
   through the FMUs, (d) OSP libcosim and (e) ecos on the exported SSP package of the
   same scenario, timed in turn round after round (median of each), and (f) the floor
   of any FMI route: (a) plus the FMI calls a step makes times the measured cost of one;
+- ``overhead``: what the routes do besides the models (the ship's step doing nothing);
 - ``memory``: a long calm_pd run streamed to CSV, peak memory against a 1 h run;
 - ``sweep_throughput``: runs per second of a seed sweep on a local cluster, for each
   backend with 1 and 2 workers.
@@ -178,6 +179,40 @@ def fmi_call_cost(master, calls: int = 20_000) -> float:
         write([0.1])
         read()
     return (time.perf_counter() - started) / calls
+
+
+def overhead(repeats: int) -> dict[str, float]:
+    """What the routes do besides the models: calm_pd with the ship's step doing nothing,
+    by hand (``cosim.direct``), the master with no FMU behind it (null backend) and the
+    in-process master; microseconds per step, timed in turn."""
+    from unittest import mock
+
+    from ship_fmu.vessel import Vessel
+
+    from .. import scenarios
+    from ..core.master import Master
+    from .direct import run_direct
+
+    system = scenarios.load("calm_pd")
+    null, inprocess = Master(system, backend="null"), Master(system, backend="inprocess")
+    try:
+        _require_in_process(inprocess.notes)
+        with mock.patch.object(Vessel, "step", lambda self, *args, **kwargs: None):
+            times = side_by_side({"direct": lambda: run_direct(system), "null": null.run,
+                                  "inprocess": _master_runner(inprocess)}, repeats)
+    finally:
+        null.free()
+        inprocess.free()
+    per_step = {key: t / STEPS * 1e6 for key, t in times.items()}
+    print(f"What the routes do besides the models: calm_pd, {STEPS} steps with the ship's step "
+          f"doing nothing, median of {repeats} runs taken in turn, on {machine()}")
+    for key, label in (("direct", "cosim.direct (the modules wired by hand)"),
+                       ("null", "our master, no FMU behind it (null backend)"),
+                       ("inprocess", "our master, in-process backend")):
+        print(f"  {label:48} {per_step[key]:6.1f} us/step")
+    print(f"  the in-process master's calls into the slaves: "
+          f"{per_step['inprocess'] - per_step['null']:.1f} us/step")
+    return per_step
 
 
 def memory(hours: float, backends: tuple[str, ...] = ("fmi", "inprocess")) -> None:
