@@ -27,9 +27,12 @@ def main(argv: list[str] | None = None) -> int:
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--repeats", type=int, default=5, help="runs per median (default 5)")
     commands = parser.add_subparsers(dest="command")
-    commands.add_parser("engines", help="engines side by side (the default)")
-    commands.add_parser("overhead", help="what the routes do besides the models (the ship's "
-                                         "step doing nothing)")
+    repeats = argparse.ArgumentParser(add_help=False)       # also after the subcommand
+    repeats.add_argument("--repeats", type=int, default=argparse.SUPPRESS,
+                         help="runs per median (default 5)")
+    commands.add_parser("engines", parents=[repeats], help="engines side by side (the default)")
+    commands.add_parser("overhead", parents=[repeats],
+                        help="what the routes do besides the models (the ship's step idle)")
     mem = commands.add_parser("memory", help="peak memory of a long run streamed to disk")
     mem.add_argument("--hours", type=float, default=24.0, help="simulated hours (default 24)")
     sweep = commands.add_parser("sweep", help="runs per second of a sweep with 1 and 2 workers")

@@ -42,7 +42,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--backend", choices=("fmi", "inprocess"), default="fmi",
                         help="fmi: every run through the FMUs (default); inprocess: this "
                              "project's FMUs as Python classes, without FMI: the same results, "
-                             "about 1.5-2 times faster. Yours runs in-process only if it is one "
+                             "about 1.3-2 times faster. Yours runs in-process only if it is one "
                              "of ours built from this checkout; any FMU that runs through FMI "
                              "instead is noted before the scorecard starts")
     parser.add_argument("--out", type=Path, help="output folder (default: results/score/NAME)")

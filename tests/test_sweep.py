@@ -133,6 +133,14 @@ def test_an_in_process_sweep_notes_each_fmu_that_runs_through_fmi(c_autopilot, t
         "model 'pd_autopilot_c' is not one of this project's Python FMUs"]
     with pytest.raises(ValueError, match="backend must be fmi or inprocess, got 'null'"):
         sweep.execute(spec, tmp_path, backend="null")
+    # a row says how its components ran, not only what was asked
+    spec = sweep.Spec.read(write_spec(tmp_path, f'stop_time = 5\n[controllers]\npd = "waves_pd"\n'
+                                                f'c = "{c_autopilot}"\n[axes]\nwave_seed = [1]\n'))
+    rows = {r["controller"]: sweep.run_locally(spec, r, "inprocess") for r in spec.runs()}
+    assert rows["pd"]["backend"] == "inprocess"
+    assert rows["c"]["backend"] == "inprocess; autopilot: fmi"
+    assert rows["c"]["J"] == rows["pd"]["J"]                 # the same PD law, in C
+    sweep_task.free_masters()
 
 
 def test_task_records_a_failed_run_with_its_message(fmu_paths, tmp_path):

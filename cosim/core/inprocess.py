@@ -100,7 +100,8 @@ def _refusal(path: Path) -> str | None:
                             "(another FMU of that name)")
                 if not here.is_file() or here.read_bytes() != fmu.read(entry):
                     return (f"it was built from other sources than this process runs "
-                            f"({relative} differs: {BUILD_HINT})")
+                            f"({relative} differs: another FMU of that name, or ours "
+                            f"before a change: {BUILD_HINT})")
     except (OSError, KeyError, UnicodeDecodeError, zipfile.BadZipFile,
             ElementTree.ParseError) as error:
         return f"it cannot be read as an FMU ({type(error).__name__}: {error})"

@@ -278,9 +278,9 @@ def _say(message: str) -> None:
     print(message, file=sys.stderr, flush=True)
 
 
-def run_locally(spec: Spec, run: dict[str, Any]) -> dict[str, Any]:
+def run_locally(spec: Spec, run: dict[str, Any], backend: str = "fmi") -> dict[str, Any]:
     """One run of ``spec`` in this process, as a worker would do it."""
-    job = spec.job(run, "local")
+    job = spec.job(run, "local", backend)
     return run_one(job, {sha: spec.files()[sha].read_bytes() for sha in job.bundle.fmu_hashes()})
 
 

@@ -90,6 +90,18 @@ class SweepTeardown(WorkerPlugin):
         free_masters(self.sweep)
 
 
+def ran_on(master, asked: str) -> str:
+    """How a run's components ran: "inprocess" or "fmi" if all alike, else each named
+    ("inprocess; autopilot: fmi"); ``asked`` where no master was made."""
+    if master is None:
+        return asked
+    kinds = master.backends
+    if len(set(kinds.values())) == 1:
+        return next(iter(kinds.values()))
+    others = [f"{name}: {kind}" for name, kind in kinds.items() if kind != asked]
+    return "; ".join([asked, *others])
+
+
 def worker_facts() -> dict[str, Any]:
     """What the client checks of a worker before it sends work: the code it runs."""
     return {"code": code_version()}
@@ -131,7 +143,7 @@ def run_one(job: Job, blobs: dict[str, bytes]) -> dict[str, Any]:
             row.update(_metrics(recording))
             if job.track:
                 row["track"] = _track(recording, master.parameters)
-    row["backend"] = job.backend            # how the row was computed (the same either way)
+    row["backend"] = ran_on(_masters.get(_key(job)), job.backend)   # results: the same either way
     row["seconds"] = time.perf_counter() - started
     return row
 
