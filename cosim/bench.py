@@ -33,9 +33,11 @@ def main(argv: list[str] | None = None) -> int:
     commands.add_parser("engines", parents=[repeats], help="engines side by side (the default)")
     commands.add_parser("overhead", parents=[repeats],
                         help="what the routes do besides the models (the ship's step idle)")
-    mem = commands.add_parser("memory", help="peak memory of a long run streamed to disk")
+    mem = commands.add_parser("memory", help="peak memory of a long run streamed to disk, "
+                                             "both backends")
     mem.add_argument("--hours", type=float, default=24.0, help="simulated hours (default 24)")
-    sweep = commands.add_parser("sweep", help="runs per second of a sweep with 1 and 2 workers")
+    sweep = commands.add_parser("sweep", help="runs per second of a sweep, both backends, with 1 "
+                                             "and 2 workers")
     sweep.add_argument("--runs", type=int, default=16, help="runs per measurement (even)")
     args = parser.parse_args(argv)
     try:
