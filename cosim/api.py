@@ -63,9 +63,10 @@ def simulate(scenario: str | Path, autopilot: str | Path | None = None,
     its ports renamed by ``port_map``; ``set``: parameter values by
     ``"component.variable"`` (SI units, radians); ``stop_time`` in s (default: the
     scenario's). ``backend="inprocess"`` runs this project's FMUs as Python classes,
-    without FMI: the same results bit for bit, about 1.5-2.5 times faster (an FMU not built
-    from this checkout's classes runs through FMI, with a warning). ValueError or FileNotFoundError for bad input,
-    naming it; SimulationError if an FMU fails during the run.
+    without FMI: the same results bit for bit, about 1.5-2.5 times faster (an FMU not
+    built from this checkout's classes runs through FMI, with a warning). ValueError or
+    FileNotFoundError for bad input, naming it; SimulationError if an FMU fails during
+    the run.
     """
     master = Master(scenarios.load(scenario, autopilot, port_map), coupling=coupling,
                     backend=backend, overrides=overrides_of(set or {}))

@@ -64,6 +64,7 @@ class WaveComponents:
     k: np.ndarray           # rad/m
     amplitude: np.ndarray   # m
     phase: np.ndarray       # rad
+
     @classmethod
     def from_spectrum(cls, Hs: float, T0: float, n: int, seed: int,
                       band_fraction: float = 0.98) -> WaveComponents:
@@ -105,11 +106,12 @@ class WaveLoads:
     On 50 components numpy's cost is its calls, not its arithmetic, so an
     evaluation makes no call it can share: omega_i t is computed once per time
     (RK4's second and third stages share one), into arrays allocated once, and the
-    last evaluation is kept (the end of a step is usually the next one's first stage). The arithmetic of every value
-    is the one the equations write, in their order, so the results are those of
-    a plain evaluation to the bit. (Summing both sums in one matrix product, or
-    the phases in one, would save a call or three but add in another order, and the
-    chattering sliding-mode loop turns last bits into visibly different runs.)
+    last evaluation is kept (the end of a step is usually the next one's first
+    stage). The arithmetic of every value is the one the equations write, in their
+    order, so the results are those of a plain evaluation to the bit. (Summing both
+    sums in one matrix product, or the phases in one, would save a call or three but
+    add in another order, and the chattering sliding-mode loop turns last bits into
+    visibly different runs.)
     """
 
     def __init__(self, components: WaveComponents, hull: Hull, psi_w: float,

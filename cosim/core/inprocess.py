@@ -72,6 +72,14 @@ def in_process_refusal(path: str | Path) -> str | None:
 _refusals: dict[tuple, str | None] = {}
 
 
+def fallback_note(name: str, path: str | Path) -> str | None:
+    """The note for component ``name`` when its FMU must run through FMI instead of
+    in-process (``in_process_refusal``), or None."""
+    refusal = in_process_refusal(path)
+    return None if refusal is None else (f"{name} ({Path(path).name}) runs through FMI, "
+                                         f"not in-process: {refusal}")
+
+
 def _refusal(path: Path) -> str | None:
     try:
         with zipfile.ZipFile(path) as fmu:
@@ -136,12 +144,12 @@ class InProcessInstance(Instance):
         (``in_process_refusal``), or, without ``same_sources``, only if it is not one of
         ours (``cosim.studies.direct``: the modules as they are, whatever the FMU)."""
         self.path, self.name = Path(path), name
-        refusal = in_process_refusal(self.path)
-        if refusal and (same_sources or _description(self.path).get("modelName") not in FMUS):
-            raise ValueError(f"FMU '{name}' ({self.path.name}) cannot run in-process: "
-                             f"{refusal}")
         description = _description(self.path)
         self.model_name, self.guid = description.get("modelName"), description.get("guid")
+        refusal = in_process_refusal(self.path)
+        if refusal and (same_sources or self.model_name not in FMUS):
+            raise ValueError(f"FMU '{name}' ({self.path.name}) cannot run in-process: "
+                             f"{refusal}")
         self.slave = slave_class(self.model_name)(instance_name=name)
         self.variables = {}
         for vr, var in self.slave.registry.by_vr.items():

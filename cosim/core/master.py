@@ -25,7 +25,7 @@ from fmukit.timebase import communication_point, nanoseconds, seconds, step_coun
 
 from .coupling import COUPLINGS
 from .fmi import FmuInstance
-from .inprocess import InProcessInstance, in_process_refusal
+from .inprocess import InProcessInstance, fallback_note
 from .instance import FmuCallError, Instance
 from .interrupt import StopSignals
 from .null import NullInstance
@@ -75,12 +75,10 @@ class Master:
 
     def _instantiate(self, path: Path, name: str) -> Instance:
         backend = self.backend
-        if backend == "inprocess":
-            refusal = in_process_refusal(path)
-            if refusal:
-                backend = "fmi"
-                self.notes.append(f"{name} ({path.name}) runs through FMI, not in-process: "
-                                  f"{refusal}")
+        note = fallback_note(name, path) if backend == "inprocess" else None
+        if note:
+            backend = "fmi"
+            self.notes.append(note)
         self.backends[name] = backend
         return BACKENDS[backend](path, name)
 

@@ -63,7 +63,7 @@ import numpy as np
 
 from .. import scenarios
 from ..analysis.seastate import model_scale
-from ..core.inprocess import in_process_refusal
+from ..core.inprocess import fallback_note
 from ..core.provenance import PACKAGE, code_version
 from ..scenarios.autopilot import check_autopilot
 from .bundle import Bundle, bundle
@@ -177,11 +177,9 @@ class Spec:
         notes = []
         for controller, shipped in self.bundles().items():
             for name, component in shipped.system.components.items():
-                path = self.files()[Path(component.source).stem]
-                refusal = in_process_refusal(path)
-                if refusal:
-                    notes.append(f"controller {controller!r}: {name} ({path.name}) runs through "
-                                 f"FMI, not in-process: {refusal}")
+                note = fallback_note(name, self.files()[Path(component.source).stem])
+                if note:
+                    notes.append(f"controller {controller!r}: {note}")
         return notes
 
     def settings(self, run: dict[str, Any]) -> tuple[str, dict[str, dict[str, Any]]]:

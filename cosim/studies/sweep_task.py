@@ -126,6 +126,7 @@ def run_one(job: Job, blobs: dict[str, bytes]) -> dict[str, Any]:
     if job.code != code_version():          # a worker that joined after the client's check
         return blank_row(job.run, f"worker runs {code_version()}, the client {job.code}: "
                                   "install the client's version on every worker")
+    master = None
     try:
         master = _master(job, blobs)
         master.configure(job.overrides)
@@ -143,7 +144,7 @@ def run_one(job: Job, blobs: dict[str, bytes]) -> dict[str, Any]:
             row.update(_metrics(recording))
             if job.track:
                 row["track"] = _track(recording, master.parameters)
-    row["backend"] = ran_on(_masters.get(_key(job)), job.backend)   # results: the same either way
+    row["backend"] = ran_on(master, job.backend)   # the results are the same either way
     row["seconds"] = time.perf_counter() - started
     return row
 
