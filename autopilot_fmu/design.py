@@ -77,7 +77,7 @@ class NomotoModel:
         (m11, m12), (m21, m22) = model.M
         (n11, n12), (n21, n22) = model.N
         b1, b2 = model.b
-        det_N = np.linalg.det(model.N)
+        det_N = n11 * n22 - n12 * n21
         T1_plus_T2 = (n11 * m22 + n22 * m11 - n12 * m21 - n21 * m12) / det_N   # (28)
         K_R = (n21 * b1 - n11 * b2) / det_N                                     # (29)
         T3 = (m21 * b1 - m11 * b2) / det_N / K_R                                # (30)
@@ -98,10 +98,9 @@ class NomotoModel:
         """K / T."""
         return self.K / self.T
 
-    def state_model(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    def state_model(self) -> tuple[list[list[float]], list[float], list[float], float]:
         """(A_h, B_h, C_h, D_h) of eqs (33)-(36), state [psi, r]."""
-        return (np.array([[0.0, 1.0], [0.0, self.a22]]), np.array([0.0, self.b2]),
-                np.array([1.0, 0.0]), 0.0)
+        return [[0.0, 1.0], [0.0, self.a22]], [0.0, self.b2], [1.0, 0.0], 0.0
 
 
 def design_model(name: str, u0: float) -> SwayYawModel:

@@ -41,7 +41,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numpy as np
 
 from fmukit.numerics import require_finite, substeps, wrap
 
@@ -77,16 +76,52 @@ class SlidingModeDesign:
         # Pole placement, eq (38): det(sI - A_c) = s^2 - (a22 - b2 k2) s + b2 k1.
         k1 = lambda1 * lambda2 / b2
         k2 = (a22 - lambda1 - lambda2) / b2
-        A_c = A - np.outer(B, [k1, k2])
-        eigenvalues, vectors = np.linalg.eig(A_c.T)
-        h = np.real(vectors[:, np.argmin(np.abs(eigenvalues))])
-        h = h / np.linalg.norm(h) * np.sign(h[0])
+        A_c = [[A[0][0] - B[0] * k1, A[0][1] - B[0] * k2],
+               [A[1][0] - B[1] * k1, A[1][1] - B[1] * k2]]
+        A_c_T = [[A_c[0][0], A_c[1][0]], [A_c[0][1], A_c[1][1]]]
+        slow = min(_eigenvalues(A_c_T), key=abs)
+        h1, h2 = _null_vector(A_c_T, slow)
+        scale = math.copysign(1.0, h1) / math.hypot(h1, h2)
         # Eqs (40)-(41): [N_x; N_u] = [[A, B], [C, D]]^-1 [0; 1].
-        system = np.block([[A, B[:, None]], [C[None, :], np.array([[D]])]])
-        N_xu = np.linalg.solve(system, [0.0, 0.0, 1.0])
-        N = N_xu[2] + k1 * N_xu[0] + k2 * N_xu[1]
+        N_x1, N_x2, N_u = _solve([[A[0][0], A[0][1], B[0]], [A[1][0], A[1][1], B[1]],
+                                  [C[0], C[1], D]], [0.0, 0.0, 1.0])
+        N = N_u + k1 * N_x1 + k2 * N_x2
         return cls(nomoto=nomoto, lambda1=lambda1, lambda2=lambda2,
-                   K=(float(k1), float(k2)), h=(float(h[0]), float(h[1])), N=float(N))
+                   K=(k1, k2), h=(h1 * scale, h2 * scale), N=N)
+
+
+# The design's linear algebra, written out for 2 x 2 and 3 x 3 in +, -, *, / and sqrt
+# (exactly rounded), not by LAPACK, whose BLAS kernels round differently on different
+# CPUs: the chattering loop turns a last bit of h into a visibly different run.
+def _eigenvalues(M: list[list[float]]) -> tuple[float, float]:
+    """The real eigenvalues of a 2 x 2 matrix, from its characteristic polynomial."""
+    trace, det = M[0][0] + M[1][1], M[0][0] * M[1][1] - M[0][1] * M[1][0]
+    discriminant = trace * trace - 4.0 * det
+    if discriminant < 0.0:
+        raise ValueError(f"the closed loop has complex eigenvalues (trace {trace}, "
+                         f"determinant {det}); lambda1 and lambda2 must be real")
+    q = 0.5 * (trace + math.copysign(math.sqrt(discriminant), trace))
+    return (q, det / q) if q != 0.0 else (0.0, trace)
+
+
+def _null_vector(M: list[list[float]], eigenvalue: float) -> tuple[float, float]:
+    """A vector h with (M - eigenvalue I) h = 0, from the row of larger norm."""
+    rows = [(M[0][0] - eigenvalue, M[0][1]), (M[1][0], M[1][1] - eigenvalue)]
+    a, b = max(rows, key=lambda row: math.hypot(*row))
+    return -b, a
+
+
+def _solve(M: list[list[float]], b: list[float]) -> list[float]:
+    """x with M x = b for a 3 x 3 M, by Cramer's rule."""
+    def det(m: list[list[float]]) -> float:
+        return (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+                - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+                + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]))
+    d = det(M)
+    if d == 0.0:
+        raise ValueError("the design system of eqs (40)-(41) is singular")
+    return [det([row[:j] + [b[i]] + row[j + 1:] for i, row in enumerate(M)]) / d
+            for j in range(3)]
 
 
 class SlidingModeAutopilot:

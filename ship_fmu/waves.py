@@ -8,11 +8,14 @@ A_i sin(theta_i).
 Discretisation: the band [omega_lo, omega_hi] holds ``band_fraction`` (98 %) of
 the spectrum's variance, with equal tails. It is cut into N bins of equal variance
 (the spectrum's cumulative distribution has a closed form, so the bin edges are
-exact quantiles); A_i = sqrt(2 m0_i) with m0_i the exact variance of bin i, so the
+exact quantiles, computed in decimal arithmetic and rounded once: see
+``frequency_at_fraction``); A_i = sqrt(2 m0_i) with m0_i the exact variance of bin i, so the
 components carry the band's variance exactly. omega_i is drawn uniformly inside
 its bin: equally spaced frequencies would repeat the sea every 2 pi / d_omega
 (about 15 s here). Frequencies and phases come from a seeded generator, so a seed
-names one realisation.
+names one realisation, with the same bits on every CPU: the realisation uses
+only exactly rounded operations (+, -, *, /, sqrt, and decimal logarithms), never
+a vectorised transcendental function or BLAS, whose last bits vary with the CPU.
 
 Encounter phase: theta_i must obey d theta_i/dt = omega_e,i = omega_i - k_i U cos(beta),
 with U the ship's speed and beta = psi_w - psi. Writing omega_e,i * t instead drifts
@@ -28,6 +31,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from decimal import Decimal, localcontext
 
 import numpy as np
 
@@ -35,15 +39,22 @@ from .data import G, RHO_WATER, Hull
 
 
 def spectrum(omega: np.ndarray | float, Hs: float, T0: float) -> np.ndarray | float:
-    """Modified Pierson-Moskowitz spectral density S(omega), m^2 s, eq (17)."""
-    Tz4 = (0.710 * T0) ** 4
-    return (4.0 * math.pi ** 3 * Hs ** 2 / (Tz4 * omega ** 5)
-            * np.exp(-16.0 * math.pi ** 3 / (Tz4 * omega ** 4)))
+    """Modified Pierson-Moskowitz spectral density S(omega), m^2 s, eq (17).
+
+    S = A omega^-5 exp(-B omega^-4) with B = 16 pi^3 / (0.710 T0)^4 and A = Hs^2 B / 4.
+    """
+    B = _spectrum_b(T0)
+    return Hs * Hs / 4.0 * B / omega ** 5 * np.exp(-B / omega ** 4)
 
 
 def _spectrum_b(T0: float) -> float:
-    """B in S = A omega^-5 exp(-B omega^-4); the variance below omega is m0 exp(-B/omega^4)."""
-    return 16.0 * math.pi ** 3 / (0.710 * T0) ** 4
+    """B in S = A omega^-5 exp(-B omega^-4); the variance below omega is m0 exp(-B/omega^4).
+
+    Products, not ``**``: Python's float power is the C library's pow, whose last bit
+    depends on the CPU.
+    """
+    Tz = 0.710 * T0
+    return 16.0 * math.pi * math.pi * math.pi / (Tz * Tz * Tz * Tz)
 
 
 def variance_fraction_below(omega: np.ndarray | float, T0: float) -> np.ndarray | float:
@@ -51,9 +62,17 @@ def variance_fraction_below(omega: np.ndarray | float, T0: float) -> np.ndarray 
     return np.exp(-_spectrum_b(T0) / np.asarray(omega, dtype=float) ** 4)
 
 
-def frequency_at_fraction(fraction: np.ndarray | float, T0: float) -> np.ndarray | float:
-    """Inverse of ``variance_fraction_below``."""
-    return (_spectrum_b(T0) / -np.log(fraction)) ** 0.25
+def frequency_at_fraction(fraction: float, T0: float) -> float:
+    """Inverse of ``variance_fraction_below``: omega = (B / -ln F)^(1/4), rad/s.
+
+    In decimal arithmetic at 34 digits (its ln and sqrt are correctly rounded) and
+    rounded once to a float, so the result is the same on every CPU and C library,
+    where numpy's vectorised log and power round differently from one CPU to another.
+    """
+    with localcontext() as context:
+        context.prec = 34
+        quotient = Decimal(_spectrum_b(T0)) / -Decimal(fraction).ln()
+        return float(quotient.sqrt().sqrt())
 
 
 @dataclass(frozen=True)
@@ -71,12 +90,12 @@ class WaveComponents:
         """Equal-variance discretisation of eq (17); see the module docstring."""
         tail = 0.5 * (1.0 - band_fraction)
         edges_fraction = np.linspace(tail, 1.0 - tail, n + 1)
-        edges = frequency_at_fraction(edges_fraction, T0)
+        edges = np.array([frequency_at_fraction(float(f), T0) for f in edges_fraction])
         rng = np.random.default_rng(seed)
         omega = rng.uniform(edges[:-1], edges[1:])
         phase = rng.uniform(0.0, 2.0 * math.pi, n)
-        m0_bins = Hs ** 2 / 16.0 * np.diff(edges_fraction)
-        return cls(omega=omega, k=omega ** 2 / G,
+        m0_bins = Hs * Hs / 16.0 * np.diff(edges_fraction)
+        return cls(omega=omega, k=omega * omega / G,
                    amplitude=np.sqrt(2.0 * m0_bins), phase=phase)
 
     def phases(self, t: float, xi: float, out: np.ndarray | None = None,
@@ -90,10 +109,6 @@ class WaveComponents:
         out = np.multiply(self.k, xi, out)
         np.subtract(omega_t, out, out)
         return np.add(out, self.phase, out)
-
-    def elevation(self, t: float, xi: float) -> float:
-        """Wave elevation at the ship, m."""
-        return float(self.amplitude @ np.sin(self.phases(t, xi)))
 
 
 class WaveLoads:
@@ -120,10 +135,10 @@ class WaveLoads:
         self.components = components
         self.psi_w = psi_w
         self._c_force = rho * G * h.B * h.L * h.T
-        self._c_moment = rho * G * h.B * h.L * (h.L ** 2 - h.B ** 2) / 24.0
+        self._c_moment = rho * G * h.B * h.L * (h.L * h.L - h.B * h.B) / 24.0
         self._slope_amplitude = components.amplitude * components.k
         # Work arrays, so that an evaluation allocates nothing.
-        self._omega_t, self._s = np.empty(n), np.empty(n)
+        self._omega_t, self._s, self._s2 = np.empty(n), np.empty(n), np.empty(n)
         self._t: float | None = None                  # the time of _omega_t
         self._key: tuple = (None, None, None)         # the last evaluation's arguments,
         self._loads = (0.0, 0.0, 0.0)                 # and its loads
@@ -139,9 +154,11 @@ class WaveLoads:
         np.sin(s, s)
         np.multiply(self._slope_amplitude, s, s)          # s_i = A_i k_i sin(theta_i)
         beta = self.psi_w - psi
-        # np.add.reduce and np.dot: what s.sum() and s @ s compute, without their wrappers
+        # np.add.reduce: what s.sum() computes, without its wrapper; and sum s_i^2 the
+        # same way, not by np.dot, whose BLAS kernel (hence its last bit) varies by CPU
         force = self._c_force * float(np.add.reduce(s))
+        sum_s2 = float(np.add.reduce(np.multiply(s, s, self._s2)))
         self._key = (t, xi, psi)
         self._loads = (force * math.cos(beta), force * math.sin(beta),
-                       self._c_moment * math.sin(2.0 * beta) * float(np.dot(s, s)))
+                       self._c_moment * math.sin(2.0 * beta) * sum_s2)
         return self._loads
