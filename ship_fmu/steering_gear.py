@@ -13,7 +13,6 @@ full-scale steering rate (SOLAS: 35 deg port to 30 deg starboard in 28 s, about
 from __future__ import annotations
 
 import math
-from typing import Callable
 
 DELTA_MAX = math.radians(35.0)
 DELTA_RATE_MAX = math.radians(20.0)
@@ -24,25 +23,27 @@ def rudder_target(delta_c: float, delta_max: float = DELTA_MAX) -> float:
     return min(max(delta_c, -delta_max), delta_max)
 
 
-def rudder_motion(delta0: float, delta_c: float, delta_max: float = DELTA_MAX,
-                 delta_rate_max: float = DELTA_RATE_MAX) -> Callable[[float], float]:
+class RudderMotion:
     """The rudder angle as a function of the time s >= 0 since it was delta0, with
-    delta_c held: what a step needs at its RK4 stages."""
-    target = rudder_target(delta_c, delta_max)
-    error = target - delta0
+    delta_c held: at the rate limit toward the target until ``reach``, then at the
+    target. ``reach`` is the kink of that function (0 if the rudder is there already):
+    the vessel's integrator cuts its steps there."""
 
-    def angle(s: float) -> float:
-        travel = delta_rate_max * s
-        if error > travel:
-            return delta0 + travel
-        if error < -travel:
-            return delta0 - travel
-        return target
-    return angle
+    __slots__ = ("delta0", "target", "velocity", "reach")
+
+    def __init__(self, delta0: float, delta_c: float, delta_max: float = DELTA_MAX,
+                 delta_rate_max: float = DELTA_RATE_MAX):
+        self.delta0, self.target = delta0, rudder_target(delta_c, delta_max)
+        error = self.target - delta0
+        self.velocity = math.copysign(delta_rate_max, error)
+        self.reach = abs(error) / delta_rate_max
+
+    def __call__(self, s: float) -> float:
+        return self.target if s >= self.reach else self.delta0 + self.velocity * s
 
 
 def rudder_angle(delta0: float, delta_c: float, s: float,
                  delta_max: float = DELTA_MAX,
                  delta_rate_max: float = DELTA_RATE_MAX) -> float:
     """Rudder angle a time s >= 0 after it was delta0, with delta_c held."""
-    return rudder_motion(delta0, delta_c, delta_max, delta_rate_max)(s)
+    return RudderMotion(delta0, delta_c, delta_max, delta_rate_max)(s)

@@ -8,7 +8,7 @@ import pytest
 from ship_fmu.data import Actuators, Hull
 from ship_fmu.hull import coriolis_forces, damping_forces, mass_matrix
 from ship_fmu.manoeuvres import turning_circle, zigzag
-from ship_fmu.steering_gear import rudder_angle
+from ship_fmu.steering_gear import RudderMotion, rudder_angle
 from ship_fmu.thrusters import actuator_forces
 from ship_fmu.vessel import N_PROPELLER, Vessel, VesselParameters
 from fmukit.timebase import communication_point
@@ -93,6 +93,30 @@ def test_steering_gear_rate_limit_and_stops():
     assert rudder_angle(0.0, 1.0, 10.0, stop, rate) == stop
     assert rudder_angle(0.0, -1.0, 10.0, stop, rate) == -stop
     assert rudder_angle(0.1, 0.1 + 1e-3, 0.5, stop, rate) == 0.1 + 1e-3
+
+
+def test_steering_gear_kink_is_where_the_rudder_reaches_its_command_or_its_stop():
+    rate, stop = math.radians(20.0), math.radians(35.0)
+    gear = RudderMotion(0.1, 0.1 - 0.01, stop, rate)        # 0.01 rad back: 0.0286 s
+    assert gear.reach == pytest.approx(0.01 / rate)
+    assert gear(gear.reach) == gear(1.0) == 0.1 - 0.01 and gear(0.0) == 0.1
+    assert gear(0.5 * gear.reach) == pytest.approx(0.095, abs=1e-15)
+    assert RudderMotion(0.0, 5.0, stop, rate).reach == pytest.approx(stop / rate)
+    assert RudderMotion(0.2, 0.2, stop, rate).reach == 0.0
+
+
+def test_a_step_is_cut_at_the_kink():
+    """The rudder reaches its command 0.03 s into a 0.1 s step: the step gives what two
+    steps of 0.03 and 0.07 s give, the rudder held after the first."""
+    whole, split = run(Vessel(), 5.0), run(Vessel(), 5.0)
+    delta_c = 0.3 * DT * math.radians(20.0)
+    whole.step(whole.t, DT, delta_c)
+    t = split.t
+    split.step(t, 0.3 * DT, delta_c)
+    split.step(t + 0.3 * DT, 0.7 * DT, delta_c)
+    for name in ("x", "y", "psi", "u", "v", "r", "delta"):
+        assert getattr(whole, name) == pytest.approx(getattr(split, name), rel=1e-13,
+                                                     abs=1e-16), name
 
 
 def test_turning_circle_35_deg():

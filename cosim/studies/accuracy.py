@@ -5,10 +5,10 @@ FMU wraps) under a rudder program held over each 0.1 s communication step, as a
 master delivers it, integrated by its fixed-step RK4 at h_max = 0.1, 0.05 and
 0.025 s, against a reference solution of the same equations: scipy's ``solve_ivp``
 (DOP853, rtol = atol = 1e-12) on each communication step. The steering gear's
-response is piecewise linear in time (``steering_gear.rudder_angle``); its kink,
-where the rudder reaches the command, is found analytically and the reference
-restarts there, so no step of the reference straddles a discontinuity of the
-derivative. The reference's own error is estimated by solving again with the
+response is piecewise linear in time (``steering_gear.RudderMotion``); its kink,
+where the rudder reaches the command or its stop, is known exactly (``reach``), and
+both the reference and the vessel's RK4 restart there, so no step straddles a
+discontinuity of the derivative. The reference's own error is estimated by solving again with the
 tolerances halved.
 
 Programs, 400 s from straight running at 0.3 m/s, calm water: a 20 deg rudder step;
@@ -26,7 +26,7 @@ from scipy.integrate import solve_ivp
 
 from fmukit.timebase import communication_point, step_count
 from ship_fmu.manoeuvres import RudderProgram
-from ship_fmu.steering_gear import rudder_angle, rudder_target
+from ship_fmu.steering_gear import RudderMotion, rudder_target
 from ship_fmu.thrusters import actuator_model
 from ship_fmu.vessel import N_PROPELLER, Vessel, VesselParameters
 
@@ -78,19 +78,17 @@ def reference(delta_c: np.ndarray, tolerance: float = TOLERANCE) -> dict[str, np
     delta = vessel.delta
     rows = [[y[2], y[5], y[0], y[1]]]
     for k, command in enumerate(delta_c):
-        t, command = communication_point(0.0, k, H), float(command)
-        target = rudder_target(command, p.delta_max)
-        reach = abs(target - delta) / p.delta_rate_max
-        pieces = [(0.0, reach), (reach, H)] if 0.0 < reach < H else [(0.0, H)]
+        t = communication_point(0.0, k, H)
+        gear = RudderMotion(delta, float(command), p.delta_max, p.delta_rate_max)
+        pieces = [(0.0, gear.reach), (gear.reach, H)] if 0.0 < gear.reach < H else [(0.0, H)]
 
-        def f(s: float, state: np.ndarray, t=t, delta0=delta, command=command) -> list[float]:
-            gear = rudder_angle(delta0, command, s, p.delta_max, p.delta_rate_max)
-            return list(vessel.rates(t + s, tuple(state), forces(gear)))
+        def f(s: float, state: np.ndarray, t=t, gear=gear) -> list[float]:
+            return list(vessel.rates(t + s, tuple(state), forces(gear(s))))
 
         for a, b in pieces:
             y = solve_ivp(f, (a, b), y, method="DOP853", rtol=tolerance,
                           atol=tolerance).y[:, -1]
-        delta = rudder_angle(delta, command, H, p.delta_max, p.delta_rate_max)
+        delta = gear(H)
         rows.append([y[2], y[5], y[0], y[1]])
     return dict(zip(SIGNALS, np.array(rows).T))
 
