@@ -11,6 +11,19 @@ from fmukit.packaging import FMU_DIR, FMUS, ROOT, build
 
 pytest_plugins = ["pytester"]       # to run the example test file for each autopilot
 
+HARD_LIMIT = 1200
+"""Seconds any test may take, its fixtures' setup included, unless it has a limit of its own:
+more than the whole suite's budget (15 min), so only a hang reaches it."""
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Every test without ``@pytest.mark.timeout`` gets HARD_LIMIT (pytest-timeout's thread
+    method: it prints every thread's stack and ends the session, wherever the test is stuck,
+    instead of waiting for ever)."""
+    for item in items:
+        if item.get_closest_marker("timeout") is None:
+            item.add_marker(pytest.mark.timeout(HARD_LIMIT, method="thread"))
+
 
 def _stale(name: str, sources: list[Path]) -> bool:
     fmu = FMU_DIR / f"{name}.fmu"
