@@ -13,6 +13,16 @@ from .studies.sweep_figures import save_figures
 RESULTS = Path("results/sweeps")
 
 
+def seconds(text: str) -> float:
+    """A number of seconds > 0, for argparse."""
+    try:
+        if 0 < float(text) < float("inf"):
+            return float(text)
+    except ValueError:
+        pass
+    raise argparse.ArgumentTypeError(f"give a number of seconds > 0, got {text!r}")
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m cosim.sweep",
                                      description=sweep.__doc__.split("\n\n")[0],
@@ -32,6 +42,11 @@ def main(argv: list[str] | None = None) -> int:
                              "project's FMUs as Python classes, without FMI: the same results, "
                              "about 1.3-2 times faster per run (an FMU not of this checkout "
                              "runs through FMI, with a note)")
+    parser.add_argument("--no-worker-timeout", type=seconds, metavar="SECONDS",
+                        default=sweep.NO_WORKER_TIMEOUT,
+                        help="stop when the cluster has had no worker for this long, keeping "
+                             "every row done (exit status "
+                             f"{sweep.NoWorkers.exit_status}; default: %(default)g s)")
     parser.add_argument("--csv", action="store_true", help="also write results.csv")
     parser.add_argument("--no-progress", action="store_true",
                         help="no progress bar (for logs)")
@@ -47,17 +62,17 @@ def main(argv: list[str] | None = None) -> int:
             print(f"note: {note}", file=sys.stderr)
         rows = sweep.execute(spec, out, args.scheduler, args.workers,
                              progress=not args.no_progress, scheduler_file=args.scheduler_file,
-                             backend=args.backend)
+                             backend=args.backend, no_worker_timeout=args.no_worker_timeout)
     except (sweep.SweepError, ValueError) as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
-    except Interrupted as interrupted:
+    except (Interrupted, sweep.NoWorkers) as stopped:
         rows = sweep.completed(spec, out)
         written = sweep.write_tables(rows, out, args.csv) if rows else []
-        print(f"{interrupted}: {len(rows)} of {len(spec.runs())} runs done, kept in "
+        print(f"{stopped}: {len(rows)} of {len(spec.runs())} runs done, kept in "
               f"{out / 'runs.jsonl'}{''.join(f', {p}' for p in written)}; the same command "
               "resumes the sweep", file=sys.stderr)
-        return interrupted.exit_status
+        return stopped.exit_status
     written = sweep.write_tables(rows, out, args.csv)
     if any(r["status"] == "ok" for r in rows):
         written += save_figures(spec, rows, out)

@@ -4,6 +4,8 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
+import time
 from pathlib import Path
 
 import pyarrow.parquet as pq
@@ -151,6 +153,7 @@ def test_task_records_a_failed_run_with_its_message(fmu_paths, tmp_path):
     sweep_task.free_masters()
 
 
+@pytest.mark.timeout(180, method="thread")
 def test_dask_sweep_writes_resumes_and_plots(fmu_paths, tmp_path, capsys):
     spec = sweep.Spec.read(write_spec(tmp_path, SMALL))
     out = tmp_path / "out"
@@ -194,16 +197,76 @@ def test_a_journal_has_one_writer(fmu_paths, tmp_path):
             sweep.execute(spec, tmp_path, workers=1, progress=False)
 
 
+@pytest.mark.timeout(120, method="thread")
 def test_a_worker_killed_on_every_retry_is_recorded_as_failed(fmu_paths, tmp_path):
+    """The nanny restarts the worker each time; were it to fail to (as seen on a loaded
+    machine), the sweep stops for want of a worker and the test fails, naming that."""
     from sweep_faults import killing_task
     spec = sweep.Spec.read(write_spec(tmp_path, 'stop_time = 5\n[axes]\nwave_seed = [1, 2]\n'))
-    rows = sweep.execute(spec, tmp_path, workers=1, progress=False, task=killing_task)
+    rows = sweep.execute(spec, tmp_path, workers=1, progress=False, task=killing_task,
+                         no_worker_timeout=30)
     by_seed = {(r["controller"], r["wave_seed"]): r for r in rows}
     assert by_seed[("pd", 1)]["status"] == "ok"
     assert by_seed[("pd", 2)]["status"] == "failed"
     assert "KilledWorker" in by_seed[("pd", 2)]["error"]
 
 
+@pytest.mark.timeout(40, method="thread")
+def test_a_sweep_left_without_a_worker_stops_keeps_its_rows_and_says_why(
+        fmu_paths, tmp_path, capsys, monkeypatch):
+    """The only worker is killed and not replaced (its nanny told not to restart it, as one
+    that fails to): the command stops after --no-worker-timeout instead of waiting for ever."""
+    from sweep_faults import killing_task_after_one_row
+
+    from cosim import sweep as command
+    from cosim.studies.cluster import local_cluster
+
+    spec = write_spec(tmp_path, 'name = "orphan"\nstop_time = 5\n[axes]\nwave_seed = [1, 2]\n')
+    out = tmp_path / "out" / "orphan"
+    monkeypatch.setattr(sweep, "run_one", killing_task_after_one_row)
+    monkeypatch.setenv("SWEEP_FAULTS_JOURNAL", str(out / "runs.jsonl"))
+    cluster = local_cluster(1)
+    try:
+        for nanny in cluster.workers.values():
+            nanny.close_gracefully()                        # no restart when its worker dies
+        started = time.monotonic()
+        status = command.main([str(spec), "--scheduler", cluster.scheduler_address, "--out",
+                               str(tmp_path / "out"), "--no-worker-timeout", "2",
+                               "--no-progress"])
+        took = time.monotonic() - started
+    finally:
+        cluster.close()
+    err = capsys.readouterr().err
+    assert status == sweep.NoWorkers.exit_status == 3, err
+    assert re.search(r"no worker in the cluster for 2 s \(the last one left by [-\d]+ [:\d]+\); "
+                     r"the sweep stopped: 1 of 4 runs done, kept in \S+/runs.jsonl, "
+                     r"\S+/results.parquet", err), err
+    journal = [json.loads(line) for line in (out / "runs.jsonl").read_text().splitlines()]
+    assert [r["status"] for r in journal] == ["ok"]
+    assert pq.read_table(out / "results.parquet").num_rows == 1
+    assert took < 25                        # the run done, 2 s without a worker, the closing
+
+
+@pytest.mark.timeout(30, method="thread")
+def test_a_sweep_on_a_cluster_that_never_had_a_worker_stops_too(fmu_paths, tmp_path):
+    from cosim.studies.cluster import local_cluster
+
+    spec = sweep.Spec.read(write_spec(tmp_path, 'stop_time = 5\n[axes]\nwave_seed = [1]\n'))
+    with pytest.raises(ValueError, match="no_worker_timeout must be a number of seconds > 0, "
+                                         "got 0"):
+        sweep.execute(spec, tmp_path, progress=False, no_worker_timeout=0)
+    cluster = local_cluster(0)
+    try:
+        with pytest.raises(sweep.NoWorkers, match=r"no worker in the cluster for 0.5 s \(none "
+                                                  r"has joined since [-\d]+ [:\d]+\)"):
+            sweep.execute(spec, tmp_path, scheduler=cluster.scheduler_address, progress=False,
+                          no_worker_timeout=0.5)
+    finally:
+        cluster.close()
+    assert sweep.completed(spec, tmp_path) == []
+
+
+@pytest.mark.timeout(300, method="thread")
 def test_two_sweeps_on_one_cluster_both_finish_with_every_row(fmu_paths, tmp_path):
     """Each sweep frees only its own FMUs: the first to end must not free the other's."""
     from concurrent.futures import ThreadPoolExecutor

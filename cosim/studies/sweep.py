@@ -45,19 +45,23 @@ fails again at once, one caused by a lost worker deserves its retry).
 results.parquet (and results.csv with --csv) hold the table at the end; a summary
 is printed, figures are written, and comparison.md pairs every controller with pd
 seed by seed. A task whose worker dies is retried twice, then recorded as failed;
-an FMU error is recorded as failed at once, with its message.
+an FMU error is recorded as failed at once, with its message. A sweep whose cluster
+has had no worker for 60 s (``--no-worker-timeout``) stops as on Ctrl-C, every
+row done kept, and says so.
 """
 from __future__ import annotations
 
 import hashlib
 import itertools
 import json
+import queue
 import sys
+import time
 import tomllib
 import uuid
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterator
 
 import numpy as np
 
@@ -76,6 +80,8 @@ DEFAULT_CONTROLLERS = {"pd": {"scenario": "waves_pd"}, "smc": {"scenario": "wave
 # Axis shorthands: name -> the FMU parameter it sets.
 SHORTHANDS = {"wave_seed": "ship.wave_seed", "Hs": "ship.Hs", "T0": "ship.T0",
               "psi_w": "ship.psi_w", "route": "guidance.waypoints"}
+NO_WORKER_TIMEOUT = 60.0
+"""Seconds a sweep waits while its cluster has no worker, then stops (``NoWorkers``)."""
 
 
 @dataclass
@@ -272,6 +278,76 @@ class SweepError(RuntimeError):
     """The sweep cannot start: a worker runs other code, or another sweep holds the journal."""
 
 
+class NoWorkers(RuntimeError):
+    """The sweep stopped: its cluster had no worker for as long as it waits for one. The
+    runs completed stay in the journal, as on an interruption."""
+
+    exit_status = 3
+    """The command's exit status for it (0: every run ok, 1: some failed, 2: cannot start)."""
+
+
+class _WorkerWatch:
+    """Raises ``NoWorkers`` from ``check`` once the scheduler has counted no worker for
+    ``timeout`` seconds; it is asked at most every ``interval`` seconds (1 s, or less for a
+    short timeout), and only while the client waits."""
+
+    def __init__(self, client, timeout: float):
+        self.client, self.timeout = client, timeout
+        self.interval = min(1.0, timeout / 4)
+        self.seen = False                   # a worker was counted at least once
+        self.gone_since: float | None = None
+        self.gone_at = ""                   # when none was first counted, for the message
+        self.next_check = 0.0
+        self.check()
+
+    def check(self) -> None:
+        now = time.monotonic()
+        if now < self.next_check:
+            return
+        self.next_check = now + self.interval
+        try:
+            workers = len(self.client.nthreads())
+        except OSError:                     # the scheduler cannot be reached: no worker either
+            workers = 0
+        if workers:
+            self.seen, self.gone_since = True, None
+        elif self.gone_since is None:
+            self.gone_since, self.gone_at = now, time.strftime("%Y-%m-%d %H:%M:%S")
+        elif now - self.gone_since >= self.timeout:
+            since = "the last one left by" if self.seen else "none has joined since"
+            raise NoWorkers(f"no worker in the cluster for {self.timeout:g} s ({since} "
+                            f"{self.gone_at}); the sweep stopped")
+
+    def result(self, future):
+        """``future.result()``, checking the cluster while it waits: a finished run's result
+        is fetched from its worker, and computed again if that worker has just died."""
+        from dask.distributed import TimeoutError
+
+        while True:
+            try:
+                return future.result(timeout=self.interval)
+            except TimeoutError:
+                if future.status == "error":    # the task's own TimeoutError
+                    raise
+                self.check()
+
+
+def _as_completed(futures: list, watch: _WorkerWatch) -> Iterator:
+    """Each future as it completes, from its done callback (run by the future's own client,
+    not the newest one); while none completes, ``watch`` is checked. Dask's ``as_completed``
+    cannot do this: its timeout is a deadline for the whole iteration."""
+    done: queue.SimpleQueue = queue.SimpleQueue()
+    for future in futures:
+        future.add_done_callback(done.put)
+    for _ in futures:
+        while True:
+            try:
+                yield done.get(timeout=watch.interval)
+                break
+            except queue.Empty:
+                watch.check()
+
+
 def _say(message: str) -> None:
     print(message, file=sys.stderr, flush=True)
 
@@ -326,7 +402,7 @@ def _worker_saturation(dask_scheduler=None) -> float:
 
 def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | None = None,
             progress: bool = True, task=None, scheduler_file: str | None = None,
-            backend: str = "fmi") -> list[dict]:
+            backend: str = "fmi", no_worker_timeout: float = NO_WORKER_TIMEOUT) -> list[dict]:
     """Run every run of ``spec`` without an ok row in the journal (failed rows are run
     again); return every row of the sweep.
 
@@ -340,11 +416,15 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
     is released as soon as its row is journaled, so a lost worker costs only the runs
     it had in flight. On Ctrl-C or SIGTERM (``Interrupted``, raised again once the
     cluster is closed) the runs completed so far stay in the journal (``completed``);
-    the same call then resumes. SweepError if a worker runs other code than the client
-    or another sweep writes the journal.
+    the same call then resumes. A cluster with no worker for ``no_worker_timeout``
+    seconds ends the sweep the same way, with ``NoWorkers``. SweepError if a worker runs
+    other code than the client or another sweep writes the journal.
     """
     if backend not in ("fmi", "inprocess"):
         raise ValueError(f"backend must be fmi or inprocess, got {backend!r}")
+    if not 0 < no_worker_timeout < float("inf"):
+        raise ValueError(f"no_worker_timeout must be a number of seconds > 0, got "
+                         f"{no_worker_timeout!r}")
     try:
         with Journal(out / "runs.jsonl") as journal:
             runs = spec.runs()
@@ -354,16 +434,14 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
                      f"{journal.path}; {len(todo)} to run")
             if todo:
                 _run_on_cluster(spec, todo, journal, connect(scheduler, workers, scheduler_file),
-                                progress, task or run_one, backend)
+                                progress, task or run_one, backend, no_worker_timeout)
     except JournalLocked as locked:
         raise SweepError(str(locked)) from None
     return completed(spec, out)
 
 
 def _run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, progress: bool,
-                    task, backend: str) -> None:
-    from dask.distributed import as_completed
-
+                    task, backend: str, no_worker_timeout: float) -> None:
     client, cluster = connection
     token = uuid.uuid4().hex[:12]
     teardown = SweepTeardown(token)
@@ -389,18 +467,24 @@ def _run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, 
             from tqdm import tqdm
             bar = tqdm(total=len(todo), desc=spec.name, unit="run", file=sys.stderr,
                        disable=None)                # None: only on a terminal
-        # On this client's loop: by default as_completed takes the newest client's, and a
-        # sweep beside another in this process would wait forever once that one closed.
-        for future in as_completed(futures, loop=client.loop):
-            run = futures.pop(future)
-            try:
-                row = future.result()
-            except Exception as error:          # the worker died on every retry
-                row = {**blank_row(run, f"{type(error).__name__}: {error}"), "backend": backend}
-            journal.add(row)
-            future.release()                    # done: nothing to recompute if a worker dies
-            if bar is not None:
-                bar.update()
+        watch = _WorkerWatch(client, no_worker_timeout)
+        try:
+            for future in _as_completed(list(futures), watch):
+                try:
+                    row = watch.result(future)
+                except NoWorkers:
+                    raise
+                except Exception as error:      # the worker died on every retry
+                    row = {**blank_row(futures[future], f"{type(error).__name__}: {error}"),
+                           "backend": backend}
+                journal.add(row)
+                del futures[future]
+                future.release()                # done: nothing to recompute if a worker dies
+                if bar is not None:
+                    bar.update()
+        except NoWorkers:
+            client.cancel([*futures, *shipped.values()])
+            raise
         if bar is not None:
             bar.close()
     finally:
