@@ -1,6 +1,10 @@
 """A real Dask cluster: a scheduler and two workers as separate processes, the project
 installed from a wheel into their own environment (no checkout on their path); a sweep
-with a user's autopilot FMU; one worker killed mid-sweep."""
+with a user's autopilot FMU; one worker killed mid-sweep.
+
+Every wait has a limit: the child processes' (``timeout``), the sweep's thread (``join``),
+and the test's own (pytest-timeout's signal method, so that the fixture still kills the
+cluster, whose processes are in sessions of their own and would outlive pytest)."""
 from __future__ import annotations
 
 import os
@@ -27,18 +31,19 @@ def wheel_python(tmp_path_factory) -> Path:
     """A Python whose environment has the project from a wheel, and its dependencies."""
     root = tmp_path_factory.mktemp("wheel_env")
     subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w",
-                    str(root / "dist"), str(ROOT)], check=True, capture_output=True)
+                    str(root / "dist"), str(ROOT)], check=True, capture_output=True,
+                   timeout=300)
     venv.create(root / "env", with_pip=False)
     python = root / "env" / "bin" / "python"
     site = Path(subprocess.run([str(python), "-c", "import sysconfig; print(sysconfig.get_paths()"
                                 "['purelib'])"], capture_output=True, text=True,
-                               check=True).stdout.strip())
+                               check=True, timeout=60).stdout.strip())
     # The dependencies from this environment: a plain path, so its .pth files (this
     # project's editable install among them) are not run.
     (site / "dependencies.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
     wheel = next((root / "dist").glob("*.whl"))
     subprocess.run([sys.executable, "-m", "pip", "install", "--no-deps", "-q", "--target",
-                    str(site), str(wheel)], check=True, capture_output=True)
+                    str(site), str(wheel)], check=True, capture_output=True, timeout=300)
     return python
 
 
@@ -58,6 +63,10 @@ def cluster(wheel_python, tmp_path):
     deadline = time.monotonic() + 60
     while not scheduler_file.exists() and time.monotonic() < deadline:
         time.sleep(0.1)
+    if not scheduler_file.exists():
+        os.killpg(processes[0].pid, signal.SIGKILL)
+        processes[0].wait(timeout=10)
+        pytest.fail("the Dask scheduler wrote no scheduler file within 60 s")
     for _ in range(2):
         processes.append(subprocess.Popen(
             [str(wheel_python), "-m", "dask", "worker", "--scheduler-file", str(scheduler_file),
@@ -67,9 +76,10 @@ def cluster(wheel_python, tmp_path):
     for process in processes:
         if process.poll() is None:
             os.killpg(process.pid, signal.SIGKILL)
-            process.wait()
+            process.wait(timeout=10)
 
 
+@pytest.mark.timeout(300, method="signal")
 def test_a_wheel_cluster_runs_a_sweep_and_loses_only_the_runs_in_flight(
         fmu_paths, cluster, tmp_path):
     from dask.distributed import Client
@@ -100,16 +110,18 @@ def test_a_wheel_cluster_runs_a_sweep_and_loses_only_the_runs_in_flight(
     result = {}
     running = threading.Thread(target=lambda: result.update(rows=sweep.execute(
         spec, out, scheduler_file=str(scheduler_file), progress=False,
-        task=slow_counted_task)))
+        task=slow_counted_task, no_worker_timeout=30)), daemon=True)
     running.start()
     journal = out / "runs.jsonl"
-    while running.is_alive() and (not journal.exists()
-                                  or len(journal.read_text().splitlines()) < 3):
+    deadline = time.monotonic() + 120
+    while running.is_alive() and time.monotonic() < deadline and (
+            not journal.exists() or len(journal.read_text().splitlines()) < 3):
         time.sleep(0.05)
     killed_after = len(journal.read_text().splitlines())
     os.killpg(processes[1].pid, signal.SIGKILL)            # a worker and its nanny, gone
-    running.join(timeout=300)
+    running.join(timeout=120)
 
+    assert not running.is_alive(), "the sweep did not end within 120 s of the kill"
     rows = result["rows"]
     assert killed_after < RUNS                             # mid-sweep
     assert len(rows) == RUNS and all(r["status"] == "ok" for r in rows), [r["error"] for r in rows]
