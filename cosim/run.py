@@ -5,6 +5,8 @@ Examples:
   python -m cosim.run waves_smc --out /tmp/w   the sliding-mode autopilot in waves
   python -m cosim.run calm_pd --set ship.Hs=0.003 --set autopilot.Kd=30
   python -m cosim.run --all                    the paper's four runs, Tables 1-2
+  python -m cosim.run --all --spread           ... with each figure's range under last-bit
+                                               perturbations (as docs/reproduction.md)
   python -m cosim.run waves_pd --autopilot my.fmu   your own autopilot in waves_pd's place
 
 Each scenario is an SSP system structure file in cosim/scenarios/ (the FMUs, their
@@ -37,6 +39,7 @@ from .core.master import BACKENDS, Master
 from .core.provenance import write_metadata
 from .core.ssd import SystemDescription
 from .scenarios.autopilot import COMPONENT
+from .studies.spread import PERTURBED, spread
 
 RUN_BACKENDS = [b for b in BACKENDS if b != "null"]     # null runs measure the master only
 
@@ -168,6 +171,13 @@ def main(argv: list[str] | None = None) -> int:
                         help="also write an animation of the ship along its track: "
                              f"SCENARIO.gif, or .mp4 where ffmpeg is installed (here: "
                              f"{video_format()})")
+    parser.add_argument("--spread", nargs="?", type=int, const=20, metavar="ULPS",
+                        help="also run each course-keeping scenario with "
+                             f"{' and then '.join('.'.join(p) for p in PERTURBED)} moved by "
+                             "1 ... ULPS units in the last place either way (4 ULPS more "
+                             "runs, in-process; ULPS = 20 if not given, as in the published "
+                             "tables) and print the range of psi_E, delta_E and J where it "
+                             "is wider than the printed digits")
     parser.add_argument("--stream", action="store_true",
                         help="write rows to the CSV in chunks as the run goes: flat memory "
                              "for long runs (--stop-time 86400); no report or figure")
@@ -182,11 +192,16 @@ def main(argv: list[str] | None = None) -> int:
 
     if args.animate and args.stream:
         parser.error("--animate needs the run in memory; it cannot be combined with --stream")
+    if args.spread is not None and args.spread < 1:
+        parser.error(f"--spread takes a number of ulps >= 1, got {args.spread}")
+    if args.spread and args.stream:
+        parser.error("--spread needs each run's report; it cannot be combined with --stream")
     if args.animate == "mp4" and video_format() != "mp4":
         parser.error("--animate mp4 needs ffmpeg, which is not installed here; use gif")
     options = Options(args.coupling, args.stop_time, args.lam, args.backend,
                       not args.no_plot, ("png", *args.figure_format), args.stream, args.animate)
-    status, costs = 0, {}
+    status, costs, ranges = 0, {}, {}
+    perturbed = ", ".join(".".join(p) for p in PERTURBED)
     for run in runs_asked(names, args.all, args.autopilot, args.name):
         out = args.out or Path("results") / run.label
         if args.all and args.out:
@@ -206,11 +221,24 @@ def main(argv: list[str] | None = None) -> int:
         status = max(status, code)
         if code > 128:                          # interrupted: no further run
             return code
+        if result is not None and args.spread:
+            try:
+                ensemble = spread(system, overrides if run.autopilot else paper_overrides,
+                                  args.spread, args.lam, args.coupling, args.stop_time)
+            except (ValueError, RuntimeError) as error:
+                print(f"error: {error}", file=sys.stderr)
+                status = max(status, 1)
+            else:
+                print(f"  range over {ensemble.runs} runs ({perturbed} moved by up to "
+                      f"{args.spread} ulp): {ensemble.describe()}")
+                ranges[run.table_row] = ensemble.describe()
         if result is not None and run.table_row is not None:
             costs[run.table_row] = result
     if args.all and costs:
         print()
-        print(tables(costs))
+        print(tables(costs, ranges, f"Range of each figure over {4 * (args.spread or 0) + 1} "
+                                    f"runs, {perturbed} moved by up to {args.spread} ulp "
+                                    "(min-max, where wider than the printed digits)"))
     return status
 
 

@@ -13,8 +13,8 @@ from dataclasses import dataclass
 from ..core.recording import Recording
 from .metrics import cost_terms
 
-LAMBDA = 1.8652802015251224
-"""Weight of eq (19): psi_E / sum(delta^2) of calm_pd (100.167 rad^2 / 53.701 rad^2)."""
+LAMBDA = 1.8649470947066942
+"""Weight of eq (19): psi_E / sum(delta^2) of calm_pd (100.175 rad^2 / 53.715 rad^2)."""
 
 
 @dataclass(frozen=True)

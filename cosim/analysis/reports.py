@@ -56,11 +56,19 @@ def zigzag_report(recording: Recording, parameters: dict, **_) -> list[str]:
             f"{math.degrees(zz.second_overshoot):.2f} deg"]
 
 
-def tables(costs: dict[tuple[str, str], Cost]) -> str:
+def _label(sea: str, controller: str) -> str:
+    """The paper's controllers in capitals (PD, SMC), a user's as named."""
+    return controller.upper() if f"{sea}_{controller}" in PAPER_TABLES else controller
+
+
+def tables(costs: dict[tuple[str, str], Cost],
+           ranges: dict[tuple[str, str], str] | None = None, ranges_title: str = "") -> str:
     """Tables 1 and 2 of the paper next to ours; ``costs`` by (sea, controller).
 
     The sea is "calm" or "waves"; the controllers "pd" and "smc" are the paper's and
     get its values beside ours, any other (a user's autopilot) gets a row of its own.
+    ``ranges``: what a perturbation ensemble says of each row (``cosim.studies.spread``),
+    printed below the tables under ``ranges_title``.
     """
     lines = []
     for title, sea in (("Table 1, calm water", "calm"), ("Table 2, waves", "waves")):
@@ -70,12 +78,15 @@ def tables(costs: dict[tuple[str, str], Cost]) -> str:
             if row_sea != sea:
                 continue
             paper = PAPER_TABLES.get(f"{sea}_{controller}")
-            label = controller.upper() if paper else controller
             theirs = (f"{paper[0]:12.2f}{paper[1]:9.2f}{paper[2]:9.2f}" if paper
                       else f"{'-':>12}{'-':>9}{'-':>9}")
-            lines.append(f"  {label + ' controller':16}{c.psi_E:9.2f}{c.delta_E:9.2f}"
-                         f"{c.J:9.2f}   |{theirs}")
+            name = f"{_label(sea, controller)} controller"
+            lines.append(f"  {name:16}{c.psi_E:9.2f}{c.delta_E:9.2f}{c.J:9.2f}   |{theirs}")
     lam = next(iter(costs.values())).lam if costs else LAMBDA
     lines.append(f"  (lambda = {lam:.4f}, delta_E = lambda * sum delta^2; sums over the "
                  "0.1 s samples, rad^2)")
+    if ranges:
+        lines.append(f"{ranges_title}:")
+        lines += [f"  {sea} {_label(sea, controller)}: {text}"
+                  for (sea, controller), text in ranges.items()]
     return "\n".join(lines)
