@@ -3,12 +3,16 @@ against a monolithic model with the controller inside the solver.
 
     python -m cosim.accuracy            # the full study, about 3-5 minutes on 2 cores
     python -m cosim.accuracy --quick    # shorter runs and fewer steps (CI)
+    python -m cosim.accuracy --cpus     # every scenario as other CPUs would run it, about
+                                        # 20 s: numpy, OpenBLAS and libm variants, bit for bit
 
 Prints three tables (integration error open loop; co-simulation against the
 monolithic reference; convergence in the communication step) and writes them, with
 a convergence figure, to results/accuracy/. The quick mode's figures cover shorter
 runs in calm water only: they differ from docs/reproduction.md's, which are the full
-study's.
+study's. With --cpus it writes cpus.md instead: each scenario run in a child process
+under each variant of ``cosim.studies.cpu_variants`` and compared bit for bit with
+this machine's own run.
 """
 from __future__ import annotations
 
@@ -18,7 +22,9 @@ import time
 from pathlib import Path
 
 from ._cli import entry, writable_folder
-from .studies import accuracy
+from .analysis.figures import whole_file
+from .scenarios import names
+from .studies import accuracy, cpu_variants
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -31,9 +37,18 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, default=Path("results/accuracy"),
                         help="folder for accuracy.md and convergence.png "
                              "(default: results/accuracy)")
+    parser.add_argument("--cpus", action="store_true",
+                        help="instead: run every scenario under other CPUs' numpy dispatch, "
+                             "OpenBLAS kernels and libm variants and compare bit for bit")
     args = parser.parse_args(argv)
     out = writable_folder(args.out)
     started = time.perf_counter()
+    if args.cpus:
+        table = cpu_variants.audit_table(cpu_variants.audit(names()))
+        print(table)
+        _write(out / "cpus.md", table)
+        print(f"wrote {out / 'cpus.md'} ({time.perf_counter() - started:.0f} s)")
+        return 0
     open_end, closed_end = (60.0, 120.0) if args.quick else (400.0, None)
     runs = accuracy.PAPER_RUNS[:2] if args.quick else accuracy.PAPER_RUNS
     steps = (0.1, 0.05, 0.025) if args.quick else accuracy.STEPS
@@ -52,10 +67,15 @@ def main(argv: list[str] | None = None) -> int:
     tables += ["\n## J against the communication step\n",
                accuracy.convergence_table(converging, references)]
     print("".join(tables[-2:]), flush=True)
-    (out / "accuracy.md").write_text("\n".join(tables) + "\n")
+    _write(out / "accuracy.md", "\n".join(tables))
     figure = accuracy.convergence_figure(converging, out / "convergence.png")
     print(f"wrote {out / 'accuracy.md'}, {figure} ({time.perf_counter() - started:.0f} s)")
     return 0
+
+
+def _write(path: Path, text: str) -> None:
+    with whole_file(path) as temporary:
+        Path(temporary).write_text(text + "\n")
 
 
 if __name__ == "__main__":

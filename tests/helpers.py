@@ -7,6 +7,24 @@ import sys
 from pathlib import Path
 
 
+WAVE_DIGESTS = {0: "8c8ded2e7a2092c0", 7: "f9203af72900f20e"}
+"""SHA-256 (first 16 hex digits) of the sea of seeds 0 and 7 at Hs = 5 cm, T0 = 0.8 s."""
+
+
+def wave_digest(seed: int) -> str:
+    """The frequencies, wave numbers, amplitudes and phases of a seed's sea, by SHA-256."""
+    import hashlib
+
+    import numpy as np
+
+    from ship_fmu.waves import WaveComponents
+
+    c = WaveComponents.from_spectrum(0.05, 0.8, 50, seed)
+    arrays = (c.omega, c.k, c.amplitude, c.phase)
+    return hashlib.sha256(b"".join(np.asarray(a, "<f8").tobytes() for a in arrays)
+                          ).hexdigest()[:16]
+
+
 def fmpy_cli(*args: str, cwd: Path) -> None:
     """Run fmpy's command line in a subprocess."""
     subprocess.run([sys.executable, "-m", "fmpy.cli", *args], cwd=cwd, check=True,

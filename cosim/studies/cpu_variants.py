@@ -1,0 +1,104 @@
+"""Does a run depend on the CPU? The same run under other CPUs' numpy, OpenBLAS and libm.
+
+numpy picks its SIMD loops (SSE, AVX2, AVX-512) by CPU, OpenBLAS its kernels, and
+glibc's libm an FMA variant of sin, cos, exp, pow, atan2 and tanh; any of them may
+round a last bit differently. Each can be made to choose as on another CPU:
+
+- ``NPY_DISABLE_CPU_FEATURES`` turns numpy's dispatch off above a feature set;
+- ``OPENBLAS_CORETYPE`` forces an OpenBLAS kernel (Haswell, SkylakeX, Zen, ...);
+- ``GLIBC_TUNABLES=glibc.cpu.hwcaps=-AVX2,-FMA`` makes glibc pick its variants for a
+  CPU without FMA (x86-64 before 2013; every current server CPU has FMA).
+
+All three are read once at start-up, so each run is a child process with its own
+environment. A run's CSV holds every signal at every step, printed to 12 significant
+digits; the runs are compared on those bytes, and on the first row and column that
+differ.
+"""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import tempfile
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+_AVX512 = "AVX512F AVX512CD AVX512_SKX AVX512_CLX AVX512_CNL AVX512_ICL AVX512_SPR X86_V4"
+VARIANTS: dict[str, dict[str, str]] = {
+    "default": {},
+    "numpy without AVX-512": {"NPY_DISABLE_CPU_FEATURES": _AVX512},
+    "numpy at its baseline": {"NPY_DISABLE_CPU_FEATURES": f"X86_V3 AVX2 FMA3 {_AVX512}"},
+    "OpenBLAS Haswell": {"OPENBLAS_CORETYPE": "Haswell"},
+    "OpenBLAS SkylakeX": {"OPENBLAS_CORETYPE": "SkylakeX"},
+    "OpenBLAS Zen": {"OPENBLAS_CORETYPE": "Zen"},
+    "OpenBLAS Sandybridge": {"OPENBLAS_CORETYPE": "Sandybridge"},
+    "OpenBLAS Prescott": {"OPENBLAS_CORETYPE": "Prescott"},
+    "glibc without FMA": {"GLIBC_TUNABLES": "glibc.cpu.hwcaps=-AVX2,-FMA"},
+}
+"""Environments a run is repeated in; "default" is this machine as it is."""
+
+TIMEOUT = 300.0
+"""s: the most one child run may take."""
+
+_CHILD = """
+import sys
+from cosim import simulate
+stop = float(sys.argv[3]) if sys.argv[3] != "-" else None
+simulate(sys.argv[1], stop_time=stop, backend="inprocess").write_csv(sys.argv[2])
+"""
+
+
+def run_in(variant: str, scenario: str, csv_path: Path,
+           stop_time: float | None = None) -> Path:
+    """Run ``scenario`` in-process in a child under ``VARIANTS[variant]``; its CSV.
+
+    RuntimeError with the child's last words if it fails; it is killed after ``TIMEOUT``.
+    """
+    env = {**os.environ, **VARIANTS[variant]}
+    child = subprocess.run([sys.executable, "-c", _CHILD, scenario, str(csv_path),
+                            "-" if stop_time is None else repr(stop_time)],
+                           env=env, capture_output=True, text=True, timeout=TIMEOUT)
+    if child.returncode != 0:
+        raise RuntimeError(f"{scenario} under {variant!r} failed (status {child.returncode}): "
+                           f"{child.stderr.strip().splitlines()[-1:]}")
+    return csv_path
+
+
+def difference(a: Path, b: Path) -> str | None:
+    """None if two CSVs are the same bytes; else where they first differ."""
+    if a.read_bytes() == b.read_bytes():
+        return None
+    header = a.read_text().split("\n", 1)[0].split(",")
+    x, y = (np.loadtxt(p, delimiter=",", skiprows=1, ndmin=2) for p in (a, b))
+    if x.shape != y.shape:
+        return f"{len(x)} rows against {len(y)}"
+    rows, columns = np.nonzero(x != y)
+    first = int(np.argmin(rows))
+    return (f"from t = {x[rows[first], 0]:g} s ({header[columns[first]]}), "
+            f"{len(set(columns.tolist()))} of {len(header)} columns")
+
+
+def audit(scenario_names: list[str], variants: list[str] | None = None,
+          stop_time: float | None = None, workers: int = 2) -> dict[str, dict[str, str | None]]:
+    """Each scenario under each variant against "default": {scenario: {variant: difference}}."""
+    variants = [v for v in (variants or list(VARIANTS)) if v != "default"]
+    with tempfile.TemporaryDirectory(prefix="cosim-cpus-") as folder, \
+            ThreadPoolExecutor(workers) as pool:
+        jobs = [(s, v) for s in scenario_names for v in ["default", *variants]]
+        paths = dict(zip(jobs, pool.map(
+            lambda i: run_in(jobs[i][1], jobs[i][0], Path(folder) / f"{i}.csv", stop_time),
+            range(len(jobs)))))
+        return {s: {v: difference(paths[(s, "default")], paths[(s, v)]) for v in variants}
+                for s in scenario_names}
+
+
+def audit_table(results: dict[str, dict[str, str | None]]) -> str:
+    """The audit as a Markdown table: 'same' or where the run first differs."""
+    variants = list(next(iter(results.values())))
+    lines = ["| scenario | " + " | ".join(variants) + " |", "|---|" + "---|" * len(variants)]
+    for scenario, by_variant in results.items():
+        lines.append(f"| {scenario} | " + " | ".join(
+            "same" if d is None else f"differs {d}" for d in by_variant.values()) + " |")
+    return "\n".join(lines)
