@@ -195,9 +195,13 @@ def test_wave_loads_at_every_rk4_stage_are_eqs_14_to_16_to_the_bit():
             t = communication_point(start, k, DT)
             seen.clear()
             before = vessel.xi
+            gear = RudderMotion(vessel.delta, 0.3 * math.sin(k))
             vessel.step(t, DT, 0.3 * math.sin(k))
-            # stages 1-4 at t, t + h/2, t + h/2, t + h, and the end of the step
-            assert [s[0] for s in seen] == [t, t + DT / 2, t + DT / 2, t + DT, t + DT]
+            # stages 1-4 at t, t + h/2, t + h/2, t + h, of each piece of the step (cut where
+            # the rudder reaches its command), and the end of the step
+            cuts = (0.0, gear.reach, DT) if 0.0 < gear.reach < DT else (0.0, DT)
+            stages = [t + a + f * (b - a) for a, b in zip(cuts, cuts[1:]) for f in (0, .5, .5, 1)]
+            assert [s[0] for s in seen] == stages + [t + DT]
             assert seen[0][1] == before and seen[-1][1] == vessel.xi
             for stage in seen:
                 assert waves(*stage) == _loads_as_written(waves, *stage)
