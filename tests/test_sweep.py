@@ -199,8 +199,8 @@ def test_a_journal_has_one_writer(fmu_paths, tmp_path):
 
 @pytest.mark.timeout(120, method="thread")
 def test_a_worker_killed_on_every_retry_is_recorded_as_failed(fmu_paths, tmp_path):
-    """The nanny restarts the worker each time; were it to fail to (as seen on a loaded
-    machine), the sweep stops for want of a worker and the test fails, naming that."""
+    """The nanny restarts the worker each time; were it to fail to (as it once did in CI, on
+    another machine), the sweep stops for want of a worker and the test fails, naming that."""
     from sweep_faults import killing_task
     spec = sweep.Spec.read(write_spec(tmp_path, 'stop_time = 5\n[axes]\nwave_seed = [1, 2]\n'))
     rows = sweep.execute(spec, tmp_path, workers=1, progress=False, task=killing_task,
