@@ -147,7 +147,7 @@ class SlidingModeAutopilot:
         # RK4 stays accurate and stable with |lambda| h <= 1 on the reference model's
         # fastest eigenvalue; with the paper's omega_n and zeta that is H_MAX itself.
         fastest = omega_n * (zeta + math.sqrt(max(zeta * zeta - 1.0, 0.0)))
-        self._h_max = min(H_MAX, 1.0 / fastest)
+        self._h_max = H_MAX if fastest * H_MAX <= 1.0 else 1.0 / fastest
 
     def r_z_dot(self, psi_d: float, psi_z: float | None = None,
                 r_z: float | None = None) -> float:
