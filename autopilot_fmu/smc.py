@@ -52,6 +52,16 @@ H_MAX = 0.1
 EQUIVALENT_CONTROLS = ("paper", "tracking")
 
 
+def reference_step_bound(omega_n: float, zeta: float) -> float:
+    """The largest RK4 step of the reference model (44), s.
+
+    RK4 stays accurate and stable with |lambda| h <= 1 on the model's fastest eigenvalue;
+    with the paper's omega_n and zeta that is H_MAX itself.
+    """
+    fastest = omega_n * (zeta + math.sqrt(max(zeta * zeta - 1.0, 0.0)))
+    return H_MAX if fastest * H_MAX <= 1.0 else 1.0 / fastest
+
+
 @dataclass(frozen=True)
 class SlidingModeDesign:
     """Gains of the sliding-mode autopilot for a Nomoto model, eqs (38)-(41)."""
@@ -144,10 +154,7 @@ class SlidingModeAutopilot:
         self.tracking = equivalent_control == "tracking"
         self.eta_h, self.phi_h, self.omega_n, self.zeta = eta_h, phi_h, omega_n, zeta
         self.psi_z, self.r_z = psi_z, r_z
-        # RK4 stays accurate and stable with |lambda| h <= 1 on the reference model's
-        # fastest eigenvalue; with the paper's omega_n and zeta that is H_MAX itself.
-        fastest = omega_n * (zeta + math.sqrt(max(zeta * zeta - 1.0, 0.0)))
-        self._h_max = H_MAX if fastest * H_MAX <= 1.0 else 1.0 / fastest
+        self._h_max = reference_step_bound(omega_n, zeta)
 
     def r_z_dot(self, psi_d: float, psi_z: float | None = None,
                 r_z: float | None = None) -> float:

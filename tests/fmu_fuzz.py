@@ -35,6 +35,7 @@ from hypothesis import strategies as st
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from autopilot_fmu.smc import reference_step_bound  # noqa: E402
 from cosim.core.fmi import FmuInstance  # noqa: E402
 from cosim.core.instance import FmuCallError  # noqa: E402
 from fmukit.timebase import MAX_TIME  # noqa: E402
@@ -224,8 +225,7 @@ def _largest_internal_step(e: Expectation) -> float:
     if "h_max" in e.values:
         return e.values["h_max"]
     if "omega_n" in e.values:
-        w, z = e.values["omega_n"], e.values["zeta"]
-        return min(0.1, 1.0 / (w * (z + math.sqrt(max(z * z - 1.0, 0.0)))))
+        return reference_step_bound(e.values["omega_n"], e.values["zeta"])
     return math.inf
 
 

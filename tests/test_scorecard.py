@@ -4,6 +4,8 @@ from __future__ import annotations
 import re
 
 from cosim import score as cli
+from cosim import simulate
+from cosim.analysis.cost import cost
 
 
 def _rows(text: str, heading: str) -> dict[str, list[str]]:
@@ -60,4 +62,5 @@ def test_an_autopilot_that_fails_is_scored_as_failed_and_the_rest_goes_on(tmp_pa
     assert _rows(text, "## Wave ensemble")["idle_pilot"][-1] == "0/1"
     assert "- idle_pilot, calm water: `FMU 'autopilot': doStep at t = 150 s returned " \
            "fatal`" in text
-    assert _rows(text, "## The paper's route")["PD"][2] == "200.3"   # the others still run
+    calm_pd = cost(simulate("calm_pd", backend="inprocess")).J      # the others still run
+    assert _rows(text, "## The paper's route")["PD"][2] == f"{calm_pd:.1f}"
