@@ -17,6 +17,7 @@ from pathlib import Path
 
 from ._cli import add_port_options, checked_autopilot, entry, setting_option, writable_folder
 from .studies.scorecard import backend_notes, score
+from .studies.sweep import NoWorkers
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -76,6 +77,10 @@ def main(argv: list[str] | None = None) -> int:
         bar.close()
         print(f"error: {error}", file=sys.stderr)
         return 1
+    except NoWorkers as stopped:
+        bar.close()
+        print(f"{stopped}: no scorecard written", file=sys.stderr)
+        return stopped.exit_status
     bar.close()
     print(text)
     print(f"wrote {out / 'scorecard.md'} and its figures in {time.perf_counter() - started:.0f} s")

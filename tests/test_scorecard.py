@@ -64,3 +64,15 @@ def test_an_autopilot_that_fails_is_scored_as_failed_and_the_rest_goes_on(tmp_pa
            "fatal`" in text
     calm_pd = cost(simulate("calm_pd", backend="inprocess")).J      # the others still run
     assert _rows(text, "## The paper's route")["PD"][2] == f"{calm_pd:.1f}"
+
+
+def test_a_scorecard_left_without_workers_says_so_and_exits_3(fmu_paths, tmp_path, capsys,
+                                                              monkeypatch):
+    from cosim.studies.sweep import NoWorkers
+
+    def no_workers(*args, **kwargs):
+        raise NoWorkers("no worker in the cluster for 60 s (none has joined since 12:00:00)")
+    monkeypatch.setattr(cli, "score", no_workers)
+    assert cli.main([str(fmu_paths["pd_autopilot"]), "--out", str(tmp_path / "s")]) == 3
+    assert "no worker in the cluster for 60 s (none has joined since 12:00:00): no " \
+           "scorecard written" in capsys.readouterr().err
