@@ -1,7 +1,7 @@
 """How large are the set-up's own numerical errors? RK4 against DOP853, co-simulation
 against a monolithic model with the controller inside the solver.
 
-    python -m cosim.accuracy            # the full study, about 3-5 minutes on 2 cores
+    python -m cosim.accuracy            # the full study, about a minute on 2 cores
     python -m cosim.accuracy --quick    # shorter runs and fewer steps (CI)
     python -m cosim.accuracy --cpus     # every scenario as other CPUs would run it, about
                                         # 20 s: numpy, OpenBLAS and libm variants, bit for bit
