@@ -5,8 +5,8 @@ Examples:
   python -m cosim.run waves_smc --out /tmp/w   the sliding-mode autopilot in waves
   python -m cosim.run calm_pd --set ship.Hs=0.003 --set autopilot.Kd=30
   python -m cosim.run --all                    the paper's four runs, Tables 1-2
-  python -m cosim.run --all --spread           ... with each figure's range under last-bit
-                                               perturbations (as docs/reproduction.md)
+  python -m cosim.run --all --spread           ... with how far one last bit moves each
+                                               figure (as docs/reproduction.md)
   python -m cosim.run waves_pd --autopilot my.fmu   your own autopilot in waves_pd's place
 
 Each scenario is an SSP system structure file in cosim/scenarios/ (the FMUs, their
@@ -176,8 +176,8 @@ def main(argv: list[str] | None = None) -> int:
                              f"{' and then '.join('.'.join(p) for p in PERTURBED)} moved by "
                              "1 ... ULPS units in the last place either way (4 ULPS more "
                              "runs, in-process; ULPS = 20 if not given, as in the published "
-                             "tables) and print the range of psi_E, delta_E and J where it "
-                             "is wider than the printed digits")
+                             "tables) and print how far that moves psi_E, delta_E and J "
+                             "(the largest change), where it shows at the printed digits")
     parser.add_argument("--stream", action="store_true",
                         help="write rows to the CSV in chunks as the run goes: flat memory "
                              "for long runs (--stop-time 86400); no report or figure")
@@ -200,7 +200,7 @@ def main(argv: list[str] | None = None) -> int:
         parser.error("--animate mp4 needs ffmpeg, which is not installed here; use gif")
     options = Options(args.coupling, args.stop_time, args.lam, args.backend,
                       not args.no_plot, ("png", *args.figure_format), args.stream, args.animate)
-    status, costs, ranges = 0, {}, {}
+    status, costs, spreads = 0, {}, {}
     perturbed = ", ".join(".".join(p) for p in PERTURBED)
     for run in runs_asked(names, args.all, args.autopilot, args.name):
         out = args.out or Path("results") / run.label
@@ -229,16 +229,17 @@ def main(argv: list[str] | None = None) -> int:
                 print(f"error: {error}", file=sys.stderr)
                 status = max(status, 1)
             else:
-                print(f"  range over {ensemble.runs} runs ({perturbed} moved by up to "
-                      f"{args.spread} ulp): {ensemble.describe()}")
-                ranges[run.table_row] = ensemble.describe()
+                print(f"  last-bit spread over {ensemble.runs} runs ({perturbed} moved by up "
+                      f"to {args.spread} ulp): {ensemble.describe()}")
+                spreads[run.table_row] = ensemble.describe()
         if result is not None and run.table_row is not None:
             costs[run.table_row] = result
     if args.all and costs:
         print()
-        print(tables(costs, ranges, f"Range of each figure over {4 * (args.spread or 0) + 1} "
-                                    f"runs, {perturbed} moved by up to {args.spread} ulp "
-                                    "(min-max, where wider than the printed digits)"))
+        print(tables(costs, spreads, f"How far one last bit moves each figure (the largest "
+                                    f"change over {4 * (args.spread or 0) + 1} runs, "
+                                    f"{perturbed} moved by up to {args.spread} ulp; where "
+                                    "it shows at the printed digits)"))
     return status
 
 

@@ -226,31 +226,29 @@ def test_all_prints_tables_1_and_2_beside_the_paper(tmp_path, capsys):
 
 
 def _check_published(cell: str, value: str) -> None:
-    """'201.56' equals the printed value; '201.56 (199.86-202.19)' is the run's value and
-    the range of a perturbation ensemble (cosim.run --all --spread): the printed value,
-    rounded the same way on any CPU, lies inside it."""
-    number, low, high = re.fullmatch(r"([\d.]+)(?: \(([\d.]+)-([\d.]+)\))?",
-                                     cell.strip()).groups()
-    if low is None:
+    """'201.56' equals the printed value; '201.56 ± 1.77' is the run's value and how far one
+    last bit moves it (cosim.run --all --spread): the value printed on this CPU, or on one
+    whose C library rounds a sin differently, lies within it."""
+    number, change = re.fullmatch(r"([\d.]+)(?: ± ([\d.]+))?", cell.strip()).groups()
+    if change is None:
         assert number == value
     else:
-        assert float(low) <= float(value) <= float(high), (cell, value)
+        assert abs(float(value) - float(number)) <= float(change), (cell, value)
 
 
-@pytest.mark.parametrize("name", PAPER)
-def test_the_published_ranges_hold_a_small_ensemble(name):
-    """The members moved by up to 2 ulps are among the published 20-ulp ensemble's: their
-    range lies within the published one, or rounds to the printed value where none is."""
-    from cosim.studies.spread import spread
+def test_the_spread_of_a_run_is_how_far_a_last_bit_moves_it():
+    """Calm water amplifies no last bit; the chattering SMC in waves does, within 60 s."""
+    from cosim.studies.spread import nudged, spread
 
-    rows = dict(zip(PAPER, re.findall(
-        r"^\| (?:PD|SMC) controller \| ([^|]+) \| ([^|]+) \| ([^|]+) \|",
-        (ROOT / "docs" / "reproduction.md").read_text(), re.M)))
-    ranges = spread(system(name), ulps=2).ranges
-    for cell, figure in zip(rows[name], ("psi_E", "delta_E", "J")):
-        low, high = ranges[figure]
-        _check_published(cell, f"{low:.2f}")
-        _check_published(cell, f"{high:.2f}")
+    assert nudged(0.3, 2) == math.nextafter(math.nextafter(0.3, 1.0), 1.0)
+    assert nudged(math.pi, -1) == math.nextafter(math.pi, 0.0)
+    calm = spread(system("calm_pd"), ulps=1, stop_time=60.0)
+    assert calm.runs == 5 and calm.describe() == "every figure as printed"
+    waves = spread(system("waves_smc"), ulps=1, stop_time=60.0)
+    assert waves.runs == 5 and max(waves.deviation.values()) > 0.0
+    assert all(waves.nominal[f] - waves.deviation[f] > 0.0 for f in ("psi_E", "J"))
+    with pytest.raises(ValueError, match="ulps must be >= 1"):
+        spread(system("calm_pd"), ulps=0)
 
 
 def test_stop_time_and_set_reach_the_fmus(tmp_path):

@@ -62,13 +62,13 @@ def _label(sea: str, controller: str) -> str:
 
 
 def tables(costs: dict[tuple[str, str], Cost],
-           ranges: dict[tuple[str, str], str] | None = None, ranges_title: str = "") -> str:
+           spreads: dict[tuple[str, str], str] | None = None, spreads_title: str = "") -> str:
     """Tables 1 and 2 of the paper next to ours; ``costs`` by (sea, controller).
 
     The sea is "calm" or "waves"; the controllers "pd" and "smc" are the paper's and
     get its values beside ours, any other (a user's autopilot) gets a row of its own.
-    ``ranges``: what a perturbation ensemble says of each row (``cosim.studies.spread``),
-    printed below the tables under ``ranges_title``.
+    ``spreads``: what a perturbation ensemble says of each row (``cosim.studies.spread``),
+    printed below the tables under ``spreads_title``.
     """
     lines = []
     for title, sea in (("Table 1, calm water", "calm"), ("Table 2, waves", "waves")):
@@ -85,8 +85,8 @@ def tables(costs: dict[tuple[str, str], Cost],
     lam = next(iter(costs.values())).lam if costs else LAMBDA
     lines.append(f"  (lambda = {lam:.4f}, delta_E = lambda * sum delta^2; sums over the "
                  "0.1 s samples, rad^2)")
-    if ranges:
-        lines.append(f"{ranges_title}:")
+    if spreads:
+        lines.append(f"{spreads_title}:")
         lines += [f"  {sea} {_label(sea, controller)}: {text}"
-                  for (sea, controller), text in ranges.items()]
+                  for (sea, controller), text in spreads.items()]
     return "\n".join(lines)

@@ -7,9 +7,9 @@ moves a run by as much. The ensemble here makes that size visible: the run itsel
 and the same run with one parameter moved by k units in the last place (ulp),
 k = +-1 ... +-ulps: the ship's initial surge speed u0 (a change that the run then
 carries), and the direction the waves travel to psi_w (a change to the wave loads at
-every step, as a C library's sin that rounds differently makes). The range of each figure of eq (19) over it is
-the precision a published figure of that run has; a figure whose range rounds to one
-printed value is exact at the printed digits.
+every step, as a C library's sin that rounds differently makes). The largest change
+of each figure of eq (19) over it is the precision a published figure of that run
+has; a figure that no member moves at the printed digits is exact there.
 
 Members run on the in-process backend (the same bits as through FMI, faster); a
 component that cannot runs through FMI.
@@ -39,22 +39,29 @@ def nudged(value: float, ulps: int) -> float:
 
 @dataclass(frozen=True)
 class Spread:
-    """The range of each figure of eq (19) over a perturbation ensemble."""
+    """How far one last bit moves each figure of eq (19): the run's value and the largest
+    change from it over a perturbation ensemble.
+
+    The largest change, not the ensemble's range: a member is one more draw of a chaotic
+    run, the run itself may lie at either end of what such draws give (waves_smc's delta_E
+    does: no member exceeds it), and another CPU's run may diverge from it in either
+    direction.
+    """
 
     runs: int
     ulps: int                       # each member moved one parameter by -ulps ... +ulps
-    ranges: dict[str, tuple[float, float]]      # figure: (min, max)
+    nominal: dict[str, float]       # figure: the unperturbed run's value
+    deviation: dict[str, float]     # figure: the largest |member - nominal|
 
     def wider_than(self, figure: str, digits: int = 2) -> bool:
-        """Whether the range of ``figure`` shows at ``digits`` decimals."""
-        low, high = self.ranges[figure]
-        return f"{low:.{digits}f}" != f"{high:.{digits}f}"
+        """Whether value +- deviation shows at ``digits`` decimals."""
+        value, change = self.nominal[figure], self.deviation[figure]
+        return f"{value - change:.{digits}f}" != f"{value + change:.{digits}f}"
 
     def describe(self, digits: int = 2) -> str:
-        """'psi_E 467.07-486.88, J 592.29-619.61', or 'every figure as printed'."""
-        wide = [f"{figure} {low:.{digits}f}-{high:.{digits}f}"
-                for figure, (low, high) in self.ranges.items()
-                if self.wider_than(figure, digits)]
+        """'psi_E 472.76 +- 18.67, J 612.45 +- 20.18', or 'every figure as printed'."""
+        wide = [f"{f} {self.nominal[f]:.{digits}f} +- {self.deviation[f]:.{digits}f}"
+                for f in FIGURES if self.wider_than(f, digits)]
         return ", ".join(wide) if wide else "every figure as printed"
 
 
@@ -63,7 +70,7 @@ def spread(system: SystemDescription, overrides: dict[str, dict[str, Any]] | Non
            stop_time: float | None = None,
            progress: Callable[[int, int], None] | None = None) -> Spread:
     """The run and 2 ulps runs for each of ``PERTURBED``, its value moved by -ulps ...
-    +ulps; the range of eq (19) over them.
+    +ulps; how far they move each figure of eq (19) from the run's.
 
     ValueError if ulps < 1 or the system lacks a perturbed parameter; RuntimeError
     naming the member if a run fails.
@@ -99,6 +106,6 @@ def spread(system: SystemDescription, overrides: dict[str, dict[str, Any]] | Non
                 progress(i + 1, len(members))
     finally:
         master.free()
-    ranges = {f: (min(getattr(c, f) for c in costs), max(getattr(c, f) for c in costs))
-              for f in FIGURES}
-    return Spread(len(costs), ulps, ranges)
+    nominal = {f: getattr(costs[0], f) for f in FIGURES}
+    deviation = {f: max(abs(getattr(c, f) - nominal[f]) for c in costs) for f in FIGURES}
+    return Spread(len(costs), ulps, nominal, deviation)
