@@ -14,8 +14,10 @@ attributes alone), ``step_model`` and, if the initial state depends on inputs,
   value references (``plans``, which a host in the same process may call);
 - ``fmukit.state``: saving and restoring the whole state (serialisable);
 - ``fmukit.model_description``: a complete modelDescription.xml;
-- ``fmukit.entry``: every FMI entry point made safe against pythonfmu 0.7's error path;
-- ``fmukit.signals``: the host's Ctrl-C handled in the host's code, not inside the FMU.
+- ``fmukit.refusals``: how a call is refused, and the message that says why;
+- ``fmukit.pythonfmu07``: pythonfmu, and what is owed to version 0.7.0's defects (every
+  FMI entry point made safe against its error path; the host's Ctrl-C handled in the
+  host's code, not inside the FMU; its messages heard without a flag).
 
 What a host sees. pythonfmu 0.7 can return fmi2OK, fmi2Fatal (any Python
 exception) and fmi2Discard with fmi2Terminated true (do_step returning False),
@@ -39,7 +41,7 @@ only failure status there is to give (docs/robustness.md argues it):
 
 The reason, beginning with the FMU's instance name, reaches the user through the
 host's logger when it listens, and on standard error when it does not
-(``fmukit.hostlog``).
+(``fmukit.pythonfmu07.hostlog``).
 
 Time is rounded to whole nanoseconds before the model sees it (``fmukit.timebase``).
 """
@@ -48,14 +50,12 @@ from __future__ import annotations
 from typing import Any, Callable, ClassVar, NoReturn
 from xml.etree.ElementTree import Element
 
-from pythonfmu import DefaultExperiment, Fmi2Slave
-from pythonfmu.enums import Fmi2Status
-
 from . import model_description, state
-from . import signals
-from .entry import Refused, explain, fmi_entry, naming
 from .fastpath import FastPaths
-from .hostlog import HostLog
+from .pythonfmu07 import DefaultExperiment, Fmi2Slave, Fmi2Status, signals
+from .pythonfmu07.entry import fmi_entry
+from .pythonfmu07.hostlog import HostLog
+from .refusals import Refused, explain, naming
 from .registry import Registry
 from .sequence import CallSequence
 from .timebase import MAX_TIME, on_time_base
@@ -197,7 +197,7 @@ class ModelSlave(Fmi2Slave):
     def interrupted(self, where: str, error: BaseException) -> Refused:
         """Fail the FMU for a KeyboardInterrupt (or any BaseException) raised in its code
         while the host called ``where``, and return the refusal to raise. (Rare: the
-        host's signal handlers wait until FMU code returns, ``fmukit.signals``.)"""
+        host's signal handlers wait until FMU code returns, ``fmukit.pythonfmu07.signals``.)"""
         number = signals.interrupt_signal(error)
         cause = f"interrupted by {number.name}" if number else explain(error)
         self.failure = self.failure or f"{where}: {cause}; the FMU has failed"

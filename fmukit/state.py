@@ -43,7 +43,7 @@ def decode(data: bytes) -> dict[str, Any]:
     """A serialised state, or ``{"invalid": why}`` for ``restore`` to refuse.
 
     pythonfmu calls the decoder on the class, where an exception cannot be made
-    safe (``fmukit.entry``): the problem travels in the state instead.
+    safe (``fmukit.pythonfmu07.entry``): the problem travels in the state instead.
     """
     try:
         decoded = json.loads(data.decode("utf-8"))

@@ -6,8 +6,10 @@ from pathlib import Path
 
 import pytest
 
-from fmukit.cbuild import C_FMUS, build_c, c_compiler
-from fmukit.packaging import FMU_DIR, FMUS, ROOT, build
+from fmubuild.cbuild import build_c, c_compiler
+from fmubuild.manifest import read, staleness
+from fmubuild.packaging import build
+from fmubuild.project import C_FMUS, FMU_DIR, FMUS, ROOT
 
 pytest_plugins = ["pytester"]       # to run the example test file for each autopilot
 
@@ -25,23 +27,29 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
             item.add_marker(pytest.mark.timeout(HARD_LIMIT, method="thread"))
 
 
-def _stale(name: str, sources: list[Path]) -> bool:
-    fmu = FMU_DIR / f"{name}.fmu"
+def _stale(path: Path) -> bool:
+    """Missing, built without a manifest, or not current: a module it carries differs
+    from this checkout's."""
+    manifest = read(path) if path.exists() else None
+    return manifest is None or staleness(manifest) is not None
+
+
+def _older(fmu: Path, sources: list[Path]) -> bool:
     return not fmu.exists() or max(p.stat().st_mtime for p in sources) > fmu.stat().st_mtime
 
 
 @pytest.fixture(scope="session")
 def fmu_paths() -> dict[str, Path]:
-    """Every FMU in fmus/, rebuilt first if missing or older than its sources (the C FMU
-    only where there is a C compiler)."""
-    for name, (script, packages) in FMUS.items():
-        if _stale(name, [ROOT / script] + [p for pkg in packages
-                                           for p in (ROOT / pkg).rglob("*.py")]):
+    """Every FMU in fmus/, rebuilt first if missing or not current (its manifest against
+    the sources; the C FMU, which has none, by file times, and only where there is a C
+    compiler)."""
+    for name in FMUS:
+        if _stale(FMU_DIR / f"{name}.fmu"):
             build(name)
     built = list(FMUS)
     if c_compiler() is not None:
         for name, folder in C_FMUS.items():
-            if _stale(name, list((ROOT / folder).iterdir())):
+            if _older(FMU_DIR / f"{name}.fmu", list((ROOT / folder).iterdir())):
                 build_c(name)
         built += list(C_FMUS)
     return {name: FMU_DIR / f"{name}.fmu" for name in built}

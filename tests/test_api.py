@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from cosim import SimulationError, simulate
-from fmukit.packaging import ROOT, build_script
+from fmubuild.packaging import build_script
+from fmubuild.project import ROOT
 
 EXAMPLE = ROOT / "docs" / "own_autopilot" / "test_my_autopilot.py"
 
@@ -32,7 +33,7 @@ def test_simulate_in_process_gives_the_same_run_and_warns_for_a_foreign_fmu(fmu_
     assert inprocess.meta["backends"]["ship"] == "inprocess"
     np.testing.assert_array_equal(fmi.data, inprocess.data)
     with pytest.warns(UserWarning, match=r"autopilot \(pd_autopilot_c\.fmu\) runs through FMI, "
-                                         r"not in-process: its model 'pd_autopilot_c'"):
+                                         r"not in-process: it was not built with fmukit"):
         mixed = simulate("waves_pd", stop_time=30, backend="inprocess", autopilot=c_autopilot)
     assert mixed.meta["backends"] == {"guidance": "inprocess", "autopilot": "fmi",
                                       "ship": "inprocess"}

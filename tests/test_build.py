@@ -14,8 +14,8 @@ from cosim import scenarios
 from cosim.core.master import Master
 from cosim.interop.engines import run as run_engine
 from cosim.interop.ssp import export
-from fmukit import build as cli
-from fmukit.packaging import ROOT
+from fmubuild import cli
+from fmubuild.project import ROOT
 
 
 def _run(scenario: str, autopilot: Path | None = None, coupling: str = "gauss-seidel"):

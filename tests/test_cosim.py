@@ -21,7 +21,7 @@ from cosim.core import ssd
 from cosim.core.ssd import read_ssd, write_ssd
 from cosim.core.wiring import WiringError
 from cosim.studies.direct import SIGNALS, run_direct
-from fmukit.packaging import ROOT
+from fmubuild.project import ROOT
 from helpers import fmu_variant
 
 SCENARIOS = scenarios.SCENARIO_DIR
@@ -108,41 +108,41 @@ def test_fmi_and_inprocess_backends_agree_bit_for_bit(name):
         assert set(inprocess.meta["backends"].values()) == {"inprocess"}, inprocess.meta["notes"]
 
 
-def test_only_our_fmus_as_built_from_this_checkout_run_in_process(fmu_paths, tmp_path):
+def test_only_fmus_current_in_this_process_run_in_process(fmu_paths, tmp_path, monkeypatch):
     from cosim.core.inprocess import in_process_refusal
+    from fmubuild.packaging import build_script
+
     ship = fmu_paths["ship"]
     assert in_process_refusal(ship) is None
     # by content, whatever the file's name (a sweep's worker names them by hash)
     assert in_process_refusal(shutil.copy(ship, tmp_path / "0a1b2c.fmu")) is None
     edited = fmu_variant(ship, tmp_path / "edited.fmu", edit={
         "resources/ship_fmu/hull.py": lambda text: text + "\n# changed\n"})
-    assert "other sources than this process runs (ship_fmu/hull.py differs" in \
-        in_process_refusal(edited)
+    assert in_process_refusal(edited) == "its ship_fmu/hull.py is not the source its manifest lists"
     renamed = fmu_variant(ship, tmp_path / "renamed.fmu",
                           lambda xml: xml.replace('name="delta_c"', 'name="rudder"'))
-    assert "its ModelVariables differ from those of this project's 'ship'" in \
-        in_process_refusal(renamed)
+    assert in_process_refusal(renamed) == ("its ModelVariables differ from those its class "
+                                           "ship_fmu.ship_slave.ShipSlave declares")
     other = fmu_variant(ship, tmp_path / "other.fmu",
                         lambda xml: xml.replace('modelName="ship"', 'modelName="tanker"'))
-    assert in_process_refusal(other) == "its model 'tanker' is not one of this project's " \
-                                        "Python FMUs"
-    # someone's copy of our slave script, keeping our model name (a user's own PID, say)
-    pid = fmu_paths["pid_autopilot"]
-    copied = tmp_path / "my_pid.fmu"
-    with zipfile.ZipFile(pid) as original, zipfile.ZipFile(copied, "w") as copy:
-        for info in original.infolist():
-            data = original.read(info)
-            if info.filename == "resources/slavemodule.txt":
-                data = b"my_pid"
-            copy.writestr(info.filename.replace("pid_autopilot_slave.py", "my_pid.py"), data)
-    assert in_process_refusal(copied) == ("its slave is my_pid.py, not this project's "
-                                          "pid_autopilot_slave.py (another FMU of the name "
-                                          "'pid_autopilot')")
+    assert in_process_refusal(other) == ("its model description names the model 'tanker', its "
+                                         "manifest 'ship'")
     extra = tmp_path / "extra.fmu"
-    shutil.copy(pid, extra)
+    shutil.copy(fmu_paths["pid_autopilot"], extra)
     with zipfile.ZipFile(extra, "a") as fmu:
         fmu.writestr("resources/tuning.py", "GAIN = 0.5\n")
-    assert in_process_refusal(extra).startswith("it carries tuning.py, which this project's")
+    assert in_process_refusal(extra) == "it carries tuning.py, which its manifest does not list"
+    assert in_process_refusal(fmu_paths["pd_autopilot_c"]) == ("it was not built with fmukit "
+                                                               "(it has no manifest)")
+    # a user's FMU built with fmukit qualifies too, where its sources are importable
+    script = shutil.copy(ROOT / "autopilot_fmu" / "pid_autopilot_slave.py", tmp_path / "my_pid.py")
+    mine = build_script(Path(script), ("fmukit",), tmp_path / "out" / "my_pid.fmu")
+    assert in_process_refusal(mine) == "its module my_pid is not importable here"
+    monkeypatch.syspath_prepend(str(tmp_path))
+    assert in_process_refusal(shutil.copy(mine, tmp_path / "mine.fmu")) is None
+    Path(script).write_text(Path(script).read_text() + "\n# tuned\n")
+    assert in_process_refusal(shutil.copy(mine, tmp_path / "tuned.fmu")).startswith(
+        f"its my_pid differs from {script} (built before a change: rebuild it)")
     master = Master(system("calm_pd"), backend="inprocess")
     try:
         assert master.backends == dict.fromkeys(["guidance", "autopilot", "ship"], "inprocess")

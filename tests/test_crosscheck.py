@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fmukit.crosscheck import CASES, files, read_opt
+from fmubuild.crosscheck import CASES, files, read_opt
 from helpers import fmpy_cli
 
 

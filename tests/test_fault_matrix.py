@@ -42,7 +42,8 @@ import pytest
 
 from cosim.core.ssd import Component, Connection, SystemDescription, write_ssd
 from cosim.interop.ssp import export
-from fmukit.packaging import ROOT, build_script
+from fmubuild.packaging import build_script
+from fmubuild.project import ROOT
 
 FAULTS = ("nan", "range", "parameter", "exception", "sigint", "sigterm", "corrupt")
 HOSTS = ("master-fmi", "master-inprocess", "fmpy-cli", "fmpy-api", "fmpy-ssp",

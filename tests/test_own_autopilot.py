@@ -178,7 +178,8 @@ def test_the_in_process_backend_runs_a_foreign_fmu_through_fmi_and_says_so(forei
                 "--backend", "inprocess", "--stop-time", "20") == 0
     err = capsys.readouterr().err
     assert ("note: autopilot (heading_pilot.fmu) runs through FMI, not in-process: its "
-            "ModelVariables differ from those of this project's 'pid_autopilot'") in err
+            "ModelVariables differ from those its class "
+            "autopilot_fmu.pid_autopilot_slave.PIDAutopilotSlave declares") in err
     meta = json.loads(next(tmp_path.glob("*.json")).read_text())
     assert meta["backends"] == {"guidance": "inprocess", "autopilot": "fmi",
                                 "ship": "inprocess"}

@@ -20,7 +20,8 @@ from cosim.core.master import Master
 from cosim.core.ssd import Component, Connection, SystemDescription, write_ssd
 from cosim.interop.engines import run as run_engine
 from cosim.interop.ssp import export
-from fmukit.packaging import ROOT, build_script
+from fmubuild.packaging import build_script
+from fmubuild.project import ROOT
 from fmukit.timebase import communication_point
 
 # Inputs that drive each FMU through something worth restoring, by step k.
@@ -237,7 +238,7 @@ def test_a_host_that_loaded_an_fmu_exits_with_its_heap_intact(fmu_paths, exit_he
 
 def test_without_the_exit_fix_the_same_host_aborts(fmu_paths, exit_heap_host, tmp_path):
     """The check above can fail: pythonfmu 0.7.0's own binary corrupts the heap at exit."""
-    from fmukit.exit_fix import KNOWN_BINARIES
+    from fmukit.pythonfmu07.binary import KNOWN_BINARIES
 
     known = next(iter(KNOWN_BINARIES.values()))
     offset, original, patched = known.offset, known.code, known.patched
@@ -254,7 +255,7 @@ def test_without_the_exit_fix_the_same_host_aborts(fmu_paths, exit_heap_host, tm
 
 
 def test_the_exit_fix_refuses_a_binary_it_does_not_know():
-    from fmukit.exit_fix import patch
+    from fmubuild.exit_fix import patch
 
     with pytest.raises(RuntimeError, match="ship.so is not the pythonfmu 0.7.0 linux64 binary"):
         patch(b"\x7fELF something else", "ship.fmu:binaries/linux64/ship.so")

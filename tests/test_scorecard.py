@@ -45,7 +45,8 @@ def test_the_scorecard_refuses_a_file_that_is_not_an_autopilot(tmp_path, capsys)
 
 
 def test_an_autopilot_that_fails_is_scored_as_failed_and_the_rest_goes_on(tmp_path, capsys):
-    from fmukit.packaging import ROOT, build_script
+    from fmubuild.packaging import build_script
+    from fmubuild.project import ROOT
 
     failing = build_script(ROOT / "tests" / "faulty" / "idle_pilot_slave.py", ("fmukit",),
                            tmp_path / "idle_pilot.fmu")
@@ -54,7 +55,7 @@ def test_an_autopilot_that_fails_is_scored_as_failed_and_the_rest_goes_on(tmp_pa
                      "--workers", "1", "--out", str(out), "--backend", "inprocess"]) == 0
     err = capsys.readouterr().err
     assert ("note: controller 'idle_pilot': autopilot (idle_pilot.fmu) runs through FMI, not "
-            "in-process: its model 'idle_pilot' is not one of this project's Python FMUs") in err
+            "in-process: its module idle_pilot_slave is not importable here") in err
     assert err.count("note:") == 1
     text = (out / "scorecard.md").read_text()
     assert _rows(text, "## The paper's route")["idle_pilot"][:6] == ["failed"] * 6

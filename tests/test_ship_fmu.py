@@ -162,9 +162,9 @@ def test_the_fmu_runs_on_its_bundled_code_alone(fmu_paths, tmp_path):
         import fmpy
         result = fmpy.simulate_fmu({str(fmu_paths['ship'])!r}, stop_time=5.0,
                                    start_values={{"Hs": 0.005}})
-        import ship_fmu, fmukit
-        print(ship_fmu.__file__)
-        print(fmukit.__file__)
+        import ship_fmu.vessel, fmukit.slave
+        print(ship_fmu.vessel.__file__)
+        print(fmukit.slave.__file__)
         print(result["u"][-1])
     """)
     out = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True,

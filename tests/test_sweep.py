@@ -131,8 +131,8 @@ def test_an_in_process_sweep_notes_each_fmu_that_runs_through_fmi(c_autopilot, t
                                                 f'c = "{c_autopilot}"\n[axes]\nwave_seed = [1]\n'))
     assert spec.backend_notes("fmi") == []
     assert spec.backend_notes("inprocess") == [
-        "controller 'c': autopilot (pd_autopilot_c.fmu) runs through FMI, not in-process: its "
-        "model 'pd_autopilot_c' is not one of this project's Python FMUs"]
+        "controller 'c': autopilot (pd_autopilot_c.fmu) runs through FMI, not in-process: it "
+        "was not built with fmukit (it has no manifest)"]
     with pytest.raises(ValueError, match="backend must be fmi or inprocess, got 'null'"):
         sweep.execute(spec, tmp_path, backend="null")
     # a row says how its components ran, not only what was asked

@@ -18,8 +18,8 @@ from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFr
                        fmi2True, fmi2ValueReference)
 from fmpy.model_description import ModelDescription
 
-from fmukit.entry import Refused, unnamed
-from fmukit.packaging import BUILD_HINT, FMUS
+from fmubuild.project import BUILD_HINT, FMUS
+from fmukit.refusals import Refused, unnamed
 
 from .instance import FmuCallError, Instance, logged_error
 

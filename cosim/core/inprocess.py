@@ -1,8 +1,9 @@
 """The master's in-process backend: the FMUs' Python classes, called without FMI.
 
 An ``InProcessInstance`` has the same interface as ``cosim.core.fmi.FmuInstance`` but
-instantiates the slave class an FMU was built from (``fmukit.packaging.FMUS``) in this
-process and calls its methods directly. A run on this backend differs from a
+instantiates the slave class an FMU built with fmukit was made from (its manifest,
+``fmubuild.manifest``) in this process and calls its methods directly; the FMU must
+be current here: the modules it carries are the ones this process imports. A run on this backend differs from a
 co-simulation only by the FMI layer (C wrapper, fmpy, ctypes), which is what the
 equality tests compare: every column of every row is the same, bit for bit.
 
@@ -17,8 +18,8 @@ value refuses the run with the same message as through FMI.
 """
 from __future__ import annotations
 
+import hashlib
 import importlib
-import inspect
 import re
 import zipfile
 from dataclasses import dataclass
@@ -27,8 +28,10 @@ from pathlib import Path
 from typing import Any
 from xml.etree import ElementTree
 
-from fmukit.entry import explain, unguarded, unnamed
-from fmukit.packaging import BUILD_HINT, FMUS, ROOT
+from fmubuild.manifest import Manifest, read, staleness
+from fmubuild.project import BUILD_HINT, FMUS
+from fmukit.pythonfmu07.entry import unguarded
+from fmukit.refusals import explain, unnamed
 from fmukit.slave import ModelSlave
 
 from .instance import FmuCallError, Instance, logged_error
@@ -45,22 +48,18 @@ class VariableInfo:
     unit: str
 
 
-def slave_class(fmu_name: str) -> type[ModelSlave]:
-    """The ModelSlave subclass that this project's FMU ``fmu_name`` is built from."""
-    if fmu_name not in FMUS:
-        raise ValueError(f"no FMU named '{fmu_name}' is built by this project "
-                         f"(known: {', '.join(FMUS)})")
-    module_name = FMUS[fmu_name][0].removesuffix(".py").replace("/", ".")
-    module = importlib.import_module(module_name)
-    return next(cls for _, cls in inspect.getmembers(module, inspect.isclass)
-                if issubclass(cls, ModelSlave) and getattr(cls, "model_name", None) == fmu_name)
+def slave_class(manifest: Manifest) -> type[ModelSlave]:
+    """The slave class an FMU's manifest names, imported in this process."""
+    module = importlib.import_module(manifest.slave_module)
+    return getattr(module, manifest.slave_class)
 
 
 def in_process_refusal(path: str | Path) -> str | None:
-    """Why the FMU at ``path`` cannot run in-process, or None if it can: it must be one
-    this project builds (by its modelName, whatever its file name), declare the
-    variables, units and dependencies its class declares, and carry the same Python
-    sources this process runs, so that both routes compute the same."""
+    """Why the FMU at ``path`` cannot run in-process, or None if it can: it must be built
+    with fmukit (a manifest), hold what its manifest lists, declare the variables, units
+    and dependencies its class declares, and be current here (the modules it carries
+    are those this process imports, ``fmubuild.manifest.staleness``), so that both
+    routes compute the same."""
     path = Path(path)
     stat = path.stat()
     key = (path.resolve(), stat.st_size, stat.st_mtime_ns)
@@ -82,41 +81,50 @@ def fallback_note(name: str, path: str | Path) -> str | None:
 
 def _refusal(path: Path) -> str | None:
     try:
+        manifest = read(path)
+        if manifest is None:
+            return "it was not built with fmukit (it has no manifest)"
         with zipfile.ZipFile(path) as fmu:
             declared = ElementTree.fromstring(fmu.read("modelDescription.xml"))
-            name = declared.get("modelName")
-            if name not in FMUS:
-                return f"its model '{name}' is not one of this project's Python FMUs"
-            ours = slave_class(name)(instance_name=name).to_xml()
+            if declared.get("modelName") != manifest.model_name:
+                return (f"its model description names the model '{declared.get('modelName')}', "
+                        f"its manifest '{manifest.model_name}'")
+            refusal = _contents_refusal(fmu, manifest)
+        rebuild = BUILD_HINT if manifest.slave_module in _PROJECT_SLAVES else "rebuild it"
+        refusal = refusal or staleness(manifest, rebuild)
+        if refusal is None:
+            ours = slave_class(manifest)(instance_name=manifest.model_name).to_xml()
             for section in _DECLARATIONS:
                 if _canonical(declared.find(section)) != _canonical(ours.find(section)):
-                    return (f"its {section} differ from those of this project's '{name}' "
-                            f"(another FMU of that name, or ours before a change: {BUILD_HINT})")
-            script = Path(FMUS[name][0])
-            module = fmu.read("resources/slavemodule.txt").decode().strip()
-            if module != script.stem:
-                return (f"its slave is {module}.py, not this project's {script.name} "
-                        f"(another FMU of the name '{name}')")
-            for entry in fmu.namelist():
-                relative = entry.removeprefix("resources/")
-                if relative == entry or not relative.endswith(".py") \
-                        or relative.startswith("pythonfmu/"):     # pythonfmu's own
-                    continue
-                here = _source_here(relative, script)
-                if here is None:
-                    return (f"it carries {relative}, which this project's '{name}' does not "
-                            "(another FMU of that name)")
-                if not here.is_file() or here.read_bytes() != fmu.read(entry):
-                    return (f"it was built from other sources than this process runs "
-                            f"({relative} differs: another FMU of that name, or ours "
-                            f"before a change: {BUILD_HINT})")
-    except (OSError, KeyError, UnicodeDecodeError, zipfile.BadZipFile,
-            ElementTree.ParseError) as error:
-        return f"it cannot be read as an FMU ({type(error).__name__}: {error})"
+                    return (f"its {section} differ from those its class "
+                            f"{manifest.slave_module}.{manifest.slave_class} declares")
+        return refusal
+    except (OSError, KeyError, UnicodeDecodeError, ValueError, ImportError, AttributeError,
+            zipfile.BadZipFile, ElementTree.ParseError) as error:
+        return f"it cannot be read as an FMU built with fmukit ({type(error).__name__}: {error})"
+
+
+def _contents_refusal(fmu: zipfile.ZipFile, manifest: Manifest) -> str | None:
+    """Why the FMU does not hold exactly the Python modules its manifest lists, or None."""
+    listed = {c["file"]: c["sha256"] for c in manifest.modules.values()}
+    carried = {n for n in fmu.namelist() if n.startswith("resources/") and n.endswith(".py")
+               and not n.startswith("resources/pythonfmu/")}     # pythonfmu's own
+    for name in sorted(carried - set(listed)):
+        return f"it carries {name.removeprefix('resources/')}, which its manifest does not list"
+    for name, digest in sorted(listed.items()):
+        if name not in carried:
+            return f"it lacks {name.removeprefix('resources/')}, which its manifest lists"
+        if hashlib.sha256(fmu.read(name)).hexdigest() != digest:
+            return f"its {name.removeprefix('resources/')} is not the source its manifest lists"
+    slave = manifest.modules[manifest.slave_module]["file"]
+    module = fmu.read("resources/slavemodule.txt").decode().strip()
+    if f"resources/{module}.py" != slave:
+        return f"its slave is {module}.py, not {slave.removeprefix('resources/')} (its manifest)"
     return None
 
 
 _DECLARATIONS = ("ModelVariables", "UnitDefinitions", "ModelStructure")
+_PROJECT_SLAVES = {".".join(Path(script).with_suffix("").parts) for script in FMUS.values()}
 
 
 def _canonical(element: ElementTree.Element | None) -> str:
@@ -124,33 +132,22 @@ def _canonical(element: ElementTree.Element | None) -> str:
                                                                strip_text=True)
 
 
-def _source_here(relative: str, script: Path) -> Path | None:
-    """This process's file for a Python source an FMU carries: its slave script, or a module
-    of this project's packages; None for anything else."""
-    if relative == script.name:
-        return ROOT / script
-    package = relative.split("/", 1)[0]
-    return ROOT / relative if "/" in relative and package in _PACKAGES else None
-
-
-_PACKAGES = {p for _, packages in FMUS.values() for p in packages}
-
-
 class InProcessInstance(Instance):
     """A slave class instantiated and driven in this process."""
 
     def __init__(self, path: str | Path, name: str, same_sources: bool = True):
         """The class of the FMU at ``path``; ValueError if it cannot run in-process
-        (``in_process_refusal``), or, without ``same_sources``, only if it is not one of
-        ours (``cosim.studies.direct``: the modules as they are, whatever the FMU)."""
+        (``in_process_refusal``), or, without ``same_sources``, only if it was not built
+        with fmukit (``cosim.studies.direct``: the modules as they are, whatever the FMU)."""
         self.path, self.name = Path(path), name
         description = _description(self.path)
         self.model_name, self.guid = description.get("modelName"), description.get("guid")
         refusal = in_process_refusal(self.path)
-        if refusal and (same_sources or self.model_name not in FMUS):
+        manifest = read(self.path)
+        if refusal and (same_sources or manifest is None):
             raise ValueError(f"FMU '{name}' ({self.path.name}) cannot run in-process: "
                              f"{refusal}")
-        self.slave = slave_class(self.model_name)(instance_name=name)
+        self.slave = slave_class(manifest)(instance_name=name)
         self.variables = {}
         for vr, var in self.slave.registry.by_vr.items():
             self.variables[var.name] = VariableInfo(var.name, vr, _FMI_TYPE[var.kind],

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from fmukit.packaging import BUILD_HINT, FMU_DIR, FMUS
+from fmubuild.project import BUILD_HINT, FMU_DIR, FMUS
 
 NS = {
     "ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",

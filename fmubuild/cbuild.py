@@ -12,13 +12,10 @@ import os
 import shutil
 import subprocess
 import tempfile
-import zipfile
 from pathlib import Path
 
-from .packaging import FMU_DIR, ROOT
-
-C_FMUS = {"pd_autopilot_c": "autopilot_fmu/pd_autopilot_c"}
-"""FMU name: the folder of its C source and model description."""
+from . import reproducible
+from .project import C_FMUS, FMU_DIR, ROOT
 
 _LIBRARY = {"linux64": ".so", "darwin64": ".dylib"}
 
@@ -56,10 +53,10 @@ def build_c(name: str, dest: Path = FMU_DIR) -> Path:
         if compiled.returncode != 0:
             raise RuntimeError(f"{compiler} could not compile {source}:\n{compiled.stderr}")
         fmu = dest / f"{name}.fmu"
-        with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as package:
-            package.write(folder / "modelDescription.xml", "modelDescription.xml")
-            package.write(library, f"binaries/{fmpy.platform}/{library.name}")
-            package.write(source, f"sources/{source.name}")
+        reproducible.write(fmu, {
+            "modelDescription.xml": (folder / "modelDescription.xml").read_bytes(),
+            f"binaries/{fmpy.platform}/{library.name}": library.read_bytes(),
+            f"sources/{source.name}": source.read_bytes()})
     problems = validate_fmu(str(fmu))
     if problems:
         raise RuntimeError(f"{fmu} does not validate:\n" + "\n".join(problems))

@@ -5,7 +5,7 @@ host has debug logging on (``loggingOn`` of fmi2Instantiate, or
 fmi2SetDebugLogging): fmpy's command line, for one, leaves it off, and its user
 would never learn why a call failed. The FMU's Python side is handed the address
 of pythonfmu's C++ logger (keyword ``logger``), which holds that flag. In the
-binary fmukit builds (``fmukit.exit_fix.FIXED``: known layout, by SHA-256) the
+binary fmukit builds (``binary.FIXED``: known layout, by SHA-256) the
 flag is read there; an error goes to the host's logger when it listens, and to
 standard error when it does not, never to both. With any other binary the flag
 cannot be trusted, and every error also goes to standard error.
@@ -17,8 +17,8 @@ import hashlib
 import sys
 from pathlib import Path
 
-from .entry import naming
-from .exit_fix import FIXED
+from ..refusals import naming
+from .binary import FIXED
 
 
 def _debug_flag(logger: int | None, resources: str | None) -> ctypes.c_bool | None:

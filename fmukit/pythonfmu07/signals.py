@@ -7,7 +7,7 @@ KeyboardInterrupt would surface in FMU code, where it can only fail the FMU (a
 host that ignores statuses, ecos, would step on), or, raised at the first
 instruction of an FMI entry point before any ``try``, escape to pythonfmu's C++
 layer, which loses it and releases the instance once too often
-(``fmukit.entry``).
+(``fmukit.pythonfmu07.entry``).
 
 So FMU code is a critical section for the host's Python handlers of SIGINT and
 SIGTERM. ``defer_host_handlers`` wraps each (once per process, from the main
@@ -35,7 +35,7 @@ from types import FrameType
 from typing import Callable
 
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
-_ENTRY_FILE = os.path.join("fmukit", "entry.py")   # where fmi_entry's wrapper runs
+_ENTRY_FILE = os.path.join(os.path.dirname(__file__), "entry.py")  # fmi_entry's wrapper
 
 _pending: set[signal.Signals] = set()   # arrived while FMU code ran; not yet handled
 
@@ -44,7 +44,7 @@ def _in_fmu_code(frame: FrameType | None) -> bool:
     """Whether ``frame`` runs inside an FMI entry point of a ModelSlave."""
     while frame is not None:
         code = frame.f_code
-        if code.co_name == "entry" and code.co_filename.endswith(_ENTRY_FILE):
+        if code.co_name == "entry" and code.co_filename == _ENTRY_FILE:
             return True
         frame = frame.f_back
     return False

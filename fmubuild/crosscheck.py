@@ -1,6 +1,6 @@
 """FMI cross-check reference files for every FMU, in the fmi-cross-check layout.
 
-    python -m fmukit.crosscheck          # writes fmus/crosscheck/2.0/cs/linux64/...
+    python -m fmubuild.crosscheck        # writes fmus/crosscheck/2.0/cs/linux64/...
 
 For each FMU: <name>_in.csv (inputs), <name>_ref.csv (reference outputs),
 <name>_ref.opt (start, stop, step, tolerance), ReadMe.txt, and a copy of the FMU
@@ -18,7 +18,7 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from .packaging import FMU_DIR
+from .project import FMU_DIR
 
 TOOL, VERSION = "ship_autopilot_cosim", "0.1.0"
 CROSSCHECK_DIR = FMU_DIR / "crosscheck" / "2.0" / "cs" / "linux64" / TOOL / VERSION
@@ -90,7 +90,7 @@ def generate(name: str) -> Path:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m fmukit.crosscheck",
+    parser = argparse.ArgumentParser(prog="python -m fmubuild.crosscheck",
                                      description=__doc__.splitlines()[0])
     parser.add_argument("names", nargs="*", metavar="NAME", help=f"FMUs (default: all of "
                                                                   f"{', '.join(CASES)})")

@@ -1,0 +1,12 @@
+"""Building FMUs, on the host: no FMU carries this package.
+
+- ``project``: this project's FMUs, their scripts and where they are built to;
+- ``packaging``: a slave script written with fmukit into a validated FMU that carries
+  exactly its model (``manifest``), the same bytes from the same sources;
+- ``manifest``: what an FMU carries and a digest of it, and whether it is current;
+- ``exit_fix``: pythonfmu 0.7.0's linux64 binary, patched against its exit-time heap
+  corruption;
+- ``cbuild``: FMUs written in C;
+- ``crosscheck``: the cross-check reference files (``python -m fmubuild.crosscheck``);
+- ``cli``: the build command, ``python -m fmukit.build``.
+"""

@@ -1,0 +1,84 @@
+"""What an FMU built with fmukit carries, and whether it is current: its manifest.
+
+Every such FMU holds ``resources/fmukit_manifest.json``: its model name, the slave
+class (module and name, as this project imports them), each Python module it
+carries (the module's name, where the FMU holds it, the SHA-256 of its source), a
+digest of them all, the pythonfmu version and the options it was built with. No
+time, path or machine is in it, so the same sources give the same manifest.
+
+An FMU is current when every module it carries is importable in this process and
+has the same source: ``staleness`` says why not, or None. This is the one notion of
+a stale FMU: the in-process backend runs only current FMUs, a run's metadata records
+it, and the tests rebuild what is not.
+"""
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import json
+import zipfile
+from dataclasses import dataclass
+from pathlib import Path
+
+MANIFEST = "resources/fmukit_manifest.json"
+FORMAT = 1
+
+
+@dataclass(frozen=True)
+class Manifest:
+    model_name: str
+    slave_module: str                       # as this project imports it
+    slave_class: str
+    modules: dict[str, dict[str, str]]      # module: {"file": in the FMU, "sha256": ...}
+    digest: str                             # of every module's name and SHA-256
+    pythonfmu: str
+    options: dict[str, bool]
+
+    def to_json(self) -> str:
+        return json.dumps({"format": FORMAT, "model_name": self.model_name,
+                           "slave": {"module": self.slave_module, "class": self.slave_class},
+                           "modules": self.modules, "digest": self.digest,
+                           "pythonfmu": self.pythonfmu, "options": self.options},
+                          indent=1, sort_keys=True) + "\n"
+
+
+def sha256(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def digest_of(modules: dict[str, str]) -> str:
+    """The digest of a set of modules: SHA-256 over each one's name and source SHA-256."""
+    return hashlib.sha256("".join(f"{name} {modules[name]}\n" for name in sorted(modules))
+                          .encode()).hexdigest()
+
+
+def read(fmu: str | Path) -> Manifest | None:
+    """The manifest of an FMU, or None if it has none (not built with fmukit).
+    ValueError naming the file if it has one that cannot be read."""
+    with zipfile.ZipFile(fmu) as package:
+        if MANIFEST not in package.namelist():
+            return None
+        try:
+            data = json.loads(package.read(MANIFEST))
+            if data["format"] != FORMAT:
+                raise ValueError(f"format {data['format']}, not {FORMAT}")
+            return Manifest(data["model_name"], data["slave"]["module"],
+                            data["slave"]["class"], data["modules"], data["digest"],
+                            data["pythonfmu"], data["options"])
+        except (KeyError, TypeError, ValueError) as error:
+            raise ValueError(f"{fmu}: its {MANIFEST} cannot be read ({error})") from error
+
+
+def staleness(manifest: Manifest, rebuild: str = "rebuild it") -> str | None:
+    """Why the FMU is not current in this process (a module it carries cannot be found
+    here, or has another source: then ``rebuild`` says what to do), or None if it is."""
+    for module, carried in manifest.modules.items():
+        try:
+            spec = importlib.util.find_spec(module)
+        except (ImportError, ValueError):
+            spec = None
+        if spec is None or not spec.origin or not Path(spec.origin).is_file():
+            return f"its module {module} is not importable here"
+        if sha256(Path(spec.origin)) != carried["sha256"]:
+            return f"its {module} differs from {spec.origin} (built before a change: {rebuild})"
+    return None

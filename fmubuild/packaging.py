@@ -1,0 +1,198 @@
+"""Building FMUs: this project's FMUs (``project.FMUS``) and any slave script written with fmukit.
+
+An FMU carries exactly its model: the slave script, the modules of fmukit and of this
+project's packages that it imports (followed through, ``imports``), a user's modules
+given with ``--include``, a requirements.txt (a host needs only Python with numpy:
+``pythonfmu deploy -f fmus/ship.fmu`` installs it) and its manifest
+(``manifest``). After building, the binary gets ``exit_fix`` (pythonfmu 0.7.0
+corrupts its host's heap at exit); the archive is written again in a fixed order with
+fixed times and a GUID derived from its contents (``reproducible``), so the same
+sources give the same bytes; the model description is checked with fmpy's validator
+and the FMU is instantiated once without this checkout. A problem fails the build.
+
+A package whose __init__.py holds nothing but a docstring is carried without it, as a
+namespace package. A host that is not Python (ecos, OMSimulator) runs all its Python
+FMUs in one interpreter, where the first FMU to import a package would otherwise own
+it: the guidance carries ship_fmu's data alone, and the ship, loaded after it, would
+find no vessel there. A namespace package spans every FMU's folder on sys.path.
+"""
+from __future__ import annotations
+
+import ast
+import contextlib
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+from . import exit_fix, reproducible
+from .imports import needed_modules
+from .manifest import Manifest, digest_of, sha256
+from .project import FMU_DIR, FMUS, ROOT
+
+RUNTIME_REQUIREMENTS = "numpy\n"
+PROJECT_PACKAGES = ("fmukit", "ship_fmu", "autopilot_fmu")
+OPTIONS = {"canGetAndSetFMUstate": True, "canSerializeFMUstate": True}
+
+
+def build(name: str, dest: Path = FMU_DIR) -> Path:
+    """Build one FMU of this project to dest/name.fmu, validate it, and return its path."""
+    return build_script(ROOT / FMUS[name], PROJECT_PACKAGES, dest / f"{name}.fmu")
+
+
+def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path) -> Path:
+    """Build the slave in ``script`` into ``dest`` (a .fmu path, or a folder where the FMU
+    is named after the slave's model_name). ``packages``: names of this project's
+    packages (fmukit among them), of which the FMU carries what the script imports, and
+    paths of a user's modules and packages, which it carries whole. Returns the FMU's path.
+
+    ValueError naming the script if it cannot be built (no ModelSlave in it, or it
+    does not import); RuntimeError if the result does not validate.
+    """
+    from fmpy.validation import validate_fmu
+    from pythonfmu import FmuBuilder
+    from pythonfmu import __version__ as pythonfmu_version
+    from pythonfmu.builder import get_model_class
+
+    script, dest = Path(script), Path(dest)
+    if script.suffix != ".py":
+        raise ValueError(f"{script} is not a Python script (.py) to build an FMU from")
+    if not script.is_file():
+        raise ValueError(f"{script} does not exist")
+    includes = [Path(p) for p in packages if not isinstance(p, str)]
+    for include in includes:
+        if not include.exists():
+            raise ValueError(f"{include}, to be carried by {script.name}'s FMU, does not exist")
+    (dest.parent if dest.suffix == ".fmu" else dest).mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix=f"build_{script.stem}_") as tmp, \
+            _imports_undone(tmp):
+        stage = Path(tmp)
+        modules = _stage(script, [p for p in packages if isinstance(p, str)], includes, stage)
+        try:
+            sys.path.insert(0, str(stage))
+            slave = get_model_class(stage / script.name)
+            manifest = Manifest(slave.model_name, _module_name(script), slave.__name__,
+                                modules, digest_of({m: c["sha256"] for m, c in modules.items()}),
+                                pythonfmu_version, OPTIONS)
+            (stage / "fmukit_manifest.json").write_text(manifest.to_json())
+            (stage / "requirements.txt").write_text(RUNTIME_REQUIREMENTS)
+            fmu = Path(FmuBuilder.build_FMU(
+                stage / script.name, dest=dest,
+                project_files=[p for p in stage.iterdir() if p.name != script.name],
+                **OPTIONS))
+        except Exception as error:      # the script's own import errors included
+            why = str(error).replace(str(stage / script.name), str(script))
+            raise ValueError(f"cannot build an FMU from {script}: "
+                             f"{type(error).__name__}: {why}") from error
+    exit_fix.fix_fmu(fmu)
+    reproducible.rewrite(fmu)
+    problems = validate_fmu(str(fmu))
+    if problems:
+        raise RuntimeError(f"{fmu} does not validate:\n" + "\n".join(problems))
+    try:
+        check_instantiates(fmu)
+    except RuntimeError:
+        fmu.unlink()
+        raise
+    return fmu
+
+
+def _stage(script: Path, packages: list[str], includes: list[Path],
+           stage: Path) -> dict[str, dict[str, str]]:
+    """Copy into ``stage`` what the FMU carries besides its manifest; return the manifest's
+    modules: the script, what it imports of ``packages``, and every module of
+    ``includes``."""
+    shutil.copy2(script, stage)
+    modules = {_module_name(script): _carried(script, script.name)}
+    for module, file in needed_modules(script, {p: ROOT for p in packages}).items():
+        if _only_documents(file):
+            continue                    # a namespace package in the FMU: see the docstring
+        relative = file.relative_to(ROOT)
+        (stage / relative).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(file, stage / relative)
+        modules[module] = _carried(file, relative.as_posix())
+    for include in includes:
+        files = ([include] if include.is_file() else
+                 sorted(f for f in include.rglob("*") if f.is_file()
+                        and "__pycache__" not in f.parts and f.suffix != ".pyc"))
+        for file in files:
+            relative = file.relative_to(include.parent)
+            (stage / relative).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(file, stage / relative)
+            if file.suffix == ".py":
+                module = ".".join(relative.with_suffix("").parts).removesuffix(".__init__")
+                modules[module] = _carried(file, relative.as_posix())
+    return dict(sorted(modules.items()))
+
+
+def _only_documents(file: Path) -> bool:
+    """Whether ``file`` is a package's __init__.py that holds no more than a docstring."""
+    if file.name != "__init__.py":
+        return False
+    body = ast.parse(file.read_bytes()).body
+    return all(isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant)
+               for node in body)
+
+
+def _carried(file: Path, relative: str) -> dict[str, str]:
+    return {"file": f"resources/{relative}", "sha256": sha256(file)}
+
+
+def _module_name(script: Path) -> str:
+    """How this project imports a slave script: by its package path where it lies in one
+    of the project's packages (ship_fmu.ship_slave), else by its name (a user's script)."""
+    try:
+        relative = script.resolve().relative_to(ROOT)
+    except ValueError:
+        return script.stem
+    if len(relative.parts) > 1 and relative.parts[0] in PROJECT_PACKAGES:
+        return ".".join(relative.with_suffix("").parts)
+    return script.stem
+
+
+_TRIAL = """
+import sys
+sys.path = [p for p in sys.path if p not in ("", {root!r})]
+sys.meta_path = [f for f in sys.meta_path if "editable" not in repr(f).lower()]
+from fmpy import extract, read_model_description
+from fmpy.fmi2 import FMU2Slave
+description = read_model_description(sys.argv[1])
+slave = FMU2Slave(guid=description.guid, unzipDirectory=extract(sys.argv[1]),
+                  modelIdentifier=description.coSimulation.modelIdentifier,
+                  instanceName="trial")
+slave.instantiate(loggingOn=True)     # pythonfmu 0.7 logs only then
+slave.freeInstance()
+"""
+
+
+def check_instantiates(fmu: Path) -> None:
+    """Instantiate the FMU once in a fresh interpreter that cannot import this checkout:
+    RuntimeError with its last words if it fails, as it would on a host without the
+    modules the FMU forgot to carry."""
+    with tempfile.TemporaryDirectory() as elsewhere:
+        child = subprocess.run([sys.executable, "-c", _TRIAL.format(root=str(ROOT)), str(fmu)],
+                               cwd=elsewhere, capture_output=True, text=True, timeout=120)
+    if child.returncode != 0:
+        log = [line for line in child.stdout.splitlines() if line.strip()][-3:]  # the FMU's
+        words = log or [line for line in child.stderr.splitlines() if line.strip()][-3:]
+        raise RuntimeError(f"{fmu.name} was built but does not instantiate without this "
+                           "checkout, so it was removed; a module it imports is probably "
+                           "missing from it (carry it with --include):\n  "
+                           + "\n  ".join(words))
+
+
+@contextlib.contextmanager
+def _imports_undone(stage: str):
+    """Forget what building imported from ``stage``: pythonfmu imports the script and the
+    packages it carries from the temporary folder, and leaves that on sys.path. Left
+    there, the next build in this process (or an in-process run) would find those stale
+    modules. Modules imported from elsewhere (numpy, say) stay: they cannot be reloaded."""
+    path, modules = list(sys.path), set(sys.modules)
+    try:
+        yield
+    finally:
+        sys.path[:] = path
+        for name in set(sys.modules) - modules:
+            if str(getattr(sys.modules[name], "__file__", None) or "").startswith(stage):
+                del sys.modules[name]

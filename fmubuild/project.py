@@ -1,0 +1,23 @@
+"""This project's FMUs: where their sources are, and where they are built to."""
+from __future__ import annotations
+
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+FMU_DIR = ROOT / "fmus"
+
+FMUS: dict[str, str] = {
+    "ship": "ship_fmu/ship_slave.py",
+    "manoeuvre": "ship_fmu/manoeuvre_slave.py",
+    "pd_autopilot": "autopilot_fmu/pd_autopilot_slave.py",
+    "smc_autopilot": "autopilot_fmu/smc_autopilot_slave.py",
+    "guidance": "autopilot_fmu/guidance_slave.py",
+    # Written as a user's own autopilot is (docs/own_autopilot.md): one file and fmukit.
+    "pid_autopilot": "autopilot_fmu/pid_autopilot_slave.py",
+}
+"""FMU name: its slave script. An FMU carries the project modules its script imports."""
+
+C_FMUS = {"pd_autopilot_c": "autopilot_fmu/pd_autopilot_c"}
+"""FMU name: the folder of its C source and model description."""
+
+BUILD_HINT = "build the FMUs with: python -m fmukit.build"

@@ -1,0 +1,54 @@
+"""The same sources give the same FMU, byte for byte.
+
+pythonfmu writes its archive in the order the file system lists the files, with
+their modification times, a time-based GUID and the time of the build. An FMU is
+written again here: its entries in name order, each with one fixed time and mode,
+no generation time, and a GUID derived from the contents (a version-5 UUID of their
+SHA-256), so that a changed FMU gets a new GUID and an unchanged one keeps its own.
+"""
+from __future__ import annotations
+
+import hashlib
+import re
+import uuid
+import zipfile
+from pathlib import Path
+
+EPOCH = (1980, 1, 1, 0, 0, 0)
+"""The time of every entry: the earliest a zip file can hold."""
+
+_GUID = re.compile(rb'\sguid="[^"]*"')
+_GENERATED = re.compile(rb'\sgenerationDateAndTime="[^"]*"')
+
+
+def rewrite(fmu: Path) -> str:
+    """Write ``fmu`` again reproducibly, in place (whole or not at all); its new GUID."""
+    with zipfile.ZipFile(fmu) as package:
+        entries = {info.filename: package.read(info) for info in package.infolist()
+                   if not info.is_dir()}
+    description = _GENERATED.sub(b"", entries["modelDescription.xml"])
+    entries["modelDescription.xml"] = _GUID.sub(b' guid=""', description, count=1)
+    contents = hashlib.sha256()
+    for name in sorted(entries):
+        contents.update(name.encode() + b"\0" + hashlib.sha256(entries[name]).digest())
+    guid = str(uuid.uuid5(uuid.NAMESPACE_OID, contents.hexdigest()))
+    entries["modelDescription.xml"] = entries["modelDescription.xml"].replace(
+        b' guid=""', f' guid="{{{guid}}}"'.encode(), 1)
+    write(fmu, entries)
+    return guid
+
+
+def write(fmu: Path, entries: dict[str, bytes]) -> None:
+    """An archive of ``entries`` (name: bytes) at ``fmu``, in name order, fixed times and
+    modes, compressed; written beside it, then renamed."""
+    temporary = fmu.with_name(f".{fmu.name}.tmp")
+    try:
+        with zipfile.ZipFile(temporary, "w", zipfile.ZIP_DEFLATED) as package:
+            for name in sorted(entries):
+                info = zipfile.ZipInfo(name, EPOCH)
+                info.compress_type = zipfile.ZIP_DEFLATED
+                info.external_attr = (0o755 if name.startswith("binaries/") else 0o644) << 16
+                package.writestr(info, entries[name])
+        temporary.replace(fmu)
+    finally:
+        temporary.unlink(missing_ok=True)
