@@ -1,0 +1,77 @@
+"""Each FMU carries exactly its model; the runtime imports nothing of the project; builds repeat."""
+from __future__ import annotations
+
+import ast
+import zipfile
+from pathlib import Path
+
+import pytest
+
+from fmubuild.cbuild import build_c
+from fmubuild.manifest import digest_of, read, staleness
+from fmubuild.packaging import build
+from fmubuild.project import FMUS, ROOT
+
+PROJECT = {"cosim", "fmubuild", "fmukit", "ship_fmu", "autopilot_fmu"}
+# What each FMU carries of the model packages, beside its slave and fmukit.
+MODELS = {
+    "ship": {"ship_fmu.data", "ship_fmu.hull", "ship_fmu.steering_gear", "ship_fmu.thrusters",
+             "ship_fmu.vessel", "ship_fmu.waves"},
+    "manoeuvre": {"ship_fmu.data", "ship_fmu.hull", "ship_fmu.manoeuvres",
+                  "ship_fmu.steering_gear", "ship_fmu.thrusters", "ship_fmu.vessel",
+                  "ship_fmu.waves"},
+    "pd_autopilot": {"autopilot_fmu.pd"},
+    # design_model 'ship' linearises the vessel model
+    "smc_autopilot": {"autopilot_fmu.design", "autopilot_fmu.smc", "ship_fmu.data",
+                      "ship_fmu.hull", "ship_fmu.steering_gear", "ship_fmu.thrusters",
+                      "ship_fmu.vessel", "ship_fmu.waves"},
+    # the circle of acceptance is two ship lengths
+    "guidance": {"autopilot_fmu.guidance", "ship_fmu.data"},
+    "pid_autopilot": set(),
+}
+
+
+@pytest.mark.parametrize("name", list(FMUS))
+def test_each_fmu_carries_exactly_its_model_and_says_so(fmu_paths, name):
+    manifest = read(fmu_paths[name])
+    slave = ".".join(Path(FMUS[name]).with_suffix("").parts)
+    assert manifest.model_name == name and manifest.slave_module == slave
+    models = {m for m in manifest.modules if not m.startswith("fmukit") and m != slave}
+    assert models == MODELS[name]
+    assert "fmukit.build" not in manifest.modules and "fmukit.slave" in manifest.modules
+    with zipfile.ZipFile(fmu_paths[name]) as fmu:
+        python = {n for n in fmu.namelist() if n.endswith(".py")
+                  and not n.startswith("resources/pythonfmu/")}    # pythonfmu's own runtime
+    assert python == {carried["file"] for carried in manifest.modules.values()}
+    assert digest_of({m: c["sha256"] for m, c in manifest.modules.items()}) == manifest.digest
+    assert staleness(manifest) is None
+    # so no host-only module (fmubuild, cosim), edited or not, can make an FMU stale
+    assert not any(m.split(".")[0] in ("fmubuild", "cosim") for m in manifest.modules)
+
+
+def _imports(path: Path) -> set[str]:
+    names = set()
+    for node in ast.walk(ast.parse(path.read_bytes())):
+        if isinstance(node, ast.Import):
+            names |= {alias.name.split(".")[0] for alias in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            names.add(node.module.split(".")[0])
+    return names
+
+
+def test_the_runtime_imports_no_project_module_and_only_its_adapter_imports_pythonfmu():
+    for path in sorted((ROOT / "fmukit").rglob("*.py")):
+        if path.name == "build.py" and path.parent.name == "fmukit":
+            continue                    # the build command's published name: host-only
+        imported = _imports(path)
+        assert not imported & (PROJECT - {"fmukit"}), path
+        if "pythonfmu" in imported:
+            assert path.parent.name == "pythonfmu07", path
+
+
+def test_two_builds_of_one_commit_are_byte_identical(fmu_paths, tmp_path, c_autopilot):
+    first = build("pid_autopilot", tmp_path / "a").read_bytes()
+    assert build("pid_autopilot", tmp_path / "b").read_bytes() == first
+    assert fmu_paths["pid_autopilot"].read_bytes() == first        # and the suite's own
+    c = build_c("pd_autopilot_c", tmp_path / "a").read_bytes()
+    assert build_c("pd_autopilot_c", tmp_path / "b").read_bytes() == c
