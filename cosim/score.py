@@ -17,7 +17,7 @@ from pathlib import Path
 
 from ._cli import add_port_options, checked_autopilot, entry, setting_option, writable_folder
 from .studies.scorecard import backend_notes, score
-from .studies.sweep import NoWorkers
+from .studies.sweep_client import NoWorkers
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -8,9 +8,14 @@ from pathlib import Path
 from ._cli import entry, writable_folder
 from .core.interrupt import Interrupted
 from .studies import sweep
+from .studies.sweep_client import NoWorkers, SweepError
 from .studies.sweep_figures import save_figures
+from .studies.sweep_spec import Spec
+from .studies.sweep_tables import comparison, summary, write_tables
 
 RESULTS = Path("results/sweeps")
+USAGE = sweep.__doc__.partition("\n\nModules: ")[0]
+"""--help: the sweep's documentation, without its closing paragraph on the modules."""
 
 
 def seconds(text: str) -> float:
@@ -25,8 +30,8 @@ def seconds(text: str) -> float:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m cosim.sweep",
-                                     description=sweep.__doc__.split("\n\n")[0],
-                                     epilog="\n\n".join(sweep.__doc__.split("\n\n")[1:]),
+                                     description=USAGE.split("\n\n")[0],
+                                     epilog="\n\n".join(USAGE.split("\n\n")[1:]),
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("spec", type=Path, help="sweep file (TOML)")
     parser.add_argument("--scheduler", metavar="ADDRESS",
@@ -46,13 +51,13 @@ def main(argv: list[str] | None = None) -> int:
                         default=sweep.NO_WORKER_TIMEOUT,
                         help="stop when the cluster has had no worker for this long, keeping "
                              "every row done (exit status "
-                             f"{sweep.NoWorkers.exit_status}; default: %(default)g s)")
+                             f"{NoWorkers.exit_status}; default: %(default)g s)")
     parser.add_argument("--csv", action="store_true", help="also write results.csv")
     parser.add_argument("--no-progress", action="store_true",
                         help="no progress bar (for logs)")
     args = parser.parse_args(argv)
     try:
-        spec = sweep.Spec.read(args.spec)
+        spec = Spec.read(args.spec)
     except ValueError as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
@@ -63,25 +68,25 @@ def main(argv: list[str] | None = None) -> int:
         rows = sweep.execute(spec, out, args.scheduler, args.workers,
                              progress=not args.no_progress, scheduler_file=args.scheduler_file,
                              backend=args.backend, no_worker_timeout=args.no_worker_timeout)
-    except (sweep.SweepError, ValueError) as error:
+    except (SweepError, ValueError) as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
-    except (Interrupted, sweep.NoWorkers) as stopped:
+    except (Interrupted, NoWorkers) as stopped:
         rows = sweep.completed(spec, out)
-        written = sweep.write_tables(rows, out, args.csv) if rows else []
+        written = write_tables(rows, out, args.csv) if rows else []
         print(f"{stopped}: {len(rows)} of {len(spec.runs())} runs done, kept in "
               f"{out / 'runs.jsonl'}{''.join(f', {p}' for p in written)}; the same command "
               "resumes the sweep", file=sys.stderr)
         return stopped.exit_status
-    written = sweep.write_tables(rows, out, args.csv)
+    written = write_tables(rows, out, args.csv)
     if any(r["status"] == "ok" for r in rows):
         written += save_figures(spec, rows, out)
     else:
         print("no run succeeded: no figures drawn", file=sys.stderr)
     if "pd" in spec.controllers and len(spec.controllers) > 1:
-        (out / "comparison.md").write_text(sweep.comparison(spec, rows) + "\n")
+        (out / "comparison.md").write_text(comparison(spec, rows) + "\n")
         written.append(out / "comparison.md")
-    print(sweep.summary(spec, rows))
+    print(summary(spec, rows))
     print(f"wrote {', '.join(str(p) for p in written)}")
     return 0 if all(r["status"] == "ok" for r in rows) else 1
 
