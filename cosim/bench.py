@@ -19,7 +19,7 @@ import argparse
 import sys
 
 from ._cli import entry
-from .studies import bench
+from .studies import bench, bench_sweep
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -44,7 +44,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "memory":
             bench.memory(args.hours)
         elif args.command == "sweep":
-            bench.sweep_throughput(args.runs)
+            bench_sweep.sweep_throughput(args.runs)
         elif args.command == "overhead":
             bench.overhead(args.repeats)
         else:
