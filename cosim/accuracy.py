@@ -24,7 +24,7 @@ from pathlib import Path
 from ._cli import entry, writable_folder
 from .analysis.figures import whole_file
 from .scenarios import names
-from .studies import accuracy, cpu_variants
+from .studies import accuracy, cpu_variants, integration_error
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -54,8 +54,8 @@ def main(argv: list[str] | None = None) -> int:
     steps = (0.1, 0.05, 0.025) if args.quick else accuracy.STEPS
 
     tables = ["## Integration error, open loop (calm water)\n",
-              accuracy.open_loop_table([accuracy.open_loop(p, open_end)
-                                        for p in ("step", "sine", "zigzag")])]
+              integration_error.open_loop_table([integration_error.open_loop(p, open_end)
+                                                 for p in ("step", "sine", "zigzag")])]
     print("".join(tables[-2:]), flush=True)
     closed = {name: accuracy.closed_loop(name, closed_end) for name in runs}
     tables += ["\n## Co-simulation at 0.1 s against the monolithic reference\n",

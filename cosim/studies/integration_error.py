@@ -1,0 +1,136 @@
+"""How large are the set-up's own numerical errors? (Issue 17.) Part 1: integration error,
+open loop.
+
+The ship (``ship_fmu.vessel.Vessel``, the model the FMU wraps) under a rudder program
+held over each 0.1 s communication step, as a master delivers it, integrated by its
+fixed-step RK4 at h_max = 0.1, 0.05 and 0.025 s, against a reference solution of the
+same equations: scipy's ``solve_ivp`` (DOP853, rtol = atol = 1e-12) on each
+communication step. The steering gear's response is piecewise linear in time
+(``steering_gear.RudderMotion``); its kink, where the rudder reaches the command or its
+stop, is known exactly (``reach``), and both the reference and the vessel's RK4 restart
+there, so no step straddles a discontinuity of the derivative. The reference's own error
+is estimated by solving again with the tolerances halved.
+
+Programs, 400 s from straight running at 0.3 m/s, calm water: a 20 deg rudder step;
+a sine of 10 deg amplitude and 30 s period; the 20/20 zig-zag (its commands are
+taken from one run and then fixed, so that every integrator sees the same input).
+
+Parts 2 and 3, the co-simulation against a monolithic model, are ``accuracy``.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from fmukit.timebase import communication_point, step_count
+from ship_fmu.manoeuvres import RudderProgram
+from ship_fmu.steering_gear import RudderMotion
+from ship_fmu.thrusters import actuator_model
+from ship_fmu.vessel import N_PROPELLER, Vessel, VesselParameters
+
+H = 0.1                                       # s, the communication step (of parts 2-3 too)
+H_MAX = (0.1, 0.05, 0.025)                    # s, the RK4 steps compared
+SIGNALS = ("psi", "r", "x", "y")
+TOLERANCE = 1e-12
+
+
+def _sine(t: float) -> float:
+    return math.radians(10.0) * math.sin(2.0 * math.pi * t / 30.0)
+
+
+def commands(program: str, t_end: float = 400.0) -> np.ndarray:
+    """The rudder command held over each communication step, rad."""
+    n = step_count(0.0, t_end, H)
+    times = [communication_point(0.0, k, H) for k in range(n)]
+    if program == "step":
+        return np.full(n, math.radians(20.0))
+    if program == "sine":
+        return np.array([_sine(t) for t in times])
+    if program == "zigzag":
+        rudder, vessel, out = RudderProgram(math.radians(20.0), math.radians(20.0)), Vessel(), []
+        for t in times:
+            out.append(rudder.command(vessel.psi))
+            rudder.update(vessel.psi)
+            vessel.step(t, H, out[-1])
+        return np.array(out)
+    raise ValueError(f"program must be step, sine or zigzag, got {program!r}")
+
+
+def rk4(delta_c: np.ndarray, h_max: float) -> dict[str, np.ndarray]:
+    """The FMU's model: RK4 at ``h_max``; each signal at every communication point."""
+    vessel = Vessel(VesselParameters(h_max=h_max))
+    rows = [[getattr(vessel, s) for s in SIGNALS]]
+    for k, command in enumerate(delta_c):
+        vessel.step(communication_point(0.0, k, H), H, float(command))
+        rows.append([getattr(vessel, s) for s in SIGNALS])
+    return dict(zip(SIGNALS, np.array(rows).T))
+
+
+def reference(delta_c: np.ndarray, tolerance: float = TOLERANCE) -> dict[str, np.ndarray]:
+    """The same equations by DOP853, restarted at each communication point and at each
+    kink of the steering gear's response."""
+    vessel = Vessel()
+    p = vessel.params
+    forces = actuator_model(vessel.actuators, N_PROPELLER, N_PROPELLER, 0.0)
+    y = np.array([vessel.x, vessel.y, vessel.psi, vessel.u, vessel.v, vessel.r, vessel.xi])
+    delta = vessel.delta
+    rows = [[y[2], y[5], y[0], y[1]]]
+    for k, command in enumerate(delta_c):
+        t = communication_point(0.0, k, H)
+        gear = RudderMotion(delta, float(command), p.delta_max, p.delta_rate_max)
+        pieces = [(0.0, gear.reach), (gear.reach, H)] if 0.0 < gear.reach < H else [(0.0, H)]
+
+        def f(s: float, state: np.ndarray, t=t, gear=gear) -> list[float]:
+            return list(vessel.rates(t + s, tuple(state), forces(gear(s))))
+
+        for a, b in pieces:
+            y = solve_ivp(f, (a, b), y, method="DOP853", rtol=tolerance,
+                          atol=tolerance).y[:, -1]
+        delta = gear(H)
+        rows.append([y[2], y[5], y[0], y[1]])
+    return dict(zip(SIGNALS, np.array(rows).T))
+
+
+@dataclass(frozen=True)
+class Error:
+    """Max and RMS error of one signal against the reference."""
+    max: float
+    rms: float
+
+
+def errors(run: dict[str, np.ndarray], ref: dict[str, np.ndarray]) -> dict[str, Error]:
+    out = {}
+    for s in SIGNALS:
+        e = np.abs(run[s] - ref[s])
+        out[s] = Error(float(e.max()), float(np.sqrt(np.mean(e * e))))
+    return out
+
+
+def open_loop(program: str, t_end: float = 400.0) -> dict:
+    """Errors of RK4 at each h_max, the observed orders, and the reference's own error."""
+    delta_c = commands(program, t_end)
+    ref = reference(delta_c)
+    finer = reference(delta_c, TOLERANCE / 2)
+    by_h = {h: errors(rk4(delta_c, h), ref) for h in H_MAX}
+    orders = {s: [math.log2(by_h[a][s].max / by_h[b][s].max)
+                  for a, b in zip(H_MAX, H_MAX[1:])] for s in SIGNALS}
+    return {"program": program, "errors": by_h, "orders": orders,
+            "reference_error": errors(finer, ref)}
+
+
+def open_loop_table(results: list[dict]) -> str:
+    """Part 1 as a Markdown table."""
+    lines = ["| program | h_max (s) | " + " | ".join(f"max / RMS error {s}" for s in SIGNALS)
+             + " |", "|---|---:|" + "---:|" * len(SIGNALS)]
+    for result in results:
+        for h, e in result["errors"].items():
+            lines.append(f"| {result['program']} | {h:g} | " + " | ".join(
+                f"{e[s].max:.2e} / {e[s].rms:.2e}" for s in SIGNALS) + " |")
+        lines.append(f"| {result['program']} | order | " + " | ".join(
+            ", ".join(f"{o:.2f}" for o in result["orders"][s]) for s in SIGNALS) + " |")
+        lines.append(f"| {result['program']} | reference, tol / 2 | " + " | ".join(
+            f"{result['reference_error'][s].max:.1e}" for s in SIGNALS) + " |")
+    return "\n".join(lines)

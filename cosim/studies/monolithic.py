@@ -1,0 +1,106 @@
+"""The monolithic reference of the accuracy study (``accuracy``, parts 2 and 3): guidance,
+autopilot and ship as one ODE, with the controller inside the solver."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from fmukit.timebase import communication_point, step_count
+from ship_fmu.steering_gear import rudder_target
+from ship_fmu.thrusters import actuator_model
+
+from .integration_error import H
+
+METHOD = "LSODA"
+"""Stiff where the servo slews, not elsewhere: LSODA switches between Adams and BDF as
+needed, 7x faster than Radau in waves; on calm_smc both give J equal to 1e-8."""
+MAX_STEP = 1.0
+"""s: on a straight leg the solver's steps grow long enough to pass through a circle of
+acceptance (5 m across, 16 s at 0.3 m/s) without an endpoint inside it, and the
+event would be missed."""
+SERVO_GAIN = 1000.0
+"""1/s: the steering gear as a stiff servo in the monolithic model (see ``monolithic``)."""
+
+
+def monolithic(system, stop_time: float | None = None, servo_gain: float = SERVO_GAIN,
+               tolerance: float = 1e-9) -> dict[str, np.ndarray]:
+    """Guidance, autopilot and ship as one ODE, the controller evaluated at every stage of
+    the solver (``METHOD``), as a continuous Simulink block would be; sampled every 0.1 s
+    like the master's rows.
+
+    State: the ship's (x, y, psi, u, v, r, xi), the rudder angle delta and, for the SMC,
+    its reference model (psi_z, r_z). The steering gear, a rate limiter in the FMU, is
+    here delta' = clip(k (sat(delta_c) - delta), +-delta_rate_max) with k = ``servo_gain``:
+    it slews at the rate limit as the FMU's does, and otherwise follows the command with a
+    lag of 1/k (1 ms, against the 50 ms mean delay of a 0.1 s zero-order hold); the stiff
+    k is why the solver must handle stiffness. The guidance's waypoint switching is an event (the
+    circle of acceptance reached, or the leg's end passed): the solver stops there,
+    switches the leg, and restarts (steps of at most ``MAX_STEP``, so that no crossing is
+    stepped over). The SMC's switching term is eq (42)'s tanh boundary
+    layer (phi_h), continuous: no event is needed.
+    """
+    from .direct import build_models, shaft_speeds
+
+    models = build_models(system)
+    guidance, autopilot, ship = (models[n] for n in ("guidance", "autopilot", "ship"))
+    forces = actuator_model(ship.actuators, *shaft_speeds(system))
+    p = ship.params
+    smc = hasattr(autopilot, "r_z_dot")
+    stop = system.stop_time if stop_time is None else stop_time
+    grid = np.array([communication_point(0.0, k, H) for k in range(step_count(0.0, stop, H) + 1)])
+
+    def rhs(t: float, Y: np.ndarray, leg: int) -> list[float]:
+        psi_d = guidance.course(leg)
+        if smc:
+            autopilot.psi_z, autopilot.r_z = Y[8], Y[9]
+        delta_c = autopilot.command(Y[2], Y[5], psi_d)
+        target = rudder_target(delta_c, p.delta_max)
+        delta_dot = min(max(servo_gain * (target - Y[7]), -p.delta_rate_max), p.delta_rate_max)
+        rates = [*ship.rates(t, tuple(Y[:7]), forces(Y[7])), delta_dot]
+        if smc:
+            rates += [Y[9], autopilot.r_z_dot(psi_d, Y[8], Y[9])]
+        return rates
+
+    def arrival(leg: int):
+        (x0, y0), (x1, y1) = guidance.points[leg], guidance.points[leg + 1]
+        length = math.hypot(x1 - x0, y1 - y0)
+
+        def inside(t, Y, leg):
+            return math.hypot(x1 - Y[0], y1 - Y[1]) - guidance.R_accept
+
+        def past(t, Y, leg):
+            return ((Y[0] - x0) * (x1 - x0) + (Y[1] - y0) * (y1 - y0)) / length - length
+
+        for event in (inside, past):
+            event.terminal, event.direction = True, 0.0
+        return [inside, past]
+
+    Y = [ship.x, ship.y, ship.psi, ship.u, ship.v, ship.r, ship.xi, ship.delta]
+    if smc:
+        Y += [autopilot.psi_z, autopilot.r_z]
+    leg, finished, t = guidance.leg, guidance.finished, 0.0
+    sampled: dict[float, tuple[np.ndarray, int]] = {}      # grid time: (state, leg)
+    while True:
+        events = [] if finished else arrival(leg)
+        solution = solve_ivp(rhs, (t, stop), Y, method=METHOD, rtol=tolerance,
+                             atol=tolerance, dense_output=True, events=events, args=(leg,),
+                             max_step=MAX_STEP)
+        end = solution.t[-1]
+        for g in grid[(grid >= t) & (grid <= end)]:
+            sampled.setdefault(float(g), (solution.sol(g), leg))
+        if solution.status != 1:                 # the stop time, not an event
+            break
+        t, Y = end, solution.y[:, -1]
+        if leg + 2 < len(guidance.points):
+            leg += 1
+        else:
+            finished = True
+    times = sorted(sampled)
+    values = np.array([sampled[g][0] for g in times])
+    return {"t": np.array(times),
+            "psi_d": np.array([guidance.course(sampled[g][1]) for g in times]),
+            "psi": values[:, 2], "r": values[:, 5], "x": values[:, 0], "y": values[:, 1],
+            "delta": values[:, 7]}
+
