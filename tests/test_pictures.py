@@ -16,8 +16,8 @@ from cosim import simulate
 from cosim.analysis.animation import animate, frame_times
 from cosim.analysis.figures import (course_keeping_figure, save, turning_circle_figure,
                                     zigzag_figure)
+from cosim.analysis.manoeuvres import zigzag
 from ship_fmu.data import Hull
-from ship_fmu.manoeuvres import zigzag
 
 
 @pytest.fixture(scope="module")

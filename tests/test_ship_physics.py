@@ -4,9 +4,9 @@ import math
 import numpy as np
 import pytest
 
+from cosim.analysis.manoeuvres import turning_circle, zigzag
 from ship_fmu.data import Actuators, Hull
 from ship_fmu.hull import coriolis_forces, damping_forces, mass_matrix
-from ship_fmu.manoeuvres import turning_circle, zigzag
 from ship_fmu.steering_gear import RudderMotion, rudder_angle
 from ship_fmu.thrusters import actuator_forces
 from ship_fmu.vessel import N_PROPELLER, Vessel, VesselParameters

@@ -26,10 +26,10 @@ from matplotlib.patches import Circle, Polygon  # noqa: E402
 
 from autopilot_fmu.guidance import parse_waypoints  # noqa: E402
 from ship_fmu.data import Hull  # noqa: E402
-from ship_fmu.manoeuvres import crossing, turning_circle_figures, zigzag_figures  # noqa: E402
 
 from ..core.recording import Recording  # noqa: E402
 from .describe import title  # noqa: E402
+from .manoeuvres import crossing, turning_circle_figures, zigzag_figures  # noqa: E402
 from .metrics import heading_error  # noqa: E402
 
 FORMATS = ("png", "svg", "pdf")

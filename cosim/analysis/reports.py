@@ -6,10 +6,9 @@ import math
 
 import numpy as np
 
-from ship_fmu.manoeuvres import turning_circle_figures, zigzag_figures
-
 from ..core.recording import Recording
 from .cost import LAMBDA, Cost, cost
+from .manoeuvres import turning_circle_figures, zigzag_figures
 from .metrics import sign_reversals_per_minute
 
 PAPER_TABLES = {   # Tomera (2010), Tables 1 and 2: psi_E, delta_E, J
