@@ -69,6 +69,8 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path) -> 
             _imports_undone(tmp):
         stage = Path(tmp)
         modules = _stage(script, [p for p in packages if isinstance(p, str)], includes, stage)
+        # pythonfmu imports the script by its name: not a module of that name imported before
+        shadowed = sys.modules.pop(script.stem, None)
         try:
             sys.path.insert(0, str(stage))
             slave = get_model_class(stage / script.name)
@@ -85,6 +87,9 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path) -> 
             why = str(error).replace(str(stage / script.name), str(script))
             raise ValueError(f"cannot build an FMU from {script}: "
                              f"{type(error).__name__}: {why}") from error
+        finally:
+            if shadowed is not None:
+                sys.modules[script.stem] = shadowed
     exit_fix.fix_fmu(fmu)
     reproducible.rewrite(fmu)
     problems = validate_fmu(str(fmu))

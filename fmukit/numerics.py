@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import math
 
+from .refusals import Refused
+
 MAX_SUBSTEPS = 100_000
 """Most integration steps one communication step may take."""
 
@@ -21,10 +23,10 @@ def wrap(angle: float) -> float:
 
 
 def require_finite(**values: float) -> None:
-    """Raise ValueError naming the first input that is NaN or infinite."""
+    """Raise Refused (a ValueError) naming the first input that is NaN or infinite."""
     for name, value in values.items():
         if not math.isfinite(value):
-            raise ValueError(f"input {name} = {value} is not finite")
+            raise Refused(f"input {name} = {value} is not finite", "nonfinite_input", name)
 
 
 def substeps(h: float, h_max: float, what: str) -> int:

@@ -7,6 +7,7 @@ fmi2Reset returns to instantiated (pythonfmu makes a new slave object for it).
 """
 from __future__ import annotations
 
+from .refusals import Refused
 from .variables import Var
 
 _AFTER = {"instantiated": "fmi2Instantiate or fmi2Reset",
@@ -21,10 +22,10 @@ class CallSequence:
         self.phase = phase
 
     def require(self, call: str, *phases: str) -> None:
-        """ValueError naming the call and the phase unless the phase is one of ``phases``."""
+        """Refused naming the call and the phase unless the phase is one of ``phases``."""
         if self.phase not in phases:
-            raise ValueError(f"{call} is not allowed in phase '{self.phase}' (FMI 2.0 allows "
-                             f"it after {' or '.join(_AFTER[p] for p in phases)})")
+            raise Refused(f"{call} is not allowed in phase '{self.phase}' (FMI 2.0 allows "
+                          f"it after {' or '.join(_AFTER[p] for p in phases)})", "call")
 
     def step_refusal(self) -> str | None:
         """Why fmi2DoStep is not allowed now, or None if it is."""
@@ -34,12 +35,12 @@ class CallSequence:
         return None
 
     def check_settable(self, var: Var) -> None:
-        """ValueError naming ``var`` if the standard forbids setting it now."""
+        """Refused naming ``var`` if the standard forbids setting it now."""
         if var.causality == "output":
-            raise ValueError(f"{var.name} is an output and cannot be set")
+            raise Refused(f"{var.name} is an output and cannot be set", "call", var.name)
         if var.causality == "parameter" and self.phase not in ("instantiated",
                                                                "initialization"):
-            raise ValueError(f"parameter {var.name} is fixed after initialisation "
-                             f"(phase '{self.phase}')")
+            raise Refused(f"parameter {var.name} is fixed after initialisation "
+                          f"(phase '{self.phase}')", "call", var.name)
         if self.phase == "terminated":
-            raise ValueError(f"cannot set {var.name} after terminate")
+            raise Refused(f"cannot set {var.name} after terminate", "call", var.name)

@@ -39,8 +39,10 @@ only failure status there is to give (docs/robustness.md argues it):
   is applied, and the FMU goes on as before;
 - reading an output never fails: what cannot be evaluated reads NaN.
 
-The reason, beginning with the FMU's instance name, reaches the user through the
-host's logger when it listens, and on standard error when it does not
+The reason, beginning with the FMU's instance name (libcosim's log shows neither the
+instance nor the call), reaches the user through the host's logger when it listens,
+under the category ``fmukit.<cause>`` that says what was refused
+(``fmukit.refusals.CAUSES``), and on standard error when it does not
 (``fmukit.pythonfmu07.hostlog``).
 
 Time is rounded to whole nanoseconds before the model sees it (``fmukit.timebase``).
@@ -55,7 +57,7 @@ from .fastpath import FastPaths
 from .pythonfmu07 import DefaultExperiment, Fmi2Slave, Fmi2Status, signals
 from .pythonfmu07.entry import fmi_entry
 from .pythonfmu07.hostlog import HostLog
-from .refusals import Refused, explain, naming
+from .refusals import CAUSES, Refused, explain, naming
 from .registry import Registry
 from .sequence import CallSequence
 from .timebase import MAX_TIME, on_time_base
@@ -70,6 +72,9 @@ class ModelSlave(Fmi2Slave):
     model_name: ClassVar[str]
     variables: ClassVar[tuple[Var, ...]]
     default_experiment = DefaultExperiment(start_time=0.0, stop_time=400.0, step_size=0.1)
+    log_categories = {**Fmi2Slave.log_categories,
+                      **{f"fmukit.{cause}": f"Refused: {meaning}."
+                         for cause, meaning in CAUSES.items()}}
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
@@ -78,6 +83,7 @@ class ModelSlave(Fmi2Slave):
         self.host_log = HostLog(kwargs.get("logger"), kwargs.get("resources"),
                                 in_process="logger" not in kwargs)
         self.failure: str | None = None       # why the FMU failed; until fmi2Reset
+        self.failure_cause = "model"          # its cause (fmukit.refusals.CAUSES)
         self.start_time = 0.0                 # of the experiment, for messages
         self._step_size = (None, None)        # the last step size given, on the time base
         signals.defer_host_handlers()
@@ -159,7 +165,9 @@ class ModelSlave(Fmi2Slave):
         except Exception as error:            # reported now, refused at the first step
             self.failure = (f"exitInitializationMode at t = {self.start_time}: {error}; the FMU "
                             "has failed")
-            self.log(naming(self.instance_name, self.failure), Fmi2Status.error)
+            self.failure_cause = _cause(error, "parameter")
+            self.log(naming(self.instance_name, self.failure), Fmi2Status.error,
+                     f"fmukit.{self.failure_cause}")
             self.host_log.tell(self.instance_name, self.failure)
 
     @fmi_entry
@@ -171,13 +179,13 @@ class ModelSlave(Fmi2Slave):
     @fmi_entry
     def do_step(self, current_time: float, step_size: float) -> bool:
         if self.failure:
-            raise Refused(self.failure)
+            raise Refused(self.failure, self.failure_cause)
         refusal = self.sequence.step_refusal()
         if refusal:                           # like any call out of sequence: nothing done
-            raise Refused(refusal)
+            raise Refused(refusal, "call")
         if not (1e-9 <= step_size <= MAX_TIME and abs(current_time) <= MAX_TIME):
             self._fail(f"doStep at t = {current_time} with communication step {step_size}: the "
-                       f"step must be at least 1 ns, and both within +-{MAX_TIME:g} s")
+                       f"step must be at least 1 ns, and both within +-{MAX_TIME:g} s", "step")
         try:
             self._check_inputs(self)
             # The time base of fmukit.timebase: whole nanoseconds, whatever the master.
@@ -186,10 +194,9 @@ class ModelSlave(Fmi2Slave):
             self.step_model(on_time_base(current_time), self._step_size[1])
         except ValueError as error:
             self._fail(f"doStep at t = {current_time}: {error}; the FMU has failed (its "
-                       "outputs read NaN until fmi2Reset)")
+                       "outputs read NaN until fmi2Reset)", _cause(error, "model"))
         except Exception as error:            # the model's own exception
-            self.failure = f"doStep at t = {current_time}: {explain(error)}"
-            raise Refused(self.failure) from error
+            self._fail(f"doStep at t = {current_time}: {explain(error)}", "model", error)
         except BaseException as error:        # Ctrl-C or the like, raised in this FMU's code
             raise self.interrupted(f"doStep at t = {current_time}", error) from None
         return True
@@ -200,13 +207,16 @@ class ModelSlave(Fmi2Slave):
         host's signal handlers wait until FMU code returns, ``fmukit.pythonfmu07.signals``.)"""
         number = signals.interrupt_signal(error)
         cause = f"interrupted by {number.name}" if number else explain(error)
-        self.failure = self.failure or f"{where}: {cause}; the FMU has failed"
-        return Refused(self.failure)
+        if not self.failure:
+            self.failure = f"{where}: {cause}; the FMU has failed"
+            self.failure_cause = "interrupted"
+        return Refused(self.failure, self.failure_cause)
 
-    def _fail(self, reason: str) -> NoReturn:
-        """Fail the FMU for ``reason``: refuse this call and every step until fmi2Reset."""
-        self.failure = reason
-        raise Refused(reason)
+    def _fail(self, reason: str, cause: str, error: BaseException | None = None) -> NoReturn:
+        """Fail the FMU for ``reason`` (its ``cause``): refuse this call and every step until
+        fmi2Reset."""
+        self.failure, self.failure_cause = reason, cause
+        raise Refused(reason, cause) from error
 
     # -- setters: refuse what the standard does not allow ----------------------
     def _set(self, vrs: list[int], values: list, convert: type) -> None:
@@ -215,7 +225,7 @@ class ModelSlave(Fmi2Slave):
         for vr, value in zip(vrs, values):
             var = self.registry.by_vr[vr]
             if var.kind is not convert:
-                raise ValueError(f"{var.name} is not of type {convert.__name__}")
+                raise Refused(f"{var.name} is not of type {convert.__name__}", "call", var.name)
             setattr(self, var.name, convert(value))
             if var.causality == "parameter":
                 self._model = None
@@ -238,7 +248,7 @@ class ModelSlave(Fmi2Slave):
 
     @fmi_entry
     def set_boolean(self, vrs: list[int], values: list[bool]) -> None:
-        raise ValueError("this FMU has no Boolean variables")
+        raise Refused("this FMU has no Boolean variables", "call")
 
     # -- getters ---------------------------------------------------------------------
     @fmi_entry
@@ -275,3 +285,8 @@ class ModelSlave(Fmi2Slave):
     # -- modelDescription.xml ------------------------------------------------------
     def to_xml(self, model_options: dict[str, str] = dict()) -> Element:
         return model_description.complete(super().to_xml(model_options), self.variables)
+
+
+def _cause(error: BaseException, otherwise: str) -> str:
+    """A refusal's own cause; ``otherwise`` for any other exception."""
+    return error.cause if isinstance(error, Refused) else otherwise

@@ -22,6 +22,7 @@ def capture(slave: Any) -> dict[str, Any]:
                    if v.causality != "output"},
         "model": slave._model.snapshot() if slave._model is not None else None,
         "failure": slave.failure,
+        "failure_cause": slave.failure_cause,
     }
 
 
@@ -33,6 +34,7 @@ def restore(slave: Any, state: dict[str, Any]) -> None:
         setattr(slave, name, value)
     slave.sequence.phase = state["phase"]
     slave.failure = state.get("failure")
+    slave.failure_cause = state.get("failure_cause", "model")
     slave._model = None
     if state["model"] is not None:
         slave._model = slave.build_model()

@@ -11,6 +11,7 @@ import sys
 from dataclasses import dataclass
 from typing import Any, Callable
 
+from .refusals import Refused
 from .units import UNITS
 
 
@@ -61,15 +62,16 @@ class Var:
                    get)
 
     def check(self, value: Any) -> None:
-        """ValueError naming this variable if a number is NaN, infinite or out of range."""
+        """Refused naming this variable if a number is NaN, infinite or out of range."""
         if self.kind is str:
             return
         kind = "input" if self.causality == "input" else "parameter"
         if not math.isfinite(value):
-            raise ValueError(f"{kind} {self.name} = {value} is not finite")
+            raise Refused(f"{kind} {self.name} = {value} is not finite",
+                          "nonfinite_input" if kind == "input" else kind, self.name)
         if not self.min <= value <= self.max:
-            raise ValueError(f"{kind} {self.name} = {value} is outside its range "
-                             f"[{self.min:g}, {self.max:g}]")
+            raise Refused(f"{kind} {self.name} = {value} is outside its range "
+                          f"[{self.min:g}, {self.max:g}]", kind, self.name)
 
     @property
     def is_real(self) -> bool:
@@ -78,7 +80,7 @@ class Var:
 
 def range_check(variables: tuple[Var, ...]) -> Callable[[Any], None]:
     """A function checking the numeric ``variables`` as attributes of an object at once:
-    ValueError from the first one's ``Var.check`` that fails.
+    Refused from the first one's ``Var.check`` that fails.
 
     What every step checks of its inputs, so the test is compiled to one expression,
     ``low <= obj.name <= high and ...``, each range clipped to the finite doubles,

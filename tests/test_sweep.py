@@ -303,7 +303,7 @@ def test_when_every_run_fails_the_summary_still_names_each_failure(fmu_paths, tm
     assert "bad: 2 runs, 0 ok, 2 failed" in child.stdout
     for controller in ("pd", "smc"):
         assert (f"failed {controller} (Hs = -1.0): FMU 'ship': exitInitializationMode at t = 0 s "
-                "returned OK but logged an error / ship log: [error] exitInitializationMode at "
+                "returned OK but logged an error / [error] ship: exitInitializationMode at "
                 "t = 0.0: parameter Hs = -1.0 is outside its range") in child.stdout, child.stdout
     assert "no run succeeded: no figures drawn" in child.stderr
     assert (tmp_path / "out" / "bad" / "results.parquet").exists()

@@ -1,8 +1,6 @@
 """The master's FMI backend: one FMU instance driven through fmpy, its log captured, clear errors."""
 from __future__ import annotations
 
-import ast
-import re
 import shutil
 import signal
 import subprocess
@@ -19,9 +17,7 @@ from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFr
 from fmpy.model_description import ModelDescription
 
 from fmubuild.project import BUILD_HINT, FMUS
-from fmukit.refusals import Refused, unnamed
-
-from .instance import FmuCallError, Instance, logged_error
+from .instance import FmuCallError, Instance, LogRecord, logged_error, one_account
 
 STATUS = ("ok", "warning", "discard", "error", "fatal", "pending")
 
@@ -60,25 +56,6 @@ def trial_instantiation(path: str | Path, timeout: float = 120.0) -> None:
                          + "".join(f"\n  {line}" for line in last))
 
 
-_PYTHONFMU_FATAL = re.compile(r"Fatal py exception encountered: \[[^]]*\] \w+\s*\n?"
-                             r"(\w+)\((.*)\)\s*$", re.S)
-
-
-def python_error(message: str) -> str:
-    """pythonfmu's 'Fatal py exception encountered: [doStep] PyObject_CallMethod
-    ValueError('why')' as 'ValueError: why' (a refusal as 'why'); other messages as they
-    are."""
-    match = _PYTHONFMU_FATAL.match(message.strip())
-    if match is None:
-        return message
-    try:
-        args = ast.literal_eval(f"({match.group(2)},)")
-    except (ValueError, SyntaxError):
-        return message
-    kind, text = match.group(1), args[0] if len(args) == 1 else args
-    return str(text) if kind == Refused.__name__ else f"{kind}: {text}"
-
-
 def feedthrough(description: ModelDescription) -> dict[str, frozenset[str]]:
     """Each output's inputs, from the model structure (all inputs where it declares none)."""
     inputs = frozenset(v.name for v in description.modelVariables if v.causality == "input")
@@ -102,7 +79,7 @@ class FmuInstance(Instance):
         self.unzip_dir = str(unzip_dir) if unzip_dir else extract(str(self.path))
         self.variables = {v.name: v for v in self.description.modelVariables}
         self.feedthrough = feedthrough(self.description)
-        self.log: deque[str] = deque(maxlen=50)     # the last messages
+        self.log: deque[LogRecord] = deque(maxlen=50)     # the last messages
         self.logged = 0                              # how many there have been
         self._callbacks = fmi2CallbackFunctions()
         self._callbacks.logger = fmi2CallbackLoggerTYPE(self._on_log)
@@ -119,7 +96,9 @@ class FmuInstance(Instance):
             if isinstance(error, FmuCallError):
                 raise
             raise FmuCallError(name, f"instantiate ({self.path.name})", None, "failure",
-                               [*self.log, f"{type(error).__name__}: {error}"]) from error
+                               [*self.log, LogRecord("fatal", None,
+                                                     f"{type(error).__name__}: {error}")]
+                               ) from error
 
     @property
     def guid(self) -> str:
@@ -127,8 +106,9 @@ class FmuInstance(Instance):
 
     def _on_log(self, env, instance, status, category, message) -> None:
         self.logged += 1
-        self.log.append(f"[{STATUS[status] if status < len(STATUS) else status}] "
-                        + unnamed(self.name, python_error(message.decode("utf-8", "replace"))))
+        self.log.append(LogRecord(STATUS[status] if status < len(STATUS) else str(status),
+                                  category.decode("utf-8", "replace") if category else None,
+                                  message.decode("utf-8", "replace")))
 
     def call(self, what: str, function, *args, time: float | None = None, strict: bool = False,
              **kwargs) -> Any:
@@ -138,18 +118,18 @@ class FmuInstance(Instance):
         try:
             result = function(*args, **kwargs)
         except FMICallException as error:
-            status = str(error).rsplit("(", 1)[-1].rstrip(").")
-            raise FmuCallError(self.name, what, time, status, self._since(before)) from error
+            raise FmuCallError(self.name, what, time, STATUS[error.status],
+                               self._since(before)) from error
         if strict and logged_error(self._since(before)):
             raise FmuCallError(self.name, what, time, "OK but logged an error",
                                self._since(before))
         return result
 
-    def _since(self, before: int) -> list[str]:
-        """The log messages of the call that began when ``before`` had been logged (the
-        last 50 of them, as the log keeps no more)."""
+    def _since(self, before: int) -> list[LogRecord]:
+        """The log of the call that began when ``before`` had been logged (the last 50
+        messages, as the log keeps no more), each failure told once."""
         new = self.logged - before
-        return list(self.log)[-new:] if new else []
+        return one_account(list(self.log)[-new:] if new else [])
 
     def fmi(self, name: str):
         return getattr(self.slave, name)
@@ -161,8 +141,9 @@ class FmuInstance(Instance):
     def reset(self) -> None:
         self.call("reset", self.slave.reset)
 
-    # Prepared calls: the raw FMI functions on preallocated ctypes arrays, without
-    # fmpy's per-call wrapping, which costs more than the call itself.
+    # Prepared calls: the raw FMI functions of the FMU's library (fmpy's ``dll``, their
+    # argument types set by fmpy) on preallocated ctypes arrays, without fmpy's per-call
+    # wrapping, which costs more than the call itself.
     def _status(self, what: str, status: int, before: int, time: float | None = None) -> None:
         if status > 1:                      # discard, error, fatal
             raise FmuCallError(self.name, what, time, STATUS[status], self._since(before))
@@ -174,7 +155,7 @@ class FmuInstance(Instance):
         return self._getter("fmi2GetInteger", fmi2Integer, vrs)
 
     def _getter(self, function: str, ctype, vrs: list[int]):
-        get, component = self.slave._functions[function], self.slave.component
+        get, component = getattr(self.slave.dll, function), self.slave.component
         n = len(vrs)
         refs, values = (fmi2ValueReference * n)(*vrs), (ctype * n)()
         what = function.removeprefix("fmi2")
@@ -188,7 +169,7 @@ class FmuInstance(Instance):
         return read
 
     def writer(self, vrs: list[int]):
-        set_, component = self.slave._functions["fmi2SetReal"], self.slave.component
+        set_, component = self.slave.dll.fmi2SetReal, self.slave.component
         n = len(vrs)
         refs, values = (fmi2ValueReference * n)(*vrs), (fmi2Real * n)()
 
@@ -201,7 +182,7 @@ class FmuInstance(Instance):
         return write
 
     def stepper(self):
-        do_step, component = self.slave._functions["fmi2DoStep"], self.slave.component
+        do_step, component = self.slave.dll.fmi2DoStep, self.slave.component
 
         def step(t: float, h: float) -> None:
             before = self.logged

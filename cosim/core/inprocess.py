@@ -31,10 +31,10 @@ from xml.etree import ElementTree
 from fmubuild.manifest import Manifest, read, staleness
 from fmubuild.project import BUILD_HINT, FMUS
 from fmukit.pythonfmu07.entry import unguarded
-from fmukit.refusals import explain, unnamed
+from fmukit.refusals import Refused, explain, naming
 from fmukit.slave import ModelSlave
 
-from .instance import FmuCallError, Instance, logged_error
+from .instance import FmuCallError, Instance, LogRecord, logged_error
 
 _FMI_TYPE = {float: "Real", int: "Integer", str: "String"}
 
@@ -170,8 +170,14 @@ class InProcessInstance(Instance):
         return result
 
     def _failure(self, what: str, time: float | None, error: Exception) -> FmuCallError:
-        return FmuCallError(self.name, what, time, "fatal",      # as pythonfmu logs it
-                            [*self._drain(), f"[fatal] {unnamed(self.name, explain(error))}"])
+        """The refusal as FMI reports it: fatal (as pythonfmu does) with the FMU's log; a
+        refusal the FMU did not log itself (a step called past the FMI entry's wrapper)
+        as a message of its own, with its cause."""
+        records = self._drain()
+        if not any(r.cause for r in records):
+            category = error.category if isinstance(error, Refused) else None
+            records.append(LogRecord("fatal", category, naming(self.name, explain(error))))
+        return FmuCallError(self.name, what, time, "fatal", records)
 
     def _judge(self, what: str, time: float | None, result: Any, strict: bool) -> None:
         """FmuCallError if a call refused (returned False) or, ``strict``, logged an error;
@@ -182,11 +188,10 @@ class InProcessInstance(Instance):
         if strict and logged_error(messages):
             raise FmuCallError(self.name, what, time, "OK but logged an error", messages)
 
-    def _drain(self) -> list[str]:
-        messages = [f"[{m.status.name}] {unnamed(self.name, m.msg)}"
-                    for m in self.slave.log_queue]
+    def _drain(self) -> list[LogRecord]:
+        records = [LogRecord(m.status.name, m.category, m.msg) for m in self.slave.log_queue]
         self.slave.log_queue.clear()
-        return messages
+        return records
 
     def fmi(self, name: str):
         """The slave method behind an FMI call name: setReal -> set_real."""

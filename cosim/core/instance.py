@@ -8,26 +8,58 @@ loop uses with faster ones; everything else is shared here.
 """
 from __future__ import annotations
 
-from typing import Any, Callable, Iterable
+from typing import Any, Callable, Iterable, NamedTuple
 
 _CONVERT = {"Real": float, "Integer": int, "Boolean": bool, "String": str}
 
 
+class LogRecord(NamedTuple):
+    """One message an FMU logged: its status, its category and its text."""
+
+    status: str                 # ok, warning, discard, error, fatal, pending
+    category: str | None
+    text: str
+
+    def __str__(self) -> str:
+        return f"[{self.status}] {self.text}"
+
+    @property
+    def cause(self) -> str | None:
+        """What an FMU built with fmukit refused (its category is fmukit.<cause>,
+        ``fmukit.refusals.CAUSES``); None for any other message."""
+        prefix = "fmukit."
+        return self.category[len(prefix):] if (self.category or "").startswith(prefix) else None
+
+
 class FmuCallError(RuntimeError):
-    """An FMI call returned discard, error or fatal; carries the FMU's own log."""
+    """An FMI call returned discard, error or fatal; carries the FMU's own log, as records
+    and as lines (``messages``), and the cause of the refusal where the FMU says it."""
 
     def __init__(self, instance: str, call: str, time: float | None, status: str,
-                 messages: Iterable[str]):
+                 records: Iterable[LogRecord]):
         self.instance, self.call, self.time, self.status = instance, call, time, status
-        self.messages = list(messages)
+        self.records = list(records)
+        self.messages = [str(r) for r in self.records]
+        self.cause = next((r.cause for r in self.records if r.cause), None)
         at = "" if time is None else f" at t = {time:.6g} s"
-        log = "".join(f"\n  {instance} log: {m}" for m in self.messages)
+        # an FMU built with fmukit names itself in its messages; any other's are labelled
+        log = "".join(f"\n  {r}" if r.cause else f"\n  {instance} log: {r}"
+                      for r in self.records)
         super().__init__(f"FMU '{instance}': {call}{at} returned {status}{log}")
 
 
-def logged_error(messages: Iterable[str]) -> bool:
-    """Whether a call's log messages include an error (``[error]`` or ``[fatal]``)."""
-    return any(m.startswith(("[error]", "[fatal]")) for m in messages)
+def logged_error(records: Iterable[LogRecord]) -> bool:
+    """Whether a call's log includes an error (status error or fatal)."""
+    return any(r.status in ("error", "fatal") for r in records)
+
+
+def one_account(records: list[LogRecord]) -> list[LogRecord]:
+    """The records of one call, each failure told once: where an FMU built with fmukit
+    logged its refusal (a cause), the message its FMI layer logs for the same exception
+    (pythonfmu's, with no category) is left out."""
+    if not any(r.cause for r in records):
+        return records
+    return [r for r in records if r.category is not None or r.status != "fatal"]
 
 
 class Instance:

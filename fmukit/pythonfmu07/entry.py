@@ -5,7 +5,8 @@ releases the instance, its class and its log queue once per exception and again
 at fmi2FreeInstance, a use-after-free that crashes the host later. ``fmi_entry``
 takes one extra reference on those three objects before any exception leaves
 Python, so the host survives; and it tells the user why, through the host's
-logger or on standard error (``hostlog``). A KeyboardInterrupt (or any
+logger (a message whose category, ``fmukit.<cause>``, says what was refused) or on
+standard error (``hostlog``). A KeyboardInterrupt (or any
 other BaseException) raised in FMU code fails the FMU like a refusal does
 (``ModelSlave.interrupted``).
 """
@@ -16,7 +17,7 @@ import functools
 from typing import Callable
 
 from ..refusals import Refused, explain, naming
-from . import ACTIVE
+from . import ACTIVE, Fmi2Status
 
 
 def fmi_entry(method: Callable) -> Callable:
@@ -28,13 +29,15 @@ def fmi_entry(method: Callable) -> Callable:
         except BaseException as error:
             if not isinstance(error, Exception):  # Ctrl-C or the like: the FMU has failed
                 error = self.interrupted(method.__name__, error)
-            text = (explain(error) if isinstance(error, Refused)
-                    else f"{method.__name__}: {explain(error)}")
-            self.host_log.tell(self.instance_name, text)
+            refused = (error if isinstance(error, Refused)
+                       else Refused(f"{method.__name__}: {explain(error)}", "model"))
+            # The cause as data: the category. pythonfmu logs the exception too, with none.
+            self.log(naming(self.instance_name, str(refused)), Fmi2Status.fatal, refused.category)
+            self.host_log.tell(self.instance_name, str(refused))
             if ACTIVE:             # pythonfmu 0.7.0 releases them once per exception
                 for obj in (self, type(self), self.log_queue):
                     ctypes.pythonapi.Py_IncRef(ctypes.py_object(obj))
-            raise Refused(naming(self.instance_name, text)) from error
+            raise refused from error
     return entry
 
 
