@@ -13,12 +13,14 @@ Layers, each a sub-package whose docstring says more:
   in-process reference.
 
 On top of them, directly in ``cosim/``: the Python entry point ``cosim.simulate``
-(``api.py``), the pytest plugin (``testing.py``), and the commands (``python -m
+(``api.py``), a run with what it writes (``outputs.py``: ``cosim.run_and_write``, the one
+lifecycle of a run and its files), the pytest plugin (``testing.py``), and the commands (``python -m
 cosim.run``, ``cosim.sweep``, ``cosim.export``, ``cosim.bench``, ``cosim.engines``,
 ``cosim.score``), which parse options and print; ``_cli.py`` is what they share. A
 module imports only from the sub-packages listed before its own (the core from
 none); nothing imports a command.
 """
 from .api import SimulationError, simulate
+from .outputs import run_and_write
 
-__all__ = ["simulate", "SimulationError"]
+__all__ = ["simulate", "SimulationError", "run_and_write"]

@@ -68,14 +68,11 @@ def simulate(scenario: str | Path, autopilot: str | Path | None = None,
     FileNotFoundError for bad input, naming it; SimulationError if an FMU fails during
     the run.
     """
-    master = Master(scenarios.load(scenario, autopilot, port_map), coupling=coupling,
-                    backend=backend, overrides=overrides_of(set or {}))
-    for note in master.notes:
-        warnings.warn(note, stacklevel=2)
-    try:
+    with Master(scenarios.load(scenario, autopilot, port_map), coupling=coupling,
+                backend=backend, overrides=overrides_of(set or {})) as master:
+        for note in master.notes:
+            warnings.warn(note, stacklevel=2)
         recording = master.run(stop_time)
-    finally:
-        master.free()
     if recording.error:
         raise SimulationError(recording.error, recording)
     return recording

@@ -18,26 +18,23 @@ from __future__ import annotations
 
 import argparse
 import sys
-from dataclasses import dataclass
 from pathlib import Path
 from typing import NamedTuple
 
 from . import scenarios
 from ._cli import (Progress, add_autopilot_options, checked_autopilot, chosen_scenarios, entry,
                    setting_option, writable_folder)
-from .analysis.animation import animate, require_track, video_format
-from .analysis.cost import LAMBDA, Cost, cost
+from .analysis.animation import video_format
+from .analysis.cost import LAMBDA, Cost
 from .analysis.describe import conditions
-from .analysis.figures import save_figure
-from .analysis.kinds import analysis
 from .analysis.reports import tables
 from .api import overrides_of
 from .core.coupling import COUPLINGS
 from .core.instance import FmuCallError
 from .core.interrupt import StopSignals
-from .core.master import BACKENDS, Master
-from .core.provenance import write_metadata
+from .core.master import BACKENDS
 from .core.ssd import SystemDescription
+from .outputs import Options, run_and_write
 from .scenarios.autopilot import COMPONENT
 from .studies.spread import PERTURBED, spread
 
@@ -45,70 +42,36 @@ RUN_BACKENDS = [b for b in BACKENDS if b != "null"]     # null runs measure the 
 
 
 
-@dataclass(frozen=True)
-class Options:
-    """How to run and what to write, from the command line."""
-
-    coupling: str = "gauss-seidel"
-    stop_time: float | None = None
-    lam: float = LAMBDA
-    backend: str = "fmi"
-    plot: bool = True
-    formats: tuple[str, ...] = ("png",)
-    stream: bool = False
-    animate: str | None = None          # "gif" or "mp4"
-
-
 def run_scenario(system: SystemDescription, label: str, out: Path, overrides: dict,
                  options: Options) -> tuple[int, Cost | None]:
-    """Simulate one system; write its CSV, its metadata and its figure as ``label``; print
+    """Simulate one system and write its outputs as ``label`` (``cosim.outputs``); print
     what it was and its report. The status is 0, 1 if an FMU failed, or 130 / 143 if
     Ctrl-C or SIGTERM stopped the run (its rows are written all the same)."""
-    kind = analysis(system.report)
     with StopSignals() as stop:           # from here on, a signal stops between steps
-        master = Master(system, coupling=options.coupling, overrides=overrides,
-                        backend=options.backend)
-        for note in master.notes:
-            print(f"note: {note}", file=sys.stderr)
         progress = Progress(label)
-        csv_path = out / f"{label}.csv"
         try:
-            if options.animate:
-                require_track(master.columns)
-            for old in out.glob(f"{label}.*"):     # a previous run's outputs would mislead
-                if old.suffix in (".csv", ".json", ".png", ".svg", ".pdf", ".gif", ".mp4"):
-                    old.unlink()
-            recording = master.run(options.stop_time, progress=progress,
-                                   csv_path=csv_path if options.stream else None, stop=stop)
+            outcome = run_and_write(system, label, out, overrides, options, progress, stop,
+                                    notes=lambda note: print(f"note: {note}", file=sys.stderr))
         finally:
             progress.close()
-            master.free()
-    if not options.stream:
-        recording.write_csv(csv_path)
-    written = [csv_path, write_metadata(recording, out / f"{label}.json")]
+    recording, csv_path = outcome.recording, outcome.csv
     print(f"{label}: {system.description}")
     for line in conditions(recording.meta):
         print(f"  {line}")
     if recording.interrupted:
         print(f"{recording.error}; written to {csv_path}", file=sys.stderr)
-        return stop.exit_status, None
-    if recording.error:
+    elif recording.error:
         print(f"error: {recording.error}", file=sys.stderr)
         print(f"  the {recording.rows} rows recorded before the error are in {csv_path}",
               file=sys.stderr)
-        return 1, None
-    if options.stream:
+    elif options.stream:
         print(f"  {recording.rows} rows streamed to {csv_path} "
               "(no report or figure in --stream mode)")
-        return 0, None
-    for line in kind.report(recording, lam=options.lam, parameters=master.parameters):
-        print(f"  {line}")
-    if options.plot and kind.figure is not None:
-        written += save_figure(recording, kind.figure, out / label, label, options.formats)
-    if options.animate:
-        written.append(animate(recording, out / label, label, options.animate))
-    print(f"  wrote {', '.join(str(p) for p in written)}")
-    return 0, cost(recording, options.lam) if system.report == "course_keeping" else None
+    else:
+        for line in outcome.report:
+            print(f"  {line}")
+        print(f"  wrote {', '.join(str(p) for p in outcome.written)}")
+    return outcome.status, outcome.cost
 
 
 class Run(NamedTuple):

@@ -334,7 +334,7 @@ def test_unwritable_output_folder_is_refused_before_simulating(tmp_path, monkeyp
 
     def no_simulation(*args, **kwargs):
         raise AssertionError("simulated although the output folder is unusable")
-    monkeypatch.setattr(cli, "Master", no_simulation)
+    monkeypatch.setattr(cli, "run_and_write", no_simulation)
     with pytest.raises(SystemExit, match="not writable"):
         cli.main(["calm_pd", "--out", str(blocker / "results")])
 

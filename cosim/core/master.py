@@ -43,7 +43,11 @@ null: nothing but the FMUs' interfaces, to measure the master's own cost
 
 
 class Master:
-    """Instantiate, initialise and step the components of a system description."""
+    """Instantiate, initialise and step the components of a system description.
+
+    A context manager: ``with Master(system) as master: recording = master.run()``
+    frees the FMUs however the block ends.
+    """
 
     def __init__(self, system: SystemDescription, coupling: str = "gauss-seidel",
                  backend: str = "fmi", overrides: dict[str, dict[str, Any]] | None = None,
@@ -181,8 +185,15 @@ class Master:
             recording = recorder.close(error)
         return recording
 
+    def __enter__(self) -> Master:
+        return self
+
+    def __exit__(self, *exc_info) -> None:
+        self.free()
+
     def free(self) -> None:
-        """Terminate and free every FMU."""
+        """Terminate and free every FMU (what leaving ``with Master(...) as master:`` does,
+        on every path)."""
         for instance in self.instances.values():
             instance.free()
         self.instances = {}

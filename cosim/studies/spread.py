@@ -80,9 +80,8 @@ def spread(system: SystemDescription, overrides: dict[str, dict[str, Any]] | Non
     overrides = {c: dict(v) for c, v in (overrides or {}).items()}
     members = [(None, 0)] + [(p, k) for p in PERTURBED
                              for j in range(1, ulps + 1) for k in (-j, j)]
-    master = Master(system, coupling=coupling, backend="inprocess", overrides=overrides)
     costs: list[Cost] = []
-    try:
+    with Master(system, coupling=coupling, backend="inprocess", overrides=overrides) as master:
         for component, name in PERTURBED:
             instance = master.instances.get(component)
             if instance is None or name not in instance.variables:
@@ -104,8 +103,6 @@ def spread(system: SystemDescription, overrides: dict[str, dict[str, Any]] | Non
             costs.append(cost(recording, lam))
             if progress is not None:
                 progress(i + 1, len(members))
-    finally:
-        master.free()
     nominal = {f: getattr(costs[0], f) for f in FIGURES}
     deviation = {f: max(abs(getattr(c, f) - nominal[f]) for c in costs) for f in FIGURES}
     return Spread(len(costs), ulps, nominal, deviation)
