@@ -16,6 +16,7 @@ from typing import Any
 
 from . import scenarios
 from .core.master import Master
+from .core.ssd import split_name
 from .core.recording import Recording
 
 
@@ -31,9 +32,12 @@ def parse_setting(text: str) -> tuple[str, int | float | str]:
     """'component.variable=value' -> ('component.variable', value); numbers become int or
     float. ValueError naming the text if it is not of that form."""
     target, sep, raw = text.partition("=")
-    component, dot, variable = target.partition(".")
-    if not (sep and dot and component and variable):
-        raise ValueError(f"--set expects COMPONENT.VARIABLE=VALUE, got {text!r}")
+    try:
+        if not sep:
+            raise ValueError("no '='")
+        split_name(target)
+    except ValueError:
+        raise ValueError(f"--set expects COMPONENT.VARIABLE=VALUE, got {text!r}") from None
     for convert in (int, float):
         try:
             return target, convert(raw)
@@ -46,9 +50,10 @@ def overrides_of(settings: dict[str, Any]) -> dict[str, dict[str, Any]]:
     """{'ship.Hs': 0.01} -> {'ship': {'Hs': 0.01}}; ValueError for a key without a dot."""
     overrides: dict[str, dict[str, Any]] = {}
     for target, value in settings.items():
-        component, dot, variable = target.partition(".")
-        if not (dot and component and variable):
-            raise ValueError(f"set: {target!r} is not 'component.variable'")
+        try:
+            component, variable = split_name(target)
+        except ValueError as error:
+            raise ValueError(f"set: {error}") from None
         overrides.setdefault(component, {})[variable] = value
     return overrides
 

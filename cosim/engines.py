@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ._cli import entry
-from .interop.engines import ENGINES, SIGNALS, EngineError, run
+from .interop.engines import ENGINES, TRACED, EngineError, run
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -25,7 +25,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("engine", choices=ENGINES)
     parser.add_argument("ssp", type=Path)
     parser.add_argument("--out", type=Path, required=True, help=".npz file to write")
-    parser.add_argument("--signals", nargs="+", default=list(SIGNALS),
+    parser.add_argument("--signals", nargs="+", default=list(TRACED),
                         help="component.variable names to record (Real)")
     args = parser.parse_args(argv)
     try:

@@ -32,13 +32,11 @@ from .api import overrides_of
 from .core.coupling import COUPLINGS
 from .core.instance import FmuCallError
 from .core.interrupt import StopSignals
-from .core.master import BACKENDS
+from .core.master import RUN_BACKENDS
 from .core.ssd import SystemDescription
 from .outputs import Options, run_and_write
 from .scenarios.autopilot import COMPONENT
 from .studies.spread import PERTURBED, spread
-
-RUN_BACKENDS = [b for b in BACKENDS if b != "null"]     # null runs measure the master only
 
 
 

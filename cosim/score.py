@@ -16,6 +16,7 @@ import time
 from pathlib import Path
 
 from ._cli import add_port_options, checked_autopilot, entry, setting_option, writable_folder
+from .core.master import RUN_BACKENDS
 from .studies.scorecard import backend_notes, score
 from .studies.sweep_client import NoWorkers
 
@@ -40,7 +41,7 @@ def main(argv: list[str] | None = None) -> int:
                              "cluster)")
     parser.add_argument("--workers", type=int, help="local Dask worker processes "
                                                     "(default: one per core)")
-    parser.add_argument("--backend", choices=("fmi", "inprocess"), default="fmi",
+    parser.add_argument("--backend", choices=RUN_BACKENDS, default="fmi",
                         help="fmi: every run through the FMUs (default); inprocess: this "
                              "project's FMUs as Python classes, without FMI: the same results, "
                              "about 1.3-2 times faster. Yours runs in-process only if it is one "

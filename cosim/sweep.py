@@ -7,6 +7,7 @@ from pathlib import Path
 
 from ._cli import entry, writable_folder
 from .core.interrupt import Interrupted
+from .core.master import RUN_BACKENDS
 from .studies import sweep
 from .studies.sweep_client import NoWorkers, SweepError
 from .studies.sweep_figures import save_figures
@@ -42,7 +43,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--workers", type=int,
                         help="worker processes of the local cluster (default: cores)")
     parser.add_argument("--out", type=Path, default=RESULTS, help="parent folder of the results")
-    parser.add_argument("--backend", choices=("fmi", "inprocess"), default="fmi",
+    parser.add_argument("--backend", choices=RUN_BACKENDS, default="fmi",
                         help="fmi: each run through the FMUs (default); inprocess: this "
                              "project's FMUs as Python classes, without FMI: the same results, "
                              "about 1.3-2 times faster per run (an FMU not of this checkout "

@@ -13,7 +13,7 @@ import pytest
 
 from cosim import scenarios
 from cosim.core.master import Master
-from cosim.interop.engines import SIGNALS, EngineError, run
+from cosim.interop.engines import TRACED, EngineError, run
 from cosim.interop.ssp import export
 from fmukit.timebase import nanoseconds
 
@@ -59,7 +59,7 @@ def _compare(engine_trace: dict, name: str) -> tuple[float, int]:
     beyond = sum(r is None for r in rows)
     both = [(i, r) for i, r in enumerate(rows) if r is not None]
     ei, oi = map(list, zip(*both))
-    worst = max(np.abs(engine_trace[s][ei] - rec[s][oi]).max() for s in SIGNALS)
+    worst = max(np.abs(engine_trace[s][ei] - rec[s][oi]).max() for s in TRACED)
     return worst, beyond
 
 

@@ -30,16 +30,18 @@ from .instance import FmuCallError, Instance
 from .interrupt import StopSignals
 from .null import NullInstance
 from .recording import Recorder, Recording
-from .ssd import SystemDescription
+from .ssd import SystemDescription, split_name
 from .wiring import check_connections, feedthrough_order, layout
 
 
 BACKENDS: dict[str, type[Instance]] = {"fmi": FmuInstance, "inprocess": InProcessInstance,
                                        "null": NullInstance}
-"""fmi: the FMUs through fmpy; inprocess: their Python classes without FMI (an FMU this
-project does not build, or built from other sources, runs through FMI, with a note);
-null: nothing but the FMUs' interfaces, to measure the master's own cost
-(``cosim.core.null``)."""
+"""fmi: the FMUs through fmpy; inprocess: their Python classes without FMI (an FMU that
+is not current in this process runs through FMI, with a note:
+``cosim.core.inprocess.fallback_note``, the one place that decides it); null: nothing
+but the FMUs' interfaces, to measure the master's own cost (``cosim.core.null``)."""
+RUN_BACKENDS = ("fmi", "inprocess")
+"""The backends a run of a scenario may take (null measures the master only)."""
 
 
 class Master:
@@ -73,7 +75,7 @@ class Master:
             raise
         self.units = {column: self.instances[component].unit(variable)
                       for column in self.columns
-                      for component, variable in [column.split(".", 1)]}
+                      for component, variable in [split_name(column)]}
 
     def _instantiate(self, path: Path, name: str) -> Instance:
         backend = self.backend

@@ -37,6 +37,15 @@ for _prefix, _uri in NS.items():
     ET.register_namespace(_prefix, _uri)
 
 
+
+def split_name(name: str) -> tuple[str, str]:
+    """'ship.psi' -> ('ship', 'psi'): a variable by its component; ValueError naming ``name``
+    if it is not of the form component.variable."""
+    component, dot, variable = name.partition(".")
+    if not (dot and component and variable):
+        raise ValueError(f"{name!r} is not 'component.variable'")
+    return component, variable
+
 @dataclass
 class Component:
     name: str

@@ -39,21 +39,17 @@ import numpy as np
 
 from fmukit.timebase import communication_point, step_count
 
-from ..core.interrupt import SIGNALS as SIGNALS_TO_STOP, Interrupted, StopSignals
+from ..core.interrupt import STOP_SIGNALS, Interrupted, StopSignals
+from ..core.ssd import split_name
 
 from .ssp import read_package
 
 ENGINES = ("libcosim", "ecos", "fmpy")
-SIGNALS = ("ship.psi", "ship.r", "ship.delta")
+TRACED = ("ship.psi", "ship.r", "ship.delta")
 
 
 class EngineError(RuntimeError):
     """An engine failed or produced undefined values; the message holds its output."""
-
-
-def _split(signal: str) -> tuple[str, str]:
-    component, _, variable = signal.partition(".")
-    return component, variable
 
 
 def _libcosim(ssp: Path, signals: tuple[str, ...], stop: StopSignals) -> dict[str, np.ndarray]:
@@ -70,7 +66,7 @@ def _libcosim(ssp: Path, signals: tuple[str, ...], stop: StopSignals) -> dict[st
                   for name, i in slaves.items()}
     observer = CosimObserver.create_last_value()
     execution.add_observer(observer)
-    reads = [(slaves[c], references[c][v]) for c, v in map(_split, signals)]
+    reads = [(slaves[c], references[c][v]) for c, v in map(split_name, signals)]
 
     def sample() -> list[float]:
         return [observer.last_real_values(index, [vr])[0] for index, vr in reads]
@@ -94,7 +90,7 @@ def _ecos(ssp: Path, signals: tuple[str, ...], stop: StopSignals) -> dict[str, n
     system = read_package(ssp)
     n_steps = step_count(system.start_time, system.stop_time, system.step_size)
     simulation = EcosSimulation(step_size=system.step_size, ssp_path=str(ssp))
-    identifiers = [f"{c}::{v}" for c, v in map(_split, signals)]
+    identifiers = [f"{c}::{v}" for c, v in map(split_name, signals)]
     try:
         if not simulation.init(parameter_set="scenario"):
             raise EngineError(f"ecos failed to initialise: {EcosLib.get_last_error()}")
@@ -165,7 +161,7 @@ def check_package(ssp: Path) -> None:
                                   "finite")
 
 
-def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = SIGNALS,
+def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = TRACED,
         isolate: bool = True) -> dict[str, np.ndarray]:
     """Run ``ssp`` in ``engine``; raise EngineError with the engine's output if it fails.
 
@@ -188,7 +184,7 @@ def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = SIGNALS,
                                 *signals], capture_output=True, text=True, timeout=600)
         log = _summary(child.stdout + child.stderr)
         number = -child.returncode if child.returncode < 0 else child.returncode - 128
-        if number in SIGNALS_TO_STOP:       # Ctrl-C or a kill: not the engine's fault
+        if number in STOP_SIGNALS:       # Ctrl-C or a kill: not the engine's fault
             raise Interrupted(number)
         if child.returncode != 0 or not out.exists():
             how = (f"killed by {signal.Signals(-child.returncode).name}"

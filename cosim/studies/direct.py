@@ -17,8 +17,9 @@ from ship_fmu.vessel import N_PROPELLER
 from ..core.inprocess import InProcessInstance
 from ..core.ssd import SystemDescription
 
-SIGNALS = ("guidance.psi_d", "autopilot.delta_c", "ship.x", "ship.y", "ship.psi", "ship.u",
-           "ship.v", "ship.r", "ship.delta")
+COMPARED = ("guidance.psi_d", "autopilot.delta_c", "ship.x", "ship.y", "ship.psi", "ship.u",
+            "ship.v", "ship.r", "ship.delta")
+"""The signals compared between the co-simulation and the modules wired by hand."""
 
 
 def build_models(system: SystemDescription) -> dict:
@@ -50,7 +51,7 @@ def run_direct(system: SystemDescription, stop_time: float | None = None) -> dic
     stepping_pilot = hasattr(autopilot, "step")
     h, t0 = system.step_size, system.start_time
     n_steps = step_count(t0, system.stop_time if stop_time is None else stop_time, h)
-    out = np.empty((n_steps + 1, len(SIGNALS)))
+    out = np.empty((n_steps + 1, len(COMPARED)))
     for k in range(n_steps + 1):
         t = communication_point(t0, k, h)
         psi_d = guidance.psi_d(ship.x, ship.y)
@@ -62,4 +63,4 @@ def run_direct(system: SystemDescription, stop_time: float | None = None) -> dic
         if stepping_pilot:
             autopilot.step(t, h, psi_d)
         ship.step(t, h, delta_c, n1, n2, n3)
-    return dict(zip(SIGNALS, out.T))
+    return dict(zip(COMPARED, out.T))
