@@ -1,21 +1,15 @@
 """Standard manoeuvres (IMO MSC.137(76) definitions): the rudder program of a turning
-circle or a zig-zag test, and the ship run alone under it (``trial``).
+circle or a zig-zag test (the ship run alone under it: ``ship_fmu.trial``).
 
 The ship starts in steady straight running; a positive rudder turns it to port
 (see ``thrusters``), so headings here go negative first. The manoeuvre FMU
-(``manoeuvre_slave``) runs the program; the figures of a run, recorded or from
-``trial``, are post-processing: ``cosim.analysis.manoeuvres``.
+(``manoeuvre_slave``) runs the program and carries nothing else of the ship; the
+figures of a run, recorded or from ``trial``, are post-processing:
+``cosim.analysis.manoeuvres``.
 """
 from __future__ import annotations
 
 import math
-from dataclasses import replace
-
-from fmukit.timebase import step_count
-
-from .vessel import Vessel, VesselParameters
-
-DT = 0.1
 
 
 class RudderProgram:
@@ -57,19 +51,3 @@ class RudderProgram:
 
     def restore(self, snapshot: dict[str, int]) -> None:
         self.sign, self.reversals = int(snapshot["sign"]), int(snapshot["reversals"])
-
-
-def trial(program: RudderProgram, t_end: float, params: VesselParameters) -> dict[str, list]:
-    """The ship alone under ``program`` for ``t_end`` s in steps of ``DT``, from steady
-    straight running at the origin along x: its x, y, psi, u, v and r at the start of
-    each step, and the program's reversals so far."""
-    vessel = Vessel(replace(params, x0=0.0, y0=0.0, psi0=0.0))
-    track = {name: [] for name in ("x", "y", "psi", "u", "v", "r", "reversals")}
-    for k in range(step_count(0.0, t_end, DT)):
-        delta_c = program.command(vessel.psi)
-        program.update(vessel.psi)
-        for name in track:
-            source = program if name == "reversals" else vessel
-            track[name].append(getattr(source, name))
-        vessel.step(k * DT, DT, delta_c)
-    return track

@@ -4,6 +4,7 @@ from __future__ import annotations
 import math
 import re
 import shutil
+import sys
 import zipfile
 from pathlib import Path
 
@@ -134,7 +135,10 @@ def test_only_fmus_current_in_this_process_run_in_process(fmu_paths, tmp_path, m
     assert in_process_refusal(extra) == "it carries tuning.py, which its manifest does not list"
     assert in_process_refusal(fmu_paths["pd_autopilot_c"]) == ("it was not built with fmukit "
                                                                "(it has no manifest)")
-    # a user's FMU built with fmukit qualifies too, where its sources are importable
+    # a user's FMU built with fmukit qualifies too, where its sources are importable (not
+    # an FMU's copy that a run in this process imported before: pythonfmu runs an FMU's
+    # Python in its host's interpreter)
+    monkeypatch.delitem(sys.modules, "my_pid", raising=False)
     script = shutil.copy(ROOT / "autopilot_fmu" / "pid_autopilot_slave.py", tmp_path / "my_pid.py")
     mine = build_script(Path(script), ("fmukit",), tmp_path / "out" / "my_pid.fmu")
     assert in_process_refusal(mine) == "its module my_pid is not importable here"

@@ -17,9 +17,7 @@ PROJECT = {"cosim", "fmubuild", "fmukit", "ship_fmu", "autopilot_fmu"}
 MODELS = {
     "ship": {"ship_fmu.data", "ship_fmu.hull", "ship_fmu.steering_gear", "ship_fmu.thrusters",
              "ship_fmu.vessel", "ship_fmu.waves"},
-    "manoeuvre": {"ship_fmu.data", "ship_fmu.hull", "ship_fmu.manoeuvres",
-                  "ship_fmu.steering_gear", "ship_fmu.thrusters", "ship_fmu.vessel",
-                  "ship_fmu.waves"},
+    "manoeuvre": {"ship_fmu.manoeuvres"},         # the rudder program, and nothing of the ship
     "pd_autopilot": {"autopilot_fmu.pd"},
     # design_model 'ship' linearises the vessel model
     "smc_autopilot": {"autopilot_fmu.design", "autopilot_fmu.smc", "ship_fmu.data",

@@ -4,7 +4,7 @@ a turning circle's advance, transfer and tactical diameter, a zig-zag's overshoo
 A positive rudder turns the ship to port, so headings go negative first. The
 co-simulated scenarios (``cosim/scenarios/turning_circle.ssd``, ``zigzag_20_20.ssd``:
 ``reports``, ``figures``) and the ship run alone in-process (``turning_circle``,
-``zigzag``, by ``ship_fmu.manoeuvres.trial``) share these figures.
+``zigzag``, by ``ship_fmu.trial``) share these figures.
 """
 from __future__ import annotations
 
@@ -13,7 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ship_fmu.manoeuvres import RudderProgram, trial
+from ship_fmu.manoeuvres import RudderProgram
+from ship_fmu.trial import trial
 from ship_fmu.vessel import VesselParameters
 
 

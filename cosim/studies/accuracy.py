@@ -35,11 +35,8 @@ def cosimulation(name: str, step: float, coupling: str,
     from ..core.master import Master
 
     system = dataclasses.replace(scenarios.load(name), step_size=step)
-    master = Master(system, coupling=coupling, backend="inprocess")
-    try:
+    with Master(system, coupling=coupling, backend="inprocess") as master:
         recording = master.run(stop_time)
-    finally:
-        master.free()
     every = max(1, round(H / step))
     return {"t": recording.t[::every], "psi_d": recording["guidance.psi_d"][::every],
             "psi": recording["ship.psi"][::every], "delta": recording["ship.delta"][::every],

@@ -22,6 +22,8 @@ import time
 from pathlib import Path
 from typing import Callable
 
+from ..core.master import RUN_BACKENDS
+
 STEPS = 4000
 
 
@@ -102,8 +104,9 @@ def engines(repeats: int) -> dict[str, dict[str, float]]:
         for name in ("calm_pd", "waves_pd"):
             system = scenarios.load(name)
             ssp = export(name, Path(tmp))
-            masters = {b: Master(system, backend=b) for b in ("inprocess", "fmi")}
-            try:
+            with Master(system, backend="inprocess") as inprocess, \
+                    Master(system, backend="fmi") as fmi:
+                masters = {"inprocess": inprocess, "fmi": fmi}
                 require_in_process(masters["inprocess"].notes)
                 runners = {"direct": lambda: run_direct(system),
                            **{b: _master_runner(m) for b, m in masters.items()}}
@@ -113,10 +116,7 @@ def engines(repeats: int) -> dict[str, dict[str, float]]:
                     except Exception as error:          # not installed here: say so
                         print(f"  {key} unavailable: {type(error).__name__}: {error}")
                 times = side_by_side(runners, repeats)
-                calls, per_call = fmi_calls_per_step(masters["fmi"]), fmi_call_cost(masters["fmi"])
-            finally:
-                for master in masters.values():
-                    master.free()
+                calls, per_call = fmi_calls_per_step(fmi), fmi_call_cost(fmi)
             times["floor"] = times["direct"] + STEPS * calls * per_call
             results[name] = times
             _print_engines(name, times, calls, per_call)
@@ -194,15 +194,12 @@ def overhead(repeats: int) -> dict[str, float]:
     from .direct import run_direct
 
     system = scenarios.load("calm_pd")
-    null, inprocess = Master(system, backend="null"), Master(system, backend="inprocess")
-    try:
+    with Master(system, backend="null") as null, \
+            Master(system, backend="inprocess") as inprocess:
         require_in_process(inprocess.notes)
         with mock.patch.object(Vessel, "step", lambda self, *args, **kwargs: None):
             times = side_by_side({"direct": lambda: run_direct(system), "null": null.run,
                                   "inprocess": _master_runner(inprocess)}, repeats)
-    finally:
-        null.free()
-        inprocess.free()
     per_step = {key: t / STEPS * 1e6 for key, t in times.items()}
     print(f"What the routes do besides the models: calm_pd, {STEPS} steps with the ship's step "
           f"doing nothing, median of {repeats} runs taken in turn, on {machine()}")
@@ -216,7 +213,7 @@ def overhead(repeats: int) -> dict[str, float]:
     return per_step
 
 
-def memory(hours: float, backends: tuple[str, ...] = ("fmi", "inprocess")) -> None:
+def memory(hours: float, backends: tuple[str, ...] = RUN_BACKENDS) -> None:
     """A long calm_pd run with rows streamed to disk; peak RSS against a short run, for each
     backend."""
     print(f"Memory: calm_pd streamed to CSV in chunks of 10,000 rows, on {machine()}")

@@ -6,11 +6,12 @@ import tempfile
 import time
 from pathlib import Path
 
+from ..core.master import RUN_BACKENDS
 from .bench import machine, require_in_process
 
 
 def sweep_throughput(runs: int, worker_counts: tuple[int, ...] = (1, 2),
-                     backends: tuple[str, ...] = ("fmi", "inprocess")) -> dict:
+                     backends: tuple[str, ...] = RUN_BACKENDS) -> dict:
     """Runs per second of a waves_pd/waves_smc seed sweep (400 s each) on a local cluster,
     for each backend and number of workers; the scaling from one worker to more, the
     overhead per run (in the task: its wall time minus the master's run; outside it:

@@ -33,7 +33,7 @@ from ship_fmu.vessel import N_PROPELLER, Vessel, VesselParameters
 
 H = 0.1                                       # s, the communication step (of parts 2-3 too)
 H_MAX = (0.1, 0.05, 0.025)                    # s, the RK4 steps compared
-SIGNALS = ("psi", "r", "x", "y")
+STATES = ("psi", "r", "x", "y")
 TOLERANCE = 1e-12
 
 
@@ -62,11 +62,11 @@ def commands(program: str, t_end: float = 400.0) -> np.ndarray:
 def rk4(delta_c: np.ndarray, h_max: float) -> dict[str, np.ndarray]:
     """The FMU's model: RK4 at ``h_max``; each signal at every communication point."""
     vessel = Vessel(VesselParameters(h_max=h_max))
-    rows = [[getattr(vessel, s) for s in SIGNALS]]
+    rows = [[getattr(vessel, s) for s in STATES]]
     for k, command in enumerate(delta_c):
         vessel.step(communication_point(0.0, k, H), H, float(command))
-        rows.append([getattr(vessel, s) for s in SIGNALS])
-    return dict(zip(SIGNALS, np.array(rows).T))
+        rows.append([getattr(vessel, s) for s in STATES])
+    return dict(zip(STATES, np.array(rows).T))
 
 
 def reference(delta_c: np.ndarray, tolerance: float = TOLERANCE) -> dict[str, np.ndarray]:
@@ -91,7 +91,7 @@ def reference(delta_c: np.ndarray, tolerance: float = TOLERANCE) -> dict[str, np
                           atol=tolerance).y[:, -1]
         delta = gear(H)
         rows.append([y[2], y[5], y[0], y[1]])
-    return dict(zip(SIGNALS, np.array(rows).T))
+    return dict(zip(STATES, np.array(rows).T))
 
 
 @dataclass(frozen=True)
@@ -103,7 +103,7 @@ class Error:
 
 def errors(run: dict[str, np.ndarray], ref: dict[str, np.ndarray]) -> dict[str, Error]:
     out = {}
-    for s in SIGNALS:
+    for s in STATES:
         e = np.abs(run[s] - ref[s])
         out[s] = Error(float(e.max()), float(np.sqrt(np.mean(e * e))))
     return out
@@ -116,21 +116,21 @@ def open_loop(program: str, t_end: float = 400.0) -> dict:
     finer = reference(delta_c, TOLERANCE / 2)
     by_h = {h: errors(rk4(delta_c, h), ref) for h in H_MAX}
     orders = {s: [math.log2(by_h[a][s].max / by_h[b][s].max)
-                  for a, b in zip(H_MAX, H_MAX[1:])] for s in SIGNALS}
+                  for a, b in zip(H_MAX, H_MAX[1:])] for s in STATES}
     return {"program": program, "errors": by_h, "orders": orders,
             "reference_error": errors(finer, ref)}
 
 
 def open_loop_table(results: list[dict]) -> str:
     """Part 1 as a Markdown table."""
-    lines = ["| program | h_max (s) | " + " | ".join(f"max / RMS error {s}" for s in SIGNALS)
-             + " |", "|---|---:|" + "---:|" * len(SIGNALS)]
+    lines = ["| program | h_max (s) | " + " | ".join(f"max / RMS error {s}" for s in STATES)
+             + " |", "|---|---:|" + "---:|" * len(STATES)]
     for result in results:
         for h, e in result["errors"].items():
             lines.append(f"| {result['program']} | {h:g} | " + " | ".join(
-                f"{e[s].max:.2e} / {e[s].rms:.2e}" for s in SIGNALS) + " |")
+                f"{e[s].max:.2e} / {e[s].rms:.2e}" for s in STATES) + " |")
         lines.append(f"| {result['program']} | order | " + " | ".join(
-            ", ".join(f"{o:.2f}" for o in result["orders"][s]) for s in SIGNALS) + " |")
+            ", ".join(f"{o:.2f}" for o in result["orders"][s]) for s in STATES) + " |")
         lines.append(f"| {result['program']} | reference, tol / 2 | " + " | ".join(
-            f"{result['reference_error'][s].max:.1e}" for s in SIGNALS) + " |")
+            f"{result['reference_error'][s].max:.1e}" for s in STATES) + " |")
     return "\n".join(lines)

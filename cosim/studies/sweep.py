@@ -62,6 +62,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from ..core.master import RUN_BACKENDS
 from .cluster import connect
 from .journal import Journal, JournalLocked, read_rows
 from .sweep_client import NoWorkers, SweepError, check_workers, run_on_cluster
@@ -98,7 +99,7 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
     seconds ends the sweep the same way, with ``NoWorkers``. SweepError if a worker runs
     other code than the client or another sweep writes the journal.
     """
-    if backend not in ("fmi", "inprocess"):
+    if backend not in RUN_BACKENDS:
         raise ValueError(f"backend must be fmi or inprocess, got {backend!r}")
     if not 0 < no_worker_timeout < float("inf"):
         raise ValueError(f"no_worker_timeout must be a number of seconds > 0, got "
