@@ -16,7 +16,7 @@ On top of them, directly in ``cosim/``: the Python entry point ``cosim.simulate`
 (``api.py``), a run with what it writes (``outputs.py``: ``cosim.run_and_write``, the one
 lifecycle of a run and its files), the pytest plugin (``testing.py``), and the commands (``python -m
 cosim.run``, ``cosim.sweep``, ``cosim.export``, ``cosim.bench``, ``cosim.engines``,
-``cosim.score``), which parse options and print; ``_cli.py`` is what they share. A
+``cosim.score``, ``cosim.accuracy``), which parse options and print; ``_cli.py`` is what they share. A
 module imports only from the sub-packages listed before its own (the core from
 none); nothing imports a command.
 """

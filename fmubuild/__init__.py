@@ -2,7 +2,8 @@
 
 - ``project``: this project's FMUs, their scripts and where they are built to;
 - ``packaging``: a slave script written with fmukit into a validated FMU that carries
-  exactly its model (``manifest``), the same bytes from the same sources;
+  exactly its model: what the script imports (``imports``), with its ``manifest``;
+  the same bytes from the same sources (``reproducible``);
 - ``manifest``: what an FMU carries and a digest of it, and whether it is current;
 - ``exit_fix``: pythonfmu 0.7.0's linux64 binary, patched against its exit-time heap
   corruption;

@@ -7,6 +7,8 @@
 - ``wiring``: connection checks, the Gauss-Seidel order, the column layout;
 - ``coupling``: the Gauss-Seidel and Jacobi steps;
 - ``recording``: the rows of a run, in memory or streamed to CSV;
+- ``interrupt``: Ctrl-C and SIGTERM taken between two steps (``StopSignals``);
+- ``provenance``: what it takes to reproduce a run, written as JSON beside its CSV;
 - ``master``: ``Master``, which wires, orders and delegates to the above.
 
 No code here depends on the ship, the paper or the command line (the docstrings use
