@@ -84,11 +84,11 @@ def _refusal(path: Path) -> str | None:
         manifest = read(path)
         if manifest is None:
             return "it was not built with fmukit (it has no manifest)"
+        declared = _description(path)
+        if declared.get("modelName") != manifest.model_name:
+            return (f"its model description names the model '{declared.get('modelName')}', "
+                    f"its manifest '{manifest.model_name}'")
         with zipfile.ZipFile(path) as fmu:
-            declared = ElementTree.fromstring(fmu.read("modelDescription.xml"))
-            if declared.get("modelName") != manifest.model_name:
-                return (f"its model description names the model '{declared.get('modelName')}', "
-                        f"its manifest '{manifest.model_name}'")
             refusal = _contents_refusal(fmu, manifest)
         rebuild = BUILD_HINT if manifest.slave_module in _PROJECT_SLAVES else "rebuild it"
         refusal = refusal or staleness(manifest, rebuild)
