@@ -4,7 +4,7 @@ against a monolithic model with the controller inside the solver.
     python -m cosim.accuracy            # the full study, about a minute on 2 cores
     python -m cosim.accuracy --quick    # shorter runs and fewer steps (CI)
     python -m cosim.accuracy --cpus     # every scenario as other CPUs would run it, about
-                                        # 20 s: numpy, OpenBLAS and libm variants, bit for bit
+                                        # 25 s: numpy, OpenBLAS and libm variants, bit for bit
 
 Prints three tables (integration error open loop; co-simulation against the
 monolithic reference; convergence in the communication step) and writes them, with

@@ -157,13 +157,15 @@ def _module_name(script: Path) -> str:
 
 
 _TRIAL = """
+import os
 import sys
 sys.path = [p for p in sys.path if p not in ("", {root!r})]
 sys.meta_path = [f for f in sys.meta_path if "editable" not in repr(f).lower()]
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 description = read_model_description(sys.argv[1])
-slave = FMU2Slave(guid=description.guid, unzipDirectory=extract(sys.argv[1]),
+unzipped = extract(sys.argv[1], os.path.abspath("unzipped"))  # in the child's folder: removed
+slave = FMU2Slave(guid=description.guid, unzipDirectory=unzipped,
                   modelIdentifier=description.coSimulation.modelIdentifier,
                   instanceName="trial")
 slave.instantiate(loggingOn=True)     # pythonfmu 0.7 logs only then
