@@ -5,6 +5,7 @@
   exactly its model: what the script imports (``imports``), with its ``manifest``;
   the same bytes from the same sources (``reproducible``);
 - ``manifest``: what an FMU carries and a digest of it, and whether it is current;
+- ``trial``: an FMU instantiated once in a child process, here or away from the checkout;
 - ``exit_fix``: pythonfmu 0.7.0's linux64 binary, patched against its exit-time heap
   corruption;
 - ``cbuild``: FMUs written in C;

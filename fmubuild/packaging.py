@@ -8,7 +8,7 @@ given with ``--include``, a requirements.txt (a host needs only Python with nump
 corrupts its host's heap at exit); the archive is written again in a fixed order with
 fixed times and a GUID derived from its contents (``reproducible``), so the same
 sources give the same bytes; the model description is checked with fmpy's validator
-and the FMU is instantiated once without this checkout. A problem fails the build.
+and the FMU is instantiated once without this checkout (``trial``). A problem fails the build.
 
 A package whose __init__.py holds nothing but a docstring is carried without it, as a
 namespace package. A host that is not Python (ecos, OMSimulator) runs all its Python
@@ -21,7 +21,6 @@ from __future__ import annotations
 import ast
 import contextlib
 import shutil
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -30,6 +29,7 @@ from . import exit_fix, reproducible
 from .imports import needed_modules
 from .manifest import Manifest, digest_of, sha256
 from .project import FMU_DIR, FMUS, ROOT
+from .trial import TrialFailed, trial
 
 RUNTIME_REQUIREMENTS = "numpy\n"
 PROJECT_PACKAGES = ("fmukit", "ship_fmu", "autopilot_fmu")
@@ -96,10 +96,13 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path) -> 
     if problems:
         raise RuntimeError(f"{fmu} does not validate:\n" + "\n".join(problems))
     try:
-        check_instantiates(fmu)
-    except RuntimeError:
+        trial(fmu, isolated=True)
+    except TrialFailed as failed:
         fmu.unlink()
-        raise
+        raise RuntimeError(f"{fmu.name} was built but does not instantiate without this "
+                           "checkout, so it was removed; a module it imports is probably "
+                           "missing from it (carry it with --include):\n  "
+                           + "\n  ".join(failed.last_words)) from None
     return fmu
 
 
@@ -154,39 +157,6 @@ def _module_name(script: Path) -> str:
     if len(relative.parts) > 1 and relative.parts[0] in PROJECT_PACKAGES:
         return ".".join(relative.with_suffix("").parts)
     return script.stem
-
-
-_TRIAL = """
-import os
-import sys
-sys.path = [p for p in sys.path if p not in ("", {root!r})]
-sys.meta_path = [f for f in sys.meta_path if "editable" not in repr(f).lower()]
-from fmpy import extract, read_model_description
-from fmpy.fmi2 import FMU2Slave
-description = read_model_description(sys.argv[1])
-unzipped = extract(sys.argv[1], os.path.abspath("unzipped"))  # in the child's folder: removed
-slave = FMU2Slave(guid=description.guid, unzipDirectory=unzipped,
-                  modelIdentifier=description.coSimulation.modelIdentifier,
-                  instanceName="trial")
-slave.instantiate(loggingOn=True)     # pythonfmu 0.7 logs only then
-slave.freeInstance()
-"""
-
-
-def check_instantiates(fmu: Path) -> None:
-    """Instantiate the FMU once in a fresh interpreter that cannot import this checkout:
-    RuntimeError with its last words if it fails, as it would on a host without the
-    modules the FMU forgot to carry."""
-    with tempfile.TemporaryDirectory() as elsewhere:
-        child = subprocess.run([sys.executable, "-c", _TRIAL.format(root=str(ROOT)), str(fmu)],
-                               cwd=elsewhere, capture_output=True, text=True, timeout=120)
-    if child.returncode != 0:
-        log = [line for line in child.stdout.splitlines() if line.strip()][-3:]  # the FMU's
-        words = log or [line for line in child.stderr.splitlines() if line.strip()][-3:]
-        raise RuntimeError(f"{fmu.name} was built but does not instantiate without this "
-                           "checkout, so it was removed; a module it imports is probably "
-                           "missing from it (carry it with --include):\n  "
-                           + "\n  ".join(words))
 
 
 @contextlib.contextmanager

@@ -2,9 +2,6 @@
 from __future__ import annotations
 
 import shutil
-import signal
-import subprocess
-import sys
 from collections import deque
 from pathlib import Path
 from typing import Any
@@ -35,25 +32,6 @@ def read_description(path: Path, name: str) -> ModelDescription:
     if description.coSimulation is None:
         raise ValueError(f"{path} is not a co-simulation FMU (model exchange only)")
     return description
-
-
-def trial_instantiation(path: str | Path, timeout: float = 120.0) -> None:
-    """Instantiate and free an FMU in a child process; ValueError naming the file if that fails.
-
-    Some FMUs take their host down when they cannot instantiate (pythonfmu 0.7's C++
-    dereferences a NULL class when its Python script fails to import): trying it in a
-    child first keeps the master alive to say so.
-    """
-    code = ("import sys\nfrom cosim.core.fmi import FmuInstance\n"
-            "FmuInstance(sys.argv[1], 'trial').free()\n")
-    child = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True,
-                           text=True, timeout=timeout)
-    if child.returncode != 0:
-        how = (f"crashed its host ({signal.Signals(-child.returncode).name})"
-               if child.returncode < 0 else "failed")
-        last = [line for line in child.stderr.strip().splitlines() if line.strip()][-3:]
-        raise ValueError(f"{path}: instantiating the FMU {how}"
-                         + "".join(f"\n  {line}" for line in last))
 
 
 def feedthrough(description: ModelDescription) -> dict[str, frozenset[str]]:

@@ -22,11 +22,13 @@ import copy
 from pathlib import Path
 
 import fmpy
-import fmukit.autopilot
 from fmpy import read_model_description
 from fmpy.model_description import ModelDescription
 
-from ..core.fmi import trial_instantiation
+import fmukit.autopilot
+from fmubuild.trial import TrialFailed
+from fmubuild.trial import trial as instantiate_in_child
+
 from ..core.ssd import Connection, SystemDescription
 
 COMPONENT = "autopilot"
@@ -55,7 +57,7 @@ def check_autopilot(fmu: str | Path, port_map: dict[str, str] | None = None,
                     trial: bool = False) -> ModelDescription:
     """The FMU's model description if it keeps the port contract; AutopilotError if not.
 
-    ``trial`` also instantiates it once in a child process (``trial_instantiation``).
+    ``trial`` also instantiates it once in a child process (``fmubuild.trial``).
     """
     fmu, port_map = Path(fmu), port_map or {}
     if not fmu.is_file():
@@ -102,9 +104,9 @@ def check_autopilot(fmu: str | Path, port_map: dict[str, str] | None = None,
                                  "converted)")
     if trial:
         try:
-            trial_instantiation(fmu)
-        except ValueError as error:
-            raise AutopilotError(str(error)) from None
+            instantiate_in_child(fmu)
+        except TrialFailed as failed:
+            raise AutopilotError(str(failed)) from None
     return description
 
 
