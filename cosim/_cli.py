@@ -12,9 +12,12 @@ import tempfile
 from pathlib import Path
 from typing import Callable
 
+from fmubuild.project import BUILD_HINT
+
 from . import scenarios
 from .api import parse_setting
 from .core.interrupt import Interrupted, raise_on_signals
+from .core.recording import TooManyRows
 from .scenarios.autopilot import AutopilotError, check_autopilot
 
 
@@ -66,6 +69,16 @@ def add_port_options(parser: argparse.ArgumentParser) -> None:
                         help="the FMU's name of an autopilot port, e.g. psi=heading; repeatable")
     parser.add_argument("--name", help="the autopilot's name in file names and tables "
                                        "(default: the FMU's file name)")
+
+
+def say_error(error: BaseException) -> None:
+    """``error: ...`` on standard error, with the command line's advice where the error
+    says what would mend it (an FMU of ours not built; a run too long to hold in memory)."""
+    print(f"error: {error}", file=sys.stderr)
+    if getattr(error, "ours", False):
+        print(f"  {BUILD_HINT}", file=sys.stderr)
+    if isinstance(error, TooManyRows):
+        print("  cosim.run --stream writes the rows to the CSV as the run goes", file=sys.stderr)
 
 
 def checked_autopilot(parser: argparse.ArgumentParser, args: argparse.Namespace) -> bool:

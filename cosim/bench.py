@@ -18,7 +18,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ._cli import entry
+from ._cli import entry, say_error
 from .studies import bench, bench_sweep
 
 
@@ -50,7 +50,7 @@ def main(argv: list[str] | None = None) -> int:
         else:
             bench.engines(args.repeats)
     except (RuntimeError, ValueError, FileNotFoundError) as error:   # e.g. stale FMUs
-        print(f"error: {error}", file=sys.stderr)
+        say_error(error)
         return 2
     return 0
 

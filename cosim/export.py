@@ -16,7 +16,7 @@ import sys
 from pathlib import Path
 
 from . import scenarios
-from ._cli import (add_autopilot_options, checked_autopilot, chosen_scenarios, entry,
+from ._cli import (add_autopilot_options, checked_autopilot, chosen_scenarios, entry, say_error,
                    writable_folder)
 from .interop.ssp import export
 
@@ -39,7 +39,7 @@ def main(argv: list[str] | None = None) -> int:
         try:
             print(f"wrote {export(name, args.out, None, args.autopilot, dict(args.map), args.name)}")
         except (ValueError, FileNotFoundError) as error:
-            print(f"error: {error}", file=sys.stderr)
+            say_error(error)
             return 2
     return 0
 

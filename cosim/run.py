@@ -23,7 +23,7 @@ from typing import NamedTuple
 
 from . import scenarios
 from ._cli import (Progress, add_autopilot_options, checked_autopilot, chosen_scenarios, entry,
-                   setting_option, writable_folder)
+                   say_error, setting_option, writable_folder)
 from .analysis.animation import video_format
 from .analysis.cost import LAMBDA, Cost
 from .analysis.describe import conditions
@@ -175,7 +175,7 @@ def main(argv: list[str] | None = None) -> int:
                                         overrides if run.autopilot else paper_overrides,
                                         options)
         except (ValueError, FileNotFoundError, FmuCallError) as error:
-            print(f"error: {error}", file=sys.stderr)
+            say_error(error)
             if created and not any(out.iterdir()):
                 out.rmdir()                     # nothing was run: leave nothing behind
             return 2

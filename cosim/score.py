@@ -15,7 +15,8 @@ import sys
 import time
 from pathlib import Path
 
-from ._cli import add_port_options, checked_autopilot, entry, setting_option, writable_folder
+from ._cli import (add_port_options, checked_autopilot, entry, say_error, setting_option,
+                   writable_folder)
 from .core.master import RUN_BACKENDS
 from .studies.scorecard import backend_notes, score
 from .studies.sweep_client import NoWorkers
@@ -76,7 +77,7 @@ def main(argv: list[str] | None = None) -> int:
         bar.update()
     except (ValueError, FileNotFoundError) as error:
         bar.close()
-        print(f"error: {error}", file=sys.stderr)
+        say_error(error)
         return 1
     except NoWorkers as stopped:
         bar.close()

@@ -5,7 +5,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ._cli import entry, writable_folder
+from ._cli import entry, say_error, writable_folder
 from .core.interrupt import Interrupted
 from .core.master import RUN_BACKENDS
 from .studies import sweep
@@ -70,7 +70,7 @@ def main(argv: list[str] | None = None) -> int:
                              progress=not args.no_progress, scheduler_file=args.scheduler_file,
                              backend=args.backend, no_worker_timeout=args.no_worker_timeout)
     except (SweepError, ValueError) as error:
-        print(f"error: {error}", file=sys.stderr)
+        say_error(error)
         return 2
     except (Interrupted, NoWorkers) as stopped:
         rows = sweep.completed(spec, out)

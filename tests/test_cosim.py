@@ -289,15 +289,26 @@ def _variant(tmp_path: Path, name: str, edit) -> Path:
     return path
 
 
-def test_missing_fmu_names_the_paths_tried_and_says_how_to_build_it(tmp_path, monkeypatch):
+def test_missing_fmu_names_the_paths_tried_and_says_how_to_build_it(tmp_path, monkeypatch,
+                                                                    capsys):
+    """The core says what is missing and that it is ours (as data); the command says how
+    to build it."""
     monkeypatch.setattr(ssd, "FMU_SEARCH_PATH", [tmp_path / "empty"])
 
     def edit(d):
         d.components["ship"].source = str(tmp_path / "nowhere" / "ship.fmu")
-    with pytest.raises(FileNotFoundError, match="python -m fmukit.build") as missing:
+    with pytest.raises(FileNotFoundError, match="one of this project's FMUs, not built") as missing:
         Master(read_ssd(_variant(tmp_path, "calm_pd", edit)))
     assert f"tried {tmp_path / 'nowhere' / 'ship.fmu'}, {tmp_path / 'empty' / 'ship.fmu'}" \
         in str(missing.value)
+    assert missing.value.ours and "python -m" not in str(missing.value)
+    variant = tmp_path / "calm_pd.ssd"
+    variant.write_text((SCENARIOS / "calm_pd.ssd").read_text().replace(
+        "../../fmus/ship.fmu", str(tmp_path / "nowhere" / "ship.fmu")))
+    assert cli.main([str(variant), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert "not found" in err and "one of this project's FMUs, not built\n" \
+        "  build the FMUs with: python -m fmukit.build" in err
 
 
 def test_a_missing_fmu_of_the_user_is_not_a_build_problem(tmp_path):
@@ -321,8 +332,9 @@ def test_corrupt_fmu_says_how_to_build_it(tmp_path):
 
     def edit(d):
         d.components["ship"].source = str(corrupt)
-    with pytest.raises(ValueError, match="not a readable FMU.*python -m fmukit.build"):
+    with pytest.raises(ValueError, match="not a readable FMU") as unreadable:
         Master(read_ssd(_variant(tmp_path, "calm_pd", edit)))
+    assert unreadable.value.ours
 
 
 def test_connection_to_a_missing_variable_is_refused_by_name(tmp_path):

@@ -13,22 +13,23 @@ from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFr
                        fmi2True, fmi2ValueReference)
 from fmpy.model_description import ModelDescription
 
-from fmubuild.project import BUILD_HINT, FMUS
+from fmubuild.project import FMUS
+from .errors import FmuNotFound, FmuUnreadable
 from .instance import FmuCallError, Instance, LogRecord, logged_error, one_account
 
 STATUS = ("ok", "warning", "discard", "error", "fatal", "pending")
 
 
 def read_description(path: Path, name: str) -> ModelDescription:
-    """An FMU's model description; FileNotFoundError or ValueError naming the file (and,
-    for one named as ours, how to build it) when the FMU is missing or not readable."""
-    hint = f"; {BUILD_HINT}" if path.stem in FMUS else ""      # one of ours: build it
+    """An FMU's model description; FmuNotFound or FmuUnreadable naming the file (and
+    whether it is named as one of this project's FMUs) when it is missing or not readable."""
+    ours = path.stem in FMUS
     if not path.is_file():
-        raise FileNotFoundError(f"FMU for '{name}' not found: {path}{hint}")
+        raise FmuNotFound(f"FMU for '{name}' not found: {path}", ours)
     try:
         description = read_model_description(str(path))
     except Exception as error:
-        raise ValueError(f"{path} is not a readable FMU ({error}){hint}") from error
+        raise FmuUnreadable(f"{path} is not a readable FMU ({error})", ours) from error
     if description.coSimulation is None:
         raise ValueError(f"{path} is not a co-simulation FMU (model exchange only)")
     return description

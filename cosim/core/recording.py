@@ -123,11 +123,15 @@ def available_memory() -> int:
     return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
 
 
+class TooManyRows(ValueError):
+    """A run whose rows would not fit in memory: to be streamed to CSV instead."""
+
+
 def require_memory(rows: int, columns: int) -> None:
-    """ValueError if ``rows`` x ``columns`` floats would not fit in the memory available."""
+    """TooManyRows if ``rows`` x ``columns`` floats would not fit in the memory available."""
     needed, available = rows * columns * 8, available_memory()
     if needed > 0.8 * available:
-        raise ValueError(f"the run would hold {rows} rows of {columns} values in memory, "
-                         f"{needed / 2**30:,.1f} GiB, more than the {available / 2**30:,.1f} GiB "
-                         "available: stream the rows to a CSV file as the run goes "
-                         "(cosim.run --stream; Master.run(csv_path=...))")
+        raise TooManyRows(f"the run would hold {rows} rows of {columns} values in memory, "
+                          f"{needed / 2**30:,.1f} GiB, more than the {available / 2**30:,.1f} "
+                          "GiB available: stream the rows to a CSV file as the run goes "
+                          "(Master.run's csv_path)")

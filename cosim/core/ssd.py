@@ -14,7 +14,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from fmubuild.project import BUILD_HINT, FMU_DIR, FMUS
+from fmubuild.project import FMU_DIR, FMUS
+
+from .errors import FmuNotFound
 
 NS = {
     "ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",
@@ -105,10 +107,11 @@ class SystemDescription:
             if path.is_file():
                 return path
         source = Path(self.components[component].source)
-        hint = (BUILD_HINT if source.stem in FMUS
+        ours = source.stem in FMUS
+        hint = ("one of this project's FMUs, not built" if ours
                 else f"check the source of component '{component}' in {self.path or 'the system'}")
-        raise FileNotFoundError(f"FMU for '{component}' not found; tried "
-                                f"{', '.join(map(str, candidates))}; {hint}")
+        raise FmuNotFound(f"FMU for '{component}' not found; tried "
+                          f"{', '.join(map(str, candidates))}; {hint}", ours)
 
 
 def _q(prefix: str, tag: str) -> str:
