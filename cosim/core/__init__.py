@@ -4,6 +4,7 @@
   with three backends: ``fmi`` (FMUs through fmpy), ``inprocess`` (the FMUs' Python
   classes without FMI) and ``null`` (interfaces only, to measure the master);
 - ``ssd``: SSP system structure descriptions, read and written;
+- ``errors``: an FMU file missing or unreadable, and whether it is one this project builds;
 - ``wiring``: connection checks, the Gauss-Seidel order, the column layout;
 - ``coupling``: the Gauss-Seidel and Jacobi steps;
 - ``recording``: the rows of a run, in memory or streamed to CSV;
