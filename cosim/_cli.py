@@ -81,6 +81,14 @@ def say_error(error: BaseException) -> None:
         print("  cosim.run --stream writes the rows to the CSV as the run goes", file=sys.stderr)
 
 
+def say_note(note: str) -> None:
+    """``note: ...`` on standard error, and how to build our FMUs where the note says one
+    was built before a change (``cosim.core.inprocess.Reason``)."""
+    print(f"note: {note}", file=sys.stderr)
+    if getattr(note, "rebuild", False):
+        print(f"  {BUILD_HINT}", file=sys.stderr)
+
+
 def checked_autopilot(parser: argparse.ArgumentParser, args: argparse.Namespace) -> bool:
     """Check --autopilot against the port contract before anything runs; False (and the
     reason on standard error) if it fails."""

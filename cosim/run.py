@@ -23,7 +23,7 @@ from typing import NamedTuple
 
 from . import scenarios
 from ._cli import (Progress, add_autopilot_options, checked_autopilot, chosen_scenarios, entry,
-                   say_error, setting_option, writable_folder)
+                   say_error, say_note, setting_option, writable_folder)
 from .analysis.animation import video_format
 from .analysis.cost import LAMBDA, Cost
 from .analysis.describe import conditions
@@ -49,7 +49,7 @@ def run_scenario(system: SystemDescription, label: str, out: Path, overrides: di
         progress = Progress(label)
         try:
             outcome = run_and_write(system, label, out, overrides, options, progress, stop,
-                                    notes=lambda note: print(f"note: {note}", file=sys.stderr))
+                                    notes=say_note)
         finally:
             progress.close()
     recording, csv_path = outcome.recording, outcome.csv

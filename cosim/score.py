@@ -15,8 +15,8 @@ import sys
 import time
 from pathlib import Path
 
-from ._cli import (add_port_options, checked_autopilot, entry, say_error, setting_option,
-                   writable_folder)
+from ._cli import (add_port_options, checked_autopilot, entry, say_error, say_note,
+                   setting_option, writable_folder)
 from .core.master import RUN_BACKENDS
 from .studies.scorecard import backend_notes, score
 from .studies.sweep_client import NoWorkers
@@ -59,7 +59,7 @@ def main(argv: list[str] | None = None) -> int:
     name = args.name or args.autopilot.stem
     out = writable_folder(args.out or Path("results") / "score" / name)
     for note in backend_notes(args.autopilot.resolve(), name, dict(args.map), args.backend):
-        print(f"note: {note}", file=sys.stderr)
+        say_note(note)
     started = time.perf_counter()
     steps = 4 * 2 + 4 + 1
 

@@ -5,7 +5,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ._cli import entry, say_error, writable_folder
+from ._cli import entry, say_error, say_note, writable_folder
 from .core.interrupt import Interrupted
 from .core.master import RUN_BACKENDS
 from .studies import sweep
@@ -65,7 +65,7 @@ def main(argv: list[str] | None = None) -> int:
     out = writable_folder(args.out / spec.name)
     try:
         for note in spec.backend_notes(args.backend):
-            print(f"note: {note}", file=sys.stderr)
+            say_note(note)
         rows = sweep.execute(spec, out, args.scheduler, args.workers,
                              progress=not args.no_progress, scheduler_file=args.scheduler_file,
                              backend=args.backend, no_worker_timeout=args.no_worker_timeout)

@@ -69,9 +69,9 @@ def read(fmu: str | Path) -> Manifest | None:
             raise ValueError(f"{fmu}: its {MANIFEST} cannot be read ({error})") from error
 
 
-def staleness(manifest: Manifest, rebuild: str = "rebuild it") -> str | None:
+def staleness(manifest: Manifest) -> str | None:
     """Why the FMU is not current in this process (a module it carries cannot be found
-    here, or has another source: then ``rebuild`` says what to do), or None if it is."""
+    here, or has another source), or None if it is."""
     for module, carried in manifest.modules.items():
         try:
             spec = importlib.util.find_spec(module)
@@ -80,5 +80,5 @@ def staleness(manifest: Manifest, rebuild: str = "rebuild it") -> str | None:
         if spec is None or not spec.origin or not Path(spec.origin).is_file():
             return f"its module {module} is not importable here"
         if sha256(Path(spec.origin)) != carried["sha256"]:
-            return f"its {module} differs from {spec.origin} (built before a change: {rebuild})"
+            return f"its {module} differs from {spec.origin} (built before a change: rebuild it)"
     return None

@@ -29,7 +29,7 @@ from typing import Any
 from xml.etree import ElementTree
 
 from fmubuild.manifest import Manifest, read, staleness
-from fmubuild.project import BUILD_HINT, FMUS
+from fmubuild.project import FMUS
 from fmukit.pythonfmu07.entry import unguarded
 from fmukit.refusals import Refused, explain, naming
 from fmukit.slave import ModelSlave
@@ -71,12 +71,27 @@ def in_process_refusal(path: str | Path) -> str | None:
 _refusals: dict[tuple, str | None] = {}
 
 
-def fallback_note(name: str, path: str | Path) -> str | None:
+class Reason(str):
+    """Why an FMU runs through FMI (or the note that says so); ``rebuild``: it is one of
+    this project's FMUs built before a change (a command may say how to build it)."""
+
+    rebuild: bool = False
+
+    @classmethod
+    def of(cls, text: str, rebuild: bool) -> Reason:
+        reason = cls(text)
+        reason.rebuild = rebuild
+        return reason
+
+
+def fallback_note(name: str, path: str | Path) -> Reason | None:
     """The note for component ``name`` when its FMU must run through FMI instead of
     in-process (``in_process_refusal``), or None."""
     refusal = in_process_refusal(path)
-    return None if refusal is None else (f"{name} ({Path(path).name}) runs through FMI, "
-                                         f"not in-process: {refusal}")
+    if refusal is None:
+        return None
+    return Reason.of(f"{name} ({Path(path).name}) runs through FMI, not in-process: {refusal}",
+                     getattr(refusal, "rebuild", False))
 
 
 def _refusal(path: Path) -> str | None:
@@ -90,8 +105,9 @@ def _refusal(path: Path) -> str | None:
                     f"its manifest '{manifest.model_name}'")
         with zipfile.ZipFile(path) as fmu:
             refusal = _contents_refusal(fmu, manifest)
-        rebuild = BUILD_HINT if manifest.slave_module in _PROJECT_SLAVES else "rebuild it"
-        refusal = refusal or staleness(manifest, rebuild)
+        stale = None if refusal else staleness(manifest)
+        if stale is not None:
+            refusal = Reason.of(stale, manifest.slave_module in _PROJECT_SLAVES)
         if refusal is None:
             ours = slave_class(manifest)(instance_name=manifest.model_name).to_xml()
             for section in _DECLARATIONS:
