@@ -86,6 +86,8 @@ def test_next_to_every_csv_a_json_with_what_it_takes_to_reproduce_the_run(fmu_pa
     assert fmu["guid"] == read_model_description(fmu["file"]).guid
     with open(fmu["file"], "rb") as f:
         assert fmu["sha256"] == hashlib.sha256(f.read()).hexdigest()
+    from fmubuild.manifest import read          # the one notion of a current FMU
+    assert fmu["current"] is True and fmu["sources_digest"] == read(fmu["file"]).digest
     assert (meta["coupling"], meta["step_size"], meta["stop_time"], meta["rows"]) == \
         ("gauss-seidel", 0.1, 20.0, 201)
     assert meta["wall_time_s"] > 0 and meta["versions"]["ship-autopilot-cosim"] == "0.1.0"

@@ -3,7 +3,8 @@
 The unit of every column, every parameter value the FMUs held (defaults and what
 was set) with its unit, the values the scenario sets (inputs such as propeller
 speeds included) and those given on top of it, the scenario file and its SHA-256,
-each FMU's file, GUID and SHA-256, the backend, coupling, step and times, the wall
+each FMU's file, GUID and SHA-256 (and, for one built with fmukit, its sources' digest
+and whether they are this process's: ``current``), the backend, coupling, step and times, the wall
 time, the command, and the versions of this package (with its git commit), Python,
 numpy, fmpy and pythonfmu. Strict JSON: a non-finite number is written as a string.
 """
@@ -17,10 +18,13 @@ import math
 import platform
 import subprocess
 import sys
+import zipfile
 from datetime import datetime, timezone
 from importlib import metadata
 from pathlib import Path
 from typing import Any
+
+from fmubuild.manifest import read, staleness
 
 from .recording import Recording
 
@@ -40,6 +44,21 @@ def _sha256(path: str) -> str | None:
         return hashlib.sha256(Path(path).read_bytes()).hexdigest()
     except OSError:
         return None
+
+
+def _manifest(path: str) -> dict[str, Any]:
+    """What an FMU built with fmukit says of its sources (``fmubuild.manifest``): their
+    digest, and whether they are the ones this process imports (``current``: the one
+    notion of a stale FMU; the reason where not). Nothing for any other FMU."""
+    try:
+        manifest = read(path)
+    except (OSError, ValueError, zipfile.BadZipFile):
+        return {}
+    if manifest is None:
+        return {}
+    stale = staleness(manifest)
+    return {"sources_digest": manifest.digest, "current": stale is None,
+            **({"stale": stale} if stale else {})}
 
 
 def _commit() -> str | None:
@@ -85,7 +104,7 @@ def _strict(value: Any) -> Any:
 def run_metadata(recording: Recording, command: list[str] | None = None) -> dict[str, Any]:
     """The metadata of a run, as plain JSON values (non-finite numbers as strings)."""
     meta = dict(recording.meta)
-    meta["fmus"] = {name: {**fmu, "sha256": _sha256(fmu["file"])}
+    meta["fmus"] = {name: {**fmu, "sha256": _sha256(fmu["file"]), **_manifest(fmu["file"])}
                     for name, fmu in meta.get("fmus", {}).items()}
     if meta.get("scenario_file"):
         meta["scenario_sha256"] = _sha256(meta["scenario_file"])
