@@ -34,6 +34,11 @@ def test_the_scorecard_ranks_an_autopilot_beside_the_three_baselines(fmu_paths, 
     for figure in ("route_calm", "route_waves", "course_change", "J_distribution"):
         assert (out / f"{figure}.png").stat().st_size > 10_000
         assert f"({figure}.png)" in text
+    # each run's signals and metadata, written as cosim.run writes them
+    runs = sorted(p.name for p in (out / "runs").iterdir())
+    assert runs == sorted(f"{test}_{name}.{suffix}" for test in ("route_calm", "route_waves",
+                                                                    "course_change")
+                          for name in ("PD", "SMC", "PID", "mine") for suffix in ("csv", "json"))
 
 
 def test_the_scorecard_refuses_a_file_that_is_not_an_autopilot(tmp_path, capsys):

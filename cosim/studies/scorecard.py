@@ -10,13 +10,14 @@ Three tests, the same for every controller:
   sweep machinery (``cosim.studies.sweep``): J per seed, its spread, and seed-paired
   wins against the PD.
 
-``score`` runs them, writes scorecard.md and the figures, and returns the markdown.
+``score`` runs them, writes scorecard.md and the figures, and each run's CSV and
+metadata in runs/ (through ``cosim.outputs``, as ``cosim.run`` does), and returns the
+markdown.
 """
 from __future__ import annotations
 
 import math
 import shutil
-import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
@@ -27,8 +28,10 @@ from ..analysis.cost import Cost, cost
 from ..analysis.figures import comparison_figure
 from ..analysis.metrics import heading_error, overshoot, settling_time, sign_reversals_per_minute
 from ..analysis.reports import PAPER_TABLES
-from ..api import SimulationError, simulate
+from .. import scenarios
+from ..api import SimulationError, overrides_of
 from ..core.recording import Recording
+from ..outputs import Options, run_and_write
 from .sweep import Spec, comparison, controller_entry, execute
 from .sweep_figures import distribution, tracks
 
@@ -51,16 +54,21 @@ class Contender:
     port_map: dict[str, str] | None = None
     settings: dict[str, Any] | None = None   # --set values, for the user's autopilot only
 
-    def run(self, sea: str, stop_time: float | None = None, route: str | None = None,
-            backend: str = "fmi") -> Recording:
+    def run(self, label: str, out: Path, sea: str, stop_time: float | None = None,
+            route: str | None = None, backend: str = "fmi") -> Recording:
+        """The run of a test, its CSV and metadata written to out/<label>_<name>.*
+        (``cosim.outputs``); SimulationError if an FMU fails."""
         settings = dict(self.settings or {})
         if route is not None:
             settings["guidance.waypoints"] = route
-        with warnings.catch_warnings():       # which FMU runs through FMI: noted once, up front
-            warnings.simplefilter("ignore")
-            return simulate(f"{sea}_{self.suffix}", autopilot=self.fmu,
-                            port_map=self.port_map, set=settings, stop_time=stop_time,
-                            backend=backend)
+        system = scenarios.load(f"{sea}_{self.suffix}", self.fmu, self.port_map)
+        out.mkdir(parents=True, exist_ok=True)
+        outcome = run_and_write(system, f"{label}_{self.name}", out,
+                                overrides_of(settings),   # notes: said once, up front
+                                Options(stop_time=stop_time, backend=backend, plot=False))
+        if outcome.recording.error:
+            raise SimulationError(outcome.recording.error, outcome.recording)
+        return outcome.recording
 
 
 @dataclass(frozen=True)
@@ -94,23 +102,25 @@ def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | Non
     contenders = _contenders(fmu, name, port_map, settings)
     failures: dict[tuple[str, str], str] = {}
 
-    def attempt(contender: Contender, test: str, **kwargs) -> Recording | None:
+    def attempt(contender: Contender, test: str, label: str, **kwargs) -> Recording | None:
         progress(f"{test}, {contender.name}")
         try:
-            return contender.run(**kwargs, backend=backend)
+            return contender.run(label, out / "runs", **kwargs, backend=backend)
         except SimulationError as error:
             failures[contender.name, test] = str(error).splitlines()[0]
             return None
 
     paper: dict[tuple[str, str], Cost] = {}
     for sea in ("calm", "waves"):
-        runs = {c.name: attempt(c, f"{sea} water", sea=sea) for c in contenders}
+        runs = {c.name: attempt(c, f"{sea} water", f"route_{sea}", sea=sea)
+                for c in contenders}
         runs = {n: r for n, r in runs.items() if r is not None}
         paper.update({(n, sea): cost(r) for n, r in runs.items()})
         comparison_figure(runs, out / f"route_{sea}.png",
                           f"The paper's route in {'calm water' if sea == 'calm' else 'waves'}")
-    runs = {c.name: attempt(c, "course change", sea="calm", stop_time=COURSE_CHANGE_TIME,
-                            route=COURSE_CHANGE_ROUTE) for c in contenders}
+    runs = {c.name: attempt(c, "course change", "course_change", sea="calm",
+                            stop_time=COURSE_CHANGE_TIME, route=COURSE_CHANGE_ROUTE)
+            for c in contenders}
     runs = {n: r for n, r in runs.items() if r is not None}
     changes = {n: course_change(r) for n, r in runs.items()}
     comparison_figure(runs, out / "course_change.png",
