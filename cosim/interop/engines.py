@@ -39,6 +39,7 @@ import numpy as np
 
 from fmukit.timebase import communication_point, step_count
 
+from ..core.fmi import read_description
 from ..core.interrupt import STOP_SIGNALS, Interrupted, StopSignals
 from ..core.ssd import split_name
 
@@ -112,7 +113,6 @@ def _ecos(ssp: Path, signals: tuple[str, ...], stop: StopSignals) -> dict[str, n
 
 
 def _fmpy(ssp: Path, signals: tuple[str, ...], stop: StopSignals) -> dict[str, np.ndarray]:
-    from fmpy import read_model_description
     from fmpy.ssp.simulation import simulate_ssp
     from fmpy.ssp.ssd import Parameter, ParameterSet
 
@@ -125,8 +125,8 @@ def _fmpy(ssp: Path, signals: tuple[str, ...], stop: StopSignals) -> dict[str, n
         with zipfile.ZipFile(ssp) as package:
             package.extractall(tmp)
         for name, component in system.components.items():
-            starts = {v.name: v.start for v in read_model_description(
-                str(Path(tmp) / component.source)).modelVariables}
+            starts = {v.name: v.start for v in read_description(
+                Path(tmp) / component.source, name).modelVariables}
             for variable, value in component.parameters.items():
                 if isinstance(value, str):
                     if value != starts[variable]:
