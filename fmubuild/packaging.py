@@ -74,8 +74,9 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path) -> 
         try:
             sys.path.insert(0, str(stage))
             slave = get_model_class(stage / script.name)
-            manifest = Manifest(slave.model_name, _module_name(script), slave.__name__,
-                                modules, digest_of({m: c["sha256"] for m, c in modules.items()}),
+            manifest = Manifest(getattr(slave, "model_name", script.stem), _module_name(script),
+                                slave.__name__, modules,
+                                digest_of({m: c["sha256"] for m, c in modules.items()}),
                                 pythonfmu_version, OPTIONS)
             (stage / "fmukit_manifest.json").write_text(manifest.to_json())
             (stage / "requirements.txt").write_text(RUNTIME_REQUIREMENTS)

@@ -90,7 +90,7 @@ def spread(system: SystemDescription, overrides: dict[str, dict[str, Any]] | Non
         for i, (parameter, k) in enumerate(members):
             if parameter is not None:
                 component, name = parameter
-                value = nudged(float(nominal[component][name]), k)
+                value = nudged(float(held[component][name]), k)
                 master.configure({**overrides, component: {**overrides.get(component, {}),
                                                            name: value}})
                 master.reset()
@@ -99,7 +99,7 @@ def spread(system: SystemDescription, overrides: dict[str, dict[str, Any]] | Non
                 moved = f"{'.'.join(parameter)} moved by {k} ulp" if parameter else "nominal"
                 raise RuntimeError(f"spread: the run ({moved}) failed: {recording.error}")
             if parameter is None:
-                nominal = master.parameter_values
+                held = master.parameter_values     # the values the unperturbed run used
             costs.append(cost(recording, lam))
             if progress is not None:
                 progress(i + 1, len(members))
