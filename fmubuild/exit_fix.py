@@ -21,7 +21,6 @@ fix: drop ``onLibraryUnload``, or never destroy ``pyState``.
 from __future__ import annotations
 
 import hashlib
-import zipfile
 from pathlib import Path
 
 from fmukit.pythonfmu07.binary import KNOWN_BINARIES
@@ -44,15 +43,7 @@ def patch(binary: bytes, where: str) -> bytes:
     return fixed
 
 
-def fix_fmu(fmu_path: Path) -> None:
-    """Apply ``patch`` to every linux64 binary inside a freshly built FMU, in place."""
-    with zipfile.ZipFile(fmu_path) as fmu:
-        entries = [(info, fmu.read(info)) for info in fmu.infolist()]
-    entries = [(info, patch(data, f"{fmu_path}:{info.filename}")
-                if info.filename.startswith("binaries/linux64/") else data)
-               for info, data in entries]
-    tmp = fmu_path.with_name(fmu_path.name + ".tmp")
-    with zipfile.ZipFile(tmp, "w") as fmu:
-        for info, data in entries:
-            fmu.writestr(info, data)
-    tmp.replace(fmu_path)
+def patch_binaries(entries: dict[str, bytes], fmu: Path) -> dict[str, bytes]:
+    """An FMU's entries (name: bytes) with ``patch`` applied to every linux64 binary."""
+    return {name: patch(data, f"{fmu}:{name}") if name.startswith("binaries/linux64/") else data
+            for name, data in entries.items()}

@@ -91,8 +91,7 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path) -> 
         finally:
             if shadowed is not None:
                 sys.modules[script.stem] = shadowed
-    exit_fix.fix_fmu(fmu)
-    reproducible.rewrite(fmu)
+    reproducible.rewrite(fmu, lambda entries: exit_fix.patch_binaries(entries, fmu))
     problems = validate_fmu(str(fmu))
     if problems:
         raise RuntimeError(f"{fmu} does not validate:\n" + "\n".join(problems))

@@ -13,6 +13,7 @@ import re
 import uuid
 import zipfile
 from pathlib import Path
+from typing import Callable
 
 EPOCH = (1980, 1, 1, 0, 0, 0)
 """The time of every entry: the earliest a zip file can hold."""
@@ -21,11 +22,15 @@ _GUID = re.compile(rb'\sguid="[^"]*"')
 _GENERATED = re.compile(rb'\sgenerationDateAndTime="[^"]*"')
 
 
-def rewrite(fmu: Path) -> str:
-    """Write ``fmu`` again reproducibly, in place (whole or not at all); its new GUID."""
+def rewrite(fmu: Path,
+            transform: Callable[[dict[str, bytes]], dict[str, bytes]] | None = None) -> str:
+    """Write ``fmu`` again reproducibly, in place (whole or not at all), its entries (name:
+    bytes) passed through ``transform`` first; its new GUID."""
     with zipfile.ZipFile(fmu) as package:
         entries = {info.filename: package.read(info) for info in package.infolist()
                    if not info.is_dir()}
+    if transform is not None:
+        entries = transform(entries)
     description = _GENERATED.sub(b"", entries["modelDescription.xml"])
     entries["modelDescription.xml"] = _GUID.sub(b' guid=""', description, count=1)
     contents = hashlib.sha256()
