@@ -86,7 +86,7 @@ def run_and_write(system: SystemDescription, label: str, out: Path,
     outcome = Outcome(recording, csv_path,
                       [csv_path, write_metadata(recording, out / f"{label}.json")])
     if recording.interrupted:
-        outcome.status = stop.exit_status if stop is not None else 130
+        outcome.status = stop.exit_status          # only a run given ``stop`` is interrupted
         return outcome
     if recording.error:
         outcome.status = 1

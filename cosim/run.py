@@ -161,7 +161,7 @@ def main(argv: list[str] | None = None) -> int:
         parser.error("--animate mp4 needs ffmpeg, which is not installed here; use gif")
     options = Options(args.coupling, args.stop_time, args.lam, args.backend,
                       not args.no_plot, ("png", *args.figure_format), args.stream, args.animate)
-    status, costs, spreads = 0, {}, {}
+    status, costs, spreads, runs = 0, {}, {}, 0
     perturbed = ", ".join(".".join(p) for p in PERTURBED)
     for run in runs_asked(names, args.all, args.autopilot, args.name):
         out = args.out or Path("results") / run.label
@@ -192,13 +192,13 @@ def main(argv: list[str] | None = None) -> int:
             else:
                 print(f"  last-bit spread over {ensemble.runs} runs ({perturbed} moved by up "
                       f"to {args.spread} ulp): {ensemble.describe()}")
-                spreads[run.table_row] = ensemble.describe()
+                spreads[run.table_row], runs = ensemble.describe(), ensemble.runs
         if result is not None and run.table_row is not None:
             costs[run.table_row] = result
     if args.all and costs:
         print()
         print(tables(costs, spreads, f"How far one last bit moves each figure (the largest "
-                                    f"change over {4 * (args.spread or 0) + 1} runs, "
+                                    f"change over {runs} runs, "
                                     f"{perturbed} moved by up to {args.spread} ulp; where "
                                     "it shows at the printed digits)"))
     return status

@@ -16,7 +16,6 @@ to stop (``cosim.core.interrupt``: Ctrl-C, SIGTERM), between two steps.
 """
 from __future__ import annotations
 
-import re
 import time
 from pathlib import Path
 from typing import Any, Callable

@@ -87,6 +87,7 @@ def spread(system: SystemDescription, overrides: dict[str, dict[str, Any]] | Non
             if instance is None or name not in instance.variables:
                 raise ValueError(f"spread: the system {system.name!r} has no "
                                  f"{component}.{name} to perturb")
+        held: dict[str, dict[str, Any]] = {}     # the values the unperturbed run used
         for i, (parameter, k) in enumerate(members):
             if parameter is not None:
                 component, name = parameter
@@ -99,7 +100,7 @@ def spread(system: SystemDescription, overrides: dict[str, dict[str, Any]] | Non
                 moved = f"{'.'.join(parameter)} moved by {k} ulp" if parameter else "nominal"
                 raise RuntimeError(f"spread: the run ({moved}) failed: {recording.error}")
             if parameter is None:
-                held = master.parameter_values     # the values the unperturbed run used
+                held = master.parameter_values
             costs.append(cost(recording, lam))
             if progress is not None:
                 progress(i + 1, len(members))
