@@ -22,7 +22,7 @@ import time
 from pathlib import Path
 
 from ._cli import entry, writable_folder
-from .analysis.figures import whole_file
+from .core.files import whole_file
 from .scenarios import names
 from .studies import accuracy, cpu_variants, integration_error
 
@@ -75,7 +75,7 @@ def main(argv: list[str] | None = None) -> int:
 
 def _write(path: Path, text: str) -> None:
     with whole_file(path) as temporary:
-        Path(temporary).write_text(text + "\n")
+        temporary.write_text(text + "\n")
 
 
 if __name__ == "__main__":

@@ -26,7 +26,8 @@ from autopilot_fmu.guidance import parse_waypoints  # noqa: E402
 
 from ..core.recording import Recording  # noqa: E402
 from .describe import title  # noqa: E402
-from .figures import legend_if_any, hull_outline, track_panel, whole_file  # noqa: E402
+from ..core.files import whole_file  # noqa: E402
+from .figures import legend_if_any, hull_outline, track_panel  # noqa: E402
 
 FPS = 10
 VIDEO_SECONDS = 25.0
@@ -135,7 +136,7 @@ def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> P
     return target
 
 
-def _write(frames: list[np.ndarray], path: str, fmt: str, width: int, height: int) -> None:
+def _write(frames: list[np.ndarray], path: Path, fmt: str, width: int, height: int) -> None:
     """RGB frames to a GIF (Pillow) or to an MP4 (ffmpeg, fed raw frames on a pipe)."""
     if fmt == "gif":
         from PIL import Image

@@ -9,12 +9,9 @@ show from the recording: its columns, and the parameter values the run used
 """
 from __future__ import annotations
 
-import contextlib
 import math
-import os
-import tempfile
 from pathlib import Path
-from typing import Any, Callable, Iterator
+from typing import Any, Callable
 
 import matplotlib
 
@@ -27,6 +24,7 @@ from matplotlib.patches import Circle, Polygon  # noqa: E402
 from autopilot_fmu.guidance import parse_waypoints  # noqa: E402
 from ship_fmu.data import Hull  # noqa: E402
 
+from ..core.files import whole_file  # noqa: E402
 from ..core.recording import Recording  # noqa: E402
 from .describe import title  # noqa: E402
 from .manoeuvres import crossing, turning_circle_figures, zigzag_figures  # noqa: E402
@@ -221,24 +219,6 @@ def zigzag_figure(run: Recording) -> Figure:
     _degrees(r, run, "ship.r", "yaw rate r (deg/s)")
     _rudder(rudder, run, "ship.delta_c")
     return fig
-
-
-@contextlib.contextmanager
-def whole_file(target: Path) -> Iterator[str]:
-    """A temporary name beside ``target`` to write to; renamed to ``target`` if the writing
-    succeeds, removed if it fails: a reader never finds half a file."""
-    handle, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.stem}.",
-                                   suffix=target.suffix)
-    os.close(handle)
-    try:
-        yield tmp
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)       # as a file opened for writing would be
-        os.replace(tmp, target)
-    finally:
-        if os.path.exists(tmp):
-            os.remove(tmp)
 
 
 def save(fig: Figure, path: Path, formats: tuple[str, ...] = ("png",)) -> list[Path]:

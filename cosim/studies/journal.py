@@ -4,7 +4,7 @@ The journal is what a sweep resumes from, so it must survive what ends a process
 mid-write: a torn last line (a write cut by a kill) is skipped with a warning, and
 its run is done again. One sweep writes a journal at a time: a second writer is
 refused with a message naming the holder of the lock (process, host, since when).
-Tables derived from it are written atomically (``write_atomically``).
+Tables derived from it are written atomically (``cosim.core.files``).
 """
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ import socket
 import sys
 import time
 from pathlib import Path
-from typing import Callable, TextIO
+from typing import TextIO
 
 
 class JournalLocked(RuntimeError):
@@ -92,15 +92,3 @@ class Journal:
             f.flush()
             os.fsync(f.fileno())
         self.rows[row["run_id"]] = row
-
-
-def write_atomically(target: Path, write: Callable[[Path], None]) -> Path:
-    """``write(path)`` to a temporary path beside ``target``, then rename it to ``target``:
-    a reader sees the old file or the new one, never half of one."""
-    temporary = target.with_name(f".{target.name}.{os.getpid()}.tmp")
-    try:
-        write(temporary)
-        os.replace(temporary, target)
-    finally:
-        temporary.unlink(missing_ok=True)
-    return target

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .journal import write_atomically
+from ..core.files import write_atomically
 from .sweep_spec import Spec
 from .sweep_task import METRICS
 

@@ -1,0 +1,171 @@
+"""Output files written whole or not at all, and output folders written by one process at a time.
+
+``whole_file`` hands out a temporary name beside the target and renames it into
+place only when the writing succeeded: a reader finds the old file or the new one,
+never half of one, and a failed write (a full disk, a kill) leaves the old file
+as it was. ``Outputs`` does the same for a group of files (a run's CSV, JSON and
+figures): every file is written under a temporary name first and the group is put
+in place only once all of them are complete. ``FolderLock`` holds an output folder
+for one process; a second is refused at once, with a message naming the folder.
+A failed write raises ``OutputError``, which names the file and says what was kept.
+"""
+from __future__ import annotations
+
+import contextlib
+import errno
+import os
+import tempfile
+from pathlib import Path
+from typing import Callable, Iterator
+
+try:
+    import fcntl
+except ImportError:                     # Windows: msvcrt's byte-range lock instead
+    fcntl = None
+    import msvcrt
+
+TEMPORARY_PREFIX = ".partial-"
+"""Temporary files beside their targets start with this (a dot file: hidden, and never
+a name a command writes for good)."""
+
+
+class OutputError(OSError):
+    """A file could not be written: names the file and the reason; earlier files are kept."""
+
+    def __init__(self, target: Path, error: OSError, kept: str = ""):
+        reason = error.strerror or str(error)
+        if error.errno == errno.EFBIG:
+            reason += " (a limit on file size)"
+        message = f"cannot write {target}: {reason}"
+        super().__init__(error.errno, message + (f"; {kept}" if kept else ""))
+        self.target = target
+
+    def __str__(self) -> str:
+        return self.strerror
+
+
+class FolderBusy(RuntimeError):
+    """Another process is writing into this output folder."""
+
+
+def _temporary(target: Path) -> Path:
+    handle, name = tempfile.mkstemp(dir=target.parent, prefix=f"{TEMPORARY_PREFIX}{target.stem}.",
+                                    suffix=target.suffix)     # the suffix tells the format
+    os.close(handle)
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(name, 0o666 & ~umask)       # as a file opened for writing would be
+    return Path(name)
+
+
+@contextlib.contextmanager
+def whole_file(target: Path) -> Iterator[Path]:
+    """``with whole_file(target) as tmp``: write to ``tmp``; it becomes ``target`` if the
+    block succeeds and is removed if it fails (OutputError for an OSError; the old
+    ``target`` is kept either way)."""
+    target = Path(target)
+    tmp = _temporary(target)
+    try:
+        try:
+            yield tmp
+            os.replace(tmp, target)
+        except OSError as error:
+            raise OutputError(target, error, f"{target.name} as it was before") from error
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def write_atomically(target: Path, write: Callable[[Path], object]) -> Path:
+    """``write(path)`` to a temporary path beside ``target``, then rename it to ``target``."""
+    with whole_file(target) as tmp:
+        write(tmp)
+    return Path(target)
+
+
+class Outputs:
+    """A group of output files put in place together, once all are complete.
+
+    ``with Outputs(folder, stale=[...]) as outputs``: ``outputs.path("x.csv")`` is a
+    temporary path to write ``folder/x.csv`` to. If the block succeeds, every file
+    written is renamed into place and then each ``stale`` file not rewritten is
+    removed (a previous run's figure that this one did not draw, say). If it fails,
+    the temporary files are removed and the folder is as it was.
+    """
+
+    def __init__(self, folder: Path, stale: list[Path] | tuple[Path, ...] = ()):
+        self.folder, self.stale = Path(folder), list(stale)
+        self.staged: dict[Path, Path] = {}          # target: temporary
+
+    def path(self, name: str) -> Path:
+        target = self.folder / name
+        if target not in self.staged:
+            self.staged[target] = _temporary(target)
+        return self.staged[target]
+
+    def adopt(self, target: Path, temporary: Path) -> None:
+        """Put an existing temporary file (a streamed CSV) in place with the others."""
+        self.staged[Path(target)] = Path(temporary)
+
+    @property
+    def targets(self) -> list[Path]:
+        return list(self.staged)
+
+    def __enter__(self) -> Outputs:
+        return self
+
+    def __exit__(self, kind, error, trace) -> None:
+        try:
+            if kind is None:
+                self.commit()
+        finally:
+            for temporary in self.staged.values():
+                temporary.unlink(missing_ok=True)
+
+    def commit(self) -> None:
+        """Rename every staged file into place, then remove the stale ones."""
+        for target, temporary in self.staged.items():
+            try:
+                os.replace(temporary, target)
+            except OSError as error:
+                raise OutputError(target, error) from error
+        for old in self.stale:
+            if old not in self.staged:
+                old.unlink(missing_ok=True)
+
+
+class FolderLock:
+    """``with FolderLock(folder)``: this process alone writes into ``folder`` until the block
+    ends; FolderBusy at once if another holds it. The lock is the kernel's (released if
+    the process dies, however): on the folder itself where the system allows, so that no
+    file is left behind; on Windows on a file ``.cosim-lock`` in it."""
+
+    def __init__(self, folder: Path):
+        self.folder = Path(folder)
+        self._handle: int | None = None
+
+    def __enter__(self) -> FolderLock:
+        if fcntl is not None:
+            handle = os.open(self.folder, os.O_RDONLY)
+            try:
+                fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                os.close(handle)
+                raise FolderBusy(self._busy()) from None
+        else:
+            handle = os.open(self.folder / ".cosim-lock", os.O_RDWR | os.O_CREAT)
+            try:
+                msvcrt.locking(handle, msvcrt.LK_NBLCK, 1)
+            except OSError:
+                os.close(handle)
+                raise FolderBusy(self._busy()) from None
+        self._handle = handle
+        return self
+
+    def _busy(self) -> str:
+        return (f"output folder {self.folder} is being written by another command; wait "
+                "for it to end, or give this one another --out")
+
+    def __exit__(self, *exc) -> None:
+        if self._handle is not None:
+            os.close(self._handle)          # closing releases the lock
+            self._handle = None
