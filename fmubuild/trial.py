@@ -35,26 +35,40 @@ slave.freeInstance()
 
 
 class TrialFailed(RuntimeError):
-    """The FMU did not instantiate, or took its host down: ``crashed`` names the signal
-    (None if it failed), ``last_words`` are the child's last lines (the FMU's first)."""
+    """The FMU did not instantiate, took its host down, or did not end in time: ``crashed``
+    names the signal (None otherwise), ``timed_out`` the limit in seconds (None unless it
+    ran out), ``last_words`` are the child's last lines (the FMU's first)."""
 
-    def __init__(self, fmu: Path, returncode: int, last_words: list[str]):
-        self.fmu, self.last_words = fmu, last_words
-        self.crashed = signal.Signals(-returncode).name if returncode < 0 else None
-        how = f"crashed its host ({self.crashed})" if self.crashed else "failed"
+    def __init__(self, fmu: Path, returncode: int | None, last_words: list[str],
+                 timed_out: float | None = None):
+        self.fmu, self.last_words, self.timed_out = fmu, last_words, timed_out
+        self.crashed = signal.Signals(-returncode).name if returncode and returncode < 0 \
+            else None
+        how = (f"did not end within {timed_out:g} s (the child was killed)" if timed_out
+               else f"crashed its host ({self.crashed})" if self.crashed else "failed")
         super().__init__(f"{fmu}: instantiating the FMU {how}"
                          + "".join(f"\n  {line}" for line in last_words))
 
 
+def _last_lines(text: str | bytes | None) -> list[str]:
+    if isinstance(text, bytes):
+        text = text.decode(errors="replace")
+    return [line for line in (text or "").splitlines() if line.strip()][-3:]
+
+
 def trial(fmu: str | Path, isolated: bool = False, timeout: float = 120.0) -> None:
-    """Instantiate and free ``fmu`` in a child process; TrialFailed if that fails. The
-    child is killed after ``timeout`` seconds (subprocess.TimeoutExpired)."""
+    """Instantiate and free ``fmu`` in a child process; TrialFailed if that fails, or if it
+    has not ended after ``timeout`` seconds (the child is killed then)."""
     fmu = Path(fmu).resolve()
     with tempfile.TemporaryDirectory() as elsewhere:
-        child = subprocess.run([sys.executable, "-c", _CHILD.format(root=str(ROOT)), str(fmu),
-                                "isolated" if isolated else "here"],
-                               cwd=elsewhere, capture_output=True, text=True, timeout=timeout)
+        try:
+            child = subprocess.run([sys.executable, "-c", _CHILD.format(root=str(ROOT)),
+                                    str(fmu), "isolated" if isolated else "here"],
+                                   cwd=elsewhere, capture_output=True, text=True,
+                                   timeout=timeout)
+        except subprocess.TimeoutExpired as expired:
+            raise TrialFailed(fmu, None, _last_lines(expired.stdout) or _last_lines(
+                expired.stderr), timed_out=timeout) from None
     if child.returncode != 0:
-        said = [line for line in child.stdout.splitlines() if line.strip()][-3:]  # the FMU's
-        raise TrialFailed(fmu, child.returncode, said or [
-            line for line in child.stderr.splitlines() if line.strip()][-3:])
+        raise TrialFailed(fmu, child.returncode,    # the FMU's words, else Python's
+                          _last_lines(child.stdout) or _last_lines(child.stderr))
