@@ -6,12 +6,14 @@ import sys
 from pathlib import Path
 
 from ._cli import entry, say_error, say_note, writable_folder
+from .core.files import write_atomically
 from .core.interrupt import Interrupted
 from .core.master import RUN_BACKENDS
 from .studies import sweep
+from .studies.cluster import CONNECT_TIMEOUT
 from .studies.sweep_client import NoWorkers, SweepError
 from .studies.sweep_figures import save_figures
-from .studies.sweep_spec import Spec
+from .studies.sweep_spec import MAX_RUNS, Spec
 from .studies.sweep_tables import comparison, summary, write_tables
 
 RESULTS = Path("results/sweeps")
@@ -29,6 +31,16 @@ def seconds(text: str) -> float:
     raise argparse.ArgumentTypeError(f"give a number of seconds > 0, got {text!r}")
 
 
+def count(text: str) -> int:
+    """A whole number >= 1, for argparse."""
+    try:
+        if int(text) >= 1:
+            return int(text)
+    except ValueError:
+        pass
+    raise argparse.ArgumentTypeError(f"give a whole number >= 1, got {text!r}")
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m cosim.sweep",
                                      description=USAGE.split("\n\n")[0],
@@ -40,8 +52,16 @@ def main(argv: list[str] | None = None) -> int:
                              "else a local cluster)")
     parser.add_argument("--scheduler-file", metavar="FILE",
                         help="an existing Dask scheduler, from its --scheduler-file")
-    parser.add_argument("--workers", type=int,
-                        help="worker processes of the local cluster (default: cores)")
+    parser.add_argument("--workers", type=count,
+                        help="worker processes of the local cluster (default and most: the "
+                             "cores this process may use)")
+    parser.add_argument("--connect-timeout", type=seconds, metavar="SECONDS",
+                        default=CONNECT_TIMEOUT,
+                        help="how long to try to reach an existing scheduler "
+                             "(default: %(default)g s)")
+    parser.add_argument("--max-runs", type=count, metavar="N", default=MAX_RUNS,
+                        help="refuse a spec of more runs, before anything is allocated "
+                             "(default: %(default)d)")
     parser.add_argument("--out", type=Path, default=RESULTS, help="parent folder of the results")
     parser.add_argument("--backend", choices=RUN_BACKENDS, default="fmi",
                         help="fmi: each run through the FMUs (default); inprocess: this "
@@ -58,9 +78,9 @@ def main(argv: list[str] | None = None) -> int:
                         help="no progress bar (for logs)")
     args = parser.parse_args(argv)
     try:
-        spec = Spec.read(args.spec)
-    except ValueError as error:
-        print(f"error: {error}", file=sys.stderr)
+        spec = Spec.read(args.spec, max_runs=args.max_runs)
+    except (ValueError, FileNotFoundError) as error:     # FileNotFoundError: an FMU
+        say_error(error)
         return 2
     out = writable_folder(args.out / spec.name)
     try:
@@ -68,8 +88,9 @@ def main(argv: list[str] | None = None) -> int:
             say_note(note)
         rows = sweep.execute(spec, out, args.scheduler, args.workers,
                              progress=not args.no_progress, scheduler_file=args.scheduler_file,
-                             backend=args.backend, no_worker_timeout=args.no_worker_timeout)
-    except (SweepError, ValueError) as error:
+                             backend=args.backend, no_worker_timeout=args.no_worker_timeout,
+                             connect_timeout=args.connect_timeout)
+    except (SweepError, ValueError, OSError) as error:   # OSError: the journal's folder
         say_error(error)
         return 2
     except (Interrupted, NoWorkers) as stopped:
@@ -79,14 +100,21 @@ def main(argv: list[str] | None = None) -> int:
               f"{out / 'runs.jsonl'}{''.join(f', {p}' for p in written)}; the same command "
               "resumes the sweep", file=sys.stderr)
         return stopped.exit_status
-    written = write_tables(rows, out, args.csv)
-    if any(r["status"] == "ok" for r in rows):
-        written += save_figures(spec, rows, out)
-    else:
-        print("no run succeeded: no figures drawn", file=sys.stderr)
-    if "pd" in spec.controllers and len(spec.controllers) > 1:
-        (out / "comparison.md").write_text(comparison(spec, rows) + "\n")
-        written.append(out / "comparison.md")
+    try:
+        written = write_tables(rows, out, args.csv)
+        if any(r["status"] == "ok" for r in rows):
+            written += save_figures(spec, rows, out)
+        else:
+            print("no run succeeded: no figures drawn", file=sys.stderr)
+        if "pd" in spec.controllers and len(spec.controllers) > 1:
+            table = comparison(spec, rows) + "\n"
+            written.append(write_atomically(out / "comparison.md",
+                                            lambda path: path.write_text(table)))
+    except OSError as error:            # OutputError: names the file, each file whole
+        say_error(error)
+        print(f"  every row is kept in {out / 'runs.jsonl'}; the same command writes the "
+              "tables and figures again", file=sys.stderr)
+        return 2
     print(summary(spec, rows))
     print(f"wrote {', '.join(str(p) for p in written)}")
     return 0 if all(r["status"] == "ok" for r in rows) else 1

@@ -4,10 +4,16 @@ from __future__ import annotations
 
 import functools
 import re
+import subprocess
+import sys
+import time
+from pathlib import Path
 
 import pytest
 
 import cosim.scenarios.autopilot as autopilot
+from cosim.studies import sweep
+from cosim.studies.cluster import ClusterError, connect, local_workers
 from fmubuild.trial import TrialFailed, trial
 
 
@@ -21,3 +27,176 @@ def test_a_trial_that_runs_out_of_time_names_the_fmu_and_the_limit(fmu_paths, mo
     monkeypatch.setattr(autopilot, "instantiate_in_child", functools.partial(trial, timeout=0.01))
     with pytest.raises(autopilot.AutopilotError, match=re.escape(said)):
         autopilot.check_autopilot(fmu, trial=True)
+
+
+# -- the spec: what would run something other than the file says ------------------------
+def spec_file(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "spec.toml"
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize("text, said", [
+    # one parameter set twice: by two axes, or by an axis and a controller's set
+    ('[axes]\nwave_seed = [1]\n"ship.wave_seed" = [2]',
+     "axes 'wave_seed' and 'ship.wave_seed' both set ship.wave_seed"),
+    ("[axes]\nsea_state = [2]\nHs = [0.01]", "axes 'sea_state' and 'Hs' both set ship.Hs"),
+    ('[axes]\n"ship.T0" = [1.0]\nsea_state = [2]',
+     "axes 'ship.T0' and 'sea_state' both set ship.T0"),
+    ('[controllers]\npd = { scenario = "waves_pd", set = { "ship.Hs" = 0.01 } }\n'
+     "[axes]\nsea_state = [2]", "controller 'pd' sets ship.Hs, which axis 'sea_state' sets"),
+    # a value twice in one axis, as the FMU receives it
+    ("[axes]\nwave_seed = [1, 1, 2]", "axis 'wave_seed' has 1 twice"),
+    ('[axes]\n"ship.delta_rate_max" = [1, 1.0]',
+     "axis 'ship.delta_rate_max' has 1 and 1.0, one value for the FMU"),
+    ("[axes]\nHs = [0.01, 1e-2]", "axis 'Hs' has 0.01 twice"),
+    ("[axes]\nsea_state = [3, 3]", "axis 'sea_state' has 3 twice"),
+    # values the parameter's FMI type cannot hold
+    ("[axes]\nwave_seed = [4294967297]", "axis 'wave_seed' = 4294967297: the parameter is an "
+                                         "FMI Integer; give a whole number from -2147483648"),
+    ("[axes]\nwave_seed = [1.5]", "axis 'wave_seed' = 1.5: the parameter is an FMI Integer"),
+    ("[axes]\nwave_seed = [true]", "axis 'wave_seed' = True: the parameter is an FMI Integer"),
+    ("[axes]\nwave_seed = { start = 2147483647, count = 2 }",
+     "axis 'wave_seed' = 2147483648: the parameter is an FMI Integer"),
+    ('[axes]\nHs = ["0.01"]', "axis 'Hs' = '0.01': the parameter is an FMI Real; give a finite"),
+    ("[axes]\nHs = [nan]", "axis 'Hs' = nan: the parameter is an FMI Real"),
+    ("[axes]\npsi_w = [-inf]", "axis 'psi_w' = -inf: the parameter is an FMI Real"),
+    ("[axes]\nHs = [[0.01]]", "axis 'Hs' = \\[0.01\\]: the parameter is an FMI Real"),
+    ("[axes]\nroute = [1]", "axis 'route' = 1: the parameter is an FMI String"),
+    ('[axes]\nroute = ["0,0;10,0\\u0000"]', "axis 'route' = '0,0;10,0\\\\x00': the parameter "
+                                             "is an FMI String; give a string \\(without NUL"),
+    ('[controllers]\npd = { scenario = "waves_pd", set = { "ship.wave_seed" = -2147483649 } }',
+     "controller 'pd' set 'ship.wave_seed' = -2147483649: the parameter is an FMI Integer"),
+    ("[axes]\nsea_state = [true]", "axis 'sea_state' has True: give WMO codes"),
+    ("[axes]\nsea_state = [2.0]", "axis 'sea_state' has 2.0: give WMO codes"),
+    # what the systems do not have
+    ('[axes]\n"ship.nope" = [1.0]', "axis 'ship.nope' sets ship.nope, but in controller 'pd' "
+                                    "ship \\(ship.fmu\\) has no parameter 'nope'; it has x0"),
+    ('[axes]\n"ship.psi" = [1.0]', "axis 'ship.psi' .* has no parameter 'psi'"),   # an output
+    ('[axes]\n"rudder.x" = [1.0]', "axis 'rudder.x' sets rudder.x, but in controller 'pd' "
+                                    "there is no component 'rudder' \\(there are guidance"),
+    ("[axes]\nship.Hs = [0.01]", "axis 'ship' is neither .* quote the key: \"ship.Hs\""),
+    ('[controllers]\npd = { scenario = "waves_pd", set = { autopilot.Kp = 2.0 } }',
+     "controller 'pd' set 'autopilot' = {'Kp': 2.0}: give component.variable = value"),
+    # malformed tables and keys
+    ("stop_time = inf", "stop_time = inf: give a number of seconds > 0"),
+    ("[controllers]", "\\[controllers\\] is empty"),
+    ("[controllers]\npd = { scenario = 3 }", "controller 'pd' scenario = 3: give a string"),
+    ('[controllers]\npd = { scenario = "waves_pd", set = [1] }',
+     "controller 'pd' set = \\[1\\]: give a table"),
+    ('[controllers]\npd = { autopilot = "x.fmu", map = { psi = 1 } }',
+     "controller 'pd' map 'psi' = 1: give the FMU's name"),
+    ("[plots]\nmap = [{ a = 1 }]", "\\[plots\\] map = \\[{'a': 1}\\]: give two different axes"),
+    ("[axes]\nHs = [0.01]\n[plots]\nmap = ['Hs', 'Hs']",
+     "\\[plots\\] map = \\['Hs', 'Hs'\\]: give two different axes"),
+    ("[plots]\nmaps = []", "\\[plots\\] has maps; it has map and tracks"),
+    ("[axes]\nwave_seed = [1, 2]\n[plots]\ntracks = { wave_seed = true }",
+     "\\[plots\\] tracks selects wave_seed = True"),
+    # a name that would write outside the output folder, or oddly in it
+    ('name = "../../x"', "name = '../../x': a name in the output folder must be one plain file"),
+    ('name = "/abs/x"', "name = '/abs/x'"),
+    ('name = "a/b"', "name = 'a/b'"),
+    ('name = "a\\\\b"', "name = 'a\\\\\\\\b'"),
+    ('name = ""', "name = ''"),
+    ('name = ".."', "name = '..'"),
+    ('name = "a\\u0000b"', "name = 'a\\\\x00b'"),
+    ('name = "x\\n"', "name = 'x\\\\n'"),
+    ("name = 3", "name = 3"),
+    ('[controllers]\n"../evil" = "waves_pd"', "controller '../evil' = '../evil': a name in the "
+                                              "output folder"),
+])
+def test_a_spec_that_would_run_something_else_is_refused_by_file_and_key(tmp_path, text, said):
+    path = spec_file(tmp_path, text)
+    with pytest.raises(ValueError, match=f"^{re.escape(str(path))}: {said}"):
+        sweep.Spec.read(path)
+
+
+def test_a_sweep_is_counted_before_it_is_listed(tmp_path):
+    """A range of 2^62 values is refused at once, without a list of them; so is a product
+    of axes beyond max_runs, with the count."""
+    path = spec_file(tmp_path, "[axes]\nwave_seed = { start = 1, count = 4611686018427387904 }")
+    started = time.perf_counter()
+    with pytest.raises(ValueError, match="4611686018427387904 values, more than the 100000 runs "
+                                         "a sweep may have \\(cosim.sweep --max-runs\\)"):
+        sweep.Spec.read(path)
+    assert time.perf_counter() - started < 1
+    path = spec_file(tmp_path, "[axes]\nwave_seed = { start = 1, count = 300 }\n"
+                               "psi_w = { start = 0, count = 3 }")
+    with pytest.raises(ValueError, match=re.escape(
+            f"{path}: 2 controllers x 300 wave_seed x 3 psi_w = 1800 runs, more than the 1000")):
+        sweep.Spec.read(path, max_runs=1000)
+    assert len(sweep.Spec.read(path, max_runs=1800).runs()) == 1800
+
+
+def test_the_command_refuses_a_bad_spec_with_one_line_and_writes_nothing(tmp_path):
+    out = tmp_path / "out"
+    for text, said in [('name = "../escaped"\n', "name = '../escaped'"),
+                       ("[axes]\nwave_seed = [1, 1]\n", "axis 'wave_seed' has 1 twice"),
+                       ("[axes]\nwave_seed = { start = 1, count = 60 }\n",
+                        "2 controllers x 60 wave_seed = 120 runs, more than the 100")]:
+        child = subprocess.run([sys.executable, "-m", "cosim.sweep",
+                                str(spec_file(tmp_path, text)), "--out", str(out),
+                                "--max-runs", "100"],
+                               capture_output=True, text=True, timeout=120)
+        assert child.returncode == 2 and child.stdout == "", child
+        assert child.stderr.startswith(f"error: {tmp_path / 'spec.toml'}: {said}"), child.stderr
+        assert len(child.stderr.splitlines()) == 1 and "Traceback" not in child.stderr
+    assert not out.exists() and not (tmp_path / "escaped").exists()
+
+
+# -- cluster options: a clear error, never a hang ---------------------------------------
+@pytest.mark.timeout(30, method="thread")
+def test_a_scheduler_file_that_is_missing_empty_or_malformed_is_named(tmp_path):
+    missing = tmp_path / "sched.json"
+    with pytest.raises(ClusterError, match=f"scheduler file {missing} does not exist"):
+        connect(scheduler_file=str(missing))          # Dask's own client waits for ever
+    for content, said in [("", "is not a Dask scheduler file"), ("[1]", "is not a Dask"),
+                          ('{"address": 3}', "names no scheduler address"),
+                          ('{"id": "x"}', "names no scheduler address")]:
+        missing.write_text(content)
+        with pytest.raises(ClusterError, match=re.escape(f"scheduler file {missing} {said}")):
+            connect(scheduler_file=str(missing))
+
+
+@pytest.mark.timeout(30, method="thread")
+def test_an_unreachable_or_malformed_scheduler_address_is_named_within_the_timeout(tmp_path):
+    started = time.perf_counter()
+    with pytest.raises(ClusterError, match="cannot reach the Dask scheduler at "
+                                           "tcp://127.0.0.1:9 \\(from --scheduler\\) within 1 s"):
+        connect("tcp://127.0.0.1:9", timeout=1)
+    assert time.perf_counter() - started < 10
+    with pytest.raises(ClusterError, match="'nowhere' \\(from --scheduler\\) is not a Dask "
+                                           "scheduler address"):
+        connect("nowhere", timeout=1)
+    (tmp_path / "sched.json").write_text('{"address": "tcp://127.0.0.1:9"}')
+    with pytest.raises(ClusterError, match=f"from scheduler file {tmp_path / 'sched.json'}"):
+        connect(scheduler_file=str(tmp_path / "sched.json"), timeout=1)
+
+
+def test_a_worker_count_that_makes_no_sense_is_refused_or_capped():
+    from dask.system import CPU_COUNT
+
+    for nonsense in (0, -3, True, 2.5):
+        with pytest.raises(ClusterError, match="a local cluster needs at least one worker"):
+            local_workers(nonsense)
+    assert local_workers(None) == (None, None) and local_workers(1) == (1, None)
+    workers, note = local_workers(10 ** 6)
+    assert workers == CPU_COUNT and note.startswith(
+        f"--workers 1000000: this machine gives this process {CPU_COUNT} cores")
+
+
+@pytest.mark.timeout(60, method="thread")
+def test_the_command_ends_bad_cluster_options_in_one_line(tmp_path):
+    spec = spec_file(tmp_path, "stop_time = 5\n[axes]\nwave_seed = [1]\n")
+    for options, said in [(["--scheduler", "tcp://127.0.0.1:9", "--connect-timeout", "1"],
+                           "error: cannot reach the Dask scheduler at tcp://127.0.0.1:9"),
+                          (["--scheduler-file", str(tmp_path / "none.json")],
+                           f"error: scheduler file {tmp_path / 'none.json'} does not exist"),
+                          (["--workers", "0"], "argument --workers: give a whole number >= 1"),
+                          (["--max-runs", "-1"], "argument --max-runs: give a whole number")]:
+        child = subprocess.run([sys.executable, "-m", "cosim.sweep", str(spec), "--out",
+                                str(tmp_path / "out"), *options],
+                               capture_output=True, text=True, timeout=50)
+        assert child.returncode == 2 and said in child.stderr, child
+        assert "Traceback" not in child.stderr
+    assert not list((tmp_path / "out").rglob("*.*"))         # no file of any kind

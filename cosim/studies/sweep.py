@@ -63,7 +63,7 @@ from pathlib import Path
 from typing import Any
 
 from ..core.master import RUN_BACKENDS
-from .cluster import connect
+from .cluster import CONNECT_TIMEOUT, connect
 from .journal import Journal, JournalLocked, read_rows
 from .sweep_client import NoWorkers, SweepError, check_workers, run_on_cluster
 from .sweep_spec import Spec, controller_entry
@@ -81,7 +81,8 @@ NO_WORKER_TIMEOUT = 60.0
 
 def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | None = None,
             progress: bool = True, task=None, scheduler_file: str | None = None,
-            backend: str = "fmi", no_worker_timeout: float = NO_WORKER_TIMEOUT) -> list[dict]:
+            backend: str = "fmi", no_worker_timeout: float = NO_WORKER_TIMEOUT,
+            connect_timeout: float = CONNECT_TIMEOUT) -> list[dict]:
     """Run every run of ``spec`` without an ok row in the journal (failed rows are run
     again); return every row of the sweep.
 
@@ -97,7 +98,9 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
     cluster is closed) the runs completed so far stay in the journal (``completed``);
     the same call then resumes. A cluster with no worker for ``no_worker_timeout``
     seconds ends the sweep the same way, with ``NoWorkers``. SweepError if a worker runs
-    other code than the client or another sweep writes the journal.
+    other code than the client or another sweep writes the journal; ``cluster.ClusterError``
+    (a ValueError) if the scheduler cannot be found or reached within ``connect_timeout``
+    seconds, or ``workers`` makes no sense.
     """
     if backend not in RUN_BACKENDS:
         raise ValueError(f"backend must be fmi or inprocess, got {backend!r}")
@@ -112,7 +115,8 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
                 print(f"{len(runs) - len(todo)} of {len(runs)} runs already done in "
                       f"{journal.path}; {len(todo)} to run", file=sys.stderr, flush=True)
             if todo:
-                run_on_cluster(spec, todo, journal, connect(scheduler, workers, scheduler_file),
+                run_on_cluster(spec, todo, journal,
+                               connect(scheduler, workers, scheduler_file, connect_timeout),
                                progress, task or run_one, backend, no_worker_timeout)
     except JournalLocked as locked:
         raise SweepError(str(locked)) from None

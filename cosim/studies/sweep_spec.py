@@ -4,12 +4,22 @@ The format is documented in ``cosim.studies.sweep`` and docs/sweeps/example.toml
 run is one controller at one combination of axis values; its id hashes everything
 that determines its result (``Spec.runs``), and ``Spec.job`` is what a worker needs
 to run it (``sweep_task``).
+
+``Spec.read`` refuses, before anything runs or is allocated, what would run something
+else than the file says: a parameter set by two axes (or by an axis and a controller's
+``set``), a value twice in one axis (as the FMU would receive it: 1 and 1.0 of a Real
+are one value), a value the parameter's FMI type cannot hold (a string for a Real,
+NaN, 4294967297 for an Integer), a sweep of more than ``max_runs`` runs, and a name
+(of the sweep or a controller) that is not one plain file name, since both name
+files in the output folder.
 """
 from __future__ import annotations
 
 import hashlib
 import itertools
 import json
+import math
+import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -17,6 +27,8 @@ from typing import Any
 
 from .. import scenarios
 from ..analysis.seastate import model_scale
+from ..core.errors import FmuNotFound, FmuUnreadable
+from ..core.fmi import read_description
 from ..core.inprocess import fallback_note
 from ..core.provenance import code_version
 from ..scenarios.autopilot import check_autopilot
@@ -27,6 +39,18 @@ DEFAULT_CONTROLLERS = {"pd": {"scenario": "waves_pd"}, "smc": {"scenario": "wave
 # Axis shorthands: name -> the FMU parameter it sets.
 SHORTHANDS = {"wave_seed": "ship.wave_seed", "Hs": "ship.Hs", "T0": "ship.T0",
               "psi_w": "ship.psi_w", "route": "guidance.waypoints"}
+SEA_STATE = ("ship.Hs", "ship.T0")
+"""What the sea_state axis sets: a WMO code's Hs and T0 at model scale."""
+
+MAX_RUNS = 100_000
+"""The most runs a sweep may have unless told otherwise (``cosim.sweep --max-runs``)."""
+
+FILE_NAME = re.compile(r"\w(?:[\w .+-]{0,98}[\w+-])?")
+"""A sweep's or a controller's name: one plain file name (letters, digits, _ . + - and
+inner spaces; no separator, no leading dot, at most 100 characters)."""
+
+INTEGER = (-2 ** 31, 2 ** 31 - 1)
+"""The values of an FMI 2.0 Integer (a C int)."""
 
 
 @dataclass
@@ -47,44 +71,110 @@ class Spec:
         return self.tracks is not None and all(run.get(k) == v for k, v in self.tracks.items())
 
     @classmethod
-    def read(cls, path: str | Path) -> Spec:
-        """Parse a sweep file; ValueError naming the file, the key and the problem."""
+    def read(cls, path: str | Path, max_runs: int = MAX_RUNS) -> Spec:
+        """Parse a sweep file; ValueError naming the file, the key and the problem (FmuNotFound
+        or FmuUnreadable, naming them too, for a controller whose FMU is missing or broken).
+        More than ``max_runs`` runs are refused before any is listed."""
         path = Path(path)
         try:
             data = tomllib.loads(path.read_text())
-        except (OSError, tomllib.TOMLDecodeError) as error:
+        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as error:
             raise ValueError(f"cannot read sweep spec {path}: {error}") from None
         unknown = set(data) - {"name", "stop_time", "controllers", "axes", "plots"}
         if unknown:
             raise ValueError(f"{path}: unknown key {', '.join(sorted(unknown))}; a sweep file "
                              "has name, stop_time, [controllers], [axes] and [plots]")
-        name = _typed(path, "name", data.get("name", path.stem), str, "a string")
+        name = _file_name(path, "name", data.get("name", path.stem))
         stop_time = data.get("stop_time")
         if stop_time is not None and (isinstance(stop_time, bool)
                                       or not isinstance(stop_time, (int, float))
-                                      or not stop_time > 0):
+                                      or not 0 < stop_time < math.inf):
             raise ValueError(f"{path}: stop_time = {stop_time!r}: give a number of seconds > 0")
         entries = _typed(path, "[controllers]", data.get("controllers", DEFAULT_CONTROLLERS),
                          dict, "a table")
-        controllers = {name: controller_entry(entry, path, name)
-                       for name, entry in entries.items()}
-        axes = {name: _axis(path, name, values)
+        if not entries:
+            raise ValueError(f"{path}: [controllers] is empty; name at least one controller")
+        for controller in entries:
+            _file_name(path, f"controller {controller!r}", controller)
+        axes = {name: _axis(path, name, values, max_runs)
                 for name, values in _typed(path, "[axes]", data.get("axes", {}), dict,
                                            "a table").items()}
+        _check_size(path, len(entries), axes, max_runs)
+        controllers = {name: controller_entry(entry, path, name)
+                       for name, entry in entries.items()}
+        _check_overlaps(path, controllers, axes)
         plots = _typed(path, "[plots]", data.get("plots", {}), dict, "a table")
+        unknown = set(plots) - {"map", "tracks"}
+        if unknown:
+            raise ValueError(f"{path}: [plots] has {', '.join(sorted(unknown))}; it has map "
+                             "and tracks")
         map_axes = _typed(path, "[plots] map", plots.get("map", []), list, "a list of axes")
+        if map_axes and (len(map_axes) != 2 or map_axes[0] == map_axes[1]):
+            raise ValueError(f"{path}: [plots] map = {map_axes!r}: give two different axes")
         for axis in map_axes:
-            if axis not in axes:
+            if not isinstance(axis, str) or axis not in axes:
                 raise ValueError(f"{path}: [plots] map names {axis!r}, which is not an axis")
         tracks = _typed(path, "[plots] tracks", plots.get("tracks", {}), dict,
                         "a table of axis = value") or None
         for key, value in (tracks or {}).items():
-            known = list(controllers) if key == "controller" else axes.get(key)
-            if known is None or value not in known:
+            known = list(controllers) if key == "controller" else axes.get(key, [])
+            if not any(value == v and type(value) is type(v) for v in known):
                 raise ValueError(f"{path}: [plots] tracks selects {key} = {value!r}; "
                                  f"select by controller or an axis, with one of its values")
-        return cls(name=name, controllers=controllers, axes=axes, stop_time=stop_time,
+        spec = cls(name=name, controllers=controllers, axes=axes, stop_time=stop_time,
                    map_axes=map_axes, tracks=tracks)
+        spec._check_values(path)
+        return spec
+
+    def _check_values(self, path: Path) -> None:
+        """Every parameter the axes and the controllers' ``set`` name exists in each
+        controller's system and takes its values (by FMI type), and no axis repeats a
+        value as the FMU would receive it; ValueError naming the file, key and value."""
+        try:
+            self.bundles()
+        except (FmuNotFound, FmuUnreadable) as error:
+            raise type(error)(f"{path}: {error}", error.ours) from None
+        kinds: dict[tuple[str, str], str] = {}
+
+        def kind(controller: str, target: str, key: str) -> str:
+            if (controller, target) not in kinds:
+                kinds[controller, target] = self._kind(controller, target, key, path)
+            return kinds[controller, target]
+
+        for controller in self.controllers:
+            for target, value in self.controllers[controller]["set"].items():
+                _fmi_value(kind(controller, target, f"controller {controller!r} set"), value,
+                           path, f"controller {controller!r} set {target!r}")
+            for axis, values in self.axes.items():
+                seen: dict[tuple, Any] = {}
+                for value in values:
+                    received = tuple(
+                        _fmi_value(kind(controller, target, f"axis {axis!r}"), v, path,
+                                   f"axis {axis!r}")
+                        for target, v in assignments(axis, value).items())
+                    if received in seen:
+                        same = (f"{value!r} twice" if repr(seen[received]) == repr(value) else
+                                f"{seen[received]!r} and {value!r}, one value for the FMU")
+                        raise ValueError(f"{path}: axis {axis!r} has {same}: each of its runs "
+                                         "would be run twice; give each value once")
+                    seen[received] = value
+
+    def _kind(self, controller: str, target: str, key: str, path: Path) -> str:
+        """The FMI type of parameter ``target`` (component.variable) in a controller's
+        system; ValueError if it has no such parameter."""
+        system = self.bundles()[controller].system
+        component, _, variable = target.partition(".")
+        where = f"{path}: {key} sets {target}, but in controller {controller!r}"
+        if component not in system.components:
+            raise ValueError(f"{where} there is no component {component!r} (there are "
+                             f"{', '.join(system.components)})")
+        fmu = self.files()[Path(system.components[component].source).stem]
+        variables = {v.name: v for v in read_description(fmu, component).modelVariables}
+        parameters = [n for n, v in variables.items() if v.causality == "parameter"]
+        if variable not in parameters:
+            raise ValueError(f"{where} {component} ({fmu.name}) has no parameter "
+                             f"{variable!r}; it has {', '.join(parameters)}")
+        return variables[variable].type
 
     def bundles(self) -> dict[str, Bundle]:
         """Each controller's system with its FMUs named by content (read once)."""
@@ -147,14 +237,16 @@ class Spec:
         for target, value in controller.get("set", {}).items():
             put(target, value)
         for axis in self.axes:
-            value = run[axis]
-            if axis == "sea_state":
-                Hs, T0 = model_scale(value)
-                put("ship.Hs", Hs)
-                put("ship.T0", T0)
-            else:
-                put(SHORTHANDS.get(axis, axis), value)
+            for target, value in assignments(axis, run[axis]).items():
+                put(target, value)
         return controller["scenario"], overrides
+
+
+def assignments(axis: str, value: Any) -> dict[str, Any]:
+    """What one value of an axis sets: component.variable -> value."""
+    if axis == "sea_state":
+        return dict(zip(SEA_STATE, model_scale(value)))
+    return {SHORTHANDS.get(axis, axis): value}
 
 
 def _typed(path: Path, key: str, value: Any, kind: type, what: str) -> Any:
@@ -163,11 +255,24 @@ def _typed(path: Path, key: str, value: Any, kind: type, what: str) -> Any:
     return value
 
 
-def _axis(path: Path, name: str, values: Any) -> list:
-    """An axis's values: a non-empty list, or a range { start = integer, count = integer }."""
+def _file_name(path: Path, key: str, value: Any) -> str:
+    """A name that becomes a file or folder name in the output folder, checked."""
+    if not isinstance(value, str) or not FILE_NAME.fullmatch(value):
+        raise ValueError(f"{path}: {key} = {value!r}: a name in the output folder must be one "
+                         "plain file name of 1-100 letters, digits, _ . + - and inner spaces "
+                         "(no / or \\, not starting with a dot)")
+    return value
+
+
+def _axis(path: Path, name: str, values: Any, max_runs: int) -> list:
+    """An axis's values: a non-empty list, or a range { start = integer, count = integer }
+    of at most ``max_runs`` values."""
     if name not in SHORTHANDS and name != "sea_state" and "." not in name:
+        hint = (f"; for component.variable, quote the key: \"{name}.{next(iter(values))}\" = "
+                "[...]" if isinstance(values, dict) and values
+                and set(values) != {"start", "count"} else "")
         raise ValueError(f"{path}: axis {name!r} is neither one of "
-                         f"{', '.join(['sea_state', *SHORTHANDS])} nor component.variable")
+                         f"{', '.join(['sea_state', *SHORTHANDS])} nor component.variable{hint}")
     if isinstance(values, dict):
         start, count = values.get("start"), values.get("count")
         if set(values) != {"start", "count"} or not all(
@@ -175,16 +280,73 @@ def _axis(path: Path, name: str, values: Any) -> list:
                 or count < 1:
             raise ValueError(f"{path}: axis {name!r} = {values!r}: a range is "
                              "{ start = <integer>, count = <integer >= 1> }")
+        if count > max_runs:
+            raise ValueError(f"{path}: axis {name!r} = {values!r}: {count} values, more than "
+                             f"the {max_runs} runs a sweep may have (cosim.sweep --max-runs)")
         values = list(range(start, start + count))
     if not isinstance(values, list) or not values:
         raise ValueError(f"{path}: axis {name!r} needs a non-empty list of values")
     if name == "sea_state":
         for code in values:
+            if isinstance(code, bool) or not isinstance(code, int):
+                raise ValueError(f"{path}: axis 'sea_state' has {code!r}: give WMO codes, "
+                                 "the integers 0-6")
             try:
                 model_scale(code)
             except ValueError as error:
                 raise ValueError(f"{path}: axis 'sea_state': {error}") from None
     return values
+
+
+def _check_size(path: Path, controllers: int, axes: dict[str, list], max_runs: int) -> None:
+    """ValueError if the sweep has more than ``max_runs`` runs (counted, not listed)."""
+    runs = controllers * math.prod(len(values) for values in axes.values())
+    if runs > max_runs:
+        factors = " x ".join([f"{controllers} controllers",
+                              *(f"{len(v)} {a}" for a, v in axes.items())])
+        raise ValueError(f"{path}: {factors} = {runs} runs, more than the {max_runs} a sweep "
+                         "may have (cosim.sweep --max-runs)")
+
+
+def _check_overlaps(path: Path, controllers: dict[str, dict[str, Any]],
+                    axes: dict[str, list]) -> None:
+    """ValueError if two axes, or an axis and a controller's ``set``, set one parameter:
+    the rows would be labelled with values that were not used."""
+    setters: dict[str, str] = {}
+    for axis, values in axes.items():
+        for target in assignments(axis, values[0]):
+            if target in setters:
+                raise ValueError(f"{path}: axes {setters[target]!r} and {axis!r} both set "
+                                 f"{target}; give it one axis")
+            setters[target] = axis
+    for name, controller in controllers.items():
+        for target in controller["set"]:
+            if target in setters:
+                raise ValueError(f"{path}: controller {name!r} sets {target}, which axis "
+                                 f"{setters[target]!r} sets in every run; give it one place")
+
+
+def _fmi_value(kind: str, value: Any, path: Path, key: str) -> Any:
+    """``value`` as a parameter of FMI type ``kind`` receives it; ValueError naming the
+    file, the key and the value where the type cannot hold it exactly."""
+    number = isinstance(value, (int, float)) and not isinstance(value, bool)
+    if kind == "Real" and number:
+        try:
+            if math.isfinite(float(value)):
+                return float(value)
+        except OverflowError:
+            pass
+    elif kind in ("Integer", "Enumeration") and number and isinstance(value, int):
+        if INTEGER[0] <= value <= INTEGER[1]:
+            return value
+    elif kind == "Boolean" and isinstance(value, bool):
+        return value
+    elif kind == "String" and isinstance(value, str) and "\0" not in value:
+        return value
+    takes = {"Real": "a finite number", "Boolean": "true or false",
+             "String": "a string (without NUL)"}.get(
+        kind, f"a whole number from {INTEGER[0]} to {INTEGER[1]}")
+    raise ValueError(f"{path}: {key} = {value!r}: the parameter is an FMI {kind}; give {takes}")
 
 
 def controller_entry(entry: str | dict[str, Any], spec: Path, name: str) -> dict[str, Any]:
@@ -202,6 +364,19 @@ def controller_entry(entry: str | dict[str, Any], spec: Path, name: str) -> dict
     if unknown:
         raise ValueError(f"{spec}: controller {name!r} has {', '.join(sorted(unknown))}; a "
                          "controller has scenario, autopilot, map and set")
+    for key in ("scenario", "autopilot"):
+        _typed(spec, f"controller {name!r} {key}", entry.get(key, ""), str, "a string")
+    ports = _typed(spec, f"controller {name!r} map", entry.get("map", {}), dict,
+                   "a table of autopilot port = the FMU's name for it")
+    for port, renamed in ports.items():
+        _typed(spec, f"controller {name!r} map {port!r}", renamed, str,
+               "the FMU's name of the port")
+    settings = _typed(spec, f"controller {name!r} set", entry.get("set", {}), dict,
+                      "a table of component.variable = value")
+    for target, value in settings.items():
+        if "." not in target or isinstance(value, dict):
+            raise ValueError(f"{spec}: controller {name!r} set {target!r} = {value!r}: give "
+                             "component.variable = value, the key quoted (\"autopilot.Kp\" = 2.0)")
 
     def beside_spec(value: str) -> str:
         return str((spec.parent / value).resolve()) if value.endswith((".ssd", ".fmu")) \
