@@ -3,7 +3,9 @@ message naming the input, before anything runs, with no partial output file."""
 from __future__ import annotations
 
 import functools
+import os
 import re
+import stat
 import subprocess
 import sys
 import time
@@ -12,7 +14,8 @@ from pathlib import Path
 import pytest
 
 import cosim.scenarios.autopilot as autopilot
-from cosim.studies import sweep
+from cosim.studies import sweep, sweep_task
+from cosim.studies.bundle import UnsafeCache, fmu_cache
 from cosim.studies.cluster import ClusterError, connect, local_workers
 from fmubuild.trial import TrialFailed, trial
 
@@ -200,3 +203,58 @@ def test_the_command_ends_bad_cluster_options_in_one_line(tmp_path):
         assert child.returncode == 2 and said in child.stderr, child
         assert "Traceback" not in child.stderr
     assert not list((tmp_path / "out").rglob("*.*"))         # no file of any kind
+
+
+# -- the workers' FMU cache: private, and checked when used ------------------------------
+def test_the_fmu_cache_is_a_private_folder_of_this_user(tmp_path, monkeypatch):
+    monkeypatch.delenv("COSIM_FMU_CACHE", raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    folder = fmu_cache()
+    assert folder == tmp_path / "cache" / "cosim-fmus"
+    assert stat.S_IMODE(folder.stat().st_mode) & 0o077 == 0
+    folder.chmod(0o777)                     # anyone may plant an FMU there
+    with pytest.raises(UnsafeCache, match=f"the FMU cache {folder} may be written by others "
+                                          "\\(mode drwxrwxrwx\\)"):
+        fmu_cache()
+    folder.chmod(0o700)
+    real = os.getuid()
+    monkeypatch.setattr(os, "getuid", lambda: real + 1)
+    with pytest.raises(UnsafeCache, match=f"{folder} belongs to another user \\(uid {real}\\)"):
+        fmu_cache()
+    monkeypatch.undo()
+    elsewhere = tmp_path / "link"
+    elsewhere.symlink_to(folder)
+    monkeypatch.setenv("COSIM_FMU_CACHE", str(elsewhere))
+    with pytest.raises(UnsafeCache, match=f"{elsewhere} is not a folder"):
+        fmu_cache()
+
+
+def test_a_corrupt_cached_fmu_is_written_again_and_said_to_be_the_cache(
+        fmu_paths, tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv("COSIM_FMU_CACHE", str(tmp_path / "cache"))
+    spec = sweep.Spec.read(spec_file(tmp_path, "stop_time = 2\n[controllers]\npd = 'waves_pd'\n"
+                                               "[axes]\nwave_seed = [1]\n"))
+    ship = next(sha for sha, path in spec.files().items() if path.name == "ship.fmu")
+    cached = fmu_cache() / f"{ship}.fmu"
+    cached.write_bytes(b"PK\x03\x04 not an FMU")          # a crash while it was written, say
+    row = sweep.run_locally(spec, spec.runs()[0])
+    assert row["status"] == "ok", row["error"]
+    assert f"the FMU cache's {cached} does not match its hash" in capsys.readouterr().err
+    assert cached.read_bytes() == spec.files()[ship].read_bytes()
+    sweep_task.free_masters()
+
+
+@pytest.mark.timeout(90, method="thread")
+def test_a_sweep_on_workers_with_an_unsafe_cache_is_refused_before_any_run(
+        fmu_paths, tmp_path, monkeypatch):
+    cache = tmp_path / "shared"
+    cache.mkdir()
+    cache.chmod(0o777)
+    monkeypatch.setenv("COSIM_FMU_CACHE", str(cache))     # the local cluster's workers inherit it
+    spec = sweep.Spec.read(spec_file(tmp_path, "stop_time = 2\n[axes]\nwave_seed = [1]\n"))
+    (tmp_path / "out").mkdir()
+    with pytest.raises(sweep.SweepError, match=f"workers whose FMU cache is not safe to run FMUs "
+                                               f"from:\n  tcp://.*: the FMU cache {cache} may be "
+                                               "written by others"):
+        sweep.execute(spec, tmp_path / "out", workers=1, progress=False)
+    assert not (tmp_path / "out" / "runs.jsonl").exists() and not list(cache.iterdir())

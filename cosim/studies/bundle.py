@@ -5,7 +5,9 @@ checkout, no build step). The client reads each controller's system (its scenari
 with a user's autopilot in place if given) and hashes every FMU it uses; a
 ``Bundle`` carries the system with each FMU named by its SHA-256, and the FMU
 files travel once per worker as Dask data, addressed by that hash. A worker writes
-each FMU once into its cache folder (``fmu_cache``) and points the system at it.
+each FMU once into its cache folder (``fmu_cache``: private to its user) and points
+the system at it; a cached file is checked against its hash whenever a system is
+made from it, and one that does not match is written again from the bytes sent.
 
 The same hashes make a run's identity (``Bundle.digest``): anything that changes an
 FMU or the system changes the digest, and so every run id of that controller.
@@ -16,13 +18,20 @@ import dataclasses
 import hashlib
 import json
 import os
-import tempfile
+import stat
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from .. import scenarios
+from ..core.files import write_atomically
 from ..core.ssd import SystemDescription
+
+
+class UnsafeCache(RuntimeError):
+    """The FMU cache folder is not private to this user: anyone else who can write it could
+    put code in the FMUs this worker runs."""
 
 
 @dataclass(frozen=True)
@@ -61,28 +70,44 @@ def bundle(controller: dict[str, Any]) -> tuple[Bundle, dict[str, Path]]:
 
 
 def fmu_cache() -> Path:
-    """Where a worker keeps the FMUs it was sent: $COSIM_FMU_CACHE, or a folder in the
-    temporary directory."""
+    """Where a worker keeps the FMUs it was sent: $COSIM_FMU_CACHE, else cosim-fmus in
+    $XDG_CACHE_HOME (default ~/.cache). Created with mode 0o700; UnsafeCache if it is not a
+    folder of this user's that no one else may write (not a symbolic link either)."""
     folder = Path(os.environ.get("COSIM_FMU_CACHE")
-                  or Path(tempfile.gettempdir()) / f"cosim-fmus-{os.getuid()}")
-    folder.mkdir(parents=True, exist_ok=True)
+                  or Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
+                  / "cosim-fmus")
+    folder.mkdir(mode=0o700, parents=True, exist_ok=True)
+    facts = os.lstat(folder)
+    if not stat.S_ISDIR(facts.st_mode):
+        raise UnsafeCache(f"the FMU cache {folder} is not a folder (a symbolic link?); remove "
+                          "it, or set COSIM_FMU_CACHE to a folder of your own")
+    if facts.st_uid != os.getuid() or facts.st_mode & 0o022:
+        whose = (f"belongs to another user (uid {facts.st_uid})" if facts.st_uid != os.getuid()
+                 else f"may be written by others (mode {stat.filemode(facts.st_mode)})")
+        raise UnsafeCache(f"the FMU cache {folder} {whose}, who could change the FMUs run "
+                          "from it; use a folder only you may write (chmod go-w, or set "
+                          "COSIM_FMU_CACHE)")
     return folder
 
 
 def materialise(shipped: Bundle, blobs: dict[str, bytes]) -> SystemDescription:
-    """The bundle's system with its FMUs in this machine's cache (written once, by hash)."""
+    """The bundle's system with its FMUs in this machine's cache (written once, by hash;
+    a cached file whose content does not match its hash is written again, with a warning)."""
     cache = fmu_cache()
     components = {}
     for name, component in shipped.system.components.items():
         sha = Path(component.source).stem
         target = cache / f"{sha}.fmu"
-        if not target.exists():
+        cached = target.exists()
+        if cached and file_hash(target) != sha:
+            print(f"warning: the FMU cache's {target} does not match its hash (a corrupt or "
+                  "changed file); written again from the FMU sent", file=sys.stderr)
+            cached = False
+        if not cached:
             data = blobs[sha]
             if hashlib.sha256(data).hexdigest() != sha:
                 raise ValueError(f"the FMU sent for component '{name}' does not match its "
                                  f"hash {sha[:12]}")
-            temporary = target.with_name(f".{sha}.{os.getpid()}.tmp")
-            temporary.write_bytes(data)
-            os.replace(temporary, target)        # atomic: another worker may write it too
+            write_atomically(target, lambda path: path.write_bytes(data))  # noqa: B023
         components[name] = dataclasses.replace(component, source=str(target))
     return dataclasses.replace(shipped.system, components=components)

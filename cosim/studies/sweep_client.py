@@ -12,6 +12,7 @@ import uuid
 from typing import Iterator
 
 from ..core.provenance import PACKAGE, code_version
+from .bundle import UnsafeCache, fmu_cache
 from .journal import Journal
 from .sweep_spec import Spec
 from .sweep_task import SweepTeardown, blank_row, fmu_bytes, worker_facts
@@ -98,7 +99,7 @@ def _say(message: str) -> None:
 
 def check_workers(client) -> None:
     """SweepError naming each worker that runs other code than this client (or none of
-    it); a warning for workers with more than one thread, or a scheduler that queues
+    it), or whose FMU cache is not private to its user; a warning for workers with more than one thread, or a scheduler that queues
     more than one run per thread."""
     mine = code_version()
     try:
@@ -114,6 +115,10 @@ def check_workers(client) -> None:
         raise SweepError(f"workers run other code than this client ({PACKAGE} {mine}):\n"
                          + "\n".join(wrong) + "\ninstall the client's version on every worker "
                          "(a wheel: pip wheel --no-deps -w dist . ; pip install dist/*.whl)")
+    unsafe = {a: problem for a, problem in client.run(_cache_problem).items() if problem}
+    if unsafe:
+        raise SweepError("workers whose FMU cache is not safe to run FMUs from:\n" + "\n".join(
+            f"  {address}: {problem}" for address, problem in sorted(unsafe.items())))
     threaded = {a: n for a, n in client.nthreads().items() if n > 1}
     if threaded:
         _say(f"warning: {', '.join(f'{a} has {n} threads' for a, n in threaded.items())}; a "
@@ -124,6 +129,15 @@ def check_workers(client) -> None:
         _say(f"warning: the scheduler's worker-saturation is {saturation}: it queues more than "
              "one run per worker thread, and a worker killed by one run takes the queued ones "
              "with it; start the scheduler with DASK_DISTRIBUTED__SCHEDULER__WORKER_SATURATION=1.0")
+
+
+def _cache_problem() -> str:
+    """Why this worker's FMU cache is unsafe (``bundle.fmu_cache``), or ""."""
+    try:
+        fmu_cache()
+    except (UnsafeCache, OSError) as error:
+        return str(error)
+    return ""
 
 
 def _has_dashboard(dask_scheduler=None) -> bool:
