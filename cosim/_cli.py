@@ -44,6 +44,17 @@ def setting_option(text: str) -> tuple[str, int | float | str]:
         raise argparse.ArgumentTypeError(str(error)) from None
 
 
+def positive_seconds(text: str) -> float:
+    """A time limit in seconds, for argparse: a finite number > 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0 < value < float("inf"):
+        raise argparse.ArgumentTypeError(f"expected a positive number of seconds, got {text!r}")
+    return value
+
+
 def parse_port_map(text: str) -> tuple[str, str]:
     """'psi=heading' -> ('psi', 'heading')."""
     port, sep, name = text.partition("=")

@@ -18,6 +18,7 @@ from pathlib import Path
 from . import scenarios
 from ._cli import (add_autopilot_options, checked_autopilot, chosen_scenarios, entry, say_error,
                    writable_folder)
+from .core.files import OutputError
 from .interop.ssp import export
 
 
@@ -41,6 +42,9 @@ def main(argv: list[str] | None = None) -> int:
         except (ValueError, FileNotFoundError) as error:
             say_error(error)
             return 2
+        except OutputError as error:
+            say_error(error)
+            return 1
     return 0
 
 

@@ -4,11 +4,19 @@
 ends) and writes, as ``label`` in a folder: the CSV of every signal at every step
 (streamed as the run goes with ``stream``), the metadata JSON (``core.provenance``)
 and, for a finished run, its figure (``analysis.kinds``) and an animation if asked.
-A previous run's outputs of that label are removed first, so that none is left to
-mislead. It prints nothing: the ``Outcome`` says what happened, and the report.
+
+Nothing of a previous run is touched until the new outputs are complete: they are
+written into a hidden folder beside them and put in place together
+(``core.files.Outputs``), and only then are the previous run's other files of that
+label (``SUFFIXES``, by exact name) removed, so that none is left to mislead. A
+refused run, a full disk or a second Ctrl-C leaves the folder as it was. One process
+writes into a folder at a time (``core.files.FolderLock``). The run has time limits
+(``core.watchdog``). It prints nothing: the ``Outcome`` says what happened, and the
+report.
 """
 from __future__ import annotations
 
+import signal
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
@@ -17,11 +25,13 @@ from .analysis.animation import animate, require_track
 from .analysis.cost import LAMBDA, Cost, cost
 from .analysis.figures import save_figure
 from .analysis.kinds import analysis
+from .core.files import FolderLock, Outputs
 from .core.interrupt import StopSignals
 from .core.master import Master
 from .core.provenance import write_metadata
 from .core.recording import Recording
 from .core.ssd import SystemDescription
+from .core.watchdog import Limits, TimeLimit, Watchdog
 
 SUFFIXES = (".csv", ".json", ".png", ".svg", ".pdf", ".gif", ".mp4")
 """What a run writes, by suffix: a previous run's files of these are removed first."""
@@ -39,6 +49,11 @@ class Options:
     formats: tuple[str, ...] = ("png",)
     stream: bool = False
     animate: str | None = None          # "gif" or "mp4"
+    limits: Limits = Limits()           # step and run time limits (``core.watchdog``)
+
+
+class TimedOut(RuntimeError):
+    """The FMUs did not come up within the step time limit."""
 
 
 @dataclass
@@ -51,6 +66,7 @@ class Outcome:
     report: list[str] = field(default_factory=list)   # the report's lines, for a finished run
     cost: Cost | None = None                          # eq (19), for course keeping
     status: int = 0             # 0, 1 if an FMU failed, 130 / 143 if a signal stopped it
+    late_signal: bool = False   # a signal came after the last step: the outputs are whole
 
 
 def run_and_write(system: SystemDescription, label: str, out: Path,
@@ -63,42 +79,101 @@ def run_and_write(system: SystemDescription, label: str, out: Path,
 
     ``notes`` hears what the user should know of how it runs (a component through FMI,
     say) as soon as the FMUs are instantiated; ``stop`` ends the run between two steps
-    once it has received a signal. ValueError or FileNotFoundError for bad input
-    (nothing is removed or written then); FmuCallError if an FMU cannot be instantiated.
+    once it has received a signal. ValueError or FileNotFoundError for bad input;
+    FmuCallError if an FMU cannot be instantiated; TimedOut if that takes longer than the
+    step time limit; ``core.files`` FolderBusy if another process writes into ``out``,
+    OutputError if a file cannot be written: in each case ``out`` is as it was.
     """
     kind = analysis(system.report)
-    csv_path = out / f"{label}.csv"
-    with Master(system, coupling=options.coupling, overrides=overrides,
-                backend=options.backend) as master:
-        for note in master.notes:
-            if notes is not None:
-                notes(note)
-        if options.animate:
-            require_track(master.columns)
-        for old in out.glob(f"{label}.*"):
-            if old.suffix in SUFFIXES:
-                old.unlink()
-        recording = master.run(options.stop_time, progress=progress,
-                               csv_path=csv_path if options.stream else None, stop=stop)
-        parameters = master.parameters
-    if not options.stream:
-        recording.write_csv(csv_path)
-    outcome = Outcome(recording, csv_path,
-                      [csv_path, write_metadata(recording, out / f"{label}.json")])
+    stale = [out / f"{label}{suffix}" for suffix in SUFFIXES]
+    with FolderLock(out), Outputs(out, stale, label) as outputs:
+        csv_path = outputs.path(f"{label}.csv")
+        forget = stop.keep(lambda: _discard(outputs, label)) if stop is not None else None
+        master: Master | None = None
+
+        def salvage(reason: str) -> str:      # the watchdog's, if the run never returns
+            recording = master.abandon(reason) if master is not None else None
+            if recording is None:
+                return f"nothing was written; {_discard(outputs, label)}"
+            _write_rows(recording, outputs, label, options.stream)
+            csv, meta = outputs.commit()
+            return f"the {recording.rows} rows recorded are in {csv}, with {meta}"
+
+        try:
+            with Watchdog(options.limits, stop, salvage) as watchdog:
+                watchdog.beat(f"instantiating {', '.join(system.components)}")
+                try:
+                    master = Master(system, coupling=options.coupling, overrides=overrides,
+                                    backend=options.backend)
+                except TimeLimit:
+                    raise TimedOut(watchdog.expired) from None
+                except Exception as error:
+                    if watchdog.expired:
+                        raise TimedOut(f"{watchdog.expired}: {error}") from None
+                    raise
+                with master:
+                    for note in master.notes:
+                        if notes is not None:
+                            notes(note)
+                    if options.animate:
+                        require_track(master.columns)
+                    with outputs.writing(f"{label}.csv"):
+                        recording = master.run(options.stop_time, progress=progress,
+                                               csv_path=csv_path if options.stream else None,
+                                               stop=stop, watchdog=watchdog)
+                    parameters = master.parameters
+            outcome = Outcome(recording, out / f"{label}.csv",
+                              _write_rows(recording, outputs, label, options.stream))
+            _analyse(outcome, system, kind, label, outputs, options, parameters)
+            outcome.written = [outputs.final(path) for path in outcome.written]
+        finally:
+            if forget is not None:
+                forget()
+    if options.stream:
+        recording.path = outcome.csv
+    if stop is not None and stop.received and not recording.interrupted:
+        outcome.status, outcome.late_signal = stop.exit_status, True
+    return outcome
+
+
+def _discard(outputs: Outputs, label: str) -> str:
+    """Remove this run's unfinished outputs; say what is kept."""
+    outputs.discard()
+    return f"the earlier outputs of {label} in {outputs.folder}, if any, are as they were"
+
+
+def _write_rows(recording: Recording, outputs: Outputs, label: str, streamed: bool
+                ) -> list[Path]:
+    """The CSV (unless the rows were streamed to it) and the metadata JSON, staged."""
+    with outputs.writing(f"{label}.csv") as csv_path:
+        if not streamed:
+            recording.write_csv(csv_path)
+    with outputs.writing(f"{label}.json") as json_path:
+        write_metadata(recording, json_path)
+    return [csv_path, json_path]
+
+
+def _analyse(outcome: Outcome, system: SystemDescription, kind, label: str, outputs: Outputs,
+             options: Options, parameters: dict) -> None:
+    """Status, report, figure, animation and cost of a run whose rows are written."""
+    recording = outcome.recording
     if recording.interrupted:
-        outcome.status = stop.exit_status          # only a run given ``stop`` is interrupted
-        return outcome
+        outcome.status = 128 + int(signal.Signals[recording.interrupted])
+        return
     if recording.error:
         outcome.status = 1
-        return outcome
+        return
     if options.stream:
-        return outcome
+        return
     outcome.report = kind.report(recording, lam=options.lam, parameters=parameters)
     if options.plot and kind.figure is not None:
-        outcome.written += save_figure(recording, kind.figure, out / label, label,
-                                       options.formats)
+        with outputs.writing(f"{label}.{options.formats[0]}") as path:
+            outcome.written += save_figure(recording, kind.figure, path.with_suffix(""),
+                                           label, options.formats)
     if options.animate:
-        outcome.written.append(animate(recording, out / label, label, options.animate))
+        with outputs.writing(f"{label}.{options.animate}") as path:
+            outcome.written.append(animate(recording, path.with_suffix(""), label,
+                                           options.animate))
     if system.report == "course_keeping":
         outcome.cost = cost(recording, options.lam)
-    return outcome
+

@@ -23,18 +23,20 @@ from typing import NamedTuple
 
 from . import scenarios
 from ._cli import (Progress, add_autopilot_options, checked_autopilot, chosen_scenarios, entry,
-                   say_error, say_note, setting_option, writable_folder)
+                   positive_seconds, say_error, say_note, setting_option, writable_folder)
 from .analysis.animation import video_format
 from .analysis.cost import LAMBDA, Cost
 from .analysis.describe import conditions
 from .analysis.reports import tables
 from .api import overrides_of
 from .core.coupling import COUPLINGS
+from .core.files import FolderBusy, OutputError
 from .core.instance import FmuCallError
 from .core.interrupt import StopSignals
 from .core.master import RUN_BACKENDS
 from .core.ssd import SystemDescription
-from .outputs import Options, run_and_write
+from .core.watchdog import STEP_LIMIT_S, Limits
+from .outputs import Options, TimedOut, run_and_write
 from .scenarios.autopilot import COMPONENT
 from .studies.spread import PERTURBED, spread
 
@@ -57,7 +59,7 @@ def run_scenario(system: SystemDescription, label: str, out: Path, overrides: di
     for line in conditions(recording.meta):
         print(f"  {line}")
     if recording.interrupted:
-        print(f"{recording.error}; written to {csv_path}", file=sys.stderr)
+        print(f"{recording.error}; written to {csv_path}, with its metadata", file=sys.stderr)
     elif recording.error:
         print(f"error: {recording.error}", file=sys.stderr)
         print(f"  the {recording.rows} rows recorded before the error are in {csv_path}",
@@ -69,6 +71,9 @@ def run_scenario(system: SystemDescription, label: str, out: Path, overrides: di
         for line in outcome.report:
             print(f"  {line}")
         print(f"  wrote {', '.join(str(p) for p in outcome.written)}")
+    if outcome.late_signal:
+        print(f"interrupted by {stop.received.name} after the last step; the outputs above "
+              "are complete", file=sys.stderr)
     return outcome.status, outcome.cost
 
 
@@ -141,7 +146,17 @@ def main(argv: list[str] | None = None) -> int:
                              "(the largest change), where it shows at the printed digits")
     parser.add_argument("--stream", action="store_true",
                         help="write rows to the CSV in chunks as the run goes: flat memory "
-                             "for long runs (--stop-time 86400); no report or figure")
+                             "for long runs (--stop-time 86400); no report or figure. (The "
+                             "CSV grows in a hidden folder .partial-SCENARIO-* beside it, and "
+                             "takes its name when the run ends)")
+    parser.add_argument("--step-timeout", type=positive_seconds, default=STEP_LIMIT_S,
+                        metavar="S",
+                        help="end the run with an error if one step of the FMUs (or their "
+                             f"instantiation) takes longer than S s of wall-clock time "
+                             f"(default {STEP_LIMIT_S:g})")
+    parser.add_argument("--run-timeout", type=positive_seconds, metavar="S",
+                        help="end the run with an error, keeping its rows, if it takes "
+                             "longer than S s of wall-clock time (default: no limit)")
     args = parser.parse_args(argv)
     names = chosen_scenarios(parser, args.scenario, args.all)
     if not checked_autopilot(parser, args):
@@ -160,7 +175,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.animate == "mp4" and video_format() != "mp4":
         parser.error("--animate mp4 needs ffmpeg, which is not installed here; use gif")
     options = Options(args.coupling, args.stop_time, args.lam, args.backend,
-                      not args.no_plot, ("png", *args.figure_format), args.stream, args.animate)
+                      not args.no_plot, ("png", *args.figure_format), args.stream, args.animate,
+                      Limits(args.step_timeout, args.run_timeout))
     status, costs, spreads, runs = 0, {}, {}, 0
     perturbed = ", ".join(".".join(p) for p in PERTURBED)
     for run in runs_asked(names, args.all, args.autopilot, args.name):
@@ -174,11 +190,12 @@ def main(argv: list[str] | None = None) -> int:
             code, result = run_scenario(system, run.label, out,
                                         overrides if run.autopilot else paper_overrides,
                                         options)
-        except (ValueError, FileNotFoundError, FmuCallError) as error:
+        except (ValueError, FileNotFoundError, FmuCallError, FolderBusy, OutputError,
+                TimedOut) as error:
             say_error(error)
             if created and not any(out.iterdir()):
                 out.rmdir()                     # nothing was run: leave nothing behind
-            return 2
+            return 1 if isinstance(error, (OutputError, TimedOut)) else 2
         status = max(status, code)
         if code > 128:                          # interrupted: no further run
             return code

@@ -4,7 +4,7 @@
 place only when the writing succeeded: a reader finds the old file or the new one,
 never half of one, and a failed write (a full disk, a kill) leaves the old file
 as it was. ``Outputs`` does the same for a group of files (a run's CSV, JSON and
-figures): every file is written under a temporary name first and the group is put
+figures): every file is written into a hidden folder first and the group is put
 in place only once all of them are complete. ``FolderLock`` holds an output folder
 for one process; a second is refused at once, with a message naming the folder.
 A failed write raises ``OutputError``, which names the file and says what was kept.
@@ -14,6 +14,7 @@ from __future__ import annotations
 import contextlib
 import errno
 import os
+import shutil
 import tempfile
 from pathlib import Path
 from typing import Callable, Iterator
@@ -70,7 +71,9 @@ def whole_file(target: Path) -> Iterator[Path]:
             yield tmp
             os.replace(tmp, target)
         except OSError as error:
-            raise OutputError(target, error, f"{target.name} as it was before") from error
+            kept = (f"{target.name} is as it was before" if target.exists()
+                    else f"no {target.name} was written")
+            raise OutputError(target, error, kept) from error
     finally:
         tmp.unlink(missing_ok=True)
 
@@ -85,30 +88,27 @@ def write_atomically(target: Path, write: Callable[[Path], object]) -> Path:
 class Outputs:
     """A group of output files put in place together, once all are complete.
 
-    ``with Outputs(folder, stale=[...]) as outputs``: ``outputs.path("x.csv")`` is a
-    temporary path to write ``folder/x.csv`` to. If the block succeeds, every file
-    written is renamed into place and then each ``stale`` file not rewritten is
-    removed (a previous run's figure that this one did not draw, say). If it fails,
-    the temporary files are removed and the folder is as it was.
+    ``with Outputs(folder, stale) as outputs``: write every file into ``outputs.stage``
+    (a hidden folder inside ``folder``; ``outputs.path(name)``). If the block succeeds,
+    each file written there is renamed to ``folder/name`` and then every ``stale`` path
+    not rewritten is removed (a previous run's figure that this one did not draw, say).
+    If it fails, or ``discard`` is called, the stage goes and the folder is as it was.
     """
 
-    def __init__(self, folder: Path, stale: list[Path] | tuple[Path, ...] = ()):
-        self.folder, self.stale = Path(folder), list(stale)
-        self.staged: dict[Path, Path] = {}          # target: temporary
+    def __init__(self, folder: Path, stale: list[Path] | tuple[Path, ...] = (),
+                 label: str = "outputs"):
+        self.folder, self.stale = Path(folder), [Path(p) for p in stale]
+        self.stage = Path(tempfile.mkdtemp(dir=self.folder, prefix=f"{TEMPORARY_PREFIX}{label}-"))
 
     def path(self, name: str) -> Path:
-        target = self.folder / name
-        if target not in self.staged:
-            self.staged[target] = _temporary(target)
-        return self.staged[target]
+        """Where to write the file that becomes ``folder/name``."""
+        return self.stage / name
 
-    def adopt(self, target: Path, temporary: Path) -> None:
-        """Put an existing temporary file (a streamed CSV) in place with the others."""
-        self.staged[Path(target)] = Path(temporary)
-
-    @property
-    def targets(self) -> list[Path]:
-        return list(self.staged)
+    def final(self, path: Path) -> Path:
+        """The name in ``folder`` of a file written to the stage."""
+        path = Path(path)
+        return self.folder / path.relative_to(self.stage) if path.is_relative_to(self.stage) \
+            else path
 
     def __enter__(self) -> Outputs:
         return self
@@ -118,19 +118,38 @@ class Outputs:
             if kind is None:
                 self.commit()
         finally:
-            for temporary in self.staged.values():
-                temporary.unlink(missing_ok=True)
+            self.discard()
 
-    def commit(self) -> None:
+    @contextlib.contextmanager
+    def writing(self, name: str) -> Iterator[Path]:
+        """``with outputs.writing("x.csv") as path``: an OSError names ``folder/x.csv``."""
+        try:
+            yield self.path(name)
+        except OutputError:
+            raise
+        except OSError as error:
+            raise OutputError(self.folder / name, error,
+                              f"the earlier files in {self.folder} are kept") from error
+
+    def commit(self) -> list[Path]:
         """Rename every staged file into place, then remove the stale ones."""
-        for target, temporary in self.staged.items():
+        placed = []
+        for staged in sorted(self.stage.iterdir()):
+            target = self.folder / staged.name
             try:
-                os.replace(temporary, target)
+                os.replace(staged, target)
             except OSError as error:
                 raise OutputError(target, error) from error
+            placed.append(target)
         for old in self.stale:
-            if old not in self.staged:
+            if old not in placed:
                 old.unlink(missing_ok=True)
+        self.discard()
+        return placed
+
+    def discard(self) -> None:
+        """Remove the stage and whatever is in it."""
+        shutil.rmtree(self.stage, ignore_errors=True)
 
 
 class FolderLock:

@@ -4,16 +4,20 @@ Our FMUs' Python code runs in the master's own interpreter, so Python's default
 KeyboardInterrupt would be raised inside an FMU's call and turn into an FMU
 failure. Within ``StopSignals`` a SIGINT or SIGTERM only records itself; the
 master checks between steps, stops, and keeps every row computed
-(``Master.run``'s ``stop``). Within ``raise_on_signals`` either signal raises
-``Interrupted`` wherever the program is: for code that runs no FMU, such as a
-sweep's client, or a command outside its runs.
+(``Master.run``'s ``stop``). A second signal ends the process at once, saying
+what was kept (``StopSignals.receive``; while an FMU never returns, the run's
+``cosim.core.watchdog`` takes the signals). Within ``raise_on_signals`` either
+signal raises ``Interrupted`` wherever the program is: for code that runs no FMU,
+such as a sweep's client, or a command outside its runs.
 """
 from __future__ import annotations
 
+import os
 import signal
+import sys
 import threading
 from contextlib import contextmanager
-from typing import Iterator
+from typing import Callable, Iterator
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
@@ -25,6 +29,8 @@ class StopSignals:
     def __init__(self) -> None:
         self.received: signal.Signals | None = None
         self._previous: dict[signal.Signals, object] = {}
+        self._keepers: list[Callable[[], str]] = []
+        self._ending = threading.Lock()
 
     def __enter__(self) -> StopSignals:
         if threading.current_thread() is threading.main_thread():
@@ -33,8 +39,32 @@ class StopSignals:
         return self
 
     def _handle(self, number: int, frame) -> None:
+        self.receive(signal.Signals(number))
+
+    def receive(self, number: signal.Signals) -> None:
+        """Take a signal: the first asks the run to stop between steps; a second ends the
+        process at once (status 130 or 143), after each ``keep`` callback has said (and
+        done) what is kept."""
         if self.received is None:
-            self.received = signal.Signals(number)
+            self.received = number
+            return
+        if not self._ending.acquire(blocking=False):
+            return                              # already ending
+        kept = []
+        for keeper in self._keepers:
+            try:
+                kept.append(keeper())
+            except Exception as error:          # the process ends all the same
+                kept.append(f"(could not tidy up: {error})")
+        print(f"{number.name} again: stopped at once; " + ("; ".join(kept) or
+              "nothing of the run under way was written"), file=sys.stderr, flush=True)
+        os._exit(128 + self.received)
+
+    def keep(self, keeper: Callable[[], str]) -> Callable[[], None]:
+        """Have ``keeper`` run if a second signal ends the process (it tidies up and says
+        what is kept); returns the function that forgets it again."""
+        self._keepers.append(keeper)
+        return lambda: self._keepers.remove(keeper) if keeper in self._keepers else None
 
     def __exit__(self, *exc) -> None:
         for number, handler in self._previous.items():

@@ -30,6 +30,7 @@ from .interrupt import StopSignals
 from .null import NullInstance
 from .recording import Recorder, Recording
 from .ssd import SystemDescription, split_name
+from .watchdog import TimeLimit, Watchdog
 from .wiring import check_connections, feedthrough_order, layout
 
 
@@ -41,6 +42,10 @@ is not current in this process runs through FMI, with a note:
 but the FMUs' interfaces, to measure the master's own cost (``cosim.core.null``)."""
 RUN_BACKENDS = ("fmi", "inprocess")
 """The backends a run of a scenario may take (null measures the master only)."""
+
+
+def _no_watchdog(what: object) -> None:
+    """What ``Watchdog.beat`` does when a run has none."""
 
 
 class Master:
@@ -134,7 +139,7 @@ class Master:
     def run(self, stop_time: float | None = None,
             progress: Callable[[int, int], None] | None = None,
             csv_path: str | Path | None = None, chunk_rows: int = 10_000,
-            stop: StopSignals | None = None) -> Recording:
+            stop: StopSignals | None = None, watchdog: Watchdog | None = None) -> Recording:
         """Simulate to stop_time (default: the system's); never raises on an FMU error.
 
         ValueError if the stop time is not a whole number of steps after the start, or
@@ -142,7 +147,9 @@ class Master:
         file in chunks of ``chunk_rows`` as the run proceeds, and memory stays flat
         however long the run; the returned recording then holds no rows itself
         (``rows`` counts those written). Once ``stop`` has received a signal, the run
-        ends before the next step (``Recording.interrupted``).
+        ends before the next step (``Recording.interrupted``). A ``watchdog`` times
+        the initialisation and each step; a limit passed ends the run with an error
+        (``cosim.core.watchdog``), as an FMU failure does.
         """
         system = self.system
         t0, h = system.start_time, seconds(nanoseconds(system.step_size))
@@ -163,10 +170,14 @@ class Master:
             name: {n: i.unit(n) for n, v in i.variables.items() if v.causality == "parameter"}
             for name, i in self.instances.items()}
         self.parameter_values = {}
+        self._recorder = recorder
+        beat = watchdog.beat if watchdog is not None else _no_watchdog
         try:
+            beat("the initialisation")
             self.initialize()
             for k in range(n_steps + 1):
                 t = communication_point(t0, k, h)
+                beat(t)
                 if stop is not None and stop.received:
                     recorder.interrupted = stop.received.name
                     t = communication_point(t0, k - 1, h) if k else t0
@@ -176,15 +187,28 @@ class Master:
                 recorder.append(t, values)
                 if progress is not None and k % 100 == 0:
                     progress(k, n_steps)
-        except FmuCallError as failure:
-            error = (f"{failure}\n  (run stopped at step {k}, t = {t:.6g} s; "
-                     f"{recorder.rows} rows recorded)")
+        except (FmuCallError, TimeLimit) as failure:
+            error = f"{failure}\n  " if isinstance(failure, FmuCallError) else ""
+            if watchdog is not None and watchdog.expired:
+                error = f"{watchdog.expired}\n  {error}"
+            if stop is not None and stop.received:     # the step the signal waited for
+                recorder.interrupted = stop.received.name
+            error += f"(run stopped at step {k}, t = {t:.6g} s; {recorder.rows} rows recorded)"
         finally:
+            self._recorder = None
             if self.parameter_values:
                 meta["parameters"] = self.parameter_values
             meta["wall_time_s"] = time.perf_counter() - started
             recording = recorder.close(error)
         return recording
+
+    def abandon(self, reason: str) -> Recording | None:
+        """The rows of the run under way, closed with ``reason`` as its error, for a
+        watchdog whose run will never return (None if no run is under way)."""
+        recorder, self._recorder = getattr(self, "_recorder", None), None
+        if recorder is None:
+            return None
+        return recorder.close(f"{reason} ({recorder.rows} rows recorded)")
 
     def __enter__(self) -> Master:
         return self

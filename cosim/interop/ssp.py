@@ -3,7 +3,9 @@
 The package is a zip holding SystemStructure.ssd (components, connections, the
 scenario's parameter values, the fixed step as an OSP annotation) and
 resources/<fmu>.fmu for every FMU it uses. OSP libcosim, ecos, fmpy and
-OMSimulator load it unchanged (see README, "Using the FMUs elsewhere").
+OMSimulator load it unchanged (see README, "Using the FMUs elsewhere"). It is
+written whole or not at all: a full disk or a kill leaves no package, or the
+previous one (``cosim.core.files``).
 """
 from __future__ import annotations
 
@@ -12,6 +14,7 @@ import zipfile
 from pathlib import Path
 
 from .. import scenarios
+from ..core.files import whole_file
 from ..core.ssd import SystemDescription, read_ssd, write_ssd
 
 SSD_NAME = "SystemStructure.ssd"
@@ -36,7 +39,8 @@ def export(scenario: str | Path, out: Path, overrides: dict[str, dict] | None = 
     with tempfile.TemporaryDirectory() as tmp:
         ssd = Path(tmp) / SSD_NAME
         write_ssd(system, ssd, sources)
-        with zipfile.ZipFile(target, "w", zipfile.ZIP_DEFLATED) as package:
+        with whole_file(target) as partial, \
+                zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as package:
             package.write(ssd, SSD_NAME)
             for path in sorted(set(fmus.values())):
                 package.write(path, f"resources/{path.name}")

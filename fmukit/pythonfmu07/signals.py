@@ -15,7 +15,9 @@ thread): a signal that arrives while FMU code runs is kept pending and
 signalled again each millisecond, from a helper thread, until the main thread
 runs host code, where the host's own handler takes it as if no FMU had been
 there: fmpy and ecospy scripts get their KeyboardInterrupt between two FMI
-calls, our master its request to stop between steps.
+calls, our master its request to stop between steps. A handler that says it may
+run anywhere (an attribute ``safe_in_fmu_code``, true: it raises nothing, as our
+master's run watchdog's) is left as it is.
 
 A C or C++ host (the ``ecos`` program) has no Python code of its own; pythonfmu
 starts Python in a thread of its own, which becomes Python's main thread and
@@ -85,7 +87,8 @@ def defer_host_handlers() -> None:
     elif threading.current_thread() is threading.main_thread():
         for number in SIGNALS:
             handler = signal.getsignal(number)
-            if callable(handler) and not isinstance(handler, _DeferringHandler):
+            if (callable(handler) and not isinstance(handler, _DeferringHandler)
+                    and not getattr(handler, "safe_in_fmu_code", False)):
                 signal.signal(number, _DeferringHandler(handler))
 
 

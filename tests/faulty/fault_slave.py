@@ -5,14 +5,17 @@ Until ``fault_time`` it commands a constant rudder and full ahead; from then on,
 NaN), 2 'range' (the propeller command n1 is 100 rev/s, outside the ship's +-50),
 3 'raise' (its own step raises: an exception inside a model), 4 'sigint' and
 5 'sigterm' (its step sends that signal to its own process, once: Ctrl-C or a
-kill arriving while FMU code runs), 0 'none'.
+kill arriving while FMU code runs), 6 'loop' (its step never returns, looping in
+Python), 7 'block' (its step never returns, waiting in C: a sleep that no Python
+exception interrupts), 0 'none'.
 """
 import os
 import signal
+import time
 
 from fmukit.slave import ModelSlave, Var
 
-KINDS = ("none", "nan", "range", "raise", "sigint", "sigterm")
+KINDS = ("none", "nan", "range", "raise", "sigint", "sigterm", "loop", "block")
 
 
 class Fault:
@@ -35,6 +38,11 @@ class Fault:
         if self.fault_kind.startswith("sig") and t >= self.fault_time and not self.signalled:
             self.signalled = True
             os.kill(os.getpid(), getattr(signal, self.fault_kind.upper()))
+        if self.fault_kind == "loop" and t >= self.fault_time:
+            while True:
+                pass
+        if self.fault_kind == "block" and t >= self.fault_time:
+            time.sleep(10**6)
         self.t = t + h
 
     def snapshot(self) -> dict:
@@ -53,7 +61,7 @@ class FaultSlave(ModelSlave):
         Var.output("n1", "rev/s", "propeller command", get=lambda s: s.model.n1()),
         Var.parameter("fault_time", 50.0, "s", "time of the fault"),
         Var.parameter("fault", 3, description="0 none, 1 nan, 2 range, 3 raise, 4 sigint, "
-                      "5 sigterm", min=0, max=5),
+                      "5 sigterm, 6 loop, 7 block", min=0, max=7),
     )
 
     def build_model(self) -> Fault:

@@ -1,0 +1,221 @@
+"""Time limits for a run, and signals that reach it even while an FMU never returns.
+
+The master's loop checks for Ctrl-C and SIGTERM between steps
+(``cosim.core.interrupt``), and that is all it can do from its own thread: an FMU
+that loops in fmi2DoStep never lets it run again. A ``Watchdog`` is a thread
+beside the loop that enforces
+
+- a **step time limit** (``Limits.step``, wall-clock seconds): one communication
+  step, every FMU's calls at one time, or one FMU's instantiation and
+  initialisation, must end within it;
+- a **run time limit** (``Limits.run``): the whole run must end within it;
+- a **signal's grace** (``Limits.grace``): after Ctrl-C or SIGTERM the step under
+  way must end within it, so that the run can stop between steps.
+
+In the main thread it takes SIGINT and SIGTERM itself, from Python's wakeup file
+descriptor (``signal.set_wakeup_fd``: written by the C-level handler, in whatever
+thread the signal lands, while FMU code runs, Python or not), with Python-level
+handlers that do nothing meanwhile; a second signal ends the process at once
+(``StopSignals.receive``).
+
+When a limit is passed, the watchdog first raises ``TimeLimit`` in the loop's thread
+(``PyThreadState_SetAsyncExc``): Python FMU code fails its call (fmukit turns it into
+a refusal), and the master stops, names the FMU and call, and writes what it kept as
+after any FMU failure. Code that runs no Python (a C FMU in an endless loop) cannot
+take an exception: after ``Limits.grace`` more, the watchdog writes the rows kept
+(``salvage``) from its own thread, says so, and ends the process (status 1, or 130 /
+143 after a signal); ``faulthandler`` ends it regardless if even that cannot run.
+"""
+from __future__ import annotations
+
+import ctypes
+import faulthandler
+import os
+import select
+import signal
+import socket
+import sys
+import threading
+import time
+from types import TracebackType
+from typing import Callable, NamedTuple
+
+from .interrupt import STOP_SIGNALS, StopSignals
+
+STEP_LIMIT_S = 60.0
+"""The default step time limit: a step of our FMUs takes about 0.1 ms, their
+instantiation about 0.3 s."""
+
+
+class Limits(NamedTuple):
+    """Wall-clock limits in seconds (None: no limit)."""
+
+    step: float | None = STEP_LIMIT_S
+    run: float | None = None
+    grace: float = 3.0
+
+    def check(self) -> Limits:
+        """These limits, or ValueError naming the one that is not a positive number."""
+        for name, value in (("step", self.step), ("run", self.run), ("grace", self.grace)):
+            if value is not None and not (value > 0 and value < float("inf")):
+                raise ValueError(f"the {name} time limit must be a positive number of "
+                                 f"seconds, got {value!r}")
+        return self
+
+
+class TimeLimit(BaseException):
+    """Raised in the loop's thread when a limit is passed (a BaseException, so that no
+    ``except Exception`` in the way swallows it; ``Watchdog.expired`` says which)."""
+
+    def __init__(self, *args: object):
+        super().__init__(*(args or ("a time limit of the run was passed",)))
+
+
+class Watchdog:
+    """``with Watchdog(limits, stop) as dog``: call ``dog.beat(what)`` as each step (or
+    instantiation) begins; ``dog.expired`` says which limit was passed, if one was.
+
+    ``salvage(reason)`` is what to keep if the loop's thread never returns: it writes
+    what it can and returns a sentence saying what was kept (called from this thread).
+    """
+
+    def __init__(self, limits: Limits = Limits(), stop: StopSignals | None = None,
+                 salvage: Callable[[str], str] | None = None):
+        self.limits, self.stop, self.salvage = limits.check(), stop, salvage
+        self.expired: str | None = None
+        self._what: str | float = "the run"
+        self._beat = self._start = time.monotonic()
+        self._signal_at: float | None = None
+        self._target = threading.get_ident()
+        self._done = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._signals = stop is not None and threading.current_thread() is threading.main_thread()
+        self._wakeup: tuple[socket.socket, socket.socket] | None = None
+        self._saved: tuple[int, dict] = (-1, {})
+
+    def beat(self, what: str | float) -> None:
+        """A new step (its time, in s) or call (``what``, a phrase) begins: its time limit
+        starts now."""
+        self._beat, self._what = time.monotonic(), what
+
+    @property
+    def what(self) -> str:
+        what = self._what
+        return f"the step at t = {what:.6g} s" if isinstance(what, float) else what
+
+    def __enter__(self) -> Watchdog:
+        if self.limits.step is None and self.limits.run is None and not self._signals:
+            return self
+        if self._signals:
+            self._take_signals()
+        self._thread = threading.Thread(target=self._watch, name="cosim-watchdog", daemon=True)
+        self._thread.start()
+        return self
+
+    def __exit__(self, kind: type | None, error: BaseException | None,
+                 trace: TracebackType | None) -> None:
+        if self._thread is None:
+            return
+        self._done.set()
+        self._thread.join()
+        self._thread = None
+        if self.expired:              # one raised too late to land is cleared, not left armed
+            _raise_in(self._target, None)
+        if self._signals:
+            self._give_back_signals()
+
+    def _take_signals(self) -> None:
+        """Signals to this thread's socket; Python's handlers idle meanwhile."""
+        self._wakeup = socket.socketpair()
+        for end in self._wakeup:
+            end.setblocking(False)
+        handlers = {number: signal.signal(number, _idle) for number in STOP_SIGNALS}
+        self._saved = (signal.set_wakeup_fd(self._wakeup[1].fileno(),
+                                            warn_on_full_buffer=False), handlers)
+
+    def _give_back_signals(self) -> None:
+        fd, handlers = self._saved
+        signal.set_wakeup_fd(fd)
+        for number, handler in handlers.items():
+            signal.signal(number, handler)
+        for received in self._received():       # one that came as the run ended
+            self.stop.receive(received)
+        for end in self._wakeup:
+            end.close()
+        self._wakeup = None
+
+    def _received(self) -> list[signal.Signals]:
+        """The signals the wakeup socket has seen since last asked."""
+        try:
+            data = self._wakeup[0].recv(64)
+        except BlockingIOError:
+            return []
+        return [signal.Signals(number) for number in data if number in STOP_SIGNALS]
+    def _deadline(self) -> tuple[float, str]:
+        """When the next limit falls, and what it is."""
+        candidates = [(float("inf"), "")]
+        if self.limits.step is not None:
+            candidates.append((self._beat + self.limits.step,
+                               f"{self.what} did not end within the step time limit of "
+                               f"{self.limits.step:g} s"))
+        if self.limits.run is not None:
+            candidates.append((self._start + self.limits.run,
+                               f"the run did not end within its time limit of "
+                               f"{self.limits.run:g} s"))
+        if self._signal_at is not None:
+            candidates.append((self._signal_at + self.limits.grace,
+                               f"{self.what} did not end within {self.limits.grace:g} s of "
+                               f"{self.stop.received.name}"))
+        return min(candidates)
+
+    def _watch(self) -> None:
+        while not self._done.is_set():
+            deadline, reason = self._deadline()
+            wait = min(max(deadline - time.monotonic(), 0.0), 0.5)
+            if self._signals:
+                select.select([self._wakeup[0]], [], [], wait)
+                received = self._received()
+                for number in received:
+                    self._signal_at = self._signal_at or time.monotonic()
+                    self.stop.receive(number)        # a second one ends the process
+                if received:
+                    continue
+            elif self._done.wait(wait):
+                return
+            if time.monotonic() >= deadline and not self._done.is_set():
+                self._expire(reason)
+                return
+
+    def _expire(self, reason: str) -> None:
+        """Raise TimeLimit in the loop's thread; if it has not returned after the grace,
+        keep what can be kept and end the process."""
+        self.expired = reason
+        _raise_in(self._target, TimeLimit)
+        if self._done.wait(self.limits.grace):
+            return
+        faulthandler.dump_traceback_later(self.limits.grace + 10, exit=True)
+        kept = "nothing was written"
+        if self.salvage is not None:
+            try:
+                kept = self.salvage(reason)
+            except BaseException as error:         # whatever happens, the process ends
+                kept = f"the rows could not be written ({error})"
+        print(f"error: {reason}, and it cannot be stopped (code that is not Python); "
+              f"{kept}; ending the process", file=sys.stderr, flush=True)
+        status = self.stop.exit_status if self.stop is not None and self.stop.received else 1
+        os._exit(status)
+
+
+def _idle(number: int, frame: object) -> None:
+    """Python's handler of SIGINT and SIGTERM while a watchdog takes them: nothing to do."""
+
+
+_idle.safe_in_fmu_code = True      # fmukit need not defer it (fmukit.pythonfmu07.signals)
+
+
+def _raise_in(thread_id: int, exception: type[BaseException] | None) -> None:
+    """Raise ``exception`` in a thread at its next Python instruction (None: clear one
+    raised before and not yet taken)."""
+    ctypes.pythonapi.PyThreadState_SetAsyncExc(ctypes.c_ulong(thread_id),
+                                               ctypes.py_object(exception) if exception
+                                               else None)
