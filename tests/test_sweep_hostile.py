@@ -2,6 +2,7 @@
 message naming the input, before anything runs, with no partial output file."""
 from __future__ import annotations
 
+import errno
 import functools
 import os
 import re
@@ -16,7 +17,9 @@ import pytest
 import cosim.scenarios.autopilot as autopilot
 from cosim.studies import sweep, sweep_task
 from cosim.studies.bundle import UnsafeCache, fmu_cache
+from cosim.studies import journal
 from cosim.studies.cluster import ClusterError, connect, local_workers
+from cosim.studies.journal import Journal, JournalLocked
 from fmubuild.trial import TrialFailed, trial
 
 
@@ -258,3 +261,77 @@ def test_a_sweep_on_workers_with_an_unsafe_cache_is_refused_before_any_run(
                                                "written by others"):
         sweep.execute(spec, tmp_path / "out", workers=1, progress=False)
     assert not (tmp_path / "out" / "runs.jsonl").exists() and not list(cache.iterdir())
+
+
+# -- outputs: whole or not at all; the journal's lock ------------------------------------
+def test_the_journal_lock_is_removed_at_the_end_and_never_shared(tmp_path, monkeypatch):
+    path = tmp_path / "runs.jsonl"
+    lock = tmp_path / "runs.jsonl.lock"
+    lock.write_text("process 1 on gone since 2026-01-01 00:00:00\n")   # left by a kill
+    with Journal(path):
+        assert "process" in lock.read_text() and "gone" not in lock.read_text()
+    assert not lock.exists()
+    # A second sweep that opened the lock file just before the first removed it holds a file
+    # no longer there: it must not count as the lock while a third sweep holds the new one.
+    first = Journal(path).__enter__()
+    stale = open(lock, "a+")
+    first.__exit__(None, None, None)
+    with Journal(path):
+        opened = iter([stale])
+        monkeypatch.setattr(journal, "open", lambda *a: next(opened, None) or open(*a),
+                            raising=False)
+        with pytest.raises(JournalLocked, match=f"being written by process {os.getpid()}"):
+            Journal(path).__enter__()
+    assert stale.closed
+
+
+def _rows(spec) -> list[dict]:
+    return [{**run, "status": "ok", "error": "", **{m: 1.0 + i for m in sweep.METRICS},
+             "seconds": 0.1, "sim_seconds": 0.1, "backend": "fmi"}
+            for i, run in enumerate(spec.runs())]
+
+
+def test_a_figure_that_cannot_be_written_leaves_the_old_one(tmp_path, monkeypatch):
+    from matplotlib.figure import Figure
+
+    from cosim.core.files import OutputError
+    from cosim.studies.sweep_figures import save_figures
+
+    spec = sweep.Spec.read(spec_file(tmp_path, "[axes]\nwave_seed = [1, 2]\n"))
+    old = tmp_path / "J_distribution.png"
+    old.write_bytes(b"the previous sweep's figure")
+
+    def disk_full(self, target, **options):
+        Path(target).write_bytes(b"\x89PNG half")
+        raise OSError(errno.ENOSPC, "No space left on device")
+    monkeypatch.setattr(Figure, "savefig", disk_full)
+    with pytest.raises(OutputError, match=f"cannot write {old}: No space left on device"):
+        save_figures(spec, _rows(spec), tmp_path)
+    assert old.read_bytes() == b"the previous sweep's figure"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["J_distribution.png", "spec.toml"]
+
+
+def test_a_comparison_that_cannot_be_written_leaves_the_old_one(tmp_path, monkeypatch, capsys):
+    from cosim import sweep as command
+
+    spec_path = spec_file(tmp_path, 'name = "full"\n[axes]\nwave_seed = [1, 2]\n')
+    out = tmp_path / "out" / "full"
+    out.mkdir(parents=True)
+    (out / "comparison.md").write_text("the previous comparison\n")
+    monkeypatch.setattr(command.sweep, "execute",
+                        lambda spec, *args, **options: _rows(spec))
+    write_text = Path.write_text
+
+    def disk_full(self, text, *args, **options):
+        if self.suffix == ".md":
+            write_text(self, text[:10])
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return write_text(self, text, *args, **options)
+    monkeypatch.setattr(Path, "write_text", disk_full)
+    assert command.main([str(spec_path), "--out", str(tmp_path / "out"), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert f"error: cannot write {out / 'comparison.md'}: No space left on device" in err
+    assert f"every row is kept in {out / 'runs.jsonl'}" in err
+    monkeypatch.undo()
+    assert (out / "comparison.md").read_text() == "the previous comparison\n"
+    assert not [p for p in out.iterdir() if p.name.startswith(".")]

@@ -4,6 +4,8 @@ The journal is what a sweep resumes from, so it must survive what ends a process
 mid-write: a torn last line (a write cut by a kill) is skipped with a warning, and
 its run is done again. One sweep writes a journal at a time: a second writer is
 refused with a message naming the holder of the lock (process, host, since when).
+The lock file (runs.jsonl.lock) is removed when the writer closes the journal; one
+left by a killed process is stale, and the next writer takes it over.
 Tables derived from it are written atomically (``cosim.core.files``).
 """
 from __future__ import annotations
@@ -41,6 +43,16 @@ def read_rows(path: Path, quiet: bool = False) -> dict[str, dict]:
     return rows
 
 
+def _same_file(handle: TextIO, path: Path) -> bool:
+    """Whether ``path`` is still the file open as ``handle``."""
+    try:
+        facts = os.stat(path)
+    except FileNotFoundError:
+        return False
+    mine = os.fstat(handle.fileno())
+    return (facts.st_dev, facts.st_ino) == (mine.st_dev, mine.st_ino)
+
+
 class Journal:
     """The journal of one sweep, locked for writing while open (``with Journal(path)``)."""
 
@@ -51,15 +63,19 @@ class Journal:
 
     def __enter__(self) -> Journal:
         lock = self.path.with_name(self.path.name + ".lock")
-        handle = open(lock, "a+")
-        try:
-            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            handle.seek(0)
-            holder = handle.read().strip() or "another process"
-            handle.close()
-            raise JournalLocked(f"{self.path} is being written by {holder}; wait for that "
-                                "sweep to end, or give this one another --out") from None
+        while True:
+            handle = open(lock, "a+")
+            try:
+                fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                handle.seek(0)
+                holder = handle.read().strip() or "another process"
+                handle.close()
+                raise JournalLocked(f"{self.path} is being written by {holder}; wait for "
+                                    "that sweep to end, or give this one another --out") from None
+            if _same_file(handle, lock):
+                break
+            handle.close()          # its writer removed it as we opened it: take the new one
         handle.seek(0)
         handle.truncate()
         handle.write(f"process {os.getpid()} on {socket.gethostname()} since "
@@ -71,6 +87,8 @@ class Journal:
 
     def __exit__(self, *exc) -> None:
         if self._lock_file is not None:
+            # Removed while still held: whoever opened it meanwhile sees it is gone, above.
+            Path(self._lock_file.name).unlink(missing_ok=True)
             fcntl.flock(self._lock_file, fcntl.LOCK_UN)
             self._lock_file.close()
             self._lock_file = None

@@ -1,4 +1,5 @@
-"""Figures of a sweep: J per controller and sea state, and the J_SMC / J_PD map."""
+"""Figures of a sweep: J per controller and sea state, and the J_SMC / J_PD map; each file
+written whole or not at all (``cosim.analysis.figures.save``)."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -11,6 +12,7 @@ import numpy as np  # noqa: E402
 
 from autopilot_fmu.guidance import parse_waypoints  # noqa: E402
 
+from ..analysis.figures import save  # noqa: E402
 from ..analysis.seastate import model_scale  # noqa: E402
 
 SEA_AXES = ("sea_state", "Hs")
@@ -45,9 +47,7 @@ def distribution(spec, rows: list[dict], path: Path) -> Path:
     ax.set_ylabel("J of eq (19) (rad^2)")
     ax.set_title(f"{spec.name}: J per controller" + (f" and {sea}" if sea else ""), fontsize=10)
     ax.grid(alpha=0.3, axis="y")
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save(fig, path)[0]
 
 
 def ratio_map(spec, rows: list[dict], path: Path, numerator: str = "smc",
@@ -79,9 +79,7 @@ def ratio_map(spec, rows: list[dict], path: Path, numerator: str = "smc",
     fig.colorbar(image, label=f"log2(J_{numerator} / J_{denominator})")
     ax.set_title(f"{spec.name}: J_{numerator} / J_{denominator} (< 1: {numerator} better)",
                  fontsize=10)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save(fig, path)[0]
 
 
 def tracks(spec, rows: list[dict], path: Path) -> Path | None:
@@ -111,9 +109,7 @@ def tracks(spec, rows: list[dict], path: Path) -> Path | None:
         Hs, T0 = model_scale(spec.tracks["sea_state"])
         where += f" (Hs {Hs * 1000:.3g} mm, T0 {T0:.2g} s)"
     ax.set_title(f"{spec.name}: tracks ({where})", fontsize=10)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save(fig, path)[0]
 
 
 def save_figures(spec, rows: list[dict], out: Path) -> list[Path]:
