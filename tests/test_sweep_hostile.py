@@ -15,8 +15,10 @@ from pathlib import Path
 import pytest
 
 import cosim.scenarios.autopilot as autopilot
+from cosim import scenarios
+from cosim.core.ssd import write_ssd
 from cosim.studies import sweep, sweep_task
-from cosim.studies.bundle import UnsafeCache, fmu_cache
+from cosim.studies.bundle import UnsafeCache, file_hash, fmu_cache
 from cosim.studies import journal
 from cosim.studies.cluster import ClusterError, connect, local_workers
 from cosim.studies.journal import Journal, JournalLocked
@@ -335,3 +337,37 @@ def test_a_comparison_that_cannot_be_written_leaves_the_old_one(tmp_path, monkey
     monkeypatch.undo()
     assert (out / "comparison.md").read_text() == "the previous comparison\n"
     assert not [p for p in out.iterdir() if p.name.startswith(".")]
+
+
+# -- a rebuild of unchanged sources reruns nothing --------------------------------------
+@pytest.mark.timeout(120, method="thread")
+def test_a_finished_sweep_resumed_after_a_rebuild_reruns_nothing(fmu_paths, tmp_path, capsys):
+    """The FMUs are built into a folder of the test's, the sweep runs on waves_pd pointed at
+    them, they are built again from the same sources, and the sweep is resumed."""
+    built = tmp_path / "fmus"
+
+    def build() -> dict[str, str]:
+        subprocess.run([sys.executable, "-m", "fmukit.build", "ship", "pd_autopilot",
+                        "guidance", "--out", str(built)],
+                       check=True, capture_output=True, timeout=100)
+        return {p.name: file_hash(p) for p in built.glob("*.fmu")}
+
+    before = build()
+    system = scenarios.load("waves_pd")
+    for name, component in system.components.items():
+        component.source = str(built / Path(component.source).name)
+    write_ssd(system, tmp_path / "rebuilt.ssd")
+    spec = sweep.Spec.read(spec_file(tmp_path, "stop_time = 2\n[controllers]\n"
+                                               "pd = 'rebuilt.ssd'\n[axes]\nwave_seed = [1, 2]\n"))
+    assert set(spec.files().values()) == {built / name for name in before}
+    out = tmp_path / "out"
+    out.mkdir()
+    rows = sweep.execute(spec, out, workers=1, progress=False)
+    assert [r["status"] for r in rows] == ["ok", "ok"]
+    journal = (out / "runs.jsonl").read_text()
+    assert build() == before                                   # the same bytes
+    capsys.readouterr()
+    again = sweep.execute(sweep.Spec.read(tmp_path / "spec.toml"), out, workers=1,
+                          progress=False)
+    assert "2 of 2 runs already done" in capsys.readouterr().err
+    assert (out / "runs.jsonl").read_text() == journal and again == rows
