@@ -10,7 +10,10 @@ from __future__ import annotations
 
 from typing import Any, Callable, Iterable, NamedTuple
 
-_CONVERT = {"Real": float, "Integer": int, "Boolean": bool, "String": str}
+from .values import fmi_value, no_variable
+
+_CALL_TYPE = {"Enumeration": "Integer"}
+"""The FMI 2.0 calls of a type other than its own name: fmi2SetInteger sets an Enumeration."""
 
 
 class LogRecord(NamedTuple):
@@ -94,8 +97,7 @@ class Instance:
         try:
             return self.variables[name]
         except KeyError:
-            raise ValueError(f"FMU '{self.name}' ({self.path.name}) has no variable '{name}'; "
-                             f"it has: {', '.join(self.variables)}") from None
+            raise no_variable(self.name, self.path, self.variables, name) from None
 
     def vr(self, name: str) -> int:
         return self.variable(name).valueReference
@@ -107,22 +109,25 @@ class Instance:
         return getattr(variable, "unit", None) or getattr(declared, "unit", None) or ""
 
     def set(self, values: dict[str, Any], time: float | None = None) -> None:
-        """Set variables by name, each with the FMI type of its declaration."""
+        """Set variables by name, each through the FMI call of its declared type.
+
+        The FMU judges the values (its range checks, as a host without our master would
+        reach them); the master sets only values ``cosim.core.values.checked`` against the
+        declarations first. What the call could not carry exactly (1.5 or 2**32 for an
+        Integer, a NUL in a String: ``fmi_value``) is refused here too, as ValueError.
+        """
         for name, value in values.items():
             kind = self.variable(name).type
-            try:
-                converted = _CONVERT[kind](value)
-            except (TypeError, ValueError):
-                raise ValueError(f"FMU '{self.name}': {name} needs a {kind} value, "
-                                 f"got {value!r}") from None
-            self.call(f"set {name} = {value!r}", self.fmi(f"set{kind}"), [self.vr(name)],
-                      [converted], time=time)
+            exact = fmi_value(f"{self.name}.{name}", _CALL_TYPE.get(kind, kind), value)
+            self.call(f"set {name} = {exact!r}", self.fmi(f"set{_CALL_TYPE.get(kind, kind)}"),
+                      [self.vr(name)], [exact], time=time)
 
     def get(self, names: Iterable[str]) -> dict[str, Any]:
         """Current values of variables by name."""
         out = {}
         for name in names:
-            getter = self.fmi(f"get{self.variable(name).type}")
+            kind = self.variable(name).type
+            getter = self.fmi(f"get{_CALL_TYPE.get(kind, kind)}")
             value = self.call(f"get {name}", getter, [self.vr(name)])[0]
             out[name] = value.decode("utf-8") if isinstance(value, bytes) else value
         return out

@@ -1,0 +1,309 @@
+"""Values for FMU variables, checked against what the FMU declares before any FMU call.
+
+Every value the master sets (a ``--set`` text, a .ssd parameter binding, a Python
+caller's override) passes through ``checked``, on every backend: it returns the exact
+value to set, or raises ValueError naming the component, the variable, the value and
+what the variable takes. Two stages:
+
+- ``fmi_value``: what the FMI 2.0 call of the variable's type carries exactly
+  (section 2.1.2: fmi2Real a C double, fmi2Integer a C int, fmi2Boolean, fmi2String a
+  UTF-8 C string). Nothing is rounded, truncated or wrapped: an Integer is a whole
+  number in [-2^31, 2^31 - 1] (7, 7.0, "7", "+7", "7.0" and "1e3" are whole numbers;
+  1.5 and 4294967297 are refused, not set as 1); a Boolean is a bool, 0 or 1, or the
+  text true, false, 1 or 0 in any case; a String is text as given, without NUL. A
+  number given as text is read as the type declares (ASCII digits, optional sign,
+  fraction and exponent; surrounding blanks ignored, as XML Schema does; no "0x10",
+  "1_000" or other digits); a Real's text may also be inf or nan, and a text beyond
+  the range of a double is refused rather than read as infinite.
+- ``checked``: that value against the declaration (section 2.2.7): a Real finite
+  (+inf only where the FMU declares max="INF", -inf only where min="-INF"; NaN never)
+  and within the declared min and max, an Integer within them, an Enumeration one of
+  its items (by number or by name).
+
+``setting`` also refuses a variable that does not exist or that a master may not set
+in initialisation mode, where ours sets them (section 4.2.4: variability other than
+constant and initial exact, or an input): outputs, calculated parameters, constants,
+locals; ``parameters`` checks every value of a run so (``Master.configure``), from
+the model descriptions alone, before any FMU is instantiated.
+"""
+from __future__ import annotations
+
+import math
+import numbers
+import re
+from dataclasses import dataclass
+from decimal import Decimal
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Iterable, Mapping
+
+from fmpy.model_description import ModelDescription
+
+if TYPE_CHECKING:
+    from .ssd import SystemDescription
+
+INTEGER_RANGE = (-2**31, 2**31 - 1)
+"""What fmi2Integer, a C int, holds (FMI 2.0, section 2.1.2)."""
+
+Value = bool | int | float | str
+
+_DECIMAL = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
+_SPECIAL = re.compile(r"[+-]?(?:inf|infinity|nan)", re.IGNORECASE)
+_BOOLEAN = {"true": True, "1": True, "false": False, "0": False}
+
+
+@dataclass(frozen=True)
+class Declaration:
+    """What an FMU declares of one variable (FMI 2.0, section 2.2.7): its type (Real,
+    Integer, Boolean, String or Enumeration), causality, variability and initial, its
+    min and max (None where undeclared) and an Enumeration's items (name, value)."""
+
+    name: str
+    type: str
+    causality: str = "parameter"
+    variability: str = "fixed"
+    initial: str | None = "exact"
+    min: float | int | None = None
+    max: float | int | None = None
+    items: tuple[tuple[str, int], ...] = ()
+
+    @property
+    def settable(self) -> bool:
+        """Whether a master may set it in initialisation mode (FMI 2.0, section 4.2.4)."""
+        return self.causality == "input" or (self.variability != "constant"
+                                             and self.initial == "exact")
+
+    def takes(self) -> str:
+        """What it takes, in words: 'a finite Real, from 0.0 to 0.1'."""
+        if self.type == "Enumeration":
+            return "an Enumeration item: " + ", ".join(f"{v} ({n})" for n, v in self.items)
+        if self.type == "Integer":
+            low, high = _integer_bounds(self)
+            return f"an Integer, a whole number from {low} to {high}"
+        if self.type != "Real":
+            return _TAKES[self.type]
+        infinite = self.max == math.inf or self.min == -math.inf
+        low, high = (None if b is None or math.isinf(b) else b for b in (self.min, self.max))
+        kind = "a Real, not NaN" if infinite else "a finite Real"
+        if low is not None and high is not None:
+            return f"{kind}, from {low!r} to {high!r}"
+        if low is not None or high is not None:
+            return f"{kind}, {'>=' if high is None else '<='} {low if high is None else high!r}"
+        return kind
+
+
+_TAKES = {"Real": "a Real (a double)", "Integer": "an Integer, a whole number from "
+          f"{INTEGER_RANGE[0]} to {INTEGER_RANGE[1]}",
+          "Boolean": "a Boolean: true, false, 1 or 0",
+          "String": "a String: UTF-8 text without NUL"}
+
+
+def declarations(description: ModelDescription) -> dict[str, Declaration]:
+    """Every variable's declaration in an FMU's model description, as fmpy reads it
+    (``cosim.core.fmi.read_description``, which validates it against the FMI schema: a
+    bound is a number of its variable's type), min and max from the variable or else its
+    declared type."""
+    out = {}
+    for v in description.modelVariables:
+        declared, number = v.declaredType, float if v.type == "Real" else int
+        low, high = (getattr(v, bound, None) or getattr(declared, bound, None)
+                     for bound in ("min", "max"))
+        items = tuple((i.name, int(i.value)) for i in getattr(declared, "items", None) or ())
+        out[v.name] = Declaration(v.name, v.type, v.causality, v.variability, v.initial,
+                                  None if low is None else number(low),
+                                  None if high is None else number(high), items)
+    return out
+
+
+class _Refusal(ValueError):
+    """Why a value is refused, in words that follow it: 'is not a whole number'."""
+
+
+def fmi_value(target: str, type_name: str, value: Any) -> Value:
+    """``value`` as the FMI 2.0 call of ``type_name`` carries it, exactly (see the module);
+    ValueError naming ``target`` (component.variable), the value and what the type takes."""
+    try:
+        return _CARRIED[type_name](value)
+    except _Refusal as refusal:
+        raise ValueError(f"{target} = {value!r} {refusal}; {target} is "
+                         f"{_TAKES.get(type_name, 'of type ' + type_name)}") from None
+    except KeyError:
+        raise ValueError(f"{target} is of type {type_name!r}, which FMI 2.0 does not "
+                         f"have") from None
+
+
+def checked(component: str, declaration: Declaration, value: Any) -> Value:
+    """The exact value to set for ``component``'s variable so declared; ValueError naming
+    the component, the variable, the value and what the variable takes."""
+    target = f"{component}.{declaration.name}"
+    carried_as = "Integer" if declaration.type == "Enumeration" else declaration.type
+    try:
+        if declaration.type == "Enumeration" and isinstance(value, str) and \
+                value.strip() in dict(declaration.items):
+            return dict(declaration.items)[value.strip()]
+        exact = _CARRIED[carried_as](value)
+        _within(declaration, exact)
+    except _Refusal as refusal:
+        raise ValueError(f"{target} = {value!r} {refusal}; {target} is "
+                         f"{declaration.takes()}") from None
+    except KeyError:
+        raise ValueError(f"{target} is of type {declaration.type!r}, which FMI 2.0 does "
+                         "not have") from None
+    return exact
+
+
+def setting(component: str, path: str | Path, declared: dict[str, Declaration], name: str,
+            value: Any) -> Value:
+    """``checked`` for the variable ``name`` of ``component`` (its FMU at ``path``),
+    which must exist and be settable; ValueError naming what the FMU has otherwise."""
+    if name not in declared:
+        raise no_variable(component, path, declared, name)
+    declaration = declared[name]
+    if not declaration.settable:
+        kind = (f"a {declaration.variability} {declaration.causality}"
+                if declaration.variability == "constant" else
+                f"{_article(declaration.causality)} {declaration.causality}"
+                f"{f' (initial {declaration.initial})' if declaration.initial else ''}")
+        names = [n for n, d in declared.items() if d.settable]
+        raise ValueError(f"{component}.{name} cannot be set: it is {kind}; FMU "
+                         f"'{component}' ({Path(path).name}) takes values for "
+                         f"{', '.join(names) or 'no variable'}")
+    return checked(component, declaration, value)
+
+
+def no_variable(component: str, path: str | Path, names: Iterable[str],
+                name: str) -> ValueError:
+    """The error for a variable the FMU does not have, listing those it has."""
+    return ValueError(f"FMU '{component}' ({Path(path).name}) has no variable '{name}'; "
+                      f"it has: {', '.join(names)}")
+
+
+def _article(word: str) -> str:
+    return "an" if word[0] in "aeiou" else "a"
+
+
+# -- what each FMI type carries ------------------------------------------------------
+def _real(value: Any) -> float:
+    if isinstance(value, str):
+        text = value.strip()
+        if _SPECIAL.fullmatch(text):
+            return float(text)
+        if not _DECIMAL.fullmatch(text):
+            raise _Refusal("is not a number")
+        number = float(text)
+        if math.isinf(number):
+            raise _Refusal("is beyond the range of a double")
+        if number == 0 and Decimal(text) != 0:
+            raise _Refusal("is below the smallest double (it would be set as 0)")
+        return number
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise _Refusal("is not a number")
+    try:
+        number = float(value)
+    except OverflowError:
+        raise _Refusal("is beyond the range of a double") from None
+    if number != value and not math.isnan(number):
+        raise _Refusal(f"has no exact double (the nearest is {number!r})")
+    return number
+
+
+def _integer(value: Any) -> int:
+    if isinstance(value, str):
+        text = value.strip()
+        if not _DECIMAL.fullmatch(text):
+            raise _Refusal("is not a whole number")
+        exact: Decimal | float | int = Decimal(text)
+    elif isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise _Refusal("is not a whole number")
+    elif isinstance(value, numbers.Integral):
+        exact = int(value)
+    else:
+        exact = float(value)
+        if not math.isfinite(exact):
+            raise _Refusal("is not a whole number")
+    if exact != (exact.to_integral_value() if isinstance(exact, Decimal) else int(exact)):
+        raise _Refusal("is not a whole number")
+    if not INTEGER_RANGE[0] <= exact <= INTEGER_RANGE[1]:
+        raise _Refusal("is outside the range of an FMI Integer (32 bits)")
+    return int(exact)
+
+
+def _boolean(value: Any) -> bool:
+    if isinstance(value, bool):
+        return value
+    if isinstance(value, str) and value.strip().lower() in _BOOLEAN:
+        return _BOOLEAN[value.strip().lower()]
+    if isinstance(value, numbers.Integral) and value in (0, 1):
+        return bool(value)
+    raise _Refusal("is not a Boolean")
+
+
+def _string(value: Any) -> str:
+    if not isinstance(value, str):
+        raise _Refusal("is not text")
+    if "\0" in value:
+        raise _Refusal("holds a NUL character, where an FMI string ends")
+    try:
+        value.encode("utf-8")
+    except UnicodeEncodeError:
+        raise _Refusal("is not encodable as UTF-8") from None
+    return value
+
+
+_CARRIED = {"Real": _real, "Integer": _integer, "Boolean": _boolean, "String": _string}
+
+
+def _integer_bounds(declaration: Declaration) -> tuple[int, int]:
+    low, high = INTEGER_RANGE
+    return (low if declaration.min is None else max(low, declaration.min),
+            high if declaration.max is None else min(high, declaration.max))
+
+
+def _within(declaration: Declaration, value: Value) -> None:
+    """_Refusal if a value of the declared type is outside what the declaration allows."""
+    if declaration.type == "Real":
+        if math.isnan(value):
+            raise _Refusal("is not a number (NaN)")
+        if math.isinf(value) and value != (declaration.max if value > 0 else declaration.min):
+            raise _Refusal("is not finite")
+    if declaration.type in ("Real", "Integer", "Enumeration"):
+        low, high = declaration.min, declaration.max
+        if (low is not None and value < low) or (high is not None and value > high):
+            raise _Refusal("is outside its declared range")
+    if declaration.type == "Enumeration" and declaration.items and \
+            value not in dict(declaration.items).values():
+        raise _Refusal("is not one of its items")
+
+
+def parameters(system: SystemDescription, paths: dict[str, Path],
+               declared: dict[str, dict[str, Declaration]],
+               overrides: Mapping[str, Mapping[str, Any]] | None = None
+               ) -> tuple[dict[str, dict[str, Value]], dict[str, dict[str, Value]]]:
+    """The values of a run, each as ``setting`` returns it for its component (its FMU at
+    ``paths[component]``, declaring ``declared[component]``): the system's parameter
+    bindings updated by ``overrides`` (by component, then variable); and the overrides
+    alone, as set. ValueError naming the value (and the .ssd, for a binding of its own),
+    also for an input that a connection sets."""
+    given: dict[str, dict[str, Any]] = {}
+    for component, values in (overrides or {}).items():
+        if not isinstance(values, Mapping):
+            raise ValueError(f"set: the values for '{component}' must map variable names to "
+                             f"values, got {values!r}")
+        given[component] = dict(values)
+    connected = {(c.end_element, c.end_connector): f"{c.start_element}.{c.start_connector}"
+                 for c in system.connections}
+    result: dict[str, dict[str, Value]] = {}
+    for component, values in system.parameters(given).items():
+        result[component] = {}
+        for name, value in values.items():
+            try:
+                if (component, name) in connected:
+                    raise ValueError(f"{component}.{name} is an input that the connection "
+                                     f"from {connected[component, name]} sets")
+                result[component][name] = setting(component, paths[component],
+                                                  declared[component], name, value)
+            except ValueError as error:
+                if name in given.get(component, {}):
+                    raise
+                raise ValueError(f"{system.path or system.name}: parameter binding "
+                                 f"{error}") from None
+    return result, {c: {n: result[c][n] for n in v} for c, v in given.items()}
