@@ -36,7 +36,7 @@ def chosen_scenarios(parser: argparse.ArgumentParser, scenario: str | None,
     return names
 
 
-def setting_option(text: str) -> tuple[str, int | float | str]:
+def setting_option(text: str) -> tuple[str, str]:
     """--set COMPONENT.VARIABLE=VALUE, for argparse."""
     try:
         return parse_setting(text)

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import warnings
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterable, Mapping
 
 from . import scenarios
 from .core.master import Master
@@ -28,9 +28,11 @@ class SimulationError(RuntimeError):
         self.recording = recording
 
 
-def parse_setting(text: str) -> tuple[str, int | float | str]:
-    """'component.variable=value' -> ('component.variable', value); numbers become int or
-    float. ValueError naming the text if it is not of that form."""
+def parse_setting(text: str) -> tuple[str, str]:
+    """'component.variable=value' -> ('component.variable', 'value'). The value stays text:
+    the master reads it as the type the FMU declares for the variable, once, and refuses
+    what that type cannot hold exactly (``cosim.core.values``). ValueError naming the
+    text if it is not of that form."""
     target, sep, raw = text.partition("=")
     try:
         if not sep:
@@ -38,22 +40,24 @@ def parse_setting(text: str) -> tuple[str, int | float | str]:
         split_name(target)
     except ValueError:
         raise ValueError(f"--set expects COMPONENT.VARIABLE=VALUE, got {text!r}") from None
-    for convert in (int, float):
-        try:
-            return target, convert(raw)
-        except ValueError:
-            pass
     return target, raw
 
 
-def overrides_of(settings: dict[str, Any]) -> dict[str, dict[str, Any]]:
-    """{'ship.Hs': 0.01} -> {'ship': {'Hs': 0.01}}; ValueError for a key without a dot."""
+def overrides_of(settings: Mapping[str, Any] | Iterable[tuple[str, Any]]
+                 ) -> dict[str, dict[str, Any]]:
+    """{'ship.Hs': 0.01} (or pairs, as ``parse_setting`` gives them) -> {'ship': {'Hs':
+    0.01}}; ValueError for a key that is not 'component.variable' or a variable given
+    twice."""
+    pairs = settings.items() if isinstance(settings, Mapping) else settings
     overrides: dict[str, dict[str, Any]] = {}
-    for target, value in settings.items():
+    for target, value in pairs:
         try:
             component, variable = split_name(target)
-        except ValueError as error:
-            raise ValueError(f"set: {error}") from None
+        except ValueError:
+            raise ValueError(f"set: {target!r} is not 'component.variable'") from None
+        if variable in overrides.get(component, {}):
+            raise ValueError(f"set: {target} is given twice ({overrides[component][variable]!r}"
+                             f" and {value!r})")
         overrides.setdefault(component, {})[variable] = value
     return overrides
 

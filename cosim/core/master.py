@@ -23,13 +23,14 @@ from typing import Any, Callable
 from fmukit.timebase import communication_point, nanoseconds, seconds, step_count
 
 from .coupling import COUPLINGS
-from .fmi import FmuInstance
+from .fmi import FmuInstance, read_description
 from .inprocess import InProcessInstance, fallback_note
 from .instance import FmuCallError, Instance
 from .interrupt import StopSignals
 from .null import NullInstance
 from .recording import Recorder, Recording
 from .ssd import SystemDescription, split_name
+from .values import declarations, parameters
 from .watchdog import TimeLimit, Watchdog
 from .wiring import check_connections, feedthrough_order, layout
 
@@ -63,13 +64,16 @@ class Master:
             if value not in known:
                 raise ValueError(f"{what} must be one of {', '.join(known)}, got {value!r}")
         self.system, self.coupling, self.backend = system, coupling, backend
+        self.paths = {name: system.fmu_path(name) for name in system.components}
+        self.declarations = {name: declarations(read_description(path, name))
+                             for name, path in self.paths.items()}
         self.configure(overrides)
         self.instances: dict[str, Instance] = {}
         self.notes: list[str] = []        # what the user should know about how this runs
         self.backends: dict[str, str] = {}    # how each component runs
         try:
-            for name in system.components:
-                self.instances[name] = self._instantiate(system.fmu_path(name), name)
+            for name, path in self.paths.items():
+                self.instances[name] = self._instantiate(path, name)
             check_connections(system, self.instances)
             self.order = feedthrough_order(system, self.instances)
             self.verify_inputs = verify_inputs
@@ -91,9 +95,12 @@ class Master:
         return BACKENDS[backend](path, name)
 
     def configure(self, overrides: dict[str, dict[str, Any]] | None = None) -> None:
-        """Parameters for the next run: the system's, updated by ``overrides``."""
-        self.parameters = self.system.parameters(overrides)
-        self.overrides = {c: dict(v) for c, v in (overrides or {}).items()}
+        """Parameters for the next run: the system's, updated by ``overrides``, each checked
+        against its FMU's model description before any FMU call and kept as it will be set
+        (``cosim.core.values.parameters``); ValueError naming a value refused, the
+        parameters left as they were."""
+        self.parameters, self.overrides = parameters(self.system, self.paths,
+                                                     self.declarations, overrides)
 
     def _prepare(self) -> None:
         """Lay out the columns and prepare each component's calls for the loop."""
