@@ -5,10 +5,13 @@ FMU components with connectors, inline parameter sets (ssv:Real, Integer, Boolea
 String), connections, and a DefaultExperiment whose OSP annotation gives the fixed
 step. This project adds one annotation of its own (type ``REPORT_ANNOTATION``)
 naming the kind of analysis a run of the system gets (``cosim.analysis.kinds``);
-other tools ignore it.
+other tools ignore it. ``read_ssd`` refuses what is not in this subset (nested
+systems, connectors of the system itself, parameter values in .ssv files or with
+units, ...) or not well formed, naming the file, the element and the attribute.
 """
 from __future__ import annotations
 
+import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -17,6 +20,7 @@ from typing import Any
 from fmubuild.project import FMU_DIR, FMUS
 
 from .errors import FmuNotFound
+from .values import fmi_value
 
 NS = {
     "ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",
@@ -28,8 +32,9 @@ NS = {
 OSP_ANNOTATION = "com.opensimulationplatform"
 REPORT_ANNOTATION = "org.ship-autopilot-cosim"
 PARAMETER_SET = "scenario"
-_TYPES = {"Real": float, "Integer": int, "Boolean": lambda s: s.strip().lower() in ("true", "1"),
-          "String": str}
+_TYPES = ("Real", "Integer", "Boolean", "String")
+FMU_TYPE = "application/x-fmu-sharedlibrary"
+CONNECTOR_KINDS = ("input", "output", "inout", "parameter", "calculatedParameter")
 
 FMU_SEARCH_PATH = [FMU_DIR]
 """Folders searched, by file name, for an FMU not found where its .ssd points: the
@@ -43,7 +48,7 @@ for _prefix, _uri in NS.items():
 def split_name(name: str) -> tuple[str, str]:
     """'ship.psi' -> ('ship', 'psi'): a variable by its component; ValueError naming ``name``
     if it is not of the form component.variable."""
-    component, dot, variable = name.partition(".")
+    component, dot, variable = name.partition(".") if isinstance(name, str) else ("", "", "")
     if not (dot and component and variable):
         raise ValueError(f"{name!r} is not 'component.variable'")
     return component, variable
@@ -118,58 +123,194 @@ def _q(prefix: str, tag: str) -> str:
     return f"{{{NS[prefix]}}}{tag}"
 
 
-def _type_of(element: ET.Element, prefix: str) -> tuple[str, ET.Element]:
-    for name in _TYPES:
-        child = element.find(f"{prefix}:{name}", NS)
-        if child is not None:
-            return name, child
-    raise ValueError(f"{element.get('name')!r} has no Real, Integer, Boolean or String type")
+def _local(element: ET.Element) -> str:
+    """An element's tag as the file writes it: 'ssv:Real'."""
+    uri, _, tag = element.tag.rpartition("}")
+    prefix = next((p for p, u in NS.items() if f"{{{u}" == uri), None)
+    return f"{prefix}:{tag}" if prefix else tag
+
+
+class _Reader:
+    """Reads one .ssd; every error names the file, the element and the attribute."""
+
+    def __init__(self, path: Path):
+        self.path = path
+
+    def error(self, where: str, problem: str) -> ValueError:
+        return ValueError(f"{self.path}: {where}: {problem}")
+
+    def required(self, element: ET.Element, attribute: str, where: str,
+                 hint: str = "") -> str:
+        """The attribute's value; an error if it is missing or blank."""
+        value = element.get(attribute)
+        if value is None or not value.strip():
+            raise self.error(where, f"{'no' if value is None else 'an empty'} {attribute} "
+                                    f"attribute{hint}")
+        return value
+
+    def typed(self, element: ET.Element, prefix: str, where: str) -> tuple[str, ET.Element]:
+        """The one Real, Integer, Boolean or String child of a Connector (ssc) or a
+        Parameter (ssv), by its type's name."""
+        children = [c for c in element if c.tag.startswith(f"{{{NS[prefix]}}}")]
+        known = [c for c in children if c.tag.rpartition("}")[2] in _TYPES]
+        if len(children) != 1 or len(known) != 1:
+            found = ", ".join(_local(c) for c in children) or "none"
+            raise self.error(where, f"needs one of {', '.join(f'{prefix}:{t}' for t in _TYPES)}"
+                                    f" (found: {found})")
+        return known[0].tag.rpartition("}")[2], known[0]
+
+    def number(self, element: ET.Element, attribute: str, where: str,
+               default: float) -> float:
+        """A finite number from an attribute, ``default`` where it is absent."""
+        text = element.get(attribute)
+        if text is None:
+            return default
+        try:
+            value = fmi_value(attribute, "Real", text)
+        except ValueError:
+            value = math.nan
+        if not math.isfinite(value):
+            raise self.error(where, f"{attribute}={text!r} is not a finite number")
+        return value
+
+    def system(self) -> SystemDescription:
+        try:
+            root = ET.parse(self.path).getroot()
+        except (ET.ParseError, OSError) as error:
+            raise ValueError(f"cannot read system structure {self.path}: {error}") from error
+        if root.tag != _q("ssd", "SystemStructureDescription"):
+            raise ValueError(f"{self.path} is not an SSP system structure description "
+                             f"(its root element is {_local(root)})")
+        name = self.required(root, "name", "SystemStructureDescription")
+        systems = root.findall("ssd:System", NS)
+        if len(systems) != 1:
+            raise self.error("SystemStructureDescription", f"needs one System element, has "
+                                                           f"{len(systems)}")
+        system = systems[0]
+        components: dict[str, Component] = {}
+        for i, element in enumerate(system.findall("ssd:Elements/*", NS), 1):
+            if element.tag != _q("ssd", "Component"):
+                raise self.error(f"System, element {i} of Elements",
+                                 f"{_local(element)} is not read: only Components (FMUs)")
+            component = self.component(element, i)
+            if component.name in components:
+                raise self.error(f"Component {i}", f"a second Component named "
+                                                   f"'{component.name}'")
+            components[component.name] = component
+        if not components:
+            raise self.error("System", "no Component in its Elements")
+        connections = self.connections(system, components)
+        description = SystemDescription(name=name, components=components,
+                                        connections=connections,
+                                        description=system.get("description", ""),
+                                        path=self.path)
+        experiment = root.find("ssd:DefaultExperiment", NS)
+        if experiment is not None:
+            self.experiment(experiment, description)
+        return description
+
+    def component(self, element: ET.Element, index: int) -> Component:
+        name = self.required(element, "name", f"Component {index}")
+        where = f"Component '{name}'"
+        if "." in name:
+            raise self.error(where, "a '.' in its name, which separates a component from "
+                                    "its variables ('ship.psi')")
+        kind = element.get("type", FMU_TYPE)
+        if kind != FMU_TYPE:
+            raise self.error(where, f"type {kind!r} is not read: only FMUs ({FMU_TYPE})")
+        component = Component(name=name, source=self.required(element, "source", where))
+        for j, connector in enumerate(element.findall("ssd:Connectors/ssd:Connector", NS), 1):
+            connector_name = self.required(connector, "name", f"{where}, Connector {j}")
+            at = f"{where}, Connector '{connector_name}'"
+            causality = self.required(connector, "kind", at)
+            if causality not in CONNECTOR_KINDS:
+                raise self.error(at, f"kind {causality!r} is not one of "
+                                     f"{', '.join(CONNECTOR_KINDS)}")
+            if connector_name in component.connectors:
+                raise self.error(at, "declared twice")
+            component.connectors[connector_name] = (causality,
+                                                    self.typed(connector, "ssc", at)[0])
+        for binding in element.findall("ssd:ParameterBindings/ssd:ParameterBinding", NS):
+            self.binding(binding, component, f"{where}, ParameterBinding")
+        return component
+
+    def binding(self, binding: ET.Element, component: Component, where: str) -> None:
+        for attribute, what in (("source", "parameter values in another file"),
+                                ("prefix", "a prefix to parameter names")):
+            if binding.get(attribute):
+                raise self.error(where, f"{attribute}={binding.get(attribute)!r}: {what} is "
+                                        "not read; give the values inline")
+        if binding.find("ssd:ParameterMapping", NS) is not None:
+            raise self.error(where, "a ParameterMapping is not read")
+        values = binding.find("ssd:ParameterValues", NS)
+        if values is None:
+            raise self.error(where, "no ParameterValues")
+        for k, p in enumerate(values.findall("ssv:ParameterSet/ssv:Parameters/ssv:Parameter",
+                                             NS), 1):
+            name = self.required(p, "name", f"{where}, Parameter {k}")
+            at = f"Component '{component.name}', Parameter '{name}'"
+            if name in component.parameters:
+                raise self.error(at, "given twice")
+            type_name, value = self.typed(p, "ssv", at)
+            text = self.required(value, "value", f"{at}, ssv:{type_name}")
+            if value.get("unit") is not None:
+                raise self.error(f"{at}, ssv:{type_name}", f"unit={value.get('unit')!r} is "
+                                 "not read; give the value in the FMU's unit, without unit=")
+            try:
+                component.parameters[name] = fmi_value(f"{component.name}.{name}", type_name,
+                                                       text)
+            except ValueError as error:
+                raise self.error(f"{at}, ssv:{type_name}", str(error)) from None
+
+    def connections(self, system: ET.Element, components: dict[str, Component]
+                    ) -> list[Connection]:
+        connections, fed = [], {}
+        hint = " (connectors of the system itself are not read)"
+        for i, c in enumerate(system.findall("ssd:Connections/ssd:Connection", NS), 1):
+            where = f"Connection {i}"
+            connection = Connection(*(self.required(c, a, where, hint if "Element" in a else "")
+                                      for a in ("startElement", "startConnector",
+                                                "endElement", "endConnector")))
+            where = f"Connection {i} ({connection})"
+            for element in (connection.start_element, connection.end_element):
+                if element not in components:
+                    raise self.error(where, f"names the component '{element}', which the "
+                                            f"system does not have; it has "
+                                            f"{', '.join(components)}")
+            end = (connection.end_element, connection.end_connector)
+            if end in fed:
+                raise self.error(where, f"{'.'.join(end)} is fed already by Connection "
+                                        f"{fed[end]}")
+            fed[end] = i
+            connections.append(connection)
+        return connections
+
+    def experiment(self, experiment: ET.Element, description: SystemDescription) -> None:
+        where = "DefaultExperiment"
+        description.start_time = self.number(experiment, "startTime", where, 0.0)
+        description.stop_time = self.number(experiment, "stopTime", where,
+                                            description.stop_time)
+        if not description.stop_time > description.start_time:
+            raise self.error(where, f"stopTime {description.stop_time!r} is not after "
+                                    f"startTime {description.start_time!r}")
+        annotations = "ssd:Annotations/ssc:Annotation/"
+        algorithm = experiment.find(f"{annotations}osp:Algorithm/osp:FixedStepAlgorithm", NS)
+        if algorithm is not None:
+            at = f"{where}, osp:FixedStepAlgorithm"
+            self.required(algorithm, "baseStepSize", at)
+            description.step_size = self.number(algorithm, "baseStepSize", at, math.nan)
+            if not description.step_size > 0:
+                raise self.error(at, f"baseStepSize {description.step_size!r} is not > 0")
+        report = experiment.find(f"{annotations}sap:Report", NS)
+        if report is not None:
+            description.report = self.required(report, "kind", f"{where}, sap:Report")
 
 
 def read_ssd(path: str | Path) -> SystemDescription:
-    """Parse a .ssd file; ValueError naming the file and the problem if it is not one."""
-    path = Path(path)
-    try:
-        root = ET.parse(path).getroot()
-    except (ET.ParseError, OSError) as error:
-        raise ValueError(f"cannot read system structure {path}: {error}") from error
-    if root.tag != _q("ssd", "SystemStructureDescription"):
-        raise ValueError(f"{path} is not an SSP system structure description")
-    system = root.find("ssd:System", NS)
-    components = {}
-    for c in system.findall("ssd:Elements/ssd:Component", NS):
-        component = Component(name=c.get("name"), source=c.get("source"))
-        for connector in c.findall("ssd:Connectors/ssd:Connector", NS):
-            kind_type = _type_of(connector, "ssc")[0]
-            component.connectors[connector.get("name")] = (connector.get("kind"), kind_type)
-        for p in c.findall("ssd:ParameterBindings/ssd:ParameterBinding/ssd:ParameterValues/"
-                           "ssv:ParameterSet/ssv:Parameters/ssv:Parameter", NS):
-            type_name, value = _type_of(p, "ssv")
-            component.parameters[p.get("name")] = _TYPES[type_name](value.get("value"))
-        components[component.name] = component
-    connections = [Connection(c.get("startElement"), c.get("startConnector"),
-                              c.get("endElement"), c.get("endConnector"))
-                   for c in system.findall("ssd:Connections/ssd:Connection", NS)]
-    description = SystemDescription(name=root.get("name"), components=components,
-                                    connections=connections,
-                                    description=system.get("description", ""), path=path)
-    experiment = root.find("ssd:DefaultExperiment", NS)
-    if experiment is not None:
-        description.start_time = float(experiment.get("startTime", 0.0))
-        description.stop_time = float(experiment.get("stopTime", description.stop_time))
-        algorithm = experiment.find("ssd:Annotations/ssc:Annotation/osp:Algorithm/"
-                                    "osp:FixedStepAlgorithm", NS)
-        if algorithm is not None:
-            description.step_size = float(algorithm.get("baseStepSize"))
-        report = experiment.find("ssd:Annotations/ssc:Annotation/sap:Report", NS)
-        if report is not None:
-            description.report = report.get("kind")
-    for connection in connections:
-        for element in (connection.start_element, connection.end_element):
-            if element not in components:
-                raise ValueError(f"{path}: connection {connection} names the component "
-                                 f"'{element}', which the system does not have")
-    return description
+    """Parse a .ssd file of the subset this module reads; ValueError naming the file, the
+    element and the attribute for anything else (a parameter's value read by the rules
+    of ``cosim.core.values.fmi_value``)."""
+    return _Reader(Path(path)).system()
 
 
 def _format(value: float | int | bool | str) -> tuple[str, str]:
@@ -192,7 +333,7 @@ def write_ssd(system: SystemDescription, path: str | Path,
     for c in system.components.values():
         source = (sources or {}).get(c.name, c.source)
         comp = ET.SubElement(elements, _q("ssd", "Component"), name=c.name, source=source,
-                             type="application/x-fmu-sharedlibrary")
+                             type=FMU_TYPE)
         connectors = ET.SubElement(comp, _q("ssd", "Connectors"))
         for name, (kind, type_name) in c.connectors.items():
             connector = ET.SubElement(connectors, _q("ssd", "Connector"), name=name, kind=kind)
