@@ -171,6 +171,12 @@ MALFORMED = [   # (what, old text, new text, the message's element and problem)
     ("a step of 0", 'baseStepSize="0.1"', 'baseStepSize="0"', "baseStepSize 0.0 is not > 0"),
     ("a step that is not a number", 'baseStepSize="0.1"', 'baseStepSize="0,1"',
      "baseStepSize='0,1' is not a finite number"),
+    ("a step off the time base", 'baseStepSize="0.1"', 'baseStepSize="0.10000000001"',
+     "DefaultExperiment: baseStepSize 0.10000000001 s is not a whole number of nanoseconds"),
+    ("a step below a nanosecond", 'baseStepSize="0.1"', 'baseStepSize="1e-12"',
+     "DefaultExperiment: baseStepSize 1e-12 s is not a whole number of nanoseconds"),
+    ("a stop time between two steps", 'stopTime="400.0"', 'stopTime="400.05"',
+     "DefaultExperiment: stop time 400.05 s is not a whole number of 0.1 s steps after 0.0 s"),
     ("a report without a kind", '<sap:Report kind="course_keeping" />', "<sap:Report />",
      "DefaultExperiment, sap:Report: no kind attribute"),
 ]

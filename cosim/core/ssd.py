@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from fmubuild.project import FMU_DIR, FMUS
+from fmukit.timebase import on_time_base, step_count
 
 from .errors import FmuNotFound
 from .values import fmi_value
@@ -304,6 +305,16 @@ class _Reader:
         report = experiment.find(f"{annotations}sap:Report", NS)
         if report is not None:
             description.report = self.required(report, "kind", f"{where}, sap:Report")
+        for name, t in (("startTime", description.start_time),
+                        ("stopTime", description.stop_time),
+                        ("baseStepSize", description.step_size)):
+            if on_time_base(t) != t:
+                raise self.error(where, f"{name} {t!r} s is not a whole number of "
+                                        "nanoseconds, the time base (fmukit.timebase)")
+        try:
+            step_count(description.start_time, description.stop_time, description.step_size)
+        except ValueError as error:
+            raise self.error(where, str(error)) from None
 
 
 def read_ssd(path: str | Path) -> SystemDescription:

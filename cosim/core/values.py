@@ -283,6 +283,9 @@ def parameters(system: SystemDescription, paths: dict[str, Path],
     bindings updated by ``overrides`` (by component, then variable); and the overrides
     alone, as set. ValueError naming the value (and the .ssd, for a binding of its own),
     also for an input that a connection sets."""
+    if not isinstance(overrides or {}, Mapping):
+        raise ValueError(f"set: overrides must map component names to their values, got "
+                         f"{overrides!r}")
     given: dict[str, dict[str, Any]] = {}
     for component, values in (overrides or {}).items():
         if not isinstance(values, Mapping):
