@@ -371,3 +371,30 @@ def test_a_finished_sweep_resumed_after_a_rebuild_reruns_nothing(fmu_paths, tmp_
                           progress=False)
     assert "2 of 2 runs already done" in capsys.readouterr().err
     assert (out / "runs.jsonl").read_text() == journal and again == rows
+
+
+@pytest.mark.parametrize("make, said", [
+    (lambda tmp: tmp / "none.toml", "no such file"),
+    (lambda tmp: tmp, "not a regular file"),
+    (lambda tmp: Path("/dev/zero"), "not a regular file"),      # read, it would never end
+    (lambda tmp: _written(tmp / "big.toml", b"#" * (17 << 20)), "more than 16 MiB"),
+    (lambda tmp: _written(tmp / "latin1.toml", b'name = "\xe9t\xe9"'), "can't decode byte"),
+])
+def test_a_spec_that_is_not_a_small_text_file_is_not_read(tmp_path, make, said):
+    path = make(tmp_path)
+    with pytest.raises(ValueError, match=f"^cannot read sweep spec {re.escape(str(path))}: .*"
+                                         f"{said}"):
+        sweep.Spec.read(path)
+
+
+def _written(path: Path, data: bytes) -> Path:
+    path.write_bytes(data)
+    return path
+
+
+def test_a_controller_whose_runs_cannot_be_measured_is_refused(tmp_path):
+    path = spec_file(tmp_path, '[controllers]\nturn = "turning_circle"\n')
+    with pytest.raises(ValueError, match=re.escape(
+            f"{path}: controller 'turn': its system 'turning_circle' has no output "
+            "guidance.psi_d; a run is measured by guidance.psi_d, ship.psi")):
+        sweep.Spec.read(path)

@@ -45,12 +45,18 @@ SEA_STATE = ("ship.Hs", "ship.T0")
 MAX_RUNS = 100_000
 """The most runs a sweep may have unless told otherwise (``cosim.sweep --max-runs``)."""
 
+MAX_SPEC_BYTES = 16 << 20
+"""The largest sweep file read (a list of MAX_RUNS values takes about 1 MiB)."""
+
 FILE_NAME = re.compile(r"\w(?:[\w .+-]{0,98}[\w+-])?")
 """A sweep's or a controller's name: one plain file name (letters, digits, _ . + - and
 inner spaces; no separator, no leading dot, at most 100 characters)."""
 
 INTEGER = (-2 ** 31, 2 ** 31 - 1)
 """The values of an FMI 2.0 Integer (a C int)."""
+
+MEASURED = ("guidance.psi_d", "ship.psi", "ship.delta", "ship.x", "ship.y")
+"""The outputs a run's figures of merit and its track are computed from (``sweep_task``)."""
 
 
 @dataclass
@@ -77,8 +83,12 @@ class Spec:
         More than ``max_runs`` runs are refused before any is listed."""
         path = Path(path)
         try:
+            if not path.is_file():
+                raise ValueError("no such file" if not path.exists() else "not a regular file")
+            if path.stat().st_size > MAX_SPEC_BYTES:
+                raise ValueError(f"more than {MAX_SPEC_BYTES >> 20} MiB")
             data = tomllib.loads(path.read_text())
-        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as error:
+        except (OSError, ValueError) as error:      # UnicodeDecodeError, TOMLDecodeError
             raise ValueError(f"cannot read sweep spec {path}: {error}") from None
         unknown = set(data) - {"name", "stop_time", "controllers", "axes", "plots"}
         if unknown:
@@ -127,13 +137,27 @@ class Spec:
         return spec
 
     def _check_values(self, path: Path) -> None:
-        """Every parameter the axes and the controllers' ``set`` name exists in each
-        controller's system and takes its values (by FMI type), and no axis repeats a
-        value as the FMU would receive it; ValueError naming the file, key and value."""
+        """Every controller's system has the outputs a run is measured by (``MEASURED``),
+        every parameter the axes and the controllers' ``set`` name exists in it and takes
+        their values (by FMI type), and no axis repeats a value as the FMU would receive
+        it; ValueError naming the file, key and value."""
         try:
             self.bundles()
         except (FmuNotFound, FmuUnreadable) as error:
             raise type(error)(f"{path}: {error}", error.ours) from None
+        for controller, shipped in self.bundles().items():
+            missing = []
+            for target in MEASURED:
+                component, _, variable = target.partition(".")
+                declared = (self._declared(controller, component)[1].get(variable)
+                            if component in shipped.system.components else None)
+                if declared is None or declared.causality != "output":
+                    missing.append(target)
+            if missing:
+                raise ValueError(f"{path}: controller {controller!r}: its system "
+                                 f"{shipped.system.name!r} has no output {', '.join(missing)}; "
+                                 "a run is measured by " + ", ".join(MEASURED) + " (J of eq "
+                                 "19 and the track): give a course-keeping scenario")
         kinds: dict[tuple[str, str], str] = {}
 
         def kind(controller: str, target: str, key: str) -> str:
@@ -168,13 +192,18 @@ class Spec:
         if component not in system.components:
             raise ValueError(f"{where} there is no component {component!r} (there are "
                              f"{', '.join(system.components)})")
-        fmu = self.files()[Path(system.components[component].source).stem]
-        variables = {v.name: v for v in read_description(fmu, component).modelVariables}
+        fmu, variables = self._declared(controller, component)
         parameters = [n for n, v in variables.items() if v.causality == "parameter"]
         if variable not in parameters:
             raise ValueError(f"{where} {component} ({fmu.name}) has no parameter "
                              f"{variable!r}; it has {', '.join(parameters)}")
         return variables[variable].type
+
+    def _declared(self, controller: str, component: str) -> tuple[Path, dict[str, Any]]:
+        """A component's FMU in a controller's system, and its variables by name."""
+        source = self.bundles()[controller].system.components[component].source
+        fmu = self.files()[Path(source).stem]
+        return fmu, {v.name: v for v in read_description(fmu, component).modelVariables}
 
     def bundles(self) -> dict[str, Bundle]:
         """Each controller's system with its FMUs named by content (read once)."""
