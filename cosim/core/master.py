@@ -46,7 +46,7 @@ RUN_BACKENDS = ("fmi", "inprocess")
 
 
 def _no_watchdog(what: object) -> None:
-    """What ``Watchdog.beat`` does when a run has none."""
+    """What ``Watchdog.beat`` does when a run has none: no limit expires."""
 
 
 class Master:
@@ -184,11 +184,14 @@ class Master:
             self.initialize()
             for k in range(n_steps + 1):
                 t = communication_point(t0, k, h)
-                beat(t)
-                if stop is not None and stop.received:
-                    recorder.interrupted = stop.received.name
+                expired = beat(t)
+                if (stop is not None and stop.received) or expired:
                     t = communication_point(t0, k - 1, h) if k else t0
-                    error = f"interrupted at t = {t:.6g} s, {recorder.rows} rows kept"
+                    if stop is not None and stop.received:
+                        recorder.interrupted = stop.received.name
+                        error = f"interrupted at t = {t:.6g} s, {recorder.rows} rows kept"
+                    else:
+                        error = f"{expired}: stopped at t = {t:.6g} s, {recorder.rows} rows kept"
                     break
                 exchange(nodes, values, t, h, k < n_steps)
                 recorder.append(t, values)

@@ -18,10 +18,13 @@ thread the signal lands, while FMU code runs, Python or not), with Python-level
 handlers that do nothing meanwhile; a second signal ends the process at once
 (``StopSignals.receive``).
 
-When a limit is passed, the watchdog first raises ``TimeLimit`` in the loop's thread
-(``PyThreadState_SetAsyncExc``): Python FMU code fails its call (fmukit turns it into
-a refusal), and the master stops, names the FMU and call, and writes what it kept as
-after any FMU failure. Code that runs no Python (a C FMU in an endless loop) cannot
+Once the run time limit is passed, the loop stops at its next step (``beat``
+returns why). A step that does not end (past the step limit, or the grace after a
+signal or after the run limit) is hung: the watchdog raises ``TimeLimit`` in the
+loop's thread (``PyThreadState_SetAsyncExc``), where Python FMU code fails its
+call (fmukit turns it into a refusal), and the master stops, names the FMU and
+call, and writes what it kept as after any FMU failure. (Raised only into a step
+that has hung, the exception cannot land in the master's own writing.) Code that runs no Python (a C FMU in an endless loop) cannot
 take an exception: after ``Limits.grace`` more, the watchdog writes the rows kept
 (``salvage``) from its own thread, says so, and ends the process (status 1, or 130 /
 143 after a signal); ``faulthandler`` ends it regardless if even that cannot run.
@@ -40,6 +43,7 @@ import time
 from types import TracebackType
 from typing import Callable, NamedTuple
 
+from .instance import Instance
 from .interrupt import STOP_SIGNALS, StopSignals
 
 STEP_LIMIT_S = 60.0
@@ -85,7 +89,8 @@ class Watchdog:
         self.expired: str | None = None
         self._what: str | float = "the run"
         self._beat = self._start = time.monotonic()
-        self._signal_at: float | None = None
+        self._signal_at: float | None = None      # when a signal came
+        self._halt_at: float | None = None        # when the run time limit was passed
         self._target = threading.get_ident()
         self._done = threading.Event()
         self._thread: threading.Thread | None = None
@@ -93,10 +98,11 @@ class Watchdog:
         self._wakeup: tuple[socket.socket, socket.socket] | None = None
         self._saved: tuple[int, dict] = (-1, {})
 
-    def beat(self, what: str | float) -> None:
+    def beat(self, what: str | float) -> str | None:
         """A new step (its time, in s) or call (``what``, a phrase) begins: its time limit
-        starts now."""
+        starts now. Returns ``expired``: the loop is to stop here if it is not None."""
         self._beat, self._what = time.monotonic(), what
+        return self.expired
 
     @property
     def what(self) -> str:
@@ -158,10 +164,12 @@ class Watchdog:
             candidates.append((self._beat + self.limits.step,
                                f"{self.what} did not end within the step time limit of "
                                f"{self.limits.step:g} s"))
-        if self.limits.run is not None:
-            candidates.append((self._start + self.limits.run,
-                               f"the run did not end within its time limit of "
-                               f"{self.limits.run:g} s"))
+        if self.limits.run is not None and self.expired is None:
+            candidates.append((self._start + self.limits.run, ""))
+        if self._halt_at is not None:
+            candidates.append((self._halt_at + self.limits.grace,
+                               f"{self.what} did not end within {self.limits.grace:g} s of "
+                               "the run time limit"))
         if self._signal_at is not None:
             candidates.append((self._signal_at + self.limits.grace,
                                f"{self.what} did not end within {self.limits.grace:g} s of "
@@ -183,13 +191,19 @@ class Watchdog:
             elif self._done.wait(wait):
                 return
             if time.monotonic() >= deadline and not self._done.is_set():
+                if not reason:          # the run limit: the loop stops at its next beat
+                    self.expired = (f"the run did not end within its time limit of "
+                                    f"{self.limits.run:g} s")
+                    self._halt_at = time.monotonic()
+                    continue
                 self._expire(reason)
                 return
 
     def _expire(self, reason: str) -> None:
-        """Raise TimeLimit in the loop's thread; if it has not returned after the grace,
-        keep what can be kept and end the process."""
-        self.expired = reason
+        """The step under way is hung: raise TimeLimit in the loop's thread; if it has not
+        returned after the grace, keep what can be kept and end the process."""
+        where = _calling(self._target)
+        self.expired = reason = f"{reason} ({where})" if where else reason
         _raise_in(self._target, TimeLimit)
         if self._done.wait(self.limits.grace):
             return
@@ -204,6 +218,24 @@ class Watchdog:
               f"{kept}; ending the process", file=sys.stderr, flush=True)
         status = self.stop.exit_status if self.stop is not None and self.stop.received else 1
         os._exit(status)
+
+
+def _calling(thread_id: int) -> str | None:
+    """The FMU and call that the thread is in, from its Python stack ("FMU 'ship' in
+    doStep"), or None if it is in none. (A backend's prepared calls are closures over
+    the instance: ``step``, ``read``, ``write``.)"""
+    frame = sys._current_frames().get(thread_id)
+    while frame is not None:
+        owner, what = frame.f_locals.get("self"), frame.f_locals.get("what")
+        if isinstance(owner, Instance):
+            call = what if isinstance(what, str) else _PREPARED.get(frame.f_code.co_name,
+                                                                     frame.f_code.co_name)
+            return f"FMU '{owner.name}' in {call}"
+        frame = frame.f_back
+    return None
+
+
+_PREPARED = {"step": "doStep", "read": "a get call", "write": "a set call"}
 
 
 def _idle(number: int, frame: object) -> None:

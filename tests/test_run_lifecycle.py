@@ -1,0 +1,269 @@
+"""A run ends in one of two ways: complete outputs, or a non-zero exit that says why and
+leaves the earlier results as they were (issue 25: nothing lost, nothing hangs).
+
+The hung FMUs are the fault FMU of the fault matrix (``tests/faulty/fault_slave.py``)
+looping in Python ('loop') or waiting in C ('block') from t = 5 s; every child process
+here has a time limit of its own.
+"""
+from __future__ import annotations
+
+import json
+import os
+import resource
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from cosim import run as cli
+from cosim.core.files import FolderLock, Outputs, OutputError, whole_file
+from cosim.core.interrupt import StopSignals
+from cosim.core.ssd import Component, Connection, SystemDescription, write_ssd
+from cosim.core.watchdog import Limits, Watchdog
+from fmubuild.packaging import build_script
+from fmubuild.project import ROOT
+
+PY = sys.executable
+LIMIT = 120                      # seconds any child process here may take
+KINDS = {"none": 0, "loop": 6, "block": 7}
+
+
+@pytest.fixture(scope="module")
+def hung(fmu_paths, tmp_path_factory) -> dict[str, Path]:
+    """A system per kind: the ship steered by the fault FMU, which hangs from t = 5 s."""
+    root = tmp_path_factory.mktemp("hung")
+    fault = build_script(ROOT / "tests" / "faulty" / "fault_slave.py", ("fmukit",),
+                         root / "fault.fmu")
+    systems = {}
+    for kind, number in KINDS.items():
+        system = SystemDescription(
+            kind, {"fault": Component("fault", str(fault),
+                                      {"psi": ("input", "Real"), "delta_c": ("output", "Real"),
+                                       "n1": ("output", "Real")},
+                                      {"fault_time": 5.0, "fault": number}),
+                   "ship": Component("ship", str(fmu_paths["ship"]),
+                                     {"delta_c": ("input", "Real"), "n1": ("input", "Real"),
+                                      "psi": ("output", "Real")}, {})},
+            [Connection("ship", "psi", "fault", "psi"),
+             Connection("fault", "delta_c", "ship", "delta_c"),
+             Connection("fault", "n1", "ship", "n1")],
+            stop_time=1000.0, report="none", description=f"hangs: {kind}")
+        systems[kind] = root / f"{kind}.ssd"
+        write_ssd(system, systems[kind])
+    return systems
+
+
+def _run(args: list[str], cwd: Path, **popen) -> subprocess.CompletedProcess:
+    return subprocess.run([PY, "-m", "cosim.run", *args], cwd=cwd, capture_output=True,
+                          text=True, timeout=LIMIT, env={**os.environ, "PYTHONPATH": str(ROOT)},
+                          **popen)
+
+
+def _folder(path: Path) -> dict[str, bytes]:
+    """Every file in a folder, hidden ones included, by name."""
+    return {p.name: p.read_bytes() for p in path.iterdir()} if path.exists() else {}
+
+
+def _errors(stderr: str) -> list[str]:
+    return [line for line in stderr.splitlines() if line.startswith("error:")]
+
+
+@pytest.fixture(scope="module")
+def good(tmp_path_factory, fmu_paths) -> Path:
+    """A folder holding a good calm_pd run (no figure), and a file of the user's beside it."""
+    out = tmp_path_factory.mktemp("good")
+    assert cli.main(["calm_pd", "--out", str(out), "--no-plot", "--backend", "inprocess"]) == 0
+    (out / "calm_pd.orig.csv").write_text("the user's own file\n")
+    return out
+
+
+def test_a_refused_command_keeps_the_previous_results(good, capsys):
+    before = _folder(good)
+    assert cli.main(["calm_pd", "--out", str(good), "--stop-time", "400.05"]) == 2
+    assert "400.05" in capsys.readouterr().err
+    assert _folder(good) == before
+
+
+def test_a_new_run_replaces_only_its_own_files_by_exact_name(good, tmp_path):
+    out = tmp_path / "out[1]*"                 # glob characters in the folder's name
+    out.mkdir()
+    for name in ("calm_pd.orig.csv", "calm_pd.gif", "calm_pd[x].csv", "calm_pd.csv"):
+        (out / name).write_text("old\n")
+    assert cli.main(["calm_pd", "--out", str(out), "--no-plot", "--backend", "inprocess",
+                     "--stop-time", "10"]) == 0
+    files = _folder(out)
+    assert sorted(files) == ["calm_pd.csv", "calm_pd.json", "calm_pd.orig.csv", "calm_pd[x].csv"]
+    assert files["calm_pd.csv"].count(b"\n") == 102       # header and 101 rows, not "old"
+
+
+def test_a_second_writer_of_one_folder_is_refused(tmp_path, capsys):
+    with FolderLock(tmp_path):
+        assert cli.main(["calm_pd", "--out", str(tmp_path), "--stop-time", "1"]) == 2
+    assert "being written by another command" in capsys.readouterr().err
+    assert _folder(tmp_path) == {}
+
+
+def _file_size_limit(size: int):
+    def limit() -> None:                # a full disk, as the process sees it
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (size, size))
+    return limit
+
+
+@pytest.mark.parametrize("stream", [False, True], ids=["in-memory", "stream"])
+def test_a_full_disk_says_which_file_and_keeps_the_previous_results(good, stream, tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    for name, data in _folder(good).items():
+        (out / name).write_bytes(data)
+    before = _folder(out)
+    result = _run(["calm_pd", "--out", str(out), "--backend", "inprocess",
+                   *(["--stream"] if stream else [])], tmp_path,
+                  preexec_fn=_file_size_limit(300_000))
+    assert result.returncode == 1, result.stderr
+    assert _errors(result.stderr) == [f"error: cannot write {out / 'calm_pd.csv'}: File too "
+                                      f"large (a limit on file size); the earlier files in "
+                                      f"{out} are kept"]
+    assert "Traceback" not in result.stderr
+    assert _folder(out) == before
+
+
+def test_an_export_on_a_full_disk_leaves_no_package(tmp_path):
+    result = subprocess.run([PY, "-m", "cosim.export", "calm_pd", "--out", str(tmp_path)],
+                            capture_output=True, text=True, timeout=LIMIT, cwd=ROOT,
+                            preexec_fn=_file_size_limit(300_000))
+    assert result.returncode == 1
+    assert _errors(result.stderr) == [f"error: cannot write {tmp_path / 'calm_pd.ssp'}: File "
+                                      "too large (a limit on file size); no calm_pd.ssp was "
+                                      "written"]
+    assert _folder(tmp_path) == {}
+
+
+def test_whole_file_and_outputs_leave_nothing_when_interrupted(tmp_path):
+    target = tmp_path / "x.ssp"
+    target.write_text("old")
+    with pytest.raises(KeyboardInterrupt), whole_file(target) as partial:
+        partial.write_text("half")
+        raise KeyboardInterrupt
+    (tmp_path / "x.csv").write_text("old")
+    with pytest.raises(KeyboardInterrupt), Outputs(tmp_path, [tmp_path / "x.csv"]) as outputs:
+        outputs.path("x.csv").write_text("new")
+        raise KeyboardInterrupt
+    assert _folder(tmp_path) == {"x.ssp": b"old", "x.csv": b"old"}
+    with pytest.raises(OutputError, match=f"cannot write {tmp_path / 'x.json'}"), \
+            Outputs(tmp_path) as outputs, outputs.writing("x.json"):
+        raise OSError(28, "No space left on device")
+    assert _folder(tmp_path) == {"x.ssp": b"old", "x.csv": b"old"}
+
+
+@pytest.mark.parametrize("backend", ["fmi", "inprocess"])
+@pytest.mark.parametrize("kind", ["loop", "block"])
+def test_a_hung_fmu_ends_at_the_step_time_limit_with_its_rows(hung, kind, backend, tmp_path):
+    started = time.monotonic()
+    result = _run([str(hung[kind]), "--out", str(tmp_path), "--backend", backend,
+                   "--step-timeout", "1"], tmp_path)
+    took = time.monotonic() - started
+    assert result.returncode == 1, result.stderr
+    assert "Traceback" not in result.stderr
+    expected = ("error: the step at t = 5 s did not end within the step time limit of 1 s "
+                "(FMU 'fault' in doStep)")
+    assert _errors(result.stderr)[0].startswith(expected), result.stderr
+    meta = json.loads((tmp_path / f"{kind}.json").read_text())
+    assert meta["rows"] == 50 and "step time limit of 1 s" in meta["error"]
+    assert (tmp_path / f"{kind}.csv").read_text().count("\n") == 51
+    assert sorted(_folder(tmp_path)) == [f"{kind}.csv", f"{kind}.json"]
+    assert took < 30, f"took {took:.1f} s"
+
+
+@pytest.mark.parametrize("number", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+@pytest.mark.parametrize("kind", ["loop", "block"])
+def test_a_signal_stops_a_hung_fmu_within_its_grace(hung, kind, number, tmp_path):
+    with subprocess.Popen([PY, "-m", "cosim.run", str(hung[kind]), "--out", str(tmp_path)],
+                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                          cwd=tmp_path, start_new_session=True) as child:
+        _await_hang(child, tmp_path)
+        sent = time.monotonic()
+        child.send_signal(number)
+        _, stderr = child.communicate(timeout=LIMIT)
+    took = time.monotonic() - sent
+    assert child.returncode == 128 + number, stderr
+    assert took < 3 * Limits().grace + 2, f"took {took:.1f} s"
+    assert f"within {Limits().grace:g} s of {number.name}" in stderr
+    assert json.loads((tmp_path / f"{kind}.json").read_text())["rows"] == 50
+
+
+def _await_hang(child: subprocess.Popen, out: Path) -> None:
+    """Until the FMU has been stuck for a second (its fault is at t = 5 s, 50 steps in)."""
+    deadline = time.monotonic() + LIMIT
+    while time.monotonic() < deadline and child.poll() is None:
+        if any(out.glob(".partial-*")):
+            time.sleep(1.5)
+            return
+        time.sleep(0.05)
+    pytest.fail("the run did not start")
+
+
+def test_a_second_signal_ends_the_run_at_once_keeping_the_earlier_results(hung, tmp_path):
+    (tmp_path / "block.csv").write_text("earlier\n")
+    with subprocess.Popen([PY, "-m", "cosim.run", str(hung["block"]), "--out", str(tmp_path)],
+                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                          cwd=tmp_path, start_new_session=True) as child:
+        _await_hang(child, tmp_path)
+        child.send_signal(signal.SIGINT)
+        time.sleep(0.3)
+        sent = time.monotonic()
+        child.send_signal(signal.SIGINT)
+        _, stderr = child.communicate(timeout=LIMIT)
+    assert child.returncode == 130
+    assert time.monotonic() - sent < 2
+    assert "SIGINT again: stopped at once; the earlier outputs of block" in stderr
+    assert _folder(tmp_path) == {"block.csv": b"earlier\n"}
+
+
+def test_the_run_time_limit_keeps_the_rows(tmp_path, capsys):
+    assert cli.main(["calm_pd", "--out", str(tmp_path), "--backend", "inprocess",
+                     "--stop-time", "100000", "--stream", "--run-timeout", "1"]) == 1
+    err = capsys.readouterr().err
+    assert "the run did not end within its time limit of 1 s" in err
+    meta = json.loads((tmp_path / "calm_pd.json").read_text())
+    rows = (tmp_path / "calm_pd.csv").read_text().count("\n") - 1
+    assert 100 < rows == meta["rows"] < 1_000_001
+
+
+def test_a_signal_after_the_last_step_leaves_complete_outputs(tmp_path, capsys, monkeypatch):
+    """SIGTERM as the last step is recorded: the outputs are written whole, then the
+    status says the command was signalled."""
+    def progress(label):
+        def tick(k: int, n: int) -> None:
+            if k == n:
+                os.kill(os.getpid(), signal.SIGTERM)
+        tick.close = lambda: None
+        return tick
+    monkeypatch.setattr(cli, "Progress", progress)
+    assert cli.main(["calm_pd", "--out", str(tmp_path), "--backend", "inprocess"]) == 143
+    assert "interrupted by SIGTERM after the last step" in capsys.readouterr().err
+    assert sorted(_folder(tmp_path)) == ["calm_pd.csv", "calm_pd.json", "calm_pd.png"]
+    assert json.loads((tmp_path / "calm_pd.json").read_text())["rows"] == 4001
+
+
+def test_limits_are_positive_numbers():
+    for bad in (Limits(step=0), Limits(run=-1), Limits(step=float("inf")),
+                Limits(grace=float("nan"))):
+        with pytest.raises(ValueError, match="time limit must be a positive number"):
+            Watchdog(bad)
+    assert Limits().step is not None           # the default catches a hung FMU
+    for bad in ("0", "-1", "inf", "nan", "x"):
+        with pytest.raises(SystemExit):
+            cli.main(["calm_pd", "--step-timeout", bad])
+
+
+def test_a_watchdog_without_signals_leaves_the_handlers_alone():
+    before = signal.getsignal(signal.SIGINT)
+    with StopSignals() as stop, Watchdog(Limits(), stop):
+        assert signal.getsignal(signal.SIGINT) is not before
+    assert signal.getsignal(signal.SIGINT) is before
+    with Watchdog(Limits(step=None)):
+        assert signal.getsignal(signal.SIGINT) is before
