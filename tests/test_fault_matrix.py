@@ -1,11 +1,13 @@
 """The fault matrix: every fault, in every host, ends in a failure the user is told of.
 
-Faults, from 5 s of a 10 s run (1000 s for signals, so that a host that ignored one
-would be seen finishing; the fault FMU, ``tests/faulty/fault_slave.py``, as
-component "fault", drives the ship's rudder and propeller): a NaN input, an input
+Faults, from 5 s of a 10 s run (1000 s for signals and hangs, so that a host that
+ignored one would be seen finishing; the fault FMU, ``tests/faulty/fault_slave.py``,
+as component "fault", drives the ship's rudder and propeller): a NaN input, an input
 out of its range, an invalid parameter (the ship's Hs = -1, at t = 0), an exception
 in a model, SIGINT and SIGTERM arriving while FMU code runs (the fault FMU signals
-its own process), and a corrupt (truncated) FMU or package.
+its own process), a corrupt (truncated) FMU or package, and a step that never
+returns, looping in Python ('loop') or waiting in C ('block'): only our master has
+a step time limit (``cosim.core.watchdog``), so the hangs are its cells alone.
 
 Hosts: our master (FMI and in-process backends), fmpy's command line, its Python
 API and its SSP runner, libcosim (a libcosimpy script, and ``cosim.engines``), ecos
@@ -45,7 +47,8 @@ from cosim.interop.ssp import export
 from fmubuild.packaging import build_script
 from fmubuild.project import ROOT
 
-FAULTS = ("nan", "range", "parameter", "exception", "sigint", "sigterm", "corrupt")
+FAULTS = ("nan", "range", "parameter", "exception", "sigint", "sigterm", "corrupt", "loop",
+          "block")
 HOSTS = ("master-fmi", "master-inprocess", "fmpy-cli", "fmpy-api", "fmpy-ssp",
          "libcosim-script", "libcosim-cli", "ecos-script", "ecos-cli", "ecos-program")
 OURS = ("master-fmi", "master-inprocess", "libcosim-cli", "ecos-cli")
@@ -54,8 +57,13 @@ NOT_APPLICABLE = {   # the in-process backend runs this project's own FMU classe
     ("master-inprocess", "exception"): "runs only this project's FMU classes",
     ("master-inprocess", "corrupt"): "loads no FMU file",
 }
+HANGS = ("loop", "block")
+NOT_APPLICABLE.update({(host, fault): "has no time limit: waits as long as the FMU computes"
+                       for host in HOSTS if not host.startswith("master") for fault in HANGS})
 CELLS = [(h, f) for h in HOSTS for f in FAULTS if (h, f) not in NOT_APPLICABLE]
-KIND = {"nan": 1, "range": 2, "parameter": 0, "exception": 3, "sigint": 4, "sigterm": 5}
+KIND = {"nan": 1, "range": 2, "parameter": 0, "exception": 3, "sigint": 4, "sigterm": 5,
+        "loop": 6, "block": 7}
+STEP_TIMEOUT = "2"
 CRASHES = {signal.SIGSEGV, signal.SIGABRT, signal.SIGBUS, signal.SIGILL, signal.SIGFPE}
 FAULT_TIME = 5.0
 T5 = r"t = (5(\.0*)?|4\.9999\d*)( s)?\b"       # ecos's time is a sum of floats
@@ -64,9 +72,11 @@ T0 = r"t = 0(\.0*)?( s)?\b"
 NAMES = {"nan": ("ship", "delta_c", T5), "range": ("ship", "n1", T5),
          "parameter": ("ship", "Hs", T0), "exception": ("fault", "injected fault", T5)}
 INPROCESS_SET = {"nan": "ship.n3=nan", "range": "ship.n1=100", "parameter": "ship.Hs=-1"}
-INPROCESS_NAMES = {"nan": ("ship", "n3", T0), "range": ("ship", "n1", T0),
-                   "parameter": ("ship", "Hs", T0)}
+BEFORE = r"is (not a number|outside its declared range)"  # checked before any FMU call
+INPROCESS_NAMES = {"nan": ("ship", "n3", BEFORE), "range": ("ship", "n1", BEFORE),
+                   "parameter": ("ship", "Hs", BEFORE)}
 TIME_LIMIT = 120.0
+FAULTY = Path(__file__).parent / "faulty"
 PY = sys.executable
 
 FMPY_API = """import sys, json, numpy as np
@@ -152,7 +162,7 @@ def _system(ship: Path, fault_fmu: Path, fault: str) -> SystemDescription:
 
 
 def _stop_time(fault: str) -> float:
-    return 1000.0 if fault.startswith("sig") else 10.0
+    return 1000.0 if fault.startswith("sig") or fault in HANGS else 10.0
 
 
 def _truncated(source: Path, target: Path) -> Path:
@@ -164,7 +174,7 @@ def _truncated(source: Path, target: Path) -> Path:
 @pytest.fixture(scope="session")
 def files(fmu_paths, tmp_path_factory) -> Files:
     root = tmp_path_factory.mktemp("fault_matrix")
-    fault_fmu = build_script(Path(__file__).parent / "faulty" / "fault_slave.py", ("fmukit",),
+    fault_fmu = build_script(FAULTY / "fault_slave.py", ("fmukit",),
                              root / "fault.fmu")
     ship = fmu_paths["ship"]
     (root / "packages").mkdir()
@@ -216,17 +226,23 @@ def _parameters(fault: str) -> dict:
 def cell(host: str, fault: str, files: Files, out: Path) -> Cell:
     """The command a user of ``host`` would run, for ``fault``."""
     package, stop = files.package(fault), f"{_stop_time(fault):g}"
-    if host == "master-fmi":
+    if host == "master-fmi" or (host == "master-inprocess" and fault in HANGS):
         ssd = files.root / ("corrupt.ssd" if fault == "corrupt" else f"{fault}.ssd")
-        return Cell([PY, "-m", "cosim.run", str(ssd), "--out", str(out), "--no-plot"], ROOT)
+        argv = [PY, "-m", "cosim.run", str(ssd), "--out", str(out), "--no-plot"]
+        if fault in HANGS:          # the fault FMU's class importable: in-process too
+            backend = host.split("-")[1]
+            return Cell(argv + ["--step-timeout", STEP_TIMEOUT, "--backend", backend], ROOT,
+                        env={"PYTHONPATH": os.pathsep.join([str(ROOT), str(FAULTY)])})
+        return Cell(argv, ROOT)
     if host == "master-inprocess":
         argv = [PY, "-m", "cosim.run", "calm_pd", "--backend", "inprocess", "--out", str(out),
                 "--no-plot"]
         if fault in INPROCESS_SET:
             return Cell(argv + ["--stop-time", "10", "--set", INPROCESS_SET[fault]], ROOT)
-        csv = out / "calm_pd.csv"      # a signal from outside, once rows are being written
+        # a signal from outside, once rows are being written (into the run's hidden stage)
         return Cell(argv + ["--stop-time", "100000", "--stream"], ROOT,
-                    signal_after=lambda: csv.exists() and csv.stat().st_size > 2000,
+                    signal_after=lambda: any(csv.stat().st_size > 2000 for csv in
+                                             out.glob(".partial-calm_pd-*/calm_pd.csv")),
                     fault_signal=signal.Signals[f"SIG{fault[3:].upper()}"])
     if host in ("fmpy-cli", "fmpy-api"):
         fmu, options = _fmu_and_options(files, fault)
@@ -326,6 +342,14 @@ def test_fault_matrix(host, fault, outcomes):
         else:                              # Python re-raises an uncaught KeyboardInterrupt
             assert code == -number, said
         return
+    if fault in HANGS:                     # ends at the step time limit, rows and all
+        assert code == 1 and "Traceback" not in result.output, said
+        assert re.search(rf"error: the step at {T5} did not end within the step time limit of "
+                         rf"{STEP_TIMEOUT} s \(FMU 'fault' in doStep\)", result.output), said
+        assert re.search(r"the 50 rows recorded (before the error )?are in \S+\.csv",
+                         result.output), said
+        assert host == "master-fmi" or "runs through FMI" not in result.output, said
+        return
     if host in IGNORES_STATUS and code == 0:
         assert "nan" in (result.output + result.files).lower(), said
     else:
@@ -335,4 +359,6 @@ def test_fault_matrix(host, fault, outcomes):
             assert "corrupt" in result.output, said
         return
     fmu, what, when = (INPROCESS_NAMES if host == "master-inprocess" else NAMES)[fault]
+    if host == "master-fmi" and fault == "parameter":      # the master checks it first
+        when = BEFORE
     assert _named(result.output, fmu, what, when), said

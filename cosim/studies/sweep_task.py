@@ -20,6 +20,7 @@ from distributed import WorkerPlugin
 from ..analysis.cost import cost
 from ..analysis.metrics import sign_reversals_per_minute
 from ..core.provenance import code_version
+from ..core.watchdog import Limits, TimeLimit, Watchdog
 from .bundle import Bundle, materialise
 
 METRICS = {"psi_E": "rad^2", "sum_delta2": "rad^2", "J": "rad^2",
@@ -38,6 +39,7 @@ class Job:
     track: bool                         # record the track for the tracks figure
     code: str                           # the client's code_version(): the worker's must match
     backend: str = "fmi"                # the master's: fmi, or inprocess for our FMUs
+    limits: Limits = Limits()           # the run's step and run time limits
 
 
 _masters: dict[tuple[str, int, str, str], Any] = {}    # (sweep, thread, digest, backend)
@@ -120,22 +122,27 @@ def blank_row(run: dict[str, Any], error: str = "") -> dict[str, Any]:
 
 def run_one(job: Job, blobs: dict[str, bytes]) -> dict[str, Any]:
     """One whole co-simulation; never raises for a failed run, records it. ``seconds`` is
-    the task's wall time, ``sim_seconds`` the master's run alone."""
+    the task's wall time, ``sim_seconds`` the master's run alone. A run past its time
+    limits fails (``core.watchdog``; one whose FMU runs no Python ends the worker, and
+    the sweep retries it, then records it failed, as any run that kills its worker)."""
     started = time.perf_counter()
     row = blank_row(job.run)
     if job.code != code_version():          # a worker that joined after the client's check
         return blank_row(job.run, f"worker runs {code_version()}, the client {job.code}: "
                                   "install the client's version on every worker")
-    master = None
+    master, watchdog = None, Watchdog(job.limits)
     try:
-        master = _master(job, blobs)
-        master.configure(job.overrides)
-        simulating = time.perf_counter()
-        recording = master.run(job.stop_time)
+        with watchdog:                          # a hung FMU fails its run, not the worker
+            watchdog.beat("instantiating the FMUs")
+            master = _master(job, blobs)
+            master.configure(job.overrides)
+            simulating = time.perf_counter()
+            recording = master.run(job.stop_time, watchdog=watchdog)
         row["sim_seconds"] = time.perf_counter() - simulating
-    except Exception as error:              # a bad setting: not worth retrying
+    except (Exception, TimeLimit) as error:  # a bad setting: not worth retrying
         _drop_master(job)
-        row = blank_row(job.run, f"{type(error).__name__}: {error}")
+        reason = watchdog.expired if watchdog.expired else f"{type(error).__name__}: {error}"
+        row = blank_row(job.run, reason)
     else:
         if recording.error:
             _drop_master(job)               # its FMUs may be in an error state
