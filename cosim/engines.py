@@ -12,10 +12,9 @@ import argparse
 import sys
 from pathlib import Path
 
-import numpy as np
-
 from ._cli import entry
-from .interop.engines import ENGINES, TRACED, EngineError, run
+from .core.files import OutputError
+from .interop.engines import ENGINES, TRACED, EngineError, run, save_trace
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -33,7 +32,11 @@ def main(argv: list[str] | None = None) -> int:
     except EngineError as error:        # the engine's failure, with the FMU's message
         print(f"error: {error}", file=sys.stderr)
         return 1
-    np.savez(args.out, **result)
+    try:
+        save_trace(args.out, result)
+    except OutputError as error:
+        print(f"error: {error}", file=sys.stderr)
+        return 1
     print(f"wrote {args.out}: {', '.join(args.signals)} at {len(result['time'])} times")
     return 0
 

@@ -85,6 +85,25 @@ def write_atomically(target: Path, write: Callable[[Path], object]) -> Path:
     return Path(target)
 
 
+@contextlib.contextmanager
+def fresh_folder(target: Path) -> Iterator[Path]:
+    """``with fresh_folder(target) as folder``: fill an empty folder; it replaces ``target``
+    (and all in it) if the block succeeds, and is removed if it fails, ``target`` kept."""
+    target = Path(target)
+    folder = Path(tempfile.mkdtemp(dir=target.parent, prefix=f"{TEMPORARY_PREFIX}{target.name}-"))
+    try:
+        yield folder
+        if target.exists():
+            old = Path(tempfile.mkdtemp(dir=target.parent, prefix=f"{TEMPORARY_PREFIX}old-"))
+            os.replace(target, old / target.name)
+            os.replace(folder, target)
+            shutil.rmtree(old, ignore_errors=True)
+        else:
+            os.replace(folder, target)
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+
+
 class Outputs:
     """A group of output files put in place together, once all are complete.
 

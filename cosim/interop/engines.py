@@ -39,6 +39,7 @@ import numpy as np
 
 from fmukit.timebase import communication_point, step_count
 
+from ..core.files import write_atomically
 from ..core.fmi import read_description
 from ..core.interrupt import STOP_SIGNALS, Interrupted, StopSignals
 from ..core.ssd import split_name
@@ -214,8 +215,17 @@ def record(engine: str, ssp: str, out: str, signals: tuple[str, ...]) -> int:
     except Exception as error:          # the engine's own exceptions, with their message
         print(f"error: {type(error).__name__}: {error}", file=sys.stderr)
         return 1
-    np.savez(out, **result)
+    save_trace(Path(out), result)
     return 0
+
+
+def save_trace(path: Path, result: dict[str, np.ndarray]) -> None:
+    """A trace as .npz, written whole or not at all, at exactly ``path`` (np.savez would
+    add .npz to a name without it)."""
+    def write(temporary: Path) -> None:
+        with open(temporary, "wb") as f:
+            np.savez(f, **result)
+    write_atomically(path, write)
 
 
 def _summary(log: str, head: int = 20, tail: int = 5) -> str:

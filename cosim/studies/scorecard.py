@@ -17,7 +17,6 @@ markdown.
 from __future__ import annotations
 
 import math
-import shutil
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
@@ -30,6 +29,7 @@ from ..analysis.metrics import heading_error, overshoot, settling_time, sign_rev
 from ..analysis.reports import PAPER_TABLES
 from .. import scenarios
 from ..api import SimulationError, overrides_of
+from ..core.files import fresh_folder, write_atomically
 from ..core.recording import Recording
 from ..outputs import Options, run_and_write
 from .sweep import Spec, comparison, controller_entry, execute
@@ -126,16 +126,14 @@ def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | Non
     comparison_figure(runs, out / "course_change.png",
                       "40 deg course change from straight running, calm water")
     progress(f"wave ensemble, {seeds} seeds on Dask")
-    ensemble = out / "ensemble"
-    shutil.rmtree(ensemble, ignore_errors=True)          # a fresh ensemble every time
-    ensemble.mkdir(parents=True)
     spec = _ensemble(contenders, seeds, out)
-    rows = execute(spec, ensemble, scheduler=scheduler, workers=workers, progress=False,
-                   backend=backend)
+    with fresh_folder(out / "ensemble") as ensemble:     # a fresh ensemble every time
+        rows = execute(spec, ensemble, scheduler=scheduler, workers=workers, progress=False,
+                       backend=backend)
     distribution(spec, rows, out / "J_distribution.png")
     tracks(spec, rows, out / "tracks_waves.png")
     text = _markdown(fmu, name, seeds, contenders, paper, changes, failures, spec, rows)
-    (out / "scorecard.md").write_text(text)
+    write_atomically(out / "scorecard.md", lambda path: path.write_text(text))
     return text
 
 
