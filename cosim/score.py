@@ -17,7 +17,9 @@ from pathlib import Path
 
 from ._cli import (add_port_options, checked_autopilot, entry, say_error, say_note,
                    setting_option, writable_folder)
+from .core.files import FolderBusy, OutputError
 from .core.master import RUN_BACKENDS
+from .outputs import TimedOut
 from .studies.scorecard import backend_notes, score
 from .studies.sweep_client import NoWorkers
 
@@ -75,7 +77,7 @@ def main(argv: list[str] | None = None) -> int:
         text = score(args.autopilot.resolve(), name, out, args.seeds, dict(args.map),
                      dict(args.set), args.workers, args.scheduler, progress, args.backend)
         bar.update()
-    except (ValueError, FileNotFoundError) as error:
+    except (ValueError, FileNotFoundError, FolderBusy, OutputError, TimedOut) as error:
         bar.close()
         say_error(error)
         return 1
