@@ -83,7 +83,8 @@ def _component(name: str = "ship", source: str = "x.fmu", extra: str = "") -> st
 MALFORMED = [   # (what, old text, new text, the message's element and problem)
     ("no System", (GOOD[GOOD.index("  <ssd:System "):GOOD.index("  <ssd:DefaultExperiment")]),
      "", "SystemStructureDescription: needs one System element, has 0"),
-    ("two Systems", "  <ssd:DefaultExperiment", '  <ssd:System name="b" />\n  <ssd:DefaultExperiment',
+    ("two Systems", "  <ssd:DefaultExperiment",
+     '  <ssd:System name="b" />\n  <ssd:DefaultExperiment',
      "needs one System element, has 2"),
     ("no root name", 'version="1.0" name="tiny"', 'version="1.0"',
      "SystemStructureDescription: no name attribute"),

@@ -75,7 +75,8 @@ class Declaration:
     def takes(self) -> str:
         """What it takes, in words: 'a finite Real, from 0.0 to 0.1'."""
         if self.type == "Enumeration":
-            return "an Enumeration item: " + ", ".join(f"{v} ({n})" for n, v in self.items)
+            return "an Enumeration item" + "".join(
+                f"{', ' if i else ': '}{v} ({n})" for i, (n, v) in enumerate(self.items))
         if self.type == "Integer":
             low, high = _integer_bounds(self)
             return f"an Integer, a whole number from {low} to {high}"
@@ -121,34 +122,38 @@ class _Refusal(ValueError):
 def fmi_value(target: str, type_name: str, value: Any) -> Value:
     """``value`` as the FMI 2.0 call of ``type_name`` carries it, exactly (see the module);
     ValueError naming ``target`` (component.variable), the value and what the type takes."""
+    carry = _carrier(target, type_name)
     try:
-        return _CARRIED[type_name](value)
+        return carry(value)
     except _Refusal as refusal:
-        raise ValueError(f"{target} = {value!r} {refusal}; {target} is "
-                         f"{_TAKES.get(type_name, 'of type ' + type_name)}") from None
-    except KeyError:
-        raise ValueError(f"{target} is of type {type_name!r}, which FMI 2.0 does not "
-                         f"have") from None
+        raise _refused(target, value, refusal, _TAKES[type_name]) from None
 
 
 def checked(component: str, declaration: Declaration, value: Any) -> Value:
     """The exact value to set for ``component``'s variable so declared; ValueError naming
     the component, the variable, the value and what the variable takes."""
     target = f"{component}.{declaration.name}"
-    carried_as = "Integer" if declaration.type == "Enumeration" else declaration.type
+    carry = _carrier(target, "Integer" if declaration.type == "Enumeration"
+                     else declaration.type)
+    items = dict(declaration.items)
+    if isinstance(value, str) and value.strip() in items:
+        return items[value.strip()]
     try:
-        if declaration.type == "Enumeration" and isinstance(value, str) and \
-                value.strip() in dict(declaration.items):
-            return dict(declaration.items)[value.strip()]
-        exact = _CARRIED[carried_as](value)
+        exact = carry(value)
         _within(declaration, exact)
     except _Refusal as refusal:
-        raise ValueError(f"{target} = {value!r} {refusal}; {target} is "
-                         f"{declaration.takes()}") from None
-    except KeyError:
-        raise ValueError(f"{target} is of type {declaration.type!r}, which FMI 2.0 does "
-                         "not have") from None
+        raise _refused(target, value, refusal, declaration.takes()) from None
     return exact
+
+
+def _carrier(target: str, type_name: str):
+    if type_name not in _CARRIED:
+        raise ValueError(f"{target} is of type {type_name!r}, which FMI 2.0 does not have")
+    return _CARRIED[type_name]
+
+
+def _refused(target: str, value: Any, refusal: _Refusal, takes: str) -> ValueError:
+    return ValueError(f"{target} = {value!r} {refusal}; {target} is {takes}")
 
 
 def setting(component: str, path: str | Path, declared: dict[str, Declaration], name: str,
