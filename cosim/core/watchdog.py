@@ -110,6 +110,7 @@ class Watchdog:
         return f"the step at t = {what:.6g} s" if isinstance(what, float) else what
 
     def __enter__(self) -> Watchdog:
+        self._beat = self._start = time.monotonic()
         if self.limits.step is None and self.limits.run is None and not self._signals:
             return self
         if self._signals:
