@@ -146,9 +146,10 @@ def test_an_in_process_sweep_notes_each_fmu_that_runs_through_fmi(c_autopilot, t
 
 
 def test_task_records_a_failed_run_with_its_message(fmu_paths, tmp_path):
-    spec = sweep.Spec.read(write_spec(tmp_path, '[axes]\nHs = [-1.0]\n'))
+    spec = sweep.Spec.read(write_spec(tmp_path, '[axes]\nHs = [0.1]\nT0 = [0.2]\n'))  # too steep
     row = sweep.run_locally(spec, spec.runs()[0])
-    assert row["status"] == "failed" and "Hs = -1.0 is outside its" in row["error"]
+    assert row["status"] == "failed" and "parameter Hs = 0.1 m with T0 = 0.2 s: steepness" in \
+        row["error"]
     assert math.isnan(row["J"])
     sweep_task.free_masters()
 

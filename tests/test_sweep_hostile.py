@@ -59,22 +59,28 @@ def spec_file(tmp_path: Path, text: str) -> Path:
      "axis 'ship.delta_rate_max' has 1 and 1.0, one value for the FMU"),
     ("[axes]\nHs = [0.01, 1e-2]", "axis 'Hs' has 0.01 twice"),
     ("[axes]\nsea_state = [3, 3]", "axis 'sea_state' has 3 twice"),
-    # values the parameter's FMI type cannot hold
-    ("[axes]\nwave_seed = [4294967297]", "axis 'wave_seed' = 4294967297: the parameter is an "
-                                         "FMI Integer; give a whole number from -2147483648"),
-    ("[axes]\nwave_seed = [1.5]", "axis 'wave_seed' = 1.5: the parameter is an FMI Integer"),
-    ("[axes]\nwave_seed = [true]", "axis 'wave_seed' = True: the parameter is an FMI Integer"),
+    # values the parameter does not take (cosim.core.values), or not of its TOML kind
+    ("[axes]\nwave_seed = [4294967297]", "axis 'wave_seed': ship.wave_seed = 4294967297 is "
+                                         "outside the range of an FMI Integer \\(32 bits\\)"),
     ("[axes]\nwave_seed = { start = 2147483647, count = 2 }",
-     "axis 'wave_seed' = 2147483648: the parameter is an FMI Integer"),
-    ('[axes]\nHs = ["0.01"]', "axis 'Hs' = '0.01': the parameter is an FMI Real; give a finite"),
-    ("[axes]\nHs = [nan]", "axis 'Hs' = nan: the parameter is an FMI Real"),
-    ("[axes]\npsi_w = [-inf]", "axis 'psi_w' = -inf: the parameter is an FMI Real"),
-    ("[axes]\nHs = [[0.01]]", "axis 'Hs' = \\[0.01\\]: the parameter is an FMI Real"),
-    ("[axes]\nroute = [1]", "axis 'route' = 1: the parameter is an FMI String"),
-    ('[axes]\nroute = ["0,0;10,0\\u0000"]', "axis 'route' = '0,0;10,0\\\\x00': the parameter "
-                                             "is an FMI String; give a string \\(without NUL"),
+     "axis 'wave_seed': ship.wave_seed = 2147483648 is outside the range of an FMI Integer"),
     ('[controllers]\npd = { scenario = "waves_pd", set = { "ship.wave_seed" = -2147483649 } }',
-     "controller 'pd' set 'ship.wave_seed' = -2147483649: the parameter is an FMI Integer"),
+     "controller 'pd' set 'ship.wave_seed': ship.wave_seed = -2147483649 is outside the range"),
+    ("[axes]\nwave_seed = [-1]", "axis 'wave_seed': ship.wave_seed = -1 is outside its declared "
+                                 "range; ship.wave_seed is an Integer, a whole number from 0"),
+    ("[axes]\nHs = [-1.0]", "axis 'Hs': ship.Hs = -1.0 is outside its declared range; ship.Hs "
+                            "is a finite Real, from 0.0 to 0.1"),
+    ("[axes]\nHs = [nan]", "axis 'Hs': ship.Hs = nan is not a number \\(NaN\\)"),
+    ("[axes]\npsi_w = [-inf]", "axis 'psi_w': ship.psi_w = -inf is not finite"),
+    ('[axes]\nroute = ["0,0;10,0\\u0000"]', "axis 'route': guidance.waypoints = '0,0;10,0\\\\x00' "
+                                             "holds a NUL character"),
+    ("[axes]\nwave_seed = [1.5]", "axis 'wave_seed' = 1.5: ship.wave_seed is an FMI Integer; "
+                                  "give an integer"),
+    ("[axes]\nwave_seed = [true]", "axis 'wave_seed' = True: ship.wave_seed is an FMI Integer"),
+    ('[axes]\nHs = ["0.01"]', "axis 'Hs' = '0.01': ship.Hs is an FMI Real; give a number"),
+    ("[axes]\nHs = [[0.01]]", "axis 'Hs' = \\[0.01\\]: ship.Hs is an FMI Real; give a number"),
+    ("[axes]\nroute = [1]", "axis 'route' = 1: guidance.waypoints is an FMI String; give a "
+                            "string"),
     ("[axes]\nsea_state = [true]", "axis 'sea_state' has True: give WMO codes"),
     ("[axes]\nsea_state = [2.0]", "axis 'sea_state' has 2.0: give WMO codes"),
     # what the systems do not have
@@ -354,7 +360,7 @@ def test_a_finished_sweep_resumed_after_a_rebuild_reruns_nothing(fmu_paths, tmp_
 
     before = build()
     system = scenarios.load("waves_pd")
-    for name, component in system.components.items():
+    for component in system.components.values():
         component.source = str(built / Path(component.source).name)
     write_ssd(system, tmp_path / "rebuilt.ssd")
     spec = sweep.Spec.read(spec_file(tmp_path, "stop_time = 2\n[controllers]\n"

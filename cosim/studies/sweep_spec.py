@@ -8,8 +8,9 @@ to run it (``sweep_task``).
 ``Spec.read`` refuses, before anything runs or is allocated, what would run something
 else than the file says: a parameter set by two axes (or by an axis and a controller's
 ``set``), a value twice in one axis (as the FMU would receive it: 1 and 1.0 of a Real
-are one value), a value the parameter's FMI type cannot hold (a string for a Real,
-NaN, 4294967297 for an Integer), a sweep of more than ``max_runs`` runs, and a name
+are one value), a value its parameter does not take (``cosim.core.values``: NaN,
+4294967297 for an Integer, a value outside the declared range; in a spec also a string
+for a number), a sweep of more than ``max_runs`` runs, and a name
 (of the sweep or a controller) that is not one plain file name, since both name
 files in the output folder.
 """
@@ -29,6 +30,7 @@ from .. import scenarios
 from ..analysis.seastate import model_scale
 from ..core.errors import FmuNotFound, FmuUnreadable
 from ..core.fmi import read_description
+from ..core.values import Declaration, checked, declarations
 from ..core.inprocess import fallback_note
 from ..core.provenance import code_version
 from ..scenarios.autopilot import check_autopilot
@@ -52,8 +54,11 @@ FILE_NAME = re.compile(r"\w(?:[\w .+-]{0,98}[\w+-])?")
 """A sweep's or a controller's name: one plain file name (letters, digits, _ . + - and
 inner spaces; no separator, no leading dot, at most 100 characters)."""
 
-INTEGER = (-2 ** 31, 2 ** 31 - 1)
-"""The values of an FMI 2.0 Integer (a C int)."""
+TOML_TYPES = {"Real": ((int, float), "a number"), "Integer": ((int,), "an integer"),
+              "Enumeration": ((int, str), "an integer or an item's name"),
+              "Boolean": ((bool,), "true or false"), "String": ((str,), "a string")}
+"""The TOML values a parameter of each FMI type takes in a spec: one kind per type, so
+that each axis is one column of one type in the tables (no "0.01" beside 0.02)."""
 
 MEASURED = ("guidance.psi_d", "ship.psi", "ship.delta", "ship.x", "ship.y")
 """The outputs a run's figures of merit and its track are computed from (``sweep_task``)."""
@@ -158,33 +163,30 @@ class Spec:
                                  f"{shipped.system.name!r} has no output {', '.join(missing)}; "
                                  "a run is measured by " + ", ".join(MEASURED) + " (J of eq "
                                  "19 and the track): give a course-keeping scenario")
-        kinds: dict[tuple[str, str], str] = {}
+        declared: dict[tuple[str, str], Declaration] = {}
 
-        def kind(controller: str, target: str, key: str) -> str:
-            if (controller, target) not in kinds:
-                kinds[controller, target] = self._kind(controller, target, key, path)
-            return kinds[controller, target]
+        def received(controller: str, target: str, value: Any, key: str) -> Any:
+            if (controller, target) not in declared:
+                declared[controller, target] = self._parameter(controller, target, key, path)
+            return _received(declared[controller, target], target, value, path, key)
 
         for controller in self.controllers:
             for target, value in self.controllers[controller]["set"].items():
-                _fmi_value(kind(controller, target, f"controller {controller!r} set"), value,
-                           path, f"controller {controller!r} set {target!r}")
+                received(controller, target, value, f"controller {controller!r} set {target!r}")
             for axis, values in self.axes.items():
                 seen: dict[tuple, Any] = {}
                 for value in values:
-                    received = tuple(
-                        _fmi_value(kind(controller, target, f"axis {axis!r}"), v, path,
-                                   f"axis {axis!r}")
-                        for target, v in assignments(axis, value).items())
-                    if received in seen:
-                        same = (f"{value!r} twice" if repr(seen[received]) == repr(value) else
-                                f"{seen[received]!r} and {value!r}, one value for the FMU")
+                    exact = tuple(received(controller, target, v, f"axis {axis!r}")
+                                  for target, v in assignments(axis, value).items())
+                    if exact in seen:
+                        same = (f"{value!r} twice" if repr(seen[exact]) == repr(value) else
+                                f"{seen[exact]!r} and {value!r}, one value for the FMU")
                         raise ValueError(f"{path}: axis {axis!r} has {same}: each of its runs "
                                          "would be run twice; give each value once")
-                    seen[received] = value
+                    seen[exact] = value
 
-    def _kind(self, controller: str, target: str, key: str, path: Path) -> str:
-        """The FMI type of parameter ``target`` (component.variable) in a controller's
+    def _parameter(self, controller: str, target: str, key: str, path: Path) -> Declaration:
+        """The declaration of parameter ``target`` (component.variable) in a controller's
         system; ValueError if it has no such parameter."""
         system = self.bundles()[controller].system
         component, _, variable = target.partition(".")
@@ -197,13 +199,13 @@ class Spec:
         if variable not in parameters:
             raise ValueError(f"{where} {component} ({fmu.name}) has no parameter "
                              f"{variable!r}; it has {', '.join(parameters)}")
-        return variables[variable].type
+        return variables[variable]
 
-    def _declared(self, controller: str, component: str) -> tuple[Path, dict[str, Any]]:
-        """A component's FMU in a controller's system, and its variables by name."""
+    def _declared(self, controller: str, component: str) -> tuple[Path, dict[str, Declaration]]:
+        """A component's FMU in a controller's system, and its variables' declarations."""
         source = self.bundles()[controller].system.components[component].source
         fmu = self.files()[Path(source).stem]
-        return fmu, {v.name: v for v in read_description(fmu, component).modelVariables}
+        return fmu, declarations(read_description(fmu, component))
 
     def bundles(self) -> dict[str, Bundle]:
         """Each controller's system with its FMUs named by content (read once)."""
@@ -355,27 +357,18 @@ def _check_overlaps(path: Path, controllers: dict[str, dict[str, Any]],
                                  f"{setters[target]!r} sets in every run; give it one place")
 
 
-def _fmi_value(kind: str, value: Any, path: Path, key: str) -> Any:
-    """``value`` as a parameter of FMI type ``kind`` receives it; ValueError naming the
-    file, the key and the value where the type cannot hold it exactly."""
-    number = isinstance(value, (int, float)) and not isinstance(value, bool)
-    if kind == "Real" and number:
-        try:
-            if math.isfinite(float(value)):
-                return float(value)
-        except OverflowError:
-            pass
-    elif kind in ("Integer", "Enumeration") and number and isinstance(value, int):
-        if INTEGER[0] <= value <= INTEGER[1]:
-            return value
-    elif kind == "Boolean" and isinstance(value, bool):
-        return value
-    elif kind == "String" and isinstance(value, str) and "\0" not in value:
-        return value
-    takes = {"Real": "a finite number", "Boolean": "true or false",
-             "String": "a string (without NUL)"}.get(
-        kind, f"a whole number from {INTEGER[0]} to {INTEGER[1]}")
-    raise ValueError(f"{path}: {key} = {value!r}: the parameter is an FMI {kind}; give {takes}")
+def _received(declaration: Declaration, target: str, value: Any, path: Path, key: str) -> Any:
+    """``value`` exactly as the parameter so declared receives it (``cosim.core.values``);
+    ValueError naming the file, the key and the value where it does not take it, or where
+    the TOML value is not of the kind its FMI type takes in a spec (``TOML_TYPES``)."""
+    kinds, what = TOML_TYPES.get(declaration.type, ((), "nothing"))
+    if not isinstance(value, kinds) or isinstance(value, bool) != (bool in kinds):
+        raise ValueError(f"{path}: {key} = {value!r}: {target} is an FMI {declaration.type}; "
+                         f"give {what}")
+    try:
+        return checked(target.partition(".")[0], declaration, value)
+    except ValueError as error:
+        raise ValueError(f"{path}: {key}: {error}") from None
 
 
 def controller_entry(entry: str | dict[str, Any], spec: Path, name: str) -> dict[str, Any]:
