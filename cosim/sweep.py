@@ -5,10 +5,11 @@ import argparse
 import sys
 from pathlib import Path
 
-from ._cli import entry, say_error, say_note, writable_folder
+from ._cli import entry, positive_seconds, say_error, say_note, writable_folder
 from .core.files import write_atomically
 from .core.interrupt import Interrupted
 from .core.master import RUN_BACKENDS
+from .core.watchdog import STEP_LIMIT_S, Limits
 from .studies import sweep
 from .studies.cluster import CONNECT_TIMEOUT
 from .studies.sweep_client import NoWorkers, SweepError
@@ -73,6 +74,14 @@ def main(argv: list[str] | None = None) -> int:
                         help="stop when the cluster has had no worker for this long, keeping "
                              "every row done (exit status "
                              f"{NoWorkers.exit_status}; default: %(default)g s)")
+    parser.add_argument("--step-timeout", type=positive_seconds, default=STEP_LIMIT_S,
+                        metavar="S",
+                        help="a run whose FMUs take longer than S s of wall-clock time over "
+                             "one step (or their instantiation) is recorded failed "
+                             "(default %(default)g)")
+    parser.add_argument("--run-timeout", type=positive_seconds, metavar="S",
+                        help="a run longer than S s of wall-clock time is recorded failed "
+                             "(default: no limit)")
     parser.add_argument("--csv", action="store_true", help="also write results.csv")
     parser.add_argument("--no-progress", action="store_true",
                         help="no progress bar (for logs)")
@@ -89,7 +98,8 @@ def main(argv: list[str] | None = None) -> int:
         rows = sweep.execute(spec, out, args.scheduler, args.workers,
                              progress=not args.no_progress, scheduler_file=args.scheduler_file,
                              backend=args.backend, no_worker_timeout=args.no_worker_timeout,
-                             connect_timeout=args.connect_timeout)
+                             connect_timeout=args.connect_timeout,
+                             limits=Limits(args.step_timeout, args.run_timeout))
     except (SweepError, ValueError, OSError) as error:   # OSError: the journal's folder
         say_error(error)
         return 2

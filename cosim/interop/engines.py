@@ -238,9 +238,9 @@ def _summary(log: str, head: int = 20, tail: int = 5) -> str:
 
 
 def _check_defined(engine: str, result: dict[str, np.ndarray], log: str) -> None:
-    for signal, values in result.items():
+    for name, values in result.items():
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:
-            raise EngineError(f"{engine} reported success, but {signal} is undefined from "
+            raise EngineError(f"{engine} reported success, but {name} is undefined from "
                               f"t = {result['time'][bad[0]]:.6g} s: an FMU refused to run "
                               f"and the engine did not stop.\n{log}")

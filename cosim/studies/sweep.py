@@ -63,6 +63,7 @@ from pathlib import Path
 from typing import Any
 
 from ..core.master import RUN_BACKENDS
+from ..core.watchdog import Limits
 from .cluster import CONNECT_TIMEOUT, connect
 from .journal import Journal, JournalLocked, read_rows
 from .sweep_client import NoWorkers, SweepError, check_workers, run_on_cluster
@@ -82,14 +83,15 @@ NO_WORKER_TIMEOUT = 60.0
 def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | None = None,
             progress: bool = True, task=None, scheduler_file: str | None = None,
             backend: str = "fmi", no_worker_timeout: float = NO_WORKER_TIMEOUT,
-            connect_timeout: float = CONNECT_TIMEOUT) -> list[dict]:
+            connect_timeout: float = CONNECT_TIMEOUT, limits: Limits = Limits()) -> list[dict]:
     """Run every run of ``spec`` without an ok row in the journal (failed rows are run
     again); return every row of the sweep.
 
     ``backend``: the master's, "fmi" or "inprocess" (this project's FMUs as Python
     classes: the same results, faster; any other FMU runs through FMI,
     ``Spec.backend_notes`` says which). The backend is not part of a run's identity: a
-    sweep may be resumed with the other.
+    sweep may be resumed with the other. ``limits``: each run's step and run time limits
+    (``cosim.core.watchdog``): a run past them is recorded failed, saying which.
 
     ``task(job, blobs) -> row`` is what each run executes (default ``run_one``). Each
     distinct FMU goes to the cluster once (``cosim.studies.bundle``); each run's future
@@ -117,7 +119,8 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
             if todo:
                 run_on_cluster(spec, todo, journal,
                                connect(scheduler, workers, scheduler_file, connect_timeout),
-                               progress, task or run_one, backend, no_worker_timeout)
+                               progress, task or run_one, backend, no_worker_timeout,
+                               limits.check())
     except JournalLocked as locked:
         raise SweepError(str(locked)) from None
     return completed(spec, out)
@@ -129,7 +132,8 @@ def completed(spec: Spec, out: Path) -> list[dict]:
     return [rows[r["run_id"]] for r in spec.runs() if r["run_id"] in rows]
 
 
-def run_locally(spec: Spec, run: dict[str, Any], backend: str = "fmi") -> dict[str, Any]:
+def run_locally(spec: Spec, run: dict[str, Any], backend: str = "fmi",
+                limits: Limits = Limits()) -> dict[str, Any]:
     """One run of ``spec`` in this process, as a worker would do it."""
-    job = spec.job(run, "local", backend)
+    job = spec.job(run, "local", backend, limits)
     return run_one(job, {sha: spec.files()[sha].read_bytes() for sha in job.bundle.fmu_hashes()})

@@ -12,6 +12,7 @@ import uuid
 from typing import Iterator
 
 from ..core.provenance import PACKAGE, code_version
+from ..core.watchdog import Limits
 from .bundle import UnsafeCache, fmu_cache
 from .journal import Journal
 from .sweep_spec import Spec
@@ -153,7 +154,7 @@ def _worker_saturation(dask_scheduler=None) -> float:
 
 
 def run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, progress: bool,
-                   task, backend: str, no_worker_timeout: float) -> None:
+                   task, backend: str, no_worker_timeout: float, limits: Limits) -> None:
     """Run ``todo`` (runs of ``spec``) as ``task`` on the cluster of ``connection`` (a
     client and the local cluster it made, or None), journaling each row as it completes;
     the client, and a local cluster, closed on every path (``execute`` documents the rest)."""
@@ -173,7 +174,7 @@ def run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, p
                    for sha, path in spec.files().items()}
         futures = {}
         for run in todo:
-            job = spec.job(run, token, backend)
+            job = spec.job(run, token, backend, limits)
             blobs = {sha: shipped[sha] for sha in job.bundle.fmu_hashes()}
             futures[client.submit(task, job, blobs, retries=2, pure=False,
                                   key=f"run-{token}-{run['run_id']}")] = run

@@ -33,6 +33,7 @@ from ..core.fmi import read_description
 from ..core.values import Declaration, checked, declarations
 from ..core.inprocess import fallback_note
 from ..core.provenance import code_version
+from ..core.watchdog import Limits
 from ..scenarios.autopilot import check_autopilot
 from .bundle import Bundle, bundle
 from .sweep_task import Job
@@ -237,11 +238,13 @@ class Spec:
                 runs.append(point)
         return runs
 
-    def job(self, run: dict[str, Any], sweep: str, backend: str = "fmi") -> Job:
+    def job(self, run: dict[str, Any], sweep: str, backend: str = "fmi",
+            limits: Limits = Limits()) -> Job:
         """What a worker needs for ``run`` (of the sweep with token ``sweep``)."""
         return Job(sweep=sweep, run=run, bundle=self.bundles()[run["controller"]],
                    overrides=self.settings(run)[1], stop_time=self.stop_time,
-                   track=self.wants_track(run), code=code_version(), backend=backend)
+                   track=self.wants_track(run), code=code_version(), backend=backend,
+                   limits=limits)
 
     def backend_notes(self, backend: str) -> list[str]:
         """Which components of which controllers will run through FMI although ``backend``

@@ -1,6 +1,7 @@
 """An autopilot that keeps the rudder amidships: it has the ports, and does not steer.
 
-With ``fail_time`` set it fails every step from then on (an exception: fmi2Fatal).
+With ``fail_time`` set it fails every step from then on (an exception: fmi2Fatal);
+with ``hang_time`` its step at that time never returns (a loop in Python).
 """
 from fmukit.autopilot import INPUTS, rudder_command
 from fmukit.slave import ModelSlave, Var
@@ -18,7 +19,8 @@ class IdlePilotSlave(ModelSlave):
     model_name = "idle_pilot"
     description = "holds the rudder amidships"
     variables = (*INPUTS, rudder_command(depends=(), get=lambda slave: 0.0),
-                 Var.parameter("fail_time", 1e9, "s", "fail every step from then on"))
+                 Var.parameter("fail_time", 1e9, "s", "fail every step from then on"),
+                 Var.parameter("hang_time", 1e9, "s", "loop for ever in the step at this time"))
 
     def build_model(self) -> Idle:
         return Idle()
@@ -26,3 +28,5 @@ class IdlePilotSlave(ModelSlave):
     def step_model(self, t: float, h: float) -> None:
         if t >= self.fail_time:
             raise RuntimeError(f"injected failure at t = {t}")
+        while t >= self.hang_time:
+            pass
