@@ -161,7 +161,10 @@ def main(argv: list[str] | None = None) -> int:
     names = chosen_scenarios(parser, args.scenario, args.all)
     if not checked_autopilot(parser, args):
         return 2
-    overrides = overrides_of(dict(args.set))
+    try:
+        overrides = overrides_of(args.set)
+    except ValueError as error:             # a variable set twice
+        parser.error(str(error))
     # With --all, autopilot.* settings are for the user's autopilot, not the paper's.
     paper_overrides = {c: v for c, v in overrides.items()
                        if c != COMPONENT or args.autopilot is None}

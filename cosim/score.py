@@ -17,6 +17,7 @@ from pathlib import Path
 
 from ._cli import (add_port_options, checked_autopilot, entry, say_error, say_note,
                    setting_option, writable_folder)
+from .api import overrides_of
 from .core.files import FolderBusy, OutputError
 from .core.master import RUN_BACKENDS
 from .outputs import TimedOut
@@ -74,6 +75,7 @@ def main(argv: list[str] | None = None) -> int:
             bar.update()
         bar.set_postfix_str(step)
     try:
+        overrides_of(args.set)              # refuses a variable set twice
         text = score(args.autopilot.resolve(), name, out, args.seeds, dict(args.map),
                      dict(args.set), args.workers, args.scheduler, progress, args.backend)
         bar.update()

@@ -23,7 +23,7 @@ import numpy as np
 import pytest
 
 from .analysis.metrics import heading_error
-from .api import parse_setting, simulate
+from .api import overrides_of, parse_setting, simulate
 from .core.recording import Recording
 
 
@@ -62,7 +62,9 @@ def autopilot_map(request: pytest.FixtureRequest) -> dict[str, str]:
 def cosim_settings(request: pytest.FixtureRequest) -> dict[str, Any]:
     """The --set options as {"component.variable": value}."""
     try:
-        return dict(parse_setting(text) for text in request.config.getoption("cosim_set"))
+        pairs = [parse_setting(text) for text in request.config.getoption("cosim_set")]
+        overrides_of(pairs)                 # refuses a variable given twice
+        return dict(pairs)
     except ValueError as error:
         raise pytest.UsageError(str(error)) from None
 

@@ -49,7 +49,8 @@ def test_simulate_equals_the_command_line_run(fmu_paths, tmp_path):
 
 
 @pytest.mark.parametrize("kwargs, error, fragment", [
-    ({"set": {"ship.Hs": -1.0}}, SimulationError, "parameter Hs = -1.0 is outside its range"),
+    ({"set": {"ship.Hs": -1.0}}, ValueError, "ship.Hs = -1.0 is outside its declared range"),
+    ({"set": {"ship.Hs": 0.1, "ship.T0": 0.2}}, SimulationError, "Hs"),   # the FMU's own rule
     ({"set": {"Hs": 0.01}}, ValueError, "set: 'Hs' is not 'component.variable'"),
     ({"set": {"boat.Hs": 0.01}}, ValueError, "names the component 'boat'"),
     ({"stop_time": 0.05}, ValueError, "not a whole number of 0.1 s steps"),

@@ -161,15 +161,18 @@ def test_check_autopilot_accepts_every_autopilot_of_the_project(fmu_paths):
 
 
 @pytest.mark.parametrize("setting, fragment", [
-    ("autopilot.Kp=1e9", "parameter Kp = 1000000000.0 is outside its range [-10000, 10000]"),
-    ("autopilot.Ki=nan", "parameter Ki = nan is not finite"),
+    ("autopilot.Kp=1e9", "autopilot.Kp = '1e9' is outside its declared range"),
+    ("autopilot.Ki=nan", "autopilot.Ki = 'nan' is not a number (NaN)"),
 ])
 def test_a_bad_parameter_of_the_autopilot_is_named(fmu_paths, tmp_path, capsys, setting,
                                                    fragment):
+    """Checked against the user's FMU's own declaration before it is instantiated."""
     assert _run(tmp_path, "calm_pd", "--autopilot", str(fmu_paths["pid_autopilot"]),
-                "--set", setting) == 1
+                "--set", setting) == 2
     err = capsys.readouterr().err
-    assert "FMU 'autopilot': exitInitializationMode" in err and fragment in err
+    assert [line for line in err.splitlines() if line.startswith("error:")] == [
+        f"error: {fragment}; autopilot.{setting[10:12]} is a finite Real, from -10000.0 to "
+        "10000.0"]
 
 
 def test_the_in_process_backend_runs_a_foreign_fmu_through_fmi_and_says_so(foreign, tmp_path,
