@@ -2,7 +2,9 @@
 from __future__ import annotations
 
 import gc
+import os
 from pathlib import Path
+from typing import Iterator
 
 import pytest
 
@@ -25,6 +27,22 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     for item in items:
         if item.get_closest_marker("timeout") is None:
             item.add_marker(pytest.mark.timeout(HARD_LIMIT, method="thread"))
+
+
+@pytest.fixture(scope="session", autouse=True)
+def fmu_cache(tmp_path_factory) -> Iterator[Path]:
+    """The sweeps' workers keep the FMUs they are sent in the test session's own folder,
+    not the user's cache (``cosim.studies.bundle.fmu_cache``); set before any cluster
+    starts, so that its workers inherit it."""
+    folder = tmp_path_factory.mktemp("fmu_cache")
+    folder.chmod(0o700)
+    previous = os.environ.get("COSIM_FMU_CACHE")
+    os.environ["COSIM_FMU_CACHE"] = str(folder)
+    yield folder
+    if previous is None:
+        os.environ.pop("COSIM_FMU_CACHE", None)
+    else:
+        os.environ["COSIM_FMU_CACHE"] = previous
 
 
 def _stale(path: Path) -> bool:

@@ -4,11 +4,15 @@
   with three backends: ``fmi`` (FMUs through fmpy), ``inprocess`` (the FMUs' Python
   classes without FMI) and ``null`` (interfaces only, to measure the master);
 - ``ssd``: SSP system structure descriptions, read and written;
+- ``values``: a parameter value checked against its FMU's declaration (type, range)
+  before any FMU call, the same on every backend;
 - ``errors``: an FMU file missing or unreadable, and whether it is one this project builds;
 - ``wiring``: connection checks, the Gauss-Seidel order, the column layout;
 - ``coupling``: the Gauss-Seidel and Jacobi steps;
 - ``recording``: the rows of a run, in memory or streamed to CSV;
 - ``interrupt``: Ctrl-C and SIGTERM taken between two steps (``StopSignals``);
+- ``watchdog``: step and run time limits, and signals, that hold while an FMU hangs;
+- ``files``: output files written whole or not at all, output folders locked;
 - ``provenance``: what it takes to reproduce a run, written as JSON beside its CSV;
 - ``master``: ``Master``, which wires, orders and delegates to the above.
 
