@@ -16,6 +16,7 @@ from fmubuild.project import BUILD_HINT
 
 from . import scenarios
 from .api import parse_setting
+from .core.files import plain_name
 from .core.interrupt import Interrupted, raise_on_signals
 from .core.recording import TooManyRows
 from .scenarios.autopilot import AutopilotError, check_autopilot
@@ -78,8 +79,17 @@ def add_port_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--map", action="append", default=[], type=parse_port_map,
                         metavar="PORT=NAME",
                         help="the FMU's name of an autopilot port, e.g. psi=heading; repeatable")
-    parser.add_argument("--name", help="the autopilot's name in file names and tables "
-                                       "(default: the FMU's file name)")
+    parser.add_argument("--name", type=file_name_option,
+                        help="the autopilot's name in file names and tables "
+                             "(default: the FMU's file name)")
+
+
+def file_name_option(text: str) -> str:
+    """--name NAME, for argparse: a plain file name (``core.files.plain_name``)."""
+    try:
+        return plain_name(text, "--name")
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
 
 
 def say_error(error: BaseException) -> None:
@@ -134,8 +144,10 @@ def writable_folder(path: Path) -> Path:
         path.mkdir(parents=True, exist_ok=True)
         with tempfile.NamedTemporaryFile(dir=path):
             pass
-    except OSError as error:
-        raise SystemExit(f"error: output folder {path} is not writable ({error.strerror})")
+    except OSError as error:        # bad input: status 2, as every refusal of a command
+        print(f"error: output folder {path} is not writable ({error.strerror})",
+              file=sys.stderr)
+        raise SystemExit(2) from None
     return path
 
 

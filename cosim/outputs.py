@@ -86,49 +86,51 @@ def run_and_write(system: SystemDescription, label: str, out: Path,
     """
     kind = analysis(system.report)
     stale = [out / f"{label}{suffix}" for suffix in SUFFIXES]
-    with FolderLock(out), Outputs(out, stale, label) as outputs:
-        csv_path = outputs.path(f"{label}.csv")
-        forget = stop.keep(lambda: _discard(outputs, label)) if stop is not None else None
-        master: Master | None = None
+    with FolderLock(out):
+        Outputs.remove_abandoned(out, label)          # a killed run's, if any
+        with Outputs(out, stale, label) as outputs:
+            csv_path = outputs.path(f"{label}.csv")
+            forget = stop.keep(lambda: _discard(outputs, label)) if stop is not None else None
+            master: Master | None = None
 
-        def salvage(reason: str) -> str:      # the watchdog's, if the run never returns
-            recording = master.abandon(reason) if master is not None else None
-            if recording is None:
-                return f"nothing was written; {_discard(outputs, label)}"
-            _write_rows(recording, outputs, label, options.stream)
-            csv, meta = outputs.commit()
-            return f"the {recording.rows} rows recorded are in {csv}, with {meta}"
+            def salvage(reason: str) -> str:      # the watchdog's, if the run never returns
+                recording = master.abandon(reason) if master is not None else None
+                if recording is None:
+                    return f"nothing was written; {_discard(outputs, label)}"
+                _write_rows(recording, outputs, label, options.stream)
+                csv, meta = outputs.commit()
+                return f"the {recording.rows} rows recorded are in {csv}, with {meta}"
 
-        try:
-            with Watchdog(options.limits, stop, salvage) as watchdog:
-                watchdog.beat(f"instantiating {', '.join(system.components)}")
-                try:
-                    master = Master(system, coupling=options.coupling, overrides=overrides,
-                                    backend=options.backend)
-                except TimeLimit:
-                    raise TimedOut(watchdog.expired) from None
-                except Exception as error:
-                    if watchdog.expired:
-                        raise TimedOut(f"{watchdog.expired}: {error}") from None
-                    raise
-                with master:
-                    for note in master.notes:
-                        if notes is not None:
-                            notes(note)
-                    if options.animate:
-                        require_track(master.columns)
-                    with outputs.writing(f"{label}.csv"):
-                        recording = master.run(options.stop_time, progress=progress,
-                                               csv_path=csv_path if options.stream else None,
-                                               stop=stop, watchdog=watchdog)
-                    parameters = master.parameters
-            outcome = Outcome(recording, out / f"{label}.csv",
-                              _write_rows(recording, outputs, label, options.stream))
-            _analyse(outcome, system, kind, label, outputs, options, parameters)
-            outcome.written = [outputs.final(path) for path in outcome.written]
-        finally:
-            if forget is not None:
-                forget()
+            try:
+                with Watchdog(options.limits, stop, salvage) as watchdog:
+                    watchdog.beat(f"instantiating {', '.join(system.components)}")
+                    try:
+                        master = Master(system, coupling=options.coupling, overrides=overrides,
+                                        backend=options.backend)
+                    except TimeLimit:
+                        raise TimedOut(watchdog.expired) from None
+                    except Exception as error:
+                        if watchdog.expired:
+                            raise TimedOut(f"{watchdog.expired}: {error}") from None
+                        raise
+                    with master:
+                        for note in master.notes:
+                            if notes is not None:
+                                notes(note)
+                        if options.animate:
+                            require_track(master.columns)
+                        with outputs.writing(f"{label}.csv"):
+                            recording = master.run(options.stop_time, progress=progress,
+                                                   csv_path=csv_path if options.stream else None,
+                                                   stop=stop, watchdog=watchdog)
+                        parameters = master.parameters
+                outcome = Outcome(recording, out / f"{label}.csv",
+                                  _write_rows(recording, outputs, label, options.stream))
+                _analyse(outcome, system, kind, label, outputs, options, parameters)
+                outcome.written = [outputs.final(path) for path in outcome.written]
+            finally:
+                if forget is not None:
+                    forget()
     if options.stream:
         recording.path = outcome.csv
     if stop is not None and stop.received and not recording.interrupted:

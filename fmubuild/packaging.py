@@ -99,9 +99,11 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path) -> 
         trial(fmu, isolated=True)
     except TrialFailed as failed:
         fmu.unlink()
+        why = (f"it did not instantiate within {failed.timed_out:g} s (does its class, or a "
+               "module it imports, loop or wait at start?)" if failed.timed_out else
+               "a module it imports is probably missing from it (carry it with --include)")
         raise RuntimeError(f"{fmu.name} was built but does not instantiate without this "
-                           "checkout, so it was removed; a module it imports is probably "
-                           "missing from it (carry it with --include):\n  "
+                           f"checkout, so it was removed; {why}:\n  "
                            + "\n  ".join(failed.last_words)) from None
     return fmu
 

@@ -344,15 +344,16 @@ def test_connection_to_a_missing_variable_is_refused_by_name(tmp_path):
         Master(read_ssd(_variant(tmp_path, "calm_pd", edit)))
 
 
-def test_unwritable_output_folder_is_refused_before_simulating(tmp_path, monkeypatch):
+def test_unwritable_output_folder_is_refused_before_simulating(tmp_path, monkeypatch, capsys):
     blocker = tmp_path / "a_file"
     blocker.write_text("")
 
     def no_simulation(*args, **kwargs):
         raise AssertionError("simulated although the output folder is unusable")
     monkeypatch.setattr(cli, "run_and_write", no_simulation)
-    with pytest.raises(SystemExit, match="not writable"):
+    with pytest.raises(SystemExit) as refused:
         cli.main(["calm_pd", "--out", str(blocker / "results")])
+    assert refused.value.code == 2 and "not writable" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize("stream", [[], ["--stream"]])

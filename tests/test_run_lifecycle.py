@@ -63,8 +63,9 @@ def _run(args: list[str], cwd: Path, **popen) -> subprocess.CompletedProcess:
 
 
 def _folder(path: Path) -> dict[str, bytes]:
-    """Every file in a folder, hidden ones included, by name."""
-    return {p.name: p.read_bytes() for p in path.iterdir()} if path.exists() else {}
+    """Every file in a folder, hidden ones included, by name (a folder reads b"/")."""
+    return {p.name: b"/" if p.is_dir() else p.read_bytes()
+            for p in path.iterdir()} if path.exists() else {}
 
 
 def _errors(stderr: str) -> list[str]:
@@ -287,3 +288,31 @@ def test_a_sweep_records_a_hung_run_as_failed_and_goes_on(fmu_paths, tmp_path):
     assert rows[0]["error"].startswith("the step at t = 5 s did not end within the step time "
                                        "limit of 1 s (FMU 'autopilot' in doStep)")
     assert time.monotonic() - started < 30
+
+
+def test_names_that_would_write_outside_the_folder_are_refused(tmp_path, capsys):
+    for name in ("../x", "/abs", "a/b", ".hidden", ""):
+        with pytest.raises(SystemExit) as refused:
+            cli.main(["waves_pd", "--autopilot", "fmus/pid_autopilot.fmu", "--name", name,
+                      "--out", str(tmp_path / "out")])
+        assert refused.value.code == 2
+        assert "must be one plain file name" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists() and not (tmp_path / "x.csv").exists()
+
+
+def test_an_output_folder_that_cannot_be_made_is_a_refusal(tmp_path, capsys):
+    (tmp_path / "file").write_text("")
+    with pytest.raises(SystemExit) as refused:
+        cli.main(["calm_pd", "--out", str(tmp_path / "file" / "out")])
+    assert refused.value.code == 2
+    assert capsys.readouterr().err.startswith(f"error: output folder {tmp_path / 'file'}")
+
+
+def test_a_killed_run_s_stage_is_removed_by_the_next_run_of_its_label(tmp_path):
+    for name in (".partial-calm_pd-abcd1234", ".partial-calm_pd-PID-abcd1234"):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "calm_pd.csv").write_text("half")
+    assert cli.main(["calm_pd", "--out", str(tmp_path), "--no-plot", "--backend", "inprocess",
+                     "--stop-time", "1"]) == 0
+    assert sorted(_folder(tmp_path)) == [".partial-calm_pd-PID-abcd1234", "calm_pd.csv",
+                                         "calm_pd.json"]       # another label's is its own

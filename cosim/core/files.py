@@ -14,6 +14,7 @@ from __future__ import annotations
 import contextlib
 import errno
 import os
+import re
 import shutil
 import tempfile
 from pathlib import Path
@@ -28,6 +29,21 @@ except ImportError:                     # Windows: msvcrt's byte-range lock inst
 TEMPORARY_PREFIX = ".partial-"
 """Temporary files beside their targets start with this (a dot file: hidden, and never
 a name a command writes for good)."""
+
+
+FILE_NAME = re.compile(r"\w(?:[\w .+-]{0,98}[\w+-])?")
+"""A name given for files in an output folder (a sweep's, a controller's, an autopilot's
+``--name``): one plain file name of letters, digits, _ . + - and inner spaces; no
+separator, no leading dot, at most 100 characters."""
+
+
+def plain_name(value: object, what: str) -> str:
+    """``value`` if it is a plain file name (``FILE_NAME``); else ValueError naming ``what``."""
+    if not isinstance(value, str) or not FILE_NAME.fullmatch(value):
+        raise ValueError(f"{what} = {value!r}: a name in the output folder must be one plain "
+                         "file name of 1-100 letters, digits, _ . + - and inner spaces (no / "
+                         "or \\, not starting with a dot)")
+    return value
 
 
 class OutputError(OSError):
@@ -118,6 +134,15 @@ class Outputs:
                  label: str = "outputs"):
         self.folder, self.stale = Path(folder), [Path(p) for p in stale]
         self.stage = Path(tempfile.mkdtemp(dir=self.folder, prefix=f"{TEMPORARY_PREFIX}{label}-"))
+
+    @staticmethod
+    def remove_abandoned(folder: Path, label: str) -> None:
+        """Remove the stages of ``label`` that a killed process left in ``folder``: call it
+        holding the folder's ``FolderLock``, when no other process can be writing one."""
+        pattern = re.compile(re.escape(f"{TEMPORARY_PREFIX}{label}-") + r"[\w]{8}")
+        for entry in Path(folder).iterdir():
+            if entry.is_dir() and not entry.is_symlink() and pattern.fullmatch(entry.name):
+                shutil.rmtree(entry, ignore_errors=True)
 
     def path(self, name: str) -> Path:
         """Where to write the file that becomes ``folder/name``."""

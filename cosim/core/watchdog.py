@@ -24,8 +24,9 @@ signal or after the run limit) is hung: the watchdog raises ``TimeLimit`` in the
 loop's thread (``PyThreadState_SetAsyncExc``), where Python FMU code fails its
 call (fmukit turns it into a refusal), and the master stops, names the FMU and
 call, and writes what it kept as after any FMU failure. (Raised only into a step
-that has hung, the exception cannot land in the master's own writing.) Code that runs no Python (a C FMU in an endless loop) cannot
-take an exception: after ``Limits.grace`` more, the watchdog writes the rows kept
+that has hung, the exception cannot land in the master's own writing.) Code that
+runs no Python (a C FMU in an endless loop) cannot take an exception: after
+``Limits.grace`` more, the watchdog writes the rows kept
 (``salvage``) from its own thread, says so, and ends the process (status 1, or 130 /
 143 after a signal); ``faulthandler`` ends it regardless if even that cannot run.
 """

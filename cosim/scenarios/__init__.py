@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..core.files import plain_name
 from ..core.ssd import SystemDescription, read_ssd
 from .autopilot import with_autopilot
 
@@ -40,7 +41,10 @@ def path(scenario: str | Path) -> Path:
 def label(scenario: str | Path, autopilot: str | Path | None = None,
           name: str | None = None) -> str:
     """What a run of the scenario is called in file names: the scenario's name, and the
-    autopilot's (``name``, or the FMU's file name) when it replaces the scenario's."""
+    autopilot's (``name``, or the FMU's file name) when it replaces the scenario's;
+    ValueError if ``name`` is not a plain file name (``core.files.plain_name``)."""
+    if name is not None:
+        plain_name(name, "the autopilot's name")
     stem = Path(scenario).stem
     return f"{stem}-{name or Path(autopilot).stem}" if autopilot is not None else stem
 

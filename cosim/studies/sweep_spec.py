@@ -20,7 +20,6 @@ import hashlib
 import itertools
 import json
 import math
-import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -29,6 +28,7 @@ from typing import Any
 from .. import scenarios
 from ..analysis.seastate import model_scale
 from ..core.errors import FmuNotFound, FmuUnreadable
+from ..core.files import plain_name
 from ..core.fmi import read_description
 from ..core.values import Declaration, checked, declarations
 from ..core.inprocess import fallback_note
@@ -50,10 +50,6 @@ MAX_RUNS = 100_000
 
 MAX_SPEC_BYTES = 16 << 20
 """The largest sweep file read (a list of MAX_RUNS values takes about 1 MiB)."""
-
-FILE_NAME = re.compile(r"\w(?:[\w .+-]{0,98}[\w+-])?")
-"""A sweep's or a controller's name: one plain file name (letters, digits, _ . + - and
-inner spaces; no separator, no leading dot, at most 100 characters)."""
 
 TOML_TYPES = {"Real": ((int, float), "a number"), "Integer": ((int,), "an integer"),
               "Enumeration": ((int, str), "an integer or an item's name"),
@@ -291,11 +287,7 @@ def _typed(path: Path, key: str, value: Any, kind: type, what: str) -> Any:
 
 def _file_name(path: Path, key: str, value: Any) -> str:
     """A name that becomes a file or folder name in the output folder, checked."""
-    if not isinstance(value, str) or not FILE_NAME.fullmatch(value):
-        raise ValueError(f"{path}: {key} = {value!r}: a name in the output folder must be one "
-                         "plain file name of 1-100 letters, digits, _ . + - and inner spaces "
-                         "(no / or \\, not starting with a dot)")
-    return value
+    return plain_name(value, f"{path}: {key}")
 
 
 def _axis(path: Path, name: str, values: Any, max_runs: int) -> list:
