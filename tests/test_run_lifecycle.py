@@ -316,3 +316,12 @@ def test_a_killed_run_s_stage_is_removed_by_the_next_run_of_its_label(tmp_path):
                      "--stop-time", "1"]) == 0
     assert sorted(_folder(tmp_path)) == [".partial-calm_pd-PID-abcd1234", "calm_pd.csv",
                                          "calm_pd.json"]       # another label's is its own
+
+
+def test_an_error_reading_another_file_is_not_called_a_failed_write(tmp_path):
+    with pytest.raises(FileNotFoundError), whole_file(tmp_path / "x.ssp"):
+        (tmp_path / "missing.fmu").read_bytes()
+    with pytest.raises(FileNotFoundError), Outputs(tmp_path) as outputs, \
+            outputs.writing("x.csv"):
+        (tmp_path / "missing.csv").read_bytes()
+    assert _folder(tmp_path) == {}

@@ -61,6 +61,14 @@ class OutputError(OSError):
         return self.strerror
 
 
+def _writing(error: OSError, place: Path) -> bool:
+    """Whether ``error`` is of writing ``place`` or into it (a write names no file: ENOSPC,
+    EFBIG), not of reading some other file."""
+    if not error.filename:
+        return True
+    return Path(error.filename).resolve().is_relative_to(place.resolve())
+
+
 class FolderBusy(RuntimeError):
     """Another process is writing into this output folder."""
 
@@ -78,8 +86,8 @@ def _temporary(target: Path) -> Path:
 @contextlib.contextmanager
 def whole_file(target: Path) -> Iterator[Path]:
     """``with whole_file(target) as tmp``: write to ``tmp``; it becomes ``target`` if the
-    block succeeds and is removed if it fails (OutputError for an OSError; the old
-    ``target`` is kept either way)."""
+    block succeeds and is removed if it fails (OutputError for an OSError of writing it;
+    the old ``target`` is kept either way)."""
     target = Path(target)
     tmp = _temporary(target)
     try:
@@ -87,6 +95,8 @@ def whole_file(target: Path) -> Iterator[Path]:
             yield tmp
             os.replace(tmp, target)
         except OSError as error:
+            if not _writing(error, tmp):
+                raise                   # reading another file failed: its own error
             kept = (f"{target.name} is as it was before" if target.exists()
                     else f"no {target.name} was written")
             raise OutputError(target, error, kept) from error
@@ -172,6 +182,8 @@ class Outputs:
         except OutputError:
             raise
         except OSError as error:
+            if not _writing(error, self.stage):
+                raise
             raise OutputError(self.folder / name, error,
                               f"the earlier files in {self.folder} are kept") from error
 
