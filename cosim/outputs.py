@@ -24,7 +24,7 @@ from typing import Any, Callable
 from .analysis.animation import animate, require_track
 from .analysis.cost import LAMBDA, Cost, cost
 from .analysis.figures import save_figure
-from .analysis.kinds import analysis
+from .analysis.kinds import Analysis, analysis
 from .core.files import FolderLock, Outputs
 from .core.interrupt import StopSignals
 from .core.master import Master
@@ -155,8 +155,8 @@ def _write_rows(recording: Recording, outputs: Outputs, label: str, streamed: bo
     return [csv_path, json_path]
 
 
-def _analyse(outcome: Outcome, system: SystemDescription, kind, label: str, outputs: Outputs,
-             options: Options, parameters: dict) -> None:
+def _analyse(outcome: Outcome, system: SystemDescription, kind: Analysis, label: str,
+             outputs: Outputs, options: Options, parameters: dict) -> None:
     """Status, report, figure, animation and cost of a run whose rows are written."""
     recording = outcome.recording
     if recording.interrupted:
