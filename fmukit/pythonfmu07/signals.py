@@ -22,7 +22,10 @@ master's run watchdog's) is left as it is.
 A C or C++ host (the ``ecos`` program) has no Python code of its own; pythonfmu
 starts Python in a thread of its own, which becomes Python's main thread and
 never runs Python again, so Python's SIGINT handler would never run and Ctrl-C
-would not stop the host. There SIGINT gets its default action back.
+would not stop the host. There SIGINT gets its default action back, in the C
+runtime Python installed its handler with: the process's own on POSIX systems;
+on Windows the Universal CRT (``ucrtbase``) that CPython links, whose console
+control handler then lets Ctrl-C end the host as it would without Python.
 """
 from __future__ import annotations
 
@@ -92,11 +95,18 @@ def defer_host_handlers() -> None:
                 signal.signal(number, _DeferringHandler(handler))
 
 
+def _c_runtime() -> ctypes.CDLL:
+    """The C library whose ``signal`` installed Python's handlers: on Windows the Universal
+    CRT (``ctypes.CDLL(None)`` is a TypeError there, and ``msvcrt.dll`` is another CRT,
+    with a signal table of its own), elsewhere the process's."""
+    return ctypes.CDLL("ucrtbase") if sys.platform == "win32" else ctypes.CDLL(None)
+
+
 def _restore_default_sigint() -> None:
     """Undo Python's start-up SIGINT handler at the operating-system level (Python's own
     record of it stays as it was)."""
     if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
-        libc = ctypes.CDLL(None)
+        libc = _c_runtime()
         libc.signal.argtypes = (ctypes.c_int, ctypes.c_void_p)
         libc.signal.restype = ctypes.c_void_p
         libc.signal(signal.SIGINT, None)      # SIG_DFL
