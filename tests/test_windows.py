@@ -64,8 +64,6 @@ class WindowsCDLL:
         library = self._name
 
         class Function:
-            argtypes, restype = (), ctypes.c_int
-
             def __call__(self, *args):
                 c_calls.append([library, function, *args])
 
