@@ -3,11 +3,13 @@
 Every such FMU holds ``resources/fmukit_manifest.json``: its model name, the slave
 class (module and name, as this project imports them), each Python module it
 carries (the module's name, where the FMU holds it, the SHA-256 of its source), a
-digest of them all, the pythonfmu version and the options it was built with. No
+digest of them all, the pythonfmu version and the options it was built with, and the
+version of fmukit that built it (this project's, which the FMU declares as its own). No
 time, path or machine is in it, so the same sources give the same manifest.
 
-An FMU is current when every module it carries is importable in this process and
-has the same source: ``staleness`` says why not, or None. This is the one notion of
+An FMU is current when it was built by this project's version and every module it
+carries is importable in this process and has the same source: ``staleness`` says why
+not, or None. This is the one notion of
 a stale FMU: the in-process backend runs only current FMUs, a run's metadata records
 it, and the tests rebuild what is not.
 """
@@ -18,10 +20,13 @@ import importlib.util
 import json
 import zipfile
 from dataclasses import dataclass
+from importlib import metadata
 from pathlib import Path
 
 MANIFEST = "resources/fmukit_manifest.json"
 FORMAT = 1
+DISTRIBUTION = "ship-autopilot-cosim"
+"""This project's distribution, fmukit's."""
 
 
 @dataclass(frozen=True)
@@ -33,13 +38,21 @@ class Manifest:
     digest: str                             # of every module's name and SHA-256
     pythonfmu: str
     options: dict[str, bool]
+    version: str | None                     # fmukit's that built it; None before it was kept
 
     def to_json(self) -> str:
         return json.dumps({"format": FORMAT, "model_name": self.model_name,
                            "slave": {"module": self.slave_module, "class": self.slave_class},
                            "modules": self.modules, "digest": self.digest,
-                           "pythonfmu": self.pythonfmu, "options": self.options},
+                           "pythonfmu": self.pythonfmu, "options": self.options,
+                           "version": self.version},
                           indent=1, sort_keys=True) + "\n"
+
+
+def version() -> str:
+    """This project's version (fmukit's): its installed distribution's, as pyproject.toml
+    gives it."""
+    return metadata.version(DISTRIBUTION)
 
 
 def sha256(path: Path) -> str:
@@ -64,14 +77,17 @@ def read(fmu: str | Path) -> Manifest | None:
                 raise ValueError(f"format {data['format']}, not {FORMAT}")
             return Manifest(data["model_name"], data["slave"]["module"],
                             data["slave"]["class"], data["modules"], data["digest"],
-                            data["pythonfmu"], data["options"])
+                            data["pythonfmu"], data["options"], data.get("version"))
         except (KeyError, TypeError, ValueError) as error:
             raise ValueError(f"{fmu}: its {MANIFEST} cannot be read ({error})") from error
 
 
 def staleness(manifest: Manifest) -> str | None:
-    """Why the FMU is not current in this process (a module it carries cannot be found
-    here, or has another source), or None if it is."""
+    """Why the FMU is not current in this process (built by another version of fmukit, or
+    a module it carries cannot be found here, or has another source), or None if it is."""
+    if manifest.version != version():
+        return (f"it was built by fmukit {manifest.version or 'of an older version'}, this "
+                f"is fmukit {version()} (rebuild it)")
     for module, carried in manifest.modules.items():
         try:
             spec = importlib.util.find_spec(module)

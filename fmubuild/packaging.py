@@ -5,10 +5,14 @@ project's packages that it imports (followed through, ``imports``), a user's mod
 given with ``--include``, a requirements.txt (a host needs only Python with numpy:
 ``pythonfmu deploy -f fmus/ship.fmu`` installs it) and its manifest
 (``manifest``). After building, the binary gets ``exit_fix`` (pythonfmu 0.7.0
-corrupts its host's heap at exit); the archive is written again in a fixed order with
-fixed times and a GUID derived from its contents (``reproducible``), so the same
-sources give the same bytes; the model description is checked with fmpy's validator
-and the FMU is instantiated once without this checkout (``trial``). A problem fails the build.
+corrupts its host's heap at exit) and the FMU says what it is (``documentation``: its
+generation tool, fmukit; for this project's FMUs the project's author, version,
+copyright and license, ``project_identity``; documentation/index.html and model.png,
+from its model description and the docstrings of what it carries); the archive is
+written again in a fixed order with fixed times and a GUID derived from its contents
+(``reproducible``), so the same sources give the same bytes; the model description is
+checked with fmpy's validator and the FMU is instantiated once without this checkout
+(``trial``). A problem fails the build.
 
 A package whose __init__.py holds nothing but a docstring is carried without it, as a
 namespace package. A host that is not Python (ecos, OMSimulator) runs all its Python
@@ -23,11 +27,13 @@ import contextlib
 import shutil
 import sys
 import tempfile
+from collections.abc import Mapping
+from importlib import metadata
 from pathlib import Path
 
-from . import exit_fix, reproducible
+from . import documentation, exit_fix, reproducible
 from .imports import needed_modules
-from .manifest import Manifest, digest_of, sha256
+from .manifest import DISTRIBUTION, Manifest, digest_of, sha256, version
 from .project import FMU_DIR, FMUS, ROOT
 from .trial import TrialFailed, trial
 
@@ -38,14 +44,37 @@ OPTIONS = {"canGetAndSetFMUstate": True, "canSerializeFMUstate": True}
 
 def build(name: str, dest: Path = FMU_DIR) -> Path:
     """Build one FMU of this project to dest/name.fmu, validate it, and return its path."""
-    return build_script(ROOT / FMUS[name], PROJECT_PACKAGES, dest / f"{name}.fmu")
+    return build_script(ROOT / FMUS[name], PROJECT_PACKAGES, dest / f"{name}.fmu",
+                        project_identity())
 
 
-def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path) -> Path:
+def project_identity() -> dict[str, str]:
+    """Who made this project's FMUs, as their model descriptions say: the author, version,
+    copyright and license of its distribution (pyproject.toml; with no author there, the
+    project's authors by its name)."""
+    meta = metadata.metadata(DISTRIBUTION)
+    author = meta.get("Author") or meta.get("Author-email") or f"the {DISTRIBUTION} authors"
+    return {"author": author, "version": meta["Version"], "copyright": f"Copyright (c) {author}",
+            "license": meta.get("License-Expression") or meta["License"]}
+
+
+def python_hosts() -> dict[str, str]:
+    """What a host needs to run a Python FMU, by platform (``documentation.PYTHON_HOSTS``,
+    with the Python versions this project runs on)."""
+    needed = metadata.metadata(DISTRIBUTION)["Requires-Python"]
+    python = f"{needed[2:]} or later" if needed.startswith(">=") else needed
+    return {platform: needs.format(python=python)
+            for platform, needs in documentation.PYTHON_HOSTS.items()}
+
+
+def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
+                 identity: Mapping[str, str] | None = None) -> Path:
     """Build the slave in ``script`` into ``dest`` (a .fmu path, or a folder where the FMU
     is named after the slave's model_name). ``packages``: names of this project's
     packages (fmukit among them), of which the FMU carries what the script imports, and
-    paths of a user's modules and packages, which it carries whole. Returns the FMU's path.
+    paths of a user's modules and packages, which it carries whole. ``identity``: the
+    author, version, copyright or license to declare where the slave declares none.
+    Returns the FMU's path.
 
     ValueError naming the script if it cannot be built (no ModelSlave in it, or it
     does not import); RuntimeError if the result does not validate.
@@ -77,8 +106,11 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path) -> 
             manifest = Manifest(getattr(slave, "model_name", script.stem), _module_name(script),
                                 slave.__name__, modules,
                                 digest_of({m: c["sha256"] for m, c in modules.items()}),
-                                pythonfmu_version, OPTIONS)
+                                pythonfmu_version, OPTIONS, version())
             (stage / "fmukit_manifest.json").write_text(manifest.to_json())
+            sources = {m: _docstring(stage / c["file"].removeprefix("resources/"))
+                       for m, c in modules.items()
+                       if m.split(".")[0] != "fmukit" and m != manifest.slave_module}
             (stage / "requirements.txt").write_text(RUNTIME_REQUIREMENTS)
             fmu = Path(FmuBuilder.build_FMU(
                 stage / script.name, dest=dest,
@@ -91,7 +123,10 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path) -> 
         finally:
             if shadowed is not None:
                 sys.modules[script.stem] = shadowed
-    reproducible.rewrite(fmu, lambda entries: exit_fix.patch_binaries(entries, fmu))
+    tool, hosts = f"fmukit {version()} (pythonfmu {pythonfmu_version})", python_hosts()
+    reproducible.rewrite(fmu, lambda entries: documentation.describe(
+        exit_fix.patch_binaries(entries, fmu), tool, identity or {}, _docstring(script),
+        {m: doc for m, doc in sources.items() if doc}, hosts))
     problems = validate_fmu(str(fmu))
     if problems:
         raise RuntimeError(f"{fmu} does not validate:\n" + "\n".join(problems))
@@ -134,6 +169,11 @@ def _stage(script: Path, packages: list[str], includes: list[Path],
                 module = ".".join(relative.with_suffix("").parts).removesuffix(".__init__")
                 modules[module] = _carried(file, relative.as_posix())
     return dict(sorted(modules.items()))
+
+
+def _docstring(file: Path) -> str:
+    """The docstring of the module in ``file``; empty if it has none."""
+    return ast.get_docstring(ast.parse(file.read_bytes())) or ""
 
 
 def _only_documents(file: Path) -> bool:

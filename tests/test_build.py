@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import math
 import shutil
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -44,6 +45,19 @@ def test_your_script_builds_into_a_valid_fmu_that_runs_as_autopilot(fmu_paths, t
     assert validate_fmu(str(fmu)) == []
     mine, ours = _run("waves_pd", fmu), _run("waves_pid")
     np.testing.assert_array_equal(mine["ship.psi"], ours["ship.psi"])
+
+
+def test_your_scripts_fmu_names_fmukit_and_only_the_author_it_declares(tmp_path):
+    script = tmp_path / "mine.py"
+    script.write_text((ROOT / "autopilot_fmu" / "pid_autopilot_slave.py").read_text()
+                      .replace('model_name = "pid_autopilot"',
+                               'model_name = "mine"\n    author = "A. User"'))
+    assert cli.main([str(script)]) == 0
+    described = read_model_description(str(tmp_path / "mine.fmu"))
+    assert described.generationTool.startswith("fmukit ")
+    assert (described.author, described.version, described.license) == ("A. User", None, None)
+    with zipfile.ZipFile(tmp_path / "mine.fmu") as fmu:
+        assert {"documentation/index.html", "model.png"} <= set(fmu.namelist())
 
 
 def test_scripts_built_one_after_another_carry_their_own_modules(tmp_path):
