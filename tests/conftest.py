@@ -59,15 +59,16 @@ def _older(fmu: Path, sources: list[Path]) -> bool:
 @pytest.fixture(scope="session")
 def fmu_paths() -> dict[str, Path]:
     """Every FMU in fmus/, rebuilt first if missing or not current (its manifest against
-    the sources; the C FMU, which has none, by file times, and only where there is a C
-    compiler)."""
+    the sources; the C FMU, which has none, by file times, its build script's included, and
+    only where there is a C compiler)."""
     for name in FMUS:
         if _stale(FMU_DIR / f"{name}.fmu"):
             build(name)
     built = list(FMUS)
     if c_compiler() is not None:
         for name, folder in C_FMUS.items():
-            if _older(FMU_DIR / f"{name}.fmu", list((ROOT / folder).iterdir())):
+            if _older(FMU_DIR / f"{name}.fmu", [*(ROOT / folder).iterdir(),
+                                                 ROOT / "fmubuild" / "cbuild.py"]):
                 build_c(name)
         built += list(C_FMUS)
     return {name: FMU_DIR / f"{name}.fmu" for name in built}
