@@ -71,16 +71,20 @@ def test_the_documentation_cites_the_paper_and_the_equations_of_what_the_fmu_car
         assert f"<code>ship_fmu.{module}</code>: " in page and equations in page
 
 
-def test_the_documentations_worked_example_runs(fmu_paths, tmp_path):
-    page = _entry(fmu_paths["ship"], "documentation/index.html").decode()
+@pytest.mark.parametrize("name", list(FMUS))
+def test_the_documentations_worked_example_runs(fmu_paths, tmp_path, name):
+    page = _entry(fmu_paths[name], "documentation/index.html").decode()
     command = re.search(r"<pre>(fmpy simulate .*?)</pre>", page).group(1).split()
-    assert command[:3] == ["fmpy", "simulate", "ship.fmu"] and "--start-values" in command
-    (tmp_path / "ship.fmu").write_bytes(fmu_paths["ship"].read_bytes())
+    assert command[:3] == ["fmpy", "simulate", f"{name}.fmu"] and "--start-values" in command
+    (tmp_path / f"{name}.fmu").write_bytes(fmu_paths[name].read_bytes())
     fmpy = Path(sys.executable).with_name("fmpy")
     subprocess.run([str(fmpy), *command[1:]], cwd=tmp_path, check=True, capture_output=True)
-    held = command[command.index("--start-values") + 1]
-    lines = (tmp_path / "ship.csv").read_text().splitlines()
-    assert held == "delta_c" and lines[-1].startswith("400.0,")
+    header, *rows = (tmp_path / f"{name}.csv").read_text().splitlines()
+    stop = command[command.index("--stop-time") + 1]
+    outputs = [v.name for v in read_model_description(str(fmu_paths[name])).modelVariables
+               if v.causality == "output"]
+    assert header.replace('"', "").split(",") == ["time", *outputs]
+    assert rows[-1].startswith(f"{stop},")
 
 
 @pytest.mark.parametrize("name", list(FMUS))
