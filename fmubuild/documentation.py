@@ -41,8 +41,9 @@ PYTHON_HOSTS = {
                "<code>PYTHONPATH</code> naming a site-packages that has numpy if that "
                "Python's own has none.",
     "win64": "A 64-bit CPython {python} with numpy, whose folder (with python3.dll) is on "
-             "<code>PATH</code>, and the Microsoft Visual C++ runtime. (To be completed: "
-             "what each Windows host needs beyond this.)",
+             "<code>PATH</code>, and the Microsoft Visual C++ runtime. [To be refined: "
+             "what each Windows host (Simulink, Dymola, OMSimulator, cosim-cli) needs "
+             "beyond this.]",
 }
 """What a host needs to run a Python FMU, by platform; {python}: the Python versions."""
 
