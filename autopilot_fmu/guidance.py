@@ -14,10 +14,18 @@ behind it. After the last waypoint the ship holds the last leg's course.
 The guidance is memoryless apart from the index of the active leg, which only
 moves forward. ``active_leg`` evaluates the switching rule without committing
 it, so the output at a communication point is a pure function of the inputs there.
+
+The route has two forms, because some FMI hosts set no String parameter (OMSimulator
+applies no ssv:String binding): the String ``waypoints`` 'x0,y0;x1,y1;...', and the
+numbers ``n_waypoints`` with ``wp<i>_x``, ``wp<i>_y`` for i < n_waypoints (at most
+``MAX_WAYPOINTS``). ``route`` decides which one holds (docs/interop.md, "The route").
 """
 from __future__ import annotations
 
 import math
+
+from collections.abc import Mapping, Sequence
+from typing import Any
 
 from fmukit.numerics import require_finite
 from ship_fmu.data import Hull
@@ -29,6 +37,32 @@ R_ACCEPT = 2.0 * Hull.L
 """Radius of the circle of acceptance, m: two ship lengths."""
 
 
+MAX_WAYPOINTS = 16
+"""Points the numeric form of the route holds: wp0_x, wp0_y ... wp15_x, wp15_y."""
+
+
+def coordinate_names(i: int) -> tuple[str, str]:
+    """The numeric form's parameters of point ``i``: ('wp<i>_x', 'wp<i>_y')."""
+    return f"wp{i}_x", f"wp{i}_y"
+
+
+COORDINATES = tuple(name for i in range(MAX_WAYPOINTS) for name in coordinate_names(i))
+ROUTE_PARAMETERS = ("waypoints", "n_waypoints", *COORDINATES)
+"""Every parameter the route is read from (``route``)."""
+
+
+def _checked(points: list[tuple[float, float]], what: str) -> list[tuple[float, float]]:
+    """The rules of a route: finite points, no two consecutive alike, at least two;
+    ValueError naming ``what`` (the parameter or parameters giving it)."""
+    for i, (x, y) in enumerate(points):
+        if not (math.isfinite(x) and math.isfinite(y)):
+            raise ValueError(f"parameter {what}: point {i} ({x}, {y}) is not finite")
+        if i and (x, y) == points[i - 1]:
+            raise ValueError(f"parameter {what}: points {i - 1} and {i} are both "
+                             f"({x}, {y}); consecutive waypoints must differ")
+    return points
+
+
 def parse_waypoints(text: str) -> list[tuple[float, float]]:
     """'x0,y0;x1,y1;...' (m) -> [(x0, y0), ...]; ValueError naming 'waypoints'."""
     points = []
@@ -37,29 +71,71 @@ def parse_waypoints(text: str) -> list[tuple[float, float]]:
         try:
             if len(fields) != 2:
                 raise ValueError
-            x, y = float(fields[0]), float(fields[1])
+            points.append((float(fields[0]), float(fields[1])))
         except ValueError:
             raise ValueError(f"parameter waypoints: point {i} is {item.strip()!r}, "
                              "expected 'x,y' with two numbers in m") from None
-        if not (math.isfinite(x) and math.isfinite(y)):
-            raise ValueError(f"parameter waypoints: point {i} ({x}, {y}) is not finite")
-        if points and (x, y) == points[-1]:
-            raise ValueError(f"parameter waypoints: points {i - 1} and {i} are both "
-                             f"({x}, {y}); consecutive waypoints must differ")
-        points.append((x, y))
     if len(points) < 2:
         raise ValueError(f"parameter waypoints needs at least two points 'x0,y0;x1,y1', "
                          f"got {text!r}")
+    return _checked(points, "waypoints")
+
+
+def numeric_route(text: str) -> dict[str, int | float]:
+    """The route 'x0,y0;...' in the numeric form: n_waypoints and wp<i>_x, wp<i>_y of each
+    point (the others keep their default, 0); ValueError if it has more than
+    ``MAX_WAYPOINTS`` points."""
+    points = parse_waypoints(text)
+    if len(points) > MAX_WAYPOINTS:
+        raise ValueError(f"the route {text!r} has {len(points)} points; its numeric form "
+                         f"holds at most {MAX_WAYPOINTS}")
+    values: dict[str, int | float] = {"n_waypoints": len(points)}
+    for i, point in enumerate(points):
+        values.update(zip(coordinate_names(i), point))
+    return values
+
+
+def route(parameters: Mapping[str, Any]) -> list[tuple[float, float]]:
+    """The route the guidance follows, from its parameters by name (those absent at their
+    defaults); ValueError naming the parameters if it is not well defined.
+
+    ``n_waypoints`` = 0 (its default): the String ``waypoints``, and every wp<i>_x, wp<i>_y
+    must be 0 (unset). ``n_waypoints`` = n >= 2: the points wp0 .. wp<n-1>; wp<i> from n on
+    must be unset, and ``waypoints`` must be at its default (the paper's route, taken as
+    not given) or name the same points: two different routes are refused, not ranked.
+    """
+    text = parameters.get("waypoints", PAPER_ROUTE)
+    count = parameters.get("n_waypoints", 0)
+    coordinates = [float(parameters.get(name, 0.0)) for name in COORDINATES]
+    for name, value in list(zip(COORDINATES, coordinates))[2 * count:]:
+        if value != 0.0:
+            uses = (f"uses only wp0 .. wp{count - 1}" if count else
+                    "takes the route from the String waypoints")
+            raise ValueError(f"parameter {name} = {value} is set, but n_waypoints = {count} "
+                             f"{uses}")
+    if count == 0:
+        return parse_waypoints(text)
+    if not 2 <= count <= MAX_WAYPOINTS:
+        raise ValueError(f"parameter n_waypoints = {count}: a route needs 2 to "
+                         f"{MAX_WAYPOINTS} points (0: the String waypoints)")
+    points = _checked(list(zip(coordinates[0:2 * count:2], coordinates[1:2 * count:2])),
+                      f"wp0_x .. wp{count - 1}_y")
+    if text != PAPER_ROUTE and parse_waypoints(text) != points:
+        raise ValueError(f"parameters waypoints = {text!r} and n_waypoints = {count} with "
+                         "wp<i>_x, wp<i>_y give two different routes; set one of them")
     return points
 
 
 class WaypointGuidance:
     """Desired course along a route of waypoints."""
 
-    def __init__(self, waypoints: str = PAPER_ROUTE, R_accept: float = R_ACCEPT):
+    def __init__(self, waypoints: str | Sequence[tuple[float, float]] = PAPER_ROUTE,
+                 R_accept: float = R_ACCEPT):
+        """``waypoints``: 'x0,y0;x1,y1;...' or the points, as ``route`` gives them."""
         if not (math.isfinite(R_accept) and R_accept > 0.0):
             raise ValueError(f"parameter R_accept must be finite and > 0, got {R_accept}")
-        self.points = parse_waypoints(waypoints)
+        self.points = (parse_waypoints(waypoints) if isinstance(waypoints, str)
+                       else _checked(list(waypoints), "waypoints"))
         self.R_accept = R_accept
         self.leg = 0                      # active leg: from points[leg] to points[leg + 1]
         self.finished = False

@@ -1,10 +1,15 @@
 """Waypoint guidance as an FMI 2.0 co-simulation FMU (fmus/guidance.fmu), eq (18).
 
 psi_d and wp_index are direct feedthrough from the position: evaluated when read,
-with the leg switch committed at the end of each step.
+with the leg switch committed at the end of each step. The route is the String
+``waypoints`` or, for hosts that set no String parameter, the numbers ``n_waypoints``,
+``wp<i>_x``, ``wp<i>_y`` (``autopilot_fmu.guidance.route`` says which holds).
 """
-from autopilot_fmu.guidance import PAPER_ROUTE, R_ACCEPT, WaypointGuidance
+from autopilot_fmu.guidance import (MAX_WAYPOINTS, PAPER_ROUTE, R_ACCEPT, ROUTE_PARAMETERS,
+                                    WaypointGuidance, coordinate_names, route)
 from fmukit.slave import ModelSlave, Var
+
+_ROUTE = ROUTE_PARAMETERS + ("R_accept",)
 
 
 class GuidanceSlave(ModelSlave):
@@ -14,21 +19,29 @@ class GuidanceSlave(ModelSlave):
     variables = (
         Var.input("x", 0.0, "m", "ship north position"),
         Var.input("y", 0.0, "m", "ship east position"),
-        Var.output("psi_d", "rad", "desired course, eq (18)",
-                   depends=("x", "y", "waypoints", "R_accept"),
+        Var.output("psi_d", "rad", "desired course, eq (18)", depends=("x", "y") + _ROUTE,
                    get=lambda s: s.model.psi_d(s.x, s.y)),
         Var.output("wp_index", description="index of the waypoint steered to; "
                    "the number of waypoints once past the last", kind=int,
-                   depends=("x", "y", "waypoints", "R_accept"),
+                   depends=("x", "y") + _ROUTE,
                    get=lambda s: s.model.wp_index(s.x, s.y)),
         Var.parameter("waypoints", PAPER_ROUTE,
-                      description="route 'x0,y0;x1,y1;...' in m, north and east"),
+                      description="route 'x0,y0;x1,y1;...' in m, north and east; used "
+                                  "while n_waypoints = 0"),
         Var.parameter("R_accept", R_ACCEPT, "m", "radius of the circle of acceptance, "
                       "> 0", 0.0, 1e6),
+        Var.parameter("n_waypoints", 0, description=(
+            "points of the numeric route wp0 .. wp<n-1>, 2 or more; 0: the route is the "
+            "String waypoints (for hosts without String parameters)"), min=0,
+            max=MAX_WAYPOINTS),
+        *(Var.parameter(name, 0.0, "m", f"waypoint {i} of the numeric route, "
+                        f"{'north' if axis == 0 else 'east'}; 0 where unused")
+          for i in range(MAX_WAYPOINTS) for axis, name in enumerate(coordinate_names(i))),
     )
 
     def build_model(self) -> WaypointGuidance:
-        return WaypointGuidance(self.waypoints, self.R_accept)
+        return WaypointGuidance(route({name: getattr(self, name) for name in ROUTE_PARAMETERS}),
+                                self.R_accept)
 
     def step_model(self, t: float, h: float) -> None:
         self.model.update(self.x, self.y)
