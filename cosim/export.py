@@ -5,9 +5,12 @@
     python -m cosim.export waves_pd --autopilot my.fmu   -> results/ssp/waves_pd-my.ssp
 
 The package is a zip holding SystemStructure.ssd (components, connections, the
-scenario's parameter values, the fixed step as an OSP annotation) and
-resources/<fmu>.fmu for every FMU it uses (``cosim.interop.ssp``). OSP libcosim,
-ecos, fmpy and OMSimulator load it unchanged (see README, "Using the FMUs elsewhere").
+scenario's parameter values, the fixed step as OSP's and OpenModelica's annotations)
+and resources/<fmu>.fmu for every FMU it uses; beside it, DIR/<label>/ holds OSP's
+OspSystemStructure.xml and the FMUs (``cosim.interop.ssp``). OSP libcosim, ecos,
+fmpy, OMSimulator and OSP's tools load them unchanged (docs/interop.md). A String
+parameter value that OMSimulator and fmpy's SSP runner would not apply is named in a
+warning (the guidance's route is written as numbers, which they do apply).
 """
 from __future__ import annotations
 
@@ -19,7 +22,7 @@ from . import scenarios
 from ._cli import (add_autopilot_options, checked_autopilot, chosen_scenarios, entry, say_error,
                    writable_folder)
 from .core.files import OutputError
-from .interop.ssp import export
+from .interop.ssp import export, unapplied_strings
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -38,7 +41,12 @@ def main(argv: list[str] | None = None) -> int:
     writable_folder(args.out)
     for name in names:
         try:
-            print(f"wrote {export(name, args.out, None, args.autopilot, dict(args.map), args.name)}")
+            package = export(name, args.out, None, args.autopilot, dict(args.map), args.name)
+            print(f"wrote {package} and {package.with_suffix('')}/")
+            for variable, (value, default) in unapplied_strings(package).items():
+                print(f"warning: {package.name} sets the String {variable} = {value!r}; "
+                      f"OMSimulator and fmpy's SSP runner apply no String binding and "
+                      f"would run with its default {default!r}", file=sys.stderr)
         except (ValueError, FileNotFoundError) as error:
             say_error(error)
             return 2

@@ -3,9 +3,11 @@
 The subset used here is the one OSP libcosim, ecos and fmpy all read: one system of
 FMU components with connectors, inline parameter sets (ssv:Real, Integer, Boolean,
 String), connections, and a DefaultExperiment whose OSP annotation gives the fixed
-step. This project adds one annotation of its own (type ``REPORT_ANNOTATION``)
-naming the kind of analysis a run of the system gets (``cosim.analysis.kinds``);
-other tools ignore it. ``read_ssd`` refuses what is not in this subset (nested
+step. ``write_ssd`` also gives the step in OpenModelica's annotation on the System,
+the only place OMSimulator's command line learns the system's type and step from
+(without it, it aborts with '[NewSystem] internal error'). This project adds one
+annotation of its own (type ``REPORT_ANNOTATION``) naming the kind of analysis a run of
+the system gets (``cosim.analysis.kinds``); other tools ignore it. ``read_ssd`` refuses what is not in this subset (nested
 systems, connectors of the system itself, parameter values in .ssv files or with
 units, ...) or not well formed, naming the file, the element and the attribute.
 """
@@ -29,8 +31,10 @@ NS = {
     "ssv": "http://ssp-standard.org/SSP1/SystemStructureParameterValues",
     "osp": "http://opensimulationplatform.com/SSP/OSPAnnotations",
     "sap": "https://github.com/ship-autopilot-cosim/annotations",
+    "oms": "https://raw.githubusercontent.com/OpenModelica/OMSimulator/master/schema/oms.xsd",
 }
 OSP_ANNOTATION = "com.opensimulationplatform"
+OMS_ANNOTATION = "org.openmodelica"
 REPORT_ANNOTATION = "org.ship-autopilot-cosim"
 PARAMETER_SET = "scenario"
 _TYPES = ("Real", "Integer", "Boolean", "String")
@@ -324,7 +328,8 @@ def read_ssd(path: str | Path) -> SystemDescription:
     return _Reader(Path(path)).system()
 
 
-def _format(value: float | int | bool | str) -> tuple[str, str]:
+def ssv_value(value: float | int | bool | str) -> tuple[str, str]:
+    """A parameter value as its SSP type and text: ('Real', repr(value)), ..."""
     if isinstance(value, bool):
         return "Boolean", str(value).lower()
     if isinstance(value, int):
@@ -336,7 +341,11 @@ def _format(value: float | int | bool | str) -> tuple[str, str]:
 
 def write_ssd(system: SystemDescription, path: str | Path,
               sources: dict[str, str] | None = None) -> None:
-    """Write ``system`` as a .ssd; ``sources`` replaces component sources by name."""
+    """Write ``system`` as a .ssd; ``sources`` replaces component sources by name.
+
+    The fixed step goes into two annotations (SSP 1.0, 'Annotations'): OSP's
+    FixedStepAlgorithm on the DefaultExperiment, and OpenModelica's FixedStepMaster
+    ('oms-ma', its weakly coupled master) on the System, as OMSimulator writes it."""
     root = ET.Element(_q("ssd", "SystemStructureDescription"), version="1.0", name=system.name)
     sys_el = ET.SubElement(root, _q("ssd", "System"), name=system.name,
                            description=system.description)
@@ -357,7 +366,7 @@ def write_ssd(system: SystemDescription, path: str | Path,
                                  name=PARAMETER_SET)
             params = ET.SubElement(pset, _q("ssv", "Parameters"))
             for name, value in c.parameters.items():
-                type_name, text = _format(value)
+                type_name, text = ssv_value(value)
                 p = ET.SubElement(params, _q("ssv", "Parameter"), name=name)
                 ET.SubElement(p, _q("ssv", type_name), value=text)
     connections = ET.SubElement(sys_el, _q("ssd", "Connections"))
@@ -365,6 +374,12 @@ def write_ssd(system: SystemDescription, path: str | Path,
         ET.SubElement(connections, _q("ssd", "Connection"), startElement=k.start_element,
                       startConnector=k.start_connector, endElement=k.end_element,
                       endConnector=k.end_connector)
+    oms = ET.SubElement(ET.SubElement(sys_el, _q("ssd", "Annotations")), _q("ssc", "Annotation"),
+                        type=OMS_ANNOTATION)
+    information = ET.SubElement(ET.SubElement(oms, _q("oms", "Annotations")),
+                                _q("oms", "SimulationInformation"))
+    ET.SubElement(information, _q("oms", "FixedStepMaster"), description="oms-ma",
+                  stepSize=repr(system.step_size))
     experiment = ET.SubElement(root, _q("ssd", "DefaultExperiment"),
                                startTime=repr(system.start_time), stopTime=repr(system.stop_time))
     annotations = ET.SubElement(experiment, _q("ssd", "Annotations"))

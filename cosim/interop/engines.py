@@ -1,8 +1,9 @@
 """Run an exported SSP package (``cosim.export``) in another co-simulation engine.
 
 Engines: ``libcosim`` (OSP, through libcosimpy), ``ecos`` (through ecospy) and
-``fmpy`` (fmpy's own SSP runner). Each returns the signals it recorded with the
-time each value belongs to:
+``fmpy`` (fmpy's own SSP runner). libcosim also runs the OSP folder that
+``cosim.export`` writes beside the package (OspSystemStructure.xml, ``cosim.interop.osp``).
+Each returns the signals it recorded with the time each value belongs to:
 
 - ecos: t_k = k h for k = 0 .. N, read after every step (its coupling is Jacobi:
   every FMU steps on the previous step's outputs); libcosim likewise, but from t_1,
@@ -23,7 +24,8 @@ read NaN once they have failed; a crash, a failed step, or outputs that read NaN
 becomes an ``EngineError`` that carries the child's output, with the FMU's
 message and the time. A package is checked first (``check_package``).
 
-The command line: ``python -m cosim.engines ENGINE PACKAGE.ssp --out trace.npz``.
+The command line: ``python -m cosim.engines ENGINE PACKAGE.ssp --out trace.npz``
+(``libcosim`` also takes the OSP folder or its OspSystemStructure.xml).
 """
 from __future__ import annotations
 
@@ -40,11 +42,11 @@ import numpy as np
 from fmukit.timebase import communication_point, step_count
 
 from ..core.files import write_atomically
-from ..core.fmi import read_description
 from ..core.interrupt import STOP_SIGNALS, Interrupted, StopSignals
-from ..core.ssd import split_name
+from ..core.ssd import SystemDescription, split_name
 
-from .ssp import read_package
+from .osp import read_osp
+from .ssp import read_package, unapplied_strings
 
 ENGINES = ("libcosim", "ecos", "fmpy")
 TRACED = ("ship.psi", "ship.r", "ship.delta")
@@ -54,15 +56,26 @@ class EngineError(RuntimeError):
     """An engine failed or produced undefined values; the message holds its output."""
 
 
+def is_osp(path: Path) -> bool:
+    """Whether ``path`` is an OSP system structure (its folder, or the .xml itself)."""
+    return path.is_dir() or path.suffix.lower() == ".xml"
+
+
+def read_system(path: Path) -> SystemDescription:
+    """The system of an SSP package or of an OSP system structure."""
+    return read_osp(path) if is_osp(path) else read_package(path)
+
+
 def _libcosim(ssp: Path, signals: tuple[str, ...], stop: StopSignals) -> dict[str, np.ndarray]:
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimObserver import CosimObserver
 
     log_output_level(CosimLogLevel.ERROR)
-    system = read_package(ssp)
+    system = read_system(ssp)
     n_steps = step_count(system.start_time, system.stop_time, system.step_size)
-    execution = CosimExecution.from_ssp_file(str(ssp))
+    execution = (CosimExecution.from_osp_config_file if is_osp(ssp)
+                 else CosimExecution.from_ssp_file)(str(ssp))
     slaves = {s.name.decode(): s.index for s in execution.slave_infos()}
     references = {name: {v.name.decode(): v.reference for v in execution.slave_variables(i)}
                   for name, i in slaves.items()}
@@ -121,21 +134,15 @@ def _fmpy(ssp: Path, signals: tuple[str, ...], stop: StopSignals) -> dict[str, n
     # fmpy's runner applies no parameter bindings itself and cannot set Strings:
     # pass the package's own values, fully qualified; a String must equal the FMU's
     # default, or the run would not be the scenario.
+    dropped = unapplied_strings(ssp)
+    if dropped:
+        raise EngineError("fmpy's SSP runner cannot set the String " + ", ".join(
+            f"{variable} = {value!r}" for variable, (value, _) in dropped.items()))
     parameters = ParameterSet()
-    with tempfile.TemporaryDirectory() as tmp:
-        with zipfile.ZipFile(ssp) as package:
-            package.extractall(tmp)
-        for name, component in system.components.items():
-            starts = {v.name: v.start for v in read_description(
-                Path(tmp) / component.source, name).modelVariables}
-            for variable, value in component.parameters.items():
-                if isinstance(value, str):
-                    if value != starts[variable]:
-                        raise EngineError(f"fmpy's SSP runner cannot set the String "
-                                          f"{name}.{variable} = {value!r}")
-                    continue
-                parameters.parameters.append(Parameter(name=f"{name}.{variable}",
-                                                       type=type(value).__name__, value=value))
+    for name, component in system.components.items():
+        parameters.parameters.extend(
+            Parameter(name=f"{name}.{variable}", type=type(value).__name__, value=value)
+            for variable, value in component.parameters.items() if not isinstance(value, str))
     result = simulate_ssp(str(ssp), start_time=system.start_time, stop_time=system.stop_time,
                           step_size=system.step_size, parameter_set=parameters)
     stop.check()                        # fmpy's runner cannot be stopped before its end
@@ -148,10 +155,11 @@ RUNNERS = {"libcosim": _libcosim, "ecos": _ecos, "fmpy": _fmpy}
 
 def check_package(ssp: Path) -> None:
     """EngineError naming the file or the parameter if the package cannot be run as it is:
-    not an SSP package, or a parameter value that is not finite (which engines reject with
-    messages of their own, such as libcosim's 'Unable to create execution from path')."""
+    not an SSP package (or OSP system structure), or a parameter value that is not finite
+    (which engines reject with messages of their own, such as libcosim's 'Unable to create
+    execution from path')."""
     try:
-        system = read_package(ssp)
+        system = read_system(ssp)
     except (OSError, KeyError, ValueError, zipfile.BadZipFile) as error:
         raise EngineError(f"{ssp} is not an SSP package this project can run ({error})") \
             from None
@@ -173,6 +181,8 @@ def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = TRACED,
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
     ssp = Path(ssp).resolve()
+    if is_osp(ssp) and engine != "libcosim":
+        raise ValueError(f"{engine} reads SSP packages, not OSP's {ssp.name}; give the .ssp")
     check_package(ssp)
     if not isolate:
         with StopSignals() as stop:
@@ -183,7 +193,7 @@ def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = TRACED,
         out = Path(tmp) / "trace.npz"
         child = subprocess.run([sys.executable, "-c", _CHILD, engine, str(ssp), str(out),
                                 *signals], capture_output=True, text=True, timeout=600)
-        log = _summary(child.stdout + child.stderr)
+        log = log_summary(child.stdout + child.stderr)
         number = -child.returncode if child.returncode < 0 else child.returncode - 128
         if number in STOP_SIGNALS:       # Ctrl-C or a kill: not the engine's fault
             raise Interrupted(number)
@@ -228,7 +238,7 @@ def save_trace(path: Path, result: dict[str, np.ndarray]) -> None:
     write_atomically(path, write)
 
 
-def _summary(log: str, head: int = 20, tail: int = 5) -> str:
+def log_summary(log: str, head: int = 20, tail: int = 5) -> str:
     """The first lines of a log (where the cause is) and its last ones."""
     lines = [line for line in log.strip().splitlines() if line.strip()]
     if len(lines) <= head + tail:

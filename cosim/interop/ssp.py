@@ -1,30 +1,54 @@
 """SSP packages for other FMI tools: a scenario exported as one self-contained .ssp file.
 
 The package is a zip holding SystemStructure.ssd (components, connections, the
-scenario's parameter values, the fixed step as an OSP annotation) and
-resources/<fmu>.fmu for every FMU it uses. OSP libcosim, ecos, fmpy and
-OMSimulator load it unchanged (see README, "Using the FMUs elsewhere"). It is
-written whole or not at all: a full disk or a kill leaves no package, or the
-previous one (``cosim.core.files``).
+scenario's parameter values, the fixed step as OSP's and OpenModelica's annotations,
+``cosim.core.ssd.write_ssd``) and resources/<fmu>.fmu for every FMU it uses. Beside
+it, a folder of the same name holds OSP's OspSystemStructure.xml and the FMUs
+(``cosim.interop.osp``). OSP libcosim, ecos, fmpy and OMSimulator load the package
+unchanged (docs/interop.md). The guidance's route is written in its numeric form
+(``autopilot_fmu.guidance.numeric_route``), because OMSimulator and fmpy's SSP runner
+apply no String binding; ``unapplied_strings`` names any String binding left that
+such a tool would silently drop. Each is written whole or not at all: a full disk or
+a kill leaves no package, or the previous one (``cosim.core.files``).
 """
 from __future__ import annotations
 
+import shutil
 import tempfile
 import zipfile
 from pathlib import Path
 
+from autopilot_fmu.guidance import ROUTE_PARAMETERS, numeric_route, route
+
 from .. import scenarios
-from ..core.files import whole_file
+from ..core.files import fresh_folder, whole_file
+from ..core.fmi import read_description
 from ..core.ssd import SystemDescription, read_ssd, write_ssd
+from .osp import OSP_FILE, write_osp
 
 SSD_NAME = "SystemStructure.ssd"
+
+
+def _with_numeric_route(system: SystemDescription, fmus: dict[str, Path]) -> None:
+    """Replace a String route by its numbers in each component whose FMU declares both
+    forms (our guidance); ValueError if the two forms disagree or the route is too long."""
+    for name, component in system.components.items():
+        if not isinstance(component.parameters.get("waypoints"), str):
+            continue
+        declared = {v.name for v in read_description(fmus[name], name).modelVariables}
+        if declared.issuperset(ROUTE_PARAMETERS):
+            route(component.parameters)
+            parameters = dict(component.parameters)
+            parameters.update(numeric_route(parameters.pop("waypoints")))
+            component.parameters = parameters
 
 
 def export(scenario: str | Path, out: Path, overrides: dict[str, dict] | None = None,
            autopilot: str | Path | None = None, port_map: dict[str, str] | None = None,
            name: str | None = None) -> Path:
-    """Write out/<label>.ssp (``scenarios.label``): the scenario, with ``autopilot`` in
-    place of its own if given, and ``overrides`` changing parameter values by component."""
+    """Write out/<label>.ssp (``scenarios.label``) and out/<label>/ with OSP's
+    OspSystemStructure.xml and the FMUs: the scenario, with ``autopilot`` in place of
+    its own if given, and ``overrides`` changing parameter values by component."""
     system = scenarios.load(scenario, autopilot, port_map, name)
     for component, values in system.parameters(overrides).items():
         system.components[component].parameters = values
@@ -34,16 +58,21 @@ def export(scenario: str | Path, out: Path, overrides: dict[str, dict] | None = 
         if by_name.setdefault(path.name, path) != path:
             raise ValueError(f"two FMUs named {path.name} ({by_name[path.name]} and {path}) "
                              "cannot both go into resources/; rename one")
-    sources = {c: f"resources/{path.name}" for c, path in fmus.items()}
-    target = out / f"{scenarios.label(scenario, autopilot, name)}.ssp"
+    _with_numeric_route(system, fmus)
+    label = scenarios.label(scenario, autopilot, name)
+    target = out / f"{label}.ssp"
     with tempfile.TemporaryDirectory() as tmp:
         ssd = Path(tmp) / SSD_NAME
-        write_ssd(system, ssd, sources)
+        write_ssd(system, ssd, {c: f"resources/{path.name}" for c, path in fmus.items()})
         with whole_file(target) as partial, \
                 zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as package:
             package.write(ssd, SSD_NAME)
             for path in sorted(set(fmus.values())):
                 package.write(path, f"resources/{path.name}")
+    with fresh_folder(out / label) as folder:
+        for path in set(fmus.values()):
+            shutil.copyfile(path, folder / path.name)
+        write_osp(system, folder / OSP_FILE, {c: path.name for c, path in fmus.items()})
     return target
 
 
@@ -53,3 +82,24 @@ def read_package(ssp: Path) -> SystemDescription:
         with zipfile.ZipFile(ssp) as package:
             package.extract(SSD_NAME, tmp)
         return read_ssd(Path(tmp) / SSD_NAME)
+
+
+def unapplied_strings(ssp: Path) -> dict[str, tuple[str, str]]:
+    """The package's String bindings that a tool applying none (OMSimulator, fmpy's SSP
+    runner) would drop without a word, changing the run: 'component.variable':
+    (value, the FMU's default), for each whose value is not its FMU's default."""
+    system = read_package(ssp)
+    dropped = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        with zipfile.ZipFile(ssp) as package:
+            package.extractall(tmp)
+        for name, component in system.components.items():
+            strings = {v: value for v, value in component.parameters.items()
+                       if isinstance(value, str)}
+            if not strings:
+                continue
+            starts = {v.name: v.start for v in read_description(
+                Path(tmp) / component.source, name).modelVariables}
+            dropped.update({f"{name}.{v}": (value, starts[v]) for v, value in strings.items()
+                            if value != starts[v]})
+    return dropped
