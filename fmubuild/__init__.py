@@ -4,11 +4,14 @@
 - ``packaging``: a slave script written with fmukit into a validated FMU that carries
   exactly its model: what the script imports (``imports``), with its ``manifest``;
   the same bytes from the same sources (``reproducible``);
-- ``manifest``: what an FMU carries and a digest of it, and whether it is current;
+- ``manifest``: what an FMU carries and a digest of it, and whether it is current; who
+  made it (``project_identity``);
+- ``documentation``: what an FMU says of itself (its model description's author, version,
+  copyright, license and generation tool; documentation/index.html); ``icon``: its model.png;
 - ``trial``: an FMU instantiated once in a child process, here or away from the checkout;
 - ``exit_fix``: pythonfmu 0.7.0's linux64 binary, patched against its exit-time heap
   corruption;
-- ``cbuild``: FMUs written in C;
+- ``cbuild``: FMUs written in C (linux64, and win64 with mingw-w64);
 - ``crosscheck``: the cross-check reference files (``python -m fmubuild.crosscheck``);
 - ``cli``: the build command, ``python -m fmukit.build``.
 """

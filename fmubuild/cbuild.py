@@ -20,8 +20,14 @@ import sys
 import tempfile
 from pathlib import Path
 
-from . import reproducible
+from . import documentation, reproducible
+from .manifest import project_identity, version
 from .project import C_FMUS, FMU_DIR, ROOT
+
+C_HOSTS = {"linux64": "any FMI 2.0 co-simulation host; the library needs only libc and libm.",
+           "win64": "any FMI 2.0 co-simulation host; the DLL needs only KERNEL32 and msvcrt."}
+"""What a host needs for the C FMU, by platform (no Python: tests/test_windows.py reads the
+DLL's imports)."""
 
 _LIBRARY = {"linux64": ".so", "darwin64": ".dylib"}
 
@@ -77,6 +83,8 @@ def build_c(name: str, dest: Path = FMU_DIR) -> Path:
                 raise RuntimeError(f"{command[0]} could not compile {source} for {platform}:\n"
                                    f"{compiled.stderr}")
             entries[f"binaries/{platform}/{library.name}"] = library.read_bytes()
+    entries = documentation.describe(entries, f"fmukit {version()} (fmubuild.cbuild)",
+                                     project_identity(), "", {}, C_HOSTS)
     dest.mkdir(parents=True, exist_ok=True)
     fmu = dest / f"{name}.fmu"
     reproducible.write(fmu, entries)

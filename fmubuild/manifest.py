@@ -55,6 +55,16 @@ def version() -> str:
     return metadata.version(DISTRIBUTION)
 
 
+def project_identity() -> dict[str, str]:
+    """Who made this project's FMUs, as their model descriptions say: the author, version,
+    copyright and license of its distribution (pyproject.toml; with no author there, the
+    project's authors by its name)."""
+    meta = metadata.metadata(DISTRIBUTION)
+    author = meta.get("Author") or meta.get("Author-email") or f"the {DISTRIBUTION} authors"
+    return {"author": author, "version": meta["Version"], "copyright": f"Copyright (c) {author}",
+            "license": meta.get("License-Expression") or meta["License"]}
+
+
 def sha256(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
 

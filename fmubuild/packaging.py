@@ -33,7 +33,7 @@ from pathlib import Path
 
 from . import documentation, exit_fix, reproducible
 from .imports import needed_modules
-from .manifest import DISTRIBUTION, Manifest, digest_of, sha256, version
+from .manifest import DISTRIBUTION, Manifest, digest_of, project_identity, sha256, version
 from .project import FMU_DIR, FMUS, ROOT
 from .trial import TrialFailed, trial
 
@@ -46,16 +46,6 @@ def build(name: str, dest: Path = FMU_DIR) -> Path:
     """Build one FMU of this project to dest/name.fmu, validate it, and return its path."""
     return build_script(ROOT / FMUS[name], PROJECT_PACKAGES, dest / f"{name}.fmu",
                         project_identity())
-
-
-def project_identity() -> dict[str, str]:
-    """Who made this project's FMUs, as their model descriptions say: the author, version,
-    copyright and license of its distribution (pyproject.toml; with no author there, the
-    project's authors by its name)."""
-    meta = metadata.metadata(DISTRIBUTION)
-    author = meta.get("Author") or meta.get("Author-email") or f"the {DISTRIBUTION} authors"
-    return {"author": author, "version": meta["Version"], "copyright": f"Copyright (c) {author}",
-            "license": meta.get("License-Expression") or meta["License"]}
 
 
 def python_hosts() -> dict[str, str]:

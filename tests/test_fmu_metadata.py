@@ -107,3 +107,14 @@ def test_an_fmu_built_by_another_version_is_not_current(fmu_paths):
     assert staleness(replace(manifest, version="0.0.1")) == (
         f"it was built by fmukit 0.0.1, this is fmukit {PROJECT['version']} (rebuild it)")
     assert "built by fmukit of an older version" in staleness(replace(manifest, version=None))
+
+
+def test_the_c_autopilot_describes_itself_too(c_autopilot):
+    described = read_model_description(str(c_autopilot))
+    assert described.version == PROJECT["version"]
+    assert described.license == PROJECT["license"]["text"]
+    assert described.generationTool == f"fmukit {PROJECT['version']} (fmubuild.cbuild)"
+    page = _entry(c_autopilot, "documentation/index.html").decode()
+    assert "only libc and libm" in page
+    assert Image.open(io.BytesIO(_entry(c_autopilot, "model.png"))).size == (256, 256)
+    assert validate_fmu(str(c_autopilot)) == []
