@@ -40,10 +40,16 @@ PYTHON_HOSTS = {
                "<code>LD_PRELOAD=/path/to/libpython3.X.so</code>, with "
                "<code>PYTHONPATH</code> naming a site-packages that has numpy if that "
                "Python's own has none.",
-    "win64": "A 64-bit CPython {python} with numpy, whose folder (with python3.dll) is on "
-             "<code>PATH</code>, and the Microsoft Visual C++ runtime. [To be refined: "
-             "what each Windows host (Simulink, Dymola, OMSimulator, cosim-cli) needs "
-             "beyond this.]",
+    "win64": "A 64-bit CPython {python} with numpy, whose installation folder (the one "
+             "with <code>python3.dll</code>, not a venv's <code>Scripts</code>) is on "
+             "<code>PATH</code> of every host, Python or not (Simulink, Dymola, "
+             "OMSimulator, cosim-cli), and the Microsoft Visual C++ 2015-2022 "
+             "Redistributable (x64) for <code>MSVCP140.dll</code>: the binary imports "
+             "python3.dll, MSVCP140, VCRUNTIME140(_1), the Universal C runtime and KERNEL32. "
+             "Set <code>PYTHONHOME</code> to that folder if Python cannot find its "
+             "standard library, <code>PYTHONPATH</code> to a site-packages with numpy if "
+             "its own has none. (Tested on Linux with the platform faked and the DLL's "
+             "imports read, not on a Windows host.)",
 }
 """What a host needs to run a Python FMU, by platform; {python}: the Python versions."""
 
