@@ -23,7 +23,6 @@ numbers ``n_waypoints`` with ``wp<i>_x``, ``wp<i>_y`` for i < n_waypoints (at mo
 from __future__ import annotations
 
 import math
-
 from collections.abc import Mapping, Sequence
 from typing import Any
 

@@ -5,8 +5,15 @@ with the leg switch committed at the end of each step. The route is the String
 ``waypoints`` or, for hosts that set no String parameter, the numbers ``n_waypoints``,
 ``wp<i>_x``, ``wp<i>_y`` (``autopilot_fmu.guidance.route`` says which holds).
 """
-from autopilot_fmu.guidance import (MAX_WAYPOINTS, PAPER_ROUTE, R_ACCEPT, ROUTE_PARAMETERS,
-                                    WaypointGuidance, coordinate_names, route)
+from autopilot_fmu.guidance import (
+    MAX_WAYPOINTS,
+    PAPER_ROUTE,
+    R_ACCEPT,
+    ROUTE_PARAMETERS,
+    WaypointGuidance,
+    coordinate_names,
+    route,
+)
 from fmukit.slave import ModelSlave, Var
 
 _ROUTE = ROUTE_PARAMETERS + ("R_accept",)

@@ -101,7 +101,7 @@ def run(ssp: str | Path, home: str | Path, interface: str = "cli",
         argv, env = command(home, interface, ssp, result, Path(tmp))
         try:
             child = subprocess.run(argv, cwd=tmp, env={**os.environ, **env}, timeout=timeout,
-                                   capture_output=True, text=True)
+                                   capture_output=True, text=True, check=False)
         except subprocess.TimeoutExpired as expired:
             raise EngineError(f"OMSimulator ({interface}) did not finish {ssp.name} within "
                               f"{timeout:g} s") from expired
