@@ -209,7 +209,7 @@ def _predict(op, e: Expectation, clock: float) -> tuple[str, list[str]]:
             return "refuse", e.failure
         if e.phase != "step":
             return "refuse", ["phase"]
-        if not (1e-9 <= h <= MAX_TIME and abs(t) <= MAX_TIME):
+        if not (0.0 < h <= MAX_TIME and abs(t) <= MAX_TIME):
             return "refuse", ["communication step"]
         bad = [n for n, v in e.vars.items() if v.causality == "input" and not e.valid(n)]
         if bad:
