@@ -226,3 +226,22 @@ def test_a_run_that_loses_the_ship_says_so(fmu_paths, tmp_path, capsys):
     assert cli.main(["waves_pd", "--set", "ship.Hs=0.01", "--set", "ship.psi_w=1.5708",
                      "--no-plot", "--out", str(tmp_path)]) == 0
     assert "warning: the rudder was at its stops for" in capsys.readouterr().out
+
+
+def test_a_run_given_the_route_as_numbers_describes_and_draws_that_route(fmu_paths, tmp_path,
+                                                                          capsys):
+    """An exported package's .ssd gives the route as numbers (for tools without String
+    parameters): the report and the figure show that route, not the String's default."""
+    import zipfile
+
+    from cosim.interop.ssp import export
+    south = "0,0;30,0;60,-25;90,-25"
+    package = export("calm_pd", tmp_path, {"guidance": {"waypoints": south}})
+    zipfile.ZipFile(package).extractall(tmp_path / "package")
+    assert cli.main([str(tmp_path / "package" / "SystemStructure.ssd"), "--stop-time", "10",
+                     "--out", str(tmp_path / "out")]) == 0
+    assert "route (0,0) (30,0) (60,-25) (90,-25) m" in capsys.readouterr().out
+    run = simulate(tmp_path / "package" / "SystemStructure.ssd", stop_time=10.0)
+    fig = course_keeping_figure(run)
+    route = [line for line in fig.axes[0].get_lines() if line.get_label() == "route"][0]
+    assert list(route.get_xdata()) == [0, 0, -25, -25]      # east y of each point

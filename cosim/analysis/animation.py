@@ -22,7 +22,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.patches import Polygon  # noqa: E402
 
-from autopilot_fmu.guidance import parse_waypoints  # noqa: E402
+from autopilot_fmu.guidance import route as followed_route  # noqa: E402
 
 from ..core.recording import Recording  # noqa: E402
 from .describe import title  # noqa: E402
@@ -77,7 +77,7 @@ def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> P
                          linestyle="none", marker=(3, 0, 0),   # the ship to scale is small
                          label="ship (outline to scale, marker enlarged)")
     legs = run.meta.get("parameters", {}).get("guidance")
-    points = np.array(parse_waypoints(legs["waypoints"])) if legs else None
+    points = np.array(followed_route(legs)) if legs else None
     active, = track.plot([], [], color="tab:green", linewidth=3, alpha=0.6, zorder=2,
                          label="active leg" if points is not None else None)
     legend_if_any(track)

@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from autopilot_fmu.guidance import parse_waypoints
+from autopilot_fmu.guidance import route as followed_route
 
 _DISPLAY = {"rad": (math.degrees(1.0), "deg"), "rad/s": (math.degrees(1.0), "deg/s"),
             "m": (1.0, "m"), "s": (1.0, "s"), "1/s": (1.0, "1/s"), "m/s": (1.0, "m/s")}
@@ -35,7 +35,7 @@ def sea(ship: dict[str, Any]) -> str:
 
 
 def route(guidance: dict[str, Any]) -> str:
-    points = " ".join(f"({x:g},{y:g})" for x, y in parse_waypoints(guidance["waypoints"]))
+    points = " ".join(f"({x:g},{y:g})" for x, y in followed_route(guidance))
     return f"route {points} m, acceptance radius {guidance['R_accept']:.3g} m"
 
 

@@ -21,7 +21,7 @@ import numpy as np  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.patches import Circle, Polygon  # noqa: E402
 
-from autopilot_fmu.guidance import parse_waypoints  # noqa: E402
+from autopilot_fmu.guidance import route as followed_route  # noqa: E402
 from ship_fmu.data import Hull  # noqa: E402
 
 from ..core.files import whole_file  # noqa: E402
@@ -54,7 +54,7 @@ def track_panel(ax: Any, run: Recording, ship: bool = True) -> None:
     if ship:
         ax.plot(y, x, color="k", linewidth=1.0, label="track", zorder=3)
     if "guidance" in p:
-        points = np.array(parse_waypoints(p["guidance"]["waypoints"]))
+        points = np.array(followed_route(p["guidance"]))
         ax.plot(points[:, 1], points[:, 0], "--o", color="tab:blue", linewidth=0.8,
                 markersize=4, label="route", zorder=2)
         for north, east in points[1:]:

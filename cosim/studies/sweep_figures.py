@@ -97,7 +97,8 @@ def tracks(spec, rows: list[dict], path: Path) -> Path | None:
                     label=f"{controller} ({len(mine)} runs)" if i == 0 else None)
     route = chosen[0]["track"].get("route")
     if route:
-        points = np.array(parse_waypoints(route))
+        # a str: a row journaled before routes were recorded as points
+        points = np.array(parse_waypoints(route) if isinstance(route, str) else route)
         ax.plot(points[:, 1], points[:, 0], "--o", color="0.3", linewidth=0.8, markersize=3,
                 label="route")
     ax.set(xlabel="east y (m)", ylabel="north x (m)")

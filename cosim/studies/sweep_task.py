@@ -17,6 +17,8 @@ from typing import Any
 import numpy as np
 from distributed import WorkerPlugin
 
+from autopilot_fmu.guidance import route as followed_route
+
 from ..analysis.cost import cost
 from ..analysis.metrics import sign_reversals_per_minute
 from ..core.provenance import code_version
@@ -161,7 +163,7 @@ def _track(recording, parameters: dict[str, dict[str, Any]], every: float = 1.0)
     stride = max(1, round(every / recording.meta["step_size"]))
     return {"x": recording["ship.x"][::stride].tolist(),
             "y": recording["ship.y"][::stride].tolist(),
-            "route": parameters.get("guidance", {}).get("waypoints")}
+            "route": [list(point) for point in followed_route(parameters.get("guidance", {}))]}
 
 
 def _metrics(recording) -> dict[str, float]:
