@@ -134,3 +134,30 @@ def test_each_fmu_runs_in_fmpy_cli_without_this_repository(fmu_paths, tmp_path, 
     assert loaded and all("/resources/" in path for path in loaded), loaded
     assert not any("/cosim/" in path for path in loaded)
     assert len((tmp_path / "out.csv").read_text().splitlines()) > 10
+
+
+def test_the_package_s_connectors_carry_the_fmus_units(fmu_paths, tmp_path):
+    """SSP 1.0: each connector's ssc type names its unit, defined once in ssd:Units with the
+    FMU's base-unit exponents; every tool above runs the package with them."""
+    import xml.etree.ElementTree as ET
+    import zipfile
+
+    from cosim.core.fmi import read_description
+    from cosim.core.ssd import NS
+    package = export("waves_pd", tmp_path)
+    root = ET.fromstring(zipfile.ZipFile(package).read("SystemStructure.ssd"))
+    defined = {u.get("name"): u.find("ssc:BaseUnit", NS).attrib
+               for u in root.findall("ssd:Units/ssc:Unit", NS)}
+    assert defined["rad/s"] == {"s": "-1", "rad": "1"} and defined["N.m"]["m"] == "2"
+    seen = 0
+    for component in root.iter(f"{{{NS['ssd']}}}Component"):
+        name = component.get("name")
+        declared = {v.name: v.unit for v in read_description(
+            fmu_paths[Path(component.get("source")).stem], name).modelVariables}
+        for connector in component.iter(f"{{{NS['ssd']}}}Connector"):
+            unit = connector[0].get("unit")             # its one ssc type
+            assert unit == (declared[connector.get("name")] or None)
+            if unit is not None:
+                assert unit in defined
+                seen += 1
+    assert seen >= 19

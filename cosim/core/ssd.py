@@ -339,9 +339,19 @@ def ssv_value(value: float | int | bool | str) -> tuple[str, str]:
     return "String", value
 
 
+@dataclass(frozen=True)
+class Units:
+    """The units of a system's connectors, as its FMUs declare them: component: connector:
+    unit name, and each unit's definition (BaseUnit exponents kg m s A K mol cd rad, factor,
+    offset: the same attributes in FMI 2.0 and SSP 1.0)."""
+    connectors: dict[str, dict[str, str]]
+    definitions: dict[str, dict[str, float]]
+
+
 def write_ssd(system: SystemDescription, path: str | Path,
-              sources: dict[str, str] | None = None) -> None:
-    """Write ``system`` as a .ssd; ``sources`` replaces component sources by name.
+              sources: dict[str, str] | None = None, units: Units | None = None) -> None:
+    """Write ``system`` as a .ssd; ``sources`` replaces component sources by name; with
+    ``units``, each connector carries its unit, defined in the file's ssd:Units.
 
     The fixed step goes into two annotations (SSP 1.0, 'Annotations'): OSP's
     FixedStepAlgorithm on the DefaultExperiment, and OpenModelica's FixedStepMaster
@@ -357,7 +367,8 @@ def write_ssd(system: SystemDescription, path: str | Path,
         connectors = ET.SubElement(comp, _q("ssd", "Connectors"))
         for name, (kind, type_name) in c.connectors.items():
             connector = ET.SubElement(connectors, _q("ssd", "Connector"), name=name, kind=kind)
-            ET.SubElement(connector, _q("ssc", type_name))
+            unit = units.connectors.get(c.name, {}).get(name) if units else None
+            ET.SubElement(connector, _q("ssc", type_name), **({"unit": unit} if unit else {}))
         if c.parameters:
             binding = ET.SubElement(ET.SubElement(comp, _q("ssd", "ParameterBindings")),
                                     _q("ssd", "ParameterBinding"))
@@ -380,6 +391,15 @@ def write_ssd(system: SystemDescription, path: str | Path,
                                 _q("oms", "SimulationInformation"))
     ET.SubElement(information, _q("oms", "FixedStepMaster"), description="oms-ma",
                   stepSize=repr(system.step_size))
+    used = sorted({u for by_name in (units.connectors if units else {}).values()
+                   for u in by_name.values()})
+    if used:                              # SSP 1.0: Units after System, before the experiment
+        definitions = ET.SubElement(root, _q("ssd", "Units"))
+        for unit in used:
+            ET.SubElement(ET.SubElement(definitions, _q("ssc", "Unit"), name=unit),
+                          _q("ssc", "BaseUnit"),
+                          **{k: repr(v) if isinstance(v, float) else str(v)
+                             for k, v in units.definitions[unit].items()})
     experiment = ET.SubElement(root, _q("ssd", "DefaultExperiment"),
                                startTime=repr(system.start_time), stopTime=repr(system.stop_time))
     annotations = ET.SubElement(experiment, _q("ssd", "Annotations"))

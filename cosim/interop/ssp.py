@@ -23,7 +23,7 @@ from autopilot_fmu.guidance import ROUTE_PARAMETERS, numeric_route, route
 from .. import scenarios
 from ..core.files import fresh_folder, whole_file
 from ..core.fmi import read_description
-from ..core.ssd import SystemDescription, read_ssd, write_ssd
+from ..core.ssd import SystemDescription, Units, read_ssd, write_ssd
 from .osp import OSP_FILE, write_osp
 
 SSD_NAME = "SystemStructure.ssd"
@@ -41,6 +41,33 @@ def _with_numeric_route(system: SystemDescription, fmus: dict[str, Path]) -> Non
             parameters = dict(component.parameters)
             parameters.update(numeric_route(parameters.pop("waypoints")))
             component.parameters = parameters
+
+
+_EXPONENTS = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
+
+
+def connector_units(system: SystemDescription, fmus: dict[str, Path]) -> Units:
+    """Each connector's unit and each unit's definition, from the FMUs' model descriptions
+    (a connector whose variable declares no unit gets none)."""
+    connectors: dict[str, dict[str, str]] = {}
+    definitions: dict[str, dict[str, float]] = {}
+    for name, component in system.components.items():
+        described = read_description(fmus[name], name)
+        by_name = {v.name: v.unit or (v.declaredType.unit if v.declaredType else None)
+                   for v in described.modelVariables}
+        connectors[name] = {c: by_name[c] for c in component.connectors if by_name.get(c)}
+        for unit in described.unitDefinitions:
+            base = unit.baseUnit
+            definitions[unit.name] = {
+                **{k: getattr(base, k) for k in _EXPONENTS if base and getattr(base, k)},
+                **({"factor": base.factor} if base and base.factor != 1.0 else {}),
+                **({"offset": base.offset} if base and base.offset != 0.0 else {})}
+    for name, by_connector in connectors.items():
+        for connector, unit in by_connector.items():
+            if unit not in definitions:
+                raise ValueError(f"{name}.{connector}: unit {unit!r} has no definition in its "
+                                 "FMU's model description")
+    return Units(connectors, definitions)
 
 
 def export(scenario: str | Path, out: Path, overrides: dict[str, dict] | None = None,
@@ -63,7 +90,8 @@ def export(scenario: str | Path, out: Path, overrides: dict[str, dict] | None = 
     target = out / f"{label}.ssp"
     with tempfile.TemporaryDirectory() as tmp:
         ssd = Path(tmp) / SSD_NAME
-        write_ssd(system, ssd, {c: f"resources/{path.name}" for c, path in fmus.items()})
+        write_ssd(system, ssd, {c: f"resources/{path.name}" for c, path in fmus.items()},
+                  connector_units(system, fmus))
         with whole_file(target) as partial, \
                 zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as package:
             package.write(ssd, SSD_NAME)
