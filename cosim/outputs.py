@@ -66,6 +66,7 @@ class Outcome:
     report: list[str] = field(default_factory=list)   # the report's lines, for a finished run
     cost: Cost | None = None                          # eq (19), for course keeping
     status: int = 0             # 0, 1 if an FMU failed, 130 / 143 if a signal stopped it
+    # (a run that failed before its first row writes nothing: ``written`` is empty)
     late_signal: bool = False   # a signal came after the last step: the outputs are whole
 
 
@@ -124,8 +125,12 @@ def run_and_write(system: SystemDescription, label: str, out: Path,
                                                    csv_path=csv_path if options.stream else None,
                                                    stop=stop, watchdog=watchdog)
                         parameters = master.parameters
-                outcome = Outcome(recording, out / f"{label}.csv",
-                                  _write_rows(recording, outputs, label, options.stream))
+                outcome = Outcome(recording, out / f"{label}.csv")
+                if recording.error and not recording.rows and not recording.interrupted:
+                    outputs.discard()       # nothing was computed: the earlier outputs stay
+                    outcome.status = 1
+                    return outcome
+                outcome.written = _write_rows(recording, outputs, label, options.stream)
                 _analyse(outcome, system, kind, label, outputs, options, parameters)
                 outcome.written = [outputs.final(path) for path in outcome.written]
             finally:

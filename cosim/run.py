@@ -62,8 +62,12 @@ def run_scenario(system: SystemDescription, label: str, out: Path, overrides: di
         print(f"{recording.error}; written to {csv_path}, with its metadata", file=sys.stderr)
     elif recording.error:
         print(f"error: {recording.error}", file=sys.stderr)
-        print(f"  the {recording.rows} rows recorded before the error are in {csv_path}",
-              file=sys.stderr)
+        if outcome.written:
+            print(f"  the {recording.rows} rows recorded before the error are in {csv_path}",
+                  file=sys.stderr)
+        else:
+            print(f"  nothing was computed, so nothing was written: the earlier outputs of "
+                  f"{label} in {out}, if any, are as they were", file=sys.stderr)
     elif options.stream:
         print(f"  {recording.rows} rows streamed to {csv_path} "
               "(no report or figure in --stream mode)")

@@ -23,6 +23,7 @@ from .core.master import RUN_BACKENDS
 from .outputs import TimedOut
 from .studies.scorecard import backend_notes, score
 from .studies.sweep_client import NoWorkers
+from .studies.sweep_spec import MAX_RUNS
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -53,8 +54,14 @@ def main(argv: list[str] | None = None) -> int:
                              "instead is noted before the scorecard starts")
     parser.add_argument("--out", type=Path, help="output folder (default: results/score/NAME)")
     args = parser.parse_args(argv)
-    if args.seeds < 1:
-        parser.error(f"--seeds must be at least 1, got {args.seeds}")
+    if not 1 <= args.seeds <= MAX_RUNS // 4:
+        parser.error(f"--seeds must be from 1 to {MAX_RUNS // 4} (four contenders, at most "
+                     f"{MAX_RUNS} runs), got {args.seeds}")
+    others = [target for target, _ in args.set if not target.startswith("autopilot.")]
+    if others:
+        parser.error(f"--set sets your autopilot's parameters (autopilot.NAME=VALUE); "
+                     f"{', '.join(others)} would change only your runs' conditions, not the "
+                     "others': the comparison would not be fair")
     if args.workers is not None and args.workers < 1:
         parser.error(f"--workers must be at least 1, got {args.workers}")
     if not checked_autopilot(parser, args):

@@ -22,16 +22,6 @@ USAGE = sweep.__doc__.partition("\n\nModules: ")[0]
 """--help: the sweep's documentation, without its closing paragraph on the modules."""
 
 
-def seconds(text: str) -> float:
-    """A number of seconds > 0, for argparse."""
-    try:
-        if 0 < float(text) < float("inf"):
-            return float(text)
-    except ValueError:
-        pass
-    raise argparse.ArgumentTypeError(f"give a number of seconds > 0, got {text!r}")
-
-
 def count(text: str) -> int:
     """A whole number >= 1, for argparse."""
     try:
@@ -56,7 +46,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--workers", type=count,
                         help="worker processes of the local cluster (default and most: the "
                              "cores this process may use)")
-    parser.add_argument("--connect-timeout", type=seconds, metavar="SECONDS",
+    parser.add_argument("--connect-timeout", type=positive_seconds, metavar="SECONDS",
                         default=CONNECT_TIMEOUT,
                         help="how long to try to reach an existing scheduler "
                              "(default: %(default)g s)")
@@ -69,7 +59,7 @@ def main(argv: list[str] | None = None) -> int:
                              "project's FMUs as Python classes, without FMI: the same results, "
                              "about 1.3-2 times faster per run (an FMU not of this checkout "
                              "runs through FMI, with a note)")
-    parser.add_argument("--no-worker-timeout", type=seconds, metavar="SECONDS",
+    parser.add_argument("--no-worker-timeout", type=positive_seconds, metavar="SECONDS",
                         default=sweep.NO_WORKER_TIMEOUT,
                         help="stop when the cluster has had no worker for this long, keeping "
                              "every row done (exit status "

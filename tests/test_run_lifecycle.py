@@ -325,3 +325,46 @@ def test_an_error_reading_another_file_is_not_called_a_failed_write(tmp_path):
             outputs.writing("x.csv"):
         (tmp_path / "missing.csv").read_bytes()
     assert _folder(tmp_path) == {}
+
+
+def test_a_run_that_fails_before_its_first_row_keeps_the_earlier_results(good, capsys):
+    before = _folder(good)
+    assert cli.main(["calm_pd", "--out", str(good), "--backend", "inprocess",
+                     "--set", "guidance.waypoints=0,0;30,0;x"]) == 1
+    err = capsys.readouterr()
+    assert "route '0,0;30,0;x' m" in err.out            # described as given, no traceback
+    assert "point 2 is 'x'" in err.err and "nothing was written" in err.err
+    assert _folder(good) == before
+
+
+@pytest.mark.parametrize("limit", ["1e-6", "1e-3"])
+def test_an_absurdly_short_step_limit_ends_the_run_with_a_message(tmp_path, limit):
+    result = _run(["calm_pd", "--out", str(tmp_path), "--backend", "inprocess",
+                   "--step-timeout", limit, "--no-plot"], tmp_path)
+    assert result.returncode == 1 and "Traceback" not in result.stderr, result.stderr
+    assert f"within the step time limit of {float(limit):g} s" in result.stderr
+
+
+def test_a_file_is_not_written_over_a_device_or_a_folder_or_into_a_missing_one(tmp_path):
+    (tmp_path / "folder").mkdir()
+    for target, said in ((tmp_path / "folder", "is not a regular file"),
+                         (Path("/dev/null"), "is not a regular file"),
+                         (tmp_path / "missing" / "x.npz", "No such file")):
+        with pytest.raises(OutputError, match=said), whole_file(target) as partial:
+            partial.write_text("x")
+    assert Path("/dev/null").is_char_device() and (tmp_path / "folder").is_dir()
+
+
+def test_the_scorecard_refuses_settings_that_would_make_it_unfair(tmp_path, capsys):
+    from cosim import score
+    for argv, said in ((["--set", "ship.Hs=0.01"], "would change only your runs' conditions"),
+                       (["--seeds", "1000000000"], "--seeds must be from 1 to")):
+        with pytest.raises(SystemExit) as refused:
+            score.main(["fmus/pid_autopilot.fmu", "--out", str(tmp_path), *argv])
+        assert refused.value.code == 2 and said in capsys.readouterr().err
+
+
+def test_a_scheduler_file_that_is_not_small_and_regular_is_refused():
+    from cosim.studies.cluster import ClusterError, scheduler_address
+    with pytest.raises(ClusterError, match="not a regular file"):
+        scheduler_address("/dev/zero")

@@ -35,7 +35,10 @@ def sea(ship: dict[str, Any]) -> str:
 
 
 def route(guidance: dict[str, Any]) -> str:
-    points = " ".join(f"({x:g},{y:g})" for x, y in followed_route(guidance))
+    try:
+        points = " ".join(f"({x:g},{y:g})" for x, y in followed_route(guidance))
+    except ValueError:                  # the guidance refuses it: shown as given
+        points = repr(guidance.get("waypoints"))
     return f"route {points} m, acceptance radius {guidance['R_accept']:.3g} m"
 
 

@@ -73,6 +73,20 @@ class FolderBusy(RuntimeError):
     """Another process is writing into this output folder."""
 
 
+def read_small_text(path: Path, limit: int) -> str:
+    """The text of a small regular UTF-8 file; ValueError saying why not (missing, not a
+    regular file: /dev/zero would be read for ever; over ``limit`` bytes; not UTF-8)."""
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError("no such file" if not path.exists() else "not a regular file")
+    if path.stat().st_size > limit:
+        raise ValueError(f"more than {limit / 2**20:g} MiB")
+    try:
+        return path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as error:
+        raise ValueError(str(error)) from None
+
+
 def _temporary(target: Path) -> Path:
     handle, name = tempfile.mkstemp(dir=target.parent, prefix=f"{TEMPORARY_PREFIX}{target.stem}.",
                                     suffix=target.suffix)     # the suffix tells the format
@@ -89,7 +103,13 @@ def whole_file(target: Path) -> Iterator[Path]:
     block succeeds and is removed if it fails (OutputError for an OSError of writing it;
     the old ``target`` is kept either way)."""
     target = Path(target)
-    tmp = _temporary(target)
+    if target.exists() and not target.is_file():
+        raise OutputError(target, OSError(errno.EEXIST, "it exists and is not a regular file "
+                                          "(a folder or a device): give a file's name"))
+    try:
+        tmp = _temporary(target)
+    except OSError as error:
+        raise OutputError(target, error, f"no {target.name} was written") from error
     try:
         try:
             yield tmp
@@ -169,7 +189,7 @@ class Outputs:
 
     def __exit__(self, kind, error, trace) -> None:
         try:
-            if kind is None:
+            if kind is None and self.stage.exists():     # not discarded
                 self.commit()
         finally:
             self.discard()

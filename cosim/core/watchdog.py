@@ -23,8 +23,8 @@ returns why). A step that does not end (past the step limit, or the grace after 
 signal or after the run limit) is hung: the watchdog raises ``TimeLimit`` in the
 loop's thread (``PyThreadState_SetAsyncExc``), where Python FMU code fails its
 call (fmukit turns it into a refusal), and the master stops, names the FMU and
-call, and writes what it kept as after any FMU failure. (Raised only into a step
-that has hung, the exception cannot land in the master's own writing.) Code that
+call, and writes what it kept as after any FMU failure. (Raised only while an
+FMU's call is under way, the exception cannot land in the master's own writing.) Code that
 runs no Python (a C FMU in an endless loop) cannot take an exception: after
 ``Limits.grace`` more, the watchdog writes the rows kept
 (``salvage``) from its own thread, says so, and ends the process (status 1, or 130 /
@@ -88,7 +88,7 @@ class Watchdog:
                  salvage: Callable[[str], str] | None = None):
         self.limits, self.stop, self.salvage = limits.check(), stop, salvage
         self.expired: str | None = None
-        self._what: str | float = "the run"
+        self._what: str | float = "the start of the run"
         self._beat = self._start = time.monotonic()
         self._signal_at: float | None = None      # when a signal came
         self._halt_at: float | None = None        # when the run time limit was passed
@@ -206,8 +206,15 @@ class Watchdog:
         returned after the grace, keep what can be kept and end the process."""
         where = _calling(self._target)
         self.expired = reason = f"{reason} ({where})" if where else reason
-        _raise_in(self._target, TimeLimit)
-        if self._done.wait(self.limits.grace):
+        deadline = time.monotonic() + self.limits.grace
+        while not where and time.monotonic() < deadline:   # the master's own code: its
+            if self._done.wait(0.01):                       # loop stops at the next beat
+                return
+            where = _calling(self._target)
+        if where:
+            _raise_in(self._target, TimeLimit)
+        if self._done.wait(max(deadline - time.monotonic(), 0.0) if not where
+                           else self.limits.grace):
             return
         faulthandler.dump_traceback_later(self.limits.grace + 10, exit=True)
         kept = "nothing was written"

@@ -14,6 +14,8 @@ from pathlib import Path
 
 from dask.distributed import Client, LocalCluster
 
+from ..core.files import read_small_text
+
 
 def local_cluster(workers: int | None = None) -> LocalCluster:
     """``workers`` single-threaded worker processes (default: one per core), quiet; its web
@@ -36,6 +38,8 @@ class ClusterError(ValueError):
 
 
 CONNECT_TIMEOUT = 30.0
+SCHEDULER_FILE_BYTES = 1 << 20
+"""The largest scheduler file read (Dask writes a few hundred bytes)."""
 """Seconds a client tries to reach an existing scheduler (Dask's own default)."""
 
 
@@ -62,12 +66,12 @@ def scheduler_address(scheduler_file: str | Path) -> str:
     naming the file if it is missing, unreadable or holds no address. (Dask's own client
     waits for a missing file to appear, for ever.)"""
     path = Path(scheduler_file)
-    try:
-        address = json.loads(path.read_text()).get("address")
-    except FileNotFoundError:
+    if not path.exists():
         raise ClusterError(f"scheduler file {path} does not exist (has the scheduler "
-                           "started with --scheduler-file?)") from None
-    except (OSError, UnicodeDecodeError, ValueError, AttributeError) as error:
+                           "started with --scheduler-file?)")
+    try:                                # a scheduler file is a few hundred bytes
+        address = json.loads(read_small_text(path, SCHEDULER_FILE_BYTES)).get("address")
+    except (ValueError, AttributeError) as error:
         raise ClusterError(f"scheduler file {path} is not a Dask scheduler file (JSON "
                            f"with its address): {error or 'not a JSON object'}") from None
     if not isinstance(address, str) or not address:

@@ -39,7 +39,7 @@ class _WorkerWatch:
 
     def __init__(self, client, timeout: float):
         self.client, self.timeout = client, timeout
-        self.interval = min(1.0, timeout / 4)
+        self.interval = max(0.05, min(1.0, timeout / 4))   # Dask fails a shorter wait
         self.seen = False                   # a worker was counted at least once
         self.gone_since: float | None = None
         self.gone_at = ""                   # when none was first counted, for the message

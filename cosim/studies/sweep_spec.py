@@ -28,7 +28,7 @@ from typing import Any
 from .. import scenarios
 from ..analysis.seastate import model_scale
 from ..core.errors import FmuNotFound, FmuUnreadable
-from ..core.files import plain_name
+from ..core.files import plain_name, read_small_text
 from ..core.fmi import read_description
 from ..core.values import Declaration, checked, declarations
 from ..core.inprocess import fallback_note
@@ -85,12 +85,8 @@ class Spec:
         More than ``max_runs`` runs are refused before any is listed."""
         path = Path(path)
         try:
-            if not path.is_file():
-                raise ValueError("no such file" if not path.exists() else "not a regular file")
-            if path.stat().st_size > MAX_SPEC_BYTES:
-                raise ValueError(f"more than {MAX_SPEC_BYTES >> 20} MiB")
-            data = tomllib.loads(path.read_text())
-        except (OSError, ValueError) as error:      # UnicodeDecodeError, TOMLDecodeError
+            data = tomllib.loads(read_small_text(path, MAX_SPEC_BYTES))
+        except ValueError as error:                 # TOMLDecodeError too
             raise ValueError(f"cannot read sweep spec {path}: {error}") from None
         unknown = set(data) - {"name", "stop_time", "controllers", "axes", "plots"}
         if unknown:
