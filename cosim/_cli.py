@@ -6,6 +6,7 @@ Only the commands (``cosim.run``, ``cosim.sweep``, ``cosim.export``, ...) import
 from __future__ import annotations
 
 import argparse
+import math
 import signal
 import sys
 import tempfile
@@ -18,6 +19,7 @@ from . import scenarios
 from .api import parse_setting
 from .core.files import plain_name
 from .core.interrupt import Interrupted, raise_on_signals
+from .core.values import fmi_value
 from .core.recording import TooManyRows
 from .scenarios.autopilot import AutopilotError, check_autopilot
 
@@ -45,13 +47,22 @@ def setting_option(text: str) -> tuple[str, str]:
         raise argparse.ArgumentTypeError(str(error)) from None
 
 
+def number_option(text: str) -> float:
+    """A finite number, for argparse, read as a Real parameter is (``core.values``: ASCII
+    digits, no '5_0', no 'inf')."""
+    try:
+        value = fmi_value("the option", "Real", text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
+    return value
+
+
 def positive_seconds(text: str) -> float:
     """A time limit in seconds, for argparse: a finite number > 0."""
-    try:
-        value = float(text)
-    except ValueError:
-        value = float("nan")
-    if not 0 < value < float("inf"):
+    value = number_option(text)
+    if not value > 0:
         raise argparse.ArgumentTypeError(f"expected a positive number of seconds, got {text!r}")
     return value
 

@@ -23,7 +23,7 @@ from typing import NamedTuple
 
 from . import scenarios
 from ._cli import (Progress, add_autopilot_options, checked_autopilot, chosen_scenarios, entry,
-                   positive_seconds, say_error, say_note, setting_option, writable_folder)
+                   number_option, positive_seconds, say_error, say_note, setting_option, writable_folder)
 from .analysis.animation import video_format
 from .analysis.cost import LAMBDA, Cost
 from .analysis.describe import conditions
@@ -114,7 +114,7 @@ def main(argv: list[str] | None = None) -> int:
                              "paper's")
     parser.add_argument("--out", type=Path,
                         help="output folder (default: results/SCENARIO, or results/ with --all)")
-    parser.add_argument("--stop-time", type=float, metavar="T",
+    parser.add_argument("--stop-time", type=number_option, metavar="T",
                         help="end of the run in s (default: the scenario's, 400 s)")
     parser.add_argument("--set", action="append", default=[], type=setting_option,
                         metavar="FMU.VAR=VALUE",
@@ -123,7 +123,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--coupling", choices=COUPLINGS, default="gauss-seidel",
                         help="gauss-seidel: along the signal flow, as the paper's Simulink "
                              "model (default); jacobi: all FMUs on the previous step's outputs")
-    parser.add_argument("--lambda", dest="lam", type=float, default=LAMBDA,
+    parser.add_argument("--lambda", dest="lam", type=number_option, default=LAMBDA,
                         help=f"weight of eq (19) (default {LAMBDA:.4f}, calibrated on calm_pd)")
     parser.add_argument("--backend", choices=RUN_BACKENDS, default="fmi",
                         help="fmi: load the FMUs from fmus/ (default); inprocess: call the "

@@ -11,6 +11,8 @@ agree on the time to within half a nanosecond drive the FMUs bit for bit alike.
 NANOSECONDS = 1_000_000_000
 MAX_TIME = 1e15
 """Largest |t| an FMU accepts, s: 30 million years, and far from overflow in nanoseconds."""
+EXACT_TIME = 2**53 / NANOSECONDS
+"""Largest |t|, s, whose every whole nanosecond a float holds (about 104 days)."""
 
 
 def nanoseconds(t: float) -> int:
@@ -45,6 +47,10 @@ def step_count(start: float, stop: float, step: float) -> int:
     if span <= 0:
         raise ValueError(f"stop time {stop} s is not after the start time {start} s")
     n, remainder = divmod(span, h)
+    if remainder and max(abs(start), abs(stop)) > EXACT_TIME:
+        raise ValueError(f"stop time {stop} s is beyond {EXACT_TIME:.4g} s (2^53 ns, 104 "
+                         "days), past which a float no longer holds every whole nanosecond: "
+                         "its steps cannot be counted exactly")
     if remainder:
         raise ValueError(f"stop time {stop} s is not a whole number of {seconds(h)} s steps "
                          f"after {start} s")

@@ -368,3 +368,30 @@ def test_a_scheduler_file_that_is_not_small_and_regular_is_refused():
     from cosim.studies.cluster import ClusterError, scheduler_address
     with pytest.raises(ClusterError, match="not a regular file"):
         scheduler_address("/dev/zero")
+
+
+@pytest.mark.parametrize("argv, said", [
+    (["--stop-time", "5_0"], "expected a finite number, got '5_0'"),
+    (["--stop-time", "inf"], "expected a finite number"),
+    (["--step-timeout", "inf"], "expected a finite number"),
+])
+def test_numbers_on_the_command_line_are_read_strictly(argv, said, capsys):
+    with pytest.raises(SystemExit) as refused:
+        cli.main(["calm_pd", *argv])
+    assert refused.value.code == 2 and said in capsys.readouterr().err
+
+
+def test_a_stop_time_past_exact_nanoseconds_says_so(tmp_path, capsys):
+    assert cli.main(["calm_pd", "--stop-time", "1e14", "--out", str(tmp_path)]) == 2
+    assert "beyond 9.007e+06 s (2^53 ns, 104 days)" in capsys.readouterr().err
+
+
+def test_an_ssd_time_beyond_what_an_fmu_takes_is_refused_by_name(tmp_path):
+    from cosim import scenarios
+    from cosim.core.ssd import read_ssd
+    path = tmp_path / "far.ssd"
+    path.write_text(scenarios.path("calm_pd").read_text().replace('stopTime="400.0"',
+                                                                   'stopTime="1e300"'))
+    with pytest.raises(ValueError, match=r"far.ssd: DefaultExperiment: stopTime 1e\+300 s is "
+                                         r"beyond \+-1e\+15 s"):
+        read_ssd(path)

@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from fmubuild.project import FMU_DIR, FMUS
-from fmukit.timebase import on_time_base, step_count
+from fmukit.timebase import MAX_TIME, on_time_base, step_count
 
 from .errors import FmuNotFound
 from .values import fmi_value
@@ -312,6 +312,9 @@ class _Reader:
         for name, t in (("startTime", description.start_time),
                         ("stopTime", description.stop_time),
                         ("baseStepSize", description.step_size)):
+            if abs(t) > MAX_TIME:           # beyond what the FMUs take (and 2^63 ns)
+                raise self.error(where, f"{name} {t!r} s is beyond +-{MAX_TIME:g} s, the "
+                                        "times an FMU takes (fmukit.timebase)")
             if on_time_base(t) != t:
                 raise self.error(where, f"{name} {t!r} s is not a whole number of "
                                         "nanoseconds, the time base (fmukit.timebase)")
