@@ -22,6 +22,11 @@ USAGE = sweep.__doc__.partition("\n\nModules: ")[0]
 """--help: the sweep's documentation, without its closing paragraph on the modules."""
 
 
+OUTPUTS = ("results.parquet", "results.json", "results.csv", "J_distribution.png", "tracks.png",
+           "J_*_over_pd.png", "comparison.md")
+"""What a finished sweep writes beside its journal (by name, or glob of names)."""
+
+
 def count(text: str) -> int:
     """A whole number >= 1, for argparse."""
     try:
@@ -115,6 +120,10 @@ def main(argv: list[str] | None = None) -> int:
         print(f"  every row is kept in {out / 'runs.jsonl'}; the same command writes the "
               "tables and figures again", file=sys.stderr)
         return 2
+    for pattern in OUTPUTS:                 # a previous spec's, not rewritten: misleading
+        for stale in out.glob(pattern):
+            if stale not in written:
+                stale.unlink()
     print(summary(spec, rows))
     print(f"wrote {', '.join(str(p) for p in written)}")
     return 0 if all(r["status"] == "ok" for r in rows) else 1

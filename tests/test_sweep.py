@@ -310,3 +310,25 @@ def test_when_every_run_fails_the_summary_still_names_each_failure(fmu_paths, tm
             child.stdout
     assert "no run succeeded: no figures drawn" in child.stderr
     assert (tmp_path / "out" / "bad" / "results.parquet").exists()
+
+
+@pytest.mark.timeout(300)
+def test_a_finished_sweep_removes_what_an_earlier_spec_of_its_name_wrote(fmu_paths, tmp_path,
+                                                                        capsys):
+    """Run a spec with pd and smc, then one of the same name with pd alone: the ratio map
+    and comparison.md of the first would otherwise stand beside the second's tables."""
+    from cosim import sweep as command
+    both = (SMALL + '[controllers]\npd = { scenario = "waves_pd" }\n'
+            'smc = { scenario = "waves_smc" }\n')
+    alone = SMALL.replace('map = ["wave_seed", "ship.delta_rate_max"]', "") + \
+        '[controllers]\npd = { scenario = "waves_pd" }\n'
+    out = tmp_path / "out"
+    assert command.main([str(write_spec(tmp_path, both)), "--out", str(out), "--workers", "1",
+                         "--no-progress"]) == 0
+    assert {"comparison.md", "J_smc_over_pd.png"} <= {p.name for p in (out / "small").iterdir()}
+    (out / "small" / "notes.txt").write_text("the user's")
+    assert command.main([str(write_spec(tmp_path, alone)), "--out", str(out), "--workers", "1",
+                         "--no-progress"]) == 0
+    left = {p.name for p in (out / "small").iterdir()}
+    assert "comparison.md" not in left and "J_smc_over_pd.png" not in left
+    assert {"results.parquet", "results.json", "J_distribution.png", "notes.txt"} <= left
