@@ -295,12 +295,12 @@ def test_missing_fmu_names_the_paths_tried_and_says_how_to_build_it(tmp_path, mo
     to build it."""
     monkeypatch.setattr(ssd, "FMU_SEARCH_PATH", [tmp_path / "empty"])
 
-    def edit(d):
-        d.components["ship"].source = str(tmp_path / "nowhere" / "ship.fmu")
+    def edit(d):                        # relative: beside the .ssd, then by name
+        d.components["ship"].source = "nowhere/ship.fmu"
     with pytest.raises(FileNotFoundError, match="one of this project's FMUs, not built") as missing:
         Master(read_ssd(_variant(tmp_path, "calm_pd", edit)))
-    assert f"tried {tmp_path / 'nowhere' / 'ship.fmu'}, {tmp_path / 'empty' / 'ship.fmu'}" \
-        in str(missing.value)
+    beside = (SCENARIOS / "nowhere" / "ship.fmu").resolve()
+    assert f"tried {beside}, {tmp_path / 'empty' / 'ship.fmu'}" in str(missing.value)
     assert missing.value.ours and "python -m" not in str(missing.value)
     variant = tmp_path / "calm_pd.ssd"
     variant.write_text((SCENARIOS / "calm_pd.ssd").read_text().replace(

@@ -395,3 +395,15 @@ def test_an_ssd_time_beyond_what_an_fmu_takes_is_refused_by_name(tmp_path):
     with pytest.raises(ValueError, match=r"far.ssd: DefaultExperiment: stopTime 1e\+300 s is "
                                          r"beyond \+-1e\+15 s"):
         read_ssd(path)
+
+
+def test_an_absolute_fmu_source_that_is_missing_is_not_replaced_by_one_of_its_name(tmp_path):
+    from cosim import scenarios
+    from cosim.core.ssd import read_ssd
+    path = tmp_path / "mine.ssd"
+    path.write_text(scenarios.path("calm_pd").read_text().replace(
+        'source="../../fmus/pd_autopilot.fmu"', 'source="/home/me/mine/pd_autopilot.fmu"'))
+    system = read_ssd(path)
+    assert system.components["autopilot"].source == "/home/me/mine/pd_autopilot.fmu"
+    with pytest.raises(FileNotFoundError, match="tried /home/me/mine/pd_autopilot.fmu;"):
+        system.fmu_path("autopilot")

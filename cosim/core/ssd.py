@@ -104,10 +104,12 @@ class SystemDescription:
 
     def fmu_candidates(self, component: str) -> list[Path]:
         """Where a component's FMU may be: its source relative to the .ssd (or the current
-        folder), then a file of that name in each of ``FMU_SEARCH_PATH``."""
+        folder), then a file of that name in each of ``FMU_SEARCH_PATH``; an absolute
+        source is only itself (another file of its name would run in its place unseen)."""
         source = Path(self.components[component].source)
         base = self.path.parent if self.path else Path.cwd()
-        candidates = [(base / source).resolve(), *(d / source.name for d in FMU_SEARCH_PATH)]
+        elsewhere = [] if source.is_absolute() else [d / source.name for d in FMU_SEARCH_PATH]
+        candidates = [(base / source).resolve(), *elsewhere]
         return list(dict.fromkeys(candidates))
 
     def fmu_path(self, component: str) -> Path:
