@@ -36,9 +36,10 @@ def main(argv: list[str] | None = None) -> int:
                              "(rad/s), psi_d (rad), output delta_c (rad)")
     add_port_options(parser)
     parser.add_argument("--set", action="append", default=[], type=setting_option,
-                        metavar="COMPONENT.VAR=VALUE",
-                        help="a parameter value for your autopilot's runs, e.g. "
-                             "autopilot.Kp=1.5; repeatable")
+                        metavar="autopilot.VAR=VALUE",
+                        help="a parameter of your autopilot, e.g. autopilot.Kp=1.5; "
+                             "repeatable (the ship, sea and route stay the paper's, the same "
+                             "for every contender)")
     parser.add_argument("--seeds", type=int, default=20, help="wave seeds of the ensemble "
                                                               "(default 20)")
     parser.add_argument("--scheduler", metavar="ADDRESS",
