@@ -2,6 +2,8 @@
 FMU there: the guidance's route in its numeric form, since OMSimulator applies no String."""
 from __future__ import annotations
 
+import os
+
 import zipfile
 from pathlib import Path
 
@@ -18,10 +20,11 @@ from cosim.interop.omsimulator import run
 from cosim.interop.ssp import SSD_NAME, export, read_package
 
 ROOT = Path(__file__).resolve().parent.parent
-OMS = ROOT.parent / "shared" / "tools" / "omsimulator"
+OMS = Path(os.environ.get("OMSIMULATOR_HOME") or ROOT.parent / "shared" / "tools" / "omsimulator")
+"""The prebuilt OMSimulator: $OMSIMULATOR_HOME, else ../shared/tools/omsimulator."""
 needs_oms = pytest.mark.skipif(not (OMS / "bin" / "OMSimulator").is_file(),
-                               reason=f"OMSimulator is not at {OMS} "
-                                      "(../shared/tools/omsimulator; CI has it)")
+                               reason=f"OMSimulator is not at {OMS} (../shared/tools/"
+                                      "omsimulator, or set OMSIMULATOR_HOME; CI has it)")
 SOUTH = "0,0;30,0;60,-25;90,-25"          # the paper's route mirrored: ends south of the start
 
 
