@@ -93,9 +93,11 @@ def run_and_write(system: SystemDescription, label: str, out: Path,
             csv_path = outputs.path(f"{label}.csv")
             forget = stop.keep(lambda: _discard(outputs, label)) if stop is not None else None
             master: Master | None = None
+            finished: list[Recording] = []    # the run, once it has returned
 
             def salvage(reason: str) -> str:      # the watchdog's, if the run never returns
-                recording = master.abandon(reason) if master is not None else None
+                recording = finished[0] if finished else \
+                    master.abandon(reason) if master is not None else None
                 if recording is None:
                     return f"nothing was written; {_discard(outputs, label)}"
                 _write_rows(recording, outputs, label, options.stream)
@@ -124,7 +126,9 @@ def run_and_write(system: SystemDescription, label: str, out: Path,
                             recording = master.run(options.stop_time, progress=progress,
                                                    csv_path=csv_path if options.stream else None,
                                                    stop=stop, watchdog=watchdog)
+                        finished.append(recording)
                         parameters = master.parameters
+                        watchdog.finishing("terminating and freeing the FMUs")
                 outcome = Outcome(recording, out / f"{label}.csv")
                 if recording.error and not recording.rows and not recording.interrupted:
                     outputs.discard()       # nothing was computed: the earlier outputs stay

@@ -57,9 +57,9 @@ def hung(fmu_paths, tmp_path_factory) -> dict[str, Path]:
 
 
 def _run(args: list[str], cwd: Path, **popen) -> subprocess.CompletedProcess:
+    popen.setdefault("env", {**os.environ, "PYTHONPATH": str(ROOT)})
     return subprocess.run([PY, "-m", "cosim.run", *args], cwd=cwd, capture_output=True,
-                          text=True, timeout=LIMIT, env={**os.environ, "PYTHONPATH": str(ROOT)},
-                          **popen)
+                          text=True, timeout=LIMIT, **popen)
 
 
 def _folder(path: Path) -> dict[str, bytes]:
@@ -407,3 +407,24 @@ def test_an_absolute_fmu_source_that_is_missing_is_not_replaced_by_one_of_its_na
     assert system.components["autopilot"].source == "/home/me/mine/pd_autopilot.fmu"
     with pytest.raises(FileNotFoundError, match="tried /home/me/mine/pd_autopilot.fmu;"):
         system.fmu_path("autopilot")
+
+
+@pytest.mark.parametrize("backend", ["fmi", "inprocess"])
+def test_an_fmu_that_hangs_in_terminate_keeps_the_finished_run(fmu_paths, tmp_path, backend):
+    """Nothing is raised into fmi2Terminate (an exception there has no safe way out of
+    pythonfmu); past the step limit the finished run's files are written and the process
+    ends, saying so."""
+    pilot = build_script(ROOT / "tests" / "faulty" / "idle_pilot_slave.py", ("fmukit",),
+                         tmp_path / "idle_pilot.fmu")
+    result = _run(["calm_pd", "--autopilot", str(pilot), "--set", "autopilot.hang_terminate=1",
+                   "--stop-time", "10", "--step-timeout", "1", "--backend", backend,
+                   "--out", str(tmp_path / "out"), "--no-plot"], tmp_path,
+                  env={**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), str(
+                      ROOT / "tests" / "faulty")])})
+    assert result.returncode == 1 and "Traceback" not in result.stderr, result.stderr
+    assert ("terminating and freeing the FMUs did not end within the step time limit of 1 s "
+            "(FMU 'autopilot' in ") in result.stderr
+    assert "the run is over" in result.stderr
+    out = tmp_path / "out"
+    assert sorted(_folder(out)) == ["calm_pd-idle_pilot.csv", "calm_pd-idle_pilot.json"]
+    assert json.loads((out / "calm_pd-idle_pilot.json").read_text())["rows"] == 101

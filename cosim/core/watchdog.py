@@ -92,12 +92,21 @@ class Watchdog:
         self._beat = self._start = time.monotonic()
         self._signal_at: float | None = None      # when a signal came
         self._halt_at: float | None = None        # when the run time limit was passed
+        self._raise = True                        # TimeLimit may be raised into the loop
         self._target = threading.get_ident()
         self._done = threading.Event()
         self._thread: threading.Thread | None = None
         self._signals = stop is not None and threading.current_thread() is threading.main_thread()
         self._wakeup: tuple[socket.socket, socket.socket] | None = None
         self._saved: tuple[int, dict] = (-1, {})
+
+    def finishing(self, what: str) -> None:
+        """The run is over and ``what`` (terminating the FMUs) begins: its time limit starts
+        now, and nothing is raised into it any more (an exception in fmi2Terminate has no
+        safe way out of pythonfmu's C++); past the limit the rows are kept (``salvage``) and
+        the process ends."""
+        self._raise = False
+        self.beat(what)
 
     def beat(self, what: str | float) -> str | None:
         """A new step (its time, in s) or call (``what``, a phrase) begins: its time limit
@@ -207,14 +216,15 @@ class Watchdog:
         where = _calling(self._target)
         self.expired = reason = f"{reason} ({where})" if where else reason
         deadline = time.monotonic() + self.limits.grace
-        while not where and time.monotonic() < deadline:   # the master's own code: its
-            if self._done.wait(0.01):                       # loop stops at the next beat
-                return
-            where = _calling(self._target)
-        if where:
-            _raise_in(self._target, TimeLimit)
-        if self._done.wait(max(deadline - time.monotonic(), 0.0) if not where
-                           else self.limits.grace):
+        if self._raise:
+            while not where and time.monotonic() < deadline:    # the master's own code:
+                if self._done.wait(0.01):                        # its loop stops at the beat
+                    return
+                where = _calling(self._target)
+            if where:
+                _raise_in(self._target, TimeLimit)
+                deadline = time.monotonic() + self.limits.grace
+        if self._done.wait(max(deadline - time.monotonic(), 0.0)):
             return
         faulthandler.dump_traceback_later(self.limits.grace + 10, exit=True)
         kept = "nothing was written"
@@ -223,8 +233,10 @@ class Watchdog:
                 kept = self.salvage(reason)
             except BaseException as error:         # whatever happens, the process ends
                 kept = f"the rows could not be written ({error})"
-        print(f"error: {reason}, and it cannot be stopped (code that is not Python); "
-              f"{kept}; ending the process", file=sys.stderr, flush=True)
+        why = ("it cannot be stopped (code that is not Python)" if self._raise else
+               "the run is over (nothing is raised into an FMU's clean-up)")
+        print(f"error: {reason}, and {why}; {kept}; ending the process", file=sys.stderr,
+              flush=True)
         status = self.stop.exit_status if self.stop is not None and self.stop.received else 1
         os._exit(status)
 

@@ -1,7 +1,8 @@
 """An autopilot that keeps the rudder amidships: it has the ports, and does not steer.
 
 With ``fail_time`` set it fails every step from then on (an exception: fmi2Fatal);
-with ``hang_time`` its step at that time never returns (a loop in Python).
+with ``hang_time`` its step at that time never returns (a loop in Python); with
+``hang_terminate`` = 1, fmi2Terminate never returns.
 """
 from fmukit.autopilot import INPUTS, rudder_command
 from fmukit.slave import ModelSlave, Var
@@ -20,7 +21,9 @@ class IdlePilotSlave(ModelSlave):
     description = "holds the rudder amidships"
     variables = (*INPUTS, rudder_command(depends=(), get=lambda slave: 0.0),
                  Var.parameter("fail_time", 1e9, "s", "fail every step from then on"),
-                 Var.parameter("hang_time", 1e9, "s", "loop for ever in the step at this time"))
+                 Var.parameter("hang_time", 1e9, "s", "loop for ever in the step at this time"),
+                 Var.parameter("hang_terminate", 0, description="1: loop for ever in "
+                               "fmi2Terminate", min=0, max=1))
 
     def build_model(self) -> Idle:
         return Idle()
@@ -30,3 +33,8 @@ class IdlePilotSlave(ModelSlave):
             raise RuntimeError(f"injected failure at t = {t}")
         while t >= self.hang_time:
             pass
+
+    def terminate(self) -> None:
+        while self.hang_terminate:
+            pass
+        super().terminate()
