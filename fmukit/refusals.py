@@ -2,9 +2,18 @@
 
 The cause travels to the host as the log message's category, ``fmukit.<cause>``
 (declared in the model description's LogCategories), so that a host tells a bad
-parameter from an input its neighbour made NaN without reading the message.
+parameter from an input its neighbour made NaN without reading the message. An
+exception of the model's own code is told by the file and line it came from
+(``located``): the innermost frame outside fmukit, the standard library and the
+installed packages, that is, in the user's script or the modules it carries.
 """
 from __future__ import annotations
+
+import functools
+import sys
+import sysconfig
+import traceback
+from pathlib import Path
 
 CAUSES = {
     "parameter": "a parameter is invalid (refused at exitInitializationMode, failing the FMU)",
@@ -34,9 +43,54 @@ class Refused(ValueError):
 
 
 def explain(error: BaseException) -> str:
-    """What went wrong, for the user: a refusal's own message, or the exception's type and
-    message."""
-    return str(error) if isinstance(error, Refused) else f"{type(error).__name__}: {error}"
+    """What went wrong, for the user: a refusal's own message, or where in the model's code
+    the exception was raised, its type and message ('my_autopilot.py:42 in step:
+    ZeroDivisionError: float division by zero')."""
+    if isinstance(error, Refused):
+        return str(error)
+    where = located(error)
+    return f"{where + ': ' if where else ''}{type(error).__name__}: {error}"
+
+
+def reason(error: BaseException) -> str:
+    """``explain``, except for a ValueError, whose message alone is the reason: by this
+    project's convention a model raises ValueError to name the value it refuses
+    ('parameter Kp = nan is not finite')."""
+    return str(error) if isinstance(error, ValueError) else explain(error)
+
+
+def located(error: BaseException) -> str:
+    """'file.py:42 in function' for the innermost frame of ``error``'s traceback in the
+    user's code, else the innermost frame of all; '' without a traceback. The file is
+    named relative to the folder on sys.path it is imported from (an FMU's resources)."""
+    frames = traceback.extract_tb(error.__traceback__)
+    if not frames:
+        return ""
+    frame = next((f for f in reversed(frames) if _users(f.filename)), frames[-1])
+    return f"{_short(frame.filename)}:{frame.lineno} in {frame.name}"
+
+
+@functools.cache
+def _not_users() -> tuple[Path, ...]:
+    """Folders of code that is not the user's: the standard library, the installed
+    packages (numpy, pythonfmu) and fmukit itself."""
+    paths = sysconfig.get_paths()
+    return tuple({Path(paths[k]).resolve() for k in ("stdlib", "platstdlib", "purelib",
+                                                     "platlib")} | {Path(__file__).resolve().parent})
+
+
+def _users(filename: str) -> bool:
+    path = Path(filename).resolve()
+    return not filename.startswith("<") and not any(f in path.parents for f in _not_users())
+
+
+def _short(filename: str) -> str:
+    """``filename`` relative to the deepest folder of sys.path that holds it, else its name."""
+    path = Path(filename).resolve()
+    roots = [Path(p or ".").resolve() for p in sys.path]
+    inside = [r for r in roots if r in path.parents]
+    return str(path.relative_to(max(inside, key=lambda r: len(r.parts)))) if inside \
+        else path.name
 
 
 def naming(instance_name: str, text: str) -> str:

@@ -30,7 +30,8 @@ only failure status there is to give (docs/robustness.md argues it):
   then fails with that message. Not fmi2ExitInitializationMode itself: OSP
   libcosim terminates its host process when that call fails;
 - invalid inputs or step sizes, or an exception in the model: fmi2DoStep fails
-  naming the cause, and the FMU has failed;
+  naming the cause (for an exception other than a ValueError, the file and line of the
+  model's code it came from: ``fmukit.refusals.explain``), and the FMU has failed;
 - once failed, every output reads NaN and every step is refused with the first
   reason, until fmi2Reset, so that a host that ignores statuses (ecos) still
   cannot pass the rest of the run off as results;
@@ -57,7 +58,7 @@ from .fastpath import FastPaths
 from .pythonfmu07 import DefaultExperiment, Fmi2Slave, Fmi2Status, signals
 from .pythonfmu07.entry import fmi_entry
 from .pythonfmu07.hostlog import HostLog
-from .refusals import CAUSES, Refused, explain, naming
+from .refusals import CAUSES, Refused, explain, naming, reason
 from .registry import Registry
 from .sequence import CallSequence
 from .timebase import MAX_TIME, on_time_base
@@ -163,8 +164,8 @@ class ModelSlave(Fmi2Slave):
                 var.check(getattr(self, var.name))
             self._model = self._started_model()   # ValueError names a bad parameter or input
         except Exception as error:            # reported now, refused at the first step
-            self.failure = (f"exitInitializationMode at t = {self.start_time}: {error}; the FMU "
-                            "has failed")
+            self.failure = (f"exitInitializationMode at t = {self.start_time}: "
+                            f"{reason(error)}; the FMU has failed")
             self.failure_cause = _cause(error, "parameter")
             self.log(naming(self.instance_name, self.failure), Fmi2Status.error,
                      f"fmukit.{self.failure_cause}")
