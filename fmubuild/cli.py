@@ -11,14 +11,22 @@ modules or packages given with --include, in its resources; the host needs Pytho
 with numpy (``fmubuild.packaging``). Its FMU is
 named after its slave's model_name and written beside the script unless --out says
 where. docs/own_autopilot.md walks through writing one.
+
+A script is refused, with one message naming it and no FMU written, if it does
+not parse (the file, the line and the line itself), if it imports a module of your own
+without --include (the module, where it is, and the command with --include), or if it
+exits when imported (sys.exit at import, the line that did).
 """
 from __future__ import annotations
 
 import argparse
+import os
 import sys
+import traceback
 from pathlib import Path
 
 from .cbuild import NoCompiler, build_c
+from .imports import Uncarried, uncarried
 from .packaging import build, build_script
 from .project import C_FMUS, FMU_DIR, FMUS
 
@@ -49,9 +57,7 @@ def main(argv: list[str] | None = None) -> int:
             elif name in C_FMUS:
                 fmu = build_c(name, args.out or FMU_DIR)
             else:
-                script = Path(name)
-                fmu = build_script(script, ("fmukit", *args.include),
-                                   args.out or script.resolve().parent)
+                fmu = _build_script(Path(name), args.include, args.out)
         except NoCompiler as missing:
             print(f"note: {missing}", file=sys.stderr)
             continue
@@ -60,6 +66,58 @@ def main(argv: list[str] | None = None) -> int:
             return 1
         print(f"built and validated {fmu}")
     return 0
+
+
+def _build_script(script: Path, includes: list[Path], out: Path | None) -> Path:
+    """A user's script built into ``out`` (default: its folder); ValueError naming the
+    script, and what is wrong with it, if it cannot be: a module it imports that its FMU
+    would not carry, or its exiting when imported."""
+    if script.is_file() and script.suffix == ".py":
+        missing = uncarried(script, includes, ("fmukit",))
+        if missing:
+            raise ValueError(_carry_them(script, includes, missing))
+    try:
+        return build_script(script, ("fmukit", *includes), out or script.resolve().parent)
+    except SystemExit as exit_:
+        raise ValueError(f"cannot build an FMU from {script}: {_exit_site(script, exit_)} "
+                         f"called sys.exit({exit_.code!r}) when imported; a slave script "
+                         "must only define its classes (move a test run under "
+                         "'if __name__ == \"__main__\":')") from None
+
+
+def _carry_them(script: Path, includes: list[Path], missing: list[Uncarried]) -> str:
+    """What to do about modules a script's FMU would not carry: the command with an
+    --include for each, where this build finds it."""
+    one = len(missing) == 1
+    lines = [f"cannot build an FMU from {script}: {'a module' if one else 'modules'} it "
+             f"imports would not be in the FMU, and a host has only the FMU:"]
+    for m in missing:
+        where = (f"found at {_shown(m.found)}" if m.found else
+                 "found neither here nor among the packages installed in this Python: "
+                 "pip install it, if it is a package")
+        lines.append(f"  {_shown(m.importer)} imports {m.module} ({where})")
+    paths = [_shown(m.found) if m.found else f"PATH/TO/{m.module}.py" for m in missing]
+    command = ["python -m fmukit.build", _shown(script),
+               *(f"--include {_shown(p)}" for p in includes), *(f"--include {p}" for p in paths)]
+    lines.append(f"carry {'it' if one else 'them'} with --include "
+                 f"(a module's file or a package's folder):\n  {' '.join(command)}")
+    return "\n".join(lines)
+
+
+def _shown(path: Path) -> str:
+    """A path as a command typed in the working directory takes it: relative to it where
+    it lies inside it."""
+    absolute = Path(path).resolve()
+    inside = Path.cwd().resolve() in absolute.parents
+    return os.path.relpath(absolute) if inside else str(absolute)
+
+
+def _exit_site(script: Path, exit_: SystemExit) -> str:
+    """'script:line' of the sys.exit in ``script`` (the innermost call in a file of its
+    name), else 'script, or a module it imports,'."""
+    frames = [f for f in traceback.extract_tb(exit_.__traceback__)
+              if Path(f.filename).name == script.name]
+    return f"{script}:{frames[-1].lineno}" if frames else f"{script}, or a module it imports,"
 
 
 if __name__ == "__main__":

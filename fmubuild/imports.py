@@ -3,12 +3,21 @@
 Read from the sources (``ast``), not by importing them: ``import a.b``, ``from a.b
 import c`` (``c`` a module or a name), and relative imports; each module comes with
 the ``__init__`` files of the packages above it. Imports of anything else (the
-standard library, numpy, pythonfmu) are the host's, and not followed.
+standard library, numpy, pythonfmu) are the host's, and not followed; ``uncarried``
+finds those a host would not have either (a module of the user's own beside the
+script), before anything is built. A source that does not parse is refused by file,
+line and the line itself.
 """
 from __future__ import annotations
 
 import ast
+import sys
+from dataclasses import dataclass
+from importlib.machinery import ModuleSpec, PathFinder
 from pathlib import Path
+from typing import Iterable
+
+from .project import ROOT
 
 
 def needed_modules(script: Path, packages: dict[str, Path]) -> dict[str, Path]:
@@ -42,7 +51,7 @@ def _imports(path: Path, module: str | None) -> list[tuple[str, bool]]:
     package = (module if path.name == "__init__.py" else module.rpartition(".")[0]) \
         if module else ""
     names = []
-    for node in ast.walk(ast.parse(path.read_bytes(), str(path))):
+    for node in ast.walk(parsed(path)):
         if isinstance(node, ast.Import):
             names += [(alias.name, True) for alias in node.names]
         elif isinstance(node, ast.ImportFrom):
@@ -70,3 +79,97 @@ def _file(module: str, packages: dict[str, Path]) -> Path | None:
         if candidate.is_file():
             return candidate
     return None
+
+
+def parsed(path: Path) -> ast.Module:
+    """The syntax tree of the Python file ``path``; ValueError naming the file, the line and
+    what is wrong there, the line shown with a caret under the fault, if it does not
+    parse."""
+    try:
+        return ast.parse(path.read_bytes(), str(path))
+    except SyntaxError as error:
+        raise ValueError(f"{path}:{error.lineno}: {type(error).__name__}: {error.msg}"
+                         f"{_quoted(error)}") from None
+
+
+def _quoted(error: SyntaxError) -> str:
+    """The offending line of a syntax error, indented, with a caret under its column."""
+    line = (error.text or "").rstrip()
+    if not line.strip():
+        return ""
+    text = line.lstrip()
+    column = max(0, min(len(text), (error.offset or 1) - 1 - (len(line) - len(text))))
+    return f"\n    {text}\n    {' ' * column}^"
+
+
+@dataclass(frozen=True)
+class Uncarried:
+    """A module that ``importer`` imports and its FMU would neither carry nor find on a
+    host: ``found`` is where this build sees it (a file, or a package's folder), None if
+    nowhere."""
+
+    module: str
+    importer: Path
+    found: Path | None
+
+
+def uncarried(script: Path, includes: Iterable[Path], carried: Iterable[str]
+              ) -> list[Uncarried]:
+    """The top-level modules that ``script`` or the Python files of ``includes`` import
+    which a host would not have: not in the standard library, not installed in this
+    Python (numpy and pythonfmu are the host's; this checkout and the folders of the
+    script, the includes and the working directory are not), not ``carried`` (fmukit)
+    and not provided by ``includes``. An import inside a ``try`` that catches ImportError is
+    optional, and not counted. ValueError if a file does not parse (``parsed``)."""
+    includes = [Path(p) for p in includes]
+    provided = {*carried, *(p.stem if p.is_file() else p.name for p in includes)}
+    local = [script.resolve().parent, Path.cwd().resolve(), ROOT,
+             *(p.resolve().parent for p in includes)]
+    host = [p for p in sys.path if p and Path(p).exists() and Path(p).resolve() not in local]
+    missing: dict[str, Uncarried] = {}
+    for file in [script, *_python_files(includes)]:
+        for module in _top_level_imports(parsed(file)):
+            if module in provided or module in sys.stdlib_module_names or module in missing \
+                    or module in sys.builtin_module_names or PathFinder.find_spec(module, host):
+                continue
+            missing[module] = Uncarried(module, file, _where(PathFinder.find_spec(
+                module, [str(folder) for folder in local])))
+    return list(missing.values())
+
+
+def _python_files(includes: list[Path]) -> list[Path]:
+    return [f for p in includes for f in ([p] if p.is_file() else sorted(p.rglob("*.py")))
+            if f.suffix == ".py"]
+
+
+def _top_level_imports(tree: ast.Module) -> list[str]:
+    """The first name of every absolute import in ``tree`` outside a try that catches
+    ImportError."""
+    optional = {id(node) for block in ast.walk(tree) if isinstance(block, ast.Try)
+                and any(_catches_import_error(h) for h in block.handlers)
+                for statement in block.body for node in ast.walk(statement)}
+    names = []
+    for node in ast.walk(tree):
+        if id(node) in optional:
+            continue
+        if isinstance(node, ast.Import):
+            names += [alias.name.split(".")[0] for alias in node.names]
+        elif isinstance(node, ast.ImportFrom) and not node.level and node.module:
+            names.append(node.module.split(".")[0])
+    return list(dict.fromkeys(names))
+
+
+def _catches_import_error(handler: ast.ExceptHandler) -> bool:
+    caught = handler.type
+    names = [caught] if not isinstance(caught, ast.Tuple) else caught.elts
+    return caught is None or any(isinstance(n, ast.Name) and n.id in (
+        "ImportError", "ModuleNotFoundError", "Exception", "BaseException") for n in names)
+
+
+def _where(spec: ModuleSpec | None) -> Path | None:
+    """The file of a module, or the folder of a package."""
+    if spec is None:
+        return None
+    if spec.submodule_search_locations:
+        return Path(next(iter(spec.submodule_search_locations)))
+    return Path(spec.origin) if spec.origin else None

@@ -6,6 +6,7 @@ script written here.
 """
 from __future__ import annotations
 
+import os
 import textwrap
 from pathlib import Path
 
@@ -13,7 +14,9 @@ import pytest
 
 from cosim import simulate
 from cosim.api import SimulationError
+from fmubuild import cli
 from fmubuild.packaging import build_script
+from fmubuild.project import ROOT
 
 FAILING_PILOT = '''\
 """A PD autopilot of a user's own that divides by zero once t reaches t_fail."""
@@ -78,3 +81,109 @@ def test_an_exception_in_a_users_fmu_names_their_file_and_line(fmu_paths, failin
     assert (f"failing_pilot.py:{line} in do_step: ZeroDivisionError: float division by zero"
             in message), message
     assert "Traceback" not in message and "slave.py" not in message
+
+
+# -- python -m fmukit.build ---------------------------------------------------------------
+LAW_PILOT = '''\
+"""An autopilot whose law is in a module of the user's own, beside the script."""
+from fmukit.autopilot import INPUTS, rudder_command
+from fmukit.slave import ModelSlave, Var
+from mylaw import pd
+
+
+class Law:
+    def snapshot(self) -> dict:
+        return {}
+
+    def restore(self, saved: dict) -> None:
+        pass
+
+
+class LawPilot(ModelSlave):
+    model_name = "law_pilot"
+    description = "a PD in a module of its own"
+    variables = (*INPUTS, rudder_command(("psi", "r", "psi_d"),
+                                         lambda s: pd(s.psi - s.psi_d, s.r)))
+
+    def build_model(self) -> Law:
+        return Law()
+
+    def step_model(self, t: float, h: float) -> None:
+        pass
+'''
+
+
+@pytest.fixture
+def law_pilot(tmp_path) -> Path:
+    """The script, its module mylaw.py beside it, not included."""
+    _script(tmp_path / "mine", "mylaw.py", "def pd(e, r):\n    return 2.0 * e + 50.0 * r\n")
+    return _script(tmp_path / "mine", "law_pilot.py", LAW_PILOT)
+
+
+@pytest.mark.parametrize("where", ["script", "project", "elsewhere"])
+def test_a_module_not_included_is_named_with_the_include_that_carries_it(
+        law_pilot, tmp_path, monkeypatch, capsys, where):
+    """From any working folder: the script's own (where the import would succeed), the
+    project's, or one holding neither."""
+    cwd = {"script": law_pilot.parent, "project": ROOT, "elsewhere": tmp_path}[where]
+    monkeypatch.chdir(cwd)
+    given, shown = (os.path.relpath(p) if cwd in p.parents else str(p)
+                    for p in (law_pilot, law_pilot.with_name("mylaw.py")))
+    assert cli.main([given]) == 1
+    err = capsys.readouterr().err
+    assert f"cannot build an FMU from {given}" in err
+    assert f"imports mylaw (found at {shown})" in err
+    assert f"python -m fmukit.build {given} --include {shown}\n" in err
+    assert not list(law_pilot.parent.glob("*.fmu"))
+
+
+@pytest.mark.timeout(300)
+def test_the_command_the_message_gives_builds_the_fmu(law_pilot, monkeypatch, capsys):
+    monkeypatch.chdir(law_pilot.parent)
+    assert cli.main([law_pilot.name]) == 1
+    command = capsys.readouterr().err.rstrip().splitlines()[-1].split()
+    assert command[:3] == ["python", "-m", "fmukit.build"]
+    assert cli.main(command[3:]) == 0
+    assert (law_pilot.parent / "law_pilot.fmu").is_file()
+
+
+def test_every_missing_module_is_named_at_once_and_an_optional_one_is_not(tmp_path,
+                                                                           monkeypatch,
+                                                                           capsys):
+    _script(tmp_path, "gains.py", "KP = 2.0\n")
+    script = _script(tmp_path, "several.py", '''\
+        import gains
+        import nowhere_to_be_found
+        from fmukit.slave import ModelSlave
+        try:
+            import an_optional_speedup
+        except ImportError:
+            an_optional_speedup = None
+        ''')
+    monkeypatch.chdir(tmp_path)
+    assert cli.main([script.name]) == 1
+    err = capsys.readouterr().err
+    assert "imports gains (found at gains.py)" in err
+    assert "imports nowhere_to_be_found (found neither here nor among the packages" in err
+    assert "--include gains.py --include PATH/TO/nowhere_to_be_found.py" in err
+    assert "an_optional_speedup" not in err
+
+
+def test_a_syntax_error_is_one_message_with_its_file_line_and_the_line(tmp_path, capsys):
+    script = _script(tmp_path, "broken.py", FAILING_PILOT.replace(
+        "return {}", "return {'t': 1.0)", 1))
+    line = _line_of(script, "{'t': 1.0)")
+    assert cli.main([str(script)]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith(f"error: {script}:{line}: SyntaxError: ")
+    assert "\n    return {'t': 1.0)\n" in err
+    assert "Traceback" not in err and not list(tmp_path.glob("*.fmu"))
+
+
+def test_a_script_that_exits_when_imported_is_refused_by_its_line(tmp_path, capsys):
+    script = _script(tmp_path, "exits.py", FAILING_PILOT + "\nimport sys\nsys.exit(0)\n")
+    assert cli.main([str(script)]) == 1
+    err = capsys.readouterr().err
+    assert (f"cannot build an FMU from {script}: {script}:{_line_of(script, 'sys.exit(0)')} "
+            "called sys.exit(0) when imported") in err
+    assert not list(tmp_path.glob("*.fmu"))
