@@ -1,10 +1,14 @@
-"""Figures of merit of a heading response: eq (19) cost, settling, overshoot, chattering."""
+"""Figures of merit of a heading response and of a route: eq (19) cost, settling, overshoot,
+rudder activity, cross-track error and route completion. SI units and radians throughout."""
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from typing import Sequence
 
 import numpy as np
 
+from autopilot_fmu.guidance import WaypointGuidance
 from fmukit.numerics import wrap
 
 
@@ -16,6 +20,16 @@ def heading_error(psi_d: np.ndarray, psi: np.ndarray) -> np.ndarray:
 def cost_terms(psi_d: np.ndarray, psi: np.ndarray, delta: np.ndarray) -> tuple[float, float]:
     """(psi_E, sum delta^2) of eq (19), over the samples given, rad^2."""
     return float(np.sum(heading_error(psi_d, psi) ** 2)), float(np.sum(np.square(delta)))
+
+
+def rms(values: np.ndarray) -> float:
+    """Root mean square over the samples, in the values' unit."""
+    return math.sqrt(float(np.mean(np.square(values))))
+
+
+def peak(values: np.ndarray) -> float:
+    """Largest magnitude over the samples, in the values' unit."""
+    return float(np.max(np.abs(values)))
 
 
 def settling_time(t: np.ndarray, error: np.ndarray, band: float) -> float:
@@ -35,8 +49,68 @@ def overshoot(psi: np.ndarray, psi_start: float, psi_target: float) -> float:
 
 
 def sign_reversals_per_minute(t: np.ndarray, delta: np.ndarray) -> float:
-    """How often the rudder crosses from one side to the other, per minute."""
+    """Rudder reversals: how often the rudder crosses from one side to the other, per
+    minute."""
     signs = np.sign(delta)
     signs = signs[signs != 0]
     reversals = int(np.count_nonzero(signs[1:] != signs[:-1]))
     return reversals / ((t[-1] - t[0]) / 60.0)
+
+
+def mean_abs_rate(t: np.ndarray, delta: np.ndarray) -> float:
+    """Mean |d delta / dt| over the run, rad/s: the rudder's total travel over the time."""
+    return float(np.sum(np.abs(np.diff(delta)))) / float(t[-1] - t[0])
+
+
+def fraction_at_stops(delta: np.ndarray, delta_max: float) -> float:
+    """Share of the samples (0 to 1) with the rudder on its stops, |delta| >= delta_max."""
+    return float(np.mean(np.abs(delta) >= delta_max * (1 - 1e-9)))
+
+
+def cross_track_error(x: np.ndarray, y: np.ndarray, wp_index: np.ndarray,
+                      points: Sequence[tuple[float, float]]) -> np.ndarray:
+    """Signed distance of (x, y) from the line of the leg the guidance follows, m, positive
+    to starboard of it (Fossen 2011, ch 10: e = -(x - x_k) sin alpha_k + (y - y_k) cos
+    alpha_k, alpha_k the leg's course of eq 18).
+
+    ``wp_index`` is the guidance's output: the waypoint steered to, so the leg runs from
+    waypoint wp_index - 1 to wp_index; once past the last (wp_index = len(points)) the
+    guidance holds the last leg's course, and the error is measured from that leg's line.
+    """
+    guidance = WaypointGuidance(points)
+    leg = np.clip(np.asarray(wp_index, dtype=int) - 1, 0, len(points) - 2)
+    alpha = np.array([guidance.course(k) for k in range(len(points) - 1)])[leg]
+    start = np.asarray(points, dtype=float)[leg]
+    return -(x - start[:, 0]) * np.sin(alpha) + (y - start[:, 1]) * np.cos(alpha)
+
+
+@dataclass(frozen=True)
+class RouteCompletion:
+    """How close the track came to each waypoint of the route, against the guidance's
+    circle of acceptance: a waypoint is reached if the ship came within R_accept of it.
+    (The guidance also moves on once a waypoint is passed along track, so a ship set off
+    its route can have every leg "done" without reaching a waypoint.)"""
+
+    points: tuple[tuple[float, float], ...]     # the route, m
+    closest: tuple[float, ...]                  # the track's closest approach to each, m
+    R_accept: float                             # radius of the circle of acceptance, m
+
+    @property
+    def reached(self) -> tuple[bool, ...]:
+        return tuple(d <= self.R_accept for d in self.closest)
+
+    @property
+    def count(self) -> int:
+        """Waypoints reached, the start (the route's first point) included."""
+        return sum(self.reached)
+
+    @property
+    def last_reached(self) -> bool:
+        return self.reached[-1]
+
+
+def route_completion(x: np.ndarray, y: np.ndarray, points: Sequence[tuple[float, float]],
+                     R_accept: float) -> RouteCompletion:
+    """Which waypoints of ``points`` the track (x, y) reached, within ``R_accept`` (m)."""
+    closest = tuple(float(np.min(np.hypot(x - px, y - py))) for px, py in points)
+    return RouteCompletion(tuple(map(tuple, points)), closest, R_accept)

@@ -14,20 +14,26 @@ import time
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
 from distributed import WorkerPlugin
 
-from autopilot_fmu.guidance import route as followed_route
+from autopilot_fmu.guidance import R_ACCEPT, route as followed_route
 
 from ..analysis.cost import cost
-from ..analysis.metrics import sign_reversals_per_minute
+from ..analysis.metrics import (cross_track_error, fraction_at_stops, heading_error,
+                                mean_abs_rate, peak, rms, route_completion,
+                                sign_reversals_per_minute)
 from ..core.provenance import code_version
 from ..core.watchdog import Limits, TimeLimit, Watchdog
 from .bundle import Bundle, materialise
 
 METRICS = {"psi_E": "rad^2", "sum_delta2": "rad^2", "J": "rad^2",
-           "rms_heading_error_deg": "deg", "reversals_per_min": "1/min", "max_delta_deg": "deg"}
-"""The figures of merit of a run and their units, as ``cosim.run`` prints them."""
+           "rms_heading_error_deg": "deg", "reversals_per_min": "1/min", "max_delta_deg": "deg",
+           "mean_rudder_rate_deg_s": "deg/s", "at_stops_pct": "%",
+           "cross_track_rms_m": "m", "cross_track_max_m": "m",
+           "waypoints_reached": "", "waypoints": "", "last_waypoint_reached": ""}
+"""The figures of merit of a run and their units, as ``cosim.run`` prints them (angles in
+degrees for display; ``run_metrics`` says what each is). Counts and the 0/1 flag have no
+unit; every value is a float, NaN in a failed run's row."""
 
 
 @dataclass(frozen=True)
@@ -150,26 +156,51 @@ def run_one(job: Job, blobs: dict[str, bytes]) -> dict[str, Any]:
             _drop_master(job)               # its FMUs may be in an error state
             row = blank_row(job.run, recording.error)
         else:
-            row.update(_metrics(recording))
+            row.update(run_metrics(recording))
             if job.track:
-                row["track"] = _track(recording, master.parameters)
+                row["track"] = _track(recording)
     row["backend"] = ran_on(master, job.backend)   # the results are the same either way
     row["seconds"] = time.perf_counter() - started
     return row
 
 
-def _track(recording, parameters: dict[str, dict[str, Any]], every: float = 1.0) -> dict:
-    """The run's track every ``every`` s, and its route, for the tracks figure."""
+def _track(recording, every: float = 1.0) -> dict:
+    """The run's track every ``every`` s, its route and circle of acceptance, for the
+    tracks figure."""
     stride = max(1, round(every / recording.meta["step_size"]))
+    points, R_accept = route_of(recording)
     return {"x": recording["ship.x"][::stride].tolist(),
             "y": recording["ship.y"][::stride].tolist(),
-            "route": [list(point) for point in followed_route(parameters.get("guidance", {}))]}
+            "route": [list(point) for point in points], "R_accept": R_accept}
 
 
-def _metrics(recording) -> dict[str, float]:
+def route_of(recording) -> tuple[list[tuple[float, float]], float]:
+    """The route the run's guidance followed (m) and its radius of acceptance (m), from the
+    parameter values the FMUs used."""
+    guidance = recording.meta.get("parameters", {}).get("guidance", {})
+    return followed_route(guidance), float(guidance.get("R_accept", R_ACCEPT))
+
+
+def run_metrics(recording) -> dict[str, float]:
+    """Every figure of merit of ``METRICS`` of a course-keeping run: eq (19); the RMS
+    heading error psi_d - psi; from the actual rudder ship.delta its largest angle, its
+    reversals per minute, its mean absolute rate and the time on its stops; the RMS and
+    largest cross-track error from the leg the guidance follows; and the waypoints of the
+    route reached, within the circle of acceptance, of those it has."""
     c = cost(recording)
-    delta = recording["ship.delta"]
+    t, delta, x, y = (recording.t, recording["ship.delta"], recording["ship.x"],
+                      recording["ship.y"])
+    points, R_accept = route_of(recording)
+    stops = recording.meta.get("parameters", {}).get("ship", {}).get("delta_max", math.inf)
+    track = cross_track_error(x, y, recording["guidance.wp_index"], points)
+    completion = route_completion(x, y, points, R_accept)
     return {"psi_E": c.psi_E, "sum_delta2": c.sum_delta2, "J": c.J,
-            "rms_heading_error_deg": math.degrees(math.sqrt(c.psi_E / recording.rows)),
-            "reversals_per_min": sign_reversals_per_minute(recording.t, delta),
-            "max_delta_deg": math.degrees(float(np.abs(delta).max()))}
+            "rms_heading_error_deg": math.degrees(rms(heading_error(
+                recording["guidance.psi_d"], recording["ship.psi"]))),
+            "reversals_per_min": sign_reversals_per_minute(t, delta),
+            "max_delta_deg": math.degrees(peak(delta)),
+            "mean_rudder_rate_deg_s": math.degrees(mean_abs_rate(t, delta)),
+            "at_stops_pct": 100.0 * fraction_at_stops(delta, stops),
+            "cross_track_rms_m": rms(track), "cross_track_max_m": peak(track),
+            "waypoints_reached": float(completion.count), "waypoints": float(len(points)),
+            "last_waypoint_reached": float(completion.last_reached)}
