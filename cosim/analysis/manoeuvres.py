@@ -1,10 +1,28 @@
-"""The figures of a standard manoeuvre (IMO MSC.137(76)), from its recorded trajectory:
-a turning circle's advance, transfer and tactical diameter, a zig-zag's overshoots.
+"""The figures of a standard manoeuvre and the IMO criteria they are judged by, from its
+recorded trajectory: a turning circle's advance, transfer, tactical and steady diameters, a
+zig-zag's executes, overshoots, initial turning, time to check yaw and period.
+
+Definitions and criteria: IMO Resolution MSC.137(76), "Standards for ship manoeuvrability"
+(2002), 4.2 (terms) and 5.3 (criteria), with its explanatory notes MSC/Circ.1053:
+
+- 5.3.1 turning ability: advance <= 4.5 L, tactical diameter <= 5 L (35 deg rudder, or the
+  largest permissible);
+- 5.3.2 initial turning ability: with 10 deg rudder, no more than 2.5 L travelled by the
+  time the heading has changed by 10 deg;
+- 5.3.3 yaw checking: the 10/10 zig-zag's first overshoot <= 10 deg if L/V < 10 s, 20 deg
+  if L/V >= 30 s, 5 + L/(2V) deg between; its second overshoot <= 25 deg, 40 deg, and
+  17.5 + 0.75 L/V deg between (not a fixed margin over the first: 15 deg at 10 s, 20 at
+  30 s); the 20/20 zig-zag's first overshoot <= 25 deg.
+
+The standard is for ships of 100 m and over. CyberShip II is a 1:70 model (L = 1.255 m), so
+the criteria apply here through Froude scaling: angles and lengths in ship lengths are the
+same at both scales, but L/V is a time, and times scale with sqrt(70): the model's
+L/V = 4.2 s is 35 s at full scale, and that is what sets the overshoot limits.
 
 A positive rudder turns the ship to port, so headings go negative first. The
-co-simulated scenarios (``cosim/scenarios/turning_circle.ssd``, ``zigzag_20_20.ssd``:
-``reports``, ``figures``) and the ship run alone in-process (``turning_circle``,
-``zigzag``, by ``ship_fmu.trial``) share these figures.
+co-simulated scenarios (``cosim/scenarios/turning_circle.ssd``, ``zigzag_*.ssd``:
+``reports``, ``plates``) and the ship run alone in-process (``turning_circle``,
+``zigzag``, by ``ship_fmu.trial``) share these figures. SI units and radians throughout.
 """
 from __future__ import annotations
 
@@ -13,9 +31,38 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ship_fmu.data import Hull
 from ship_fmu.manoeuvres import RudderProgram
-from ship_fmu.trial import trial
+from ship_fmu.trial import DT, trial
 from ship_fmu.vessel import VesselParameters
+
+from ..core.recording import Recording
+from .seastate import SCALE
+
+STANDARD = "MSC.137(76)"
+ADVANCE_LIMIT = 4.5                   # ship lengths, 5.3.1
+TACTICAL_DIAMETER_LIMIT = 5.0         # ship lengths, 5.3.1
+INITIAL_TURNING_LIMIT = 2.5           # ship lengths, 5.3.2
+FIRST_OVERSHOOT_20_LIMIT = math.radians(25.0)   # 5.3.3.3
+TURNING_RUDDER = math.radians(35.0)   # 4.2.2: 35 deg, or the largest permissible
+_SAME_ANGLE = 1e-6                    # rad: a test's angles match the standard's within this
+
+
+@dataclass(frozen=True)
+class Criterion:
+    """One MSC.137(76) criterion: a figure of the run, its limit and the clause setting it."""
+
+    figure: str      # what is judged, in the standard's words
+    value: float     # in ``unit``; NaN if the run never produced it (a turn never checked)
+    limit: float     # the largest value that passes, in ``unit``
+    unit: str        # "L" (ship lengths) or "rad"
+    clause: str      # of MSC.137(76)
+    basis: str = ""  # what set the limit, if it depends on the ship (L/V)
+
+    @property
+    def passed(self) -> bool:
+        """Whether the figure is within its limit (a figure never produced fails)."""
+        return bool(self.value <= self.limit)
 
 
 @dataclass(frozen=True)
@@ -25,60 +72,248 @@ class TurningCircle:
     tactical_diameter: float     # m, across the approach course at 180 deg
     steady_yaw_rate: float       # rad/s, signed, at the end of the run
     steady_speed: float          # m/s, sqrt(u^2 + v^2) at the end of the run
+    steady_diameter: float = math.nan   # m, of a circle fitted to the last lap of the track
+    approach_speed: float = math.nan    # m/s, sqrt(u^2 + v^2) at the rudder order
+    drift_angle: float = math.nan       # rad, atan2(v, u) at the end of the run
+    course_change_at_tactical: float = math.nan  # rad, where the heading has changed 180 deg
+
+    @property
+    def diameter_from_rates(self) -> float:
+        """2 U / |r| of the steady turn, m: the steady diameter if the turn has settled."""
+        return 2.0 * self.steady_speed / abs(self.steady_yaw_rate)
+
+
+@dataclass(frozen=True)
+class Overshoot:
+    """A checked turn: how far the heading went beyond the switching angle, and when."""
+
+    angle: float     # rad, beyond the switching angle
+    time: float      # s, when the heading deviation peaked (NaN without times)
+    heading: float   # rad, the heading deviation at the peak, signed
 
 
 @dataclass(frozen=True)
 class ZigZagResult:
-    first_overshoot: float       # rad; NaN if the turn was never checked (no second reversal)
-    second_overshoot: float      # rad; NaN if there was no third reversal
-    reversals: int               # rudder reversals the test reached
+    """A delta/psi_switch zig-zag's figures, as MSC/Circ.1053 draws them."""
+
+    reversals: int                         # rudder reversals the test reached
+    psi_switch: float = math.nan           # rad, heading deviation that reverses the rudder
+    overshoots: tuple[Overshoot, ...] = ()  # one per checked turn, in order
+    executes: tuple[float, ...] = ()       # s, the rudder orders: the first, then reversals
+    initial_turning_distance: float = math.nan  # m travelled until |psi| reached psi_switch
 
     @property
     def checked(self) -> bool:
         """Whether the ship checked its turns: three reversals, both overshoots defined."""
         return self.reversals >= 3
 
+    def overshoot(self, n: int) -> float:
+        """The n-th overshoot angle (1, 2, ...), rad; NaN if that turn was never checked."""
+        return self.overshoots[n - 1].angle if len(self.overshoots) >= n else math.nan
+
+    @property
+    def first_overshoot(self) -> float:
+        return self.overshoot(1)
+
+    @property
+    def second_overshoot(self) -> float:
+        return self.overshoot(2)
+
+    @property
+    def initial_turning_time(self) -> float:
+        """From the first execute to the second (|psi| reached psi_switch), s."""
+        return self._between(0, 1)
+
+    @property
+    def time_to_check_yaw(self) -> float:
+        """From the second execute to the first overshoot's peak (yaw rate zero), s."""
+        if not self.overshoots or len(self.executes) < 2:
+            return math.nan
+        return self.overshoots[0].time - self.executes[1]
+
+    @property
+    def period(self) -> float:
+        """One full cycle, from the second execute to the fourth, s."""
+        return self._between(1, 3)
+
+    def _between(self, first: int, last: int) -> float:
+        """Time from execute ``first`` to execute ``last`` (0-based), s; NaN if not reached."""
+        return self.executes[last] - self.executes[first] if len(self.executes) > last \
+            else math.nan
+
+
+def _first_reaching(level: np.ndarray, target: float, *series: np.ndarray) -> list[float]:
+    """Each series, linearly interpolated where ``level`` first reaches ``target``."""
+    i = int(np.argmax(level >= target))
+    if level[i] < target or i == 0:
+        raise ValueError(f"heading never changed by {math.degrees(target):.0f} deg")
+    w = (target - level[i - 1]) / (level[i] - level[i - 1])
+    return [float(s[i - 1] + w * (s[i] - s[i - 1])) for s in series]
 
 
 def crossing(x: np.ndarray, y: np.ndarray, psi: np.ndarray,
-              target: float) -> tuple[float, float]:
-    """(x, y) where |psi| first reaches target, linearly interpolated."""
-    heading = np.abs(psi)
-    i = int(np.argmax(heading >= target))
-    if heading[i] < target or i == 0:
-        raise ValueError(f"heading never changed by {math.degrees(target):.0f} deg")
-    w = (target - heading[i - 1]) / (heading[i] - heading[i - 1])
-    return x[i - 1] + w * (x[i] - x[i - 1]), y[i - 1] + w * (y[i] - y[i - 1])
+             target: float) -> tuple[float, float]:
+    """(x, y) where the heading has first changed by target from psi[0], interpolated."""
+    psi = np.asarray(psi)
+    x_at, y_at = _first_reaching(np.abs(psi - psi[0]), target, np.asarray(x), np.asarray(y))
+    return x_at, y_at
+
+
+def approach_frame(x: np.ndarray, y: np.ndarray, psi0: float) -> tuple[np.ndarray, np.ndarray]:
+    """(along, across) the approach course psi0 from the first point, m (across: to
+    starboard of it)."""
+    dx, dy = np.asarray(x) - x[0], np.asarray(y) - y[0]
+    c, s = math.cos(psi0), math.sin(psi0)
+    return dx * c + dy * s, -dx * s + dy * c
+
+
+def fitted_diameter(x: np.ndarray, y: np.ndarray) -> float:
+    """Diameter of the circle fitted to the points (x, y) by least squares (Kasa), m."""
+    x, y = np.asarray(x), np.asarray(y)
+    A = np.column_stack([2.0 * x, 2.0 * y, np.ones_like(x)])
+    (cx, cy, c), *_ = np.linalg.lstsq(A, x * x + y * y, rcond=None)
+    return 2.0 * math.sqrt(c + cx * cx + cy * cy)
+
+
+def _last_lap_diameter(x: np.ndarray, y: np.ndarray, psi: np.ndarray) -> float:
+    """The steady turning diameter: a circle fitted to the track over the last 360 deg of
+    heading, m; NaN unless the heading turned 540 deg (the lap starts past 180 deg)."""
+    if abs(psi[-1] - psi[0]) < 3.0 * math.pi:
+        return math.nan
+    lap = np.abs(psi[-1] - psi) <= 2.0 * math.pi
+    return fitted_diameter(x[lap], y[lap])
 
 
 def turning_circle_figures(x, y, psi, u, v, r) -> TurningCircle:
-    """Turning-circle figures of a run that starts along x at psi = 0."""
-    x, y, psi = map(np.asarray, (x, y, psi))
-    advance, transfer = crossing(x, y, psi, math.pi / 2)
-    _, across = crossing(x, y, psi, math.pi)
-    return TurningCircle(advance=float(advance), transfer=float(abs(transfer)),
-                         tactical_diameter=float(abs(across)),
+    """Turning-circle figures of a run from steady straight running along psi[0]."""
+    x, y, psi, u, v, r = map(np.asarray, (x, y, psi, u, v, r))
+    along, across = approach_frame(x, y, float(psi[0]))
+    change = np.abs(psi - psi[0])
+    advance, transfer = _first_reaching(change, math.pi / 2, along, across)
+    _, tactical, u180, v180 = _first_reaching(change, math.pi, along, across, u, v)
+    turn = math.copysign(math.pi, psi[-1] - psi[0])
+    course = turn + math.atan2(v180, u180) - math.atan2(v[0], u[0])
+    return TurningCircle(advance=advance, transfer=abs(transfer),
+                         tactical_diameter=abs(tactical),
                          steady_yaw_rate=float(r[-1]),
-                         steady_speed=float(math.hypot(u[-1], v[-1])))
+                         steady_speed=float(math.hypot(u[-1], v[-1])),
+                         steady_diameter=_last_lap_diameter(x, y, psi),
+                         approach_speed=float(math.hypot(u[0], v[0])),
+                         drift_angle=float(math.atan2(v[-1], u[-1])),
+                         course_change_at_tactical=abs(course))
 
 
-def zigzag_figures(psi, reversals, psi_switch: float) -> ZigZagResult:
-    """Overshoot angles after the first and second rudder reversal.
+def zigzag_figures(psi, reversals, psi_switch: float, t=None, x=None,
+                   y=None) -> ZigZagResult:
+    """A zig-zag's figures from its heading deviation psi (the rudder program's, from
+    psi = 0) and the program's reversal count, each sample.
 
-    An overshoot is measured once the next reversal shows the turn was checked; a
-    ship that never checks its turn (a straight-line unstable one, with too little
-    rudder) leaves it NaN.
+    An overshoot is measured once the next reversal shows the turn was checked; a ship
+    that never checks its turn (a straight-line unstable one, with too little rudder)
+    has none. The times (executes, overshoots, initial turning, period) need ``t``, the
+    distance travelled to the switching angle needs ``x`` and ``y``: without them those
+    are empty or NaN.
     """
-    psi, reversals = np.abs(np.asarray(psi)), np.asarray(reversals)
+    psi, reversals = np.asarray(psi), np.asarray(reversals)
+    times = np.asarray(t) if t is not None else np.full(len(psi), math.nan)
     reached = int(reversals.max())
+    overshoots = []
+    for n in range(1, reached):
+        turn = np.flatnonzero(reversals == n)
+        k = turn[np.argmax(np.abs(psi[turn]))]
+        overshoots.append(Overshoot(float(abs(psi[k]) - psi_switch), float(times[k]),
+                                    float(psi[k])))
+    executes = () if t is None else (float(times[0]), *(
+        float(times[k]) for k in np.flatnonzero(np.diff(reversals)) + 1))
+    distance = math.nan
+    if x is not None and y is not None and np.abs(psi).max() >= psi_switch:
+        travelled = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(x), np.diff(y)))])
+        distance, = _first_reaching(np.abs(psi), psi_switch, travelled)
+    return ZigZagResult(reached, psi_switch, tuple(overshoots), executes, distance)
 
-    def overshoot(n: int) -> float:
-        return float(psi[reversals == n].max() - psi_switch) if reached > n else math.nan
-    return ZigZagResult(overshoot(1), overshoot(2), reached)
+
+def length_over_speed(length: float, speed: float, scale: float = SCALE) -> float:
+    """L/V at full scale, s, of a model of ``length`` m at ``speed`` m/s: Froude scaling
+    multiplies the model's L/V by sqrt(scale)."""
+    return math.sqrt(scale) * length / speed
 
 
+def overshoot_limits(lv: float) -> tuple[float, float]:
+    """(first, second) overshoot limits of the 10/10 zig-zag, rad, for L/V in s at full
+    scale (MSC.137(76) 5.3.3.1-2)."""
+    if lv < 10.0:
+        first, second = 10.0, 25.0
+    elif lv >= 30.0:
+        first, second = 20.0, 40.0
+    else:
+        first, second = 5.0 + 0.5 * lv, 17.5 + 0.75 * lv
+    return math.radians(first), math.radians(second)
 
-def turning_circle(delta: float = math.radians(35.0), t_end: float = 300.0,
+
+def _is(angle: float, degrees: float) -> bool:
+    return abs(angle - math.radians(degrees)) < _SAME_ANGLE
+
+
+def turning_circle_criteria(tc: TurningCircle, delta: float, delta_max: float,
+                            length: float = Hull.L) -> tuple[Criterion, ...]:
+    """MSC.137(76) 5.3.1, for a turning circle at 35 deg rudder or the largest the gear
+    allows; none for another rudder angle."""
+    if abs(delta - min(TURNING_RUDDER, delta_max)) >= _SAME_ANGLE:
+        return ()
+    return (Criterion("advance", tc.advance / length, ADVANCE_LIMIT, "L", "5.3.1"),
+            Criterion("tactical diameter", tc.tactical_diameter / length,
+                      TACTICAL_DIAMETER_LIMIT, "L", "5.3.1"))
+
+
+def zigzag_criteria(zz: ZigZagResult, delta: float, approach_speed: float,
+                    length: float = Hull.L, scale: float = SCALE) -> tuple[Criterion, ...]:
+    """MSC.137(76) 5.3.2-3 for a 10/10 or a 20/20 zig-zag; none for another test."""
+    if _is(delta, 10.0) and _is(zz.psi_switch, 10.0):
+        lv = length_over_speed(length, approach_speed, scale)
+        first, second = overshoot_limits(lv)
+        basis = (f"L/V = {lv:.1f} s at full scale (1:{scale:g}; "
+                 f"{length / approach_speed:.2f} s for the model)")
+        return (Criterion("initial turning: distance by 10 deg heading change",
+                          zz.initial_turning_distance / length, INITIAL_TURNING_LIMIT, "L",
+                          "5.3.2"),
+                Criterion("first overshoot", zz.first_overshoot, first, "rad", "5.3.3.1",
+                          basis),
+                Criterion("second overshoot", zz.second_overshoot, second, "rad", "5.3.3.2",
+                          basis))
+    if _is(delta, 20.0) and _is(zz.psi_switch, 20.0):
+        return (Criterion("first overshoot", zz.first_overshoot, FIRST_OVERSHOOT_20_LIMIT,
+                          "rad", "5.3.3.3"),)
+    return ()
+
+
+@dataclass(frozen=True)
+class Assessment:
+    """A recorded manoeuvre: its figures and the criteria that apply to it."""
+
+    figures: TurningCircle | ZigZagResult
+    criteria: tuple[Criterion, ...]
+    delta: float                # rad, the test's rudder angle
+    length: float = Hull.L      # m, the ship's
+
+
+def turning_circle_of(run: Recording) -> Assessment:
+    """The turning circle of a recorded run, and its criteria."""
+    tc = turning_circle_figures(*(run[f"ship.{n}"] for n in ("x", "y", "psi", "u", "v", "r")))
+    p = run.meta["parameters"]
+    delta = p["program"]["delta"]
+    return Assessment(tc, turning_circle_criteria(tc, delta, p["ship"]["delta_max"]), delta)
+
+
+def zigzag_of(run: Recording) -> Assessment:
+    """The zig-zag of a recorded run, and its criteria."""
+    program = run.meta["parameters"]["program"]
+    zz = zigzag_figures(run["ship.psi"], run["program.reversals"], program["psi_switch"],
+                        run.t, run["ship.x"], run["ship.y"])
+    approach = math.hypot(run["ship.u"][0], run["ship.v"][0])
+    return Assessment(zz, zigzag_criteria(zz, program["delta"], approach), program["delta"])
+
+
+def turning_circle(delta: float = TURNING_RUDDER, t_end: float = 300.0,
                    params: VesselParameters = VesselParameters()) -> TurningCircle:
     """Turning circle from steady straight running with rudder delta."""
     track = trial(RudderProgram(delta, 0.0), t_end, params)
@@ -88,6 +323,8 @@ def turning_circle(delta: float = math.radians(35.0), t_end: float = 300.0,
 def zigzag(delta: float = math.radians(20.0), psi_switch: float = math.radians(20.0),
            t_end: float = 300.0,
            params: VesselParameters = VesselParameters()) -> ZigZagResult:
-    """First and second overshoot angles of a delta/psi_switch zig-zag test."""
+    """The figures of a delta/psi_switch zig-zag test from steady straight running."""
     track = trial(RudderProgram(delta, psi_switch), t_end, params)
-    return zigzag_figures(track["psi"], track["reversals"], psi_switch)
+    t = DT * np.arange(len(track["psi"]))
+    return zigzag_figures(track["psi"], track["reversals"], psi_switch, t, track["x"],
+                          track["y"])
