@@ -8,8 +8,10 @@ import numpy as np
 
 from ..core.recording import Recording
 from .cost import LAMBDA, Cost, cost
-from .manoeuvres import turning_circle_figures, zigzag_figures
+from .manoeuvres import (STANDARD, Assessment, Criterion, TurningCircle, turning_circle_of,
+                         zigzag_of)
 from .metrics import sign_reversals_per_minute
+from .seastate import SCALE
 
 PAPER_TABLES = {   # Tomera (2010), Tables 1 and 2: psi_E, delta_E, J
     "calm_pd": (128.20, 128.74, 256.94), "calm_smc": (117.07, 117.42, 234.49),
@@ -33,26 +35,85 @@ def course_keeping_report(recording: Recording, lam: float = LAMBDA, **_) -> lis
             f"{sign_reversals_per_minute(t, delta):.1f} sign reversals per minute"]
 
 
+def criterion_text(c: Criterion) -> str:
+    """One criterion for people: the figure, its limit, PASS or FAIL, the clause."""
+    value = "not reached in the run" if math.isnan(c.value) else _amount(c.value, c.unit)
+    basis = f"; {c.basis}" if c.basis else ""
+    return (f"{'PASS' if c.passed else 'FAIL'}  {c.figure} {value} (limit {_amount(c.limit, c.unit)}"
+            f"; {STANDARD} {c.clause}{basis})")
+
+
+def _amount(x: float, unit: str) -> str:
+    """A criterion's value in its unit: degrees for angles, ship lengths for distances."""
+    return f"{math.degrees(x):.1f} deg" if unit == "rad" else f"{x:.2f} L"
+
+
+def scope(a: Assessment) -> str:
+    """What the criteria are worth here: the standard's ships, and this model's scale."""
+    if not a.criteria:
+        return (f"no {STANDARD} criterion applies: it judges the 35 deg turning circle and "
+                "the 10/10 and 20/20 zig-zags")
+    return (f"{STANDARD} is written for ships of 100 m and over; CyberShip II is a 1:{SCALE:g} "
+            f"model ({a.length * SCALE:.0f} m at full scale): its criteria apply here through "
+            "Froude scaling, as an indication")
+
+
+def turning_circle_lines(a: Assessment) -> list[str]:
+    """The turning circle's figures, why its two diameters differ, and its criteria."""
+    tc, L = a.figures, a.length
+    lines = [f"advance {tc.advance:.3f} m ({tc.advance / L:.2f} L), transfer {tc.transfer:.3f} m "
+             f"({tc.transfer / L:.2f} L) at 90 deg heading change; tactical diameter "
+             f"{tc.tactical_diameter:.3f} m ({tc.tactical_diameter / L:.2f} L) at 180 deg",
+             f"steady turn: {_steady_diameter(tc, L)}, yaw rate "
+             f"{math.degrees(tc.steady_yaw_rate):.3f} deg/s, speed {tc.steady_speed:.3f} m/s "
+             f"({tc.steady_speed / tc.approach_speed:.0%} of the approach), drift angle "
+             f"{math.degrees(tc.drift_angle):.1f} deg"]
+    if tc.tactical_diameter < tc.steady_diameter:
+        lines.append(f"the tactical diameter is below the steady one because the ship turns "
+                     f"with its bow {abs(math.degrees(tc.drift_angle)):.0f} deg inside its track: "
+                     f"at 180 deg heading change its course has turned only "
+                     f"{math.degrees(tc.course_change_at_tactical):.0f} deg")
+    return lines + [criterion_text(c) for c in a.criteria] + [scope(a)]
+
+
+def _steady_diameter(tc: TurningCircle, L: float) -> str:
+    """The steady turning diameter, measured and from the rates, for people."""
+    rates = f"2U/|r| = {tc.diameter_from_rates:.3f} m"
+    if math.isnan(tc.steady_diameter):
+        return f"diameter {rates} (the run turned less than 540 deg: no lap to fit)"
+    return (f"diameter {tc.steady_diameter:.3f} m ({tc.steady_diameter / L:.2f} L, circle "
+            f"fitted to the last lap; {rates})")
+
+
+def zigzag_lines(a: Assessment, psi_end: float, t_end: float) -> list[str]:
+    """The zig-zag's overshoots (or why there are none), times and criteria; ``psi_end``
+    and ``t_end``: the heading deviation (rad) and time (s) at the end of the run."""
+    zz = a.figures
+    if zz.checked:
+        lines = [f"first overshoot {math.degrees(zz.first_overshoot):.2f} deg, second "
+                 f"overshoot {math.degrees(zz.second_overshoot):.2f} deg"]
+    else:
+        lines = [f"the turn was never checked: {zz.reversals} rudder reversal(s) of 3, heading "
+                 f"{math.degrees(psi_end):.0f} deg at t = {t_end:.0f} s; with "
+                 f"{math.degrees(a.delta):.0f} deg of counter-rudder this straight-line "
+                 "unstable ship keeps turning"]
+    times = [f"initial turning time {zz.initial_turning_time:.1f} s (first to second execute, "
+             f"{zz.initial_turning_distance / a.length:.2f} L travelled)"] \
+        if len(zz.executes) > 1 else ["the heading never reached the switching angle"]
+    if zz.overshoots:
+        times.append(f"time to check yaw {zz.time_to_check_yaw:.1f} s (second execute to the "
+                     f"first overshoot, at t = {zz.overshoots[0].time:.1f} s)")
+    if not math.isnan(zz.period):
+        times.append(f"period {zz.period:.1f} s (second to fourth execute)")
+    return lines + [", ".join(times)] + [criterion_text(c) for c in a.criteria] + [scope(a)]
+
+
 def turning_circle_report(recording: Recording, **_) -> list[str]:
-    tc = turning_circle_figures(*(recording[f"ship.{n}"] for n in ("x", "y", "psi", "u", "v", "r")))
-    return [f"advance {tc.advance:.3f} m, transfer {tc.transfer:.3f} m, tactical diameter "
-            f"{tc.tactical_diameter:.3f} m, steady yaw rate "
-            f"{math.degrees(tc.steady_yaw_rate):.3f} deg/s, steady speed "
-            f"{tc.steady_speed:.3f} m/s"]
+    return turning_circle_lines(turning_circle_of(recording))
 
 
-def zigzag_report(recording: Recording, parameters: dict, **_) -> list[str]:
-    program = parameters["program"]
-    zz = zigzag_figures(recording["ship.psi"], recording["program.reversals"],
-                        program["psi_switch"])
-    if not zz.checked:
-        psi = recording["ship.psi"]
-        return [f"the turn was never checked: {zz.reversals} rudder reversal(s) of 3, heading "
-                f"{math.degrees(psi[-1]):.0f} deg at t = {recording.t[-1]:.0f} s; with "
-                f"{math.degrees(program['delta']):.0f} deg of counter-rudder this straight-line "
-                "unstable ship keeps turning"]
-    return [f"first overshoot {math.degrees(zz.first_overshoot):.2f} deg, second overshoot "
-            f"{math.degrees(zz.second_overshoot):.2f} deg"]
+def zigzag_report(recording: Recording, **_) -> list[str]:
+    return zigzag_lines(zigzag_of(recording), recording["ship.psi"][-1], recording.t[-1])
 
 
 def _label(sea: str, controller: str) -> str:
