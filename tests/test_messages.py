@@ -6,6 +6,7 @@ script written here.
 """
 from __future__ import annotations
 
+import math
 import os
 import textwrap
 from pathlib import Path
@@ -14,6 +15,9 @@ import pytest
 
 from cosim import simulate
 from cosim.api import SimulationError
+from cosim.core.values import close_matches
+from cosim.run import main as run_cli
+from cosim.scenarios.autopilot import DESCRIPTIONS, PORTS, AutopilotError, check_autopilot
 from fmubuild import cli
 from fmubuild.packaging import build_script
 from fmubuild.project import ROOT
@@ -187,3 +191,120 @@ def test_a_script_that_exits_when_imported_is_refused_by_its_line(tmp_path, caps
     assert (f"cannot build an FMU from {script}: {script}:{_line_of(script, 'sys.exit(0)')} "
             "called sys.exit(0) when imported") in err
     assert not list(tmp_path.glob("*.fmu"))
+
+
+# -- the port contract ------------------------------------------------------------------------
+DEGREES_PILOT = '''\
+"""An autopilot in degrees, with a yaw rate of another name and psi_d a parameter."""
+from fmukit.slave import ModelSlave, Var
+
+
+class Law:
+    def snapshot(self) -> dict:
+        return {}
+
+    def restore(self, saved: dict) -> None:
+        pass
+
+
+class DegreesPilot(ModelSlave):
+    model_name = "degrees_pilot"
+    description = "ports in degrees"
+    variables = (Var.input("psi", 0.0, "deg", "heading"),
+                 Var.input("R", 0.0, "deg/s", "yaw rate"),
+                 Var.parameter("psi_d", 0.0, "rad", "desired heading"),
+                 Var.output("delta_c", "deg", "rudder", depends=("psi",), get=lambda s: -s.psi))
+
+    def build_model(self) -> Law:
+        return Law()
+
+    def step_model(self, t: float, h: float) -> None:
+        pass
+'''
+
+
+@pytest.fixture(scope="module")
+def degrees_pilot(tmp_path_factory) -> Path:
+    folder = tmp_path_factory.mktemp("degrees")
+    return build_script(_script(folder, "degrees_pilot.py", DEGREES_PILOT), ("fmukit",),
+                        folder)
+
+
+def _refusal(fmu: Path, port_map: dict[str, str] | None = None) -> str:
+    with pytest.raises(AutopilotError) as refused:
+        check_autopilot(fmu, port_map)
+    return str(refused.value)
+
+
+def test_every_broken_port_is_listed_at_once_with_what_was_expected(degrees_pilot):
+    message = _refusal(degrees_pilot)
+    one_degree = f"{math.pi / 180:.6g}"
+    expected = [
+        (f"port 'psi' is in deg: expected rad; the interfaces are in SI units, angles in "
+         f"radians: declare psi in rad and convert inside the FMU (1 deg = {one_degree} rad)"),
+        f"no port 'r': expected a Real input in rad/s ({DESCRIPTIONS['r']}); did you mean 'R'?",
+        "port 'psi_d' is of causality parameter and type Real: expected a Real input in rad",
+        "port 'delta_c' is in deg: expected rad;"]
+    assert message.startswith(f"{degrees_pilot} does not keep the autopilot contract")
+    listed = [line[4:] for line in message.splitlines() if line.startswith("  - ")]
+    assert len(listed) == len(expected)
+    for line, start in zip(listed, expected):
+        assert line.startswith(start), (line, start)
+    assert "It has inputs: psi (Real, deg), R (Real, deg/s)" in message
+
+
+def test_a_mapped_port_in_degrees_per_second_is_named_by_both_names(degrees_pilot):
+    message = _refusal(degrees_pilot, {"r": "R"})
+    assert ("port 'R' (for r) is in deg/s: expected rad/s; the interfaces are in SI units, "
+            f"angles in radians: declare R in rad/s and convert inside the FMU "
+            f"(1 deg/s = {math.pi / 180:.6g} rad/s)") in message
+    assert "no port" not in message
+
+
+@pytest.mark.timeout(300)
+def test_cosim_run_refuses_it_before_anything_runs(fmu_paths, degrees_pilot, tmp_path,
+                                                   capsys):
+    assert run_cli(["calm_pd", "--autopilot", str(degrees_pilot), "--out", str(tmp_path),
+                    "--no-plot"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n  - ") == 4 and "Traceback" not in err
+    assert not list(tmp_path.rglob("*.csv"))
+
+
+def test_a_mapped_name_that_is_no_port_gets_the_closest_port(degrees_pilot):
+    assert _refusal(degrees_pilot, {"ps": "psi"}).endswith(
+        f"--map names 'ps', which is not a port of an autopilot ({', '.join(PORTS)}); "
+        "did you mean 'psi'?")
+
+
+# -- names looked up by a user's string -------------------------------------------------------
+@pytest.mark.parametrize("names, typed, meant", [
+    (["Hs", "h_max", "T0"], "hs", ["Hs"]),                      # case first
+    (["Kp", "Kd", "kd", "delta_max"], "KD", ["Kd", "kd"]),     # every case variant, first
+    (["guidance", "autopilot", "ship"], "shp", ["ship"]),
+    (["delta_rate_max", "delta_max"], "delta_mx", ["delta_max", "delta_rate_max"]),  # best first
+    (["Hs", "T0"], "wave_seed", []),                            # nothing close: no guess
+])
+def test_close_matches_put_a_difference_of_case_first(names, typed, meant):
+    assert close_matches(typed, names) == meant
+    assert typed not in close_matches(typed, [*names, typed])   # never the name itself
+
+
+@pytest.mark.parametrize("setting, hint", [
+    ("ship.hs", "FMU 'ship' (ship.fmu) has no variable 'hs'; it has: "),
+    ("shp.Hs", "--set names the component 'shp'; the system has guidance, autopilot, ship"),
+    ("ship.kd", "FMU 'ship' (ship.fmu) has no variable 'kd'; it has: "),
+])
+def test_an_unknown_name_in_set_gets_the_closest_names(fmu_paths, setting, hint):
+    meant = {"ship.hs": "'Hs'", "shp.Hs": "'ship'", "ship.kd": "'autopilot.Kd'"}[setting]
+    with pytest.raises(ValueError) as refused:
+        simulate("calm_pd", set={setting: 1}, stop_time=1.0)
+    message = str(refused.value)
+    assert message.startswith(hint) and message.endswith(f"; did you mean {meant}?"), message
+
+
+def test_a_name_like_none_gets_no_guess(fmu_paths, tmp_path, capsys):
+    assert run_cli(["calm_pd", "--set", "ship.wave_height=1", "--out", str(tmp_path),
+                    "--no-plot"]) == 2
+    err = capsys.readouterr().err
+    assert "has no variable 'wave_height'; it has: " in err and "did you mean" not in err

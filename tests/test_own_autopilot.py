@@ -65,15 +65,17 @@ def test_an_autopilot_with_other_port_names_runs_through_map(foreign, tmp_path):
 
 
 @pytest.mark.parametrize("case, args, fragment", [
-    ("renamed", [], "has no port 'psi'; an autopilot needs .* inputs: heading"),
+    ("renamed", [], "no port 'psi': expected a Real input in rad \\(ship heading\\)"),
     ("renamed", ["--map", "heading=psi"], "--map names 'heading', which is not a port"),
-    ("degrees", [], "port 'psi' is in deg; the autopilot contract is in rad"),
+    ("degrees", [], "port 'psi' is in deg: expected rad; the interfaces are in SI units, "
+                    "angles in radians: declare psi in rad and convert inside the FMU"),
     ("model_exchange", [], "is a model-exchange FMU only"),
     ("windows_only", [], "has no binary for this platform \\(linux64\\); it has win64"),
-    ("renamed", MAP[:1] + ["--map", "r=Kp"], "port 'Kp' \\(for r\\) is a parameter of type "
-                                             "Real; it must be a Real input"),
+    ("renamed", MAP[:1] + ["--map", "r=Kp"], "port 'Kp' \\(for r\\) is of causality "
+                                             "parameter and type Real: expected a Real input"),
     ("guidance", ["--map=psi=x", "--map=r=y", "--map=psi_d=x", "--map=delta_c=wp_index"],
-     "port 'wp_index' \\(for delta_c\\) is an output of type Integer; it must be a Real output"),
+     "port 'wp_index' \\(for delta_c\\) is of causality output and type Integer: expected a "
+     "Real output in rad"),
     ("not_fmu", [], "notes.fmu is not an FMU"),
 ])
 def test_an_fmu_that_breaks_the_contract_is_refused_by_name_and_nothing_runs(
@@ -133,7 +135,7 @@ def test_sweep_takes_an_autopilot_fmu_and_an_ssd_path(fmu_paths, foreign, tmp_pa
 def test_sweep_refuses_a_controller_that_breaks_the_contract(foreign, tmp_path):
     spec_path = tmp_path / "spec.toml"
     spec_path.write_text(f'[controllers]\nbad = "{foreign["degrees"]}"\n')
-    with pytest.raises(ValueError, match="controller 'bad': .*port 'psi' is in deg"):
+    with pytest.raises(ValueError, match="(?s)controller 'bad': .*port 'psi' is in deg"):
         sweep.Spec.read(spec_path)
 
 
@@ -156,7 +158,7 @@ def test_exported_package_carries_the_autopilot_and_runs_in_libcosim(foreign, tm
 def test_check_autopilot_accepts_every_autopilot_of_the_project(fmu_paths):
     for name in ("pd_autopilot", "smc_autopilot", "pid_autopilot"):
         assert check_autopilot(fmu_paths[name]).coSimulation is not None
-    with pytest.raises(AutopilotError, match="has no port 'psi'"):
+    with pytest.raises(AutopilotError, match="no port 'psi'"):
         check_autopilot(fmu_paths["guidance"])
 
 

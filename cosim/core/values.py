@@ -20,7 +20,8 @@ what the variable takes. Two stages:
   and within the declared min and max, an Integer within them, an Enumeration one of
   its items (by number or by name).
 
-``setting`` also refuses a variable that does not exist or that a master may not set
+``setting`` also refuses a variable that does not exist (naming the closest names, as
+``parameters`` does for a component) or that a master may not set
 in initialisation mode, where ours sets them (section 4.2.4: variability other than
 constant and initial exact, or an input): outputs, calculated parameters, constants,
 locals; ``parameters`` checks every value of a run so (``Master.configure``), from
@@ -28,6 +29,7 @@ the model descriptions alone, before any FMU is instantiated.
 """
 from __future__ import annotations
 
+import difflib
 import math
 import numbers
 import re
@@ -157,11 +159,12 @@ def _refused(target: str, value: Any, refusal: _Refusal, takes: str) -> ValueErr
 
 
 def setting(component: str, path: str | Path, declared: dict[str, Declaration], name: str,
-            value: Any) -> Value:
+            value: Any, elsewhere: Mapping[str, Iterable[str]] | None = None) -> Value:
     """``checked`` for the variable ``name`` of ``component`` (its FMU at ``path``),
-    which must exist and be settable; ValueError naming what the FMU has otherwise."""
+    which must exist and be settable; ValueError naming what the FMU has otherwise (and,
+    for a name only ``elsewhere`` has, by component, which component has it)."""
     if name not in declared:
-        raise no_variable(component, path, declared, name)
+        raise no_variable(component, path, declared, name, elsewhere)
     declaration = declared[name]
     if not declaration.settable:
         kind = (f"a {declaration.variability} {declaration.causality}"
@@ -175,11 +178,52 @@ def setting(component: str, path: str | Path, declared: dict[str, Declaration], 
     return checked(component, declaration, value)
 
 
-def no_variable(component: str, path: str | Path, names: Iterable[str],
-                name: str) -> ValueError:
-    """The error for a variable the FMU does not have, listing those it has."""
+def no_variable(component: str, path: str | Path, names: Iterable[str], name: str,
+                elsewhere: Mapping[str, Iterable[str]] | None = None) -> ValueError:
+    """The error for a variable the FMU does not have: those it has, and the closest of
+    them or else a variable of that name (but for case) of another component
+    (``elsewhere``: its variables' names, by component)."""
+    names = list(names)
+    others = [f"{c}.{n}" for c, theirs in (elsewhere or {}).items() for n in theirs
+              if n.lower() == name.lower()]
     return ValueError(f"FMU '{component}' ({Path(path).name}) has no variable '{name}'; "
-                      f"it has: {', '.join(names)}")
+                      f"it has: {', '.join(names)}"
+                      f"{did_you_mean(close_matches(name, names) or others)}")
+
+
+def no_component(components: Iterable[str], name: str) -> ValueError:
+    """The error for a component a system does not have: those it has, and the closest."""
+    components = list(components)
+    return ValueError(f"--set names the component '{name}'; the system has "
+                      f"{', '.join(components)}{did_you_mean(close_matches(name, components))}")
+
+
+CLOSE = 0.7
+"""How alike (``difflib``'s ratio, 0 to 1) a name must be to the one typed to be offered
+instead: 'ship' for 'shp' (0.86), 'delta_max' for 'delta_mx' (0.94); not 'wave_seed' for
+'wave_height' (0.6), a guess that would mislead."""
+
+
+def close_matches(name: str, names: Iterable[str]) -> list[str]:
+    """The names a user who typed ``name`` most likely meant, best first: those equal to it
+    but for case, then up to three ``CLOSE`` ones by ``difflib`` (ignoring case)."""
+    names = list(dict.fromkeys(names))
+    same = [n for n in names if n.lower() == name.lower() and n != name]
+    folded = {}
+    for n in names:
+        folded.setdefault(n.lower(), n)
+    close = [folded[n] for n in difflib.get_close_matches(name.lower(), list(folded), 3, CLOSE)]
+    return list(dict.fromkeys(n for n in [*same, *close] if n != name))
+
+
+def did_you_mean(matches: list[str]) -> str:
+    """"; did you mean 'Hs'?", the end of a message, for ``matches`` (``close_matches``);
+    '' for none."""
+    quoted = [f"'{n}'" for n in matches]
+    if not quoted:
+        return ""
+    listed = quoted[0] if len(quoted) == 1 else f"{', '.join(quoted[:-1])} or {quoted[-1]}"
+    return f"; did you mean {listed}?"
 
 
 def _article(word: str) -> str:
@@ -297,6 +341,9 @@ def parameters(system: SystemDescription, paths: dict[str, Path],
             raise ValueError(f"set: the values for '{component}' must map variable names to "
                              f"values, got {values!r}")
         given[component] = dict(values)
+    for component in given:
+        if component not in system.components:
+            raise no_component(system.components, component)
     connected = {(c.end_element, c.end_connector): f"{c.start_element}.{c.start_connector}"
                  for c in system.connections}
     result: dict[str, dict[str, Value]] = {}
@@ -307,8 +354,10 @@ def parameters(system: SystemDescription, paths: dict[str, Path],
                 if (component, name) in connected:
                     raise ValueError(f"{component}.{name} is an input that the connection "
                                      f"from {connected[component, name]} sets")
-                result[component][name] = setting(component, paths[component],
-                                                  declared[component], name, value)
+                result[component][name] = setting(
+                    component, paths[component], declared[component], name, value,
+                    {c: [n for n, d in theirs.items() if d.settable]
+                     for c, theirs in declared.items() if c != component})
             except ValueError as error:
                 if name in given.get(component, {}):
                     raise

@@ -13,6 +13,8 @@ An FMU whose ports have other names maps them with ``port_map`` (contract name -
 the FMU's name, ``--map psi=heading`` on the command line). A port's unit, where
 the FMU declares one, must be the contract's: a heading in degrees is refused,
 not converted, so that a run never rests on a guess about what a number means.
+``check_autopilot`` lists every port that breaks the contract at once, each with
+what it expects (``port_problems``).
 ``with_autopilot`` puts such an FMU in place of the ``autopilot`` component of a
 course-keeping scenario; its parameters keep the FMU's defaults unless set.
 """
@@ -28,11 +30,14 @@ from fmpy.model_description import ModelDescription
 import fmukit.autopilot
 from fmubuild.trial import TrialFailed
 from fmubuild.trial import trial as instantiate_in_child
+from fmukit.units import UNITS
 
 from ..core.ssd import Connection, SystemDescription
+from ..core.values import close_matches, did_you_mean
 
 COMPONENT = "autopilot"
 PORTS = {v.name: (v.causality, v.unit) for v in fmukit.autopilot.PORTS}
+DESCRIPTIONS = {v.name: v.description for v in fmukit.autopilot.PORTS}
 
 
 class AutopilotError(ValueError):
@@ -51,6 +56,48 @@ def _listing(description: ModelDescription) -> str:
 def _mapped(port: str, port_map: dict[str, str]) -> str:
     name = port_map.get(port, port)
     return f"'{name}' (for {port})" if name != port else f"'{port}'"
+
+
+def _contract() -> str:
+    """'Real inputs psi (rad), r (rad/s), psi_d (rad) and a Real output delta_c (rad)'."""
+    def ports(causality: str) -> str:
+        return ", ".join(f"{n} ({unit})" for n, (c, unit) in PORTS.items() if c == causality)
+    return f"Real inputs {ports('input')} and a Real output {ports('output')}"
+
+
+def port_problems(description: ModelDescription, port_map: dict[str, str]) -> list[str]:
+    """Every way the FMU's variables break the port contract, each with what it expects: a
+    port missing (with the names closest to it), of the wrong causality or type, or in
+    another unit."""
+    variables = {v.name: v for v in description.modelVariables}
+    problems = []
+    for port, (causality, unit) in PORTS.items():
+        name, mapped = port_map.get(port, port), _mapped(port, port_map)
+        variable = variables.get(name)
+        if variable is None:
+            close = close_matches(name, variables)
+            problems.append(f"no port {mapped}: expected a Real {causality} in {unit} "
+                            f"({DESCRIPTIONS[port]}){did_you_mean(close)}")
+            continue
+        if variable.causality != causality or variable.type != "Real":
+            problems.append(f"port {mapped} is of causality {variable.causality} and type "
+                            f"{variable.type}: expected a Real {causality} in {unit}")
+        declared = variable.unit or (variable.declaredType.unit if variable.declaredType
+                                     else None)
+        if declared and declared != unit:
+            problems.append(f"port {mapped} is in {declared}: expected {unit}"
+                            f"{_unit_advice(name, declared, unit)}")
+    return problems
+
+
+def _unit_advice(name: str, declared: str, unit: str) -> str:
+    """What to do about a port in another unit than the contract's, which is not
+    converted: declare the contract's, and convert inside the FMU (by this factor)."""
+    known = UNITS.get(declared)
+    scale = (f" (1 {declared} = {known[1] / UNITS[unit][1]:.6g} {unit})"
+             if known and known[0] == UNITS[unit][0] else "")
+    return (f"; the interfaces are in SI units, angles in radians: declare {name} in {unit} "
+            f"and convert inside the FMU{scale}")
 
 
 def check_autopilot(fmu: str | Path, port_map: dict[str, str] | None = None,
@@ -79,29 +126,16 @@ def check_autopilot(fmu: str | Path, port_map: dict[str, str] | None = None,
                              f"{', '.join(platforms) or 'none'}")
     unknown = sorted(set(port_map) - set(PORTS))
     if unknown:
-        raise AutopilotError(f"{fmu}: --map names {', '.join(map(repr, unknown))}, which is "
-                             f"not a port of an autopilot ({', '.join(PORTS)})")
-    variables = {v.name: v for v in description.modelVariables}
-    for port, (causality, unit) in PORTS.items():
-        variable = variables.get(port_map.get(port, port))
-        mapped = _mapped(port, port_map)
-        if variable is None:
-            raise AutopilotError(f"{fmu} has no port {mapped}; an autopilot needs Real inputs "
-                                 f"psi, r, psi_d and a Real output delta_c (map other names "
-                                 f"with --map PORT=NAME). It has {_listing(description)}")
-        if variable.causality != causality or variable.type != "Real":
-            article = "an" if variable.causality[0] in "aeiou" else "a"
-            raise AutopilotError(f"{fmu}: port {mapped} is {article} {variable.causality} of "
-                                 f"type {variable.type}; it must be a Real {causality}. It has "
-                                 f"{_listing(description)}")
-    for port, (_, unit) in PORTS.items():          # the structure first, then the units
-        variable = variables[port_map.get(port, port)]
-        declared = variable.unit or (variable.declaredType.unit if variable.declaredType
-                                     else None)
-        if declared and declared != unit:
-            raise AutopilotError(f"{fmu}: port {_mapped(port, port_map)} is in {declared}; "
-                                 f"the autopilot contract is in {unit} (units are not "
-                                 "converted)")
+        close = [m for u in unknown for m in close_matches(u, PORTS)]
+        raise AutopilotError(f"{fmu}: --map names {', '.join(map(repr, unknown))}, which "
+                             f"{'is not a port' if len(unknown) == 1 else 'are not ports'} "
+                             f"of an autopilot ({', '.join(PORTS)}){did_you_mean(close)}")
+    problems = port_problems(description, port_map)
+    if problems:
+        raise AutopilotError(f"{fmu} does not keep the autopilot contract ("
+                             f"{_contract()}):\n" + "".join(f"  - {p}\n" for p in problems)
+                             + f"It has {_listing(description)}. Map other names with --map "
+                             "PORT=NAME (--map psi=heading)")
     if trial:
         try:
             instantiate_in_child(fmu)
