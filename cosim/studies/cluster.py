@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import logging
+import signal
 import sys
 from pathlib import Path
 
@@ -24,12 +25,31 @@ def local_cluster(workers: int | None = None) -> LocalCluster:
     One task in flight per worker thread (worker-saturation 1.0): when a run kills
     its worker, no queued neighbour is counted as having died with it (and failed
     after three deaths).
+
+    The cluster is made with SIGINT blocked in this thread: the threads it starts here
+    (its event loop, which starts and restarts the workers) and the worker processes
+    they start (a blocked signal stays blocked through exec) never take it. A Ctrl-C at
+    a terminal goes to every process of its group; the client alone stops, and closes
+    the workers, instead of each worker printing its traceback. A Ctrl-C while the
+    cluster starts arrives once it has started (and closes it).
     """
     import dask
+    from multiprocessing import resource_tracker
 
-    with dask.config.set({"distributed.scheduler.worker-saturation": 1.0}):
-        return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                            dashboard_address=":0", silence_logs=logging.ERROR)
+    resource_tracker.ensure_running()       # starting it unblocks SIGINT in this thread
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    cluster = None
+    try:
+        with dask.config.set({"distributed.scheduler.worker-saturation": 1.0}):
+            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                   dashboard_address=":0", silence_logs=logging.ERROR)
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)   # a Ctrl-C meanwhile: here
+    except BaseException:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+        if cluster is not None:
+            cluster.close()
+        raise
+    return cluster
 
 
 class ClusterError(ValueError):
@@ -38,9 +58,9 @@ class ClusterError(ValueError):
 
 
 CONNECT_TIMEOUT = 30.0
+"""Seconds a client tries to reach an existing scheduler (Dask's own default)."""
 SCHEDULER_FILE_BYTES = 1 << 20
 """The largest scheduler file read (Dask writes a few hundred bytes)."""
-"""Seconds a client tries to reach an existing scheduler (Dask's own default)."""
 
 
 def local_workers(workers: int | None) -> tuple[int | None, str | None]:
