@@ -12,7 +12,8 @@ from typing import Callable
 from matplotlib.figure import Figure
 
 from ..core.recording import Recording
-from .figures import course_keeping_figure, turning_circle_figure, zigzag_figure
+from .figures import course_keeping_figure
+from .plates import turning_circle_plate, zigzag_plate
 from .reports import course_keeping_report, turning_circle_report, zigzag_report
 
 
@@ -26,8 +27,8 @@ class Analysis:
 
 ANALYSES = {
     "course_keeping": Analysis(course_keeping_report, course_keeping_figure),
-    "turning_circle": Analysis(turning_circle_report, turning_circle_figure),
-    "zigzag": Analysis(zigzag_report, zigzag_figure),
+    "turning_circle": Analysis(turning_circle_report, turning_circle_plate),
+    "zigzag": Analysis(zigzag_report, zigzag_plate),
     "none": Analysis(lambda recording, **_: []),
 }
 

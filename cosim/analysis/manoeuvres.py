@@ -45,6 +45,7 @@ TACTICAL_DIAMETER_LIMIT = 5.0         # ship lengths, 5.3.1
 INITIAL_TURNING_LIMIT = 2.5           # ship lengths, 5.3.2
 FIRST_OVERSHOOT_20_LIMIT = math.radians(25.0)   # 5.3.3.3
 TURNING_RUDDER = math.radians(35.0)   # 4.2.2: 35 deg, or the largest permissible
+_UNCHECKED = "none: the turn was not checked within the run"
 _SAME_ANGLE = 1e-6                    # rad: a test's angles match the standard's within this
 
 
@@ -58,6 +59,7 @@ class Criterion:
     unit: str        # "L" (ship lengths) or "rad"
     clause: str      # of MSC.137(76)
     basis: str = ""  # what set the limit, if it depends on the ship (L/V)
+    missing: str = "not reached in the run"   # why ``value`` is NaN, when it is
 
     @property
     def passed(self) -> bool:
@@ -151,11 +153,17 @@ def _first_reaching(level: np.ndarray, target: float, *series: np.ndarray) -> li
     return [float(s[i - 1] + w * (s[i] - s[i - 1])) for s in series]
 
 
+def at_heading_change(psi: np.ndarray, target: float, *series: np.ndarray) -> list[float]:
+    """Each series, linearly interpolated where the heading has first changed by ``target``
+    (rad) from psi[0]; ValueError if it never does."""
+    psi = np.asarray(psi)
+    return _first_reaching(np.abs(psi - psi[0]), target, *map(np.asarray, series))
+
+
 def crossing(x: np.ndarray, y: np.ndarray, psi: np.ndarray,
              target: float) -> tuple[float, float]:
     """(x, y) where the heading has first changed by target from psi[0], interpolated."""
-    psi = np.asarray(psi)
-    x_at, y_at = _first_reaching(np.abs(psi - psi[0]), target, np.asarray(x), np.asarray(y))
+    x_at, y_at = at_heading_change(psi, target, x, y)
     return x_at, y_at
 
 
@@ -167,37 +175,38 @@ def approach_frame(x: np.ndarray, y: np.ndarray, psi0: float) -> tuple[np.ndarra
     return dx * c + dy * s, -dx * s + dy * c
 
 
-def fitted_diameter(x: np.ndarray, y: np.ndarray) -> float:
-    """Diameter of the circle fitted to the points (x, y) by least squares (Kasa), m."""
+def fitted_circle(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
+    """(x, y) of the centre and the diameter of the circle fitted to the points by least
+    squares (Kasa's algebraic fit), m."""
     x, y = np.asarray(x), np.asarray(y)
     A = np.column_stack([2.0 * x, 2.0 * y, np.ones_like(x)])
     (cx, cy, c), *_ = np.linalg.lstsq(A, x * x + y * y, rcond=None)
-    return 2.0 * math.sqrt(c + cx * cx + cy * cy)
+    return float(cx), float(cy), 2.0 * math.sqrt(c + cx * cx + cy * cy)
 
 
-def _last_lap_diameter(x: np.ndarray, y: np.ndarray, psi: np.ndarray) -> float:
-    """The steady turning diameter: a circle fitted to the track over the last 360 deg of
-    heading, m; NaN unless the heading turned 540 deg (the lap starts past 180 deg)."""
+def steady_circle(x: np.ndarray, y: np.ndarray, psi: np.ndarray) -> tuple[float, float, float]:
+    """The steady turning circle: ``fitted_circle`` over the last 360 deg of heading; NaNs
+    unless the heading turned 540 deg (so that lap starts past the first 180 deg)."""
+    x, y, psi = map(np.asarray, (x, y, psi))
     if abs(psi[-1] - psi[0]) < 3.0 * math.pi:
-        return math.nan
+        return math.nan, math.nan, math.nan
     lap = np.abs(psi[-1] - psi) <= 2.0 * math.pi
-    return fitted_diameter(x[lap], y[lap])
+    return fitted_circle(x[lap], y[lap])
 
 
 def turning_circle_figures(x, y, psi, u, v, r) -> TurningCircle:
     """Turning-circle figures of a run from steady straight running along psi[0]."""
     x, y, psi, u, v, r = map(np.asarray, (x, y, psi, u, v, r))
     along, across = approach_frame(x, y, float(psi[0]))
-    change = np.abs(psi - psi[0])
-    advance, transfer = _first_reaching(change, math.pi / 2, along, across)
-    _, tactical, u180, v180 = _first_reaching(change, math.pi, along, across, u, v)
+    advance, transfer = at_heading_change(psi, math.pi / 2, along, across)
+    _, tactical, u180, v180 = at_heading_change(psi, math.pi, along, across, u, v)
     turn = math.copysign(math.pi, psi[-1] - psi[0])
     course = turn + math.atan2(v180, u180) - math.atan2(v[0], u[0])
     return TurningCircle(advance=advance, transfer=abs(transfer),
                          tactical_diameter=abs(tactical),
                          steady_yaw_rate=float(r[-1]),
                          steady_speed=float(math.hypot(u[-1], v[-1])),
-                         steady_diameter=_last_lap_diameter(x, y, psi),
+                         steady_diameter=steady_circle(x, y, psi)[2],
                          approach_speed=float(math.hypot(u[0], v[0])),
                          drift_angle=float(math.atan2(v[-1], u[-1])),
                          course_change_at_tactical=abs(course))
@@ -275,14 +284,14 @@ def zigzag_criteria(zz: ZigZagResult, delta: float, approach_speed: float,
                  f"{length / approach_speed:.2f} s for the model)")
         return (Criterion("initial turning: distance by 10 deg heading change",
                           zz.initial_turning_distance / length, INITIAL_TURNING_LIMIT, "L",
-                          "5.3.2"),
+                          "5.3.2", missing="none: the heading never changed by 10 deg"),
                 Criterion("first overshoot", zz.first_overshoot, first, "rad", "5.3.3.1",
-                          basis),
+                          basis, _UNCHECKED),
                 Criterion("second overshoot", zz.second_overshoot, second, "rad", "5.3.3.2",
-                          basis))
+                          basis, _UNCHECKED))
     if _is(delta, 20.0) and _is(zz.psi_switch, 20.0):
         return (Criterion("first overshoot", zz.first_overshoot, FIRST_OVERSHOOT_20_LIMIT,
-                          "rad", "5.3.3.3"),)
+                          "rad", "5.3.3.3", missing=_UNCHECKED),)
     return ()
 
 

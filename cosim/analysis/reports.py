@@ -37,7 +37,7 @@ def course_keeping_report(recording: Recording, lam: float = LAMBDA, **_) -> lis
 
 def criterion_text(c: Criterion) -> str:
     """One criterion for people: the figure, its limit, PASS or FAIL, the clause."""
-    value = "not reached in the run" if math.isnan(c.value) else _amount(c.value, c.unit)
+    value = c.missing if math.isnan(c.value) else _amount(c.value, c.unit)
     basis = f"; {c.basis}" if c.basis else ""
     return (f"{'PASS' if c.passed else 'FAIL'}  {c.figure} {value} (limit {_amount(c.limit, c.unit)}"
             f"; {STANDARD} {c.clause}{basis})")

@@ -1,0 +1,327 @@
+"""IMO-style plates of the standard manoeuvres: a zig-zag and a turning circle as MSC/Circ.1053
+draws them, with the standard's figures and the MSC.137(76) criteria, PASS or FAIL.
+
+The figures and criteria come from ``manoeuvres`` (one assessment of the run), the words
+from ``reports`` (the same lines ``cosim.run`` prints), so the plate and the report cannot
+disagree. Degrees for display only. On a zig-zag plate heading and rudder share one axis
+with one sign sense, the field's: the heading psi is positive to starboard, and the rudder
+is drawn as -delta, positive when it turns the ship to starboard (in this model a positive
+delta turns it to port), so the rudder leads the heading.
+"""
+from __future__ import annotations
+
+import math
+import textwrap
+from typing import Any
+
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.figure import Figure
+from matplotlib.patches import Polygon
+
+from ..core.recording import Recording
+from .figures import hull_outline, legend_if_any, outlines, track_panel
+from .manoeuvres import (Assessment, TurningCircle, ZigZagResult, approach_frame,
+                         at_heading_change, steady_circle, turning_circle_of, zigzag_of)
+from .reports import turning_circle_lines, zigzag_lines
+
+RUDDER = "rudder -delta (deg, + turns to starboard)"
+"""The rudder on a plate: drawn with the heading's sign sense."""
+_ORDINALS = ("1st", "2nd", "3rd", "4th")
+_VERDICT_COLOURS = {"PASS": "tab:green", "FAIL": "tab:red"}
+_BOX = dict(boxstyle="round,pad=0.15", facecolor="white", alpha=0.85, edgecolor="none")
+_WRAP = 150
+"""Characters per line of a plate's text, at its font size."""
+
+
+def _grid(width_ratios: tuple[float, float], rows: int, text_lines: int) -> tuple[Figure, Any]:
+    """A figure and its grid: ``rows`` rows of panels above one row of text."""
+    fig = plt.figure(figsize=(13, 8.5 + 0.14 * text_lines), constrained_layout=True)
+    panel = (8.0 - 0.3 * rows) / rows
+    grid = fig.add_gridspec(rows + 1, 2, width_ratios=width_ratios,
+                            height_ratios=(*[panel] * rows, 0.16 * text_lines + 0.2))
+    return fig, grid
+
+
+def _wrapped(lines: list[str]) -> list[str]:
+    return [textwrap.fill(line, _WRAP, subsequent_indent="      ") for line in lines]
+
+
+def text_panel(ax: Any, lines: list[str]) -> None:
+    """The report's lines, wrapped, one under the other; a verdict in its colour."""
+    ax.set_axis_off()
+    shown = _wrapped(lines)
+    rows = sum(line.count("\n") + 1 for line in shown)
+    row = 0
+    for line in shown:
+        colour = _VERDICT_COLOURS.get(line.split(" ", 1)[0], "black")
+        ax.text(0.0, 1.0 - row / rows, line, transform=ax.transAxes, va="top", ha="left",
+                fontsize=8, family="monospace", color=colour)
+        row += line.count("\n") + 1
+
+
+def _time_axes(fig: Figure, cells: list[Any]) -> list[Any]:
+    """Panels over time, one per grid cell, sharing the time axis, labelled at the bottom."""
+    axes = [fig.add_subplot(cells[0])]
+    axes += [fig.add_subplot(c, sharex=axes[0]) for c in cells[1:]]
+    for a in axes[:-1]:
+        a.tick_params(labelbottom=False)
+    axes[-1].set_xlabel("time (s)")
+    for a in axes:
+        a.grid(alpha=0.3)
+    return axes
+
+
+def _rudder(ax: Any, run: Recording) -> None:
+    """Ordered and actual rudder, -delta in degrees (the heading's sign sense)."""
+    ax.plot(run.t, -np.degrees(run["ship.delta_c"]), "--", color="tab:blue", linewidth=0.7,
+            label="rudder ordered")
+    ax.plot(run.t, -np.degrees(run["ship.delta"]), color="tab:blue", linewidth=1.2,
+            label="rudder")
+
+
+def _span(ax: Any, start: float, end: float, height: float, label: str, colour: str) -> None:
+    """A time span drawn as a dimension line at ``height`` (axes fraction), labelled."""
+    where = ax.get_xaxis_transform()
+    ax.annotate("", xy=(end, height), xytext=(start, height), xycoords=where,
+                arrowprops=dict(arrowstyle="<->", color=colour, shrinkA=0, shrinkB=0))
+    ax.text(start, height + 0.015, label, transform=where, ha="left", va="bottom",
+            fontsize=7, color=colour)
+
+
+def _executes(ax: Any, run: Recording, zz: ZigZagResult) -> None:
+    """The executes on the heading, the first four named."""
+    rows = np.searchsorted(run.t, zz.executes)
+    psi = np.degrees(run["ship.psi"][rows])
+    ax.plot(zz.executes, psi, "o", color="tab:red", markersize=4, zorder=5,
+            label="execute (rudder ordered)")
+    for name, t, heading in zip(_ORDINALS, zz.executes, psi):
+        ax.annotate(f"{name} execute", (t, heading), textcoords="offset points",
+                    xytext=(4, -10 if heading <= 0 else 4), fontsize=7, color="tab:red")
+
+
+def _overshoots(ax: Any, zz: ZigZagResult) -> None:
+    """Each overshoot as an arrow from the switching angle to the peak, the first two named."""
+    switch = math.degrees(zz.psi_switch)
+    for n, o in enumerate(zz.overshoots):
+        peak = math.degrees(o.heading)
+        ax.annotate("", xy=(o.time, peak), xytext=(o.time, math.copysign(switch, peak)),
+                    arrowprops=dict(arrowstyle="<->", color="tab:purple", shrinkA=0,
+                                    shrinkB=0))
+        if n < 2:
+            ax.annotate(f"{_ORDINALS[n]} overshoot {math.degrees(o.angle):.1f} deg",
+                        (o.time, peak), textcoords="offset points",
+                        xytext=(5, -9 if peak < 0 else 3), fontsize=7, color="tab:purple",
+                        bbox=_BOX)
+
+
+def _spans(ax: Any, zz: ZigZagResult) -> None:
+    """Initial turning time, time to check yaw and period, as dimension lines in a band
+    below the curves."""
+    low, high = ax.get_ylim()
+    ticks = [tick for tick in ax.get_yticks() if low <= tick <= high]
+    ax.set_ylim(low - 0.5 * (high - low), high)
+    ax.set_yticks(ticks)
+    if len(zz.executes) > 1:
+        _span(ax, zz.executes[0], zz.executes[1], 0.03,
+              f"initial turning {zz.initial_turning_time:.1f} s", "tab:green")
+    if zz.overshoots:
+        _span(ax, zz.executes[1], zz.overshoots[0].time, 0.12,
+              f"check yaw {zz.time_to_check_yaw:.1f} s", "tab:purple")
+    if not math.isnan(zz.period):
+        _span(ax, zz.executes[1], zz.executes[3], 0.21, f"period {zz.period:.1f} s", "0.3")
+
+
+def _runaway(ax: Any, run: Recording, zz: ZigZagResult, a: Assessment) -> None:
+    """A turn never checked: keep the rudder in sight, show where the heading went."""
+    limit = 6.0 * max(math.degrees(zz.psi_switch), math.degrees(a.delta))
+    ax.set_ylim(-limit, limit)
+    psi = np.degrees(run["ship.psi"])
+    gone = int(np.argmax(np.abs(psi) > limit)) if np.abs(psi).max() > limit else len(psi) - 1
+    ax.set_xlim(run.t[0], min(run.t[-1], run.t[0] + 4.0 * (run.t[gone] - run.t[0])))
+    side = math.copysign(1.0, psi[-1])
+    ax.annotate(f"heading runs on to {psi[-1]:.0f} deg at t = {run.t[-1]:.0f} s: "
+                "the turn is never checked", xy=(run.t[gone], side * limit),
+                xytext=(run.t[gone] * 1.15, side * 0.75 * limit), fontsize=8, color="tab:red",
+                arrowprops=dict(arrowstyle="->", color="tab:red"))
+
+
+def _zoom(ax: Any, run: Recording, zz: ZigZagResult) -> None:
+    """Time up to a little past the fifth execute, where the standard's figures are, if the
+    run goes on longer; the heading's range over it."""
+    if len(zz.executes) < 6:
+        return
+    end = zz.executes[5] + 0.25 * (zz.executes[5] - zz.executes[4])
+    shown = run.t <= end
+    psi = np.degrees(run["ship.psi"][shown])
+    rudder = math.degrees(np.abs(run["ship.delta"]).max())
+    margin = 0.1 * (psi.max() - psi.min())
+    ax.set_xlim(run.t[0], end)
+    ax.set_ylim(min(psi.min(), -rudder) - margin, max(psi.max(), rudder) + margin)
+    ax.text(0.99, 0.99, f"first {end - run.t[0]:.0f} s of {run.t[-1] - run.t[0]:.0f} s; the "
+            "track shows all", transform=ax.transAxes, ha="right", va="top", fontsize=7,
+            color="0.4", bbox=_BOX)
+
+
+def zigzag_plate(run: Recording, **_: Any) -> Figure:
+    """Heading and rudder on one axis with the executes, overshoots and the standard's times;
+    yaw rate; the track; the figures and criteria."""
+    a = zigzag_of(run)
+    zz = a.figures
+    lines = zigzag_lines(a, run["ship.psi"][-1], run.t[-1])
+    fig, grid = _grid((2.2, 1.0), 3, sum(s.count("\n") + 1 for s in _wrapped(lines)))
+    heading, r = _time_axes(fig, [grid[0:2, 0], grid[2, 0]])
+    track_panel(fig.add_subplot(grid[0:3, 1]), run)
+    switch = math.degrees(zz.psi_switch)
+    heading.plot(run.t, np.degrees(run["ship.psi"]), color="k", linewidth=1.4,
+                 label="heading psi")
+    _rudder(heading, run)
+    for level in (-switch, switch):
+        heading.axhline(level, linestyle=":", color="0.4", linewidth=0.9)
+    heading.axhline(0.0, color="0.6", linewidth=0.6)
+    heading.text(1.0, switch, f" +{switch:g}", transform=heading.get_yaxis_transform(),
+                 va="center", fontsize=7, color="0.4")
+    heading.text(1.0, -switch, f" -{switch:g}", transform=heading.get_yaxis_transform(),
+                 va="center", fontsize=7, color="0.4")
+    _executes(heading, run, zz)
+    _overshoots(heading, zz)
+    if zz.checked:
+        _zoom(heading, run, zz)
+    else:
+        _runaway(heading, run, zz, a)
+    _spans(heading, zz)
+    heading.set_ylabel(f"heading psi, {RUDDER}")
+    legend_if_any(heading)
+    r.plot(run.t, np.degrees(run["ship.r"]), color="k")
+    r.axhline(0.0, color="0.6", linewidth=0.6)
+    r.set_ylabel("yaw rate r (deg/s)")
+    text_panel(fig.add_subplot(grid[3, :]), lines)
+    return fig
+
+
+def _earth(run: Recording, along: float, across: float) -> tuple[float, float]:
+    """(east, north) of a point given along and across (to starboard of) the approach course."""
+    x0, y0, psi0 = run["ship.x"][0], run["ship.y"][0], run["ship.psi"][0]
+    c, s = math.cos(psi0), math.sin(psi0)
+    return y0 + along * s + across * c, x0 + along * c - across * s
+
+
+def _dimension(ax: Any, run: Recording, start: tuple[float, float], end: tuple[float, float],
+               label: str, colour: str, label_at: tuple[float, float] | None = None) -> None:
+    """A dimension line between two (along, across) points, labelled at its middle or, with
+    a leader, at ``label_at``."""
+    p, q = _earth(run, *start), _earth(run, *end)
+    ax.plot([p[0], q[0]], [p[1], q[1]], color=colour, linewidth=1.6, zorder=6)
+    ax.annotate("", xy=q, xytext=p, arrowprops=dict(arrowstyle="|-|", color=colour,
+                                                    shrinkA=0, shrinkB=0,
+                                                    mutation_scale=6), zorder=6)
+    middle = (0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1]))
+    where = middle if label_at is None else _earth(run, *label_at)
+    ax.annotate(label, xy=middle, xytext=where, fontsize=8, color=colour, ha="center",
+                va="center", zorder=7,
+                bbox=dict(boxstyle="round", facecolor="white", alpha=0.85, edgecolor="none"),
+                arrowprops=None if label_at is None else dict(arrowstyle="-", color=colour,
+                                                              linewidth=0.7))
+
+
+def _extension(ax: Any, run: Recording, start: tuple[float, float],
+               end: tuple[float, float]) -> None:
+    """A thin extension line between two (along, across) points."""
+    p, q = _earth(run, *start), _earth(run, *end)
+    ax.plot([p[0], q[0]], [p[1], q[1]], color="0.5", linewidth=0.6, linestyle="--", zorder=5)
+
+
+def _turning_track(ax: Any, run: Recording, a: Assessment) -> None:
+    """The track with the approach course, advance, transfer, tactical and steady diameter."""
+    tc: TurningCircle = a.figures
+    L = a.length
+    track_panel(ax, run)
+    x, y, psi = run["ship.x"], run["ship.y"], run["ship.psi"]
+    along, across = approach_frame(x, y, float(psi[0]))
+    side = math.copysign(1.0, across[np.argmax(np.abs(across))])     # the turn's side
+    top, size = along.max(), np.ptp(across)
+    gap = 0.08 * size
+    outside = -side * (max(-side * across.min(), -side * across.max(), 0.0) + gap)
+    a90 = at_heading_change(psi, math.pi / 2, along, across)
+    a180 = at_heading_change(psi, math.pi, along, across)
+    _extension(ax, run, (-gap, 0.0), (top + 2 * gap, 0.0))
+    ax.annotate("approach course", _earth(run, -gap, 0.0), fontsize=7, color="0.4",
+                ha="center", va="top", bbox=_BOX, zorder=7)
+    _extension(ax, run, (0.0, 0.0), (0.0, outside))
+    _extension(ax, run, tuple(a90), (a90[0], outside))
+    _dimension(ax, run, (0.0, outside), (tc.advance, outside),
+               f"advance\n{tc.advance:.2f} m\n{tc.advance / L:.2f} L", "tab:green")
+    _dimension(ax, run, (a90[0], 0.0), tuple(a90),
+               f"transfer {tc.transfer:.2f} m = {tc.transfer / L:.2f} L (at 90 deg)",
+               "tab:purple", label_at=(a90[0] - 1.5 * gap, side * 3.5 * gap))
+    _extension(ax, run, (a180[0], 0.0), (top + gap, 0.0))
+    _extension(ax, run, tuple(a180), (top + gap, a180[1]))
+    _dimension(ax, run, (top + gap, 0.0), (top + gap, a180[1]),
+               f"tactical diameter {tc.tactical_diameter:.2f} m = "
+               f"{tc.tactical_diameter / L:.2f} L (at 180 deg)", "tab:brown")
+    _steady(ax, run, tc, L)
+    scale = outlines(run).scale
+    for target in (math.pi / 2, math.pi):
+        xs, ys, ps = at_heading_change(psi, target, x, y, psi)
+        ax.add_patch(Polygon(hull_outline(xs, ys, ps, scale), closed=True, facecolor="gold",
+                             edgecolor="k", linewidth=0.8, zorder=4))
+        ax.annotate(f"{math.degrees(target):.0f} deg heading change", (ys, xs),
+                    textcoords="offset points", xytext=(6, -12), fontsize=7, zorder=7)
+
+
+def _steady(ax: Any, run: Recording, tc: TurningCircle, L: float) -> None:
+    """The steady turning circle fitted to the last lap, with its diameter."""
+    centre_x, centre_y, diameter = steady_circle(run["ship.x"], run["ship.y"], run["ship.psi"])
+    if math.isnan(diameter):
+        return
+    ax.add_patch(plt.Circle((centre_y, centre_x), diameter / 2, fill=False, linestyle="--",
+                            color="tab:orange", linewidth=0.9, zorder=4))
+    east = (centre_y - diameter / 2, centre_y + diameter / 2)
+    ax.annotate("", xy=(east[1], centre_x), xytext=(east[0], centre_x),
+                arrowprops=dict(arrowstyle="<->", color="tab:orange", shrinkA=0, shrinkB=0),
+                zorder=6)
+    ax.text(centre_y, centre_x, f"steady turning diameter {diameter:.2f} m = "
+            f"{diameter / L:.2f} L\n(circle fitted to the last lap; 2U/|r| = "
+            f"{tc.diameter_from_rates:.2f} m)", ha="center", va="bottom", fontsize=7,
+            color="tab:orange", zorder=7,
+            bbox=dict(boxstyle="round", facecolor="white", alpha=0.85, edgecolor="none"))
+
+
+def _wrapped_heading(ax: Any, run: Recording) -> None:
+    """The compass heading 0-360 deg, the line broken where it wraps."""
+    heading = np.degrees(run["ship.psi"]) % 360.0
+    heading[1:][np.abs(np.diff(heading)) > 180.0] = np.nan
+    ax.plot(run.t, heading, color="k")
+    ax.set(ylim=(0, 360), yticks=(0, 90, 180, 270, 360), ylabel="heading psi\n(deg, 0-360)")
+
+
+def turning_circle_plate(run: Recording, **_: Any) -> Figure:
+    """Track with advance, transfer, tactical and steady diameter; heading 0-360 deg, speed,
+    drift angle, yaw rate and rudder; the figures and criteria."""
+    a = turning_circle_of(run)
+    tc: TurningCircle = a.figures
+    lines = turning_circle_lines(a)
+    fig, grid = _grid((1.15, 1.0), 5, sum(s.count("\n") + 1 for s in _wrapped(lines)))
+    _turning_track(fig.add_subplot(grid[0:5, 0]), run, a)
+    heading, speed, drift, r, rudder = _time_axes(fig, [grid[i, 1] for i in range(5)])
+    t, u, v = run.t, run["ship.u"], run["ship.v"]
+    _wrapped_heading(heading, run)
+    for target in (math.pi / 2, math.pi):
+        when, = at_heading_change(run["ship.psi"], target, t)
+        for panel in (heading, speed, drift, r, rudder):
+            panel.axvline(when, color="tab:gray", linestyle=":", linewidth=0.9)
+        heading.text(when, 1.0, f" {math.degrees(target):.0f} deg", va="bottom", fontsize=7,
+                     transform=heading.get_xaxis_transform(), color="tab:gray")
+    speed.plot(t, np.hypot(u, v), color="k")
+    speed.axhline(tc.steady_speed, linestyle=":", color="tab:gray")
+    speed.set_ylabel("speed U (m/s)")
+    drift.plot(t, np.degrees(np.arctan2(v, u)), color="k")
+    drift.set_ylabel("drift angle (deg)")
+    r.plot(t, np.degrees(run["ship.r"]), color="k")
+    r.axhline(math.degrees(tc.steady_yaw_rate), linestyle=":", color="tab:gray")
+    r.set_ylabel("yaw rate r (deg/s)")
+    _rudder(rudder, run)
+    rudder.set_ylabel("rudder -delta (deg,\n+ to starboard)")
+    legend_if_any(rudder)
+    text_panel(fig.add_subplot(grid[5, :]), lines)
+    return fig
