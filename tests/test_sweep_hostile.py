@@ -293,6 +293,20 @@ def test_the_journal_lock_is_removed_at_the_end_and_never_shared(tmp_path, monke
     assert stale.closed
 
 
+def test_a_journal_removes_only_its_own_lock_file(tmp_path):
+    """A lock file that someone deleted while a sweep ran, and that another sweep then made
+    and holds, is that sweep's: the first sweep's end must not remove it."""
+    path, lock = tmp_path / "runs.jsonl", tmp_path / "runs.jsonl.lock"
+    first = Journal(path).__enter__()
+    lock.unlink()                                   # a user tidying up, say
+    with Journal(path):                             # another sweep: its own lock file
+        first.__exit__(None, None, None)
+        assert lock.exists() and f"process {os.getpid()}" in lock.read_text()
+        with pytest.raises(JournalLocked):
+            Journal(path).__enter__()               # still held, by the second
+    assert not lock.exists()                        # the second removed its own
+
+
 def _rows(spec) -> list[dict]:
     return [{**run, "status": "ok", "error": "", **{m: 1.0 + i for m in sweep.METRICS},
              "seconds": 0.1, "sim_seconds": 0.1, "backend": "fmi"}

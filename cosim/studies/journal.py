@@ -4,8 +4,9 @@ The journal is what a sweep resumes from, so it must survive what ends a process
 mid-write: a torn last line (a write cut by a kill) is skipped with a warning, and
 its run is done again. One sweep writes a journal at a time: a second writer is
 refused with a message naming the holder of the lock (process, host, since when).
-The lock file (runs.jsonl.lock) is removed when the writer closes the journal; one
-left by a killed process is stale, and the next writer takes it over.
+The lock file (runs.jsonl.lock) is removed when the writer closes the journal (if it
+is still that writer's file); one left by a killed process is stale, and the next
+writer takes it over.
 Tables derived from it are written atomically (``cosim.core.files``).
 """
 from __future__ import annotations
@@ -87,8 +88,12 @@ class Journal:
 
     def __exit__(self, *exc) -> None:
         if self._lock_file is not None:
-            # Removed while still held: whoever opened it meanwhile sees it is gone, above.
-            Path(self._lock_file.name).unlink(missing_ok=True)
+            # Removed while still held (whoever opened it meanwhile sees it is gone, above),
+            # and only if it is still this writer's: a lock file someone deleted and another
+            # sweep made again is that sweep's.
+            lock = Path(self._lock_file.name)
+            if _same_file(self._lock_file, lock):
+                lock.unlink(missing_ok=True)
             fcntl.flock(self._lock_file, fcntl.LOCK_UN)
             self._lock_file.close()
             self._lock_file = None
