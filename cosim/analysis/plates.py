@@ -44,7 +44,8 @@ def _grid(width_ratios: tuple[float, float], rows: int, text_lines: int) -> tupl
 
 
 def _wrapped(lines: list[str]) -> list[str]:
-    return [textwrap.fill(line, _WRAP, subsequent_indent="      ") for line in lines]
+    return [textwrap.fill(line, _WRAP, subsequent_indent="      ", break_on_hyphens=False)
+            for line in lines]
 
 
 def text_panel(ax: Any, lines: list[str]) -> None:
@@ -120,7 +121,7 @@ def _spans(ax: Any, zz: ZigZagResult) -> None:
     below the curves."""
     low, high = ax.get_ylim()
     ticks = [tick for tick in ax.get_yticks() if low <= tick <= high]
-    ax.set_ylim(low - 0.5 * (high - low), high)
+    ax.set_ylim(low - 0.4 * (high - low), high)
     ax.set_yticks(ticks)
     if len(zz.executes) > 1:
         _span(ax, zz.executes[0], zz.executes[1], 0.03,
@@ -209,9 +210,10 @@ def _earth(run: Recording, along: float, across: float) -> tuple[float, float]:
 def _dimension(ax: Any, run: Recording, start: tuple[float, float], end: tuple[float, float],
                label: str, colour: str, label_at: tuple[float, float] | None = None) -> None:
     """A dimension line between two (along, across) points, labelled at its middle or, with
-    a leader, at ``label_at``."""
+    a leader, at ``label_at``; the line's gid is the label's first word."""
     p, q = _earth(run, *start), _earth(run, *end)
-    ax.plot([p[0], q[0]], [p[1], q[1]], color=colour, linewidth=1.6, zorder=6)
+    ax.plot([p[0], q[0]], [p[1], q[1]], color=colour, linewidth=1.6, zorder=6,
+            gid=label.split()[0])
     ax.annotate("", xy=q, xytext=p, arrowprops=dict(arrowstyle="|-|", color=colour,
                                                     shrinkA=0, shrinkB=0,
                                                     mutation_scale=6), zorder=6)
