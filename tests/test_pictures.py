@@ -14,8 +14,8 @@ from matplotlib.patches import Circle, Polygon
 from cosim import run as cli
 from cosim import simulate
 from cosim.analysis.animation import animate, frame_times
-from cosim.analysis.figures import (course_keeping_figure, save, turning_circle_figure,
-                                    zigzag_figure)
+from cosim.analysis.figures import (RUDDER_LABEL, course_keeping_figure, outlines, save,
+                                    turning_circle_figure, zigzag_figure)
 from cosim.analysis.manoeuvres import zigzag
 from cosim.core.provenance import write_metadata
 from cosim.core.recording import Recording
@@ -45,17 +45,21 @@ def test_the_track_panel_is_north_up_at_equal_scale_with_route_circles_and_switc
     assert len(switched.get_xdata()) == len(np.flatnonzero(np.diff(waves["guidance.wp_index"])))
     hulls = [p for p in track.patches if isinstance(p, Polygon)]
     assert len(hulls) >= 8
+    scale = outlines(waves).scale                 # enlarged, and the legend says how much
     corners = hulls[0].get_xy()
-    assert np.ptp(corners[:, 1]) == pytest.approx(Hull.L)      # heading north at t = 0
-    assert np.ptp(corners[:, 0]) == pytest.approx(Hull.B)
-    arrow = next(t for t in track.texts if t.arrow_patch is not None)
-    (east, north), (east0, north0) = arrow.xy, arrow.xyann      # travelling to 180 deg: south
-    assert east == pytest.approx(east0) and north < north0
-    assert "waves" in _texts(track)
+    assert np.ptp(corners[:, 1]) == pytest.approx(scale * Hull.L)  # heading north at t = 0
+    assert np.ptp(corners[:, 0]) == pytest.approx(scale * Hull.B)
+    legend = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert f"ship outline x{scale}, true heading, every 30 s" in legend
+    waves_to = next(line for line in track.lines if line.get_label().startswith("waves"))
+    assert waves_to.get_label() == "waves travel to 180 deg"
+    tip = waves_to.get_marker().vertices[0]                     # (east, north): south
+    assert tip[1] == pytest.approx(-1.0) and tip[0] == pytest.approx(0.0, abs=1e-12)
     labels = [a.get_ylabel() for a in fig.axes[1:]]
     assert labels == ["surge u (m/s)", "heading (deg)", "psi_d - psi (deg)",
-                      "yaw rate r (deg/s)", "rudder (deg)"]
-    rudder = [line.get_label() for line in fig.axes[-1].lines]
+                      "yaw rate r (deg/s)", RUDDER_LABEL]
+    rudder = [line.get_label() for line in fig.axes[-1].lines
+              if not line.get_label().startswith("_")]
     assert rudder == ["commanded delta_c", "actual delta"]
 
 
@@ -101,7 +105,7 @@ def test_next_to_every_csv_a_json_with_what_it_takes_to_reproduce_the_run(fmu_pa
 
 def test_the_turning_circle_figure_marks_advance_transfer_and_tactical_diameter(fmu_paths):
     track = turning_circle_figure(simulate("turning_circle")).axes[0]
-    legend = " | ".join(t.get_text() for t in track.get_legend().get_texts())
+    legend = " | ".join(t.get_text() for t in track.figure.legends[0].get_texts())
     assert "advance 4.42 m (at 90 deg)" in legend and "transfer 0.13 m (at 90 deg)" in legend
     assert "tactical diameter 3.70 m (at 180 deg)" in legend
     assert "steady turn: drift angle 59 deg, diameter 2U/|r| = 5.17 m" in _texts(track)
@@ -243,5 +247,5 @@ def test_a_run_given_the_route_as_numbers_describes_and_draws_that_route(fmu_pat
     assert "route (0,0) (30,0) (60,-25) (90,-25) m" in capsys.readouterr().out
     run = simulate(tmp_path / "package" / "SystemStructure.ssd", stop_time=10.0)
     fig = course_keeping_figure(run)
-    route = [line for line in fig.axes[0].get_lines() if line.get_label() == "route"][0]
+    route = [line for line in fig.axes[0].get_lines() if line.get_label().startswith("route")][0]
     assert list(route.get_xdata()) == [0, 0, -25, -25]      # east y of each point

@@ -2,11 +2,14 @@
 
 A GIF (Pillow, which comes with matplotlib), or an MP4 where ffmpeg is installed.
 The run plays at a speed that fits it into about 25 s of video at 10 frames per
-second (a 400 s run: 16 times real time, 250 frames). The route, the circles of
-acceptance and the wave direction are drawn once; each frame moves the ship's
-outline (to scale), extends its wake, highlights the active leg and moves the
-time cursor on the heading and rudder panels: only those are redrawn, on top of
-a background rendered once, which keeps a 400 s run to a few seconds of work.
+second (a 400 s run: 16 times real time, 250 frames). The route, its named
+waypoints, the circles of acceptance and the wave direction are drawn once, as on
+the run's figure (``figures.track_panel``); each frame moves the ship's outline
+(at its true heading, enlarged as on the figure and saying by how much), extends
+its wake, highlights the active leg, names it above the track as the figure names
+the waypoints (``leg_text``) and moves the time cursor on the heading and rudder
+panels: only those are redrawn, on top of a background rendered once, which keeps
+a 400 s run to a few seconds of work.
 """
 from __future__ import annotations
 
@@ -24,10 +27,11 @@ from matplotlib.patches import Polygon  # noqa: E402
 
 from autopilot_fmu.guidance import route as followed_route  # noqa: E402
 
+from ..core.files import whole_file  # noqa: E402
 from ..core.recording import Recording  # noqa: E402
 from .describe import title  # noqa: E402
-from ..core.files import whole_file  # noqa: E402
-from .figures import legend_if_any, hull_outline, track_panel  # noqa: E402
+from .figures import (RUDDER_LABEL, hull_outline, legend_if_any, outlines,  # noqa: E402
+                      track_panel, waypoint_name)
 
 FPS = 10
 VIDEO_SECONDS = 25.0
@@ -53,6 +57,18 @@ def frame_times(t: np.ndarray, fps: int = FPS, seconds: float = VIDEO_SECONDS) -
     return np.unique(np.round(np.linspace(0, len(t) - 1, frames)).astype(int))
 
 
+def leg_text(wp_index: int, points: np.ndarray) -> str:
+    """The leg the guidance steers along, its waypoints named as on the figures
+    (``figures.waypoint_name``): 'leg WP1 -> WP2 (30, 0) m' while steering for point
+    ``wp_index`` (the guidance's 0-based index, (x, y) in ``points``), or, past the last
+    point (``wp_index`` = the number of points), that it holds the last leg's course."""
+    if wp_index >= len(points):
+        return f"past {waypoint_name(len(points) - 1)}, the last: holding its course"
+    north, east = points[wp_index]
+    return (f"leg {waypoint_name(wp_index - 1)} -> {waypoint_name(wp_index)} "
+            f"({north:g}, {east:g}) m")
+
+
 def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> Path:
     """Write the animation of a run to ``path`` with the suffix of ``fmt``; its path.
 
@@ -71,11 +87,11 @@ def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> P
     track_panel(track, run, ship=False)
     track.plot(y, x, color="0.8", linewidth=0.8, zorder=1)            # the whole track, faint
     wake, = track.plot([], [], color="k", linewidth=1.2, zorder=3)
-    hull = track.add_patch(Polygon(hull_outline(x[0], y[0], psi[0]), closed=True,
+    shown = outlines(run)
+    scale = shown.scale
+    hull = track.add_patch(Polygon(hull_outline(x[0], y[0], psi[0], scale), closed=True,
                                    color="tab:red", zorder=5))
-    marker, = track.plot([], [], color="tab:red", alpha=0.35, markersize=14, zorder=4,
-                         linestyle="none", marker=(3, 0, 0),   # the ship to scale is small
-                         label="ship (outline to scale, marker enlarged)")
+    track.plot([], [], "s", color="tab:red", label=f"ship outline {shown.size}")
     legs = run.meta.get("parameters", {}).get("guidance")
     points = np.array(followed_route(legs)) if legs else None
     active, = track.plot([], [], color="tab:green", linewidth=3, alpha=0.6, zorder=2,
@@ -88,32 +104,29 @@ def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> P
     heading.set(ylabel="heading (deg)")
     legend_if_any(heading)
     rudder.plot(t, np.degrees(delta), color="k", linewidth=0.8)
-    rudder.set(xlabel="time (s)", ylabel="rudder delta (deg)")
+    rudder.set(xlabel="time (s)", ylabel=RUDDER_LABEL)
     cursors = [a.axvline(t[0], color="tab:red", linewidth=1) for a in (heading, rudder)]
     for a in (heading, rudder):
         a.grid(alpha=0.3)
-    readout = track.text(0.02, 0.98, "", transform=track.transAxes, fontsize=8, va="top",
-                         bbox=dict(boxstyle="round", facecolor="white", alpha=0.85))
     fig.suptitle(title(label, run.meta), fontsize=7)
     leg = run["guidance.wp_index"].astype(int) if "guidance.wp_index" in run.columns else None
 
-    def draw(k: int) -> None:
+    def draw(k: int) -> str:
+        """Move everything that moves to row ``k``; the readout's text there."""
         wake.set_data(y[:k + 1], x[:k + 1])
-        hull.set_xy(hull_outline(x[k], y[k], psi[k]))
-        marker.set_data([y[k]], [x[k]])
-        marker.set_marker((3, 0, -math.degrees(psi[k])))     # a triangle along the heading
+        hull.set_xy(hull_outline(x[k], y[k], psi[k], scale))
         for cursor in cursors:
             cursor.set_xdata([t[k], t[k]])
-        text = (f"t = {t[k]:.0f} s\nheading {math.degrees(psi[k]):.1f} deg\n"
+        text = (f"t = {t[k]:.0f} s   heading {math.degrees(psi[k]):.1f} deg   "
                 f"rudder {math.degrees(delta[k]):+.1f} deg")
-        if leg is not None and points is not None:
-            to = min(leg[k], len(points) - 1)
-            active.set_data(points[to - 1:to + 1, 1], points[to - 1:to + 1, 0])
-            text += (f"\nleg to waypoint {to} ({points[to][0]:g}, {points[to][1]:g}) m"
-                     if leg[k] < len(points) else "\npast the last waypoint: holding its course")
-        readout.set_text(text)
+        if leg is None or points is None:
+            return text + "\n"
+        to = min(leg[k], len(points) - 1)
+        active.set_data(points[to - 1:to + 1, 1], points[to - 1:to + 1, 0])
+        return f"{text}\n{leg_text(int(leg[k]), points)}"
 
-    dynamic = [wake, marker, hull, active, readout, *cursors]
+    readout = track.set_title(draw(0), loc="left", fontsize=8, family="monospace")
+    dynamic = [wake, hull, active, readout, *cursors]
     for artist in dynamic:
         artist.set_animated(True)           # left out of the background drawn once
     fig.canvas.draw()
@@ -124,7 +137,7 @@ def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> P
     try:
         frames = []
         for k in rows:
-            draw(k)
+            readout.set_text(draw(k))
             fig.canvas.restore_region(background)
             for artist in dynamic:
                 artist.axes.draw_artist(artist)

@@ -8,9 +8,14 @@ not made. Angles are shown in degrees.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 from typing import Any
 
 from autopilot_fmu.guidance import route as followed_route
+
+from ..core.ssd import read_ssd
+from ..scenarios import SCENARIO_DIR
+from .reports import PAPER_TABLES
 
 _DISPLAY = {"rad": (math.degrees(1.0), "deg"), "rad/s": (math.degrees(1.0), "deg/s"),
             "m": (1.0, "m"), "s": (1.0, "s"), "1/s": (1.0, "1/s"), "m/s": (1.0, "m/s")}
@@ -84,6 +89,49 @@ def conditions(meta: dict[str, Any]) -> list[str]:
     return lines
 
 
+def _scenario_stop_time(meta: dict[str, Any]) -> float | None:
+    """The stop time the run's .ssd sets, s; None if the run names no readable .ssd."""
+    if not meta.get("scenario_file"):
+        return None
+    try:
+        return read_ssd(meta["scenario_file"]).stop_time
+    except (OSError, ValueError):
+        return None
+
+
+def changes(meta: dict[str, Any]) -> str:
+    """How the run differs from its scenario, as the options that made it so: every --set,
+    and --stop-time if it ended elsewhere than the scenario's .ssd says ('' if neither)."""
+    changed = [overrides(meta)] if meta.get("overrides") else []
+    stop = _scenario_stop_time(meta)
+    if stop is not None and meta.get("stop_time", stop) != stop:
+        changed.append(f"--stop-time {meta['stop_time']:g}")
+    return " ".join(changed)
+
+
+def paper_row(meta: dict[str, Any]) -> tuple[str, tuple[float, float, float]] | None:
+    """The paper's table and its (psi_E, delta_E, J) for one of the paper's own runs: the
+    project's scenario file of that name, unchanged; None for any other run."""
+    system = meta.get("system", "")
+    if system not in PAPER_TABLES or changes(meta) or not meta.get("scenario_file"):
+        return None
+    if Path(meta["scenario_file"]).resolve() != (SCENARIO_DIR / f"{system}.ssd").resolve():
+        return None
+    table = 1 if system.startswith("calm") else 2
+    return f"Tomera (2010) Table {table}", PAPER_TABLES[system]
+
+
+def headline(label: str, meta: dict[str, Any]) -> str:
+    """The first line of a title or header: the run's label and its scenario's description,
+    or, for a run changed from its scenario, the scenario and what changed it."""
+    changed = changes(meta)
+    if not changed:
+        return f"{label}: {meta.get('description', '')}"
+    whose = "the paper's" if meta.get("system") in PAPER_TABLES else "the scenario's"
+    return (f"{label}: {meta.get('system', label)} changed by {changed} "
+            f"(not {whose} run)")
+
+
 def title(label: str, meta: dict[str, Any]) -> str:
-    """A figure title: the run's label and description, then what it was."""
-    return "\n".join([f"{label}: {meta.get('description', '')}", *conditions(meta)])
+    """A figure title: the headline, then what the run was, line by line."""
+    return "\n".join([headline(label, meta), *conditions(meta)])
