@@ -38,7 +38,9 @@ only failure status there is to give (docs/robustness.md argues it):
 - calls out of sequence (fmi2DoStep included), setting an output or a fixed
   parameter after initialisation: fmi2Fatal naming the call or variable; nothing
   is applied, and the FMU goes on as before;
-- reading an output never fails: what cannot be evaluated reads NaN.
+- reading an output never fails: what cannot be evaluated reads NaN (and, from valid
+  inputs while stepping, fails the FMU, the next doStep refusing with where it came
+  from).
 
 The reason, beginning with the FMU's instance name (libcosim's log shows neither the
 instance nor the call), reaches the user through the host's logger when it listens,
@@ -125,7 +127,9 @@ class ModelSlave(Fmi2Slave):
         parameters may still be invalid, and feedthrough outputs are evaluated from
         inputs that may be invalid; then the output is undefined, and the call
         that commits (exitInitializationMode, doStep) refuses with a message. A
-        master that ignores those statuses still sees NaN outputs.
+        master that ignores those statuses still sees NaN outputs. An output that
+        its model cannot evaluate from valid inputs while stepping fails the FMU
+        (``_unevaluable``).
         """
         if self.failure:
             return undefined
@@ -133,8 +137,26 @@ class ModelSlave(Fmi2Slave):
             if self._model is None:
                 self._model = self._started_model()
             return get(self)
-        except (ValueError, ArithmeticError):
+        except (ValueError, ArithmeticError) as error:
+            if self.sequence.phase == "step":
+                self._unevaluable(get, error)
             return undefined
+
+    def _unevaluable(self, get: Callable[[Any], Any], error: Exception) -> None:
+        """Fail the FMU, saying where in the model's code, for an output it cannot evaluate
+        from valid inputs (a ZeroDivisionError in the user's law): the read gives NaN,
+        the next doStep refuses with this reason. With an invalid input, that doStep
+        refuses naming the input instead."""
+        try:
+            self._check_inputs(self)
+        except ValueError:
+            return
+        output = next((f"output {v.name}" for v in self.variables if v.get is get), "an output")
+        self.failure = (f"{output} could not be evaluated from valid inputs: "
+                        f"{explain(error)}; the FMU has failed")
+        self.failure_cause = "model"
+        self.log(naming(self.instance_name, self.failure), Fmi2Status.error, "fmukit.model")
+        self.host_log.tell(self.instance_name, self.failure)
 
     @property
     def model(self) -> Any:

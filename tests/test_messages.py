@@ -8,7 +8,10 @@ from __future__ import annotations
 
 import math
 import os
+import shutil
+import sys
 import textwrap
+import warnings
 from pathlib import Path
 
 import pytest
@@ -23,35 +26,43 @@ from fmubuild.packaging import build_script
 from fmubuild.project import ROOT
 
 FAILING_PILOT = '''\
-"""A PD autopilot of a user's own that divides by zero once t reaches t_fail."""
+"""A PD autopilot of a user's own that divides by zero once t reaches t_fail: in its step
+(where = 0) or in its rudder command, an output (where = 1)."""
 from fmukit.autopilot import INPUTS, rudder_command
 from fmukit.slave import ModelSlave, Var
 
 
 class Law:
-    def __init__(self, t_fail: float):
-        self.t_fail = t_fail
+    def __init__(self, t_fail: float, where: int):
+        self.t_fail, self.where, self.t = t_fail, where, 0.0
 
     def do_step(self, t: float) -> None:
-        if t >= self.t_fail:
+        self.t = t
+        if self.where == 0 and t >= self.t_fail:
             print(1.0 / 0.0)
 
+    def command(self, psi: float, psi_d: float) -> float:
+        if self.where == 1 and self.t >= self.t_fail:
+            return (psi - psi_d) / 0.0
+        return 2.0 * (psi - psi_d)
+
     def snapshot(self) -> dict:
-        return {}
+        return {"t": self.t}
 
     def restore(self, saved: dict) -> None:
-        pass
+        self.t = saved["t"]
 
 
 class FailingPilot(ModelSlave):
     model_name = "failing_pilot"
     description = "a user's autopilot with a bug"
     variables = (*INPUTS,
-                 rudder_command(("psi", "psi_d"), lambda s: 2.0 * (s.psi - s.psi_d)),
-                 Var.parameter("t_fail", 1.0, "s", "when it divides by zero", 0.0, 1e6))
+                 rudder_command(("psi", "psi_d"), lambda s: s.model.command(s.psi, s.psi_d)),
+                 Var.parameter("t_fail", 1.0, "s", "when it divides by zero", 0.0, 1e6),
+                 Var.parameter("where", 0, "1", "0 in its step, 1 in its command", 0, 1))
 
     def build_model(self) -> Law:
-        return Law(self.t_fail)
+        return Law(self.t_fail, self.where)
 
     def step_model(self, t: float, h: float) -> None:
         self.model.do_step(t)
@@ -77,13 +88,28 @@ def failing_pilot(tmp_path_factory) -> Path:
 
 
 @pytest.mark.timeout(300)
-def test_an_exception_in_a_users_fmu_names_their_file_and_line(fmu_paths, failing_pilot):
-    with pytest.raises(SimulationError) as failed:
-        simulate("calm_pd", autopilot=failing_pilot, stop_time=3.0)
-    line = _line_of(failing_pilot.with_name("failing_pilot.py"), "1.0 / 0.0")
+@pytest.mark.parametrize("backend", ["fmi", "inprocess"])
+@pytest.mark.parametrize("where, function, fault", [
+    (0, "do_step", "1.0 / 0.0"),
+    (1, "command", "(psi - psi_d) / 0.0"),        # in an output: it read NaN, unexplained
+])
+def test_an_exception_in_a_users_fmu_names_their_file_and_line(fmu_paths, failing_pilot,
+                                                                tmp_path, monkeypatch, backend,
+                                                                where, function, fault):
+    script = failing_pilot.with_name("failing_pilot.py")
+    # In-process imports the script from its folder. An FMI run in this process left the
+    # module pythonfmu imported from the FMU's (removed) folder, and that FMU judged so.
+    monkeypatch.syspath_prepend(str(script.parent))
+    monkeypatch.delitem(sys.modules, "failing_pilot", raising=False)
+    fmu = shutil.copy(failing_pilot, tmp_path / failing_pilot.name)
+    with pytest.raises(SimulationError) as failed, warnings.catch_warnings():
+        warnings.simplefilter("error")      # no note that the FMU runs through FMI after all
+        simulate("calm_pd", autopilot=fmu, set={"autopilot.where": where}, stop_time=3.0,
+                 backend=backend)
     message = str(failed.value)
-    assert (f"failing_pilot.py:{line} in do_step: ZeroDivisionError: float division by zero"
-            in message), message
+    assert message.startswith("FMU 'autopilot': doStep at t = "), message
+    assert (f"failing_pilot.py:{_line_of(script, fault)} in {function}: ZeroDivisionError: "
+            "float division by zero" in message), message
     assert "Traceback" not in message and "slave.py" not in message
 
 
@@ -175,12 +201,12 @@ def test_every_missing_module_is_named_at_once_and_an_optional_one_is_not(tmp_pa
 
 def test_a_syntax_error_is_one_message_with_its_file_line_and_the_line(tmp_path, capsys):
     script = _script(tmp_path, "broken.py", FAILING_PILOT.replace(
-        "return {}", "return {'t': 1.0)", 1))
-    line = _line_of(script, "{'t': 1.0)")
+        'return {"t": self.t}', 'return {"t": self.t)'))
+    line = _line_of(script, '{"t": self.t)')
     assert cli.main([str(script)]) == 1
     err = capsys.readouterr().err
     assert err.startswith(f"error: {script}:{line}: SyntaxError: ")
-    assert "\n    return {'t': 1.0)\n" in err
+    assert '\n    return {"t": self.t)\n' in err
     assert "Traceback" not in err and not list(tmp_path.glob("*.fmu"))
 
 
