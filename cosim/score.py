@@ -3,10 +3,14 @@
     python -m cosim.score my.fmu [--name NAME] [--seeds N] [--map PORT=NAME] [--set ...]
                                  [--backend inprocess]
 
-Runs the paper's route in calm water and waves, a 40 deg course change, and an
-N-seed wave ensemble on a local Dask cluster (or --scheduler), for your FMU and the
-three project autopilots; writes scorecard.md and its figures to
-results/score/NAME/ and prints the tables (``cosim.studies.scorecard``).
+Runs the paper's route in calm water and waves, a 40 deg course change, and two
+N-seed wave ensembles (the paper's waves and WMO sea state 4) on a local Dask cluster
+(or --scheduler), for your FMU and the three project autopilots. Each controller is
+scored on every criterion, with its unit and the side that is better: J of eq (19),
+RMS heading error, rudder reversals per minute and mean |rudder rate|, time on the
+rudder stops, cross-track error and waypoints reached; in the ensembles, seed-paired
+wins, losses and ties against the PD. No overall rank. Writes scorecard.md and its
+figures to results/score/NAME/ and prints it (``cosim.studies.scorecard``).
 """
 from __future__ import annotations
 
@@ -21,8 +25,8 @@ from .api import overrides_of
 from .core.files import FolderBusy, OutputError
 from .core.master import RUN_BACKENDS
 from .outputs import TimedOut
-from .studies.scorecard import backend_notes, score
-from .studies.sweep_client import NoWorkers
+from .studies.scorecard import BASELINES, SEAS, backend_notes, score
+from .studies.sweep_client import NoWorkers, SweepError
 from .studies.sweep_spec import MAX_RUNS
 
 
@@ -40,10 +44,10 @@ def main(argv: list[str] | None = None) -> int:
                         help="a parameter of your autopilot, e.g. autopilot.Kp=1.5; "
                              "repeatable (the ship, sea and route stay the paper's, the same "
                              "for every contender)")
-    parser.add_argument("--seeds", type=int, default=20, help="wave seeds of the ensemble "
+    parser.add_argument("--seeds", type=int, default=20, help="wave seeds of each ensemble "
                                                               "(default 20)")
     parser.add_argument("--scheduler", metavar="ADDRESS",
-                        help="run the ensemble on this Dask scheduler (default: a local "
+                        help="run the ensembles on this Dask scheduler (default: a local "
                              "cluster)")
     parser.add_argument("--workers", type=int, help="local Dask worker processes "
                                                     "(default: one per core)")
@@ -57,7 +61,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if not 1 <= args.seeds <= MAX_RUNS // 4:
         parser.error(f"--seeds must be from 1 to {MAX_RUNS // 4} (four contenders, at most "
-                     f"{MAX_RUNS} runs), got {args.seeds}")
+                     f"{MAX_RUNS} runs an ensemble), got {args.seeds}")
     others = [target for target, _ in args.set if not target.startswith("autopilot.")]
     if others:
         parser.error(f"--set sets your autopilot's parameters (autopilot.NAME=VALUE); "
@@ -68,11 +72,14 @@ def main(argv: list[str] | None = None) -> int:
     if not checked_autopilot(parser, args):
         return 2
     name = args.name or args.autopilot.stem
+    if name in BASELINES:
+        parser.error(f"your autopilot's name {name!r} is one of the baselines' "
+                     f"({', '.join(BASELINES)}): give another with --name")
     out = writable_folder(args.out or Path("results") / "score" / name)
     for note in backend_notes(args.autopilot.resolve(), name, dict(args.map), args.backend):
         say_note(note)
     started = time.perf_counter()
-    steps = 4 * 2 + 4 + 1
+    steps = 4 * 2 + 4 + len(SEAS)
 
     from tqdm import tqdm
     bar = tqdm(total=steps, desc="scorecard", unit="step", file=sys.stderr, disable=None,
@@ -87,7 +94,8 @@ def main(argv: list[str] | None = None) -> int:
         text = score(args.autopilot.resolve(), name, out, args.seeds, dict(args.map),
                      dict(args.set), args.workers, args.scheduler, progress, args.backend)
         bar.update()
-    except (ValueError, FileNotFoundError, FolderBusy, OutputError, TimedOut) as error:
+    except (ValueError, FileNotFoundError, FolderBusy, OutputError, TimedOut,
+            SweepError) as error:         # SweepError: a worker runs other code
         bar.close()
         say_error(error)
         return 1

@@ -1,16 +1,23 @@
 """The scorecard: your autopilot beside the paper's PD and sliding-mode ones and the PID.
 
-Three tests, the same for every controller:
+Every controller runs the same tests and is scored on several criteria, each with its unit
+and the side that is better (``sweep_task.CRITERIA``: J of eq (19), RMS heading error,
+rudder reversals per minute and mean |rudder rate| of the actual rudder, time on the stops,
+RMS and largest cross-track error, waypoints reached). There is no overall rank: each
+criterion is won or lost on its own.
 
-- **the paper's four runs**: its route in calm water and in waves (Tables 1-2), the
-  cost of eq (19);
+- **the paper's route**, in calm water and in waves (Tables 1-2), one run each;
 - **a course change**: 40 deg from steady straight running in calm water, 300 s:
-  settling time to 2 % (0.8 deg), overshoot, rudder reversals per minute;
-- **a wave ensemble**: the route in waves over N wave seeds, on Dask through the
-  sweep machinery (``cosim.studies.sweep``): J per seed, its spread, and seed-paired
-  wins against the PD.
+  settling time to 2 % (0.8 deg), overshoot, rudder activity, cross-track error;
+- **two wave ensembles**: the route over N wave seeds in the paper's waves and in WMO sea
+  state 4, on Dask through the sweep machinery: each criterion's median and IQR, and,
+  seed-paired against the PD (the same sea for both), wins, losses and ties out of the N
+  seeds with the median paired ratio or difference.
 
-``score`` runs them, writes scorecard.md and the figures, and each run's CSV and
+Route completion (waypoints reached within the circle of acceptance, the last one
+included or not) is reported for every test that follows the route.
+
+``score`` runs them, writes scorecard.md and the figures, and each single run's CSV and
 metadata in runs/ (through ``cosim.outputs``, as ``cosim.run`` does), and returns the
 markdown.
 """
@@ -25,23 +32,30 @@ import numpy as np
 
 from ..analysis.cost import Cost, cost
 from ..analysis.figures import comparison_figure
-from ..analysis.metrics import heading_error, overshoot, settling_time, sign_reversals_per_minute
+from ..analysis.metrics import (RouteCompletion, heading_error, overshoot, route_completion,
+                                settling_time)
 from ..analysis.reports import PAPER_TABLES
+from ..analysis.seastate import WMO, model_scale
 from .. import scenarios
 from ..api import SimulationError, overrides_of
 from ..core.files import fresh_folder, write_atomically
 from ..core.recording import Recording
 from ..outputs import Options, run_and_write
-from .sweep import Spec, comparison, controller_entry, execute
-from .sweep_figures import distribution, tracks
+from .sweep import Spec, controller_entry, execute
+from .sweep_figures import STATISTICS, distribution, paired_figure, tracks
+from .sweep_task import CRITERIA, Criterion, route_of, run_metrics
 
 BASELINES = {"PD": "pd", "SMC": "smc", "PID": "pid"}
 """The project's autopilots by display name: scenarios <sea>_<suffix>."""
+BASELINE = "PD"
+"""The controller every other is paired with, seed by seed."""
 COURSE_CHANGE = math.radians(40.0)
 COURSE_CHANGE_ROUTE = f"0,0;1000,{1000 * math.tan(COURSE_CHANGE)!r}"
 """One long leg at 40 deg: the ship, heading north at t = 0, turns onto it."""
 COURSE_CHANGE_TIME = 300.0
 SETTLING_BAND = 0.02 * COURSE_CHANGE
+HEAVY_SEA = 4
+"""The WMO sea state code of the second ensemble: moderate, where the rudder saturates."""
 
 
 @dataclass(frozen=True)
@@ -72,20 +86,109 @@ class Contender:
 
 
 @dataclass(frozen=True)
+class Sea:
+    """The sea of a wave ensemble: the scenarios' own (the paper's) or a WMO code's."""
+
+    key: str                             # in file names: ensemble_<key>, criteria_<key>.png
+    name: str                            # "the paper's waves"
+    detail: str                          # its Hs and T0
+    sea_state: int | None = None         # WMO code; None: the waves_* scenarios' waves
+
+    @property
+    def title(self) -> str:
+        return f"{self.name} ({self.detail})"
+
+
+def _heavy_sea() -> Sea:
+    Hs, T0 = model_scale(HEAVY_SEA)
+    description, Hs_full, _ = WMO[HEAVY_SEA]
+    return Sea(f"sea_state_{HEAVY_SEA}", f"WMO sea state {HEAVY_SEA}, {description}",
+               f"Hs {Hs * 1000:.1f} mm, T0 {T0:.2f} s at 1:70; {Hs_full:g} m full scale",
+               HEAVY_SEA)
+
+
+SEAS = (Sea("waves", "the paper's waves", "Hs 5 mm, T0 0.8 s"), _heavy_sea())
+
+
+@dataclass(frozen=True)
 class CourseChange:
     settling_time: float          # s, inf if it never settles within the run
     overshoot: float              # rad
-    reversals_per_min: float
-    max_delta: float              # rad
+    metrics: dict[str, float]     # sweep_task.run_metrics of the run
 
 
 def course_change(run: Recording) -> CourseChange:
     """Figures of merit of the 40 deg course change."""
-    t, psi, delta = run.t, run["ship.psi"], run["ship.delta"]
+    psi = run["ship.psi"]
     error = heading_error(run["guidance.psi_d"], psi)
-    return CourseChange(settling_time(t, error, SETTLING_BAND),
-                        overshoot(psi, psi[0], psi[0] + COURSE_CHANGE),
-                        sign_reversals_per_minute(t, delta), float(np.abs(delta).max()))
+    return CourseChange(settling_time(run.t, error, SETTLING_BAND),
+                        overshoot(psi, psi[0], psi[0] + COURSE_CHANGE), run_metrics(run))
+
+
+def completion(run: Recording) -> RouteCompletion:
+    """Which waypoints of its route a run reached."""
+    points, R_accept = route_of(run)
+    return route_completion(run["ship.x"], run["ship.y"], points, R_accept)
+
+
+TIE = 0.01
+"""Two values closer than this share of the baseline's are a tie, not a win."""
+
+
+@dataclass(frozen=True)
+class Paired:
+    """One criterion of a controller against the baseline over the seeds both ran."""
+
+    wins: int
+    losses: int
+    ties: int
+    median: float                 # of the paired ratios or differences; nan if none
+
+    @property
+    def seeds(self) -> int:
+        return self.wins + self.losses + self.ties
+
+    @property
+    def verdict(self) -> str:
+        """better / worse: on more than half the seeds; else even (mostly ties) or mixed."""
+        if 2 * self.wins > self.seeds:
+            return "better"
+        if 2 * self.losses > self.seeds:
+            return "worse"
+        return "even" if 2 * self.ties > self.seeds else "mixed"
+
+
+def pairs(criterion: Criterion, rows: list[dict], controller: str,
+          baseline: str = BASELINE) -> tuple[np.ndarray, np.ndarray]:
+    """(controller's, baseline's) values of ``criterion`` on the seeds both ran ok, seed by
+    seed (the rows of one ensemble, paired by wave_seed)."""
+    values = {name: {r["wave_seed"]: r[criterion.column] for r in rows
+                     if r["status"] == "ok" and r["controller"] == name}
+              for name in (controller, baseline)}
+    seeds = sorted(set(values[controller]) & set(values[baseline]))
+    return (np.array([values[controller][s] for s in seeds], dtype=float),
+            np.array([values[baseline][s] for s in seeds], dtype=float))
+
+
+def change(criterion: Criterion, mine: np.ndarray, base: np.ndarray) -> np.ndarray:
+    """The paired ratios mine / base (where base is not 0) or differences mine - base."""
+    if criterion.paired == "ratio":
+        return mine[base != 0] / base[base != 0]
+    return mine - base
+
+
+def paired(criterion: Criterion, rows: list[dict], controller: str,
+           baseline: str = BASELINE) -> Paired:
+    """``controller`` against ``baseline`` on ``criterion`` over the seeds of one ensemble:
+    a win is the better value on the same sea, by more than ``TIE`` of the baseline's."""
+    mine, base = pairs(criterion, rows, controller, baseline)
+    sign = 1.0 if criterion.lower_is_better else -1.0
+    margin = sign * (base - mine)                # > 0: mine is better
+    tied = np.abs(margin) <= TIE * np.abs(base)
+    wins, losses = int(np.sum((margin > 0) & ~tied)), int(np.sum((margin < 0) & ~tied))
+    changes = change(criterion, mine, base)
+    return Paired(wins, losses, int(np.sum(tied)),
+                  float(np.median(changes)) if changes.size else math.nan)
 
 
 def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | None = None,
@@ -110,13 +213,12 @@ def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | Non
             failures[contender.name, test] = str(error).splitlines()[0]
             return None
 
-    paper: dict[tuple[str, str], Cost] = {}
+    route: dict[str, dict[str, Recording]] = {}
     for sea in ("calm", "waves"):
         runs = {c.name: attempt(c, f"{sea} water", f"route_{sea}", sea=sea)
                 for c in contenders}
-        runs = {n: r for n, r in runs.items() if r is not None}
-        paper.update({(n, sea): cost(r) for n, r in runs.items()})
-        comparison_figure(runs, out / f"route_{sea}.png",
+        route[sea] = {n: r for n, r in runs.items() if r is not None}
+        comparison_figure(route[sea], out / f"route_{sea}.png",
                           f"The paper's route in {'calm water' if sea == 'calm' else 'waves'}")
     runs = {c.name: attempt(c, "course change", "course_change", sea="calm",
                             stop_time=COURSE_CHANGE_TIME, route=COURSE_CHANGE_ROUTE)
@@ -125,14 +227,12 @@ def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | Non
     changes = {n: course_change(r) for n, r in runs.items()}
     comparison_figure(runs, out / "course_change.png",
                       "40 deg course change from straight running, calm water")
-    progress(f"wave ensemble, {seeds} seeds on Dask")
-    spec = _ensemble(contenders, seeds, out)
-    with fresh_folder(out / "ensemble") as ensemble:     # a fresh ensemble every time
-        rows = execute(spec, ensemble, scheduler=scheduler, workers=workers, progress=False,
-                       backend=backend)
-    distribution(spec, rows, out / "J_distribution.png")
-    tracks(spec, rows, out / "tracks_waves.png")
-    text = _markdown(fmu, name, seeds, contenders, paper, changes, failures, spec, rows)
+    ensembles = {}
+    for sea in SEAS:
+        progress(f"wave ensemble in {sea.name}, {seeds} seeds on Dask")
+        ensembles[sea] = _run_ensemble(contenders, seeds, sea, out, scheduler, workers,
+                                       backend)
+    text = _markdown(fmu, name, seeds, contenders, route, changes, failures, ensembles)
     write_atomically(out / "scorecard.md", lambda path: path.write_text(text))
     return text
 
@@ -143,15 +243,36 @@ def _contenders(fmu: Path, name: str, port_map: dict | None,
             Contender(name, fmu=fmu, port_map=port_map, settings=settings)]
 
 
-def _ensemble(contenders: list[Contender], seeds: int, out: Path) -> Spec:
-    """The wave ensemble: every contender on the paper's route in waves, over ``seeds``."""
+def _ensemble(contenders: list[Contender], seeds: int, out: Path, sea: Sea = SEAS[0]) -> Spec:
+    """A wave ensemble: every contender on the paper's route in ``sea``, over ``seeds``."""
     entries = {c.name: ({"scenario": f"waves_{c.suffix}"} if c.fmu is None else
                         {"autopilot": str(c.fmu), "map": c.port_map or {},
                          "set": c.settings or {}})
                for c in contenders}
-    return Spec(name="ensemble", axes={"wave_seed": list(range(1, seeds + 1))},
+    axes: dict[str, list] = {"wave_seed": list(range(1, seeds + 1))}
+    if sea.sea_state is not None:
+        axes["sea_state"] = [sea.sea_state]
+    return Spec(name=f"ensemble in {sea.name}", axes=axes,
                 controllers={n: controller_entry(e, out / "scorecard", n)
                              for n, e in entries.items()}, tracks={})   # every track
+
+
+def _run_ensemble(contenders: list[Contender], seeds: int, sea: Sea, out: Path,
+                  scheduler: str | None, workers: int | None,
+                  backend: str) -> tuple[Spec, list[dict]]:
+    """Run one ensemble in a fresh folder, draw its figures; (its spec, its rows)."""
+    spec = _ensemble(contenders, seeds, out, sea)
+    folder = out / ("ensemble" if sea is SEAS[0] else f"ensemble_{sea.key}")
+    with fresh_folder(folder) as ensemble:              # a fresh ensemble every time
+        rows = execute(spec, ensemble, scheduler=scheduler, workers=workers, progress=False,
+                       backend=backend)
+    distribution(spec, rows, out / f"criteria_{sea.key}.png", CRITERIA)
+    others = [c.name for c in contenders if c.name != BASELINE]
+    paired_figure(f"The route in {sea.name}", {
+        criterion: {name: change(criterion, *pairs(criterion, rows, name)) for name in others}
+        for criterion in CRITERIA}, BASELINE, out / f"paired_{sea.key}.png")
+    tracks(spec, rows, out / f"tracks_{sea.key}.png")
+    return spec, rows
 
 
 def backend_notes(fmu: Path, name: str, port_map: dict | None, backend: str) -> list[str]:
@@ -161,57 +282,225 @@ def backend_notes(fmu: Path, name: str, port_map: dict | None, backend: str) -> 
         backend)
 
 
+def _value(criterion: Criterion, value: float) -> str:
+    return f"{value:.{criterion.digits}f}" if math.isfinite(value) else "-"
+
+
+def _cell(criterion: Criterion, row: dict) -> str:
+    """A run's value of ``criterion``, '3 of 4' for a count."""
+    total = f" of {row[criterion.out_of]:.0f}" if criterion.out_of else ""
+    return _value(criterion, row[criterion.column]) + total
+
+
+def _heading(criterion: Criterion) -> str:
+    unit = f" ({criterion.unit})" if criterion.unit else ""
+    return f"{criterion.label}{unit}, {criterion.better}"
+
+
+def _reached(done: RouteCompletion) -> str:
+    """'reached 3 of 4 waypoints, the last included', plainly."""
+    last = "the last included" if done.last_reached else "**not** the last"
+    return f"reached {done.count} of {len(done.points)} waypoints, {last}"
+
+
+def _misses(done: RouteCompletion) -> str:
+    """The waypoints not reached, numbered from 1 (the start), with how far off."""
+    return ", ".join(f"waypoint {k} ({x:g}, {y:g}) by {d:.1f} m"
+                     for k, ((x, y), d, hit) in enumerate(
+                         zip(done.points, done.closest, done.reached), start=1) if not hit)
+
+
 def _markdown(fmu: Path, name: str, seeds: int, contenders: list[Contender],
-              paper: dict[tuple[str, str], Cost], changes: dict[str, CourseChange],
-              failures: dict[tuple[str, str], str], spec: Spec, rows: list[dict]) -> str:
+              route: dict[str, dict[str, Recording]], changes: dict[str, CourseChange],
+              failures: dict[tuple[str, str], str],
+              ensembles: dict[Sea, tuple[Spec, list[dict]]]) -> str:
+    names = [c.name for c in contenders]
     lines = [f"# Scorecard: {name}", "",
              f"Autopilot `{fmu}` beside the paper's PD and sliding-mode (SMC) autopilots and "
              "the project's PID, on CyberShip II (docs/own_autopilot.md says how each is run).",
-             "", "## The paper's route (Tables 1-2, eq 19; lower is better)", "",
+             "Each criterion is scored on its own, with its unit and the side that is better; "
+             "there is no overall rank. Angles in degrees, distances in m; a waypoint is "
+             "reached when the ship comes within the guidance's circle of acceptance of it "
+             "(waypoints are numbered from 1, the start).", ""]
+    lines += _at_a_glance(names, route, ensembles, seeds)
+    lines += _paper_route(contenders, route)
+    lines += _course_change(names, changes)
+    for sea, (spec, rows) in ensembles.items():
+        lines += _ensemble_section(sea, names, seeds, rows)
+    if failures:
+        lines += ["## Runs that failed", ""]
+        lines += [f"- {name}, {test}: `{message[:200]}`"
+                  for (name, test), message in failures.items()]
+        lines.append("")
+    return "\n".join(lines)
+
+
+def _at_a_glance(names: list[str], route: dict[str, dict[str, Recording]],
+                 ensembles: dict[Sea, tuple[Spec, list[dict]]], seeds: int) -> list[str]:
+    """Results up front: each controller's criteria won and lost against the PD in each
+    ensemble, and route completion in every test that follows the route."""
+    lines = [f"## At a glance: each controller against the {BASELINE}", "",
+             f"Seed-paired over {seeds} wave seeds: **better** (**worse**) means better "
+             f"(worse) than the {BASELINE} on the same sea in more than half of the seeds, "
+             f"*even* that most are ties (within {100 * TIE:g} % of the {BASELINE}'s value), "
+             "*mixed* neither; then the seeds won, lost and tied of those both ran, and the "
+             f"median paired ratio to the {BASELINE} or difference from it.", ""]
+    for sea, (_, rows) in ensembles.items():
+        lines += [f"The route in {sea.title}:", "",
+                  "| criterion | better | " + " | ".join(names[1:]) + " |",
+                  "|---|---|" + "---|" * len(names[1:])]
+        for criterion in CRITERIA:
+            cells = [_verdict(criterion, paired(criterion, rows, name)) for name in names[1:]]
+            unit = f" ({criterion.unit})" if criterion.unit else ""
+            lines.append(f"| {criterion.label}{unit} | {criterion.better.split()[0]} | "
+                         + " | ".join(cells) + " |")
+        lines.append("")
+    lines += ["Route completion (higher is better):", "",
+              "| controller | calm water | waves | "
+              + " | ".join(f"ensemble, {sea.name}" for sea in ensembles) + " |",
+              "|---|---|---|" + "---|" * len(ensembles)]
+    for name in names:
+        cells = [_reached(completion(route[sea][name])) if name in route[sea] else "failed"
+                 for sea in ("calm", "waves")]
+        cells += [_ensemble_completion(rows, name) for _, rows in ensembles.values()]
+        lines.append(f"| {name} | {' | '.join(cells)} |")
+    lines.append("")
+    for sea, (_, rows) in ensembles.items():
+        lines += _never_finished(sea, names, rows)
+    return lines + [""]
+
+
+def _never_finished(sea: Sea, names: list[str], rows: list[dict]) -> list[str]:
+    """A plain sentence for each controller that reached the last waypoint in no seed."""
+    lines = []
+    for name in names:
+        ok = [r for r in rows if r["status"] == "ok" and r["controller"] == name]
+        if ok and not any(r["last_waypoint_reached"] == 1.0 for r in ok):
+            stops = np.median([r["at_stops_pct"] for r in ok])
+            held = f", the rudder on its stops a median {stops:.0f} % of the run" if stops else ""
+            lines.append(f"- In {sea.name}, **{name} never reached the last waypoint** in any "
+                         f"of {len(ok)} seeds: it {_waypoints_reached(ok)}{held}.")
+    return lines
+
+
+def _verdict(criterion: Criterion, p: Paired) -> str:
+    """'**better**: won 18, lost 2, tied 0 of 20; median ratio 0.13'."""
+    if not p.seeds:
+        return "no seed ran for both"
+    word = f"**{p.verdict}**" if p.verdict in ("better", "worse") else f"*{p.verdict}*"
+    return (f"{word}: won {p.wins}, lost {p.losses}, tied {p.ties} of {p.seeds}; "
+            f"{_change(criterion, p.median)}")
+
+
+def _change(criterion: Criterion, median: float) -> str:
+    """The median paired ratio or difference, with its unit."""
+    if criterion.paired == "ratio":
+        return f"median ratio {median:.2f}" if math.isfinite(median) else "no ratio"
+    unit = {"": "", "%": " percentage points"}.get(criterion.unit, f" {criterion.unit}")
+    return f"median difference {median:+.{criterion.digits}f}{unit}"
+
+
+def _ensemble_completion(rows: list[dict], name: str) -> str:
+    """'reached 3 of 4 waypoints; the last in 18 of 20 seeds'."""
+    ok = [r for r in rows if r["status"] == "ok" and r["controller"] == name]
+    if not ok:
+        return "no run ok"
+    last = sum(r["last_waypoint_reached"] == 1.0 for r in ok)
+    return f"{_waypoints_reached(ok)}; the last in {last} of {len(ok)} seeds"
+
+
+def _waypoints_reached(ok: list[dict]) -> str:
+    """'reached 3 of 4 waypoints' over runs that ran ok: the count, or its median and range."""
+    reached = np.array([r["waypoints_reached"] for r in ok])
+    spread = (f"{reached.min():.0f}" if reached.min() == reached.max() else
+              f"a median {np.median(reached):g} (from {reached.min():.0f} to "
+              f"{reached.max():.0f})")
+    return f"reached {spread} of {ok[0]['waypoints']:.0f} waypoints"
+
+
+def _paper_route(contenders: list[Contender],
+                 route: dict[str, dict[str, Recording]]) -> list[str]:
+    lines = ["## The paper's route (Tables 1-2, eq 19; lower is better)", "",
              "| controller | calm psi_E | calm delta_E | calm J | waves psi_E | waves delta_E "
              "| waves J | paper J calm / waves |", "|---|---|---|---|---|---|---|---|"]
+    costs = {(n, sea): cost(r) for sea, runs in route.items() for n, r in runs.items()}
     for c in contenders:
         cells = []
         for sea in ("calm", "waves"):
-            r = paper.get((c.name, sea))
+            r: Cost | None = costs.get((c.name, sea))
             cells += ([f"{r.psi_E:.1f}", f"{r.delta_E:.1f}", f"{r.J:.1f}"] if r
                       else ["failed"] * 3)
         theirs = (f"{PAPER_TABLES[f'calm_{c.suffix}'][2]:.1f} / "
                   f"{PAPER_TABLES[f'waves_{c.suffix}'][2]:.1f}"
                   if c.fmu is None and f"calm_{c.suffix}" in PAPER_TABLES else "-")
         lines.append(f"| {c.name} | {' | '.join(cells)} | {theirs} |")
-    lines += ["", "![route in calm water](route_calm.png)", "![route in waves](route_waves.png)",
-              "", f"## A 40 deg course change, calm water, {COURSE_CHANGE_TIME:.0f} s", "",
-              "| controller | settling time to 2 % (s) | overshoot (deg) | rudder reversals "
-              "per min | max rudder (deg) |", "|---|---|---|---|---|"]
-    for c in contenders:
-        r = changes.get(c.name)
+    lines += ["", "Every criterion, one run each (the scenarios' wave seed):", "",
+              "| controller | sea | " + " | ".join(_heading(c) for c in CRITERIA) + " |",
+              "|---|---|" + "---|" * len(CRITERIA)]
+    misses = []
+    for sea, runs in route.items():
+        for name, run in runs.items():
+            row = run_metrics(run)
+            lines.append(f"| {name} | {sea} | "
+                         + " | ".join(_cell(c, row) for c in CRITERIA) + " |")
+            done = completion(run)
+            if done.count < len(done.points):
+                misses.append(f"- {name}, {sea}: {_reached(done)}; missed {_misses(done)} "
+                              f"(circle of acceptance {done.R_accept:g} m)")
+    lines += ["", *misses, "", "![route in calm water](route_calm.png)",
+              "![route in waves](route_waves.png)", ""]
+    return lines
+
+
+def _course_change(names: list[str], changes: dict[str, CourseChange]) -> list[str]:
+    lines = [f"## A 40 deg course change, calm water, {COURSE_CHANGE_TIME:.0f} s (lower is "
+             "better)", "",
+             "| controller | settling time to 2 % (s) | overshoot (deg) | rudder reversals "
+             "(1/min) | mean abs rudder rate (deg/s) | max rudder (deg) | max cross-track (m) |",
+             "|---|---|---|---|---|---|---|"]
+    for name in names:
+        r = changes.get(name)
         if r is None:
-            lines.append(f"| {c.name} | failed | failed | failed | failed |")
+            lines.append(f"| {name} |" + " failed |" * 6)
             continue
         settled = f"{r.settling_time:.1f}" if math.isfinite(r.settling_time) else \
             f"> {COURSE_CHANGE_TIME:.0f}"
-        lines.append(f"| {c.name} | {settled} | {math.degrees(r.overshoot):.2f} | "
-                     f"{r.reversals_per_min:.1f} | {math.degrees(r.max_delta):.1f} |")
+        m = r.metrics
+        lines.append(f"| {name} | {settled} | {math.degrees(r.overshoot):.2f} | "
+                     f"{m['reversals_per_min']:.1f} | {m['mean_rudder_rate_deg_s']:.2f} | "
+                     f"{m['max_delta_deg']:.1f} | {m['cross_track_max_m']:.2f} |")
+    return lines + ["", "The course change follows one leg of 1000 m, which 300 s (about "
+                        "90 m) do not finish: route completion does not apply to it.", "",
+                    "![course change](course_change.png)", ""]
+
+
+def _ensemble_section(sea: Sea, names: list[str], seeds: int, rows: list[dict]) -> list[str]:
+    """Each criterion's spread per controller (their pairing with the PD is up front)."""
+    lines = [f"## Wave ensemble: the route in {sea.title}, {seeds} wave seeds", "",
+             "Each criterion: median [IQR, 25-75 %] over the seeds that ran; waypoints "
+             "reached out of the route's.", "",
+             "| controller | runs ok | " + " | ".join(_heading(c) for c in CRITERIA) + " |",
+             "|---|---|" + "---|" * len(CRITERIA)]
     ok = [r for r in rows if r["status"] == "ok"]
-    lines += ["", "![course change](course_change.png)", "",
-              f"## Wave ensemble: the route in waves, {seeds} wave seeds (Hs 5 mm, T0 0.8 s)",
-              "", "| controller | J median | J mean | J 5-95 % | runs ok |", "|---|---|---|---|---|"]
-    for c in contenders:
-        J = np.array([r["J"] for r in ok if r["controller"] == c.name])
-        spread = (f"{np.median(J):.1f} | {J.mean():.1f} | {np.percentile(J, 5):.1f} - "
-                  f"{np.percentile(J, 95):.1f}") if J.size else "- | - | -"
-        lines.append(f"| {c.name} | {spread} | {J.size}/{seeds} |")
+    for name in names:
+        mine = [r for r in ok if r["controller"] == name]
+        cells = [_spread(c, mine) for c in CRITERIA]
+        lines.append(f"| {name} | {len(mine)}/{seeds} | {' | '.join(cells)} |")
     failed = [r for r in rows if r["status"] != "ok"]
     if failed:
         lines += ["", f"{len(failed)} runs of the ensemble failed; the first: "
                       f"`{failed[0]['error'].splitlines()[0][:200]}`"]
-    if failures:
-        lines += ["", "Runs that failed:", ""]
-        lines += [f"- {name}, {test}: `{message[:200]}`"
-                  for (name, test), message in failures.items()]
-    lines += ["", "Seed-paired against the PD (a win: lower J on the same sea):", "",
-              comparison(spec, rows, baseline="PD"), "",
-              "![J per controller](J_distribution.png)",
-              "![tracks of every seed](tracks_waves.png)", ""]
-    return "\n".join(lines)
+    return lines + ["", f"![each criterion](criteria_{sea.key}.png) ({STATISTICS})",
+                    f"![each criterion against the {BASELINE}, seed by seed]"
+                    f"(paired_{sea.key}.png)",
+                    f"![tracks of every seed](tracks_{sea.key}.png)", ""]
+
+
+def _spread(criterion: Criterion, rows: list[dict]) -> str:
+    """'median [25 % - 75 %]' of the rows' values (' of N' for a count), '-' if none."""
+    if not rows:
+        return "-"
+    q1, median, q3 = np.percentile([r[criterion.column] for r in rows], [25, 50, 75])
+    total = f" of {rows[0][criterion.out_of]:.0f}" if criterion.out_of else ""
+    return (f"{_value(criterion, median)} [{_value(criterion, q1)} - "
+            f"{_value(criterion, q3)}]{total}")

@@ -1,10 +1,14 @@
-"""Figures of a sweep: J per controller and sea state, and the J_SMC / J_PD map; each file
-written whole or not at all (``cosim.analysis.figures.save``)."""
+"""Figures of a sweep and of the scorecard: J (or each criterion) per controller and sea
+state, the tracks, and the J_SMC / J_PD map; each file written whole or not at all
+(``cosim.analysis.figures.save``)."""
 from __future__ import annotations
 
+import math
 from pathlib import Path
+from typing import Sequence
 
 import matplotlib
+import matplotlib.ticker
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -14,6 +18,7 @@ from autopilot_fmu.guidance import parse_waypoints  # noqa: E402
 
 from ..analysis.figures import save  # noqa: E402
 from ..analysis.seastate import model_scale  # noqa: E402
+from .sweep_task import CRITERIA, Criterion  # noqa: E402
 
 SEA_AXES = ("sea_state", "Hs")
 
@@ -22,32 +27,127 @@ def _sea_axis(spec) -> str | None:
     return next((a for a in SEA_AXES if a in spec.axes), None)
 
 
-def distribution(spec, rows: list[dict], path: Path) -> Path:
-    """Box plot of J per controller, grouped by sea state when that is an axis."""
+STATISTICS = ("box: median and IQR (25-75 %) of the runs, whiskers: min-max; the number "
+              "under each box: its median")
+"""What each box of ``distribution`` shows."""
+
+
+def distribution(spec, rows: list[dict], path: Path,
+                 criteria: Sequence[Criterion] = CRITERIA[:1]) -> Path:
+    """Box plots of each criterion (J alone by default) per controller, grouped by sea state
+    when that is an axis: one panel per criterion, each on a log scale where its values
+    span more than a decade (said on its axis)."""
     ok = [r for r in rows if r["status"] == "ok"]
     sea = _sea_axis(spec)
     groups = spec.axes[sea] if sea else [None]
-    fig, ax = plt.subplots(figsize=(max(6, 1.6 * len(groups) * len(spec.controllers)), 4.5),
-                           constrained_layout=True)
+    boxes = len(groups) * len(spec.controllers)
+    columns = min(4, len(criteria))
+    width = max(6.0 if len(criteria) == 1 else 3.4, 0.55 * boxes + 1.2)
+    fig, axes = plt.subplots(math.ceil(len(criteria) / columns), columns, squeeze=False,
+                             figsize=(width * columns, 3.9 * math.ceil(len(criteria) / columns)),
+                             constrained_layout=True)
+    for ax, criterion in zip(axes.flat, criteria):
+        _boxes(ax, spec, ok, criterion, sea, groups)
+    for ax in axes.flat[len(criteria):]:
+        ax.set_visible(False)
+    what = "J" if len(criteria) == 1 else "each criterion"
+    at = (f" and {sea}" if len(groups) > 1 else f", {sea} {groups[0]}") if sea else ""
+    fig.suptitle(f"{spec.name}: {what} per controller{at}\n{STATISTICS}", fontsize=9)
+    return save(fig, path)[0]
+
+
+def _boxes(ax, spec, ok: list[dict], criterion: Criterion, sea: str | None,
+           groups: list) -> None:
+    """One criterion's panel of ``distribution``."""
     positions, data, labels = [], [], []
     for g, group in enumerate(groups):
         for c, controller in enumerate(spec.controllers):
-            J = [r["J"] for r in ok if r["controller"] == controller
-                 and (sea is None or r[sea] == group)]
+            values = [r[criterion.column] for r in ok if r["controller"] == controller
+                      and (sea is None or r[sea] == group)]
             positions.append(g * (len(spec.controllers) + 1) + c)
-            data.append(J if J else [np.nan])
-            labels.append(f"{controller}\n{sea} {group}" if sea else controller)
-    ax.boxplot(data, positions=positions, widths=0.7)
-    ax.set_xticks(positions, labels, fontsize=8)
-    values = [j for J in data for j in J if np.isfinite(j)]
+            data.append([v for v in values if np.isfinite(v)] or [np.nan])
+            median = (f"{np.median(data[-1]):.{criterion.digits}f}"
+                      if np.isfinite(data[-1]).all() else "-")
+            where = f"\n{sea} {group}" if len(groups) > 1 else ""
+            labels.append(f"{controller}{where}\n{median}")
+    ax.boxplot(data, positions=positions, widths=0.7, whis=(0, 100), showfliers=False)
+    ax.set_xticks(positions, labels, fontsize=7, rotation=30 if len(positions) > 6 else 0)
+    values = [v for d in data for v in d if np.isfinite(v)]
+    unit = f" ({criterion.unit})" if criterion.unit else ""
     if not values:
         ax.text(0.5, 0.5, "no run succeeded", transform=ax.transAxes, ha="center")
     elif min(values) > 0 and max(values) > 10 * min(values):
-        ax.set_yscale("log")            # J spans decades across sea states and controllers
-    ax.set_ylabel("J of eq (19) (rad^2)")
-    ax.set_title(f"{spec.name}: J per controller" + (f" and {sea}" if sea else ""), fontsize=10)
+        ax.set_yscale("log")            # the values span decades
+        unit = f" ({criterion.unit}, log scale)" if criterion.unit else " (log scale)"
+    elif criterion.out_of:              # a count: from 0 to the most there are
+        total = max(r[criterion.out_of] for r in ok)
+        ax.set_ylim(-0.2, total + 0.2)
+        ax.set_yticks(range(int(total) + 1))
+        unit = f" (of {total:.0f})"
+    elif min(values) == max(values):    # all alike: a readable axis about them, from 0 if 0
+        ax.set_ylim(-0.05 if values[0] == 0 else values[0] - 1, values[0] + 1)
+    ax.set_xlim(min(positions) - 0.6, max(positions) + 0.6)
+    ax.set_ylabel(criterion.label + unit, fontsize=8)
+    ax.set_title(f"{criterion.label}: {criterion.better}", fontsize=9)
     ax.grid(alpha=0.3, axis="y")
+
+
+def paired_figure(title: str, changes: dict[Criterion, dict[str, np.ndarray]], baseline: str,
+                  path: Path) -> Path:
+    """Each criterion's paired ratios (or differences) of every controller to ``baseline``,
+    one dot per seed and a bar at their median, the side that is better shaded; ratios on
+    a log scale (a ratio of 0 is left out of it)."""
+    columns = min(4, len(changes))
+    rows = math.ceil(len(changes) / columns)
+    fig, axes = plt.subplots(rows, columns, squeeze=False, constrained_layout=True,
+                             figsize=(3.6 * columns, 3.6 * rows))
+    for ax, (criterion, by_controller) in zip(axes.flat, changes.items()):
+        _paired_panel(ax, criterion, by_controller, baseline)
+    for ax in axes.flat[len(changes):]:
+        ax.set_visible(False)
+    fig.suptitle(f"{title}: each controller against the {baseline} on the same sea, "
+                 "one dot per wave seed, bar: median; shaded: better", fontsize=9)
     return save(fig, path)[0]
+
+
+def _paired_panel(ax, criterion: Criterion, by_controller: dict[str, np.ndarray],
+                  baseline: str) -> None:
+    """One criterion's panel of ``paired_figure``."""
+    ratio = criterion.paired == "ratio"
+    reference = 1.0 if ratio else 0.0
+    values = np.concatenate([*by_controller.values(), np.array([])])
+    values = values[np.isfinite(values) & ((values > 0) if ratio else True)]
+    for i, (controller, change) in enumerate(by_controller.items()):
+        jitter = np.linspace(-0.18, 0.18, change.size) if change.size > 1 else np.zeros(1)
+        ax.plot(i + jitter[:change.size], change, "o", markersize=3, alpha=0.6, color=f"C{i}")
+        if np.isfinite(change).any():
+            median = float(np.nanmedian(change))
+            ax.plot([i - 0.3, i + 0.3], [median, median], color="k", linewidth=1.5)
+            ax.annotate(f"{median:.2f}" if ratio else f"{median:+.{criterion.digits}f}",
+                        (i + 0.32, median), fontsize=7, va="center")
+    ax.axhline(reference, color="0.3", linewidth=0.8)
+    if ratio:                           # symmetric about 1 in log: x2 as far as /2
+        ax.set_yscale("log")
+        span = 1.15 * max(float(np.abs(np.log(values)).max()) if values.size else 0.0,
+                          math.log(1.1))
+        low, high = math.exp(-span), math.exp(span)
+        ax.set_yticks([float(f"{t:.2g}") for t in np.exp(np.linspace(-span, span, 7)[1:-1])])
+        ax.yaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
+        ax.yaxis.set_minor_locator(matplotlib.ticker.NullLocator())
+    else:                               # symmetric about 0, never flat
+        span = 1.15 * max(float(np.abs(values).max()) if values.size else 0.0,
+                          10.0 ** -criterion.digits)
+        low, high = -span, span
+    ax.set_ylim(low, high)
+    better = (low, reference) if criterion.lower_is_better else (reference, high)
+    ax.axhspan(*better, color="tab:green", alpha=0.08)
+    ax.set_xticks(range(len(by_controller)), list(by_controller), fontsize=7)
+    ax.set_xlim(-0.6, len(by_controller) - 0.2)
+    unit = f", {criterion.unit}" if criterion.unit else ""
+    ax.set_ylabel(f"ratio to the {baseline} (log scale)" if ratio
+                  else f"difference from the {baseline}{unit}", fontsize=8)
+    ax.set_title(f"{criterion.label}: {criterion.better}", fontsize=9)
+    ax.grid(alpha=0.3, axis="y")
 
 
 def ratio_map(spec, rows: list[dict], path: Path, numerator: str = "smc",
@@ -98,9 +198,8 @@ def tracks(spec, rows: list[dict], path: Path) -> Path | None:
     route = chosen[0]["track"].get("route")
     if route:
         # a str: a row journaled before routes were recorded as points
-        points = np.array(parse_waypoints(route) if isinstance(route, str) else route)
-        ax.plot(points[:, 1], points[:, 0], "--o", color="0.3", linewidth=0.8, markersize=3,
-                label="route")
+        _route(ax, np.array(parse_waypoints(route) if isinstance(route, str) else route),
+               chosen[0]["track"].get("R_accept"))
     ax.set(xlabel="east y (m)", ylabel="north x (m)")
     ax.set_aspect("equal", adjustable="datalim")
     ax.grid(alpha=0.3)
@@ -111,6 +210,19 @@ def tracks(spec, rows: list[dict], path: Path) -> Path | None:
         where += f" (Hs {Hs * 1000:.3g} mm, T0 {T0:.2g} s)"
     ax.set_title(f"{spec.name}: tracks ({where})", fontsize=10)
     return save(fig, path)[0]
+
+
+def _route(ax, points: np.ndarray, R_accept: float | None) -> None:
+    """The route dashed, its waypoints numbered from 1 (the start), and their circles of
+    acceptance (dotted) where the row recorded the radius."""
+    ax.plot(points[:, 1], points[:, 0], "--o", color="0.3", linewidth=0.8, markersize=3,
+            label="route" + (f", circles of acceptance {R_accept:g} m" if R_accept else ""))
+    for k, (x, y) in enumerate(points, start=1):
+        ax.annotate(f"{k}", (y, x), xytext=(4, 4), textcoords="offset points", fontsize=8,
+                    color="0.2")
+        if R_accept:
+            ax.add_patch(plt.Circle((y, x), R_accept, fill=False, linestyle=":", color="0.3",
+                                    linewidth=0.8))
 
 
 def save_figures(spec, rows: list[dict], out: Path) -> list[Path]:

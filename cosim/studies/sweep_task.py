@@ -37,6 +37,40 @@ unit; every value is a float, NaN in a failed run's row."""
 
 
 @dataclass(frozen=True)
+class Criterion:
+    """A column of ``METRICS`` as a criterion to compare controllers by."""
+    column: str
+    label: str
+    lower_is_better: bool = True
+    paired: str = "ratio"           # how a run is set beside another's: ratio or difference
+    digits: int = 1                 # decimals shown
+    out_of: str | None = None       # the column it is a count out of, if any
+
+    @property
+    def unit(self) -> str:
+        return METRICS[self.column]
+
+    @property
+    def better(self) -> str:
+        return "lower is better" if self.lower_is_better else "higher is better"
+
+
+CRITERIA = (
+    Criterion("J", "J of eq (19)"),
+    Criterion("rms_heading_error_deg", "RMS heading error psi_d - psi", paired="difference",
+              digits=2),
+    Criterion("reversals_per_min", "rudder reversals"),
+    Criterion("mean_rudder_rate_deg_s", "mean abs rudder rate", digits=2),
+    Criterion("at_stops_pct", "time on the rudder stops", paired="difference"),
+    Criterion("cross_track_rms_m", "RMS cross-track error", paired="difference", digits=2),
+    Criterion("cross_track_max_m", "max cross-track error", paired="difference", digits=2),
+    Criterion("waypoints_reached", "waypoints reached", lower_is_better=False,
+              paired="difference", digits=0, out_of="waypoints"),
+)
+"""The criteria a scorecard compares controllers by, each with the side that is better."""
+
+
+@dataclass(frozen=True)
 class Job:
     """One run as a worker receives it: nothing is read from the client's disk."""
     sweep: str                          # the sweep's token: whose masters these are
