@@ -89,8 +89,8 @@ def _carry_them(script: Path, includes: list[Path], missing: list[Uncarried]) ->
     """What to do about modules a script's FMU would not carry: the command with an
     --include for each, where this build finds it."""
     one = len(missing) == 1
-    lines = [f"cannot build an FMU from {script}: {'a module' if one else 'modules'} it "
-             f"imports would not be in the FMU, and a host has only the FMU:"]
+    lines = [(f"cannot build an FMU from {script}: {'a module' if one else 'modules'} it "
+              "imports would not be in the FMU, and a host has only the FMU:")]
     for m in missing:
         where = (f"found at {_shown(m.found)}" if m.found else
                  "found neither here nor among the packages installed in this Python: "
