@@ -21,7 +21,7 @@ from cosim.analysis.seastate import SCALE
 from cosim.core.recording import Recording
 from ship_fmu.data import Hull
 from ship_fmu.manoeuvres import RudderProgram
-from ship_fmu.trial import DT, trial
+from ship_fmu.trial import trial
 from ship_fmu.vessel import VesselParameters
 
 DEG = math.radians(1.0)
@@ -65,6 +65,16 @@ def test_zigzag_figures_of_a_constructed_heading_history():
     assert zz.checked and zz.reversals == len(zz.executes) - 1
 
 
+def test_an_overshoot_counts_once_the_heading_turns_back_before_the_next_execute():
+    s = 10.0 * DEG
+    track = _zigzag_track(s, 10.0 * DEG, t_end=0.8 * math.pi / W)    # back, not yet at +s
+    zz = zigzag_figures(track["psi"], track["reversals"], s, track["t"])
+    assert zz.reversals == 1 and zz.running is None and not zz.checked
+    assert zz.first_overshoot == pytest.approx(A1 - s, abs=1e-6)
+    assert zz.overshoot_bound(2) == (pytest.approx(math.nan, nan_ok=True), False)
+    assert zigzag_criteria(zz, 20.0 * DEG, U) == ()        # 20 deg of rudder, 10 of heading
+
+
 def test_a_turn_never_checked_has_no_overshoot_and_fails_its_criteria():
     s = 10.0 * DEG
     t = np.arange(0.0, 60.0, STEP)
@@ -75,9 +85,10 @@ def test_a_turn_never_checked_has_no_overshoot_and_fails_its_criteria():
     assert math.isnan(zz.first_overshoot) and math.isnan(zz.time_to_check_yaw)
     assert math.isnan(zz.period)
     assert zz.initial_turning_time == pytest.approx(s / 0.02, abs=STEP)
+    assert zz.running.angle == pytest.approx(0.02 * t[-1] - s, rel=1e-3)   # so far
     turning, first, second = zigzag_criteria(zz, 10.0 * DEG, 0.3)
-    assert turning.passed and not first.passed and not second.passed
-    assert "not checked" in criterion_text(first) and criterion_text(first).startswith("FAIL")
+    assert (turning.verdict, first.verdict, second.verdict) == ("PASS", "FAIL", "OPEN")
+    assert first.at_least and criterion_text(first).startswith("FAIL  first overshoot at least")
 
 
 # -- a synthetic turning circle: a circle of radius R to port, the drift growing to BETA ----
@@ -158,10 +169,25 @@ def test_l_over_v_is_taken_at_full_scale_by_froude_scaling():
     assert length_over_speed(Hull.L, 0.3, scale=1.0) == pytest.approx(Hull.L / 0.3)
 
 
-def test_a_criterion_passes_at_its_limit_and_fails_beyond_it_or_unmeasured():
-    assert Criterion("advance", 4.5, 4.5, "L", "5.3.1").passed
-    assert not Criterion("advance", math.nextafter(4.5, 5.0), 4.5, "L", "5.3.1").passed
-    assert not Criterion("first overshoot", math.nan, 0.3, "rad", "5.3.3.1").passed
+def test_a_criterion_passes_at_its_limit_fails_beyond_it_and_is_open_unmeasured():
+    assert Criterion("advance", 4.5, 4.5, "L", "5.3.1").verdict == "PASS"
+    assert Criterion("advance", math.nextafter(4.5, 5.0), 4.5, "L", "5.3.1").verdict == "FAIL"
+    assert Criterion("first overshoot", math.nan, 0.3, "rad", "5.3.3.1").verdict == "OPEN"
+    bound = Criterion("first overshoot", 0.2, 0.3, "rad", "5.3.3.1", at_least=True)
+    assert bound.verdict == "OPEN" and not bound.passed          # may still exceed 0.3
+    assert Criterion("first overshoot", 0.4, 0.3, "rad", "5.3.3.1", at_least=True).verdict \
+        == "FAIL"                                                   # exceeds it already
+
+
+def test_a_turning_circle_cut_short_measures_what_it_reached():
+    track = _circle(laps=0.3)                # 108 deg of course, 168 of heading
+    tc = turning_circle_figures(*(track[n] for n in ("x", "y", "psi", "u", "v", "r")))
+    assert tc.advance == pytest.approx(R * math.sin(GROW), abs=R * SAMPLE)
+    assert math.isnan(tc.tactical_diameter)
+    assert tc.heading_change == pytest.approx(math.radians(168), abs=SAMPLE)
+    advance, tactical = turning_circle_criteria(tc, 35 * DEG, 35 * DEG)
+    assert (advance.verdict, tactical.verdict) == ("PASS", "OPEN")
+    assert "never changed by 180 deg" in criterion_text(tactical)
 
 
 def _tc(advance_L: float, tactical_L: float) -> TurningCircle:

@@ -45,7 +45,6 @@ TACTICAL_DIAMETER_LIMIT = 5.0         # ship lengths, 5.3.1
 INITIAL_TURNING_LIMIT = 2.5           # ship lengths, 5.3.2
 FIRST_OVERSHOOT_20_LIMIT = math.radians(25.0)   # 5.3.3.3
 TURNING_RUDDER = math.radians(35.0)   # 4.2.2: 35 deg, or the largest permissible
-_UNCHECKED = "none: the turn was not checked within the run"
 _SAME_ANGLE = 1e-6                    # rad: a test's angles match the standard's within this
 
 
@@ -60,15 +59,25 @@ class Criterion:
     clause: str      # of MSC.137(76)
     basis: str = ""  # what set the limit, if it depends on the ship (L/V)
     missing: str = "not reached in the run"   # why ``value`` is NaN, when it is
+    at_least: bool = False   # ``value`` is a lower bound: the run ended before the figure
+
+    @property
+    def verdict(self) -> str:
+        """PASS, FAIL, or OPEN: a figure the run did not reach, or reached only a lower
+        bound of that is within the limit, decides nothing."""
+        if self.value > self.limit:
+            return "FAIL"
+        return "OPEN" if self.at_least or math.isnan(self.value) else "PASS"
 
     @property
     def passed(self) -> bool:
-        """Whether the figure is within its limit (a figure never produced fails)."""
-        return bool(self.value <= self.limit)
+        return self.verdict == "PASS"
 
 
 @dataclass(frozen=True)
 class TurningCircle:
+    """A turning circle's figures; NaN where the run's heading never changed enough."""
+
     advance: float               # m, along the approach course at 90 deg heading change
     transfer: float              # m, across the approach course at 90 deg
     tactical_diameter: float     # m, across the approach course at 180 deg
@@ -78,6 +87,7 @@ class TurningCircle:
     approach_speed: float = math.nan    # m/s, sqrt(u^2 + v^2) at the rudder order
     drift_angle: float = math.nan       # rad, atan2(v, u) at the end of the run
     course_change_at_tactical: float = math.nan  # rad, where the heading has changed 180 deg
+    heading_change: float = math.nan    # rad, the largest |psi - psi[0]| of the run
 
     @property
     def diameter_from_rates(self) -> float:
@@ -103,15 +113,26 @@ class ZigZagResult:
     overshoots: tuple[Overshoot, ...] = ()  # one per checked turn, in order
     executes: tuple[float, ...] = ()       # s, the rudder orders: the first, then reversals
     initial_turning_distance: float = math.nan  # m travelled until |psi| reached psi_switch
+    running: Overshoot | None = None       # the turn the run ended in if the heading was
+    #                                        still going away: its overshoot so far
 
     @property
     def checked(self) -> bool:
-        """Whether the ship checked its turns: three reversals, both overshoots defined."""
-        return self.reversals >= 3
+        """Whether the ship checked its first two turns: both overshoots measured."""
+        return len(self.overshoots) >= 2
 
     def overshoot(self, n: int) -> float:
         """The n-th overshoot angle (1, 2, ...), rad; NaN if that turn was never checked."""
         return self.overshoots[n - 1].angle if len(self.overshoots) >= n else math.nan
+
+    def overshoot_bound(self, n: int) -> tuple[float, bool]:
+        """(angle, at_least) of the n-th overshoot: measured, or the least it can be if the
+        run ended in that turn before it was checked; NaN if the turn never began."""
+        if len(self.overshoots) >= n:
+            return self.overshoots[n - 1].angle, False
+        if self.running is not None and len(self.overshoots) == n - 1:
+            return self.running.angle, True
+        return math.nan, False
 
     @property
     def first_overshoot(self) -> float:
@@ -145,24 +166,28 @@ class ZigZagResult:
 
 
 def _first_reaching(level: np.ndarray, target: float, *series: np.ndarray) -> list[float]:
-    """Each series, linearly interpolated where ``level`` first reaches ``target``."""
+    """Each series, linearly interpolated where ``level`` first reaches ``target``; NaNs if
+    it never does."""
     i = int(np.argmax(level >= target))
-    if level[i] < target or i == 0:
-        raise ValueError(f"heading never changed by {math.degrees(target):.0f} deg")
+    if level[i] < target:
+        return [math.nan] * len(series)
+    if i == 0:
+        return [float(s[0]) for s in series]
     w = (target - level[i - 1]) / (level[i] - level[i - 1])
     return [float(s[i - 1] + w * (s[i] - s[i - 1])) for s in series]
 
 
 def at_heading_change(psi: np.ndarray, target: float, *series: np.ndarray) -> list[float]:
     """Each series, linearly interpolated where the heading has first changed by ``target``
-    (rad) from psi[0]; ValueError if it never does."""
+    (rad) from psi[0]; NaNs if it never does."""
     psi = np.asarray(psi)
     return _first_reaching(np.abs(psi - psi[0]), target, *map(np.asarray, series))
 
 
 def crossing(x: np.ndarray, y: np.ndarray, psi: np.ndarray,
              target: float) -> tuple[float, float]:
-    """(x, y) where the heading has first changed by target from psi[0], interpolated."""
+    """(x, y) where the heading has first changed by target from psi[0], interpolated;
+    NaNs if it never does."""
     x_at, y_at = at_heading_change(psi, target, x, y)
     return x_at, y_at
 
@@ -209,7 +234,8 @@ def turning_circle_figures(x, y, psi, u, v, r) -> TurningCircle:
                          steady_diameter=steady_circle(x, y, psi)[2],
                          approach_speed=float(math.hypot(u[0], v[0])),
                          drift_angle=float(math.atan2(v[-1], u[-1])),
-                         course_change_at_tactical=abs(course))
+                         course_change_at_tactical=abs(course),
+                         heading_change=float(np.abs(psi - psi[0]).max()))
 
 
 def zigzag_figures(psi, reversals, psi_switch: float, t=None, x=None,
@@ -217,28 +243,35 @@ def zigzag_figures(psi, reversals, psi_switch: float, t=None, x=None,
     """A zig-zag's figures from its heading deviation psi (the rudder program's, from
     psi = 0) and the program's reversal count, each sample.
 
-    An overshoot is measured once the next reversal shows the turn was checked; a ship
-    that never checks its turn (a straight-line unstable one, with too little rudder)
-    has none. The times (executes, overshoots, initial turning, period) need ``t``, the
+    An overshoot is measured once the heading has turned back after a reversal (the turn
+    was checked); a turn the run ended in with the heading still going away is
+    ``running``, its overshoot so far a lower bound (a straight-line unstable ship with
+    too little rudder never checks its turn). The times (executes, overshoots, initial turning, period) need ``t``, the
     distance travelled to the switching angle needs ``x`` and ``y``: without them those
     are empty or NaN.
     """
     psi, reversals = np.asarray(psi), np.asarray(reversals)
     times = np.asarray(t) if t is not None else np.full(len(psi), math.nan)
     reached = int(reversals.max())
-    overshoots = []
-    for n in range(1, reached):
+
+    def peak(n: int) -> tuple[Overshoot, bool]:
+        """The n-th turn's largest heading deviation, and whether the heading turned back."""
         turn = np.flatnonzero(reversals == n)
         k = turn[np.argmax(np.abs(psi[turn]))]
-        overshoots.append(Overshoot(float(abs(psi[k]) - psi_switch), float(times[k]),
-                                    float(psi[k])))
+        return Overshoot(float(abs(psi[k]) - psi_switch), float(times[k]), float(psi[k])), \
+            bool(k < turn[-1])
+    overshoots = [peak(n)[0] for n in range(1, reached)]
+    running = None
+    if reached > 0:
+        last, checked = peak(reached)
+        overshoots, running = (overshoots + [last], None) if checked else (overshoots, last)
     executes = () if t is None else (float(times[0]), *(
         float(times[k]) for k in np.flatnonzero(np.diff(reversals)) + 1))
     distance = math.nan
     if x is not None and y is not None and np.abs(psi).max() >= psi_switch:
         travelled = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(x), np.diff(y)))])
         distance, = _first_reaching(np.abs(psi), psi_switch, travelled)
-    return ZigZagResult(reached, psi_switch, tuple(overshoots), executes, distance)
+    return ZigZagResult(reached, psi_switch, tuple(overshoots), executes, distance, running)
 
 
 def length_over_speed(length: float, speed: float, scale: float = SCALE) -> float:
@@ -269,9 +302,11 @@ def turning_circle_criteria(tc: TurningCircle, delta: float, delta_max: float,
     allows; none for another rudder angle."""
     if abs(delta - min(TURNING_RUDDER, delta_max)) >= _SAME_ANGLE:
         return ()
-    return (Criterion("advance", tc.advance / length, ADVANCE_LIMIT, "L", "5.3.1"),
+    return (Criterion("advance", tc.advance / length, ADVANCE_LIMIT, "L", "5.3.1",
+                      missing="none: the heading never changed by 90 deg"),
             Criterion("tactical diameter", tc.tactical_diameter / length,
-                      TACTICAL_DIAMETER_LIMIT, "L", "5.3.1"))
+                      TACTICAL_DIAMETER_LIMIT, "L", "5.3.1",
+                      missing="none: the heading never changed by 180 deg"))
 
 
 def zigzag_criteria(zz: ZigZagResult, delta: float, approach_speed: float,
@@ -285,14 +320,18 @@ def zigzag_criteria(zz: ZigZagResult, delta: float, approach_speed: float,
         return (Criterion("initial turning: distance by 10 deg heading change",
                           zz.initial_turning_distance / length, INITIAL_TURNING_LIMIT, "L",
                           "5.3.2", missing="none: the heading never changed by 10 deg"),
-                Criterion("first overshoot", zz.first_overshoot, first, "rad", "5.3.3.1",
-                          basis, _UNCHECKED),
-                Criterion("second overshoot", zz.second_overshoot, second, "rad", "5.3.3.2",
-                          basis, _UNCHECKED))
+                _overshoot_criterion(zz, 1, first, "5.3.3.1", basis),
+                _overshoot_criterion(zz, 2, second, "5.3.3.2", basis))
     if _is(delta, 20.0) and _is(zz.psi_switch, 20.0):
-        return (Criterion("first overshoot", zz.first_overshoot, FIRST_OVERSHOOT_20_LIMIT,
-                          "rad", "5.3.3.3", missing=_UNCHECKED),)
+        return (_overshoot_criterion(zz, 1, FIRST_OVERSHOOT_20_LIMIT, "5.3.3.3"),)
     return ()
+
+
+def _overshoot_criterion(zz: ZigZagResult, n: int, limit: float, clause: str,
+                         basis: str = "") -> Criterion:
+    value, at_least = zz.overshoot_bound(n)
+    return Criterion(f"{('first', 'second')[n - 1]} overshoot", value, limit, "rad", clause,
+                     basis, "none: the run ended before that turn", at_least)
 
 
 @dataclass(frozen=True)

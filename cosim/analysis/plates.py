@@ -28,7 +28,7 @@ from .reports import turning_circle_lines, zigzag_lines
 RUDDER = "rudder -delta (deg, + turns to starboard)"
 """The rudder on a plate: drawn with the heading's sign sense."""
 _ORDINALS = ("1st", "2nd", "3rd", "4th")
-_VERDICT_COLOURS = {"PASS": "tab:green", "FAIL": "tab:red"}
+_VERDICT_COLOURS = {"PASS": "tab:green", "FAIL": "tab:red", "OPEN": "tab:orange"}
 _BOX = dict(boxstyle="round,pad=0.15", facecolor="white", alpha=0.85, edgecolor="none")
 _WRAP = 150
 """Characters per line of a plate's text, at its font size."""
@@ -169,7 +169,7 @@ def zigzag_plate(run: Recording, **_: Any) -> Figure:
     yaw rate; the track; the figures and criteria."""
     a = zigzag_of(run)
     zz = a.figures
-    lines = zigzag_lines(a, run["ship.psi"][-1], run.t[-1])
+    lines = zigzag_lines(a, run)
     fig, grid = _grid((2.2, 1.0), 3, sum(s.count("\n") + 1 for s in _wrapped(lines)))
     heading, r = _time_axes(fig, [grid[0:2, 0], grid[2, 0]])
     track_panel(fig.add_subplot(grid[0:3, 1]), run)
@@ -186,10 +186,10 @@ def zigzag_plate(run: Recording, **_: Any) -> Figure:
                  va="center", fontsize=7, color="0.4")
     _executes(heading, run, zz)
     _overshoots(heading, zz)
-    if zz.checked:
-        _zoom(heading, run, zz)
-    else:
+    if zz.running is not None:
         _runaway(heading, run, zz, a)
+    else:
+        _zoom(heading, run, zz)
     _spans(heading, zz)
     heading.set_ylabel(f"heading psi, {RUDDER}")
     legend_if_any(heading)
@@ -234,37 +234,60 @@ def _extension(ax: Any, run: Recording, start: tuple[float, float],
 
 
 def _turning_track(ax: Any, run: Recording, a: Assessment) -> None:
-    """The track with the approach course, advance, transfer, tactical and steady diameter."""
-    tc: TurningCircle = a.figures
-    L = a.length
+    """The track with the approach course, advance, transfer, tactical and steady diameter,
+    and the ship where its heading has changed 90 and 180 deg; what the run reached."""
     track_panel(ax, run)
-    x, y, psi = run["ship.x"], run["ship.y"], run["ship.psi"]
-    along, across = approach_frame(x, y, float(psi[0]))
+    psi = run["ship.psi"]
+    along, across = approach_frame(run["ship.x"], run["ship.y"], float(psi[0]))
     side = math.copysign(1.0, across[np.argmax(np.abs(across))])     # the turn's side
-    top, size = along.max(), np.ptp(across)
-    gap = 0.08 * size
+    top, gap = along.max(), 0.08 * max(np.ptp(across), a.length)
     outside = -side * (max(-side * across.min(), -side * across.max(), 0.0) + gap)
-    a90 = at_heading_change(psi, math.pi / 2, along, across)
-    a180 = at_heading_change(psi, math.pi, along, across)
     _extension(ax, run, (-gap, 0.0), (top + 2 * gap, 0.0))
     ax.annotate("approach course", _earth(run, -gap, 0.0), fontsize=7, color="0.4",
                 ha="center", va="top", bbox=_BOX, zorder=7)
+    a90 = tuple(at_heading_change(psi, math.pi / 2, along, across))
+    if not math.isnan(a.figures.advance):
+        _advance_and_transfer(ax, run, a, a90, outside, side * 3.5 * gap, gap)
+    a180 = tuple(at_heading_change(psi, math.pi, along, across))
+    if not math.isnan(a.figures.tactical_diameter):
+        _tactical(ax, run, a, a180, top + gap)
+    _steady(ax, run, a.figures, a.length)
+    _ship_at_heading_changes(ax, run)
+
+
+def _advance_and_transfer(ax: Any, run: Recording, a: Assessment, a90: tuple[float, float],
+                          outside: float, inside: float, gap: float) -> None:
+    """The advance beside the track on the side away from the turn, the transfer at the
+    90 deg point, labelled ``inside`` the circle."""
+    tc, L = a.figures, a.length
     _extension(ax, run, (0.0, 0.0), (0.0, outside))
-    _extension(ax, run, tuple(a90), (a90[0], outside))
+    _extension(ax, run, a90, (a90[0], outside))
     _dimension(ax, run, (0.0, outside), (tc.advance, outside),
                f"advance\n{tc.advance:.2f} m\n{tc.advance / L:.2f} L", "tab:green")
-    _dimension(ax, run, (a90[0], 0.0), tuple(a90),
+    _dimension(ax, run, (a90[0], 0.0), a90,
                f"transfer {tc.transfer:.2f} m = {tc.transfer / L:.2f} L (at 90 deg)",
-               "tab:purple", label_at=(a90[0] - 1.5 * gap, side * 3.5 * gap))
-    _extension(ax, run, (a180[0], 0.0), (top + gap, 0.0))
-    _extension(ax, run, tuple(a180), (top + gap, a180[1]))
-    _dimension(ax, run, (top + gap, 0.0), (top + gap, a180[1]),
+               "tab:purple", label_at=(a90[0] - 1.5 * gap, inside))
+
+
+def _tactical(ax: Any, run: Recording, a: Assessment, a180: tuple[float, float],
+              level: float) -> None:
+    """The tactical diameter across the approach course, ``level`` m along it."""
+    tc = a.figures
+    _extension(ax, run, (a180[0], 0.0), (level, 0.0))
+    _extension(ax, run, a180, (level, a180[1]))
+    _dimension(ax, run, (level, 0.0), (level, a180[1]),
                f"tactical diameter {tc.tactical_diameter:.2f} m = "
-               f"{tc.tactical_diameter / L:.2f} L (at 180 deg)", "tab:brown")
-    _steady(ax, run, tc, L)
+               f"{tc.tactical_diameter / a.length:.2f} L (at 180 deg)", "tab:brown")
+
+
+def _ship_at_heading_changes(ax: Any, run: Recording) -> None:
+    """The ship's outline where its heading has changed 90 and 180 deg: its drift shows."""
+    x, y, psi = run["ship.x"], run["ship.y"], run["ship.psi"]
     scale = outlines(run).scale
     for target in (math.pi / 2, math.pi):
         xs, ys, ps = at_heading_change(psi, target, x, y, psi)
+        if math.isnan(xs):
+            continue
         ax.add_patch(Polygon(hull_outline(xs, ys, ps, scale), closed=True, facecolor="gold",
                              edgecolor="k", linewidth=0.8, zorder=4))
         ax.annotate(f"{math.degrees(target):.0f} deg heading change", (ys, xs),
@@ -310,6 +333,8 @@ def turning_circle_plate(run: Recording, **_: Any) -> Figure:
     _wrapped_heading(heading, run)
     for target in (math.pi / 2, math.pi):
         when, = at_heading_change(run["ship.psi"], target, t)
+        if math.isnan(when):
+            continue
         for panel in (heading, speed, drift, r, rudder):
             panel.axvline(when, color="tab:gray", linestyle=":", linewidth=0.9)
         heading.text(when, 1.0, f" {math.degrees(target):.0f} deg", va="bottom", fontsize=7,

@@ -8,8 +8,8 @@ import numpy as np
 
 from ..core.recording import Recording
 from .cost import LAMBDA, Cost, cost
-from .manoeuvres import (STANDARD, Assessment, Criterion, TurningCircle, turning_circle_of,
-                         zigzag_of)
+from .manoeuvres import (STANDARD, Assessment, Criterion, TurningCircle, ZigZagResult,
+                         turning_circle_of, zigzag_of)
 from .metrics import sign_reversals_per_minute
 from .seastate import SCALE
 
@@ -36,11 +36,16 @@ def course_keeping_report(recording: Recording, lam: float = LAMBDA, **_) -> lis
 
 
 def criterion_text(c: Criterion) -> str:
-    """One criterion for people: the figure, its limit, PASS or FAIL, the clause."""
-    value = c.missing if math.isnan(c.value) else _amount(c.value, c.unit)
+    """One criterion for people: PASS, FAIL or OPEN, the figure, its limit, the clause."""
+    if math.isnan(c.value):
+        value = c.missing
+    elif c.at_least:
+        value = f"at least {_amount(c.value, c.unit)}, the turn unchecked at the end of the run"
+    else:
+        value = _amount(c.value, c.unit)
     basis = f"; {c.basis}" if c.basis else ""
-    return (f"{'PASS' if c.passed else 'FAIL'}  {c.figure} {value} (limit {_amount(c.limit, c.unit)}"
-            f"; {STANDARD} {c.clause}{basis})")
+    return (f"{c.verdict}  {c.figure} {value} (limit {_amount(c.limit, c.unit)}; {STANDARD} "
+            f"{c.clause}{basis})")
 
 
 def _amount(x: float, unit: str) -> str:
@@ -58,12 +63,32 @@ def scope(a: Assessment) -> str:
             "Froude scaling, as an indication")
 
 
+def _turning_figures(tc: TurningCircle, L: float) -> str:
+    """Advance, transfer and tactical diameter in m and ship lengths, as far as the run got."""
+    short = f"the heading changed by only {math.degrees(tc.heading_change):.0f} deg in the run"
+    if math.isnan(tc.advance):
+        return f"{short}: no advance, transfer or tactical diameter (at 90 and 180 deg)"
+    at_90 = (f"advance {tc.advance:.3f} m ({tc.advance / L:.2f} L), transfer "
+             f"{tc.transfer:.3f} m ({tc.transfer / L:.2f} L) at 90 deg heading change")
+    if math.isnan(tc.tactical_diameter):
+        return f"{at_90}; {short}: no tactical diameter (at 180 deg)"
+    return (f"{at_90}; tactical diameter {tc.tactical_diameter:.3f} m "
+            f"({tc.tactical_diameter / L:.2f} L) at 180 deg")
+
+
+def _steady_diameter(tc: TurningCircle, L: float) -> str:
+    """The steady turning diameter, measured and from the rates, for people."""
+    rates = f"2U/|r| = {tc.diameter_from_rates:.3f} m"
+    if math.isnan(tc.steady_diameter):
+        return f"diameter {rates} (the run turned less than 540 deg: no lap to fit)"
+    return (f"diameter {tc.steady_diameter:.3f} m ({tc.steady_diameter / L:.2f} L, circle "
+            f"fitted to the last lap; {rates})")
+
+
 def turning_circle_lines(a: Assessment) -> list[str]:
     """The turning circle's figures, why its two diameters differ, and its criteria."""
     tc, L = a.figures, a.length
-    lines = [f"advance {tc.advance:.3f} m ({tc.advance / L:.2f} L), transfer {tc.transfer:.3f} m "
-             f"({tc.transfer / L:.2f} L) at 90 deg heading change; tactical diameter "
-             f"{tc.tactical_diameter:.3f} m ({tc.tactical_diameter / L:.2f} L) at 180 deg",
+    lines = [_turning_figures(tc, L),
              f"steady turn: {_steady_diameter(tc, L)}, yaw rate "
              f"{math.degrees(tc.steady_yaw_rate):.3f} deg/s, speed {tc.steady_speed:.3f} m/s "
              f"({tc.steady_speed / tc.approach_speed:.0%} of the approach), drift angle "
@@ -76,36 +101,38 @@ def turning_circle_lines(a: Assessment) -> list[str]:
     return lines + [criterion_text(c) for c in a.criteria] + [scope(a)]
 
 
-def _steady_diameter(tc: TurningCircle, L: float) -> str:
-    """The steady turning diameter, measured and from the rates, for people."""
-    rates = f"2U/|r| = {tc.diameter_from_rates:.3f} m"
-    if math.isnan(tc.steady_diameter):
-        return f"diameter {rates} (the run turned less than 540 deg: no lap to fit)"
-    return (f"diameter {tc.steady_diameter:.3f} m ({tc.steady_diameter / L:.2f} L, circle "
-            f"fitted to the last lap; {rates})")
-
-
-def zigzag_lines(a: Assessment, psi_end: float, t_end: float) -> list[str]:
-    """The zig-zag's overshoots (or why there are none), times and criteria; ``psi_end``
-    and ``t_end``: the heading deviation (rad) and time (s) at the end of the run."""
-    zz = a.figures
-    if zz.checked:
-        lines = [f"first overshoot {math.degrees(zz.first_overshoot):.2f} deg, second "
-                 f"overshoot {math.degrees(zz.second_overshoot):.2f} deg"]
-    else:
-        lines = [f"the turn was never checked: {zz.reversals} rudder reversal(s) of 3, heading "
-                 f"{math.degrees(psi_end):.0f} deg at t = {t_end:.0f} s; with "
-                 f"{math.degrees(a.delta):.0f} deg of counter-rudder this straight-line "
-                 "unstable ship keeps turning"]
+def _zigzag_times(zz: ZigZagResult, L: float) -> str:
+    """Initial turning time and distance, time to check yaw and period, as far as reached."""
+    if len(zz.executes) < 2:
+        return "the heading never reached the switching angle"
     times = [f"initial turning time {zz.initial_turning_time:.1f} s (first to second execute, "
-             f"{zz.initial_turning_distance / a.length:.2f} L travelled)"] \
-        if len(zz.executes) > 1 else ["the heading never reached the switching angle"]
+             f"{zz.initial_turning_distance / L:.2f} L travelled)"]
     if zz.overshoots:
         times.append(f"time to check yaw {zz.time_to_check_yaw:.1f} s (second execute to the "
                      f"first overshoot, at t = {zz.overshoots[0].time:.1f} s)")
     if not math.isnan(zz.period):
         times.append(f"period {zz.period:.1f} s (second to fourth execute)")
-    return lines + [", ".join(times)] + [criterion_text(c) for c in a.criteria] + [scope(a)]
+    return ", ".join(times)
+
+
+def zigzag_lines(a: Assessment, run: Recording) -> list[str]:
+    """The zig-zag's overshoots (or that the turn was not checked, and where the heading
+    went), its times and its criteria."""
+    zz = a.figures
+    measured = [f"{name} overshoot {math.degrees(o.angle):.2f} deg"
+                for name, o in zip(("first", "second"), zz.overshoots)]
+    lines = [", ".join(measured)] if measured else []
+    if zz.running is not None:
+        rudder = "counter-rudder" if zz.reversals else "rudder"
+        lines.append(f"the turn was never checked: {zz.reversals} rudder reversal(s) of 3 in "
+                     f"the run, heading {math.degrees(run['ship.psi'][-1]):.0f} deg at t = "
+                     f"{run.t[-1]:.0f} s, still turning at "
+                     f"{math.degrees(run['ship.r'][-1]):.1f} deg/s with "
+                     f"{math.degrees(a.delta):.0f} deg of {rudder}")
+    elif zz.reversals > 0 and not zz.checked:
+        lines.append("the run ended before the second overshoot")
+    return lines + [_zigzag_times(zz, a.length)] + [criterion_text(c) for c in a.criteria] + \
+        [scope(a)]
 
 
 def turning_circle_report(recording: Recording, **_) -> list[str]:
@@ -113,7 +140,7 @@ def turning_circle_report(recording: Recording, **_) -> list[str]:
 
 
 def zigzag_report(recording: Recording, **_) -> list[str]:
-    return zigzag_lines(zigzag_of(recording), recording["ship.psi"][-1], recording.t[-1])
+    return zigzag_lines(zigzag_of(recording), recording)
 
 
 def _label(sea: str, controller: str) -> str:
