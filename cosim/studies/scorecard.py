@@ -282,14 +282,10 @@ def backend_notes(fmu: Path, name: str, port_map: dict | None, backend: str) -> 
         backend)
 
 
-def _value(criterion: Criterion, value: float) -> str:
-    return f"{value:.{criterion.digits}f}" if math.isfinite(value) else "-"
-
-
 def _cell(criterion: Criterion, row: dict) -> str:
     """A run's value of ``criterion``, '3 of 4' for a count."""
     total = f" of {row[criterion.out_of]:.0f}" if criterion.out_of else ""
-    return _value(criterion, row[criterion.column]) + total
+    return criterion.format(row[criterion.column]) + total
 
 
 def _heading(criterion: Criterion) -> str:
@@ -397,7 +393,7 @@ def _change(criterion: Criterion, median: float) -> str:
     if criterion.paired == "ratio":
         return f"median ratio {median:.2f}" if math.isfinite(median) else "no ratio"
     unit = {"": "", "%": " percentage points"}.get(criterion.unit, f" {criterion.unit}")
-    return f"median difference {median:+.{criterion.digits}f}{unit}"
+    return f"median difference {criterion.format(median, '+')}{unit}"
 
 
 def _ensemble_completion(rows: list[dict], name: str) -> str:
@@ -502,5 +498,5 @@ def _spread(criterion: Criterion, rows: list[dict]) -> str:
         return "-"
     q1, median, q3 = np.percentile([r[criterion.column] for r in rows], [25, 50, 75])
     total = f" of {rows[0][criterion.out_of]:.0f}" if criterion.out_of else ""
-    return (f"{_value(criterion, median)} [{_value(criterion, q1)} - "
-            f"{_value(criterion, q3)}]{total}")
+    return (f"{criterion.format(median)} [{criterion.format(q1)} - "
+            f"{criterion.format(q3)}]{total}")

@@ -66,8 +66,7 @@ def _boxes(ax, spec, ok: list[dict], criterion: Criterion, sea: str | None,
                       and (sea is None or r[sea] == group)]
             positions.append(g * (len(spec.controllers) + 1) + c)
             data.append([v for v in values if np.isfinite(v)] or [np.nan])
-            median = (f"{np.median(data[-1]):.{criterion.digits}f}"
-                      if np.isfinite(data[-1]).all() else "-")
+            median = criterion.format(float(np.median(data[-1])))
             where = f"\n{sea} {group}" if len(groups) > 1 else ""
             labels.append(f"{controller}{where}\n{median}")
     ax.boxplot(data, positions=positions, widths=0.7, whis=(0, 100), showfliers=False)
@@ -123,7 +122,7 @@ def _paired_panel(ax, criterion: Criterion, by_controller: dict[str, np.ndarray]
         if np.isfinite(change).any():
             median = float(np.nanmedian(change))
             ax.plot([i - 0.3, i + 0.3], [median, median], color="k", linewidth=1.5)
-            ax.annotate(f"{median:.2f}" if ratio else f"{median:+.{criterion.digits}f}",
+            ax.annotate(f"{median:.2f}" if ratio else criterion.format(median, "+"),
                         (i + 0.32, median), fontsize=7, va="center")
     ax.axhline(reference, color="0.3", linewidth=0.8)
     if ratio:                           # symmetric about 1 in log: x2 as far as /2

@@ -54,6 +54,13 @@ class Criterion:
     def better(self) -> str:
         return "lower is better" if self.lower_is_better else "higher is better"
 
+    def format(self, value: float, sign: str = "") -> str:
+        """``value`` to this criterion's decimals (a median of counts may be a half: 2.5),
+        '-' if it is not finite; ``sign="+"`` signs it."""
+        if not math.isfinite(value):
+            return "-"
+        return f"{value:{sign}g}" if self.digits == 0 else f"{value:{sign}.{self.digits}f}"
+
 
 CRITERIA = (
     Criterion("J", "J of eq (19)"),
