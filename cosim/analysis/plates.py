@@ -141,10 +141,10 @@ def _runaway(ax: Any, run: Recording, zz: ZigZagResult, a: Assessment) -> None:
     gone = int(np.argmax(np.abs(psi) > limit)) if np.abs(psi).max() > limit else len(psi) - 1
     ax.set_xlim(run.t[0], min(run.t[-1], run.t[0] + 4.0 * (run.t[gone] - run.t[0])))
     side = math.copysign(1.0, psi[-1])
-    ax.annotate(f"heading runs on to {psi[-1]:.0f} deg at t = {run.t[-1]:.0f} s: "
-                "the turn is never checked", xy=(run.t[gone], side * limit),
-                xytext=(run.t[gone] * 1.15, side * 0.75 * limit), fontsize=8, color="tab:red",
-                arrowprops=dict(arrowstyle="->", color="tab:red"))
+    ax.annotate(f"heading {psi[-1]:.0f} deg at t = {run.t[-1]:.0f} s, still going away: the "
+                "turn was not checked within the run", xy=(run.t[gone], side * limit),
+                xytext=(run.t[0] + 1.15 * (run.t[gone] - run.t[0]), side * 0.75 * limit),
+                fontsize=8, color="tab:red", arrowprops=dict(arrowstyle="->", color="tab:red"))
 
 
 def _zoom(ax: Any, run: Recording, zz: ZigZagResult) -> None:
@@ -164,6 +164,15 @@ def _zoom(ax: Any, run: Recording, zz: ZigZagResult) -> None:
             color="0.4", bbox=_BOX)
 
 
+def _switching_angles(ax: Any, switch: float) -> None:
+    """The heading deviations (deg) that reverse the rudder, and zero."""
+    ax.axhline(0.0, color="0.6", linewidth=0.6)
+    for level in (-switch, switch):
+        ax.axhline(level, linestyle=":", color="0.4", linewidth=0.9)
+        ax.text(1.0, level, f" {level:+g}", transform=ax.get_yaxis_transform(), va="center",
+                fontsize=7, color="0.4")
+
+
 def zigzag_plate(run: Recording, **_: Any) -> Figure:
     """Heading and rudder on one axis with the executes, overshoots and the standard's times;
     yaw rate; the track; the figures and criteria."""
@@ -173,17 +182,10 @@ def zigzag_plate(run: Recording, **_: Any) -> Figure:
     fig, grid = _grid((2.2, 1.0), 3, sum(s.count("\n") + 1 for s in _wrapped(lines)))
     heading, r = _time_axes(fig, [grid[0:2, 0], grid[2, 0]])
     track_panel(fig.add_subplot(grid[0:3, 1]), run)
-    switch = math.degrees(zz.psi_switch)
     heading.plot(run.t, np.degrees(run["ship.psi"]), color="k", linewidth=1.4,
                  label="heading psi")
     _rudder(heading, run)
-    for level in (-switch, switch):
-        heading.axhline(level, linestyle=":", color="0.4", linewidth=0.9)
-    heading.axhline(0.0, color="0.6", linewidth=0.6)
-    heading.text(1.0, switch, f" +{switch:g}", transform=heading.get_yaxis_transform(),
-                 va="center", fontsize=7, color="0.4")
-    heading.text(1.0, -switch, f" -{switch:g}", transform=heading.get_yaxis_transform(),
-                 va="center", fontsize=7, color="0.4")
+    _switching_angles(heading, math.degrees(zz.psi_switch))
     _executes(heading, run, zz)
     _overshoots(heading, zz)
     if zz.running is not None:
