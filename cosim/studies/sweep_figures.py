@@ -4,6 +4,7 @@ state, the tracks, and the J_SMC / J_PD map; each file written whole or not at a
 from __future__ import annotations
 
 import math
+import textwrap
 from pathlib import Path
 from typing import Sequence
 
@@ -52,7 +53,8 @@ def distribution(spec, rows: list[dict], path: Path,
         ax.set_visible(False)
     what = "J" if len(criteria) == 1 else "each criterion"
     at = (f" and {sea}" if len(groups) > 1 else f", {sea} {groups[0]}") if sea else ""
-    fig.suptitle(f"{spec.name}: {what} per controller{at}\n{STATISTICS}", fontsize=9)
+    caption = textwrap.fill(STATISTICS, int(12 * width * columns))   # 9 pt: ~12 a inch
+    fig.suptitle(f"{spec.name}: {what} per controller{at}\n{caption}", fontsize=9)
     return save(fig, path)[0]
 
 
