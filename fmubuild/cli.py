@@ -71,8 +71,9 @@ def main(argv: list[str] | None = None) -> int:
 def _build_script(script: Path, includes: list[Path], out: Path | None) -> Path:
     """A user's script built into ``out`` (default: its folder); ValueError naming the
     script, and what is wrong with it, if it cannot be: a module it imports that its FMU
-    would not carry, or its exiting when imported."""
-    if script.is_file() and script.suffix == ".py":
+    would not carry, or its exiting when imported (a missing script or include is
+    ``build_script``'s to name)."""
+    if script.is_file() and script.suffix == ".py" and all(p.exists() for p in includes):
         missing = uncarried(script, includes, ("fmukit",))
         if missing:
             raise ValueError(_carry_them(script, includes, missing))

@@ -199,6 +199,28 @@ def test_every_missing_module_is_named_at_once_and_an_optional_one_is_not(tmp_pa
     assert "an_optional_speedup" not in err
 
 
+def test_a_module_an_included_package_imports_is_named_by_its_importer(law_pilot, monkeypatch,
+                                                                       capsys):
+    """mylaw carried as a package of the user's, which needs a module left beside it."""
+    folder = law_pilot.parent
+    _script(folder / "mylaw", "__init__.py", "from mylaw.gains import pd\n")
+    _script(folder / "mylaw", "gains.py", "import tuning\n\ndef pd(e, r):\n    return e\n")
+    _script(folder, "tuning.py", "KP = 2.0\n")
+    (folder / "mylaw.py").unlink()
+    monkeypatch.chdir(folder)
+    assert cli.main([law_pilot.name, "--include", "mylaw"]) == 1
+    err = capsys.readouterr().err
+    assert "  mylaw/gains.py imports tuning (found at tuning.py)\n" in err
+    assert "python -m fmukit.build law_pilot.py --include mylaw --include tuning.py\n" in err
+
+
+def test_an_include_that_does_not_exist_is_named(law_pilot, capsys):
+    assert cli.main([str(law_pilot), "--include", str(law_pilot.with_name("mylaws.py"))]) == 1
+    err = capsys.readouterr().err
+    assert err == (f"error: {law_pilot.with_name('mylaws.py')}, to be carried by "
+                   f"{law_pilot.name}'s FMU, does not exist\n")
+
+
 def test_a_syntax_error_is_one_message_with_its_file_line_and_the_line(tmp_path, capsys):
     script = _script(tmp_path, "broken.py", FAILING_PILOT.replace(
         'return {"t": self.t}', 'return {"t": self.t)'))
