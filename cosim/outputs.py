@@ -180,7 +180,7 @@ def _analyse(outcome: Outcome, system: SystemDescription, kind: Analysis, label:
     if options.plot and kind.figure is not None:
         with outputs.writing(f"{label}.{options.formats[0]}") as path:
             outcome.written += save_figure(recording, kind.figure, path.with_suffix(""),
-                                           label, options.formats)
+                                           label, options.formats, lam=options.lam)
     if options.animate:
         with outputs.writing(f"{label}.{options.animate}") as path:
             outcome.written.append(animate(recording, path.with_suffix(""), label,

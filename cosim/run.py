@@ -26,7 +26,7 @@ from ._cli import (Progress, add_autopilot_options, checked_autopilot, chosen_sc
                    number_option, positive_seconds, say_error, say_note, setting_option, writable_folder)
 from .analysis.animation import video_format
 from .analysis.cost import LAMBDA, Cost
-from .analysis.describe import conditions
+from .analysis.describe import conditions, headline
 from .analysis.reports import tables
 from .api import overrides_of
 from .core.coupling import COUPLINGS
@@ -55,7 +55,7 @@ def run_scenario(system: SystemDescription, label: str, out: Path, overrides: di
         finally:
             progress.close()
     recording, csv_path = outcome.recording, outcome.csv
-    print(f"{label}: {system.description}")
+    print(headline(label, recording.meta))
     for line in conditions(recording.meta):
         print(f"  {line}")
     if recording.interrupted:

@@ -13,7 +13,6 @@ from typing import Any
 
 from autopilot_fmu.guidance import route as followed_route
 
-from ..core.ssd import read_ssd
 from ..scenarios import SCENARIO_DIR
 from .reports import PAPER_TABLES
 
@@ -89,21 +88,11 @@ def conditions(meta: dict[str, Any]) -> list[str]:
     return lines
 
 
-def _scenario_stop_time(meta: dict[str, Any]) -> float | None:
-    """The stop time the run's .ssd sets, s; None if the run names no readable .ssd."""
-    if not meta.get("scenario_file"):
-        return None
-    try:
-        return read_ssd(meta["scenario_file"]).stop_time
-    except (OSError, ValueError):
-        return None
-
-
 def changes(meta: dict[str, Any]) -> str:
     """How the run differs from its scenario, as the options that made it so: every --set,
     and --stop-time if it ended elsewhere than the scenario's .ssd says ('' if neither)."""
     changed = [overrides(meta)] if meta.get("overrides") else []
-    stop = _scenario_stop_time(meta)
+    stop = meta.get("scenario_stop_time")
     if stop is not None and meta.get("stop_time", stop) != stop:
         changed.append(f"--stop-time {meta['stop_time']:g}")
     return " ".join(changed)

@@ -166,6 +166,7 @@ class Master:
                 "backend": self.backend, "backends": self.backends, "notes": self.notes,
                 "coupling": self.coupling, "start_time": t0,
                 "step_size": h, "stop_time": communication_point(t0, n_steps, h),
+                "scenario_stop_time": system.stop_time,
                 "settings": self.parameters, "overrides": self.overrides,
                 "fmus": {name: {"file": str(i.path), "guid": getattr(i, "guid", None)}
                          for name, i in self.instances.items()}}
