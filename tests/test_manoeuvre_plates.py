@@ -75,6 +75,13 @@ def test_an_overshoot_counts_once_the_heading_turns_back_before_the_next_execute
     assert zigzag_criteria(zz, 20.0 * DEG, U) == ()        # 20 deg of rudder, 10 of heading
 
 
+def test_a_run_ending_in_a_later_turn_is_a_checked_zigzag():
+    s = 10.0 * DEG
+    track = _zigzag_track(s, 10.0 * DEG, t_end=125.0)    # heading still going away at 125 s
+    zz = zigzag_figures(track["psi"], track["reversals"], s, track["t"])
+    assert zz.reversals == 7 and zz.running is None and zz.checked   # reversed at 122.4 s
+
+
 def test_a_turn_never_checked_has_no_overshoot_and_fails_its_criteria():
     s = 10.0 * DEG
     t = np.arange(0.0, 60.0, STEP)
@@ -258,6 +265,8 @@ def test_the_zigzag_plate_overlays_heading_and_rudder_and_prints_the_criteria(zi
     a = zigzag_of(zigzag_run)
     assert len(lines["execute (rudder ordered)"].get_xdata()) == len(a.figures.executes)
     text = _texts(fig)
+    assert "not checked" not in text and "still" not in text
+    assert heading.get_xlim()[1] < zigzag_run.t[-1]           # zoomed on the first executes
     assert f"1st overshoot {math.degrees(A1) - 10:.1f} deg" in text
     assert f"2nd overshoot {math.degrees(A2) - 10:.1f} deg" in text
     assert f"period {a.figures.period:.1f} s" in text

@@ -113,8 +113,8 @@ class ZigZagResult:
     overshoots: tuple[Overshoot, ...] = ()  # one per checked turn, in order
     executes: tuple[float, ...] = ()       # s, the rudder orders: the first, then reversals
     initial_turning_distance: float = math.nan  # m travelled until |psi| reached psi_switch
-    running: Overshoot | None = None       # the turn the run ended in if the heading was
-    #                                        still going away: its overshoot so far
+    running: Overshoot | None = None       # the first or second turn, if the run ended in
+    #                           it with the heading still going away: its overshoot so far
 
     @property
     def checked(self) -> bool:
@@ -244,8 +244,8 @@ def zigzag_figures(psi, reversals, psi_switch: float, t=None, x=None,
     psi = 0) and the program's reversal count, each sample.
 
     An overshoot is measured once the heading has turned back after a reversal (the turn
-    was checked); a turn the run ended in with the heading still going away is
-    ``running``, its overshoot so far a lower bound (a straight-line unstable ship with
+    was checked); the first or second turn, if the run ended in it with the heading still
+    going away, is ``running``, its overshoot so far a lower bound (a straight-line unstable ship with
     too little rudder never checks its turn). The times (executes, overshoots, initial turning, period) need ``t``, the
     distance travelled to the switching angle needs ``x`` and ``y``: without them those
     are empty or NaN.
@@ -262,7 +262,7 @@ def zigzag_figures(psi, reversals, psi_switch: float, t=None, x=None,
             bool(k < turn[-1])
     overshoots = [peak(n)[0] for n in range(1, reached)]
     running = None
-    if reached > 0:
+    if 0 < reached < 3:                       # the run ended in the first or second turn
         last, checked = peak(reached)
         overshoots, running = (overshoots + [last], None) if checked else (overshoots, last)
     executes = () if t is None else (float(times[0]), *(
