@@ -2,6 +2,9 @@
 from __future__ import annotations
 
 import argparse
+import os
+import shlex
+import signal
 import sys
 from pathlib import Path
 
@@ -15,15 +18,21 @@ from .studies.cluster import CONNECT_TIMEOUT
 from .studies.sweep_client import NoWorkers, SweepError
 from .studies.sweep_figures import save_figures
 from .studies.sweep_spec import MAX_RUNS, Spec
-from .studies.sweep_tables import comparison, summary, write_tables
+from .studies.sweep_tables import (
+    MONTE_CARLO,
+    comparison,
+    distinct,
+    summary,
+    write_tables,
+)
 
 RESULTS = Path("results/sweeps")
 USAGE = sweep.__doc__.partition("\n\nModules: ")[0]
 """--help: the sweep's documentation, without its closing paragraph on the modules."""
 
 
-OUTPUTS = ("results.parquet", "results.json", "results.csv", "J_distribution.png", "tracks.png",
-           "J_*_over_pd.png", "comparison.md")
+OUTPUTS = ("results.parquet", "results.json", "results.csv", "summary.csv", "J_distribution.png",
+           "tracks.png", "J_*_over_pd.png", "comparison.md")
 """What a finished sweep writes beside its journal (by name, or glob of names)."""
 
 
@@ -86,40 +95,44 @@ def main(argv: list[str] | None = None) -> int:
     except (ValueError, FileNotFoundError) as error:     # FileNotFoundError: an FMU
         say_error(error)
         return 2
+    except Interrupted as stopped:
+        print(f"{stopped} while reading {args.spec}: no run was started", file=sys.stderr)
+        return stopped.exit_status
     out = writable_folder(args.out / spec.name)
+    resume = shlex.join([sys.executable, "-m", "cosim.sweep",
+                         *(sys.argv[1:] if argv is None else argv)])
+    stage = "running the sweep"
     try:
-        for note in spec.backend_notes(args.backend):
+        for note in [*spec.backend_notes(args.backend), *spec.sharing_notes()]:
             say_note(note)
         rows = sweep.execute(spec, out, args.scheduler, args.workers,
                              progress=not args.no_progress, scheduler_file=args.scheduler_file,
                              backend=args.backend, no_worker_timeout=args.no_worker_timeout,
                              connect_timeout=args.connect_timeout,
                              limits=Limits(args.step_timeout, args.run_timeout))
-    except (SweepError, ValueError, OSError) as error:   # OSError: the journal's folder
-        say_error(error)
-        return 2
-    except (Interrupted, NoWorkers) as stopped:
-        rows = sweep.completed(spec, out)
-        written = write_tables(rows, out, args.csv) if rows else []
-        print(f"{stopped}: {len(rows)} of {len(spec.runs())} runs done, kept in "
-              f"{out / 'runs.jsonl'}{''.join(f', {p}' for p in written)}; the same command "
-              "resumes the sweep", file=sys.stderr)
-        return stopped.exit_status
-    try:
-        written = write_tables(rows, out, args.csv)
+        stage = "writing the tables"
+        written = write_tables(rows, out, args.csv, spec)
+        stage = "drawing the figures"
         if any(r["status"] == "ok" for r in rows):
             written += save_figures(spec, rows, out)
         else:
             print("no run succeeded: no figures drawn", file=sys.stderr)
+        stage = "writing comparison.md"
         if "pd" in spec.controllers and len(spec.controllers) > 1:
-            table = comparison(spec, rows) + "\n"
+            table = _comparison(spec, rows)
             written.append(write_atomically(out / "comparison.md",
                                             lambda path: path.write_text(table)))
-    except OSError as error:            # OutputError: names the file, each file whole
+    except (SweepError, ValueError) as error:
         say_error(error)
-        print(f"  every row is kept in {out / 'runs.jsonl'}; the same command writes the "
-              "tables and figures again", file=sys.stderr)
         return 2
+    except OSError as error:    # the journal's folder; or OutputError: names the file
+        say_error(error)
+        if stage != "running the sweep":
+            print(f"  every row is kept in {out / 'runs.jsonl'}; the same command writes the "
+                  "tables and figures again", file=sys.stderr)
+        return 2
+    except (Interrupted, NoWorkers) as stopped:
+        return _stopped(stopped, stage, spec, out, args.csv, resume)
     for pattern in OUTPUTS:                 # a previous spec's, not rewritten: misleading
         for stale in out.glob(pattern):
             if stale not in written:
@@ -129,5 +142,43 @@ def main(argv: list[str] | None = None) -> int:
     return 0 if all(r["status"] == "ok" for r in rows) else 1
 
 
+def _comparison(spec: Spec, rows: list[dict]) -> str:
+    """comparison.md: what it is, and the table (``sweep_tables.comparison``)."""
+    pairs = f"paired by {MONTE_CARLO} (the same sea)" if MONTE_CARLO in spec.axes else \
+        "one run each"
+    return (f"# {spec.name}: each controller against pd\n\n"
+            f"J of eq (19) in rad^2, lower is better; per setting, the median over its "
+            f"runs and, {pairs}, the runs where the controller's J is lower than pd's and "
+            "the median of their ratio. A run shared by several combinations (every seed "
+            "in calm water) counts once.\n\n" + comparison(spec, rows) + "\n")
+
+
+def _stopped(stopped: Interrupted | NoWorkers, stage: str, spec: Spec, out: Path, csv: bool,
+             resume: str) -> int:
+    """Say what an interrupted or workerless sweep keeps, at whatever stage it stopped, and
+    how to resume it; its exit status."""
+    rows = sweep.completed(spec, out)
+    written = []
+    if stage == "running the sweep" and rows:
+        written = write_tables(rows, out, csv, spec)
+    runs = len(distinct(rows))
+    while_ = "" if stage == "running the sweep" else f" while {stage}"
+    then = ("resumes the sweep" if runs < len(spec.shared_runs()) else
+            "runs nothing again, and writes the tables and figures")
+    print(f"{stopped}{while_}: {runs} of {len(spec.shared_runs())} runs done, kept in "
+          f"{out / 'runs.jsonl'}{''.join(f', {p}' for p in written)}; this command {then}: "
+          f"{resume}", file=sys.stderr)
+    return stopped.exit_status
+
+
+def _end_at_a_signal(number: int, frame) -> None:
+    """After the command has said all: a signal while the interpreter shuts down ends the
+    process at once, without a traceback."""
+    os._exit(128 + number)
+
+
 if __name__ == "__main__":
-    sys.exit(entry(main))
+    status = entry(main)
+    for number in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(number, _end_at_a_signal)
+    sys.exit(status)

@@ -33,8 +33,9 @@ def local_cluster(workers: int | None = None) -> LocalCluster:
     the workers, instead of each worker printing its traceback. A Ctrl-C while the
     cluster starts arrives once it has started (and closes it).
     """
-    import dask
     from multiprocessing import resource_tracker
+
+    import dask
 
     resource_tracker.ensure_running()       # starting it unblocks SIGINT in this thread
     previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})

@@ -38,13 +38,20 @@ installed, nothing else, and runs the client's code or is refused. A worker keep
 each system's FMUs per thread and resets them (fmi2Reset) between tasks.
 
 A run's id hashes everything that determines its result (the system and its FMUs'
-contents, the settings, the stop time, the axis values). results/sweeps/<name>/
-runs.jsonl gets each row as it completes (``journal``), so an interrupted sweep
-resumes where it stopped; failed runs are run again then (a deterministic failure
-fails again at once, one caused by a lost worker deserves its retry).
-results.parquet (and results.csv with --csv) hold the table at the end; a summary
-is printed, figures are written, and comparison.md pairs every controller with pd
-seed by seed. A task whose worker dies is retried twice, then recorded as failed;
+contents, the settings, the stop time, the axis values). Combinations that differ
+only in settings that change nothing run once, and the command says so: in calm
+water (Hs = 0) the wave seed, T0, psi_w and wave_components make no difference, bit
+for bit, so "sea_state 0 is calm water (Hs = 0): the wave_seed axis does not apply
+there; 2 runs instead of 6". results/sweeps/<name>/runs.jsonl gets each row as it
+completes (``journal``), so an interrupted sweep resumes where it stopped; failed
+runs are run again then (a deterministic failure fails again at once, one caused by
+a lost worker deserves its retry). results.parquet (and results.csv with --csv, its
+headers with their units) hold one row per combination at the end, each with the
+run whose result it is (ran_as) and the cosim.run command that reproduces it, bit
+for bit (command); summary.csv gives each figure of merit per setting and
+controller (median, quartiles, extremes, over the runs of that setting), the
+summary of J is printed, figures are written, and comparison.md pairs every
+controller with pd seed by seed. A task whose worker dies is retried twice, then recorded as failed;
 an FMU error is recorded as failed at once, with its message. A sweep whose cluster
 has had no worker for 60 s (``--no-worker-timeout``) stops as on Ctrl-C, every
 row done kept, and says so.
@@ -111,10 +118,11 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
                          f"{no_worker_timeout!r}")
     try:
         with Journal(out / "runs.jsonl") as journal:
-            runs = spec.runs()
-            todo = [r for r in runs if journal.rows.get(r["run_id"], {}).get("status") != "ok"]
-            if len(todo) < len(runs):
-                print(f"{len(runs) - len(todo)} of {len(runs)} runs already done in "
+            groups = spec.shared_runs()
+            todo = [group[0] for group in groups
+                    if (_result(group, journal.rows) or {}).get("status") != "ok"]
+            if len(todo) < len(groups):
+                print(f"{len(groups) - len(todo)} of {len(groups)} runs already done in "
                       f"{journal.path}; {len(todo)} to run", file=sys.stderr, flush=True)
             if todo:
                 run_on_cluster(spec, todo, journal,
@@ -127,9 +135,34 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
 
 
 def completed(spec: Spec, out: Path) -> list[dict]:
-    """The rows of ``spec``'s runs in its journal, in the order of ``spec.runs()``."""
+    """A row for each combination of ``spec`` whose result is in its journal, in the order
+    of ``spec.runs()``: the result of its group (``Spec.shared_runs``) with the
+    combination's own axis values and run id, ``ran_as`` the run id of the run whose
+    result it is (its own, or an equivalent run's; only that row keeps the track), and
+    ``command`` the cosim.run command that reproduces it (``Spec.replay``)."""
     rows = read_rows(out / "runs.jsonl", quiet=True)
-    return [rows[r["run_id"]] for r in spec.runs() if r["run_id"] in rows]
+    found = {}
+    for group in spec.shared_runs():
+        result = _result(group, rows)
+        if result is not None:
+            for run in group:
+                found[run["run_id"]] = _as_row_of(spec, run, result)
+    return [found[r["run_id"]] for r in spec.runs() if r["run_id"] in found]
+
+
+def _result(group: list[dict], rows: dict[str, dict]) -> dict | None:
+    """The journal's row for a group of equivalent runs: a member's ok row, else a member's
+    failed row, else None."""
+    mine = [rows[r["run_id"]] for r in group if r["run_id"] in rows]
+    return next((r for r in mine if r["status"] == "ok"), mine[0] if mine else None)
+
+
+def _as_row_of(spec: Spec, run: dict, result: dict) -> dict:
+    """``result`` (a journal row) as the row of ``run``, an equivalent run."""
+    row = {**result, **run, "ran_as": result["run_id"], "command": spec.replay(run)}
+    if result["run_id"] != run["run_id"]:
+        row.pop("track", None)          # drawn once, by the run it is
+    return row
 
 
 def run_locally(spec: Spec, run: dict[str, Any], backend: str = "fmi",

@@ -5,12 +5,15 @@ completes, and the cluster watched for workers that run other code, or none at a
 """
 from __future__ import annotations
 
+import logging
 import queue
 import sys
 import time
 import uuid
+from contextlib import contextmanager
 from typing import Iterator
 
+from ..core.interrupt import Interrupted, StopSignals
 from ..core.provenance import PACKAGE, code_version
 from ..core.watchdog import Limits
 from .bundle import UnsafeCache, fmu_cache
@@ -157,59 +160,102 @@ def run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, p
                    task, backend: str, no_worker_timeout: float, limits: Limits) -> None:
     """Run ``todo`` (runs of ``spec``) as ``task`` on the cluster of ``connection`` (a
     client and the local cluster it made, or None), journaling each row as it completes;
-    the client, and a local cluster, closed on every path (``execute`` documents the rest)."""
+    the client, and a local cluster, closed on every path (``execute`` documents the rest).
+    When the sweep stops early, the cluster closes quietly (``_stopping``)."""
     client, cluster = connection
-    token = uuid.uuid4().hex[:12]
-    teardown = SweepTeardown(token)
+    teardown = SweepTeardown(uuid.uuid4().hex[:12])
+    stopped = None
     try:
-        if client.run_on_scheduler(_has_dashboard):
-            _say(f"dashboard: {client.dashboard_link}")
-        check_workers(client)
-        client.register_plugin(teardown)
-        # Each FMU as a task holding its bytes, not scattered data: a task's result lost with
-        # its worker is computed again, scattered data is gone, and every run with it. Keyed
-        # by sweep: another sweep's release of a shared key would strand this one's runs.
-        shipped = {sha: client.submit(fmu_bytes, path.read_bytes(), key=f"fmu-{token}-{sha}",
-                                      pure=False)
-                   for sha, path in spec.files().items()}
-        futures = {}
-        for run in todo:
-            job = spec.job(run, token, backend, limits)
-            blobs = {sha: shipped[sha] for sha in job.bundle.fmu_hashes()}
-            futures[client.submit(task, job, blobs, retries=2, pure=False,
-                                  key=f"run-{token}-{run['run_id']}")] = run
-        bar = None
-        if progress:
-            from tqdm import tqdm
-            bar = tqdm(total=len(todo), desc=spec.name, unit="run", file=sys.stderr,
-                       disable=None)                # None: only on a terminal
-        watch = _WorkerWatch(client, no_worker_timeout)
-        try:
-            for future in _as_completed(list(futures), watch):
-                try:
-                    row = watch.result(future)
-                except NoWorkers:
-                    raise
-                except Exception as error:      # the worker died on every retry
-                    row = {**blank_row(futures[future], f"{type(error).__name__}: {error}"),
-                           "backend": backend}
-                journal.add(row)
-                del futures[future]
-                future.release()                # done: nothing to recompute if a worker dies
-                if bar is not None:
-                    bar.update()
-        except NoWorkers:
-            client.cancel([*futures, *shipped.values()])
-            raise
-        if bar is not None:
-            bar.close()
+        _submit_and_journal(spec, todo, journal, client, progress, task, backend,
+                            no_worker_timeout, limits, teardown)
+    except BaseException as error:
+        stopped = error
+        raise
     finally:
-        if cluster is None:                     # a shared cluster: free this sweep's FMUs
-            try:
-                client.unregister_worker_plugin(teardown.name)
-            except Exception:                   # workers gone with Ctrl-C
-                pass
-        client.close()
-        if cluster is not None:                 # closing its workers frees everything
-            cluster.close()
+        with _stopping(stopped, journal):
+            _close(client, cluster, teardown)
 
+
+def _submit_and_journal(spec: Spec, todo: list[dict], journal: Journal, client, progress: bool,
+                        task, backend: str, no_worker_timeout: float, limits: Limits,
+                        teardown: SweepTeardown) -> None:
+    """Check the workers, send the FMUs and ``todo``, and journal each row as it completes."""
+    token = teardown.sweep
+    if client.run_on_scheduler(_has_dashboard):
+        _say(f"dashboard: {client.dashboard_link}")
+    check_workers(client)
+    client.register_plugin(teardown)
+    # Each FMU as a task holding its bytes, not scattered data: a task's result lost with
+    # its worker is computed again, scattered data is gone, and every run with it. Keyed
+    # by sweep: another sweep's release of a shared key would strand this one's runs.
+    shipped = {sha: client.submit(fmu_bytes, path.read_bytes(), key=f"fmu-{token}-{sha}",
+                                  pure=False)
+               for sha, path in spec.files().items()}
+    futures = {}
+    for run in todo:
+        job = spec.job(run, token, backend, limits)
+        blobs = {sha: shipped[sha] for sha in job.bundle.fmu_hashes()}
+        futures[client.submit(task, job, blobs, retries=2, pure=False,
+                              key=f"run-{token}-{run['run_id']}")] = run
+    bar = None
+    if progress:
+        from tqdm import tqdm
+        bar = tqdm(total=len(todo), desc=spec.name, unit="run", file=sys.stderr,
+                   disable=None)                # None: only on a terminal
+    watch = _WorkerWatch(client, no_worker_timeout)
+    try:
+        for future in _as_completed(list(futures), watch):
+            try:
+                row = watch.result(future)
+            except NoWorkers:
+                raise
+            except Exception as error:      # the worker died on every retry
+                row = {**blank_row(futures[future], f"{type(error).__name__}: {error}"),
+                       "backend": backend}
+            journal.add({**row, "command": spec.replay(futures[future])})
+            del futures[future]
+            future.release()                # done: nothing to recompute if a worker dies
+            if bar is not None:
+                bar.update()
+    except NoWorkers:
+        client.cancel([*futures, *shipped.values()])
+        raise
+    finally:
+        if bar is not None:
+            bar.close()                     # its line ended before any message
+
+
+def _close(client, cluster, teardown: SweepTeardown) -> None:
+    """Close the client, and the local cluster it made; on a shared cluster, free this
+    sweep's FMUs on the workers first."""
+    if cluster is None:
+        try:
+            client.unregister_worker_plugin(teardown.name)
+        except Exception:                   # workers gone with Ctrl-C
+            pass
+    client.close()
+    if cluster is not None:                 # closing its workers frees everything
+        cluster.close()
+
+
+@contextmanager
+def _stopping(stopped: BaseException | None, journal: Journal) -> Iterator[None]:
+    """Within, after the sweep stopped early (``stopped``): logging is silenced (distributed's
+    of the teardown: runs cancelled, workers lost), so the user reads only our
+    message; after Ctrl-C or SIGTERM, a second signal ends the process at once, saying
+    what the journal keeps (``StopSignals``)."""
+    if stopped is None:
+        yield
+        return
+    level = logging.root.manager.disable         # distributed's loggers set their own levels
+    logging.disable(logging.CRITICAL)
+    try:
+        if isinstance(stopped, Interrupted):
+            with StopSignals() as again:
+                again.received = stopped.signal         # the next one is the second
+                again.keep(lambda: f"{len(journal.rows)} rows kept in {journal.path}")
+                yield
+        else:
+            yield
+    finally:
+        logging.disable(level)

@@ -3,7 +3,10 @@
 The format is documented in ``cosim.studies.sweep`` and docs/sweeps/example.toml. A
 run is one controller at one combination of axis values; its id hashes everything
 that determines its result (``Spec.runs``), and ``Spec.job`` is what a worker needs
-to run it (``sweep_task``).
+to run it (``sweep_task``). Combinations that differ only in settings that change
+nothing (the wave settings in calm water, ``CALM_WATER_INERT``) have one result, run
+once (``Spec.shared_runs``, ``Spec.sharing_notes``). ``Spec.replay`` is the
+``cosim.run`` command that reproduces a combination's row bit for bit.
 
 ``Spec.read`` refuses, before anything runs or is allocated, what would run something
 else than the file says: a parameter set by two axes (or by an axis and a controller's
@@ -20,19 +23,23 @@ import hashlib
 import itertools
 import json
 import math
-import tomllib
+import shlex
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
+
+import tomllib
+
+from fmubuild.manifest import read as read_manifest
 
 from .. import scenarios
 from ..analysis.seastate import model_scale
 from ..core.errors import FmuNotFound, FmuUnreadable
 from ..core.files import plain_name, read_small_text
 from ..core.fmi import read_description
-from ..core.values import Declaration, checked, declarations
-from ..core.inprocess import fallback_note
+from ..core.inprocess import fallback_note, in_process_refusal
 from ..core.provenance import code_version
+from ..core.values import Declaration, checked, declarations
 from ..core.watchdog import Limits
 from ..scenarios.autopilot import check_autopilot
 from .bundle import Bundle, bundle
@@ -60,6 +67,18 @@ that each axis is one column of one type in the tables (no "0.01" beside 0.02)."
 MEASURED = ("guidance.psi_d", "ship.psi", "ship.delta", "ship.x", "ship.y")
 """The outputs a run's figures of merit and its track are computed from (``sweep_task``)."""
 
+SHIP_SLAVE = "ship_fmu.ship_slave"
+"""The module of this project's ship FMU (its manifest's slave module)."""
+
+CALM_WATER_INERT = ("T0", "psi_w", "wave_seed", "wave_components")
+"""The ship's parameters that change nothing in calm water (its Hs = 0): the ship makes no
+wave loads there (``ship_fmu.vessel.Vessel``), so every signal of a run is the same, bit
+for bit, whatever their values (tests/test_sweep_replay.py checks each, in calm_pd,
+waves_pd and waves_smc). Held only for a ship FMU built from this checkout's sources."""
+
+REPLAY = ("python", "-m", "cosim.run")
+"""The command ``Spec.replay`` reproduces a run with."""
+
 
 @dataclass
 class Spec:
@@ -73,6 +92,8 @@ class Spec:
     tracks: dict[str, Any] | None = None      # which runs record their track: axis values
     _bundles: dict[str, Bundle] | None = field(default=None, repr=False, compare=False)
     _files: dict[str, Path] = field(default_factory=dict, repr=False, compare=False)
+    _descriptions: dict[tuple[str, str], Any] = field(default_factory=dict, repr=False,
+                                                       compare=False)
 
     def wants_track(self, run: dict[str, Any]) -> bool:
         """Whether ``run`` is one of the runs whose tracks are drawn ([plots] tracks)."""
@@ -196,9 +217,22 @@ class Spec:
 
     def _declared(self, controller: str, component: str) -> tuple[Path, dict[str, Declaration]]:
         """A component's FMU in a controller's system, and its variables' declarations."""
-        source = self.bundles()[controller].system.components[component].source
-        fmu = self.files()[Path(source).stem]
-        return fmu, declarations(read_description(fmu, component))
+        fmu, description = self._description(controller, component)
+        return fmu, declarations(description)
+
+    def _description(self, controller: str, component: str) -> tuple[Path, Any]:
+        """A component's FMU in a controller's system, and its model description (read once)."""
+        if (controller, component) not in self._descriptions:
+            source = self.bundles()[controller].system.components[component].source
+            fmu = self.files()[Path(source).stem]
+            self._descriptions[controller, component] = fmu, read_description(fmu, component)
+        return self._descriptions[controller, component]
+
+    def _variable(self, controller: str, target: str):
+        """The model variable ``target`` (component.variable) of a controller's system."""
+        component, _, name = target.partition(".")
+        description = self._description(controller, component)[1]
+        return next(v for v in description.modelVariables if v.name == name)
 
     def bundles(self) -> dict[str, Bundle]:
         """Each controller's system with its FMUs named by content (read once)."""
@@ -223,12 +257,120 @@ class Spec:
         for controller, shipped in self.bundles().items():
             for values in itertools.product(*(self.axes[n] for n in names)):
                 point = {"controller": controller, **dict(zip(names, values))}
-                identity = {"system": shipped.digest, "settings": self.settings(point)[1],
-                            "stop_time": self.stop_time, "point": point}
-                key = json.dumps(identity, sort_keys=True, default=str)
-                point["run_id"] = hashlib.sha256(key.encode()).hexdigest()[:16]
+                point["run_id"] = _digest({"system": shipped.digest,
+                                           "settings": self.settings(point)[1],
+                                           "stop_time": self.stop_time, "point": point})
                 runs.append(point)
         return runs
+
+    def shared_runs(self) -> list[list[dict[str, Any]]]:
+        """The runs (of ``runs``, in its order) grouped by result: a group holds the runs of
+        one controller whose settings differ only in what changes nothing (the wave settings
+        in calm water, ``CALM_WATER_INERT``). Each group is run once; its result is every
+        member's."""
+        groups: dict[str, list[dict[str, Any]]] = {}
+        for run in self.runs():
+            groups.setdefault(self._result_key(run), []).append(run)
+        return list(groups.values())
+
+    def _result_key(self, run: dict[str, Any]) -> str:
+        """A hash of the controller and the settings of ``run`` that change its result."""
+        overrides = self.settings(run)[1]
+        inert = self._inert(run["controller"], overrides)
+        effective = {component: {variable: value for variable, value in values.items()
+                                 if (component, variable) not in inert}
+                     for component, values in overrides.items()}
+        return _digest({"controller": run["controller"], "settings": effective})
+
+    def _inert(self, controller: str, overrides: dict[str, dict[str, Any]]
+               ) -> set[tuple[str, str]]:
+        """(component, variable) of every setting that changes nothing in a run of
+        ``controller`` with ``overrides``: ``CALM_WATER_INERT`` of each ship in calm water."""
+        return {(component, variable) for component in self._calm_ships(controller, overrides)
+                for variable in CALM_WATER_INERT}
+
+    def _calm_ships(self, controller: str, overrides: dict[str, dict[str, Any]]) -> list[str]:
+        """The components of ``controller``'s system that are this checkout's ship FMU and
+        sail in calm water (Hs = 0: set so, else bound so in the system, else by default)."""
+        calm = []
+        for name, component in self.bundles()[controller].system.components.items():
+            if not self._is_our_ship(controller, name):
+                continue
+            Hs = overrides.get(name, {}).get("Hs", component.parameters.get("Hs"))
+            if Hs is None:
+                Hs = self._variable(controller, f"{name}.Hs").start
+            if float(Hs) == 0.0:
+                calm.append(name)
+        return calm
+
+    def _is_our_ship(self, controller: str, component: str) -> bool:
+        """Whether a component is this project's ship FMU, current here (built from the
+        sources whose behaviour ``CALM_WATER_INERT`` states)."""
+        fmu = self._description(controller, component)[0]
+        manifest = read_manifest(fmu)
+        return (manifest is not None and manifest.slave_module == SHIP_SLAVE
+                and in_process_refusal(fmu) is None)
+
+    def sharing_notes(self) -> list[str]:
+        """What ``shared_runs`` saves, in words: 'sea_state 0 is calm water (Hs = 0): the
+        wave_seed axis does not apply there; 2 runs instead of 6'."""
+        savings: dict[tuple[str, tuple[str, ...]], list[int]] = {}
+        for group in self.shared_runs():
+            if len(group) > 1:
+                varying = tuple(a for a in self.axes
+                                if len({json.dumps(r[a]) for r in group}) > 1)
+                counts = savings.setdefault((self._calm_because(group[0]), varying), [0, 0])
+                counts[0] += 1
+                counts[1] += len(group)
+        notes = []
+        for (why, varying), (runs, combinations) in savings.items():
+            axes = (f"the {varying[0]} axis does" if len(varying) == 1 else
+                    f"the {', '.join(varying[:-1])} and {varying[-1]} axes do")
+            notes.append(f"{why} is calm water (Hs = 0): {axes} not apply there; "
+                         f"{runs} run{'s' if runs > 1 else ''} instead of {combinations}")
+        return notes
+
+    def _calm_because(self, run: dict[str, Any]) -> str:
+        """What makes a run's sea calm, in words: the axis value that sets Hs = 0, else the
+        controller's system."""
+        controller = run["controller"]
+        ships = self._calm_ships(controller, self.settings(run)[1])
+        for axis in self.axes:
+            if any(f"{ship}.Hs" in assignments(axis, run[axis]) for ship in ships):
+                return f"{axis} {run[axis]}"
+        return f"controller {controller!r} ({self.bundles()[controller].system.name})"
+
+    def replay(self, run: dict[str, Any]) -> str:
+        """The ``cosim.run`` command that reproduces ``run``'s row bit for bit: its scenario
+        (and autopilot, with its port map), the stop time and every setting of the run as
+        ``--set``, each value as text that reads back as exactly it (a float's repr)."""
+        controller = self.controllers[run["controller"]]
+        scenario, overrides = self.settings(run)
+        words = [*REPLAY, scenario]
+        if controller["autopilot"] is not None:
+            words += ["--autopilot", controller["autopilot"]]
+            for port, renamed in controller["map"].items():
+                words += ["--map", f"{port}={renamed}"]
+        stop_time = (self.stop_time if self.stop_time is not None
+                     else self.bundles()[run["controller"]].system.stop_time)
+        words += ["--stop-time", _exact(stop_time)]
+        for component, values in overrides.items():
+            for variable, value in values.items():
+                words += ["--set", f"{component}.{variable}={_exact(value)}"]
+        return shlex.join(words)
+
+    def units(self) -> dict[str, str]:
+        """Each axis's unit: the one its FMU declares for the parameter it sets ("" for none,
+        and for sea_state, whose values are WMO codes)."""
+        controller = next(iter(self.controllers))
+        units = {}
+        for axis, values in self.axes.items():
+            targets = list(assignments(axis, values[0]))
+            variable = self._variable(controller, targets[0]) if len(targets) == 1 else None
+            units[axis] = (variable.unit or (variable.declaredType.unit
+                                             if variable.declaredType else None) or "") \
+                if variable is not None else ""
+        return units
 
     def job(self, run: dict[str, Any], sweep: str, backend: str = "fmi",
             limits: Limits = Limits()) -> Job:
@@ -266,6 +408,20 @@ class Spec:
             for target, value in assignments(axis, run[axis]).items():
                 put(target, value)
         return controller["scenario"], overrides
+
+
+def _digest(identity: dict[str, Any]) -> str:
+    """A short hash of a JSON-able identity."""
+    key = json.dumps(identity, sort_keys=True, default=str)
+    return hashlib.sha256(key.encode()).hexdigest()[:16]
+
+
+def _exact(value: Any) -> str:
+    """A setting as ``--set`` text that reads back as exactly the value: a float's repr
+    (the shortest text of that double), true or false for a Boolean."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    return repr(value) if isinstance(value, float) else str(value)
 
 
 def assignments(axis: str, value: Any) -> dict[str, Any]:

@@ -1,10 +1,18 @@
-"""A sweep's rows as tables: results.parquet, .csv and .json, the printed summary, and
-comparison.md (every controller against the baseline, seed by seed)."""
+"""A sweep's rows as tables: results.parquet, .csv and .json, summary.csv and the printed
+summary (each figure of merit per setting and controller), and comparison.md (every
+controller against the baseline, seed by seed).
+
+A row is a combination of the spec; combinations that share one run's result
+(``Spec.shared_runs``: the wave settings in calm water) name it in ``ran_as``, and the
+statistics count each run once. The figures of merit are those of ``sweep_task.METRICS``,
+with their units: a column added there appears here.
+"""
 from __future__ import annotations
 
 import itertools
 import json
 from pathlib import Path
+from typing import Any, Iterator
 
 import numpy as np
 
@@ -12,40 +20,133 @@ from ..core.files import write_atomically
 from .sweep_spec import Spec
 from .sweep_task import METRICS
 
+TIMES = {"seconds": "s", "sim_seconds": "s"}
+"""The wall-clock times of a row (``sweep_task.run_one``): the task's, and the master's run
+alone."""
 
-def write_tables(rows: list[dict], out: Path, csv: bool) -> list[Path]:
-    """results.parquet (each metric's unit in its field metadata), results.csv with ``csv``,
-    and results.json: the unit of every column."""
+MONTE_CARLO = "wave_seed"
+"""The axis the statistics are taken over, and that pairs runs (the same sea)."""
+
+STATISTICS = {"median": "median", "q25": "25th percentile", "q75": "75th percentile",
+              "min": "least", "max": "greatest"}
+"""What summary.csv gives of each figure of merit, over the runs of a setting (percentiles
+interpolated linearly between the ordered values, numpy's default)."""
+
+MOST_PRINTED = 48
+"""The most lines of the printed summary's table: a larger sweep prints its axes one by one
+(summary.csv has every setting)."""
+
+
+def units(spec: Spec | None, columns: list[str]) -> dict[str, str]:
+    """The unit of each column ("" for none): the figures of merit's, the times', and the
+    axes' (the parameter's declared unit; known with ``spec``)."""
+    known = {**(spec.units() if spec is not None else {}), **METRICS, **TIMES}
+    return {name: known.get(name, "") for name in columns}
+
+
+def headed(name: str, unit: str) -> str:
+    """A column header with its unit: 'J [rad^2]'; the name alone where it has none."""
+    return f"{name} [{unit}]" if unit else name
+
+
+def write_tables(rows: list[dict], out: Path, csv: bool, spec: Spec | None = None
+                 ) -> list[Path]:
+    """results.parquet (each column's unit in its field metadata), results.csv with ``csv``
+    (each header with its unit), results.json (the unit of every column) and, with
+    ``spec``, summary.csv (``summary_table``)."""
     import pyarrow as pa
     import pyarrow.csv as pacsv
     import pyarrow.parquet as pq
 
     table = pa.Table.from_pylist([{k: (json.dumps(v) if isinstance(v, (list, dict)) else v)
                                    for k, v in row.items() if k != "track"} for row in rows])
-    units = {name: METRICS.get(name, "s" if name == "seconds" else "")
-             for name in table.column_names}
-    table = table.cast(pa.schema([field.with_metadata({"unit": units[field.name]})
+    unit = units(spec, table.column_names)
+    table = table.cast(pa.schema([field.with_metadata({"unit": unit[field.name]})
                                   for field in table.schema]))
     written = [write_atomically(out / "results.parquet", lambda p: pq.write_table(table, p)),
                write_atomically(out / "results.json", lambda p: p.write_text(
-                   json.dumps({"units": units}, indent=1) + "\n"))]
+                   json.dumps({"units": unit}, indent=1) + "\n"))]
     if csv:
+        with_units = table.rename_columns([headed(n, unit[n]) for n in table.column_names])
         written.append(write_atomically(out / "results.csv",
-                                        lambda p: pacsv.write_csv(table, p)))
+                                        lambda p: pacsv.write_csv(with_units, p)))
+    if spec is not None:
+        header, *lines = summary_table(spec, rows)
+        summary = pa.Table.from_pylist([dict(zip(header, line)) for line in lines])
+        written.append(write_atomically(out / "summary.csv",
+                                        lambda p: pacsv.write_csv(summary, p)))
     return written
 
 
+def _settings_axes(spec: Spec) -> list[str]:
+    """The axes that make a setting: all but the Monte Carlo axis."""
+    return [a for a in spec.axes if a != MONTE_CARLO]
+
+
+def _settings(spec: Spec) -> Iterator[dict[str, Any]]:
+    """Each setting of the axes other than the Monte Carlo axis, as axis: value."""
+    axes = _settings_axes(spec)
+    for values in itertools.product(*(spec.axes[a] for a in axes)):
+        yield dict(zip(axes, values))
+
+
+def _in(row: dict, where: dict[str, Any]) -> bool:
+    return all(json.dumps(row[a]) == json.dumps(v) for a, v in where.items())
+
+
+def _ran_as(row: dict) -> str:
+    """The run whose result the row is (its own for a row journaled before runs were shared)."""
+    return row.get("ran_as", row["run_id"])
+
+
+def distinct(rows: list[dict]) -> list[dict]:
+    """One row per run: a result shared by several combinations counts once."""
+    return list({_ran_as(r): r for r in rows}.values())
+
+
+def _statistics(values: np.ndarray) -> dict[str, float]:
+    if not values.size:
+        return {name: np.nan for name in STATISTICS}
+    q25, median, q75 = np.percentile(values, [25, 50, 75])
+    return {"median": median, "q25": q25, "q75": q75, "min": values.min(),
+            "max": values.max()}
+
+
+def summary_table(spec: Spec, rows: list[dict]) -> list[list]:
+    """Header and lines of summary.csv: per setting (the axes but ``MONTE_CARLO``) and
+    controller, the runs ok and failed and each figure of merit's ``STATISTICS`` over the
+    ok runs, each run counted once; headers with their units ('J median [rad^2]')."""
+    axes = _settings_axes(spec)
+    header = [*axes, "controller", "runs ok", "runs failed",
+              *(headed(f"{metric} {name}", unit) for metric, unit in METRICS.items()
+                for name in STATISTICS)]
+    lines = []
+    for where in _settings(spec):
+        for controller in spec.controllers:
+            mine = distinct([r for r in rows if r["controller"] == controller
+                             and _in(r, where)])
+            ok = [r for r in mine if r["status"] == "ok"]
+            cells = [*(where[a] for a in axes), controller, len(ok), len(mine) - len(ok)]
+            for metric in METRICS:
+                stats = _statistics(np.array([r[metric] for r in ok if metric in r],
+                                             dtype=float))
+                cells += [float(stats[name]) for name in STATISTICS]
+            lines.append(cells)
+    return [header, *lines]
+
+
 def summary(spec: Spec, rows: list[dict], shown_failures: int = 10) -> str:
-    """Runs, ok and failed; J by controller; each failed run with its message."""
-    ok = [r for r in rows if r["status"] == "ok"]
-    lines = [f"{spec.name}: {len(rows)} runs, {len(ok)} ok, {len(rows) - len(ok)} failed"]
-    for controller in spec.controllers:
-        J = np.array([r["J"] for r in ok if r["controller"] == controller])
-        if J.size:
-            lines.append(f"  {controller:>14}: J median {np.median(J):9.2f}, mean {J.mean():9.2f}"
-                         f", 5-95 % {np.percentile(J, 5):9.2f} - {np.percentile(J, 95):9.2f}"
-                         f" ({J.size} runs)")
-    failed = [r for r in rows if r["status"] != "ok"]
+    """Runs, ok and failed; J per setting and controller (median, interquartile range,
+    extremes, over the Monte Carlo axis); each failed run with its message."""
+    runs = distinct(rows)
+    ok = [r for r in runs if r["status"] == "ok"]
+    shared = len(rows) - len(runs)
+    lines = [f"{spec.name}: " + (f"{len(rows)} combinations in {len(runs)} runs ({shared} "
+                                 "share an equivalent run's result)" if shared else
+                                 f"{len(rows)} runs")
+             + f", {len(ok)} ok, {len(runs) - len(ok)} failed"]
+    lines += _J_lines(spec, rows)
+    failed = [r for r in runs if r["status"] != "ok"]
     for r in failed[:shown_failures]:
         axes = ", ".join(f"{a} = {r[a]}" for a in spec.axes)
         said = [line.strip() for line in r["error"].splitlines()[:2]]   # the call, the FMU's words
@@ -56,43 +157,76 @@ def summary(spec: Spec, rows: list[dict], shown_failures: int = 10) -> str:
     return "\n".join(lines)
 
 
+def _J_lines(spec: Spec, rows: list[dict]) -> list[str]:
+    """The printed table of J: per setting and controller, or, for a sweep of more than
+    ``MOST_PRINTED`` lines, per value of each axis, pooled over the other axes."""
+    axes = _settings_axes(spec)
+    groups = [(" ".join(str(where[a]) for a in axes), where) for where in _settings(spec)]
+    pooled = len(groups) * len(spec.controllers) > MOST_PRINTED
+    if pooled:
+        groups = [(f"{a} {v}", {a: v}) for a in axes for v in spec.axes[a]]
+    per = ("per value of each axis (pooled over the other axes)" if pooled else
+           "per setting")
+    over = f"over {MONTE_CARLO}; " if MONTE_CARLO in spec.axes else ""
+    label = "setting" if pooled else " ".join(axes) or "all"
+    lines = [f"J of eq (19) [rad^2] {per} and controller: median, IQR (interquartile range, "
+             f"25th to 75th percentile), least and greatest of its runs ok ({over}a run shared "
+             "by several combinations counted once)"
+             + ("; summary.csv has every setting" if pooled else "")]
+    wide = max(len(label), *(len(name) for name, _ in groups))
+    named = max(len("controller"), *(len(c) for c in spec.controllers))
+    lines.append(f"  {label:<{wide}}  {'controller':<{named}}  runs    median  "
+                 f"{'IQR':^19}  {'least - greatest':^19}".rstrip())
+    ok = [r for r in distinct(rows) if r["status"] == "ok"]
+    for name, where in groups:
+        for controller in spec.controllers:
+            J = np.array([r["J"] for r in ok if r["controller"] == controller
+                          and _in(r, where)], dtype=float)
+            s = _statistics(J)
+            lines.append(f"  {name:<{wide}}  {controller:<{named}}  {J.size:>4}  " + (
+                f"{s['median']:8.2f}  {s['q25']:8.2f} - {s['q75']:8.2f}  "
+                f"{s['min']:8.2f} - {s['max']:8.2f}" if J.size else f"{'-':>8}"))
+    return lines
+
+
 def comparison(spec: Spec, rows: list[dict], baseline: str = "pd",
-               monte_carlo: str = "wave_seed") -> str:
+               monte_carlo: str = MONTE_CARLO) -> str:
     """Markdown table: per setting of the other axes, median J and wins against the baseline.
 
     Runs are paired by the Monte Carlo axis (the same sea for both controllers); a
-    controller wins a pair when its J is lower. The share of wins and the median J
-    ratio are given for every controller other than the baseline.
+    controller wins a pair when its J is lower. A pair of runs counts once however many
+    combinations share it (in calm water every seed is one pair). The share of wins and
+    the median J ratio are given for every controller other than the baseline.
     """
     others = [c for c in spec.controllers if c != baseline]
     axes = [a for a in spec.axes if a != monte_carlo]
     ok = {(r["controller"], *(json.dumps(r[a]) for a in spec.axes)): r
           for r in rows if r["status"] == "ok"}
-    header = [*axes, f"J {baseline}", *(f"J {c}" for c in others),
-              *(f"{c} wins" for c in others), *(f"J {c} / J {baseline}" for c in others)]
+    seeds = spec.axes.get(monte_carlo, [None])
+    header = [*axes, f"J {baseline} median", *(f"J {c} median" for c in others),
+              *(f"{c} wins" for c in others), *(f"J {c} / J {baseline} median" for c in others)]
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     for setting in itertools.product(*(spec.axes[a] for a in axes)):
         where = dict(zip(axes, setting))
-        seeds = spec.axes.get(monte_carlo, [None])
-
-        def J(controller: str) -> np.ndarray:
-            keys = [(controller, *(json.dumps(where.get(a, seed)) for a in spec.axes))
-                    for seed in seeds]
-            return np.array([ok[k]["J"] if k in ok else np.nan for k in keys])
-
-        def median(values: np.ndarray) -> str:
-            return f"{np.nanmedian(values):.1f}" if np.isfinite(values).any() else "-"
-
-        base = J(baseline)
-        cells = [str(v) for v in setting] + [median(base)]
+        runs = {controller: [ok.get((controller, *(json.dumps(where.get(a, seed))
+                                                   for a in spec.axes))) for seed in seeds]
+                for controller in spec.controllers}
+        cells = [str(v) for v in setting] + [_median_J(runs[baseline])]
         wins, ratios = [], []
         for controller in others:
-            J_c = J(controller)
-            cells.append(median(J_c))
-            decided = np.isfinite(J_c) & np.isfinite(base) & (J_c != base)
-            wins.append(f"{int(np.sum(J_c[decided] < base[decided]))}/{int(decided.sum())}")
-            defined = np.isfinite(J_c) & (base > 1e-9)
-            ratios.append(f"{np.median(J_c[defined] / base[defined]):.2f}" if defined.any()
-                          else "-")
+            cells.append(_median_J(runs[controller]))
+            pairs = list({(_ran_as(a), _ran_as(b)): (a["J"], b["J"])
+                          for a, b in zip(runs[controller], runs[baseline])
+                          if a is not None and b is not None}.values())
+            decided = [(J_c, J_b) for J_c, J_b in pairs if J_c != J_b]
+            wins.append(f"{sum(J_c < J_b for J_c, J_b in decided)}/{len(decided)}")
+            defined = [J_c / J_b for J_c, J_b in pairs if J_b > 1e-9]
+            ratios.append(f"{np.median(defined):.2f}" if defined else "-")
         lines.append("| " + " | ".join(cells + wins + ratios) + " |")
     return "\n".join(lines)
+
+
+def _median_J(found: list[dict | None]) -> str:
+    """The median J of the rows found (each run once), for a table cell."""
+    J = [r["J"] for r in distinct([r for r in found if r is not None])]
+    return f"{np.median(J):.1f}" if J else "-"
