@@ -30,6 +30,8 @@ from typing import Any, Callable
 
 import numpy as np
 
+from autopilot_fmu.guidance import parse_waypoints
+
 from ..analysis.cost import Cost, cost
 from ..analysis.figures import comparison_figure
 from ..analysis.metrics import (RouteCompletion, heading_error, overshoot, route_completion,
@@ -56,6 +58,8 @@ COURSE_CHANGE_TIME = 300.0
 SETTLING_BAND = 0.02 * COURSE_CHANGE
 HEAVY_SEA = 4
 """The WMO sea state code of the second ensemble: moderate, where the rudder saturates."""
+TIE = 0.01
+"""Two values closer than this share of the baseline's are a tie, not a win."""
 
 
 @dataclass(frozen=True)
@@ -129,10 +133,6 @@ def completion(run: Recording) -> RouteCompletion:
     """Which waypoints of its route a run reached."""
     points, R_accept = route_of(run)
     return route_completion(run["ship.x"], run["ship.y"], points, R_accept)
-
-
-TIE = 0.01
-"""Two values closer than this share of the baseline's are a tie, not a win."""
 
 
 @dataclass(frozen=True)
@@ -465,8 +465,10 @@ def _course_change(names: list[str], changes: dict[str, CourseChange]) -> list[s
         lines.append(f"| {name} | {settled} | {math.degrees(r.overshoot):.2f} | "
                      f"{m['reversals_per_min']:.1f} | {m['mean_rudder_rate_deg_s']:.2f} | "
                      f"{m['max_delta_deg']:.1f} | {m['cross_track_max_m']:.2f} |")
-    return lines + ["", "The course change follows one leg of 1000 m, which 300 s (about "
-                        "90 m) do not finish: route completion does not apply to it.", "",
+    (x0, y0), (x1, y1) = parse_waypoints(COURSE_CHANGE_ROUTE)
+    return lines + ["", f"The course change follows one leg of {math.hypot(x1 - x0, y1 - y0):.0f}"
+                        f" m, longer than the ship sails in {COURSE_CHANGE_TIME:.0f} s: route "
+                        "completion does not apply to it.", "",
                     "![course change](course_change.png)", ""]
 
 
