@@ -14,8 +14,7 @@ from matplotlib.patches import Circle, Polygon
 from cosim import run as cli
 from cosim import simulate
 from cosim.analysis.animation import animate, frame_times
-from cosim.analysis.figures import (RUDDER_LABEL, course_keeping_figure, outlines, save,
-                                    turning_circle_figure, zigzag_figure)
+from cosim.analysis.figures import RUDDER_LABEL, course_keeping_figure, outlines, save
 from cosim.analysis.manoeuvres import zigzag
 from cosim.core.provenance import write_metadata
 from cosim.core.recording import Recording
@@ -101,23 +100,6 @@ def test_next_to_every_csv_a_json_with_what_it_takes_to_reproduce_the_run(fmu_pa
     assert meta["columns"]["time"] == "s" and meta["settings"]["ship"]["n1"] == 8.13
     assert meta["scenario_sha256"] == hashlib.sha256(
         open(meta["scenario_file"], "rb").read()).hexdigest()
-
-
-def test_the_turning_circle_figure_marks_advance_transfer_and_tactical_diameter(fmu_paths):
-    track = turning_circle_figure(simulate("turning_circle")).axes[0]
-    legend = " | ".join(t.get_text() for t in track.figure.legends[0].get_texts())
-    assert "advance 4.42 m (at 90 deg)" in legend and "transfer 0.13 m (at 90 deg)" in legend
-    assert "tactical diameter 3.70 m (at 180 deg)" in legend
-    assert "steady turn: drift angle 59 deg, diameter 2U/|r| = 5.17 m" in _texts(track)
-
-
-def test_the_zigzag_figure_marks_execute_points_and_both_overshoots(fmu_paths):
-    run = simulate("zigzag_20_20")
-    heading = zigzag_figure(run).axes[1]
-    assert "overshoot 1: 31.7 deg" in _texts(heading)
-    assert "overshoot 2: 7.3 deg" in _texts(heading)
-    marks = next(line for line in heading.lines if line.get_label().startswith("rudder exec"))
-    assert len(marks.get_xdata()) == int(run["program.reversals"][-1]) + 1
 
 
 def test_the_imo_10_10_zigzag_is_never_checked_by_this_unstable_ship(fmu_paths, tmp_path,

@@ -39,7 +39,6 @@ from ..core.files import whole_file  # noqa: E402
 from ..core.recording import Recording  # noqa: E402
 from .cost import LAMBDA, cost  # noqa: E402
 from .describe import paper_row, title  # noqa: E402
-from .manoeuvres import crossing, turning_circle_figures, zigzag_figures  # noqa: E402
 from .metrics import heading_error  # noqa: E402
 
 FORMATS = ("png", "svg", "pdf")
@@ -320,73 +319,6 @@ def course_keeping_figure(run: Recording, lam: float = LAMBDA) -> Figure:
     legend_if_any(heading)
     error.plot(t, np.degrees(heading_error(run["guidance.psi_d"], run["ship.psi"])), color="k")
     error.set_ylabel("psi_d - psi (deg)")
-    _degrees(r, run, "ship.r", "yaw rate r (deg/s)")
-    _rudder(rudder, run, "ship.delta_c")
-    return fig
-
-
-def turning_circle_figure(run: Recording) -> Figure:
-    """Track with advance, transfer and tactical diameter marked; heading, yaw rate, rudder."""
-    fig, track, (heading, r, rudder) = _layout(3)
-    track_panel(track, run)
-    x, y, psi = run["ship.x"], run["ship.y"], run["ship.psi"]
-    tc = turning_circle_figures(*(run[f"ship.{n}"] for n in ("x", "y", "psi", "u", "v", "r")))
-    x90, y90 = crossing(x, y, psi, math.pi / 2)
-    x180, y180 = crossing(x, y, psi, math.pi)
-    x0, y0 = x[0], y[0]
-    u_end, v_end, r_end = (run[f"ship.{n}"][-1] for n in ("u", "v", "r"))
-    track.plot([y0, y0], [x0, x90], color="tab:green", linewidth=2.5,
-               label=f"advance {tc.advance:.2f} m (at 90 deg)")
-    track.plot([y0, y90], [x90, x90], color="tab:purple", linewidth=2.5,
-               label=f"transfer {tc.transfer:.2f} m (at 90 deg)")
-    track.plot([y0, y180], [x180, x180], color="tab:brown", linewidth=2.5,
-               label=f"tactical diameter {tc.tactical_diameter:.2f} m (at 180 deg)")
-    # IMO measures these at heading changes; with a large drift angle the heading leads the
-    # velocity, so the steady circle is wider than the tactical diameter: say so.
-    track.text(0.02, 0.02, f"steady turn: drift angle "
-               f"{math.degrees(math.atan2(v_end, u_end)):.0f} deg, diameter 2U/|r| = "
-               f"{2 * math.hypot(u_end, v_end) / abs(r_end):.2f} m",
-               transform=track.transAxes, fontsize=8,
-               bbox=dict(boxstyle="round", facecolor="white", alpha=0.9, edgecolor="none"))
-    legend_if_any(track)
-    _degrees(heading, run, "ship.psi", "heading (deg)")
-    _degrees(r, run, "ship.r", "yaw rate r (deg/s)")
-    r.axhline(math.degrees(tc.steady_yaw_rate), linestyle=":", color="tab:gray")
-    _rudder(rudder, run, "ship.delta_c")
-    return fig
-
-
-def zigzag_figure(run: Recording) -> Figure:
-    """Track; heading with the switching angles, the execute points and both overshoots."""
-    fig, track, (heading, r, rudder) = _layout(3)
-    track_panel(track, run)
-    t, psi = run.t, np.degrees(run["ship.psi"])
-    switch = run.meta["parameters"]["program"]["psi_switch"]
-    zz = zigzag_figures(run["ship.psi"], run["program.reversals"], switch)
-    reversals = run["program.reversals"]
-    heading.plot(t, psi, color="k", label="psi")
-    for level in (-math.degrees(switch), math.degrees(switch)):
-        heading.axhline(level, linestyle=":", color="tab:gray")
-    executed = [0, *(np.flatnonzero(np.diff(reversals)) + 1)]
-    heading.plot(t[executed], psi[executed], "v", color="tab:red",
-                 label="rudder executed, reversed")
-    words = []
-    for n, overshoot in ((1, zz.first_overshoot), (2, zz.second_overshoot)):
-        if math.isnan(overshoot):
-            words.append(f"no reversal {n + 1}: the turn was never checked")
-            break
-        k = np.flatnonzero(reversals == n)[np.argmax(np.abs(psi[reversals == n]))]
-        level = math.copysign(math.degrees(switch), psi[k])
-        heading.annotate("", xy=(t[k], psi[k]), xytext=(t[k], level),
-                         arrowprops=dict(arrowstyle="<->", color="tab:red"))
-        heading.text(t[k], psi[k], f" {n}", color="tab:red", fontsize=8,
-                     va="top" if psi[k] < 0 else "bottom")
-        words.append(f"overshoot {n}: {math.degrees(overshoot):.1f} deg")
-    heading.text(0.99, 0.03, "\n".join(words), transform=heading.transAxes, ha="right",
-                 fontsize=8, color="tab:red",
-                 bbox=dict(boxstyle="round", facecolor="white", alpha=0.9, edgecolor="none"))
-    heading.set_ylabel("heading (deg)")
-    legend_if_any(heading)
     _degrees(r, run, "ship.r", "yaw rate r (deg/s)")
     _rudder(rudder, run, "ship.delta_c")
     return fig
