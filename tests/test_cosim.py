@@ -281,6 +281,12 @@ def test_unknown_scenario_lists_the_valid_ones(capsys):
     assert "unknown scenario 'calm_xyz'" in err and "waves_smc" in err
 
 
+def test_a_misspelt_scenario_gets_the_names_it_could_mean(capsys):
+    with pytest.raises(SystemExit):
+        cli.main(["Waves_SMC"])
+    assert capsys.readouterr().err.rstrip().endswith("did you mean 'waves_smc' or 'waves_pd'?")
+
+
 def _variant(tmp_path: Path, name: str, edit) -> Path:
     description = system(name)
     edit(description)

@@ -11,6 +11,7 @@ from pathlib import Path
 
 from ..core.files import plain_name
 from ..core.ssd import SystemDescription, read_ssd
+from ..core.values import close_matches, did_you_mean
 from .autopilot import with_autopilot
 
 SCENARIO_DIR = Path(__file__).resolve().parent
@@ -34,7 +35,8 @@ def path(scenario: str | Path) -> Path:
             raise FileNotFoundError(f"no system structure file {scenario}")
         return Path(scenario)
     if scenario not in names():
-        raise ValueError(f"unknown scenario {scenario!r}; valid scenarios: {', '.join(names())}")
+        raise ValueError(f"unknown scenario {scenario!r}; valid scenarios: {', '.join(names())}"
+                         + did_you_mean(close_matches(str(scenario), names())))
     return SCENARIO_DIR / f"{scenario}.ssd"
 
 
