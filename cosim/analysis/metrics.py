@@ -62,9 +62,14 @@ def mean_abs_rate(t: np.ndarray, delta: np.ndarray) -> float:
     return float(np.sum(np.abs(np.diff(delta)))) / float(t[-1] - t[0])
 
 
+def at_stops(delta: np.ndarray, delta_max: float) -> np.ndarray:
+    """Whether the rudder is on its stops, |delta| >= delta_max, each sample."""
+    return np.abs(np.asarray(delta)) >= delta_max * (1 - 1e-9)
+
+
 def fraction_at_stops(delta: np.ndarray, delta_max: float) -> float:
-    """Share of the samples (0 to 1) with the rudder on its stops, |delta| >= delta_max."""
-    return float(np.mean(np.abs(delta) >= delta_max * (1 - 1e-9)))
+    """Share of the samples (0 to 1) with the rudder on its stops (``at_stops``)."""
+    return float(np.mean(at_stops(delta, delta_max)))
 
 
 def cross_track_error(x: np.ndarray, y: np.ndarray, wp_index: np.ndarray,

@@ -4,13 +4,12 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 
 from ..core.recording import Recording
 from .cost import LAMBDA, Cost, cost
 from .manoeuvres import (STANDARD, Assessment, Criterion, TurningCircle, ZigZagResult,
                          turning_circle_of, zigzag_of)
-from .metrics import sign_reversals_per_minute
+from .metrics import at_stops, sign_reversals_per_minute
 from .seastate import SCALE
 
 PAPER_TABLES = {   # Tomera (2010), Tables 1 and 2: psi_E, delta_E, J
@@ -23,7 +22,7 @@ def course_keeping_report(recording: Recording, lam: float = LAMBDA, **_) -> lis
     c = cost(recording, lam)
     t, delta = recording.t, recording["ship.delta"]
     stops = recording.meta.get("parameters", {}).get("ship", {}).get("delta_max", math.inf)
-    pinned = np.abs(delta) >= stops * (1 - 1e-9)
+    pinned = at_stops(delta, stops)
     warning = ([f"warning: the rudder was at its stops for {100 * pinned.mean():.0f} % of the "
                 f"run (from t = {t[pinned][0]:.0f} s): the autopilot could not hold the course"]
                if pinned.mean() > 0.1 else [])
