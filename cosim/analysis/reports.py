@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 
-
 from ..core.recording import Recording
 from .cost import LAMBDA, Cost, cost
 from .manoeuvres import (STANDARD, Assessment, Criterion, TurningCircle, ZigZagResult,
