@@ -45,6 +45,9 @@ def test_example_spec_expands_to_every_combination():
     runs = spec.runs()
     assert len(runs) == 2 * 3 * 3 == len({r["run_id"] for r in runs})
     assert sweep.Spec.read(EXAMPLE).runs() == runs            # stable run ids
+    # what its comment says: 18 combinations in 14 runs
+    assert "18 combinations in\n# 14 runs" in EXAMPLE.read_text()
+    assert len(spec.shared_runs()) == 14
 
 
 def test_settings_map_axes_to_fmu_parameters(tmp_path):
@@ -241,7 +244,8 @@ def test_a_sweep_left_without_a_worker_stops_keeps_its_rows_and_says_why(
     assert status == sweep.NoWorkers.exit_status == 3, err
     assert re.search(r"no worker in the cluster for 2 s \(the last one left by [-\d]+ [:\d]+\); "
                      r"the sweep stopped: 1 of 4 runs done, kept in \S+/runs.jsonl, "
-                     r"\S+/results.parquet", err), err
+                     r"\S+/results.parquet, .*; this command resumes the sweep: \S+ -m "
+                     r"cosim.sweep \S+/spec.toml --scheduler tcp://\S+ --out ", err), err
     journal = [json.loads(line) for line in (out / "runs.jsonl").read_text().splitlines()]
     assert [r["status"] for r in journal] == ["ok"]
     assert pq.read_table(out / "results.parquet").num_rows == 1
@@ -326,6 +330,9 @@ def test_a_finished_sweep_removes_what_an_earlier_spec_of_its_name_wrote(fmu_pat
     assert command.main([str(write_spec(tmp_path, both)), "--out", str(out), "--workers", "1",
                          "--no-progress"]) == 0
     assert {"comparison.md", "J_smc_over_pd.png"} <= {p.name for p in (out / "small").iterdir()}
+    # a clean finish leaves no lock and no hidden file
+    assert [p.name for p in (out / "small").iterdir()
+            if p.name.startswith(".") or p.suffix == ".lock"] == []
     (out / "small" / "notes.txt").write_text("the user's")
     assert command.main([str(write_spec(tmp_path, alone)), "--out", str(out), "--workers", "1",
                          "--no-progress"]) == 0

@@ -6,6 +6,8 @@ import errno
 import functools
 import os
 import re
+import shlex
+import signal
 import stat
 import subprocess
 import sys
@@ -20,7 +22,7 @@ from cosim.core.ssd import write_ssd
 from cosim.studies import sweep, sweep_task
 from cosim.studies.bundle import UnsafeCache, file_hash, fmu_cache
 from cosim.studies import journal
-from cosim.studies.cluster import ClusterError, connect, local_workers
+from cosim.studies.cluster import ClusterError, connect, local_cluster, local_workers
 from cosim.studies.journal import Journal, JournalLocked
 from fmubuild.trial import TrialFailed, trial
 
@@ -418,3 +420,127 @@ def test_a_controller_whose_runs_cannot_be_measured_is_refused(tmp_path):
             f"{path}: controller 'turn': its system 'turning_circle' has no output "
             "guidance.psi_d; a run is measured by guidance.psi_d, ship.psi")):
         sweep.Spec.read(path)
+
+
+# -- Ctrl-C: one message, at whatever stage, with the command that resumes ----------------
+STOPPED = re.compile(r"^interrupted by SIGINT(?P<stage> while [a-z. ]+)?: (?P<done>\d+) of "
+                     r"(?P<runs>\d+) runs done, kept in (?P<journal>\S+/runs.jsonl)"
+                     r"(?P<tables>(, \S+)*); this command (?P<then>[^:]+): (?P<resume>.+)$")
+
+
+def _sweep_child(tmp_path: Path, spec: Path, code: str | None = None) -> subprocess.Popen:
+    """The sweep command in a session of its own, as a terminal's foreground job: a signal
+    to its process group reaches the local cluster's workers too (``code``: the command's
+    module patched, then run)."""
+    options = [str(spec), "--out", str(tmp_path / "out"), "--workers", "2", "--no-progress"]
+    launch = ["-m", "cosim.sweep"] if code is None else ["-c", code]
+    return subprocess.Popen([sys.executable, *launch, *options], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, start_new_session=True)
+
+
+def _resumed(line: str, journal: Path, runs: int) -> str:
+    """Run the command an interrupted sweep printed; what it said on standard error."""
+    resume = shlex.split(STOPPED.match(line)["resume"])
+    assert resume[:3] == [sys.executable, "-m", "cosim.sweep"]
+    child = subprocess.run(resume, capture_output=True, text=True, timeout=240)
+    assert child.returncode == 0, child.stderr
+    assert len(journal.read_text().splitlines()) == runs           # nothing run twice
+    return child.stderr
+
+
+@pytest.mark.timeout(300, method="thread")
+def test_ctrl_c_during_the_runs_prints_one_line_that_says_how_to_resume(fmu_paths, tmp_path):
+    """SIGINT to the whole process group, as a terminal's Ctrl-C: the workers, which would
+    each print a traceback, do not take it; the client stops, says what it keeps and
+    removes its lock."""
+    spec = spec_file(tmp_path, 'name = "stopped"\nstop_time = 400\n[axes]\n'
+                               'wave_seed = [1, 2, 3, 4]\nsea_state = [2]\n')
+    journal = tmp_path / "out" / "stopped" / "runs.jsonl"
+    with _sweep_child(tmp_path, spec) as child:
+        deadline = time.monotonic() + 120
+        while child.poll() is None and time.monotonic() < deadline and not (
+                journal.exists() and journal.read_text().strip()):
+            time.sleep(0.05)
+        os.killpg(child.pid, signal.SIGINT)
+        _, stderr = child.communicate(timeout=60)
+    assert child.returncode == 130, stderr
+    (line,) = stderr.splitlines()
+    said = STOPPED.match(line)
+    assert said and said["stage"] is None and said["then"] == "resumes the sweep", line
+    done = int(said["done"])
+    assert 1 <= done < 8 == int(said["runs"])
+    assert len(journal.read_text().splitlines()) == done
+    assert said["tables"].endswith("results.json, " + str(journal.parent / "summary.csv"))
+    assert [p.name for p in journal.parent.iterdir() if p.name.startswith(("runs.jsonl.",
+                                                                          "."))] == []
+    assert f"{done} of 8 runs already done" in _resumed(line, journal, 8)
+
+
+@pytest.mark.timeout(300, method="thread")
+@pytest.mark.parametrize("step, stage", [("write_tables", "writing the tables"),
+                                         ("save_figures", "drawing the figures"),
+                                         ("_comparison", "writing comparison.md")])
+def test_ctrl_c_after_the_runs_says_they_are_kept_and_how_to_finish(fmu_paths, tmp_path, step,
+                                                                   stage):
+    """The stage is made to take the signal: it signals its own process, then waits."""
+    spec = spec_file(tmp_path, 'name = "late"\nstop_time = 5\n[axes]\nwave_seed = [1]\n')
+    code = ("import os, signal, sys, time\nimport cosim.sweep as command\n"
+            "from cosim._cli import entry\n"
+            f"def {step}(*args, **kwargs):\n    os.kill(os.getpid(), signal.SIGINT)\n"
+            f"    time.sleep(60)\ncommand.{step} = {step}\nsys.exit(entry(command.main))\n")
+    with _sweep_child(tmp_path, spec, code) as child:
+        _, stderr = child.communicate(timeout=240)
+    assert child.returncode == 130, stderr
+    (line,) = stderr.splitlines()
+    said = STOPPED.match(line)
+    assert said and said["stage"] == f" while {stage}", line
+    assert (said["done"], said["runs"], said["tables"]) == ("2", "2", "")
+    assert said["then"] == "runs nothing again, and writes the tables and figures"
+    journal = tmp_path / "out" / "late" / "runs.jsonl"
+    assert "2 of 2 runs already done" in _resumed(line, journal, 2)
+    assert {"results.parquet", "summary.csv", "comparison.md", "J_distribution.png"} <= {
+        p.name for p in journal.parent.iterdir()}
+
+
+@pytest.mark.timeout(300, method="thread")
+def test_a_second_ctrl_c_ends_the_sweep_at_once_without_a_traceback(fmu_paths, tmp_path):
+    """Wherever the second signal falls (while the cluster closes, while the tables are
+    written, as the process ends), one or two lines and no traceback."""
+    spec = spec_file(tmp_path, 'name = "twice"\nstop_time = 400\n[axes]\n'
+                               'wave_seed = [1, 2, 3, 4]\nsea_state = [2]\n')
+    journal = tmp_path / "out" / "twice" / "runs.jsonl"
+    with _sweep_child(tmp_path, spec) as child:
+        deadline = time.monotonic() + 120
+        while child.poll() is None and time.monotonic() < deadline and not journal.exists():
+            time.sleep(0.05)
+        os.killpg(child.pid, signal.SIGINT)
+        time.sleep(0.3)
+        if child.poll() is None:
+            os.killpg(child.pid, signal.SIGINT)
+        _, stderr = child.communicate(timeout=60)
+    # 130, or ended by the signal itself once Python has begun to shut down (a shell says 130)
+    assert child.returncode in (130, -signal.SIGINT), stderr
+    assert "Traceback" not in stderr and "KeyboardInterrupt" not in stderr, stderr
+    lines = stderr.splitlines()
+    assert 1 <= len(lines) <= 2 and all(line.startswith(("interrupted by SIGINT",
+                                                         "SIGINT again: stopped at once"))
+                                        for line in lines), stderr
+
+
+@pytest.mark.timeout(60, method="thread")
+def test_the_workers_of_a_local_cluster_never_take_sigint():
+    """Blocked in each worker process, so that Ctrl-C at a terminal reaches the client alone;
+    the client's own main thread still takes it."""
+    from dask.distributed import Client
+
+    def blocked() -> bool:
+        mask = open("/proc/self/status").read().split("SigBlk:")[1].split()[0]
+        return bool(int(mask, 16) & (1 << (signal.SIGINT - 1)))
+
+    cluster = local_cluster(2)
+    try:
+        with Client(cluster) as client:
+            assert list(client.run(blocked).values()) == [True, True]
+        assert signal.SIGINT not in signal.pthread_sigmask(signal.SIG_BLOCK, set())
+    finally:
+        cluster.close()

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import logging
+import os
 import signal
 import sys
 from pathlib import Path
@@ -33,11 +34,9 @@ def local_cluster(workers: int | None = None) -> LocalCluster:
     the workers, instead of each worker printing its traceback. A Ctrl-C while the
     cluster starts arrives once it has started (and closes it).
     """
-    from multiprocessing import resource_tracker
-
     import dask
 
-    resource_tracker.ensure_running()       # starting it unblocks SIGINT in this thread
+    _start_resource_tracker()
     previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     cluster = None
     try:
@@ -51,6 +50,24 @@ def local_cluster(workers: int | None = None) -> LocalCluster:
             cluster.close()
         raise
     return cluster
+
+
+def _start_resource_tracker() -> None:
+    """Start multiprocessing's resource tracker (if it is not running) with its standard
+    error on the null device: before SIGINT is blocked, since starting it unblocks SIGINT
+    in the thread that does; and quiet, since all it would ever tell the user is that Dask's
+    queues leaked semaphores, when a second Ctrl-C ended the process at once."""
+    from multiprocessing import resource_tracker
+
+    sys.stderr.flush()
+    saved, null = os.dup(2), os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(null, 2)
+        resource_tracker.ensure_running()
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+        os.close(null)
 
 
 class ClusterError(ValueError):

@@ -253,7 +253,8 @@ def _stopping(stopped: BaseException | None, journal: Journal) -> Iterator[None]
         if isinstance(stopped, Interrupted):
             with StopSignals() as again:
                 again.received = stopped.signal         # the next one is the second
-                again.keep(lambda: f"{len(journal.rows)} rows kept in {journal.path}")
+                again.keep(lambda: f"{journal.path} keeps every run done "
+                                   f"({len(journal.rows)})")
                 yield
         else:
             yield
