@@ -16,7 +16,7 @@ SPEC is a TOML file (see docs/sweeps/example.toml):
     mine = { autopilot = "my.fmu", map = { psi = "heading" } }   # your own, in waves_pd
     other = "path/to/other.ssd"            # or a scenario, or an autopilot FMU, alone
 
-    [axes]                                 # every combination is run
+    [axes]                                 # every combination (see below: calm water)
     wave_seed = { start = 1, count = 20 }  # or a list
     sea_state = [0, 2, 3]                  # WMO codes -> Hs, T0 at 1:70 (cosim.analysis.seastate)
     Hs = [0.005]                           # m (instead of sea_state); T0 likewise
@@ -51,10 +51,12 @@ run whose result it is (ran_as) and the cosim.run command that reproduces it, bi
 for bit (command); summary.csv gives each figure of merit per setting and
 controller (median, quartiles, extremes, over the runs of that setting), the
 summary of J is printed, figures are written, and comparison.md pairs every
-controller with pd seed by seed. A task whose worker dies is retried twice, then recorded as failed;
-an FMU error is recorded as failed at once, with its message. A sweep whose cluster
-has had no worker for 60 s (``--no-worker-timeout``) stops as on Ctrl-C, every
-row done kept, and says so.
+controller with pd seed by seed. A task whose worker dies is retried twice, then
+recorded as failed; an FMU error is recorded as failed at once, with its message.
+Ctrl-C or SIGTERM, at any stage, ends the command with one line: the runs done and
+kept, and the command that resumes (it runs nothing twice); a second one ends it at
+once. A sweep whose cluster has had no worker for 60 s (``--no-worker-timeout``)
+stops as on Ctrl-C, every row done kept, and says so.
 
 Modules: ``sweep_spec`` reads a spec and lists its runs, ``sweep_client`` drives them
 on the cluster, ``sweep_task`` is one run on a worker, ``sweep_tables`` and
