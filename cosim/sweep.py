@@ -161,11 +161,12 @@ def _stopped(stopped: Interrupted | NoWorkers, stage: str, spec: Spec, out: Path
     written = []
     if stage == "running the sweep" and rows:
         written = write_tables(rows, out, csv, spec)
-    runs = len(distinct(rows))
+    done = distinct(rows)
+    runs = len(spec.shared_runs())
     while_ = "" if stage == "running the sweep" else f" while {stage}"
-    then = ("resumes the sweep" if runs < len(spec.shared_runs()) else
+    then = ("resumes the sweep" if sum(r["status"] == "ok" for r in done) < runs else
             "runs nothing again, and writes the tables and figures")
-    print(f"{stopped}{while_}: {runs} of {len(spec.shared_runs())} runs done, kept in "
+    print(f"{stopped}{while_}: {len(done)} of {runs} runs done, kept in "
           f"{out / 'runs.jsonl'}{''.join(f', {p}' for p in written)}; this command {then}: "
           f"{resume}", file=sys.stderr)
     return stopped.exit_status
