@@ -19,9 +19,8 @@ import pytest
 import cosim.scenarios.autopilot as autopilot
 from cosim import scenarios
 from cosim.core.ssd import write_ssd
-from cosim.studies import sweep, sweep_task
+from cosim.studies import journal, sweep, sweep_task
 from cosim.studies.bundle import UnsafeCache, file_hash, fmu_cache
-from cosim.studies import journal
 from cosim.studies.cluster import ClusterError, connect, local_cluster, local_workers
 from cosim.studies.journal import Journal, JournalLocked
 from fmubuild.trial import TrialFailed, trial

@@ -94,6 +94,7 @@ class Spec:
     _files: dict[str, Path] = field(default_factory=dict, repr=False, compare=False)
     _descriptions: dict[tuple[str, str], Any] = field(default_factory=dict, repr=False,
                                                        compare=False)
+    _ships: dict[tuple[str, str], bool] = field(default_factory=dict, repr=False, compare=False)
 
     def wants_track(self, run: dict[str, Any]) -> bool:
         """Whether ``run`` is one of the runs whose tracks are drawn ([plots] tracks)."""
@@ -305,11 +306,14 @@ class Spec:
 
     def _is_our_ship(self, controller: str, component: str) -> bool:
         """Whether a component is this project's ship FMU, current here (built from the
-        sources whose behaviour ``CALM_WATER_INERT`` states)."""
-        fmu = self._description(controller, component)[0]
-        manifest = read_manifest(fmu)
-        return (manifest is not None and manifest.slave_module == SHIP_SLAVE
-                and in_process_refusal(fmu) is None)
+        sources whose behaviour ``CALM_WATER_INERT`` states); asked once."""
+        if (controller, component) not in self._ships:
+            fmu = self._description(controller, component)[0]
+            manifest = read_manifest(fmu)
+            self._ships[controller, component] = (manifest is not None
+                                                  and manifest.slave_module == SHIP_SLAVE
+                                                  and in_process_refusal(fmu) is None)
+        return self._ships[controller, component]
 
     def sharing_notes(self) -> list[str]:
         """What ``shared_runs`` saves, in words: 'sea_state 0 is calm water (Hs = 0): the
@@ -366,10 +370,8 @@ class Spec:
         units = {}
         for axis, values in self.axes.items():
             targets = list(assignments(axis, values[0]))
-            variable = self._variable(controller, targets[0]) if len(targets) == 1 else None
-            units[axis] = (variable.unit or (variable.declaredType.unit
-                                             if variable.declaredType else None) or "") \
-                if variable is not None else ""
+            units[axis] = (_declared_unit(self._variable(controller, targets[0]))
+                           if len(targets) == 1 else "")
         return units
 
     def job(self, run: dict[str, Any], sweep: str, backend: str = "fmi",
@@ -408,6 +410,11 @@ class Spec:
             for target, value in assignments(axis, run[axis]).items():
                 put(target, value)
         return controller["scenario"], overrides
+
+
+def _declared_unit(variable) -> str:
+    """The unit a model variable declares, itself or by its type ("" for none)."""
+    return variable.unit or (variable.declaredType.unit if variable.declaredType else "") or ""
 
 
 def _digest(identity: dict[str, Any]) -> str:
