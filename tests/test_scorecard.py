@@ -111,7 +111,9 @@ def test_the_scorecard_names_the_criteria_each_autopilot_wins_and_loses(fmu_path
 
 
 def _row(controller: str, seed: int, **values) -> dict:
-    return {"controller": controller, "wave_seed": seed, "status": "ok", **values}
+    """A journal row as a sweep writes it (each run its own id)."""
+    return {"run_id": f"{controller}-{seed}", "controller": controller, "wave_seed": seed,
+            "status": "ok", **values}
 
 
 def test_a_win_is_the_better_value_on_the_same_sea_and_a_tie_within_one_percent():

@@ -17,8 +17,9 @@ import numpy as np  # noqa: E402
 
 from autopilot_fmu.guidance import parse_waypoints  # noqa: E402
 
-from ..analysis.figures import save  # noqa: E402
+from ..analysis.figures import save, waypoint_name  # noqa: E402
 from ..analysis.seastate import model_scale  # noqa: E402
+from .sweep_tables import distinct  # noqa: E402
 from .sweep_task import CRITERIA, Criterion  # noqa: E402
 
 SEA_AXES = ("sea_state", "Hs")
@@ -37,8 +38,9 @@ def distribution(spec, rows: list[dict], path: Path,
                  criteria: Sequence[Criterion] = CRITERIA[:1]) -> Path:
     """Box plots of each criterion (J alone by default) per controller, grouped by sea state
     when that is an axis: one panel per criterion, each on a log scale where its values
-    span more than a decade (said on its axis)."""
-    ok = [r for r in rows if r["status"] == "ok"]
+    span more than a decade (said on its axis). A run shared by several combinations
+    (calm water over the wave seeds) counts once."""
+    ok = [r for r in distinct(rows) if r["status"] == "ok"]
     sea = _sea_axis(spec)
     groups = spec.axes[sea] if sea else [None]
     boxes = len(groups) * len(spec.controllers)
@@ -218,9 +220,9 @@ def _route(ax, points: np.ndarray, R_accept: float | None) -> None:
     acceptance (dotted) where the row recorded the radius."""
     ax.plot(points[:, 1], points[:, 0], "--o", color="0.3", linewidth=0.8, markersize=3,
             label="route" + (f", circles of acceptance {R_accept:g} m" if R_accept else ""))
-    for k, (x, y) in enumerate(points, start=1):
-        ax.annotate(f"{k}", (y, x), xytext=(4, 4), textcoords="offset points", fontsize=8,
-                    color="0.2")
+    for k, (x, y) in enumerate(points):
+        ax.annotate(waypoint_name(k), (y, x), xytext=(4, 4), textcoords="offset points",
+                    fontsize=8, color="0.2")
         if R_accept:
             ax.add_patch(plt.Circle((y, x), R_accept, fill=False, linestyle=":", color="0.3",
                                     linewidth=0.8))

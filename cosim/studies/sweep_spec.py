@@ -64,7 +64,7 @@ TOML_TYPES = {"Real": ((int, float), "a number"), "Integer": ((int,), "an intege
 """The TOML values a parameter of each FMI type takes in a spec: one kind per type, so
 that each axis is one column of one type in the tables (no "0.01" beside 0.02)."""
 
-MEASURED = ("guidance.psi_d", "ship.psi", "ship.delta", "ship.x", "ship.y")
+MEASURED = ("guidance.psi_d", "guidance.wp_index", "ship.psi", "ship.delta", "ship.x", "ship.y")
 """The outputs a run's figures of merit and its track are computed from (``sweep_task``)."""
 
 SHIP_SLAVE = "ship_fmu.ship_slave"
