@@ -10,6 +10,7 @@ from typing import Sequence
 
 import matplotlib
 import matplotlib.ticker
+import matplotlib.transforms
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -45,7 +46,7 @@ def distribution(spec, rows: list[dict], path: Path,
     groups = spec.axes[sea] if sea else [None]
     boxes = len(groups) * len(spec.controllers)
     columns = min(4, len(criteria))
-    width = max(6.0 if len(criteria) == 1 else 3.4, 0.55 * boxes + 1.2)
+    width = max(6.0 if len(criteria) == 1 else 3.4, 0.75 * boxes + 1.2)
     fig, axes = plt.subplots(math.ceil(len(criteria) / columns), columns, squeeze=False,
                              figsize=(width * columns, 3.9 * math.ceil(len(criteria) / columns)),
                              constrained_layout=True)
@@ -70,11 +71,15 @@ def _boxes(ax, spec, ok: list[dict], criterion: Criterion, sea: str | None,
                       and (sea is None or r[sea] == group)]
             positions.append(g * (len(spec.controllers) + 1) + c)
             data.append([v for v in values if np.isfinite(v)] or [np.nan])
-            median = criterion.format(float(np.median(data[-1])))
-            where = f"\n{sea} {group}" if len(groups) > 1 else ""
-            labels.append(f"{controller}{where}\n{median}")
+            labels.append(f"{controller}\n{criterion.format(float(np.median(data[-1])))}")
     ax.boxplot(data, positions=positions, widths=0.7, whis=(0, 100), showfliers=False)
-    ax.set_xticks(positions, labels, fontsize=7, rotation=30 if len(positions) > 6 else 0)
+    ax.set_xticks(positions, labels, fontsize=7)
+    if len(groups) > 1:                 # each group's name once, under its boxes
+        below = matplotlib.transforms.blended_transform_factory(ax.transData, ax.transAxes)
+        for g, group in enumerate(groups):
+            middle = g * (len(spec.controllers) + 1) + (len(spec.controllers) - 1) / 2
+            ax.text(middle, -0.2, f"{sea} {group}", transform=below, ha="center", va="top",
+                    fontsize=8, fontweight="bold")
     values = [v for d in data for v in d if np.isfinite(v)]
     unit = f" ({criterion.unit})" if criterion.unit else ""
     if not values:
