@@ -11,7 +11,7 @@ from autopilot_fmu.guidance import WaypointGuidance, parse_waypoints
 from autopilot_fmu.pd import PDAutopilot
 from autopilot_fmu.smc import SlidingModeAutopilot, SlidingModeDesign
 from cosim.analysis.metrics import (heading_error, overshoot, settling_time,
-                                   sign_reversals_per_minute)
+                                   rudder_reversals_per_minute)
 from fmukit.numerics import wrap
 from ship_fmu.vessel import Vessel
 
@@ -144,9 +144,9 @@ def test_40_deg_course_change_settles(name):
     band = 0.02 * STEP
     settle = settling_time(t, psi - STEP, band)
     over = overshoot(psi, 0.0, STEP)
-    chatter = sign_reversals_per_minute(t, delta)
+    chatter = rudder_reversals_per_minute(t, delta)
     print(f"\n{name}: 40 deg course change settles (2 %) in {settle:.1f} s, overshoot "
-          f"{math.degrees(over):.2f} deg, rudder sign reversals {chatter:.1f} per minute")
+          f"{math.degrees(over):.2f} deg, rudder reversals {chatter:.1f} per minute")
     assert settle < 500.0
     assert abs(psi[-1] - STEP) < band and np.all(np.abs(psi) < 2 * STEP)
     if name == "pd":

@@ -7,8 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from cosim.analysis.metrics import (cross_track_error, fraction_at_stops, mean_abs_rate, peak,
-                                    rms, route_completion, sign_reversals_per_minute)
+from cosim.analysis.metrics import (RUDDER_DEADBAND, cross_track_error, fraction_at_stops,
+                                    mean_abs_rate, peak, rms, route_completion,
+                                    rudder_reversals_per_minute)
 from cosim.core.recording import Recording
 from cosim.studies.sweep_task import METRICS, run_metrics
 
@@ -54,14 +55,28 @@ def test_a_route_is_completed_only_if_the_track_comes_within_the_circle_of_its_l
     assert off.count == 0 and off.closest == pytest.approx((6.0, 6.0, 6.0))
 
 
+def test_a_rudder_dithering_about_amidships_does_not_reverse():
+    """Head seas leave a rounding residue in the wave side force: the rudder flips sign at
+    1e-15 rad every step; that, or a dither inside the deadband, is no reversal."""
+    t = np.arange(0.0, 60.0 + 1e-9, 0.1)
+    flips = 1e-15 * (-1.0) ** np.arange(t.size)
+    assert rudder_reversals_per_minute(t, flips) == 0.0
+    small = 0.9 * RUDDER_DEADBAND * np.sin(2 * math.pi * 0.5 * t)
+    assert rudder_reversals_per_minute(t, small) == 0.0
+    # past the deadband each way, twice: two reversals in the minute, whatever dithers between
+    swing = np.where(t < 20, 2 * RUDDER_DEADBAND, np.where(t < 40, -2 * RUDDER_DEADBAND,
+                                                            2 * RUDDER_DEADBAND)) + flips
+    assert rudder_reversals_per_minute(t, swing) == pytest.approx(2.0)
+
+
 def test_a_rudder_sine_reverses_twice_a_period_and_travels_four_amplitudes_a_period():
     amplitude, f = math.radians(10.0), 0.05            # 10 deg at 20 s period
     t = np.arange(0.0, 600.0 + 1e-9, 0.1)               # 30 whole periods
     delta = amplitude * np.sin(2 * math.pi * f * t + 0.3)
-    assert sign_reversals_per_minute(t, delta) == pytest.approx(2 * f * 60.0)
+    assert rudder_reversals_per_minute(t, delta) == pytest.approx(2 * f * 60.0)
     assert mean_abs_rate(t, delta) == pytest.approx(4 * amplitude * f, rel=1e-3)
     # the same sine about 15 deg of helm never crosses over: no reversal, the same travel
-    assert sign_reversals_per_minute(t, delta + math.radians(15.0)) == 0.0
+    assert rudder_reversals_per_minute(t, delta + math.radians(15.0)) == 0.0
     assert mean_abs_rate(t, delta + math.radians(15.0)) == pytest.approx(mean_abs_rate(t, delta))
 
 

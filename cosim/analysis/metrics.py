@@ -48,12 +48,19 @@ def overshoot(psi: np.ndarray, psi_start: float, psi_target: float) -> float:
     return max(0.0, float(np.max(direction * (np.asarray(psi) - psi_target))))
 
 
-def sign_reversals_per_minute(t: np.ndarray, delta: np.ndarray) -> float:
-    """Rudder reversals: how often the rudder crosses from one side to the other, per
-    minute."""
-    signs = np.sign(delta)
-    signs = signs[signs != 0]
-    reversals = int(np.count_nonzero(signs[1:] != signs[:-1]))
+RUDDER_DEADBAND = math.radians(0.5)
+"""How far past amidships the rudder must go for a crossing to count, rad: a rudder that
+dithers about zero by a rounding error (1e-15 rad in head seas, where sin(pi) leaves a
+residue in the wave side force) or by a fraction of a degree does not reverse."""
+
+
+def rudder_reversals_per_minute(t: np.ndarray, delta: np.ndarray,
+                                deadband: float = RUDDER_DEADBAND) -> float:
+    """Rudder reversals per minute: how often the rudder crosses from one side to the other,
+    a crossing counted once the rudder is beyond ``deadband`` on the new side (hysteresis)."""
+    delta = np.asarray(delta)
+    sides = np.sign(delta)[np.abs(delta) > deadband]
+    reversals = int(np.count_nonzero(sides[1:] != sides[:-1]))
     return reversals / ((t[-1] - t[0]) / 60.0)
 
 

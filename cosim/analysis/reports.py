@@ -8,7 +8,7 @@ from ..core.recording import Recording
 from .cost import LAMBDA, Cost, cost
 from .manoeuvres import (STANDARD, Assessment, Criterion, TurningCircle, ZigZagResult,
                          turning_circle_of, zigzag_of)
-from .metrics import at_stops, sign_reversals_per_minute
+from .metrics import RUDDER_DEADBAND, at_stops, rudder_reversals_per_minute
 from .seastate import SCALE
 
 PAPER_TABLES = {   # Tomera (2010), Tables 1 and 2: psi_E, delta_E, J
@@ -30,7 +30,8 @@ def course_keeping_report(recording: Recording, lam: float = LAMBDA, **_) -> lis
             "(eq 19: J = psi_E + delta_E; psi_E sums the squared heading errors, delta_E = "
             "lambda sum delta^2, lambda making them equal on calm_pd; over the 0.1 s samples)",
             f"rudder: max |delta| = {math.degrees(abs(delta).max()):.1f} deg, "
-            f"{sign_reversals_per_minute(t, delta):.1f} sign reversals per minute"]
+            f"{rudder_reversals_per_minute(t, delta):.1f} reversals per minute (crossings beyond "
+            f"+-{math.degrees(RUDDER_DEADBAND):g} deg)"]
 
 
 def criterion_text(c: Criterion) -> str:

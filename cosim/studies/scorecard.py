@@ -34,8 +34,8 @@ from autopilot_fmu.guidance import parse_waypoints
 
 from ..analysis.cost import Cost, cost
 from ..analysis.figures import comparison_figure
-from ..analysis.metrics import (RouteCompletion, heading_error, overshoot, route_completion,
-                                settling_time)
+from ..analysis.metrics import (RUDDER_DEADBAND, RouteCompletion, heading_error, overshoot,
+                                route_completion, settling_time)
 from ..analysis.reports import PAPER_TABLES
 from ..analysis.seastate import WMO, model_scale
 from .. import scenarios
@@ -317,7 +317,9 @@ def _markdown(fmu: Path, name: str, seeds: int, contenders: list[Contender],
              "Each criterion is scored on its own, with its unit and the side that is better; "
              "there is no overall rank. Angles in degrees, distances in m; a waypoint is "
              "reached when the ship comes within the guidance's circle of acceptance of it "
-             "(waypoints are numbered from 1, the start).", ""]
+             "(waypoints are numbered from 1, the start); a rudder reversal is a crossing "
+             "from one side to the other, counted once the rudder is "
+             f"{math.degrees(RUDDER_DEADBAND):g} deg past amidships on the new side.", ""]
     lines += _at_a_glance(names, route, ensembles, seeds)
     lines += _paper_route(contenders, route)
     lines += _course_change(names, changes)

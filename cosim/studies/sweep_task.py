@@ -21,7 +21,7 @@ from autopilot_fmu.guidance import R_ACCEPT, route as followed_route
 from ..analysis.cost import cost
 from ..analysis.metrics import (cross_track_error, fraction_at_stops, heading_error,
                                 mean_abs_rate, peak, rms, route_completion,
-                                sign_reversals_per_minute)
+                                rudder_reversals_per_minute)
 from ..core.provenance import code_version
 from ..core.watchdog import Limits, TimeLimit, Watchdog
 from .bundle import Bundle, materialise
@@ -238,7 +238,7 @@ def run_metrics(recording) -> dict[str, float]:
     return {"psi_E": c.psi_E, "sum_delta2": c.sum_delta2, "J": c.J,
             "rms_heading_error_deg": math.degrees(rms(heading_error(
                 recording["guidance.psi_d"], recording["ship.psi"]))),
-            "reversals_per_min": sign_reversals_per_minute(t, delta),
+            "reversals_per_min": rudder_reversals_per_minute(t, delta),
             "max_delta_deg": math.degrees(peak(delta)),
             "mean_rudder_rate_deg_s": math.degrees(mean_abs_rate(t, delta)),
             "at_stops_pct": 100.0 * fraction_at_stops(delta, stops),
