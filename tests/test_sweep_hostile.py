@@ -417,7 +417,8 @@ def test_a_controller_whose_runs_cannot_be_measured_is_refused(tmp_path):
     path = spec_file(tmp_path, '[controllers]\nturn = "turning_circle"\n')
     with pytest.raises(ValueError, match=re.escape(
             f"{path}: controller 'turn': its system 'turning_circle' has no output "
-            "guidance.psi_d; a run is measured by guidance.psi_d, ship.psi")):
+            "guidance.psi_d, guidance.wp_index; a run is measured by guidance.psi_d, "
+            "guidance.wp_index, ship.psi")):
         sweep.Spec.read(path)
 
 
