@@ -81,8 +81,8 @@ def test_a_script_without_a_model_is_refused_by_name(tmp_path, capsys):
     script = tmp_path / "empty.py"
     script.write_text("x = 1\n")
     assert cli.main([str(script)]) == 1
-    assert f"cannot build an FMU from {script}: ValueError: No child class of Fmi2Slave " \
-           f"found in module {script}" in capsys.readouterr().err
+    assert f"cannot build an FMU from {script}: ValueError: {script} defines no subclass of " \
+           "fmukit.slave.ModelSlave (the FMU's model)" in capsys.readouterr().err
 
 
 def test_the_c_autopilot_equals_the_python_pd(c_autopilot):

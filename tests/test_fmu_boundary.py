@@ -40,7 +40,9 @@ def test_each_fmu_carries_exactly_its_model_and_says_so(fmu_paths, name):
     with zipfile.ZipFile(fmu_paths[name]) as fmu:
         python = {n for n in fmu.namelist() if n.endswith(".py")
                   and not n.startswith("resources/pythonfmu/")}    # pythonfmu's own runtime
-    assert python == {carried["file"] for carried in manifest.modules.values()}
+        assert fmu.read("resources/slavemodule.txt").decode() == manifest.entry["module"]
+    assert python == {carried["file"] for carried in manifest.modules.values()} | {
+        manifest.entry["file"]}                                   # the class pythonfmu loads
     assert digest_of({m: c["sha256"] for m, c in manifest.modules.items()}) == manifest.digest
     assert staleness(manifest) is None
     # so no host-only module (fmubuild, cosim), edited or not, can make an FMU stale
@@ -57,14 +59,15 @@ def _imports(path: Path) -> set[str]:
     return names
 
 
-def test_the_runtime_imports_no_project_module_and_only_its_adapter_imports_pythonfmu():
+def test_the_runtime_imports_no_project_module_and_only_its_adapters_import_pythonfmu():
+    adapters = {"pythonfmu": "pythonfmu07", "pythonfmu3": "pythonfmu3_03"}
     for path in sorted((ROOT / "fmukit").rglob("*.py")):
         if path.name == "build.py" and path.parent.name == "fmukit":
             continue                    # the build command's published name: host-only
         imported = _imports(path)
         assert not imported & (PROJECT - {"fmukit"}), path
-        if "pythonfmu" in imported:
-            assert path.parent.name == "pythonfmu07", path
+        for pythonfmu in imported & set(adapters):
+            assert path.parent.name == adapters[pythonfmu], path
 
 
 def test_two_builds_of_one_commit_are_byte_identical(fmu_paths, tmp_path, c_autopilot):

@@ -10,8 +10,8 @@ from __future__ import annotations
 import math
 from xml.etree.ElementTree import Element, SubElement
 
-from .units import DISPLAY_UNIT, unit_definitions
-from .variables import Var
+from ..units import DISPLAY_UNIT, unit_definitions
+from ..variables import Var
 
 
 def complete(root: Element, variables: tuple[Var, ...]) -> Element:
