@@ -126,8 +126,8 @@ class SystemDescription:
                 return path
         source = Path(self.components[component].source)
         ours = source.stem in FMUS
-        fmi = next(filter(None, map(project_fmi, candidates)), 2)
-        hint = (f"one of this project's FMI {fmi}.0 FMUs, not built" if ours
+        twin = 3 in map(project_fmi, candidates)
+        hint = (f"one of this project's {'FMI 3.0 ' if twin else ''}FMUs, not built" if ours
                 else f"check the source of component '{component}' in {self.path or 'the system'}")
         raise FmuNotFound(f"FMU for '{component}' not found; tried "
                           f"{', '.join(map(str, candidates))}; {hint}", ours)
