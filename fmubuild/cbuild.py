@@ -97,7 +97,8 @@ def build_c(name: str, dest: Path | None = None, fmi: int = 2) -> Path:
         targets[WINDOWS[fmi]] = ([win64, *_WIN64_FLAGS], ".dll")
     else:
         print(f"note: {WIN64_COMPILER} not found (apt-get install gcc-mingw-w64-x86-64): "
-              f"{name}.fmu is built without a {WINDOWS[fmi]} binary", file=sys.stderr)
+              f"{name}.fmu (FMI {fmi}.0) is built without its Windows binary "
+              f"(binaries/{WINDOWS[fmi]})", file=sys.stderr)
     source, *headers, description = sources(name, fmi)
     entries = {"modelDescription.xml": description.read_bytes(),
                **{f"sources/{p.name}": p.read_bytes() for p in (source, *headers)}}

@@ -7,7 +7,8 @@ unpacked and its own code (``resources/``) instantiated and stepped, as pythonfm
 does, in a child process that lacks all of these (``WINDOWS_HOST``), once as in a
 C++ host (Python embedded by pythonfmu) and once as in a Python host. The DLLs are
 read with objdump: pythonfmu's win64 binary, which every Python FMU carries, and
-the C autopilot's, cross-compiled with mingw-w64 (``fmubuild.cbuild``).
+the C autopilot's of both FMI versions, cross-compiled with mingw-w64
+(``fmubuild.cbuild``).
 """
 from __future__ import annotations
 
@@ -19,6 +20,7 @@ import sys
 import zipfile
 from pathlib import Path
 
+import fmpy
 import pytest
 from fmpy.validation import validate_fmu
 
@@ -126,6 +128,16 @@ FMI2_CO_SIMULATION = (
     "fmi2GetBooleanStatus", "fmi2GetStringStatus")
 """The functions an FMI 2.0 co-simulation FMU exports (the standard, 2.1 and 4.2)."""
 
+FMI3_FUNCTIONS = tuple(re.findall(
+    r"^#define (fmi3\w+)\s+fmi3FullName\(", (Path(fmpy.__file__).parent / "c-code" /
+                                              "fmi3Functions.h").read_text(), re.MULTILINE))
+"""The functions an FMI 3.0 FMU exports: every one of fmi3Functions.h, of whatever interface
+type (FMI 3.0.2, 2.5)."""
+
+C_EXPORTS = {2: set(FMI2_COMMON + FMI2_CO_SIMULATION), 3: set(FMI3_FUNCTIONS)}
+C_BINARIES = {2: ("linux64", "win64"), 3: ("x86_64-linux", "x86_64-windows")}
+"""FMI version: the folders of the C autopilot's Linux and Windows binaries."""
+
 PYTHONFMU_WIN64_IMPORTS = {
     "python3.dll", "MSVCP140.dll", "VCRUNTIME140.dll", "VCRUNTIME140_1.dll", "KERNEL32.dll",
     "api-ms-win-crt-runtime-l1-1-0.dll", "api-ms-win-crt-heap-l1-1-0.dll",
@@ -192,41 +204,50 @@ def test_pythonfmus_win64_binary_needs_python_and_the_vc_runtime():
     assert set(FMI2_COMMON + FMI2_CO_SIMULATION) <= exports
 
 
-@pytest.fixture(scope="module")
-def c_fmu(tmp_path_factory) -> Path:
-    """The C autopilot, built here with its win64 binary; skipped where it cannot be."""
+@pytest.fixture(scope="module", params=sorted(C_BINARIES))
+def c_fmu(request, tmp_path_factory) -> tuple[int, Path]:
+    """The C autopilot of each FMI version, built here with its Windows binary; skipped
+    where it cannot be."""
     if cbuild.c_compiler() is None or shutil.which(cbuild.WIN64_COMPILER) is None:
         pytest.skip(f"needs a C compiler and {cbuild.WIN64_COMPILER} "
                     "(apt-get install gcc-mingw-w64-x86-64)")
-    return cbuild.build_c("pd_autopilot_c", tmp_path_factory.mktemp("c"))
+    fmi = request.param
+    return fmi, cbuild.build_c("pd_autopilot_c", tmp_path_factory.mktemp(f"c{fmi}"), fmi=fmi)
 
 
-def test_the_c_autopilots_win64_dll_exports_fmi2_and_needs_only_windows(c_fmu, tmp_path):
-    with zipfile.ZipFile(c_fmu) as package:
-        assert {"binaries/linux64/pd_autopilot_c.so",
-                "binaries/win64/pd_autopilot_c.dll"} <= set(package.namelist())
+def test_the_c_autopilots_windows_dll_exports_fmi_and_needs_only_windows(c_fmu, tmp_path):
+    fmi, fmu = c_fmu
+    linux, windows = C_BINARIES[fmi]
+    with zipfile.ZipFile(fmu) as package:
+        assert {n for n in package.namelist() if n.startswith("binaries/")} == {
+            f"binaries/{linux}/pd_autopilot_c.so", f"binaries/{windows}/pd_autopilot_c.dll"}
         description = package.read("modelDescription.xml").decode()
         dll = tmp_path / "pd_autopilot_c.dll"
-        dll.write_bytes(package.read("binaries/win64/pd_autopilot_c.dll"))
+        dll.write_bytes(package.read(f"binaries/{windows}/pd_autopilot_c.dll"))
+    assert f'fmiVersion="{fmi}.0"' in description
     assert "<CoSimulation" in description and "<ModelExchange" not in description
     imports, exports = _pe(dll)
-    assert exports == set(FMI2_COMMON + FMI2_CO_SIMULATION)
+    assert exports == C_EXPORTS[fmi]
     system = [i for i in imports if i.upper() in ("KERNEL32.DLL", "MSVCRT.DLL")
               or i.lower().startswith("api-ms-win-crt-")]
     assert sorted(imports) == sorted(system), f"not only Windows' own DLLs: {imports}"
-    assert validate_fmu(str(c_fmu)) == []
+    assert validate_fmu(str(fmu)) == []
 
 
+@pytest.mark.parametrize("fmi", sorted(C_BINARIES))
 def test_without_mingw_the_c_autopilot_is_built_for_linux_alone_with_a_note(
-        monkeypatch, tmp_path, capsys):
+        monkeypatch, tmp_path, capsys, fmi):
     if cbuild.c_compiler() is None:
         pytest.skip("no C compiler on this machine (set CC or install gcc)")
     which = shutil.which
     monkeypatch.setattr(shutil, "which",
                         lambda name, *a, **k: None if name == cbuild.WIN64_COMPILER
                         else which(name, *a, **k))
-    fmu = cbuild.build_c("pd_autopilot_c", tmp_path)
+    fmu = cbuild.build_c("pd_autopilot_c", tmp_path, fmi=fmi)
+    linux, windows = C_BINARIES[fmi]
     with zipfile.ZipFile(fmu) as package:
-        assert not [n for n in package.namelist() if n.startswith("binaries/win64/")]
+        assert {n for n in package.namelist() if n.startswith("binaries/")} == {
+            f"binaries/{linux}/pd_autopilot_c.so"}
     assert (f"note: {cbuild.WIN64_COMPILER} not found (apt-get install gcc-mingw-w64-x86-64): "
-            "pd_autopilot_c.fmu is built without a win64 binary") in capsys.readouterr().err
+            f"pd_autopilot_c.fmu (FMI {fmi}.0) is built without its Windows binary "
+            f"(binaries/{windows})") in capsys.readouterr().err
