@@ -23,7 +23,6 @@ from fmpy.validation import validate_fmu
 
 from fmubuild import cbuild
 from fmubuild.crosscheck import files
-from fmubuild.project import FMU_DIRS
 
 NAME = "pd_autopilot_c"
 FMI3_FUNCTIONS = tuple(re.findall(
@@ -33,19 +32,17 @@ FMI3_FUNCTIONS = tuple(re.findall(
 
 
 @pytest.fixture(scope="module")
-def c3(tmp_path_factory) -> Path:
-    """The FMI 3.0 twin, built here; skipped without a C compiler."""
-    if cbuild.c_compiler() is None:
+def twins(fmu_paths, fmi3_paths) -> dict[int, Path]:
+    """FMI version: the C autopilot of that version, current; skipped without a compiler."""
+    if NAME not in fmi3_paths:
         pytest.skip("no C compiler on this machine (set CC or install gcc)")
-    return cbuild.build_c(NAME, tmp_path_factory.mktemp("c3"), fmi=3)
+    return {2: fmu_paths[NAME], 3: fmi3_paths[NAME]}
 
 
 @pytest.fixture(scope="module")
-def twins(c3, fmu_paths) -> dict[int, Path]:
-    """FMI version: the C autopilot of that version."""
-    if NAME not in fmu_paths:
-        pytest.skip("no C compiler on this machine (set CC or install gcc)")
-    return {2: fmu_paths[NAME], 3: c3}
+def c3(twins) -> Path:
+    """The FMI 3.0 twin."""
+    return twins[3]
 
 
 def test_it_validates_and_carries_its_binaries_and_sources(c3):
@@ -113,12 +110,10 @@ def test_it_declares_what_its_fmi2_twin_declares(twins):
     assert fmi3.modelExchange is None and fmi3.scheduledExecution is None
 
 
-def test_its_value_references_are_the_python_pds_fmi3_ones(c3):
-    python = FMU_DIRS[3] / "pd_autopilot.fmu"
-    assert python.is_file(), "build it: python -m fmukit.build --fmi 3 pd_autopilot"
+def test_its_value_references_are_the_python_pds_fmi3_ones(c3, fmi3_paths):
     ours = {v.name: v.valueReference for v in read_model_description(str(c3)).modelVariables}
-    theirs = {v.name: v.valueReference
-              for v in read_model_description(str(python)).modelVariables}
+    theirs = {v.name: v.valueReference for v in
+              read_model_description(str(fmi3_paths["pd_autopilot"])).modelVariables}
     assert ours == theirs
 
 
@@ -148,14 +143,13 @@ def _delta_c(fmu: Path, inputs: Path, stop: float, cwd: Path) -> bytes:
 
 @pytest.mark.parametrize("inputs", ["crosscheck", "wrapping"])
 def test_it_computes_what_its_fmi2_twin_and_the_python_pd_do_to_the_last_bit(
-        twins, fmu_paths, tmp_path, inputs):
-    python3 = FMU_DIRS[3] / "pd_autopilot.fmu"
-    assert python3.is_file(), "build it: python -m fmukit.build --fmi 3 pd_autopilot"
+        twins, fmu_paths, fmi3_paths, tmp_path, inputs):
     path, stop = ((files("pd_autopilot")["in"], 30.0) if inputs == "crosscheck" else
                   (_wrapping_inputs(tmp_path / "wrapping.csv"), 60.0))
     results = {label: _delta_c(fmu, path, stop, tmp_path) for label, fmu in (
         ("C, FMI 3.0", twins[3]), ("C, FMI 2.0", twins[2]),
-        ("Python, FMI 2.0", fmu_paths["pd_autopilot"]), ("Python, FMI 3.0", python3))}
+        ("Python, FMI 2.0", fmu_paths["pd_autopilot"]),
+        ("Python, FMI 3.0", fmi3_paths["pd_autopilot"]))}
     reference = results.pop("C, FMI 3.0")
     values = np.genfromtxt(reference.splitlines(), delimiter=",", names=True)["delta_c"]
     assert len(values) == 10 * stop + 1 and np.ptp(values) > 1.0
