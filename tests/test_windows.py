@@ -2,12 +2,13 @@
 
 A Python FMU's code runs in a host on Windows as it does on Linux but for what
 Windows lacks: ``ctypes.CDLL(None)`` (a TypeError there), the POSIX-only functions of
-``os`` and ``signal``, and modules such as ``fcntl`` and ``resource``. Each FMU is
-unpacked and its own code (``resources/``) instantiated and stepped, as pythonfmu
-does, in a child process that lacks all of these (``WINDOWS_HOST``), once as in a
-C++ host (Python embedded by pythonfmu) and once as in a Python host. The DLLs are
-read with objdump: pythonfmu's win64 binary, which every Python FMU carries, and
-the C autopilot's of both FMI versions, cross-compiled with mingw-w64
+``os`` and ``signal``, and modules such as ``fcntl`` and ``resource``. Each FMU, of
+either FMI version, is unpacked and its own code (``resources/``) instantiated and
+stepped, as pythonfmu and pythonfmu3 do, in a child process that lacks all of these
+(``WINDOWS_HOST``), once as in a C++ host (Python embedded by pythonfmu) and once as
+in a Python host. The DLLs are read with objdump: pythonfmu's win64 binary and
+pythonfmu3's x86_64-windows one, which every Python FMU of that version carries, and
+the C autopilot's of both versions, cross-compiled with mingw-w64
 (``fmubuild.cbuild``).
 """
 from __future__ import annotations
@@ -25,6 +26,7 @@ import pytest
 from fmpy.validation import validate_fmu
 
 import pythonfmu
+import pythonfmu3
 from fmubuild import cbuild
 from fmubuild.manifest import read
 from fmubuild.project import FMUS
@@ -35,7 +37,7 @@ from pathlib import Path
 
 import numpy
 
-resources, slave_class, host = sys.argv[1:]
+resources, slave_class, host, fmi = sys.argv[1:]
 c_calls = []
 POSIX_MODULES = ("fcntl", "resource", "pwd", "grp", "termios", "tty", "pty", "syslog", "crypt",
                  "spwd")
@@ -99,20 +101,26 @@ if host == "c++":
 
 sys.path.insert(0, resources)            # as pythonfmu does
 module = importlib.import_module(Path(resources, "slavemodule.txt").read_text().strip())
-logger = ctypes.create_string_buffer(16)     # a logger whose debug flag (byte 8) is off
+# A logger with the host's logging flag off where the binary's logger keeps it: pythonfmu's
+# at byte 8; pythonfmu3's in the first byte of Settings, which byte 16 points to.
+logger = ctypes.create_string_buffer(24)
+settings = ctypes.create_string_buffer(1)
+ctypes.c_void_p.from_buffer(logger, 16).value = ctypes.addressof(settings)
 slave = getattr(module, slave_class)(instance_name="win", resources=resources,
                                      visible=False, logger=ctypes.addressof(logger))
-slave.setup_experiment(0.0)
+if fmi == "2":
+    slave.setup_experiment(0.0)
 slave.enter_initialization_mode()
 slave.exit_initialization_mode()
-stepped = slave.do_step(0.0, 0.1)
+result = slave.do_step(0.0, 0.1)
+stepped = result is True if fmi == "2" else (result.status == 0 and not any(result[1:]))
 slave.terminate()
 print(json.dumps({"fmukit": sys.modules["fmukit.slave"].__file__, "c_calls": c_calls,
                   "sigint": type(signal.getsignal(signal.SIGINT)).__name__,
                   "stepped": stepped}))
 '''
-"""A child process's script: instantiate and step an FMU's slave class from its resources
-folder on a faked Windows; it prints what it saw as JSON."""
+"""A child process's script: instantiate and step an FMU's slave class (of FMI version
+sys.argv[4]) from its resources folder on a faked Windows; it prints what it saw as JSON."""
 
 FMI2_COMMON = (
     "fmi2GetTypesPlatform", "fmi2GetVersion", "fmi2SetDebugLogging", "fmi2Instantiate",
@@ -149,6 +157,14 @@ on PATH), the Visual C++ 2015-2022 runtime and the Universal CRT (what the host 
 PYTHONFMU_WIN64 = (Path(pythonfmu.__file__).parent / "resources" / "binaries" / "win64"
                    / "pythonfmu-export.dll")
 
+PYTHONFMU3_WIN64 = (Path(pythonfmu3.__file__).parent / "resources" / "binaries" /
+                    "x86_64-windows" / "pythonfmu-export.dll")
+"""pythonfmu3 0.3.4's binary for 64-bit Windows: it imports Python's stable ABI and
+KERNEL32 alone (its C++ runtime linked in)."""
+
+PYTHON_WIN64 = {2: ("win64", PYTHONFMU_WIN64), 3: ("x86_64-windows", PYTHONFMU3_WIN64)}
+"""FMI version: the Windows binary folder of the Python FMUs and the binary they carry."""
+
 
 def _objdump() -> str:
     """A program that reads PE files: mingw-w64's objdump, else the system's; else skip."""
@@ -169,16 +185,25 @@ def _pe(dll: Path) -> tuple[set[str], set[str]]:
     return imports, exports
 
 
+@pytest.fixture(scope="module")
+def python_fmus(fmu_paths, fmi3_paths) -> dict[int, dict[str, Path]]:
+    """FMI version: the Python FMUs of that version, current."""
+    return {2: fmu_paths, 3: fmi3_paths}
+
+
 @pytest.mark.parametrize("host", ["c++", "python"])
 @pytest.mark.parametrize("name", list(FMUS))
-def test_each_python_fmu_instantiates_and_steps_on_windows(fmu_paths, tmp_path, name, host):
-    fmu = fmu_paths[name]
+@pytest.mark.parametrize("fmi", sorted(PYTHON_WIN64))
+def test_each_python_fmu_instantiates_and_steps_on_windows(python_fmus, tmp_path, fmi, name,
+                                                           host):
+    fmu = python_fmus[fmi][name]
     with zipfile.ZipFile(fmu) as package:
         package.extractall(tmp_path / "fmu")
     resources = tmp_path / "fmu" / "resources"
-    child = subprocess.run([sys.executable, "-c", WINDOWS_HOST, str(resources),
-                            read(fmu).slave_class, host], cwd=tmp_path, capture_output=True,
-                           text=True, timeout=120)
+    # Isolated (-I): this checkout's modules, on PYTHONPATH, would shadow the FMU's own.
+    child = subprocess.run([sys.executable, "-I", "-c", WINDOWS_HOST, str(resources),
+                            read(fmu).slave_class, host, str(fmi)], cwd=tmp_path,
+                           capture_output=True, text=True, timeout=120)
     assert child.returncode == 0, child.stderr
     seen = json.loads(child.stdout)
     assert Path(seen["fmukit"]).is_relative_to(resources)     # the FMU's code, not ours
@@ -192,16 +217,25 @@ def test_each_python_fmu_instantiates_and_steps_on_windows(fmu_paths, tmp_path, 
 
 
 @pytest.mark.parametrize("name", list(FMUS))
-def test_each_python_fmu_carries_pythonfmus_win64_binary(fmu_paths, name):
-    with zipfile.ZipFile(fmu_paths[name]) as package:
-        model = read(fmu_paths[name]).model_name
-        assert package.read(f"binaries/win64/{model}.dll") == PYTHONFMU_WIN64.read_bytes()
+@pytest.mark.parametrize("fmi", sorted(PYTHON_WIN64))
+def test_each_python_fmu_carries_its_pythonfmus_windows_binary(python_fmus, fmi, name):
+    folder, binary = PYTHON_WIN64[fmi]
+    fmu = python_fmus[fmi][name]
+    with zipfile.ZipFile(fmu) as package:
+        model = read(fmu).model_name
+        assert package.read(f"binaries/{folder}/{model}.dll") == binary.read_bytes()
 
 
 def test_pythonfmus_win64_binary_needs_python_and_the_vc_runtime():
     imports, exports = _pe(PYTHONFMU_WIN64)
     assert imports == PYTHONFMU_WIN64_IMPORTS
     assert set(FMI2_COMMON + FMI2_CO_SIMULATION) <= exports
+
+
+def test_pythonfmu3s_windows_binary_needs_python_alone():
+    imports, exports = _pe(PYTHONFMU3_WIN64)
+    assert imports == {"python3.dll", "KERNEL32.dll"}
+    assert set(FMI3_FUNCTIONS) <= exports
 
 
 @pytest.fixture(scope="module", params=sorted(C_BINARIES))
