@@ -332,18 +332,18 @@ BUILD_SOURCES = ("import sys; from fmpy.build import build_platform_binary; "
 sources, with fmpy (CMake), warnings on."""
 
 
-def test_fmpy_builds_it_from_the_sources_it_carries(c3, tmp_path):
+@pytest.mark.parametrize("fmi", [2, 3])
+def test_fmpy_builds_each_twin_from_the_sources_it_carries(twins, tmp_path, fmi):
     if shutil.which("cmake") is None:
         pytest.skip("no cmake, which fmpy builds an FMU's sources with")
-    unzipped = Path(fmpy.extract(str(c3), str(tmp_path / "fmu")))
+    unzipped = Path(fmpy.extract(str(twins[fmi]), str(tmp_path / "fmu")))
     shutil.rmtree(unzipped / "binaries")
-    built = subprocess.run(
-        [sys.executable, "-I", "-c", BUILD_SOURCES, str(unzipped)],
-        capture_output=True, text=True, timeout=300)
+    built = subprocess.run([sys.executable, "-I", "-c", BUILD_SOURCES, str(unzipped)],
+                           capture_output=True, text=True, timeout=300)
     assert built.returncode == 0, built.stdout + built.stderr
     assert "warning" not in built.stdout.lower()
     rebuilt = shutil.make_archive(str(tmp_path / NAME), "zip", unzipped)
-    twin = Twin(Path(shutil.move(rebuilt, tmp_path / f"{NAME}.fmu")), 3, tmp_path / "again")
+    twin = Twin(Path(shutil.move(rebuilt, tmp_path / f"{NAME}.fmu")), fmi, tmp_path / "again")
     twin.initialize()
     twin.set(psi=0.1, r=0.001)
     assert twin.step(0.0, 0.1) == (0, [])

@@ -21,7 +21,6 @@ import sys
 import zipfile
 from pathlib import Path
 
-import fmpy
 import pytest
 from fmpy.validation import validate_fmu
 
@@ -30,6 +29,7 @@ import pythonfmu3
 from fmubuild import cbuild
 from fmubuild.manifest import read
 from fmubuild.project import FMUS
+from test_c_fmi3 import FMI3_FUNCTIONS
 
 WINDOWS_HOST = r'''
 import ast, ctypes, importlib, json, os, signal, sys
@@ -135,12 +135,6 @@ FMI2_CO_SIMULATION = (
     "fmi2CancelStep", "fmi2GetStatus", "fmi2GetRealStatus", "fmi2GetIntegerStatus",
     "fmi2GetBooleanStatus", "fmi2GetStringStatus")
 """The functions an FMI 2.0 co-simulation FMU exports (the standard, 2.1 and 4.2)."""
-
-FMI3_FUNCTIONS = tuple(re.findall(
-    r"^#define (fmi3\w+)\s+fmi3FullName\(", (Path(fmpy.__file__).parent / "c-code" /
-                                              "fmi3Functions.h").read_text(), re.MULTILINE))
-"""The functions an FMI 3.0 FMU exports: every one of fmi3Functions.h, of whatever interface
-type (FMI 3.0.2, 2.5)."""
 
 C_EXPORTS = {2: set(FMI2_COMMON + FMI2_CO_SIMULATION), 3: set(FMI3_FUNCTIONS)}
 C_BINARIES = {2: ("linux64", "win64"), 3: ("x86_64-linux", "x86_64-windows")}
