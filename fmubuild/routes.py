@@ -24,8 +24,8 @@ from pathlib import Path
 
 from .project import FMU_DIRS
 
-_ENTRY = '''"""The FMI {fmi}.0 entry of the FMU {model_name}, written by its build (fmubuild.routes):
-{cls} of {module} as an FMI {fmi}.0 co-simulation FMU of {pythonfmu} {known}."""
+_ENTRY = '''"""The FMI {fmi}.0 entry of the FMU {model_name}, written by fmubuild.routes: {cls}
+of {module} as an FMI {fmi}.0 co-simulation FMU of {pythonfmu} {known}."""
 from {pythonfmu} import {base}
 
 from {adapter}.slave import {imported}
@@ -59,7 +59,7 @@ class Route:
         """The installed version of this route's pythonfmu; RuntimeError unless it is the
         one the adapter knows, whose defects it compensates."""
         adapter = importlib.import_module(self.adapter)
-        installed = getattr(adapter, "PYTHONFMU_VERSION")
+        installed = adapter.PYTHONFMU_VERSION
         if not adapter.ACTIVE:
             raise RuntimeError(f"{self.pythonfmu} {installed} is installed; fmukit builds FMI "
                                f"{self.fmi}.0 FMUs with {self.pythonfmu} {self.known} only, "

@@ -1,4 +1,4 @@
-"""Every FMI entry point of a slave passes through ``fmi_entry``: pythonfmu's error path, made safe.
+"""Every FMI entry point of a slave passes through ``fmi_entry``: pythonfmu's error path made safe.
 
 Both pythonfmu 0.7.0 and pythonfmu3 0.3.4 turn every Python exception into a fatal
 status. Their C++ layers also release the instance, its class and its log queue once

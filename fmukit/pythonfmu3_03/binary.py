@@ -1,4 +1,4 @@
-"""pythonfmu3 0.3.4's x86_64-linux binary as fmukit knows it: where to fix it, and its logger's layout.
+"""pythonfmu3 0.3.4's x86_64-linux binary as fmukit knows it: where to fix it, its logger's layout.
 
 ``fmubuild.exit_fix`` patches the binary when an FMU is built (its exit-time heap
 corruption, as pythonfmu 0.7.0's); ``hostlog`` reads the host's logging flag where
