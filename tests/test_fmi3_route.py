@@ -218,3 +218,40 @@ def test_every_twin_is_fmi3_and_found_where_the_scenarios_look(twins):
     for name in FMUS:
         with zipfile.ZipFile(twins[name]) as fmu:
             assert b'fmiVersion="3.0"' in fmu.read("modelDescription.xml")
+
+
+@pytest.mark.parametrize("overrides", [      # judged by the FMU at exitInitializationMode
+    {"guidance": {"waypoints": "0,0;nan,1"}},
+    {"ship": {"Hs": 0.1, "T0": 0.2}}])
+def test_both_backends_refuse_what_the_twins_refuse_with_the_same_words(overrides):
+    errors = []
+    for backend in ("fmi", "inprocess"):
+        with Master(scenarios.load("calm_pd", fmi=3), backend=backend,
+                    overrides=overrides) as master:
+            errors.append(master.run(5.0).error)
+    name, value = next(iter(next(iter(overrides.values())).items()))
+    assert f"{name} = {value}" in errors[0] or f"{name}: " in errors[0], errors[0]
+    assert errors[0] == errors[1]
+
+
+def test_a_step_refused_on_fmi3_is_an_error_not_fatal_on_both_backends(monkeypatch):
+    """FMI 3.0 lets doStep refuse without fmi3Fatal: the master reports fmi3Error from either
+    backend, with the FMU's words (the twins run this process's modules: the fault is
+    injected into both)."""
+    from ship_fmu.vessel import Vessel
+    step = Vessel.step
+
+    def failing_step(self, t, h, delta_c, *args):
+        if t >= 5.0:
+            raise ValueError("injected fault")
+        return step(self, t, h, delta_c, *args)
+    monkeypatch.setattr(Vessel, "step", failing_step)
+    errors = []
+    for backend in ("fmi", "inprocess"):
+        with Master(scenarios.load("calm_pd", fmi=3), backend=backend) as master:
+            recording = master.run(10.0)
+        assert recording.rows == 50
+        errors.append(recording.error)
+    assert errors[0].startswith("FMU 'ship': doStep at t = 5 s returned error\n"), errors[0]
+    assert "injected fault" in errors[0]
+    assert errors[0] == errors[1]
