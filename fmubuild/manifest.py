@@ -12,11 +12,11 @@ declares as its own). No time, path or machine is in it, so the same sources giv
 same manifest. A manifest of format 1 (before FMI 3.0) is an FMI 2.0 FMU's without an
 entry module: read, so that ``staleness`` can say to rebuild it.
 
-An FMU is current when it was built by this project's version and every module it
-carries is importable in this process and has the same source: ``staleness`` says why
-not, or None. This is the one notion of
-a stale FMU: the in-process backend runs only current FMUs, a run's metadata records
-it, and the tests rebuild what is not.
+An FMU is current when it was built by this project's version, every module it
+carries is importable in this process and has the same source, and its entry module is
+the one this build writes (``fmubuild.routes``): ``staleness`` says why not, or None.
+This is the one notion of a stale FMU: the in-process backend runs only current FMUs, a
+run's metadata records it, and the tests rebuild what is not.
 """
 from __future__ import annotations
 
@@ -27,6 +27,8 @@ import zipfile
 from dataclasses import dataclass
 from importlib import metadata
 from pathlib import Path
+
+from .routes import ROUTES
 
 MANIFEST = "resources/fmukit_manifest.json"
 FORMAT = 2
@@ -102,7 +104,8 @@ def read(fmu: str | Path) -> Manifest | None:
 
 def staleness(manifest: Manifest) -> str | None:
     """Why the FMU is not current in this process (built by another version of fmukit, or
-    a module it carries cannot be found here, or has another source), or None if it is."""
+    a module it carries cannot be found here, or has another source, or its entry module
+    is not the one this build writes), or None if it is."""
     if manifest.version != version():
         return (f"it was built by fmukit {manifest.version or 'of an older version'}, this "
                 f"is fmukit {version()} (rebuild it)")
@@ -115,4 +118,15 @@ def staleness(manifest: Manifest) -> str | None:
             return f"its module {module} is not importable here"
         if sha256(Path(spec.origin)) != carried["sha256"]:
             return f"its {module} differs from {spec.origin} (built before a change: rebuild it)"
+    written = manifest.entry and hashlib.sha256(entry_source(manifest).encode()).hexdigest()
+    if written and written != manifest.entry["sha256"]:
+        return (f"its entry module {manifest.entry['module']} is not the one this build writes "
+                "(built before a change of fmubuild.routes: rebuild it)")
     return None
+
+
+def entry_source(manifest: Manifest) -> str:
+    """The entry module this build writes for the FMU of ``manifest`` (``fmubuild.routes``)."""
+    slave_file = Path(manifest.modules[manifest.slave_module]["file"])
+    return ROUTES[manifest.fmi].entry_source(manifest.model_name, slave_file.stem,
+                                             manifest.slave_class)

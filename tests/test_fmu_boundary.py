@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import ast
+import dataclasses
 import zipfile
 from pathlib import Path
 
@@ -47,6 +48,16 @@ def test_each_fmu_carries_exactly_its_model_and_says_so(fmu_paths, name):
     assert staleness(manifest) is None
     # so no host-only module (fmubuild, cosim), edited or not, can make an FMU stale
     assert not any(m.split(".")[0] in ("fmubuild", "cosim") for m in manifest.modules)
+
+
+def test_an_fmu_whose_entry_module_this_build_would_not_write_is_stale(fmu_paths, fmi3_paths):
+    for fmu in (fmu_paths["pd_autopilot"], fmi3_paths["pd_autopilot"]):
+        manifest = read(fmu)
+        assert staleness(manifest) is None
+        other = dataclasses.replace(manifest, entry={**manifest.entry, "sha256": "0" * 64})
+        assert staleness(other) == (f"its entry module {manifest.entry['module']} is not the "
+                                    "one this build writes (built before a change of "
+                                    "fmubuild.routes: rebuild it)")
 
 
 def _imports(path: Path) -> set[str]:
