@@ -86,12 +86,14 @@ def test_each_instance_is_of_its_fmus_version_and_matched_by_name(twins, fmu_pat
     assert read_description(twins["ship"], "ship").fmiVersion == "3.0"
 
 
-def test_mixed_versions_in_one_system_run_as_either(twins):
+@pytest.mark.parametrize("backend", ["fmi", "inprocess"])
+def test_mixed_versions_in_one_system_run_as_either(twins, backend):
     system = scenarios.load("waves_pd")
     system.components["autopilot"].source = str(twins["pd_autopilot"])
-    with Master(system) as master:
+    with Master(system, backend=backend) as master:
         mixed = master.run()
     assert mixed.error is None
+    assert set(mixed.meta["backends"].values()) == {backend}, mixed.meta["notes"]
     assert Path(mixed.meta["fmus"]["autopilot"]["file"]).parent == FMU_DIRS[3]
     assert Path(mixed.meta["fmus"]["ship"]["file"]).parent == FMU_DIRS[2]
     assert_same_bits(mixed, run("waves_pd", 2))
