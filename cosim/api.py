@@ -73,11 +73,11 @@ def simulate(scenario: str | Path, autopilot: str | Path | None = None,
     ``"component.variable"`` (SI units, radians); ``stop_time`` in s (default: the
     scenario's). ``fmi=3`` runs this project's FMI 3.0 twins (fmus/fmi3/) in place of the
     FMUs the scenario names (``fmi=2``: fmus/), with the same results bit for bit; an
-    ``autopilot`` may be of either version. ``backend="inprocess"`` runs this project's FMUs as Python classes,
-    without FMI: the same results bit for bit, about 1.5-2.5 times faster (an FMU not
-    built from this checkout's classes runs through FMI, with a warning). ValueError or
-    FileNotFoundError for bad input, naming it; SimulationError if an FMU fails during
-    the run.
+    ``autopilot`` may be of either version. ``backend="inprocess"`` runs this project's
+    FMUs as Python classes, without FMI: the same results bit for bit, about 1.5-2.5
+    times faster (an FMU not built from this checkout's classes runs through FMI, with a
+    warning). ValueError or FileNotFoundError for bad input, naming it; SimulationError if
+    an FMU fails during the run.
     """
     with Master(scenarios.load(scenario, autopilot, port_map, fmi=fmi), coupling=coupling,
                 backend=backend, overrides=overrides_of(set or {})) as master:

@@ -86,11 +86,12 @@ class FmuInstance(Instance):
     slave: Any                         # fmpy's FMU2Slave or FMU3Slave
 
     def __new__(cls, path: str | Path, name: str, unzip_dir: str | Path | None = None):
+        chosen = cls
         if cls is FmuInstance:
-            from .fmi3 import Fmu3Instance
+            from .fmi3 import Fmu3Instance     # here: fmi3 builds on this module
             version = fmi_version(read_description(Path(path), name))
-            cls = Fmu3Instance if version == 3 else Fmu2Instance
-        return super().__new__(cls)
+            chosen = Fmu3Instance if version == 3 else Fmu2Instance
+        return super().__new__(chosen)
 
     def __init__(self, path: str | Path, name: str, unzip_dir: str | Path | None = None):
         self.path, self.name = Path(path), name

@@ -140,7 +140,8 @@ def check_autopilot(fmu: str | Path, port_map: dict[str, str] | None = None,
     if problems:
         raise AutopilotError(f"{fmu} does not keep the autopilot contract of an FMI "
                              f"{description.fmiVersion} FMU ("
-                             f"{_contract(PORT_TYPES[description.fmiVersion])}):\n" + "".join(f"  - {p}\n" for p in problems)
+                             f"{_contract(PORT_TYPES[description.fmiVersion])}):\n"
+                             + "".join(f"  - {p}\n" for p in problems)
                              + f"It has {_listing(description)}. Map other names with --map "
                              "PORT=NAME (--map psi=heading)")
     if trial:
