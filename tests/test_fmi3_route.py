@@ -86,6 +86,47 @@ def test_each_instance_is_of_its_fmus_version_and_matched_by_name(twins, fmu_pat
     assert read_description(twins["ship"], "ship").fmiVersion == "3.0"
 
 
+def test_the_ship_twins_state_is_saved_restored_and_moved_by_the_fmi2_call_names(twins):
+    """The master's call names are FMI 2.0's (getFMUstate, ...); an FMI 3.0 instance maps
+    them to FMI 3.0's (getFMUState, ...): a state restored, or deserialised into another
+    instance, gives the same steps to the last bit."""
+    ship, other = FmuInstance(twins["ship"], "ship"), FmuInstance(twins["ship"], "other")
+    outputs = [n for n, v in ship.variables.items() if v.causality == "output"]
+
+    def steps(fmu, k0: int) -> list[dict]:
+        rows = []
+        for k in range(k0, k0 + 20):
+            fmu.set({"delta_c": 0.3})
+            fmu.do_step(k * 0.1, 0.1)
+            rows.append(fmu.get(outputs))
+        return rows
+    try:
+        for fmu in (ship, other):
+            fmu.initialize()
+        steps(ship, 0)
+        state = ship.call("getFMUstate", ship.fmi("getFMUstate"))
+        ahead = steps(ship, 20)
+        ship.call("setFMUstate", ship.fmi("setFMUstate"), state)
+        assert steps(ship, 20) == ahead
+        ship.call("setFMUstate", ship.fmi("setFMUstate"), state)
+        data = ship.call("serializeFMUstate", ship.fmi("serializeFMUstate"), state)
+        other.call("setFMUstate", other.fmi("setFMUstate"),
+                   other.call("deSerializeFMUstate", other.fmi("deSerializeFMUstate"), data))
+        assert steps(other, 20) == ahead
+        ship.call("freeFMUstate", ship.fmi("freeFMUstate"), state)
+    finally:
+        ship.free()
+        other.free()
+
+
+@pytest.mark.parametrize("backend", ["fmi", "inprocess"])
+def test_a_reset_master_runs_the_twins_again_to_the_same_bits(backend):
+    with Master(scenarios.load("waves_pd", fmi=3), backend=backend) as master:
+        first = master.run(150.0)
+        master.reset()
+        assert_same_bits(master.run(150.0), first)
+
+
 @pytest.mark.parametrize("backend", ["fmi", "inprocess"])
 def test_mixed_versions_in_one_system_run_as_either(twins, backend):
     system = scenarios.load("waves_pd")

@@ -23,7 +23,10 @@ from .fmi import FmuInstance
 from .instance import FmuCallError
 
 CALLS = {"setReal": "setFloat64", "getReal": "getFloat64",
-         "setInteger": "setInt32", "getInteger": "getInt32"}
+         "setInteger": "setInt32", "getInteger": "getInt32",
+         "getFMUstate": "getFMUState", "setFMUstate": "setFMUState",
+         "freeFMUstate": "freeFMUState", "serializeFMUstate": "serializeFMUState",
+         "deSerializeFMUstate": "deserializeFMUState"}
 """The master's (FMI 2.0) call names that FMI 3.0 names otherwise; the rest are the same."""
 
 
