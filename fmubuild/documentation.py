@@ -170,7 +170,7 @@ def _table(variables: list[Element], columns: tuple[str, ...],
         if typed.get("displayUnit"):
             unit += f" (shown in {typed.get('displayUnit')})"
         cells = [f"<code>{html.escape(v.get('name'))}</code>", typed.tag, unit,
-                 *(typed.get(c, "") for c in columns)]
+                 *(_attribute(typed, c) for c in columns)]
         if feedthrough is not None:
             cells.append(", ".join(feedthrough.get(v.get("name"), [])) or "none")
         cells.append(v.get("description", ""))
@@ -208,6 +208,13 @@ def _typed(variable: Element) -> Element:
     """The element of a variable's type: FMI 2.0's child of ScalarVariable, FMI 3.0's the
     variable itself."""
     return variable[0] if variable.tag == "ScalarVariable" else variable
+
+
+def _attribute(typed: Element, name: str) -> str:
+    """An attribute of a variable's type ('' if it has none); FMI 3.0 gives a String's
+    start as the value of a <Start> child."""
+    start = typed.find("Start") if name == "start" else None
+    return typed.get(name, "") if start is None else start.get("value", "")
 
 
 def _prose(doc: str) -> str:
