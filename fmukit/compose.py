@@ -21,8 +21,8 @@ What both versions' instances offer such a host:
 - ``plans`` (``fmukit.fastpath``), ``sequence.phase``, ``failure``, ``variables``;
 - ``fmukit.entry.unguarded(slave.do_step)``: the step without its FMI guard, which
   raises ``fmukit.refusals.Refused`` for every refusal, in both versions;
-- ``log_queue``: pythonfmu's log messages (``status``, ``category``, ``msg``); cleared
-  by the host;
+- ``log_queue``: pythonfmu's log messages (``status``, ``category``, ``msg``), which
+  the host clears;
 - ``TYPE_NAMES`` (Python type: the FMI type's name) and ``FMI_VERSION`` (2 or 3).
 
 The calls, by version:
@@ -31,15 +31,17 @@ The calls, by version:
   ``enter_initialization_mode()``, ``exit_initialization_mode()``, ``do_step(t, h)``
   (True, or an exception: fmi2Fatal), ``terminate()``, ``get_real``/``set_real``,
   ``get_integer``/``set_integer``, ``get_string``/``set_string``; statuses
-  ``Fmi2Status``; a message without a category has category None;
+  ``Fmi2Status``;
 - FMI 3.0 (pythonfmu3 0.3.4): no ``setup_experiment`` (pythonfmu3 drops the start
   time of fmi3EnterInitializationMode, so the FMU's messages name none),
   ``enter_initialization_mode()``, ``exit_initialization_mode()``, ``do_step(t, h)``
   returning ``Fmi3StepResult`` whose ``status`` is ``Fmi3Status.ok``, or
   ``Fmi3Status.error`` for a refused step (logged, non-fatal; every other refusal is an
   exception: fmi3Fatal), ``terminate()``, ``get_float64``/``set_float64``,
-  ``get_int32``/``set_int32``, ``get_string``/``set_string``; statuses ``Fmi3Status``;
-  a message without a category has category "" (pythonfmu3's).
+  ``get_int32``/``set_int32``, ``get_string``/``set_string``; statuses ``Fmi3Status``.
+
+A refusal's message has the category ``fmukit.<cause>`` (``fmukit.refusals.CAUSES``) in
+both; pythonfmu's own messages name their status (``logStatusFatal``).
 """
 from __future__ import annotations
 

@@ -2,9 +2,12 @@
 same bits from the same inputs, saves and restores its state, and refuses as it should."""
 from __future__ import annotations
 
+import importlib
 import math
 import shutil
+import zipfile
 from pathlib import Path
+from xml.etree.ElementTree import canonicalize, fromstring, tostring
 
 import numpy as np
 import pytest
@@ -16,6 +19,7 @@ from fmpy.validation import validate_fmu
 from fmubuild.crosscheck import CASES
 from fmubuild.manifest import read
 from fmubuild.project import FMUS
+from fmukit.compose import fmu_class
 
 TYPES = {"Float64": "Real", "Int32": "Integer", "String": "String"}
 """An FMI 3.0 type: the FMI 2.0 type of its twin."""
@@ -259,3 +263,24 @@ def test_fmi2_and_fmi3_twins_run_side_by_side_in_one_process(fmu_paths, twin, op
         three.slave.doStep(k * 0.1, 0.1)
         two.do_step(k * 0.1, 0.1)
         assert three.get("delta_c") == [two.get(["delta_c"])["delta_c"]]
+
+
+@pytest.mark.parametrize("name", list(FMUS))
+def test_the_class_composed_in_code_declares_what_each_fmu_does(fmu_paths, fmi3_paths, name):
+    """fmukit.compose.fmu_class, which the in-process backend runs: the same declarations as
+    the FMU's own class, FMI 3.0's value references FMI 2.0's plus one."""
+    manifest = read(fmu_paths[name])
+    model = getattr(importlib.import_module(manifest.slave_module), manifest.slave_class)
+    registries = {}
+    for fmi, paths in ((2, fmu_paths), (3, fmi3_paths)):
+        slave = fmu_class(model, fmi)(instance_name=name)
+        assert slave.FMI_VERSION == fmi and fmu_class(model, fmi) is type(slave)
+        with zipfile.ZipFile(paths[name]) as fmu:
+            built = fromstring(fmu.read("modelDescription.xml"))
+        for section in ("ModelVariables", "UnitDefinitions", "ModelStructure"):
+            assert canonicalize(tostring(slave.to_xml().find(section)), strip_text=True) == \
+                canonicalize(tostring(built.find(section)), strip_text=True), (fmi, section)
+        registries[fmi] = {var.name: vr for vr, var in slave.registry.by_vr.items()}
+    assert {n: vr + 1 for n, vr in registries[2].items()} == registries[3]
+    with pytest.raises(ValueError, match="FMI 1 is not one fmukit builds"):
+        fmu_class(model, 1)
