@@ -222,7 +222,7 @@ def test_with_logging_off_the_host_is_sent_nothing(pd3, tmp_path):
     assert "heard []" in quiet.stdout, quiet.stdout + quiet.stderr
     assert quiet.stderr.count("pd: doStep at t = 0.0: input psi = nan is not finite") == 1
     forwarded = _variant(pd3, tmp_path / "pd.fmu", ADAPTER_SLAVE,
-                         "if host_log is None or host_log.hears():", "if True:")
+                         "if self.host_log.hears():", "if True:")
     told = _child(HOST, forwarded, "quiet", cwd=tmp_path)
     assert "heard [3, 3]" in told.stdout, told.stdout + told.stderr
 

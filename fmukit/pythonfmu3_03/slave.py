@@ -84,8 +84,7 @@ class Fmi3Entry:
             debug: bool = False) -> None:
         """pythonfmu3's log, kept off the host's callback while its logging is off (FMI
         3.0's rule; ``host_log.tell`` writes the errors to standard error then)."""
-        host_log = getattr(self, "host_log", None)       # None while pythonfmu3 starts
-        if host_log is None or host_log.hears():
+        if self.host_log.hears():
             super().log(msg, status, category, debug)
 
     @fmi_entry(error_result=_refused_step)
