@@ -26,8 +26,9 @@ def wave_digest(seed: int) -> str:
 
 
 def fmpy_cli(*args: str, cwd: Path) -> None:
-    """Run fmpy's command line in a subprocess."""
-    subprocess.run([sys.executable, "-m", "fmpy.cli", *args], cwd=cwd, check=True,
+    """Run fmpy's command line in a subprocess, isolated (``-I``): no PYTHONPATH or working
+    folder on its path, so that a Python FMU runs the modules it carries, not a checkout's."""
+    subprocess.run([sys.executable, "-I", "-m", "fmpy.cli", *args], cwd=cwd, check=True,
                    capture_output=True, text=True, timeout=120)
 
 
