@@ -123,9 +123,9 @@ slave = FMU3Slave(guid=described.guid, modelIdentifier=described.coSimulation.mo
 slave.instantiate(loggingOn=True, logMessage=lambda *message: None)
 slave.enterInitializationMode()
 slave.exitInitializationMode()
-print("ready", flush=True)
 try:
     for k in range(30):                    # each step some 0.5 s of the ship's RK4
+        print("stepping", flush=True)
         try:
             slave.doStep(k * 4000.0, 4000.0)
         except FMICallException as failed:
@@ -233,8 +233,9 @@ def _interrupted(fmu: Path, cwd: Path) -> str:
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                             env={k: v for k, v in os.environ.items() if k != "PYTHONPATH"})
     try:
-        assert host.stdout.readline() == "ready\n"
-        time.sleep(1.0)                               # the second step is under way
+        said = [host.stdout.readline(), host.stdout.readline()]
+        assert said == ["stepping\n"] * 2, said
+        time.sleep(0.2)                               # well inside the second step
         host.send_signal(signal.SIGINT)
         return host.communicate(timeout=TIMEOUT)[0]
     finally:
