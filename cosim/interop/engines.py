@@ -19,7 +19,7 @@ By default each run happens in a child process, because neither engine can be
 trusted with its caller: libcosimpy 0.0.6 aborts the process (std::terminate
 from a worker thread) when an FMU call fails during initialisation, and ecos
 0.7.2 ignores FMI status codes and discards FMU log messages. Our FMUs write an
-error to standard error when the host does not listen (``fmukit.pythonfmu07.hostlog``) and
+error to standard error when the host does not listen (``fmukit.hostlog`` and each adapter's ``hostlog``) and
 read NaN once they have failed; a crash, a failed step, or outputs that read NaN
 becomes an ``EngineError`` that carries the child's output, with the FMU's
 message and the time. A package is checked first (``check_package``).
