@@ -2,6 +2,8 @@
 from __future__ import annotations
 
 import csv
+import ctypes.util
+import importlib.util
 import subprocess
 import sys
 from pathlib import Path
@@ -23,6 +25,15 @@ def wave_digest(seed: int) -> str:
     arrays = (c.omega, c.k, c.amplitude, c.phase)
     return hashlib.sha256(b"".join(np.asarray(a, "<f8").tobytes() for a in arrays)
                           ).hexdigest()[:16]
+
+
+def ecos_missing() -> str | None:
+    """Why the ecos tests cannot run here (None if they can)."""
+    if importlib.util.find_spec("ecospy") is None:
+        return "ecospy is not installed (pip install -e '.[engines]')"
+    if ctypes.util.find_library("tbb") is None:
+        return "ecos needs Debian's libtbb12 (setup.sh installs it where apt-get is available)"
+    return None
 
 
 def fmpy_cli(*args: str, cwd: Path) -> None:

@@ -3,8 +3,6 @@ ecos and OMSimulator run with the FMI 2.0 package's results; libcosim and fmpy's
 (FMI 2.0 only) refuse it by name."""
 from __future__ import annotations
 
-import ctypes.util
-import importlib.util
 import os
 import subprocess
 import sys
@@ -21,21 +19,14 @@ from cosim.core.master import Master
 from cosim.interop import omsimulator
 from cosim.interop.engines import EngineError, run
 from cosim.interop.ssp import export, fmi_versions
+from helpers import ecos_missing
 
 ROOT = Path(__file__).resolve().parent.parent
 OMS = Path(os.environ.get("OMSIMULATOR_HOME") or ROOT.parent / "shared" / "tools" / "omsimulator")
 NAMES = ("calm_pd", "waves_smc", "zigzag_10_10")
 
 
-def _ecos_missing() -> str | None:
-    if importlib.util.find_spec("ecospy") is None:
-        return "ecospy is not installed (pip install -e '.[engines]')"
-    if ctypes.util.find_library("tbb") is None:
-        return "ecos needs Debian's libtbb12 (setup.sh installs it where apt-get is available)"
-    return None
-
-
-needs_ecos = pytest.mark.skipif(_ecos_missing() is not None, reason=str(_ecos_missing()))
+needs_ecos = pytest.mark.skipif(ecos_missing() is not None, reason=str(ecos_missing()))
 needs_oms = pytest.mark.skipif(not (OMS / "bin" / "OMSimulator").is_file(),
                                reason=f"OMSimulator is not at {OMS} (../shared/tools/"
                                       "omsimulator, or set OMSIMULATOR_HOME; CI has it)")
