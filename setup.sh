@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Set up a fresh machine: a virtual environment in .venv with this project, its test
-# tools and the other FMI engines it is tested in, and every FMU built into fmus/.
+# tools and the other FMI engines it is tested in, and every FMU built into fmus/ (FMI 2.0)
+# and its FMI 3.0 twin into fmus/fmi3/.
 set -euo pipefail
 cd "$(dirname "$0")"
 python=${PYTHON:-python3}
@@ -21,3 +22,4 @@ fi
 chmod +x .venv/lib/python*/site-packages/ecospy/binaries/ecos \
          .venv/lib/python*/site-packages/ecospy/binaries/proxyfmu 2>/dev/null || true
 .venv/bin/python -m fmukit.build
+.venv/bin/python -m fmukit.build --fmi 3

@@ -13,7 +13,7 @@ import tempfile
 from pathlib import Path
 from typing import Callable
 
-from fmubuild.project import BUILD_HINT
+from fmubuild.project import BUILD_HINT, FMU_DIRS
 
 from . import scenarios
 from .api import parse_setting
@@ -76,10 +76,26 @@ def parse_port_map(text: str) -> tuple[str, str]:
     return port, name
 
 
+def add_fmi_option(parser: argparse.ArgumentParser) -> None:
+    """--fmi 2|3: which version of this project's FMUs a scenario runs."""
+    parser.add_argument("--fmi", type=int, choices=sorted(FMU_DIRS),
+                        help="run this project's FMI 2.0 FMUs (fmus/) or their FMI 3.0 twins "
+                             "(fmus/fmi3/, built by python -m fmukit.build --fmi 3) in place "
+                             "of those the scenario names (default: as it names them; the "
+                             "scenarios here name the FMI 2.0 ones)")
+
+
+def build_hint(error: BaseException) -> str:
+    """How to build the FMUs an error says are ours and missing: the FMI 3.0 twins where
+    it names their folder."""
+    return BUILD_HINT + (" --fmi 3" if str(FMU_DIRS[3]) in str(error) else "")
+
+
 def add_autopilot_options(parser: argparse.ArgumentParser, also: str) -> None:
     """--autopilot FMU, --map PORT=NAME, --name NAME; ``also`` says what --all does with it."""
     parser.add_argument("--autopilot", type=Path, metavar="FMU",
-                        help="your own autopilot, an FMI 2.0 co-simulation FMU with inputs psi "
+                        help="your own autopilot, an FMI 2.0 or 3.0 co-simulation FMU with "
+                             "inputs psi "
                              "(rad), r (rad/s), psi_d (rad) and output delta_c (rad), in place "
                              f"of the scenario's; {also} (see docs/own_autopilot.md)")
     add_port_options(parser)
@@ -108,7 +124,7 @@ def say_error(error: BaseException) -> None:
     says what would mend it (an FMU of ours not built; a run too long to hold in memory)."""
     print(f"error: {error}", file=sys.stderr)
     if getattr(error, "ours", False):
-        print(f"  {BUILD_HINT}", file=sys.stderr)
+        print(f"  {build_hint(error)}", file=sys.stderr)
     if isinstance(error, TooManyRows):
         print("  cosim.run --stream writes the rows to the CSV as the run goes", file=sys.stderr)
 

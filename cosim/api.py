@@ -65,19 +65,21 @@ def overrides_of(settings: Mapping[str, Any] | Iterable[tuple[str, Any]]
 def simulate(scenario: str | Path, autopilot: str | Path | None = None,
              set: dict[str, Any] | None = None, stop_time: float | None = None,
              coupling: str = "gauss-seidel", backend: str = "fmi",
-             port_map: dict[str, str] | None = None) -> Recording:
+             port_map: dict[str, str] | None = None, fmi: int | None = None) -> Recording:
     """Run a scenario (a name or a .ssd path) and return its recording.
 
     ``autopilot``: an FMU in place of the scenario's (``cosim.scenarios.autopilot``),
     its ports renamed by ``port_map``; ``set``: parameter values by
     ``"component.variable"`` (SI units, radians); ``stop_time`` in s (default: the
-    scenario's). ``backend="inprocess"`` runs this project's FMUs as Python classes,
-    without FMI: the same results bit for bit, about 1.5-2.5 times faster (an FMU not
-    built from this checkout's classes runs through FMI, with a warning). ValueError or
-    FileNotFoundError for bad input, naming it; SimulationError if an FMU fails during
-    the run.
+    scenario's). ``fmi=3`` runs this project's FMI 3.0 twins (fmus/fmi3/) in place of the
+    FMUs the scenario names (``fmi=2``: fmus/), with the same results bit for bit; an
+    ``autopilot`` may be of either version. ``backend="inprocess"`` runs this project's
+    FMUs as Python classes, without FMI: the same results bit for bit, about 1.5-2.5
+    times faster (an FMU not built from this checkout's classes runs through FMI, with a
+    warning). ValueError or FileNotFoundError for bad input, naming it; SimulationError if
+    an FMU fails during the run.
     """
-    with Master(scenarios.load(scenario, autopilot, port_map), coupling=coupling,
+    with Master(scenarios.load(scenario, autopilot, port_map, fmi=fmi), coupling=coupling,
                 backend=backend, overrides=overrides_of(set or {})) as master:
         for note in master.notes:
             warnings.warn(note, stacklevel=2)

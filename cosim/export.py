@@ -3,6 +3,7 @@
     python -m cosim.export calm_pd                 -> results/ssp/calm_pd.ssp
     python -m cosim.export --all --out DIR         -> the paper's four scenarios
     python -m cosim.export waves_pd --autopilot my.fmu   -> results/ssp/waves_pd-my.ssp
+    python -m cosim.export calm_pd --fmi 3         -> results/ssp/fmi3/calm_pd.ssp
 
 The package is a zip holding SystemStructure.ssd (components, connections, the
 scenario's parameter values, the fixed step as OSP's and OpenModelica's annotations)
@@ -10,7 +11,10 @@ and resources/<fmu>.fmu for every FMU it uses; beside it, DIR/<label>/ holds OSP
 OspSystemStructure.xml and the FMUs (``cosim.interop.ssp``). OSP libcosim, ecos,
 fmpy, OMSimulator and OSP's tools load them unchanged (docs/interop.md). A String
 parameter value that OMSimulator and fmpy's SSP runner would not apply is named in a
-warning (the guidance's route is written as numbers, which they do apply).
+warning (the guidance's route is written as numbers, which they do apply). With
+``--fmi 3`` the package holds this project's FMI 3.0 twins (fmus/fmi3/): ecos and
+OMSimulator run it, libcosim and fmpy's SSP runner cannot (FMI 2.0 only), and the
+command says so.
 """
 from __future__ import annotations
 
@@ -19,10 +23,10 @@ import sys
 from pathlib import Path
 
 from . import scenarios
-from ._cli import (add_autopilot_options, checked_autopilot, chosen_scenarios, entry, say_error,
-                   writable_folder)
+from ._cli import (add_autopilot_options, add_fmi_option, checked_autopilot, chosen_scenarios,
+                   entry, say_error, writable_folder)
 from .core.files import OutputError
-from .interop.ssp import export, unapplied_strings
+from .interop.ssp import FMI2_ONLY, export, fmi_versions, unapplied_strings
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -31,18 +35,28 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("scenario", nargs="?",
                         help=f"one of: {', '.join(scenarios.names())}; or a path to a .ssd file")
     parser.add_argument("--all", action="store_true", help="the paper's four scenarios")
-    parser.add_argument("--out", type=Path, default=Path("results/ssp"), help="output folder")
+    parser.add_argument("--out", type=Path,
+                        help="output folder (default: results/ssp, or results/ssp/fmi3 with "
+                             "--fmi 3)")
+    add_fmi_option(parser)
     add_autopilot_options(parser, "the package carries the FMU; with --all, in each of the "
                                   "four scenarios")
     args = parser.parse_args(argv)
     names = chosen_scenarios(parser, args.scenario, args.all)
     if not checked_autopilot(parser, args):
         return 2
-    writable_folder(args.out)
+    out = args.out or Path("results/ssp") / ("fmi3" if args.fmi == 3 else "")
+    writable_folder(out)
     for name in names:
         try:
-            package = export(name, args.out, None, args.autopilot, dict(args.map), args.name)
+            package = export(name, out, None, args.autopilot, dict(args.map), args.name,
+                             args.fmi)
             print(f"wrote {package} and {package.with_suffix('')}/")
+            newer = sorted({v for v in fmi_versions(package).values() if v != "2.0"})
+            if newer:
+                print(f"note: {package.name} holds FMI {' and '.join(newer)} FMUs: ecos and "
+                      f"OMSimulator run it; {' and '.join(FMI2_ONLY.values())} run FMI 2.0 "
+                      "FMUs only and cannot", file=sys.stderr)
             for variable, (value, default) in unapplied_strings(package).items():
                 print(f"warning: {package.name} sets the String {variable} = {value!r}; "
                       f"OMSimulator and fmpy's SSP runner apply no String binding and "

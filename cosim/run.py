@@ -8,6 +8,7 @@ Examples:
   python -m cosim.run --all --spread           ... with how far one last bit moves each
                                                figure (as docs/reproduction.md)
   python -m cosim.run waves_pd --autopilot my.fmu   your own autopilot in waves_pd's place
+  python -m cosim.run --all --fmi 3            the same runs through the FMI 3.0 twins
 
 Each scenario is an SSP system structure file in cosim/scenarios/ (the FMUs, their
 parameters and connections). A run writes every signal at every 0.1 s step to
@@ -22,8 +23,9 @@ from pathlib import Path
 from typing import NamedTuple
 
 from . import scenarios
-from ._cli import (Progress, add_autopilot_options, checked_autopilot, chosen_scenarios, entry,
-                   number_option, positive_seconds, say_error, say_note, setting_option, writable_folder)
+from ._cli import (Progress, add_autopilot_options, add_fmi_option, checked_autopilot,
+                   chosen_scenarios, entry, number_option, positive_seconds, say_error, say_note,
+                   setting_option, writable_folder)
 from .analysis.animation import video_format
 from .analysis.cost import LAMBDA, Cost
 from .analysis.describe import conditions, headline
@@ -126,12 +128,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--lambda", dest="lam", type=number_option, default=LAMBDA,
                         help=f"weight of eq (19) (default {LAMBDA:.4f}, calibrated on calm_pd)")
     parser.add_argument("--backend", choices=RUN_BACKENDS, default="fmi",
-                        help="fmi: load the FMUs from fmus/ (default); inprocess: call the "
+                        help="fmi: load the FMUs through FMI (default); inprocess: call the "
                              "FMUs' Python classes directly, without FMI: the same results "
                              "bit for bit, about 1.5-2.5 times faster. An FMU that is not "
                              "one of ours, or was built from other sources than this "
                              "checkout's (rebuild: python -m fmukit.build), runs through FMI, "
                              "with a note")
+    add_fmi_option(parser)
     add_autopilot_options(parser, "with --all it also runs in calm_pd's and waves_pd's "
                                   "place, as an extra row of Tables 1-2")
     parser.add_argument("--no-plot", action="store_true", help="skip the figure")
@@ -193,7 +196,8 @@ def main(argv: list[str] | None = None) -> int:
         created = not out.exists()
         writable_folder(out)
         try:
-            system = scenarios.load(run.scenario, run.autopilot, dict(args.map), args.name)
+            system = scenarios.load(run.scenario, run.autopilot, dict(args.map), args.name,
+                                    args.fmi)
             code, result = run_scenario(system, run.label, out,
                                         overrides if run.autopilot else paper_overrides,
                                         options)

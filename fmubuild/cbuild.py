@@ -1,14 +1,19 @@
-"""Building FMUs written in C: compiled against the FMI 2.0 headers fmpy ships, then zipped.
+"""Building FMUs written in C: compiled against the FMI headers fmpy ships, then zipped.
 
-Each C FMU is a folder with ``<name>.c`` (the FMI 2.0 co-simulation API) and a
-hand-written ``modelDescription.xml``. The system C compiler (``$CC``, else ``cc``
-or ``gcc``) builds the shared library for this platform, and where mingw-w64 is
-installed (Debian's gcc-mingw-w64-x86-64) it cross-compiles the win64 DLL beside
-it: one that needs only Windows' own DLLs (KERNEL32, msvcrt), with no time stamp
-and a fixed image base, so that the FMU stays the same byte for byte. The FMU
-carries the libraries, the model description and the source, and must pass fmpy's
+Each C FMU is a folder with, for FMI 2.0, ``<name>.c`` (the FMI 2.0 co-simulation API)
+and a hand-written ``modelDescription.xml``; for its FMI 3.0 twin, ``<name>_fmi3.c`` and
+``modelDescription_fmi3.xml``; and the headers (``*.h``) both include, which hold what
+the two share (the model's law). The system C compiler (``$CC``, else ``cc`` or ``gcc``)
+builds the shared library for this platform, and where mingw-w64 is installed (Debian's
+gcc-mingw-w64-x86-64) it cross-compiles the 64-bit Windows DLL beside it: one that
+needs only Windows' own DLLs (KERNEL32, msvcrt), with no time stamp and a fixed image
+base, so that the FMU stays the same byte for byte. Binaries go where each version
+wants them: ``binaries/linux64``, ``binaries/win64`` (FMI 2.0);
+``binaries/x86_64-linux``, ``binaries/x86_64-windows`` (FMI 3.0's platform tuples). The
+FMU carries the libraries, the model description and the sources (for FMI 3.0 with
+the ``sources/buildDescription.xml`` a source FMU needs), and must pass fmpy's
 validation. Without a C compiler the build says so (``NoCompiler``) and the Python
-FMUs are unaffected; without mingw-w64 the FMU is built without its win64 binary,
+FMUs are unaffected; without mingw-w64 the FMU is built without its Windows binary,
 with a note.
 """
 from __future__ import annotations
@@ -22,14 +27,26 @@ from pathlib import Path
 
 from . import documentation, reproducible
 from .manifest import project_identity, version
-from .project import C_FMUS, FMU_DIR, ROOT
+from .project import C_FMUS, FMU_DIRS, ROOT
 
-C_HOSTS = {"linux64": "any FMI 2.0 co-simulation host; the library needs only libc and libm.",
-           "win64": "any FMI 2.0 co-simulation host; the DLL needs only KERNEL32 and msvcrt."}
-"""What a host needs for the C FMU, by platform (no Python: tests/test_windows.py reads the
-DLL's imports)."""
+FILES = {2: ("{name}.c", "modelDescription.xml"),
+         3: ("{name}_fmi3.c", "modelDescription_fmi3.xml")}
+"""FMI version: the C FMU folder's entry-point source and model description for it."""
+
+WINDOWS = {2: "win64", 3: "x86_64-windows"}
+"""FMI version: the name of its folder for 64-bit Windows binaries."""
+
+C_HOSTS = {
+    2: {"linux64": "any FMI 2.0 co-simulation host; the library needs only libc and libm.",
+        "win64": "any FMI 2.0 co-simulation host; the DLL needs only KERNEL32 and msvcrt."},
+    3: {"x86_64-linux": "any FMI 3.0 co-simulation host; the library needs only libc and libm.",
+        "x86_64-windows": "any FMI 3.0 co-simulation host; the DLL needs only KERNEL32 and "
+                          "msvcrt."}}
+"""FMI version: what a host needs for the C FMU, by platform (no Python:
+tests/test_windows.py reads the DLL's imports)."""
 
 _LIBRARY = {"linux64": ".so", "darwin64": ".dylib"}
+"""fmpy's platform: the suffix of a shared library there."""
 
 WIN64_COMPILER = "x86_64-w64-mingw32-gcc"
 """mingw-w64's C compiler for 64-bit Windows (Debian: gcc-mingw-w64-x86-64)."""
@@ -50,41 +67,57 @@ def c_compiler() -> str | None:
     return shutil.which("cc") or shutil.which("gcc")
 
 
-def build_c(name: str, dest: Path = FMU_DIR) -> Path:
-    """Compile the C FMU ``name`` into dest/name.fmu, for this platform and, with mingw-w64,
-    win64, and validate it; its path."""
+def sources(name: str, fmi: int = 2) -> list[Path]:
+    """The files the C FMU ``name``'s FMI ``fmi`` twin is built from: its entry-point source,
+    the headers of its folder (shared by both versions), its model description."""
+    folder = ROOT / C_FMUS[name]
+    source, description = (folder / f.format(name=name) for f in FILES[fmi])
+    return [source, *sorted(folder.glob("*.h")), description]
+
+
+def build_c(name: str, dest: Path | None = None, fmi: int = 2) -> Path:
+    """Compile the C FMU ``name`` as FMI ``fmi`` (2 or 3) into dest/name.fmu (default: that
+    version's folder, ``FMU_DIRS``), for this platform and, with mingw-w64, 64-bit
+    Windows, and validate it; its path."""
     import fmpy
     from fmpy.validation import validate_fmu
 
+    if fmi not in FILES:
+        raise ValueError(f"FMI {fmi}: the C FMUs are built as FMI 2 or 3")
     compiler = c_compiler()
     if compiler is None:
         raise NoCompiler(f"no C compiler found (set CC, or install gcc): {name}.fmu, an "
                          "autopilot in C, is not built; everything else is")
     if fmpy.platform not in _LIBRARY:
         raise NoCompiler(f"{name}.fmu is built for Linux and macOS only, not {fmpy.platform}")
-    targets = {fmpy.platform: ([compiler, "-fPIC"], _LIBRARY[fmpy.platform])}
+    here = fmpy.platform if fmi == 2 else fmpy.platform_tuple
+    targets = {here: ([compiler, "-fPIC"], _LIBRARY[fmpy.platform])}
     win64 = shutil.which(WIN64_COMPILER)
     if win64 is not None:
-        targets["win64"] = ([win64, *_WIN64_FLAGS], ".dll")
+        targets[WINDOWS[fmi]] = ([win64, *_WIN64_FLAGS], ".dll")
     else:
         print(f"note: {WIN64_COMPILER} not found (apt-get install gcc-mingw-w64-x86-64): "
-              f"{name}.fmu is built without a win64 binary", file=sys.stderr)
-    folder, headers = ROOT / C_FMUS[name], Path(fmpy.__file__).parent / "c-code"
-    source = folder / f"{name}.c"
-    entries = {"modelDescription.xml": (folder / "modelDescription.xml").read_bytes(),
-               f"sources/{source.name}": source.read_bytes()}
+              f"{name}.fmu (FMI {fmi}.0) is built without its Windows binary "
+              f"(binaries/{WINDOWS[fmi]})", file=sys.stderr)
+    source, *headers, description = sources(name, fmi)
+    entries = {"modelDescription.xml": description.read_bytes(),
+               **{f"sources/{p.name}": p.read_bytes() for p in (source, *headers)}}
+    if fmi == 3:
+        entries["sources/buildDescription.xml"] = build_description(name, source.name)
+    fmi_headers = Path(fmpy.__file__).parent / "c-code"
     with tempfile.TemporaryDirectory(prefix=f"build_{name}_") as tmp:
         for platform, (command, suffix) in targets.items():
             library = Path(tmp) / f"{name}{suffix}"
             compiled = subprocess.run([*command, "-std=c99", "-O2", "-Wall", "-shared",
-                                       "-I", str(headers), str(source), "-o", str(library),
-                                       "-lm"], capture_output=True, text=True)
+                                       "-I", str(fmi_headers), str(source), "-o", str(library),
+                                       "-lm"], capture_output=True, text=True, timeout=120)
             if compiled.returncode != 0:
                 raise RuntimeError(f"{command[0]} could not compile {source} for {platform}:\n"
                                    f"{compiled.stderr}")
             entries[f"binaries/{platform}/{library.name}"] = library.read_bytes()
     entries = documentation.describe(entries, f"fmukit {version()} (fmubuild.cbuild)",
-                                     project_identity(), "", {}, C_HOSTS)
+                                     project_identity(), "", {}, C_HOSTS[fmi])
+    dest = FMU_DIRS[fmi] if dest is None else dest
     dest.mkdir(parents=True, exist_ok=True)
     fmu = dest / f"{name}.fmu"
     reproducible.write(fmu, entries)
@@ -92,3 +125,15 @@ def build_c(name: str, dest: Path = FMU_DIR) -> Path:
     if problems:
         raise RuntimeError(f"{fmu} does not validate:\n" + "\n".join(problems))
     return fmu
+
+
+def build_description(model_identifier: str, source: str) -> bytes:
+    """sources/buildDescription.xml of an FMI 3.0 FMU compiled from the one C file
+    ``source`` (which includes the others beside it) and the C math library."""
+    return ('<?xml version="1.0" encoding="UTF-8"?>\n<fmiBuildDescription fmiVersion="3.0">\n'
+            f'  <BuildConfiguration modelIdentifier="{model_identifier}">\n'
+            '    <SourceFileSet language="C99">\n'
+            f'      <SourceFile name="{source}"/>\n'
+            '    </SourceFileSet>\n'
+            '    <Library name="m" external="true" description="the C math library"/>\n'
+            '  </BuildConfiguration>\n</fmiBuildDescription>\n').encode()

@@ -1,16 +1,19 @@
 """Build FMUs and validate them: this project's, or your own script written with fmukit.
 
     python -m fmukit.build                          # every FMU of the project, into fmus/
+    python -m fmukit.build --fmi 3                  # their FMI 3.0 twins, into fmus/fmi3/
     python -m fmukit.build ship                     # only some
     python -m fmukit.build my_autopilot.py --out DIR   # your script -> DIR/<model_name>.fmu
 
-The project's FMUs are Python (``fmubuild.packaging``) and one in C
-(``fmubuild.cbuild``), which needs a C compiler: without one it is skipped, with a
-note, and the rest is built. A script's FMU carries what it imports of fmukit, and the
-modules or packages given with --include, in its resources; the host needs Python
-with numpy (``fmubuild.packaging``). Its FMU is
-named after its slave's model_name and written beside the script unless --out says
-where. docs/own_autopilot.md walks through writing one.
+The FMUs are FMI 2.0 co-simulation FMUs unless --fmi 3 asks for FMI 3.0: the same
+scripts and declarations give both (``fmubuild.routes``). The project's FMUs are
+Python (``fmubuild.packaging``) and one in C (``fmubuild.cbuild``), which needs a C
+compiler: without one it is skipped, with a note, and the rest is built. A script's
+FMU carries what it imports of fmukit, and the modules or packages given with
+--include, in its resources; the host needs Python with numpy (``fmubuild.packaging``).
+Its FMU is named after its slave's model_name and written beside the script (an FMI 3.0
+one in the folder fmi3 there) unless --out says where. docs/own_autopilot.md walks
+through writing one.
 
 A script is refused, with one message naming it and no FMU written, if it does
 not parse (the file, the line and the line itself), if it imports a module of your own
@@ -28,7 +31,8 @@ from pathlib import Path
 from .cbuild import NoCompiler, build_c
 from .imports import Uncarried, uncarried
 from .packaging import build, build_script
-from .project import C_FMUS, FMU_DIR, FMUS
+from .project import C_FMUS, FMU_DIRS, FMUS
+from .routes import ROUTES
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -41,10 +45,13 @@ def main(argv: list[str] | None = None) -> int:
                         help=f"FMUs of the project (default: all of {', '.join(project)}), or "
                              "paths of your own scripts")
     parser.add_argument("--out", "--dest", dest="out", type=Path,
-                        help=f"output folder (default: {FMU_DIR} for the project's FMUs, the "
-                             "script's folder for a script)")
+                        help=f"output folder (default: {FMU_DIRS[2]} for the project's FMUs, "
+                             f"{FMU_DIRS[3]} for their FMI 3.0 twins, the script's folder for "
+                             "a script, its folder fmi3 for its FMI 3.0 FMU)")
     parser.add_argument("--include", action="append", type=Path, default=[], metavar="PATH",
                         help="a module or package a script imports besides fmukit; repeatable")
+    parser.add_argument("--fmi", type=int, choices=sorted(ROUTES), default=2,
+                        help="the FMI version to build: 2 (2.0, the default) or 3 (3.0)")
     args = parser.parse_intermixed_args(argv)
     for name in args.names:
         if name not in project and not name.endswith(".py"):
@@ -53,11 +60,11 @@ def main(argv: list[str] | None = None) -> int:
     for name in args.names or project:
         try:
             if name in FMUS:
-                fmu = build(name, args.out or FMU_DIR)
+                fmu = build(name, args.out, args.fmi)
             elif name in C_FMUS:
-                fmu = build_c(name, args.out or FMU_DIR)
+                fmu = build_c(name, args.out, args.fmi)
             else:
-                fmu = _build_script(Path(name), args.include, args.out)
+                fmu = _build_script(Path(name), args.include, args.out, args.fmi)
         except NoCompiler as missing:
             print(f"note: {missing}", file=sys.stderr)
             continue
@@ -68,17 +75,18 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
-def _build_script(script: Path, includes: list[Path], out: Path | None) -> Path:
-    """A user's script built into ``out`` (default: its folder); ValueError naming the
-    script, and what is wrong with it, if it cannot be: a module it imports that its FMU
-    would not carry, or its exiting when imported (a missing script or include is
-    ``build_script``'s to name)."""
+def _build_script(script: Path, includes: list[Path], out: Path | None, fmi: int) -> Path:
+    """A user's script built as FMI ``fmi`` into ``out`` (default: its folder, for FMI 3.0
+    its folder fmi3); ValueError naming the script, and what is wrong with it, if it
+    cannot be: a module it imports that its FMU would not carry, or its exiting when
+    imported (a missing script or include is ``build_script``'s to name)."""
     if script.is_file() and script.suffix == ".py" and all(p.exists() for p in includes):
         missing = uncarried(script, includes, ("fmukit",))
         if missing:
             raise ValueError(_carry_them(script, includes, missing))
+    folder = script.resolve().parent / ("fmi3" if fmi == 3 else "")
     try:
-        return build_script(script, ("fmukit", *includes), out or script.resolve().parent)
+        return build_script(script, ("fmukit", *includes), out or folder, fmi=fmi)
     except SystemExit as exit_:
         raise ValueError(f"cannot build an FMU from {script}: {_exit_site(script, exit_)} "
                          f"called sys.exit({exit_.code!r}) when imported; a slave script "

@@ -1,27 +1,59 @@
-"""FMI cross-check reference files for every FMU, in the fmi-cross-check layout.
+"""FMI cross-check reference files for every Python FMU and its FMI 3.0 twin, in the
+fmi-cross-check layout.
 
-    python -m fmubuild.crosscheck        # writes fmus/crosscheck/2.0/cs/linux64/...
+    python -m fmubuild.crosscheck            # both versions: fmus/crosscheck/2.0/..., 3.0/...
+    python -m fmubuild.crosscheck --fmi 3    # only the FMI 3.0 twins (fmus/fmi3/)
 
 For each FMU: <name>_in.csv (inputs), <name>_ref.csv (reference outputs),
 <name>_ref.opt (start, stop, step, tolerance), ReadMe.txt, and a copy of the FMU
-(not kept in git). The references are simulated with fmpy from the built FMU and
-committed: tests/test_crosscheck.py replays every FMU with ``fmpy simulate`` and
-compares, so they catch both a broken FMI layer and any change of behaviour.
-Regenerate them, and say why in the commit, when a change of results is intended.
+(not kept in git), in fmus/crosscheck/<FMI version>/cs/<platform>/<tool>/<version>/<name>/.
+The cross-check rules (4.1) and fmpy's validator of that repository name only FMI 1.0
+and 2.0, with FMI 2.0's platform names (linux64); the FMI 3.0 files follow the same
+layout under 3.0/ with the platform as FMI 3.0 names its binaries folders, by platform
+tuple (x86_64-linux). The references are simulated with fmpy from the built FMU, in a
+child process as a host would, isolated from this checkout (its modules, on the path
+or imported by the parent, would be taken in place of those the FMU carries), and
+committed: tests/test_crosscheck.py
+replays every FMU with ``fmpy simulate`` and compares, so they catch both a broken FMI
+layer and any change of behaviour. The two
+versions of an FMU give the same references to the last digit. Regenerate them, and
+say why in the commit, when a change of results is intended.
 """
 from __future__ import annotations
 
 import argparse
 import csv
 import shutil
+import subprocess
 import sys
 from dataclasses import dataclass
+from importlib.metadata import version
 from pathlib import Path
 
-from .project import FMU_DIR
+from cosim.core.files import fresh_folder
+
+from .project import FMU_DIR, FMU_DIRS
 
 TOOL, VERSION = "ship_autopilot_cosim", "0.1.0"
-CROSSCHECK_DIR = FMU_DIR / "crosscheck" / "2.0" / "cs" / "linux64" / TOOL / VERSION
+PLATFORMS = {2: "linux64", 3: "x86_64-linux"}
+"""FMI version: the cross-check platform folder of the references (made on 64-bit Linux)."""
+BUILDERS = {2: "pythonfmu", 3: "pythonfmu3"}
+"""FMI version: the package that builds the Python FMUs of that version."""
+CROSSCHECK_DIRS = {fmi: FMU_DIR / "crosscheck" / f"{fmi}.0" / "cs" / platform / TOOL / VERSION
+                   for fmi, platform in PLATFORMS.items()}
+
+SIMULATE = """
+import sys
+from fmpy import simulate_fmu
+from fmpy.util import read_csv, write_csv
+fmu, inputs, reference, stop, step = sys.argv[1:]
+write_csv(reference, simulate_fmu(fmu, start_time=0.0, stop_time=float(stop),
+                                  step_size=float(step), output_interval=float(step),
+                                  input=read_csv(inputs)))
+"""
+"""A child process's script: simulate FMU with the inputs, write the reference CSV."""
+SIMULATE_LIMIT = 300
+"""Seconds the simulation of one reference may take."""
 
 
 @dataclass(frozen=True)
@@ -54,8 +86,9 @@ CASES = {
 }
 
 
-def files(name: str) -> dict[str, Path]:
-    folder = CROSSCHECK_DIR / name
+def files(name: str, fmi: int = 2) -> dict[str, Path]:
+    """The cross-check folder of FMU ``name``'s FMI ``fmi`` (2 or 3) twin and its files."""
+    folder = CROSSCHECK_DIRS[fmi] / name
     return {"dir": folder, "fmu": folder / f"{name}.fmu", "in": folder / f"{name}_in.csv",
             "ref": folder / f"{name}_ref.csv", "opt": folder / f"{name}_ref.opt"}
 
@@ -66,42 +99,52 @@ def read_opt(path: Path) -> dict[str, float]:
     return {key.strip(): float(value) for key, value in pairs}
 
 
-def generate(name: str) -> Path:
-    """Write the cross-check files of one FMU from the built fmus/<name>.fmu."""
-    from fmpy import simulate_fmu
-    from fmpy.util import read_csv, write_csv
-
-    case, paths = CASES[name], files(name)
-    paths["dir"].mkdir(parents=True, exist_ok=True)
-    shutil.copy2(FMU_DIR / f"{name}.fmu", paths["fmu"])
-    with open(paths["in"], "w", newline="") as f:
-        writer = csv.writer(f, quoting=csv.QUOTE_NONNUMERIC)
-        writer.writerow(["time", *case.inputs])
-        writer.writerows([float(v) for v in row] for row in case.table)
-    paths["opt"].write_text(f"StartTime, 0.0\nStopTime, {case.stop!r}\nStepSize, {case.step!r}\n"
-                            f"RelTol, {case.rel_tol!r}\n")
-    result = simulate_fmu(str(paths["fmu"]), start_time=0.0, stop_time=case.stop,
-                          step_size=case.step, output_interval=case.step,
-                          input=read_csv(str(paths["in"])))
-    write_csv(str(paths["ref"]), result)
-    (paths["dir"] / "ReadMe.txt").write_text(
-        f"{name}.fmu, FMI 2.0 co-simulation, built with pythonfmu 0.7.0 by {TOOL} {VERSION}.\n"
-        f"Reference simulated with fmpy: fixed communication step {case.step} s, inputs "
-        f"linearly interpolated from {name}_in.csv, default parameters.\n"
-        "The FMU needs Python >= 3.10 with numpy on the host (see the project README).\n")
+def generate(name: str, fmi: int = 2) -> Path:
+    """Write the cross-check files of FMU ``name``'s FMI ``fmi`` twin from the built
+    ``FMU_DIRS[fmi]/<name>.fmu``, replacing its folder whole; the folder."""
+    case, paths = CASES[name], files(name, fmi)
+    paths["dir"].parent.mkdir(parents=True, exist_ok=True)
+    with fresh_folder(paths["dir"]) as folder:
+        staged = {key: folder / path.name for key, path in paths.items() if key != "dir"}
+        shutil.copy2(FMU_DIRS[fmi] / f"{name}.fmu", staged["fmu"])
+        with open(staged["in"], "w", newline="") as f:
+            writer = csv.writer(f, quoting=csv.QUOTE_NONNUMERIC)
+            writer.writerow(["time", *case.inputs])
+            writer.writerows([float(v) for v in row] for row in case.table)
+        staged["opt"].write_text(f"StartTime, 0.0\nStopTime, {case.stop!r}\n"
+                                 f"StepSize, {case.step!r}\nRelTol, {case.rel_tol!r}\n")
+        simulated = subprocess.run(
+            [sys.executable, "-I", "-c", SIMULATE, str(staged["fmu"]), str(staged["in"]),
+             str(staged["ref"]), repr(case.stop), repr(case.step)],
+            capture_output=True, text=True, timeout=SIMULATE_LIMIT)
+        if simulated.returncode != 0:
+            raise RuntimeError(f"fmpy could not simulate {FMU_DIRS[fmi] / name}.fmu "
+                               f"(exit status {simulated.returncode}):\n{simulated.stderr}")
+        builder = BUILDERS[fmi]
+        (folder / "ReadMe.txt").write_text(
+            f"{name}.fmu, FMI {fmi}.0 co-simulation, built with {builder} {version(builder)} "
+            f"by {TOOL} {VERSION}.\n"
+            f"Reference simulated with fmpy: fixed communication step {case.step} s, inputs "
+            f"linearly interpolated from {name}_in.csv, default parameters.\n"
+            "The FMU needs Python >= 3.10 with numpy on the host (see the project README).\n")
     return paths["dir"]
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m fmubuild.crosscheck",
-                                     description=__doc__.splitlines()[0])
+                                     description=__doc__.split("\n\n")[0].replace("\n", " "))
     parser.add_argument("names", nargs="*", metavar="NAME", help=f"FMUs (default: all of "
                                                                   f"{', '.join(CASES)})")
+    parser.add_argument("--fmi", type=int, choices=sorted(CROSSCHECK_DIRS),
+                        help="only the FMUs of this FMI version (default: both, FMI 2.0's "
+                             f"from {FMU_DIRS[2]}, FMI 3.0's from {FMU_DIRS[3]})")
     args = parser.parse_args(argv)
-    for name in args.names or CASES:
+    for name in args.names:
         if name not in CASES:
             parser.error(f"unknown FMU {name!r}; known: {', '.join(CASES)}")
-        print(f"wrote {generate(name)}")
+    for fmi in [args.fmi] if args.fmi else sorted(CROSSCHECK_DIRS):
+        for name in args.names or CASES:
+            print(f"wrote {generate(name, fmi)}")
     return 0
 
 

@@ -12,7 +12,8 @@
 
 Everything is derived from the entries and the docstrings given, so the same sources give
 the same bytes (``reproducible``). The page is plain HTML5 with no external asset, and
-well-formed XML as well.
+well-formed XML as well. FMI 2.0 and FMI 3.0 model descriptions alike: a variable's type is
+its ``<Real>`` child in FMI 2.0, the variable's own element (``<Float64>``) in FMI 3.0.
 """
 from __future__ import annotations
 
@@ -40,6 +41,18 @@ PYTHON_HOSTS = {
                "<code>LD_PRELOAD=/path/to/libpython3.X.so</code>, with "
                "<code>PYTHONPATH</code> naming a site-packages that has numpy if that "
                "Python's own has none.",
+    "x86_64-linux": "CPython {python} (64-bit) with numpy. A Python host that runs FMI 3.0 "
+                    "(fmpy, ecospy) needs nothing else. A host that is not Python (ecos, "
+                    "OMSimulator, a C or C++ program) must load libpython before the FMU: "
+                    "<code>LD_PRELOAD=/path/to/libpython3.X.so</code>, with "
+                    "<code>PYTHONPATH</code> naming a site-packages that has numpy if that "
+                    "Python's own has none.",
+    "x86_64-windows": "A 64-bit CPython {python} with numpy, whose installation folder (the "
+                      "one with <code>python3.dll</code>) is on <code>PATH</code> of every "
+                      "host: the binary imports python3.dll and KERNEL32 only. Set "
+                      "<code>PYTHONHOME</code> to that folder if Python cannot find its "
+                      "standard library, <code>PYTHONPATH</code> to a site-packages with "
+                      "numpy if its own has none. (Not tested on a Windows host.)",
     "win64": "A 64-bit CPython {python} with numpy, whose installation folder (the one "
              "with <code>python3.dll</code>, not a venv's <code>Scripts</code>) is on "
              "<code>PATH</code> of every host, Python or not (Simulink, Dymola, "
@@ -51,7 +64,8 @@ PYTHON_HOSTS = {
              "its own has none. (Tested on Linux with the platform faked and the DLL's "
              "imports read, not on a Windows host.)",
 }
-"""What a host needs to run a Python FMU, by platform; {python}: the Python versions."""
+"""What a host needs to run a Python FMU, by platform (FMI 2.0's linux64 and win64, FMI
+3.0's x86_64-linux and x86_64-windows); {python}: the Python versions."""
 
 _STYLE = ("body{font-family:sans-serif;max-width:60em;margin:1em auto;padding:0 1em}"
           "table{border-collapse:collapse}th,td{border:1px solid #bbb;padding:2px 6px;"
@@ -99,10 +113,14 @@ def index_html(xml: bytes, overview: str, sources: Mapping[str, str],
     root = fromstring(xml)
     name = root.get("modelName", "")
     variables = root.find("ModelVariables")
-    by_index = {str(i): v.get("name") for i, v in enumerate(variables, 1)}
-    feedthrough = {by_index[u.get("index")]: [by_index[d] for d in
-                                              (u.get("dependencies") or "").split()]
-                   for u in root.iterfind("ModelStructure/Outputs/Unknown")}
+    if root.get("fmiVersion", "").startswith("3"):       # by value reference
+        by_key = {v.get("valueReference"): v.get("name") for v in variables}
+        unknowns, key = root.iterfind("ModelStructure/Output"), "valueReference"
+    else:                                                # by 1-based index
+        by_key = {str(i): v.get("name") for i, v in enumerate(variables, 1)}
+        unknowns, key = root.iterfind("ModelStructure/Outputs/Unknown"), "index"
+    feedthrough = {by_key[u.get(key)]: [by_key[d] for d in (u.get("dependencies") or "").split()]
+                   for u in unknowns}
     inputs, outputs, parameters = ([v for v in variables if v.get("causality") == c]
                                    for c in ("input", "output", "parameter"))
     about = [("FMI", f"{root.get('fmiVersion')}, co-simulation"),
@@ -147,12 +165,12 @@ def _table(variables: list[Element], columns: tuple[str, ...],
              *(("direct feedthrough from",) if feedthrough is not None else ()), "meaning"]
     rows = ["<tr>" + "".join(f"<th>{h}</th>" for h in heads) + "</tr>"]
     for v in variables:
-        typed = v[0]
+        typed = _typed(v)
         unit = typed.get("unit", "")
         if typed.get("displayUnit"):
             unit += f" (shown in {typed.get('displayUnit')})"
         cells = [f"<code>{html.escape(v.get('name'))}</code>", typed.tag, unit,
-                 *(typed.get(c, "") for c in columns)]
+                 *(_attribute(typed, c) for c in columns)]
         if feedthrough is not None:
             cells.append(", ".join(feedthrough.get(v.get("name"), [])) or "none")
         cells.append(v.get("description", ""))
@@ -164,13 +182,13 @@ def _table(variables: list[Element], columns: tuple[str, ...],
 def _example(name: str, inputs: list[Element], experiment: Element | None) -> str:
     """fmpy's command line and Python running the FMU alone, its first input that starts
     at 0 held at 0.1 instead (clipped to its range)."""
-    held = next((v for v in inputs if v[0].tag == "Real" and float(v[0].get("start", 1)) == 0),
-                None)
+    held = next((v for v in inputs if _typed(v).tag in ("Real", "Float64")
+                 and float(_typed(v).get("start", 1)) == 0), None)
     stop = experiment.get("stopTime") if experiment is not None else None
     stop_option = f" --stop-time {stop}" if stop else ""
     if held is None:
         return (f"<pre>fmpy simulate {name}.fmu{stop_option} --output-file {name}.csv</pre>")
-    typed = held[0]
+    typed = _typed(held)
     value = repr(min(max(0.1, float(typed.get("min", "-inf"))), float(typed.get("max", "inf"))))
     variable = held.get("name")
     arguments = f"start_values={{{variable!r}: {value}}}" + (f", stop_time={stop}" if stop
@@ -184,6 +202,19 @@ def _example(name: str, inputs: list[Element], experiment: Element | None) -> st
             f"--output-file {name}.csv</pre>\n<p>or in Python:</p>\n"
             f"<pre>from fmpy import simulate_fmu\n"
             f"result = simulate_fmu({name + '.fmu'!r}, {arguments})</pre>")
+
+
+def _typed(variable: Element) -> Element:
+    """The element of a variable's type: FMI 2.0's child of ScalarVariable, FMI 3.0's the
+    variable itself."""
+    return variable[0] if variable.tag == "ScalarVariable" else variable
+
+
+def _attribute(typed: Element, name: str) -> str:
+    """An attribute of a variable's type ('' if it has none); FMI 3.0 gives a String's
+    start as the value of a <Start> child."""
+    start = typed.find("Start") if name == "start" else None
+    return typed.get(name, "") if start is None else start.get("value", "")
 
 
 def _prose(doc: str) -> str:

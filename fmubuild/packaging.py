@@ -3,16 +3,19 @@
 An FMU carries exactly its model: the slave script, the modules of fmukit and of this
 project's packages that it imports (followed through, ``imports``), a user's modules
 given with ``--include``, a requirements.txt (a host needs only Python with numpy:
-``pythonfmu deploy -f fmus/ship.fmu`` installs it) and its manifest
-(``manifest``). After building, the binary gets ``exit_fix`` (pythonfmu 0.7.0
-corrupts its host's heap at exit) and the FMU says what it is (``documentation``: its
-generation tool, fmukit; for this project's FMUs the project's author, version,
-copyright and license, ``project_identity``; documentation/index.html and model.png,
-from its model description and the docstrings of what it carries); the archive is
-written again in a fixed order with fixed times and a GUID derived from its contents
-(``reproducible``), so the same sources give the same bytes; the model description is
-checked with fmpy's validator and the FMU is instantiated once without this checkout
-(``trial``). A problem fails the build.
+``pythonfmu deploy -f fmus/ship.fmu`` installs it), its manifest (``manifest``) and
+its entry module, which makes the slave class an FMU of the FMI version built
+(``routes``: FMI 2.0 with pythonfmu 0.7.0, or FMI 3.0 with pythonfmu3 0.3.4, each
+through its adapter, which the FMU carries too). After building, the Linux binary gets
+``exit_fix`` (both pythonfmu versions corrupt their host's heap at exit) and the FMU
+says what it is (``documentation``: its generation tool, fmukit; for this project's
+FMUs the project's author, version, copyright and license, ``project_identity``;
+documentation/index.html and model.png, from its model description and the docstrings
+of what it carries); the archive is written again in a fixed order with fixed times
+and a GUID (FMI 3.0: instantiation token) derived from its contents (``reproducible``),
+so the same sources give the same bytes; the model description is checked with fmpy's
+validator and the FMU is instantiated once without this checkout (``trial``). A problem
+fails the build.
 
 A package whose __init__.py holds nothing but a docstring is carried without it, as a
 namespace package. A host that is not Python (ecos, OMSimulator) runs all its Python
@@ -24,6 +27,9 @@ from __future__ import annotations
 
 import ast
 import contextlib
+import importlib
+import inspect
+import os
 import shutil
 import sys
 import tempfile
@@ -34,18 +40,19 @@ from pathlib import Path
 from . import documentation, exit_fix, reproducible
 from .imports import needed_modules
 from .manifest import DISTRIBUTION, Manifest, digest_of, project_identity, sha256, version
-from .project import FMU_DIR, FMUS, ROOT
+from .project import FMUS, ROOT
+from .routes import ROUTES
 from .trial import TrialFailed, trial
 
 RUNTIME_REQUIREMENTS = "numpy\n"
 PROJECT_PACKAGES = ("fmukit", "ship_fmu", "autopilot_fmu")
-OPTIONS = {"canGetAndSetFMUstate": True, "canSerializeFMUstate": True}
 
 
-def build(name: str, dest: Path = FMU_DIR) -> Path:
-    """Build one FMU of this project to dest/name.fmu, validate it, and return its path."""
-    return build_script(ROOT / FMUS[name], PROJECT_PACKAGES, dest / f"{name}.fmu",
-                        project_identity())
+def build(name: str, dest: Path | None = None, fmi: int = 2) -> Path:
+    """Build one FMU of this project as FMI ``fmi`` (2 or 3) to dest/name.fmu (default:
+    the version's folder, ``project.FMU_DIRS``), validate it, and return its path."""
+    return build_script(ROOT / FMUS[name], PROJECT_PACKAGES,
+                        (dest or ROUTES[fmi].dest) / f"{name}.fmu", project_identity(), fmi)
 
 
 def python_hosts() -> dict[str, str]:
@@ -58,22 +65,26 @@ def python_hosts() -> dict[str, str]:
 
 
 def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
-                 identity: Mapping[str, str] | None = None) -> Path:
-    """Build the slave in ``script`` into ``dest`` (a .fmu path, or a folder where the FMU
-    is named after the slave's model_name). ``packages``: names of this project's
-    packages (fmukit among them), of which the FMU carries what the script imports, and
-    paths of a user's modules and packages, which it carries whole. ``identity``: the
-    author, version, copyright or license to declare where the slave declares none.
-    Returns the FMU's path.
+                 identity: Mapping[str, str] | None = None, fmi: int = 2) -> Path:
+    """Build the slave in ``script`` as an FMI ``fmi`` (2 or 3) FMU into ``dest`` (a .fmu
+    path, or a folder where the FMU is named after the slave's model_name). ``packages``:
+    names of this project's packages (fmukit among them), of which the FMU carries what
+    the script imports, and paths of a user's modules and packages, which it carries
+    whole. ``identity``: the author, version, copyright or license to declare where the
+    slave declares none. Returns the FMU's path.
 
     ValueError naming the script if it cannot be built (no ModelSlave in it, or it
-    does not import); RuntimeError if the result does not validate.
+    does not import), or for an FMI version fmukit does not build; RuntimeError if the
+    installed pythonfmu is not the one fmukit knows, or the result does not validate.
     """
     from fmpy.validation import validate_fmu
-    from pythonfmu import FmuBuilder
-    from pythonfmu import __version__ as pythonfmu_version
-    from pythonfmu.builder import get_model_class
 
+    if fmi not in ROUTES:
+        raise ValueError(f"fmukit builds FMI {' and '.join(f'{v}.0' for v in ROUTES)} "
+                         f"FMUs, not FMI {fmi}")
+    route = ROUTES[fmi]
+    pythonfmu_version = route.gate()
+    builder = importlib.import_module(route.pythonfmu).FmuBuilder
     script, dest = Path(script), Path(dest)
     if script.suffix != ".py":
         raise ValueError(f"{script} is not a Python script (.py) to build an FMU from")
@@ -83,29 +94,37 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
     for include in includes:
         if not include.exists():
             raise ValueError(f"{include}, to be carried by {script.name}'s FMU, does not exist")
+    project = [p for p in packages if isinstance(p, str)]
     (dest.parent if dest.suffix == ".fmu" else dest).mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix=f"build_{script.stem}_") as tmp, \
             _imports_undone(tmp):
-        stage = Path(tmp)
-        modules = _stage(script, [p for p in packages if isinstance(p, str)], includes, stage)
+        stage, built = Path(tmp) / "resources", Path(tmp) / "built"
+        stage.mkdir()
+        modules = _stage(script, project, includes, stage)
         # pythonfmu imports the script by its name: not a module of that name imported before
         shadowed = sys.modules.pop(script.stem, None)
         try:
             sys.path.insert(0, str(stage))
-            slave = get_model_class(stage / script.name)
-            manifest = Manifest(getattr(slave, "model_name", script.stem), _module_name(script),
-                                slave.__name__, modules,
+            slave = _slave_class(script.stem)
+            model_name = getattr(slave, "model_name", script.stem)
+            entry = stage / f"{route.entry_module(model_name)}.py"
+            if entry.exists():
+                raise ValueError(f"its FMU's entry module would be {entry.name}, which is the "
+                                 "name of a module it carries: rename that module")
+            entry.write_text(route.entry_source(model_name, script.stem, slave.__name__))
+            modules = dict(sorted({**modules, **_carry(entry, project, stage)}.items()))
+            manifest = Manifest(model_name, _module_name(script), slave.__name__, modules,
                                 digest_of({m: c["sha256"] for m, c in modules.items()}),
-                                pythonfmu_version, OPTIONS, version())
+                                pythonfmu_version, route.options, version(), fmi,
+                                {"module": entry.stem, **_carried(entry, entry.name)})
             (stage / "fmukit_manifest.json").write_text(manifest.to_json())
             sources = {m: _docstring(stage / c["file"].removeprefix("resources/"))
                        for m, c in modules.items()
                        if m.split(".")[0] != "fmukit" and m != manifest.slave_module}
             (stage / "requirements.txt").write_text(RUNTIME_REQUIREMENTS)
-            fmu = Path(FmuBuilder.build_FMU(
-                stage / script.name, dest=dest,
-                project_files=[p for p in stage.iterdir() if p.name != script.name],
-                **OPTIONS))
+            built = Path(builder.build_FMU(
+                entry, dest=built, project_files=[p for p in stage.iterdir() if p != entry],
+                **route.options))
         except Exception as error:      # the script's own import errors included
             why = str(error).replace(str(stage / script.name), str(script))
             raise ValueError(f"cannot build an FMU from {script}: "
@@ -113,10 +132,12 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
         finally:
             if shadowed is not None:
                 sys.modules[script.stem] = shadowed
-    tool, hosts = f"fmukit {version()} (pythonfmu {pythonfmu_version})", python_hosts()
-    reproducible.rewrite(fmu, lambda entries: documentation.describe(
-        exit_fix.patch_binaries(entries, fmu), tool, identity or {}, _docstring(script),
-        {m: doc for m, doc in sources.items() if doc}, hosts))
+        fmu = dest if dest.suffix == ".fmu" else dest / built.name
+        tool = f"fmukit {version()} ({route.pythonfmu} {pythonfmu_version})"
+        reproducible.rewrite(built, lambda entries: documentation.describe(
+            exit_fix.patch_binaries(entries, fmu, fmi), tool, identity or {},
+            _docstring(script), {m: doc for m, doc in sources.items() if doc},
+            python_hosts()), to=fmu)
     problems = validate_fmu(str(fmu))
     if problems:
         raise RuntimeError(f"{fmu} does not validate:\n" + "\n".join(problems))
@@ -133,20 +154,34 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
     return fmu
 
 
+def _slave_class(module_name: str) -> type:
+    """The slave class of the script imported as ``module_name``: of the ModelSlave
+    subclasses it holds, the one with the longest MRO (as pythonfmu chooses); ValueError
+    if there is none, or no single one."""
+    module = importlib.import_module(module_name)
+    model_slave = importlib.import_module("fmukit.slave").ModelSlave   # the script's fmukit
+    classes = [c for _, c in inspect.getmembers(module, inspect.isclass)
+               if issubclass(c, model_slave) and c is not model_slave]
+    if not classes:
+        raise ValueError(f"{module.__file__} defines no subclass of fmukit.slave.ModelSlave "
+                         "(the FMU's model)")
+    longest = max(len(c.__mro__) for c in classes)
+    chosen = [c for c in classes if len(c.__mro__) == longest]
+    if len(chosen) > 1:
+        raise ValueError(f"{module.__file__} holds {len(chosen)} ModelSlave classes, "
+                         f"{', '.join(c.__name__ for c in chosen)}, none of them derived from "
+                         "the others: which is the FMU's?")
+    return chosen[0]
+
+
 def _stage(script: Path, packages: list[str], includes: list[Path],
            stage: Path) -> dict[str, dict[str, str]]:
-    """Copy into ``stage`` what the FMU carries besides its manifest; return the manifest's
-    modules: the script, what it imports of ``packages``, and every module of
-    ``includes``."""
+    """Copy into ``stage`` what the FMU carries besides its manifest and entry module;
+    return the manifest's modules: the script, what it imports of ``packages``, and every
+    module of ``includes``."""
     shutil.copy2(script, stage)
-    modules = {_module_name(script): _carried(script, script.name)}
-    for module, file in needed_modules(script, {p: ROOT for p in packages}).items():
-        if _only_documents(file):
-            continue                    # a namespace package in the FMU: see the docstring
-        relative = file.relative_to(ROOT)
-        (stage / relative).parent.mkdir(parents=True, exist_ok=True)
-        shutil.copy2(file, stage / relative)
-        modules[module] = _carried(file, relative.as_posix())
+    modules = {_module_name(script): _carried(script, script.name),
+               **_carry(script, packages, stage)}
     for include in includes:
         files = ([include] if include.is_file() else
                  sorted(f for f in include.rglob("*") if f.is_file()
@@ -159,6 +194,20 @@ def _stage(script: Path, packages: list[str], includes: list[Path],
                 module = ".".join(relative.with_suffix("").parts).removesuffix(".__init__")
                 modules[module] = _carried(file, relative.as_posix())
     return dict(sorted(modules.items()))
+
+
+def _carry(file: Path, packages: list[str], stage: Path) -> dict[str, dict[str, str]]:
+    """Copy into ``stage`` the modules of ``packages`` that ``file`` imports (followed
+    through); return them as the manifest lists them."""
+    modules = {}
+    for module, found in needed_modules(file, {p: ROOT for p in packages}).items():
+        if _only_documents(found):
+            continue                    # a namespace package in the FMU: see the docstring
+        relative = found.relative_to(ROOT)
+        (stage / relative).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(found, stage / relative)
+        modules[module] = _carried(found, relative.as_posix())
+    return modules
 
 
 def _docstring(file: Path) -> str:
@@ -193,15 +242,17 @@ def _module_name(script: Path) -> str:
 
 @contextlib.contextmanager
 def _imports_undone(stage: str):
-    """Forget what building imported from ``stage``: pythonfmu imports the script and the
-    packages it carries from the temporary folder, and leaves that on sys.path. Left
-    there, the next build in this process (or an in-process run) would find those stale
-    modules. Modules imported from elsewhere (numpy, say) stay: they cannot be reloaded."""
+    """Forget what building imported from ``stage`` or from pythonfmu's own temporary
+    folders (whose files are gone): pythonfmu imports the script and the packages it
+    carries from there, and leaves that on sys.path. Left there, the next build in this
+    process (or an in-process run) would find those stale modules. Modules imported from
+    elsewhere (numpy, say) stay: they cannot be reloaded."""
     path, modules = list(sys.path), set(sys.modules)
     try:
         yield
     finally:
         sys.path[:] = path
         for name in set(sys.modules) - modules:
-            if str(getattr(sys.modules[name], "__file__", None) or "").startswith(stage):
+            file = str(getattr(sys.modules[name], "__file__", None) or "")
+            if file.startswith(stage) or (file and not os.path.exists(file)):
                 del sys.modules[name]

@@ -5,6 +5,9 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 FMU_DIR = ROOT / "fmus"
+FMU_DIRS = {2: FMU_DIR, 3: FMU_DIR / "fmi3"}
+"""Where the FMUs of each FMI version are built: FMI 2.0's in fmus/, their FMI 3.0 twins in
+fmus/fmi3/ (the same names: fmus/fmi3/ship.fmu)."""
 
 FMUS: dict[str, str] = {
     "ship": "ship_fmu/ship_slave.py",

@@ -1,10 +1,11 @@
 """The same sources give the same FMU, byte for byte.
 
 pythonfmu writes its archive in the order the file system lists the files, with
-their modification times, a time-based GUID and the time of the build. An FMU is
-written again here: its entries in name order, each with one fixed time and mode,
-no generation time, and a GUID derived from the contents (a version-5 UUID of their
-SHA-256), so that a changed FMU gets a new GUID and an unchanged one keeps its own.
+their modification times, a time-based GUID (FMI 3.0: instantiation token) and the
+time of the build. An FMU is written again here: its entries in name order, each with
+one fixed time and mode, no generation time, and a GUID or instantiation token derived
+from the contents (a version-5 UUID of their SHA-256), so that a changed FMU gets a new
+one and an unchanged one keeps its own.
 """
 from __future__ import annotations
 
@@ -18,28 +19,31 @@ from typing import Callable
 EPOCH = (1980, 1, 1, 0, 0, 0)
 """The time of every entry: the earliest a zip file can hold."""
 
-_GUID = re.compile(rb'\sguid="[^"]*"')
+_GUID = re.compile(rb'\s(guid|instantiationToken)="[^"]*"')
 _GENERATED = re.compile(rb'\sgenerationDateAndTime="[^"]*"')
 
 
 def rewrite(fmu: Path,
-            transform: Callable[[dict[str, bytes]], dict[str, bytes]] | None = None) -> str:
-    """Write ``fmu`` again reproducibly, in place (whole or not at all), its entries (name:
-    bytes) passed through ``transform`` first; its new GUID."""
+            transform: Callable[[dict[str, bytes]], dict[str, bytes]] | None = None,
+            to: Path | None = None) -> str:
+    """Write ``fmu`` again reproducibly, in place or ``to`` another path (whole or not at
+    all), its entries (name: bytes) passed through ``transform`` first; its new GUID."""
     with zipfile.ZipFile(fmu) as package:
         entries = {info.filename: package.read(info) for info in package.infolist()
                    if not info.is_dir()}
     if transform is not None:
         entries = transform(entries)
     description = _GENERATED.sub(b"", entries["modelDescription.xml"])
-    entries["modelDescription.xml"] = _GUID.sub(b' guid=""', description, count=1)
+    found = _GUID.search(description)
+    attribute = found.group(1) if found else b"guid"
+    entries["modelDescription.xml"] = _GUID.sub(b' ' + attribute + b'=""', description, count=1)
     contents = hashlib.sha256()
     for name in sorted(entries):
         contents.update(name.encode() + b"\0" + hashlib.sha256(entries[name]).digest())
     guid = str(uuid.uuid5(uuid.NAMESPACE_OID, contents.hexdigest()))
     entries["modelDescription.xml"] = entries["modelDescription.xml"].replace(
-        b' guid=""', f' guid="{{{guid}}}"'.encode(), 1)
-    write(fmu, entries)
+        b' ' + attribute + b'=""', b' ' + attribute + f'="{{{guid}}}"'.encode(), 1)
+    write(to or fmu, entries)
     return guid
 
 

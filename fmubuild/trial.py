@@ -1,8 +1,9 @@
 """An FMU instantiated once in a child process: does it start, here or away from the checkout?
 
 Some FMUs take their host down when they cannot instantiate (pythonfmu 0.7's C++
-dereferences a NULL class when its Python script fails to import), so the try is a
-child's, and the caller lives to say what happened. ``isolated`` leaves this checkout
+dereferences a NULL class when its Python script fails to import, and pythonfmu3
+0.3.4's segfaults alike), so the try is a child's, and the caller lives to say what
+happened. An FMI 2.0 FMU is tried with fmpy's FMU2Slave, an FMI 3.0 one with FMU3Slave. ``isolated`` leaves this checkout
 off the child's import path, as on a host that has only the FMU: a module the FMU
 forgot to carry is missing there.
 """
@@ -24,11 +25,12 @@ if sys.argv[2] == "isolated":
     sys.meta_path = [f for f in sys.meta_path if "editable" not in repr(f).lower()]
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
+from fmpy.fmi3 import FMU3Slave
 description = read_model_description(sys.argv[1])
 unzipped = extract(sys.argv[1], os.path.abspath("unzipped"))  # in the child's folder: removed
-slave = FMU2Slave(guid=description.guid, unzipDirectory=unzipped,
-                  modelIdentifier=description.coSimulation.modelIdentifier,
-                  instanceName="trial")
+slave = (FMU3Slave if description.fmiVersion.startswith("3") else FMU2Slave)(
+    guid=description.guid, unzipDirectory=unzipped,
+    modelIdentifier=description.coSimulation.modelIdentifier, instanceName="trial")
 slave.instantiate(loggingOn=True)     # pythonfmu 0.7 logs only then
 slave.freeInstance()
 """

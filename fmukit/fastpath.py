@@ -1,10 +1,13 @@
-"""Plans for getReal, getInteger and setReal: a call's work decided once per list of references.
+"""Plans for reading Reals and Integers and setting Reals: a call's work decided once per list.
+
+The calls are getReal, getInteger and setReal in FMI 2.0, getFloat64, getInt32 and
+setFloat64 in FMI 3.0; "Real" below is either version's 64-bit float.
 
 A master asks for the same value references at every step. The first call with a
 list works out how to serve it and caches that plan; the next calls only execute
 it. A plan is complete: it gives what the FMI call gives in every state of the
 slave (NaN outputs once it has failed or where an output cannot be evaluated), so
-the slave's getReal is its plan, and a host in the same process (cosim's
+the slave's read of Reals is its plan, and a host in the same process (cosim's
 in-process backend) may call the plan itself. A list that is not of the plan's
 kind gets ``None`` and the slave lets pythonfmu serve it (and name any problem).
 
@@ -14,8 +17,8 @@ kind gets ``None`` and the slave lets pythonfmu serve it (and name any problem).
   parameters read back): each one's value read from the slave within one
   ``try``; where one fails, every one is read again through its own getter,
   which gives NaN for that one alone;
-- Real inputs: set as attributes of the slave (refused after fmi2Terminate, as
-  FMI 2.0 wants).
+- Real inputs: set as attributes of the slave (refused after terminate, as FMI
+  wants).
 """
 from __future__ import annotations
 

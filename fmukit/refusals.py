@@ -20,7 +20,7 @@ CAUSES = {
     "input": "an input is outside its declared range",
     "nonfinite_input": "an input is NaN or infinite (often another FMU's failure)",
     "step": "the communication step or time is out of range",
-    "call": "a call the FMI 2.0 standard does not allow now, or of the wrong type",
+    "call": "a call the FMI standard does not allow now, or of the wrong type",
     "model": "the model raised an exception",
     "interrupted": "a signal (Ctrl-C, SIGTERM) arrived while the FMU computed",
 }

@@ -1,5 +1,8 @@
 """The slave's variables registered with pythonfmu and indexed by value reference.
 
+The pythonfmu variable of each declaration is the adapter's (``ModelSlave.fmi_variable``:
+a Real of pythonfmu 0.7, a Float64 of pythonfmu3); its value reference is pythonfmu's.
+
 Parameters and inputs live as attributes of the slave, starting at their start
 values; outputs are read through ``evaluate(get, undefined)``, which the slave
 supplies (it builds the model when needed and turns what cannot be evaluated
@@ -10,19 +13,15 @@ from __future__ import annotations
 import math
 from typing import Any, Callable
 
-from .pythonfmu07 import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Integer, Real
-from .pythonfmu07 import String
-
 from .variables import Var
 
-_PYTHONFMU_TYPE = {float: Real, int: Integer, str: String}
 Evaluate = Callable[[Callable[[Any], Any], Any], Any]
 
 
 class Registry:
     """Every variable of a slave, by value reference, with its pythonfmu getter."""
 
-    def __init__(self, slave: Fmi2Slave, variables: tuple[Var, ...], evaluate: Evaluate):
+    def __init__(self, slave: Any, variables: tuple[Var, ...], evaluate: Evaluate):
         self.by_vr: dict[int, Var] = {}
         self.real_getters: dict[int, Callable[[], float]] = {}
         self.integer_getters: dict[int, Callable[[], int]] = {}
@@ -31,24 +30,16 @@ class Registry:
         for var in variables:
             self._register(slave, var, evaluate)
 
-    def _register(self, slave: Fmi2Slave, var: Var, evaluate: Evaluate) -> None:
-        kind = _PYTHONFMU_TYPE[var.kind]
+    def _register(self, slave: Any, var: Var, evaluate: Evaluate) -> None:
+        getter = None
         if var.causality == "output":
             get = var.get or (lambda s, name=var.name: getattr(s._model, name))
 
             def getter(get=get, undefined=math.nan if var.is_real else 0) -> Any:
                 return evaluate(get, undefined)
-            sv = kind(var.name, causality=Fmi2Causality.output,
-                      variability=(Fmi2Variability.continuous if var.is_real
-                                   else Fmi2Variability.discrete),
-                      initial=Fmi2Initial.calculated, description=var.description,
-                      getter=getter)
         else:
             setattr(slave, var.name, var.start)
-            variability = (Fmi2Variability.fixed if var.causality == "parameter"
-                           else Fmi2Variability.continuous)
-            sv = kind(var.name, causality=Fmi2Causality[var.causality],
-                      variability=variability, description=var.description)
+        sv = slave.fmi_variable(var, getter)
         slave.register_variable(sv)
         vr = sv.value_reference
         self.by_vr[vr] = var

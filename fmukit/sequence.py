@@ -1,34 +1,40 @@
-"""The FMI 2.0 co-simulation call sequence: which call is allowed in which phase.
+"""The co-simulation call sequence, FMI 2.0's and FMI 3.0's alike: which call is allowed when.
 
-    instantiated --fmi2EnterInitializationMode--> initialization
-                 --fmi2ExitInitializationMode--> step --fmi2Terminate--> terminated
+    instantiated --EnterInitializationMode--> initialization
+                 --ExitInitializationMode--> step --Terminate--> terminated
 
-fmi2Reset returns to instantiated (pythonfmu makes a new slave object for it).
+Reset returns to instantiated (pythonfmu and pythonfmu3 make a new slave object for
+it). Calls are named as the version's standard names them: fmi2Terminate, fmi3Terminate.
 """
 from __future__ import annotations
 
 from .refusals import Refused
 from .variables import Var
 
-_AFTER = {"instantiated": "fmi2Instantiate or fmi2Reset",
-          "initialization": "fmi2EnterInitializationMode",
-          "step": "fmi2ExitInitializationMode", "terminated": "fmi2Terminate"}
+_AFTER = {"instantiated": "{api}{instantiate} or {api}Reset",
+          "initialization": "{api}EnterInitializationMode",
+          "step": "{api}ExitInitializationMode", "terminated": "{api}Terminate"}
+_INSTANTIATE = {"fmi2": "Instantiate", "fmi3": "InstantiateCoSimulation"}
 
 
 class CallSequence:
-    """The phase of one FMU instance and the rules of the standard for it."""
+    """The phase of one FMU instance and the rules of the standard (``api``: "fmi2" or
+    "fmi3") for it."""
 
-    def __init__(self, phase: str = "instantiated"):
-        self.phase = phase
+    def __init__(self, api: str, phase: str = "instantiated"):
+        self.api, self.phase = api, phase
 
     def require(self, call: str, *phases: str) -> None:
-        """Refused naming the call and the phase unless the phase is one of ``phases``."""
+        """Refused naming the call (``Terminate``: fmi2Terminate) and the phase unless the
+        phase is one of ``phases``."""
         if self.phase not in phases:
-            raise Refused(f"{call} is not allowed in phase '{self.phase}' (FMI 2.0 allows "
-                          f"it after {' or '.join(_AFTER[p] for p in phases)})", "call")
+            after = " or ".join(_AFTER[p].format(api=self.api, instantiate=_INSTANTIATE[self.api])
+                                for p in phases)
+            raise Refused(f"{self.api}{call} is not allowed in phase '{self.phase}' (FMI "
+                          f"{self.api[3:]}.0 allows it after {after})", "call")
 
     def step_refusal(self) -> str | None:
-        """Why fmi2DoStep is not allowed now, or None if it is."""
+        """Why doStep is not allowed now, or None if it is."""
         if self.phase != "step":
             return (f"doStep called in phase '{self.phase}': "
                     "call exitInitializationMode first, and not after terminate")

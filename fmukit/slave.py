@@ -1,4 +1,4 @@
-"""``ModelSlave``: the base of every FMU in this project, a thin layer over pythonfmu's Fmi2Slave.
+"""``ModelSlave``: the base of every FMU in this project, the same for FMI 2.0 and FMI 3.0.
 
 An FMU class lists its variables once, as ``Var`` entries (``fmukit.variables``)
 with unit, causality, start value, valid range and, for outputs, the variables
@@ -7,36 +7,46 @@ attributes alone), ``step_model`` and, if the initial state depends on inputs,
 ``start_model``; the model supplies ``snapshot``/``restore``. The parts, one job each:
 
 - ``fmukit.registry``: the variables registered with pythonfmu, by value reference;
-- ``fmukit.sequence``: the FMI 2.0 call sequence, which refuses calls out of order;
+- ``fmukit.sequence``: the call sequence, which refuses calls out of order;
 - ``fmukit.variables``: the range checks of every parameter (at
   exitInitializationMode) and input (at each doStep);
-- ``fmukit.fastpath``: getReal, setReal and getInteger planned once per list of
-  value references (``plans``, which a host in the same process may call);
+- ``fmukit.fastpath``: reading Reals and Integers and setting Real inputs planned once
+  per list of value references (``plans``, which a host in the same process may call);
 - ``fmukit.state``: saving and restoring the whole state (serialisable);
-- ``fmukit.model_description``: a complete modelDescription.xml;
 - ``fmukit.refusals``: how a call is refused, and the message that says why;
-- ``fmukit.pythonfmu07``: pythonfmu, and what is owed to version 0.7.0's defects (every
-  FMI entry point made safe against its error path; the host's Ctrl-C handled in the
-  host's code, not inside the FMU; its messages heard without a flag).
+- ``fmukit.entry``: every FMI entry point made safe against pythonfmu's error path;
+  ``fmukit.hostsignals``: the host's Ctrl-C handled in the host's code, not inside the FMU.
+
+A ``ModelSlave`` is no FMU by itself: which FMI version, and which pythonfmu, is the
+adapter's, a mixin composed with the model's class and pythonfmu's slave class by the
+FMU's entry module (written by the build) or by ``fmukit.compose.fmu_class``:
+``fmukit.pythonfmu07`` (FMI 2.0, pythonfmu 0.7.0) and ``fmukit.pythonfmu3_03`` (FMI 3.0,
+pythonfmu3 0.3.4). Each supplies the typed getters and setters, doStep's result,
+the pythonfmu variable of a ``Var`` (``fmi_variable``), the statuses, where errors reach
+the user when the host does not listen (``_host_log``), and the completion of
+modelDescription.xml, with what is owed to its pythonfmu's defects.
 
 What a host sees. pythonfmu 0.7 can return fmi2OK, fmi2Fatal (any Python
 exception) and fmi2Discard with fmi2Terminated true (do_step returning False),
 which hosts such as fmpy take for the model's normal end: a refused step would
-pass for a short, successful run. So every refusal raises, and is fmi2Fatal, the
-only failure status there is to give (docs/robustness.md argues it):
+pass for a short, successful run. So every FMI 2.0 refusal raises, and is fmi2Fatal,
+the only failure status there is to give (docs/robustness.md argues it). pythonfmu3
+passes on the status doStep returns: an FMI 3.0 refused step is fmi3Error, which
+allows fmi3Reset; every other FMI 3.0 refusal is fmi3Fatal, as pythonfmu3 makes
+every exception.
 
-- invalid parameters: fmi2ExitInitializationMode reports them (an error
-  message naming the parameter) and the FMU has failed; the first fmi2DoStep
-  then fails with that message. Not fmi2ExitInitializationMode itself: OSP
+- invalid parameters: exitInitializationMode reports them (an error
+  message naming the parameter) and the FMU has failed; the first doStep
+  then fails with that message. Not exitInitializationMode itself: OSP
   libcosim terminates its host process when that call fails;
-- invalid inputs or step sizes, or an exception in the model: fmi2DoStep fails
+- invalid inputs or step sizes, or an exception in the model: doStep fails
   naming the cause (for an exception other than a ValueError, the file and line of the
   model's code it came from: ``fmukit.refusals.explain``), and the FMU has failed;
 - once failed, every output reads NaN and every step is refused with the first
-  reason, until fmi2Reset, so that a host that ignores statuses (ecos) still
+  reason, until reset, so that a host that ignores statuses (ecos) still
   cannot pass the rest of the run off as results;
-- calls out of sequence (fmi2DoStep included), setting an output or a fixed
-  parameter after initialisation: fmi2Fatal naming the call or variable; nothing
+- calls out of sequence (doStep included), setting an output or a fixed
+  parameter after initialisation: refused naming the call or variable; nothing
   is applied, and the FMU goes on as before;
 - reading an output never fails: what cannot be evaluated reads NaN (and, from valid
   inputs while stepping, fails the FMU, the next doStep refusing with where it came
@@ -45,57 +55,84 @@ only failure status there is to give (docs/robustness.md argues it):
 The reason, beginning with the FMU's instance name (libcosim's log shows neither the
 instance nor the call), reaches the user through the host's logger when it listens,
 under the category ``fmukit.<cause>`` that says what was refused
-(``fmukit.refusals.CAUSES``), and on standard error when it does not
-(``fmukit.pythonfmu07.hostlog``).
+(``fmukit.refusals.CAUSES``), and on standard error when it does not (the adapter's
+``hostlog``).
 
 Time is rounded to whole nanoseconds before the model sees it (``fmukit.timebase``).
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any, Callable, ClassVar, NoReturn
-from xml.etree.ElementTree import Element
 
-from . import model_description, state
+from . import hostsignals, state
+from .entry import fmi_entry
 from .fastpath import FastPaths
-from .pythonfmu07 import DefaultExperiment, Fmi2Slave, Fmi2Status, signals
-from .pythonfmu07.entry import fmi_entry
-from .pythonfmu07.hostlog import HostLog
 from .refusals import CAUSES, Refused, explain, naming, reason
 from .registry import Registry
 from .sequence import CallSequence
 from .timebase import MAX_TIME, on_time_base
 from .variables import Var, range_check
 
-__all__ = ["ModelSlave", "Refused", "Var"]
+__all__ = ["DefaultExperiment", "ModelSlave", "Refused", "Var"]
+
+CATEGORIES = {f"fmukit.{cause}": f"Refused: {meaning}." for cause, meaning in CAUSES.items()}
+"""The log categories of every refusal's cause, which each adapter declares."""
 
 
-class ModelSlave(Fmi2Slave):
+@dataclass(frozen=True)
+class DefaultExperiment:
+    """The experiment the model description proposes (s), in either FMI version."""
+
+    start_time: float | None = None
+    stop_time: float | None = None
+    step_size: float | None = None
+    tolerance: float | None = None
+
+
+class ModelSlave:
     """Base of every FMU in this project; see the module docstring."""
 
     model_name: ClassVar[str]
     variables: ClassVar[tuple[Var, ...]]
     default_experiment = DefaultExperiment(start_time=0.0, stop_time=400.0, step_size=0.1)
-    log_categories = {**Fmi2Slave.log_categories,
-                      **{f"fmukit.{cause}": f"Refused: {meaning}."
-                         for cause, meaning in CAUSES.items()}}
+    # The adapter's: "fmi2" or "fmi3"; the statuses of an error and of a fatal refusal;
+    # whether its binary releases the instance once per exception (``fmukit.entry``).
+    API: ClassVar[str]
+    STATUS_ERROR: ClassVar[Any]
+    STATUS_FATAL: ClassVar[Any]
+    RELEASES_ON_EXCEPTION: ClassVar[bool]
 
     def __init__(self, **kwargs):
-        super().__init__(**kwargs)
+        super().__init__(**kwargs)            # pythonfmu's slave, next in the FMU class's MRO
         self.modelName = self.model_name
-        self.sequence = CallSequence()
-        self.host_log = HostLog(kwargs.get("logger"), kwargs.get("resources"),
-                                in_process="logger" not in kwargs)
-        self.failure: str | None = None       # why the FMU failed; until fmi2Reset
+        self.sequence = CallSequence(self.API)
+        self.host_log = self._host_log(kwargs)
+        self.failure: str | None = None       # why the FMU failed; until reset
         self.failure_cause = "model"          # its cause (fmukit.refusals.CAUSES)
-        self.start_time = 0.0                 # of the experiment, for messages
+        self.start_time: float | None = 0.0   # of the experiment, for messages (None: unknown)
         self._step_size = (None, None)        # the last step size given, on the time base
-        signals.defer_host_handlers()
+        hostsignals.defer_host_handlers()
         self._model = None
+        self._before_variables()
         self.registry = Registry(self, self.variables, self._output)
         self.plans = FastPaths(self, self.registry)
         self._parameters = [v for v in self.variables if v.causality == "parameter"]
         self._check_inputs = range_check(tuple(v for v in self.variables
                                                if v.causality == "input"))
+
+    # -- the adapter's -----------------------------------------------------------
+    def _host_log(self, kwargs: dict[str, Any]) -> Any:
+        """Where errors reach the user (the adapter's ``hostlog.HostLog``), from pythonfmu's
+        keywords: without ``logger`` the host is in this process."""
+        raise NotImplementedError
+
+    def fmi_variable(self, var: Var, getter: Callable[[], Any] | None) -> Any:
+        """pythonfmu's variable for ``var``; ``getter`` reads an output."""
+        raise NotImplementedError
+
+    def _before_variables(self) -> None:
+        """What the adapter registers before the declared variables (default: nothing)."""
 
     # -- model ---------------------------------------------------------------
     def build_model(self) -> Any:
@@ -155,7 +192,7 @@ class ModelSlave(Fmi2Slave):
         self.failure = (f"{output} could not be evaluated from valid inputs: "
                         f"{explain(error)}; the FMU has failed")
         self.failure_cause = "model"
-        self.log(naming(self.instance_name, self.failure), Fmi2Status.error, "fmukit.model")
+        self.log(naming(self.instance_name, self.failure), self.STATUS_ERROR, "fmukit.model")
         self.host_log.tell(self.instance_name, self.failure)
 
     @property
@@ -167,40 +204,34 @@ class ModelSlave(Fmi2Slave):
 
     # -- FMI call sequence -----------------------------------------------------
     @fmi_entry
-    def setup_experiment(self, start_time: float, stop_time: float | None = None,
-                         tolerance: float | None = None) -> None:
-        self.sequence.require("fmi2SetupExperiment", "instantiated")
-        self.start_time = start_time
-
-    @fmi_entry
     def enter_initialization_mode(self) -> None:
-        self.sequence.require("fmi2EnterInitializationMode", "instantiated")
+        self.sequence.require("EnterInitializationMode", "instantiated")
         self.sequence.phase = "initialization"
 
     @fmi_entry
     def exit_initialization_mode(self) -> None:
-        self.sequence.require("fmi2ExitInitializationMode", "initialization")
+        self.sequence.require("ExitInitializationMode", "initialization")
         self.sequence.phase = "step"
         try:
             for var in self._parameters:      # the declared ranges, then the model's own rules
                 var.check(getattr(self, var.name))
             self._model = self._started_model()   # ValueError names a bad parameter or input
         except Exception as error:            # reported now, refused at the first step
-            self.failure = (f"exitInitializationMode at t = {self.start_time}: "
-                            f"{reason(error)}; the FMU has failed")
+            at = "" if self.start_time is None else f" at t = {self.start_time}"
+            self.failure = (f"exitInitializationMode{at}: {reason(error)}; the FMU has failed")
             self.failure_cause = _cause(error, "parameter")
-            self.log(naming(self.instance_name, self.failure), Fmi2Status.error,
+            self.log(naming(self.instance_name, self.failure), self.STATUS_ERROR,
                      f"fmukit.{self.failure_cause}")
             self.host_log.tell(self.instance_name, self.failure)
 
     @fmi_entry
     def terminate(self) -> None:
         if not self.failure:                  # a failed FMU may be terminated in any phase
-            self.sequence.require("fmi2Terminate", "step")
+            self.sequence.require("Terminate", "step")
         self.sequence.phase = "terminated"
 
-    @fmi_entry
-    def do_step(self, current_time: float, step_size: float) -> bool:
+    def _step(self, current_time: float, step_size: float) -> None:
+        """One communication step (the adapter's ``do_step``); Refused for every refusal."""
         if self.failure:
             raise Refused(self.failure, self.failure_cause)
         refusal = self.sequence.step_refusal()
@@ -220,18 +251,17 @@ class ModelSlave(Fmi2Slave):
                 self.step_model(on_time_base(current_time), self._step_size[1])
         except ValueError as error:
             self._fail(f"doStep at t = {current_time}: {error}; the FMU has failed (its "
-                       "outputs read NaN until fmi2Reset)", _cause(error, "model"))
+                       f"outputs read NaN until {self.API}Reset)", _cause(error, "model"))
         except Exception as error:            # the model's own exception
             self._fail(f"doStep at t = {current_time}: {explain(error)}", "model", error)
         except BaseException as error:        # Ctrl-C or the like, raised in this FMU's code
             raise self.interrupted(f"doStep at t = {current_time}", error) from None
-        return True
 
     def interrupted(self, where: str, error: BaseException) -> Refused:
         """Fail the FMU for a KeyboardInterrupt (or any BaseException) raised in its code
         while the host called ``where``, and return the refusal to raise. (Rare: the
-        host's signal handlers wait until FMU code returns, ``fmukit.pythonfmu07.signals``.)"""
-        number = signals.interrupt_signal(error)
+        host's signal handlers wait until FMU code returns, ``fmukit.hostsignals``.)"""
+        number = hostsignals.interrupt_signal(error)
         cause = f"interrupted by {number.name}" if number else explain(error)
         if not self.failure:
             self.failure = f"{where}: {cause}; the FMU has failed"
@@ -240,7 +270,7 @@ class ModelSlave(Fmi2Slave):
 
     def _fail(self, reason: str, cause: str, error: BaseException | None = None) -> NoReturn:
         """Fail the FMU for ``reason`` (its ``cause``): refuse this call and every step until
-        fmi2Reset."""
+        reset."""
         self.failure, self.failure_cause = reason, cause
         raise Refused(reason, cause) from error
 
@@ -256,17 +286,13 @@ class ModelSlave(Fmi2Slave):
             if var.causality == "parameter":
                 self._model = None
 
-    @fmi_entry
-    def set_real(self, vrs: list[int], values: list[float]) -> None:
+    def _set_floats(self, vrs: list[int], values: list[float]) -> None:
+        """Set Reals (the adapter's setReal or setFloat64)."""
         write = self.plans.input_writer(vrs)  # inputs only: always settable until terminate
         if write is None:
             self._set(vrs, values, float)
         else:
             write(values)
-
-    @fmi_entry
-    def set_integer(self, vrs: list[int], values: list[int]) -> None:
-        self._set(vrs, values, int)
 
     @fmi_entry
     def set_string(self, vrs: list[int], values: list[str]) -> None:
@@ -277,16 +303,6 @@ class ModelSlave(Fmi2Slave):
         raise Refused("this FMU has no Boolean variables", "call")
 
     # -- getters ---------------------------------------------------------------------
-    @fmi_entry
-    def get_real(self, vrs: list[int]) -> list[float]:
-        read = self.plans.real_reader(vrs)
-        return super().get_real(vrs) if read is None else read()   # pythonfmu names a problem
-
-    @fmi_entry
-    def get_integer(self, vrs: list[int]) -> list[int]:
-        read = self.plans.integer_reader(vrs)
-        return super().get_integer(vrs) if read is None else read()
-
     @fmi_entry
     def get_string(self, vrs: list[int]) -> list[str]:
         return super().get_string(vrs)
@@ -307,10 +323,6 @@ class ModelSlave(Fmi2Slave):
     @staticmethod
     def _fmu_state_from_bytes(data: bytes) -> dict[str, Any]:
         return state.decode(data)
-
-    # -- modelDescription.xml ------------------------------------------------------
-    def to_xml(self, model_options: dict[str, str] = dict()) -> Element:
-        return model_description.complete(super().to_xml(model_options), self.variables)
 
 
 def _cause(error: BaseException, otherwise: str) -> str:

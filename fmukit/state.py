@@ -1,10 +1,12 @@
-"""Saved FMU states: fmi2GetFMUstate, fmi2SetFMUstate and their serialised form.
+"""Saved FMU states: get and set FMU state (fmi2GetFMUstate, fmi3GetFMUState, ...) and their
+serialised form.
 
-A state is a plain dict that pythonfmu serialises as JSON: the phase of the call
-sequence, the value of every parameter and input, the model's own ``snapshot()``
-(None while there is no model), and why the FMU failed, if it has. Restoring rebuilds the model from
-the restored parameters and hands it the snapshot, so a restored run continues
-bit for bit.
+A state is a plain dict that pythonfmu (and pythonfmu3) serialises as JSON: the phase of
+the call sequence, the value of every parameter and input, the model's own
+``snapshot()`` (None while there is no model), and why the FMU failed, if it has
+(FMI 3.0's adapter adds its independent variable ``time``). Restoring rebuilds the
+model from the restored parameters and hands it the snapshot, so a restored run
+continues bit for bit.
 """
 from __future__ import annotations
 
@@ -45,7 +47,7 @@ def decode(data: bytes) -> dict[str, Any]:
     """A serialised state, or ``{"invalid": why}`` for ``restore`` to refuse.
 
     pythonfmu calls the decoder on the class, where an exception cannot be made
-    safe (``fmukit.pythonfmu07.entry``): the problem travels in the state instead.
+    safe (``fmukit.entry``): the problem travels in the state instead.
     """
     try:
         decoded = json.loads(data.decode("utf-8"))

@@ -1,4 +1,4 @@
-"""SI units used at the FMU interfaces, as FMI 2.0 <UnitDefinitions>.
+"""SI units used at the FMU interfaces, as <UnitDefinitions> (the same in FMI 2.0 and 3.0).
 
 Each unit maps to its SI base-unit exponents (kg, m, s, rad) and an optional
 conversion factor; angles offer degrees as display units.

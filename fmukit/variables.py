@@ -1,7 +1,7 @@
 """FMU variables, declared once: ``Var`` with unit, causality, start, valid range, dependencies.
 
 A variable's declaration is the single source for its pythonfmu registration
-(``fmukit.registry``), its entry in modelDescription.xml (``fmukit.model_description``)
+(``fmukit.registry``), its entry in modelDescription.xml (``fmukit.description``)
 and the range check its values must pass (``Var.check``).
 """
 from __future__ import annotations

@@ -6,9 +6,7 @@ reversal committed at the end of each step.
 """
 import math
 
-from pythonfmu import DefaultExperiment
-
-from fmukit.slave import ModelSlave, Var
+from fmukit.slave import DefaultExperiment, ModelSlave, Var
 from ship_fmu.manoeuvres import RudderProgram
 
 

@@ -8,10 +8,10 @@ from typing import Iterator
 
 import pytest
 
-from fmubuild.cbuild import build_c, c_compiler
+from fmubuild.cbuild import build_c, c_compiler, sources
 from fmubuild.manifest import read, staleness
 from fmubuild.packaging import build
-from fmubuild.project import C_FMUS, FMU_DIR, FMUS, ROOT
+from fmubuild.project import C_FMUS, FMU_DIRS, FMUS, ROOT
 
 pytest_plugins = ["pytester"]       # to run the example test file for each autopilot
 
@@ -56,22 +56,34 @@ def _older(fmu: Path, sources: list[Path]) -> bool:
     return not fmu.exists() or max(p.stat().st_mtime for p in sources) > fmu.stat().st_mtime
 
 
-@pytest.fixture(scope="session")
-def fmu_paths() -> dict[str, Path]:
-    """Every FMU in fmus/, rebuilt first if missing or not current (its manifest against
-    the sources; the C FMU, which has none, by file times, its build script's included, and
-    only where there is a C compiler)."""
+def _current(fmi: int) -> dict[str, Path]:
+    """Every FMU of FMI version ``fmi`` in its folder, rebuilt first if missing or not
+    current (its manifest against the sources; the C FMU, which has none, by file times,
+    its build script's included, and only where there is a C compiler)."""
+    folder = FMU_DIRS[fmi]
     for name in FMUS:
-        if _stale(FMU_DIR / f"{name}.fmu"):
-            build(name)
+        if _stale(folder / f"{name}.fmu"):
+            build(name, fmi=fmi)
     built = list(FMUS)
     if c_compiler() is not None:
-        for name, folder in C_FMUS.items():
-            if _older(FMU_DIR / f"{name}.fmu", [*(ROOT / folder).iterdir(),
-                                                 ROOT / "fmubuild" / "cbuild.py"]):
-                build_c(name)
+        for name in C_FMUS:
+            if _older(folder / f"{name}.fmu", [*sources(name, fmi),
+                                                ROOT / "fmubuild" / "cbuild.py"]):
+                build_c(name, fmi=fmi)
         built += list(C_FMUS)
-    return {name: FMU_DIR / f"{name}.fmu" for name in built}
+    return {name: folder / f"{name}.fmu" for name in built}
+
+
+@pytest.fixture(scope="session")
+def fmu_paths() -> dict[str, Path]:
+    """Every FMI 2.0 FMU in fmus/, current (``_current``)."""
+    return _current(2)
+
+
+@pytest.fixture(scope="session")
+def fmi3_paths() -> dict[str, Path]:
+    """Every FMI 3.0 twin in fmus/fmi3/, current (``_current``)."""
+    return _current(3)
 
 
 @pytest.fixture

@@ -1,22 +1,35 @@
 """Property-based fuzzing of one FMU through fmpy: random call sequences and values.
 
-    python tests/fmu_fuzz.py ship --examples 2000       # prints counts as JSON
+    python tests/fmu_fuzz.py ship --examples 2000       # both versions; counts as JSON
+    python tests/fmu_fuzz.py ship --fmi 3               # the FMI 3.0 twin only
     python tests/fmu_fuzz.py --all --examples 10000     # the long run (docs/robustness.md)
 
-Each example is a random program of FMI calls on a fresh instance: setupExperiment,
-enter/exitInitializationMode, terminate, reset, set (any variable, any value: in
-range, out of range, extreme, NaN, infinite, of the wrong type), doStep (any step
-size, including 0, negative, non-finite and huge, at any time), get, and a
-get/serialize/deserialize/set state round trip. A reference model of the FMI 2.0
-call sequence, of the declared variable ranges and of fmukit's failed state
+Each example is a random program of FMI calls on a fresh instance: setupExperiment
+(FMI 2.0), enter/exitInitializationMode, terminate, reset, set (any variable, any
+value: in range, out of range, extreme, NaN, infinite, of the wrong type), doStep (any
+step size, including 0, negative, non-finite and huge, at any time), get, and a
+get/serialize/deserialize/set state round trip. A reference model of the call
+sequence (Instantiated, InitializationMode, StepMode, Terminated: the same in both
+versions), of the declared variable ranges and of fmukit's failed state
 (docs/robustness.md) predicts which calls must be refused; the FMU must then
-return fatal with a log message that names the cause, must accept every call that
-is valid, must give finite outputs after every accepted step and NaN outputs once
-it has failed. Invalid parameters are accepted at exitInitializationMode with an
-error logged, and fail the FMU; a refused step fails it; every step of a failed
-FMU is refused naming the first cause, until reset. Crashes and hangs are caught
-by the caller (tests/test_fuzz.py runs this in a child process with a time
-limit).
+refuse with a log message that names the cause, must accept every call that is
+valid, must give finite outputs after every accepted step and NaN outputs once it
+has failed. Invalid parameters are accepted at exitInitializationMode with an error
+logged, and fail the FMU; a refused step fails it; every step of a failed FMU is
+refused naming the first cause, until reset.
+
+The statuses: FMI 2.0 refuses every call with fmi2Fatal (pythonfmu 0.7 has no other
+failure). An FMI 3.0 twin refuses a step with fmi3Error (non-fatal: fmi3Reset revives
+it) and every other call with fmi3Fatal, as pythonfmu3 makes every exception. FMI 3.0's
+own calls: no setupExperiment; enterInitializationMode with a random tolerance, start
+and stop time (each possibly undefined), the clock of the steps that follow starting
+at that start time; setting the independent variable ``time`` (refused); doStep's
+outputs (never terminateSimulation; lastSuccessfulTime t + h after an accepted step,
+t after a refused one; pythonfmu3 writes neither eventHandlingNeeded nor earlyReturn).
+After every call ``time`` must read 0 on a fresh or reset instance, t + h after an
+accepted step, and be unchanged by anything else (pythonfmu3 drops the start time).
+Crashes and hangs are caught by the caller (tests/test_fuzz.py runs this in a child
+process with a time limit).
 """
 from __future__ import annotations
 
@@ -26,9 +39,11 @@ import math
 import sys
 import time
 from collections import Counter
+from ctypes import byref
 from pathlib import Path
 
-from fmpy import extract, read_model_description
+from fmpy import extract
+from fmpy.fmi3 import fmi3Boolean, fmi3Float64
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -36,21 +51,39 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from autopilot_fmu.smc import reference_step_bound  # noqa: E402
-from cosim.core.fmi import FmuInstance  # noqa: E402
+from cosim.core.fmi import FmuInstance, fmi_version, read_description  # noqa: E402
 from cosim.core.instance import FmuCallError  # noqa: E402
+from fmubuild.project import FMU_DIRS  # noqa: E402
+from fmubuild.project import FMUS as PYTHON_FMUS  # noqa: E402
 from fmukit.timebase import MAX_TIME  # noqa: E402
 
 FMUS = ["ship", "pd_autopilot", "smc_autopilot", "guidance", "manoeuvre"]
+FUZZED = {2: FMUS, 3: list(PYTHON_FMUS)}
+"""The FMUs fuzzed in each FMI version: FMI 3.0, the twin of every Python FMU."""
 STEP_SIZES = [0.1, 0.1, 0.1, 0.05, 0.25, 1.0, 7.3, 1e-9, 0.0, -0.1, math.nan, math.inf, 1e-12,
               2e4, 1e9]
 EXTREMES = [0.0, -0.0, 1e-300, -1e-300, 1e300, -1e300, 1.7976931348623157e308, math.pi, 1e6]
+TEXT = st.text(max_size=40)
+TEXT3 = st.text(st.characters(exclude_characters="\x00"), max_size=40)
+"""FMI 3.0's Strings: without NUL, which ends a C string (``Instance.set`` refuses it as
+ValueError: cosim.core.values). FMI 2.0's TEXT could draw one; its fixed seeds never do."""
+START_TIMES = [0.0, 0.0, 0.0, 10.0, -3.5, 1e-9, 1e6, 2e15]
+"""FMI 3.0: enterInitializationMode's start time (also the clock of the steps after it)."""
+STATE_CALLS = {2: ("getFMUstate", "serializeFMUstate", "deSerializeFMUstate", "setFMUstate",
+                   "freeFMUstate"),
+               3: ("getFMUState", "serializeFMUState", "deserializeFMUState", "setFMUState",
+                   "freeFMUState")}
+"""fmpy's names of get, serialize, deserialize, set and free state, by FMI version."""
 
 
 class Expectation:
-    """What a correct FMU does: the FMI 2.0 phase machine and the declared ranges."""
+    """What a correct FMU does: the phase machine of its FMI version and the declared
+    ranges."""
 
     def __init__(self, md):
-        self.vars = {v.name: v for v in md.modelVariables}
+        self.fmi = fmi_version(md)
+        self.vars = {v.name: v for v in md.modelVariables if v.causality != "independent"}
+        self.time_vr = _time_vr(md)
         self.reset()
 
     def reset(self) -> None:
@@ -58,6 +91,7 @@ class Expectation:
         self.failure: list[str] | None = None      # words naming why the FMU failed
         self.values = {n: _start(v) for n, v in self.vars.items() if v.causality != "output"}
         self.defaults = True
+        self.time = 0.0                            # what FMI 3.0's time must read
 
     def valid(self, name: str) -> bool:
         v, value = self.vars[name], self.values[name]
@@ -70,6 +104,12 @@ class Expectation:
         return low <= value <= high
 
 
+def _time_vr(md) -> int | None:
+    """The value reference of FMI 3.0's independent variable ``time``; None in FMI 2.0."""
+    return next((v.valueReference for v in md.modelVariables if v.causality == "independent"),
+                None)
+
+
 def _start(v):
     if v.start is None:
         return None
@@ -80,10 +120,10 @@ def _start(v):
     return v.start
 
 
-def values_for(v) -> st.SearchStrategy:
+def values_for(v, text: st.SearchStrategy = TEXT) -> st.SearchStrategy:
     """Any value a master might send to variable v, valid or not, of its type or not."""
     if v.type == "String":
-        return st.one_of(st.text(max_size=40), st.just(v.start),
+        return st.one_of(text, st.just(v.start),
                          st.just("0,0;10,0;10,10"), st.just("1,1"), st.just("0,0;0,0"))
     if v.type == "Integer":
         return st.one_of(st.integers(-2**31, 2**31 - 1), st.integers(-3, 60))
@@ -102,17 +142,30 @@ def in_range(v) -> st.SearchStrategy:
 
 
 def programs(md) -> st.SearchStrategy:
-    variables = [v for v in md.modelVariables]
+    """Random programs for the FMU that ``md`` describes, in its FMI version's calls."""
+    fmi3 = fmi_version(md) == 3
+    variables = [v for v in md.modelVariables if v.causality != "independent"]
     inputs = [v for v in variables if v.causality == "input"]
-    sets = st.one_of(*[st.tuples(st.just("set"), st.just(v.name), values_for(v))
+    text = TEXT3 if fmi3 else TEXT
+    sets = st.one_of(*[st.tuples(st.just("set"), st.just(v.name), values_for(v, text))
                        for v in variables])
     wrong_type = st.tuples(st.just("set_wrong_type"), st.sampled_from([v.name for v in variables]))
     steps = st.tuples(st.just("step"), st.sampled_from(STEP_SIZES),
                       st.sampled_from(["clock", "clock", "clock", "zero", "huge", "negative"]))
-    calls = st.sampled_from([("setup",), ("enter",), ("exit",), ("terminate",), ("reset",),
-                             ("get",), ("state",)])
+    if fmi3:
+        undefined_or = st.one_of(st.none(), st.floats())  # tolerance, stop time
+        enter = st.tuples(st.just("enter"), undefined_or,
+                          st.one_of(st.sampled_from(START_TIMES), st.floats()), undefined_or)
+        calls = st.one_of(enter, st.sampled_from([("exit",), ("terminate",), ("reset",),
+                                                  ("get",), ("state",)]),
+                          st.tuples(st.just("set_time"), st.floats()))
+        opening = enter.map(lambda call: [call])
+    else:
+        calls = st.sampled_from([("setup",), ("enter",), ("exit",), ("terminate",), ("reset",),
+                                 ("get",), ("state",)])
+        opening = st.just([("setup",), ("enter",)])
     anything = st.lists(st.one_of(sets, wrong_type, steps, calls), max_size=25)
-    input_sets = (st.one_of(*[st.tuples(st.just("set"), st.just(v.name), values_for(v))
+    input_sets = (st.one_of(*[st.tuples(st.just("set"), st.just(v.name), values_for(v, text))
                               for v in inputs]) if inputs else st.nothing())
     valid_input_sets = (st.one_of(*[st.tuples(st.just("set"), st.just(v.name), in_range(v))
                                     for v in inputs]) if inputs else st.nothing())
@@ -122,11 +175,12 @@ def programs(md) -> st.SearchStrategy:
     running = st.lists(st.one_of(valid_input_sets, valid_input_sets, input_sets, valid_steps,
                                  valid_steps, steps, st.just(("get",)), st.just(("state",))),
                        max_size=40)
-    parameters = st.lists(st.one_of(*[st.tuples(st.just("set"), st.just(v.name), values_for(v))
+    parameters = st.lists(st.one_of(*[st.tuples(st.just("set"), st.just(v.name),
+                                                values_for(v, text))
                                       for v in variables if v.causality == "parameter"]),
                           max_size=3)
-    well_formed = st.builds(lambda p, r, a: [("setup",), ("enter",), *p, ("exit",), *r, *a],
-                            parameters, running, anything)
+    well_formed = st.builds(lambda o, p, r, a: [*o, *p, ("exit",), *r, *a],
+                            opening, parameters, running, anything)
     return st.one_of(well_formed, well_formed, anything)
 
 
@@ -147,8 +201,7 @@ def run_program(fmu: FmuInstance, expected: Expectation, program: list, counts: 
             assert must != "refuse", f"accepted an invalid call: {where}"
         else:
             assert must != "accept", f"refused a valid call: {where}: {messages}"
-            assert status == (FAILED_AT_EXIT if kind == "exit" and expected.phase ==
-                              "initialization" else "fatal"), f"{status}: {where}"
+            assert status == _refusal_status(kind, expected), f"{status}: {where}"
             text = " ".join(messages)
             assert messages and any(n in text for n in names), \
                 f"refusal does not name {names}: {where}: {messages}"
@@ -160,11 +213,17 @@ def run_program(fmu: FmuInstance, expected: Expectation, program: list, counts: 
             assert all(math.isnan(x) for x in values.values()), \
                 f"outputs of a failed FMU after {where}: {values}"
         elif kind == "step" and status == "ok":
-            clock = _clock(op, clock) + op[1]
+            clock = expected.time = _clock(op, clock) + op[1]
             values = fmu.get(outputs)
             bad = {n: x for n, x in values.items() if not math.isfinite(x)}
             assert not bad, f"non-finite outputs after an accepted {where}: {bad}"
             counts["valid steps"] += 1
+        elif kind == "enter" and status == "ok" and expected.fmi == 3:
+            clock = op[2]                       # the steps start at the start time
+        if expected.fmi == 3:
+            time_now = fmu.call("get time", fmu.slave.getFloat64, [expected.time_vr])[0]
+            assert _same(time_now, expected.time), \
+                f"time reads {time_now}, not {expected.time}, after {where}"
 
 
 def _clock(op, clock: float) -> float:
@@ -173,6 +232,19 @@ def _clock(op, clock: float) -> float:
 
 FAILED_AT_EXIT = "OK but logged an error"
 """How the master reports invalid parameters: exitInitializationMode returns OK, logs."""
+
+
+def _refusal_status(kind: str, e: Expectation) -> str:
+    """The status of a refused call: see FAILED_AT_EXIT; FMI 3.0's refused step fmi3Error;
+    every other refusal fatal."""
+    if kind == "exit" and e.phase == "initialization":
+        return FAILED_AT_EXIT
+    return "error" if kind == "step" and e.fmi == 3 else "fatal"
+
+
+def _same(a: float, b: float) -> bool:
+    """Equal, or both NaN."""
+    return a == b or (a != a and b != b)
 
 
 def _predict(op, e: Expectation, clock: float) -> tuple[str, list[str]]:
@@ -196,6 +268,8 @@ def _predict(op, e: Expectation, clock: float) -> tuple[str, list[str]]:
         return "accept", []
     if kind == "set_wrong_type":
         return "refuse", [op[1], "type"]
+    if kind == "set_time":                  # FMI 3.0's independent variable
+        return "refuse", ["time", f"value reference {e.time_vr}"]
     if kind == "set":
         v = e.vars[op[1]]
         if v.causality == "output":
@@ -233,37 +307,61 @@ def _execute(op, fmu: FmuInstance, clock: float) -> None:
     kind, slave = op[0], fmu.slave
     if kind == "setup":
         fmu.call("setupExperiment", slave.setupExperiment, startTime=0.0)
-    elif kind == "enter":
-        fmu.call("enterInitializationMode", slave.enterInitializationMode)
+    elif kind == "enter":                   # FMI 3.0: tolerance, start and stop time
+        fmu.call("enterInitializationMode", slave.enterInitializationMode, *op[1:])
     elif kind == "exit":
         fmu.exit_initialization()
     elif kind == "terminate":
         fmu.call("terminate", slave.terminate)
     elif kind == "reset":
         fmu.reset()
-    elif kind == "get":
-        fmu.get([v.name for v in fmu.description.modelVariables])
+    elif kind == "get":                     # FMI 3.0's time: after every call
+        fmu.get(fmu.variables)
     elif kind == "set":
         fmu.set({op[1]: op[2]})
     elif kind == "set_wrong_type":
         v = fmu.variable(op[1])
-        setter, value = ((slave.setInteger, 1) if v.type == "Real" else (slave.setReal, 1.0))
+        setter, value = ((fmu.fmi("setInteger"), 1) if v.type == "Real"
+                         else (fmu.fmi("setReal"), 1.0))
         fmu.call(f"set {op[1]} with the wrong type", setter, [v.valueReference], [value])
+    elif kind == "set_time":
+        fmu.call("set time", fmu.fmi("setReal"), [_time_vr(fmu.description)], [op[1]])
+    elif kind == "step" and fmi_version(fmu.description) == 3:
+        _step3(fmu, _clock(op, clock), op[1])
     elif kind == "step":
         fmu.do_step(_clock(op, clock), op[1])
     elif kind == "state":
-        names = [v.name for v in fmu.description.modelVariables]
-        before = fmu.get(names)
-        state = fmu.call("getFMUstate", slave.getFMUstate)
-        data = fmu.call("serializeFMUstate", slave.serializeFMUstate, state)
-        again = fmu.call("deSerializeFMUstate", slave.deSerializeFMUstate, data)
-        fmu.call("setFMUstate", slave.setFMUstate, again)
-        assert fmu.call("serializeFMUstate", slave.serializeFMUstate, again) == data
-        after = fmu.get(names)
-        same = all(a == b or (a != a and b != b) for a, b in zip(before.values(), after.values()))
+        get, serialize, deserialize, set_, free = STATE_CALLS[fmi_version(fmu.description)]
+        before = fmu.get(fmu.variables)
+        state = fmu.call(get, getattr(slave, get))
+        data = fmu.call(serialize, getattr(slave, serialize), state)
+        again = fmu.call(deserialize, getattr(slave, deserialize), data)
+        fmu.call(set_, getattr(slave, set_), again)
+        assert fmu.call(serialize, getattr(slave, serialize), again) == data
+        after = fmu.get(fmu.variables)
+        same = all(_same(a, b) for a, b in zip(before.values(), after.values()))
         assert same, f"state round trip changed values: {before} -> {after}"
-        fmu.call("freeFMUstate", slave.freeFMUstate, state)
-        fmu.call("freeFMUstate", slave.freeFMUstate, again)
+        fmu.call(free, getattr(slave, free), state)
+        fmu.call(free, getattr(slave, free), again)
+
+
+def _step3(fmu: FmuInstance, t: float, h: float) -> None:
+    """fmi3DoStep, its outputs checked: terminateSimulation never set, lastSuccessfulTime
+    t + h after an accepted step and t after a refused one (FmuCallError)."""
+    slave = fmu.slave
+    event, terminate, early, last = fmi3Boolean(), fmi3Boolean(), fmi3Boolean(), fmi3Float64()
+
+    def outputs(reached: float) -> None:
+        assert not terminate.value, f"doStep({t}, {h}) asked to end the simulation"
+        assert _same(last.value, reached), \
+            f"doStep({t}, {h}): lastSuccessfulTime {last.value}, not {reached}"
+    try:
+        fmu.call("doStep", slave.fmi3DoStep, slave.component, t, h, True, byref(event),
+                 byref(terminate), byref(early), byref(last), time=t)
+    except FmuCallError:
+        outputs(t)
+        raise
+    outputs(t + h)
 
 
 def _advance(op, status: str, e: Expectation, names: list[str]) -> None:
@@ -297,9 +395,11 @@ def _convert(v, value):
     return float(value)
 
 
-def fuzz(name: str, examples: int, seed: int | None = None) -> dict:
-    fmu_path = ROOT / "fmus" / f"{name}.fmu"
-    md = read_model_description(str(fmu_path))
+def fuzz(name: str, examples: int, seed: int | None = None, fmi: int = 2) -> dict:
+    """Fuzz FMU ``name`` of FMI version ``fmi`` (its FMI 3.0 twin: fmus/fmi3/) with
+    ``examples`` programs; the counts of calls by kind and status."""
+    fmu_path = FMU_DIRS[fmi] / f"{name}.fmu"
+    md = read_description(fmu_path, name)
     unzipped = extract(str(fmu_path))
     counts: Counter = Counter()
 
@@ -316,18 +416,24 @@ def fuzz(name: str, examples: int, seed: int | None = None) -> dict:
 
     started = time.perf_counter()
     check()
-    return {"fmu": name, "seconds": round(time.perf_counter() - started, 1),
+    return {"fmu": name, "fmi": fmi, "seconds": round(time.perf_counter() - started, 1),
             **dict(sorted(counts.items()))}
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("names", nargs="*", choices=[[], *FMUS], metavar="FMU")
-    parser.add_argument("--all", action="store_true")
+    parser.add_argument("names", nargs="*", choices=[[], *FUZZED[3]], metavar="FMU",
+                        help="the FMUs to fuzz (default: all); each in the versions it is "
+                        "fuzzed in (pid_autopilot: FMI 3.0 only)")
+    parser.add_argument("--all", action="store_true", help="every FMU")
+    parser.add_argument("--fmi", type=int, choices=sorted(FUZZED), action="append",
+                        help="only this FMI version (2 or 3; default: both)")
     parser.add_argument("--examples", type=int, default=2000)
     args = parser.parse_args(argv)
-    for name in (FMUS if args.all or not args.names else args.names):
-        print(json.dumps(fuzz(name, args.examples)), flush=True)
+    for fmi in args.fmi or sorted(FUZZED):
+        for name in (FUZZED[fmi] if args.all or not args.names else args.names):
+            if name in FUZZED[fmi]:
+                print(json.dumps(fuzz(name, args.examples, fmi=fmi)), flush=True)
     return 0
 
 

@@ -2,6 +2,8 @@
 from __future__ import annotations
 
 import csv
+import ctypes.util
+import importlib.util
 import subprocess
 import sys
 from pathlib import Path
@@ -25,9 +27,19 @@ def wave_digest(seed: int) -> str:
                           ).hexdigest()[:16]
 
 
+def ecos_missing() -> str | None:
+    """Why the ecos tests cannot run here (None if they can)."""
+    if importlib.util.find_spec("ecospy") is None:
+        return "ecospy is not installed (pip install -e '.[engines]')"
+    if ctypes.util.find_library("tbb") is None:
+        return "ecos needs Debian's libtbb12 (setup.sh installs it where apt-get is available)"
+    return None
+
+
 def fmpy_cli(*args: str, cwd: Path) -> None:
-    """Run fmpy's command line in a subprocess."""
-    subprocess.run([sys.executable, "-m", "fmpy.cli", *args], cwd=cwd, check=True,
+    """Run fmpy's command line in a subprocess, isolated (``-I``): no PYTHONPATH or working
+    folder on its path, so that a Python FMU runs the modules it carries, not a checkout's."""
+    subprocess.run([sys.executable, "-I", "-m", "fmpy.cli", *args], cwd=cwd, check=True,
                    capture_output=True, text=True, timeout=120)
 
 

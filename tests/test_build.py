@@ -47,6 +47,25 @@ def test_your_script_builds_into_a_valid_fmu_that_runs_as_autopilot(fmu_paths, t
     np.testing.assert_array_equal(mine["ship.psi"], ours["ship.psi"])
 
 
+def test_your_script_builds_as_fmi3_beside_it_and_runs_as_autopilot(tmp_path, capsys):
+    script = tmp_path / "my_pid.py"
+    script.write_text((ROOT / "autopilot_fmu" / "pid_autopilot_slave.py").read_text()
+                      .replace('model_name = "pid_autopilot"', 'model_name = "my_pid"'))
+    assert cli.main([str(script), "--fmi", "3"]) == 0
+    fmu = tmp_path / "fmi3" / "my_pid.fmu"
+    assert f"built and validated {fmu}" in capsys.readouterr().out
+    assert validate_fmu(str(fmu)) == [] and read_model_description(str(fmu)).fmiVersion == "3.0"
+    assert not (tmp_path / "my_pid.fmu").exists()
+    mine, ours = _run("waves_pd", fmu), _run("waves_pid")
+    np.testing.assert_array_equal(mine["ship.psi"], ours["ship.psi"])
+
+
+def test_an_fmi_version_fmukit_does_not_build_is_refused_by_the_command(capsys):
+    with pytest.raises(SystemExit):
+        cli.main(["pd_autopilot", "--fmi", "1"])
+    assert "--fmi: invalid choice: 1 (choose from 2, 3)" in capsys.readouterr().err
+
+
 def test_your_scripts_fmu_names_fmukit_and_only_the_author_it_declares(tmp_path):
     script = tmp_path / "mine.py"
     script.write_text((ROOT / "autopilot_fmu" / "pid_autopilot_slave.py").read_text()
@@ -81,8 +100,8 @@ def test_a_script_without_a_model_is_refused_by_name(tmp_path, capsys):
     script = tmp_path / "empty.py"
     script.write_text("x = 1\n")
     assert cli.main([str(script)]) == 1
-    assert f"cannot build an FMU from {script}: ValueError: No child class of Fmi2Slave " \
-           f"found in module {script}" in capsys.readouterr().err
+    assert f"cannot build an FMU from {script}: ValueError: {script} defines no subclass of " \
+           "fmukit.slave.ModelSlave (the FMU's model)" in capsys.readouterr().err
 
 
 def test_the_c_autopilot_equals_the_python_pd(c_autopilot):

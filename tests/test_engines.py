@@ -1,8 +1,6 @@
 """Our FMUs in other FMI engines: one SSP package, identical traces, visible errors."""
 from __future__ import annotations
 
-import ctypes.util
-import importlib.util
 import subprocess
 import sys
 import textwrap
@@ -16,20 +14,11 @@ from cosim.core.master import Master
 from cosim.interop.engines import TRACED, EngineError, run
 from cosim.interop.ssp import export
 from fmukit.timebase import nanoseconds
+from helpers import ecos_missing
 
 PAPER = ["calm_pd", "calm_smc", "waves_pd", "waves_smc"]
-
-
-def _ecos_missing() -> str | None:
-    if importlib.util.find_spec("ecospy") is None:
-        return "ecospy is not installed (pip install -e '.[engines]')"
-    if ctypes.util.find_library("tbb") is None:
-        return "ecos needs Debian's libtbb12 (setup.sh installs it where apt-get is available)"
-    return None
-
-
 ENGINES = ["libcosim", pytest.param("ecos", marks=pytest.mark.skipif(
-    _ecos_missing() is not None, reason=str(_ecos_missing()))), "fmpy"]
+    ecos_missing() is not None, reason=str(ecos_missing()))), "fmpy"]
 
 
 @pytest.fixture(scope="module")

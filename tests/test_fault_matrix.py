@@ -14,6 +14,12 @@ API and its SSP runner, libcosim (a libcosimpy script, and ``cosim.engines``), e
 (an ecospy script, ``cosim.engines``, and the ``ecos`` program with LD_PRELOAD as
 README says).
 
+FMI 3.0: the same faults but the corrupt file (``FMI3_FAULTS``), with the ship's twin and
+the fault FMU built as FMI 3.0, in every host that runs FMI 3.0 FMUs (``FMI3_HOSTS``: not
+fmpy's SSP runner nor libcosim); cells named fmi3-<host>-<fault>. The same must show, a
+refused step being fmi3Error where FMI 2.0's is fatal; an invalid parameter's message
+names exitInitializationMode where FMI 2.0's names t = 0 (pythonfmu3 drops the start time).
+
 What every cell must show, without any flag or environment variable set: no crash
 (no SIGSEGV, SIGABRT...) and no hang; a non-success (exit status, exception, or a
 failed libcosim step), except where the host ignores FMI statuses (an ecospy
@@ -60,7 +66,16 @@ NOT_APPLICABLE = {   # the in-process backend runs this project's own FMU classe
 HANGS = ("loop", "block")
 NOT_APPLICABLE.update({(host, fault): "has no time limit: waits as long as the FMU computes"
                        for host in HOSTS if not host.startswith("master") for fault in HANGS})
-CELLS = [(h, f) for h in HOSTS for f in FAULTS if (h, f) not in NOT_APPLICABLE]
+FMI3_HOSTS = ("master-fmi", "master-inprocess", "fmpy-cli", "fmpy-api", "ecos-script",
+              "ecos-cli", "ecos-program")
+"""The hosts that run FMI 3.0 FMUs (fmpy's SSP runner and libcosim run FMI 2.0 only:
+docs/interop.md)."""
+FMI3_FAULTS = tuple(f for f in FAULTS if f != "corrupt")
+"""The faults repeated with the FMI 3.0 twins: all but a corrupt file, which every host fails
+to unzip before it could read the FMI version."""
+CELLS = [(h, f, fmi) for fmi, hosts, faults in ((2, HOSTS, FAULTS), (3, FMI3_HOSTS, FMI3_FAULTS))
+         for h in hosts for f in faults if (h, f) not in NOT_APPLICABLE]
+IDS = [f"{h}-{f}" if fmi == 2 else f"fmi3-{h}-{f}" for h, f, fmi in CELLS]
 KIND = {"nan": 1, "range": 2, "parameter": 0, "exception": 3, "sigint": 4, "sigterm": 5,
         "loop": 6, "block": 7}
 STEP_TIMEOUT = "2"
@@ -68,6 +83,13 @@ CRASHES = {signal.SIGSEGV, signal.SIGABRT, signal.SIGBUS, signal.SIGILL, signal.
 FAULT_TIME = 5.0
 T5 = r"t = (5(\.0*)?|4\.9999\d*)( s)?\b"       # ecos's time is a sum of floats
 T0 = r"t = 0(\.0*)?( s)?\b"
+FMI3_REFUSED_STEP = {"master-fmi": r"FMU '\w+': doStep at t = [\d.]+ s returned error\b",
+                     "fmpy-cli": r"fmi3DoStep failed with status 3 \(error\)",
+                     "fmpy-api": r"fmi3DoStep failed with status 3 \(error\)"}
+"""How a host that shows statuses tells a twin's refused step: fmi3Error, not fatal."""
+AT_INITIALISATION = r"\bexitInitializationMode: "
+"""What an FMI 3.0 twin's invalid parameter names in place of t = 0: pythonfmu3 drops the
+start time fmi3EnterInitializationMode gives."""
 # What the message must name, on one line: the FMU, the variable or error, the time.
 NAMES = {"nan": ("ship", "delta_c", T5), "range": ("ship", "n1", T5),
          "parameter": ("ship", "Hs", T0), "exception": ("fault", "injected fault", T5)}
@@ -134,9 +156,11 @@ class Outcome:
 
 @dataclass
 class Files:
-    """What the cells run: a system per fault, as .ssd and as package, and fmpy inputs."""
+    """What the cells run: a system per fault, as .ssd and as package, and fmpy inputs, of
+    FMUs of FMI version ``fmi``."""
     root: Path
     fmus: dict[str, Path]
+    fmi: int
 
     def ssd(self, fault: str) -> Path:
         return self.root / f"{fault}.ssd"
@@ -171,12 +195,10 @@ def _truncated(source: Path, target: Path) -> Path:
     return target
 
 
-@pytest.fixture(scope="session")
-def files(fmu_paths, tmp_path_factory) -> Files:
-    root = tmp_path_factory.mktemp("fault_matrix")
-    fault_fmu = build_script(FAULTY / "fault_slave.py", ("fmukit",),
-                             root / "fault.fmu")
-    ship = fmu_paths["ship"]
+def _files(ship: Path, root: Path, fmi: int) -> Files:
+    """The systems of FMI version ``fmi``: this ship, and the fault FMU built as that version."""
+    fault_fmu = build_script(FAULTY / "fault_slave.py", ("fmukit",), root / "fault.fmu",
+                             fmi=fmi)
     (root / "packages").mkdir()
     for fault in KIND:
         write_ssd(_system(ship, fault_fmu, fault), root / f"{fault}.ssd")
@@ -193,7 +215,19 @@ def files(fmu_paths, tmp_path_factory) -> Files:
         for t in (FAULT_TIME, 10.0):
             lines.append(f"{t},{row['delta_c']},{row['n1']}")
         (root / f"{fault}.csv").write_text("\n".join(lines) + "\n")
-    return Files(root, {"ship": ship, "fault": fault_fmu, "corrupt": corrupt_ship})
+    return Files(root, {"ship": ship, "fault": fault_fmu, "corrupt": corrupt_ship}, fmi)
+
+
+@pytest.fixture(scope="session")
+def files(fmu_paths, tmp_path_factory) -> Files:
+    """The FMI 2.0 systems."""
+    return _files(fmu_paths["ship"], tmp_path_factory.mktemp("fault_matrix"), 2)
+
+
+@pytest.fixture(scope="session")
+def files3(fmi3_paths, tmp_path_factory) -> Files:
+    """The FMI 3.0 systems: the twins."""
+    return _files(fmi3_paths["ship"], tmp_path_factory.mktemp("fault_matrix_fmi3"), 3)
 
 
 def _libpython() -> str:
@@ -236,7 +270,7 @@ def cell(host: str, fault: str, files: Files, out: Path) -> Cell:
         return Cell(argv, ROOT)
     if host == "master-inprocess":
         argv = [PY, "-m", "cosim.run", "calm_pd", "--backend", "inprocess", "--out", str(out),
-                "--no-plot"]
+                "--no-plot", *(["--fmi", "3"] if files.fmi == 3 else [])]
         if fault in INPROCESS_SET:
             return Cell(argv + ["--stop-time", "10", "--set", INPROCESS_SET[fault]], ROOT)
         # a signal from outside, once rows are being written (into the run's hidden stage)
@@ -297,20 +331,23 @@ def run_cell(spec: Cell) -> Outcome:
     return Outcome(child.returncode, output, written)
 
 
-def _cells(session: pytest.Session) -> list[tuple[str, str]]:
-    """The (host, fault) cells this session runs."""
+def _cells(session: pytest.Session) -> list[tuple[str, str, int]]:
+    """The (host, fault, FMI version) cells this session runs."""
     chosen = []
     for item in session.items:
         if item.originalname == "test_fault_matrix" and hasattr(item, "callspec"):
-            chosen.append((item.callspec.params["host"], item.callspec.params["fault"]))
+            chosen.append(tuple(item.callspec.params[k] for k in ("host", "fault", "fmi")))
     return chosen
 
 
 @pytest.fixture(scope="session")
-def outcomes(request, files, tmp_path_factory) -> dict[tuple[str, str], Outcome]:
+def outcomes(request, tmp_path_factory) -> dict[tuple[str, str, int], Outcome]:
     """Every selected cell, run two at a time (each is a child process)."""
     cells = _cells(request.session)
-    specs = {c: cell(*c, files, tmp_path_factory.mktemp(f"{c[0]}-{c[1]}")) for c in cells}
+    systems = {fmi: request.getfixturevalue("files" if fmi == 2 else "files3")
+               for fmi in sorted({c[2] for c in cells})}
+    specs = {c: cell(c[0], c[1], systems[c[2]], tmp_path_factory.mktemp("-".join(map(str, c))))
+             for c in cells}
     with ThreadPoolExecutor(max_workers=2) as pool:
         futures = {c: pool.submit(run_cell, spec) for c, spec in specs.items()}
         return {c: future.result() for c, future in futures.items()}
@@ -327,10 +364,10 @@ def _named(output: str, fmu: str, what: str, when: str) -> bool:
                for line in output.splitlines())
 
 
-@pytest.mark.parametrize("host, fault", CELLS, ids=[f"{h}-{f}" for h, f in CELLS])
-def test_fault_matrix(host, fault, outcomes):
-    result = outcomes[(host, fault)]
-    said = f"{host} / {fault}: {_status(result.returncode)}\n{result.output[-3000:]}"
+@pytest.mark.parametrize("host, fault, fmi", CELLS, ids=IDS)
+def test_fault_matrix(host, fault, fmi, outcomes):
+    result = outcomes[(host, fault, fmi)]
+    said = f"{host} / {fault} / FMI {fmi}: {_status(result.returncode)}\n{result.output[-3000:]}"
     code = result.returncode
     assert -code not in CRASHES and code - 128 not in CRASHES, said
     if fault.startswith("sig"):
@@ -354,6 +391,9 @@ def test_fault_matrix(host, fault, outcomes):
         assert "nan" in (result.output + result.files).lower(), said
     else:
         assert code != 0, said
+    if fmi == 3 and host in FMI3_REFUSED_STEP and not (host == "master-fmi" and
+                                                       fault == "parameter"):
+        assert re.search(FMI3_REFUSED_STEP[host], result.output), said
     if fault == "corrupt":
         if host in OURS:
             assert "corrupt" in result.output, said
@@ -361,4 +401,6 @@ def test_fault_matrix(host, fault, outcomes):
     fmu, what, when = (INPROCESS_NAMES if host == "master-inprocess" else NAMES)[fault]
     if host == "master-fmi" and fault == "parameter":      # the master checks it first
         when = BEFORE
+    elif fmi == 3 and when == T0:
+        when = AT_INITIALISATION
     assert _named(result.output, fmu, what, when), said

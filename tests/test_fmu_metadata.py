@@ -24,6 +24,20 @@ from fmubuild.project import FMUS, ROOT
 PROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
 BLOCK = (0xdd, 0xe8, 0xf4)
 """The fill of a block icon (fmubuild.icon)."""
+BUILT_WITH = {2: "pythonfmu 0.7.0", 3: "pythonfmu3 0.3.4"}
+PLATFORMS = {2: ("linux64", "win64"), 3: ("x86_64-linux", "x86_64-windows")}
+"""What builds each FMI version, and the platforms of its binaries."""
+
+
+@pytest.fixture(params=[2, 3], ids=["fmi2", "fmi3"])
+def fmi(request) -> int:
+    return request.param
+
+
+@pytest.fixture
+def built(fmi, request) -> dict[str, Path]:
+    """This project's FMUs of the version ``fmi``: FMI 2.0's, or their FMI 3.0 twins."""
+    return request.getfixturevalue("fmu_paths" if fmi == 2 else "fmi3_paths")
 
 
 def _entry(fmu: Path, name: str) -> bytes:
@@ -32,24 +46,27 @@ def _entry(fmu: Path, name: str) -> bytes:
 
 
 @pytest.mark.parametrize("name", list(FMUS))
-def test_each_fmu_declares_the_projects_version_license_and_fmukit(fmu_paths, name):
-    described = read_model_description(str(fmu_paths[name]))
+def test_each_fmu_declares_the_projects_version_license_and_fmukit(built, fmi, name):
+    described = read_model_description(str(built[name]))
     assert described.version == PROJECT["version"] == metadata.version(PROJECT["name"])
     assert described.license == PROJECT["license"]["text"]
     assert described.author and described.copyright.startswith("Copyright")
-    assert described.generationTool == f"fmukit {PROJECT['version']} (pythonfmu 0.7.0)"
-    assert validate_fmu(str(fmu_paths[name])) == []
+    assert described.generationTool == f"fmukit {PROJECT['version']} ({BUILT_WITH[fmi]})"
+    assert validate_fmu(str(built[name])) == []
 
 
 @pytest.mark.parametrize("name", list(FMUS))
-def test_the_documentation_lists_every_variable_with_its_unit(fmu_paths, name):
-    page = _entry(fmu_paths[name], "documentation/index.html").decode()
+def test_the_documentation_lists_every_variable_with_its_unit(built, fmi, name):
+    page = _entry(built[name], "documentation/index.html").decode()
     root = fromstring(page)                       # well-formed, so no tag is left open
     assert not re.search(r"\b(src|href)=", page), "the page loads nothing from outside"
     rows = {"".join(tr[0].itertext()): [("".join(td.itertext())) for td in tr]
             for tr in root.iter("tr") if tr[0].tag == "td"}
-    described = read_model_description(str(fmu_paths[name]))
+    described = read_model_description(str(built[name]))
     for variable in described.modelVariables:
+        if variable.causality == "independent":        # FMI 3.0's time: no port
+            assert variable.name not in rows
+            continue
         row = rows[variable.name]
         assert row[1] == variable.type, variable.name
         assert row[2].split(" (shown in ")[0] == (variable.unit or ""), variable.name
@@ -57,8 +74,8 @@ def test_the_documentation_lists_every_variable_with_its_unit(fmu_paths, name):
         if variable.causality == "parameter":
             assert row[3] == str(variable.start), variable.name
     text = "".join(root.itertext())
-    assert described.description in text
-    for platform in ("linux64", "win64"):
+    assert described.description in text and f"FMI{described.fmiVersion}, co-simulation" in text
+    for platform in PLATFORMS[fmi]:
         assert f"{platform}: " in text and "numpy" in text
     assert "LD_PRELOAD" in text
 
@@ -72,33 +89,34 @@ def test_the_documentation_cites_the_paper_and_the_equations_of_what_the_fmu_car
 
 
 @pytest.mark.parametrize("name", list(FMUS))
-def test_the_documentations_worked_example_runs(fmu_paths, tmp_path, name):
-    page = _entry(fmu_paths[name], "documentation/index.html").decode()
+def test_the_documentations_worked_example_runs(built, tmp_path, name):
+    page = _entry(built[name], "documentation/index.html").decode()
     command = re.search(r"<pre>(fmpy simulate .*?)</pre>", page).group(1).split()
     assert command[:3] == ["fmpy", "simulate", f"{name}.fmu"] and "--start-values" in command
-    (tmp_path / f"{name}.fmu").write_bytes(fmu_paths[name].read_bytes())
+    (tmp_path / f"{name}.fmu").write_bytes(built[name].read_bytes())
     fmpy = Path(sys.executable).with_name("fmpy")
-    subprocess.run([str(fmpy), *command[1:]], cwd=tmp_path, check=True, capture_output=True)
+    subprocess.run([str(fmpy), *command[1:]], cwd=tmp_path, check=True, capture_output=True,
+                   timeout=300)
     header, *rows = (tmp_path / f"{name}.csv").read_text().splitlines()
     stop = command[command.index("--stop-time") + 1]
-    outputs = [v.name for v in read_model_description(str(fmu_paths[name])).modelVariables
+    outputs = [v.name for v in read_model_description(str(built[name])).modelVariables
                if v.causality == "output"]
     assert header.replace('"', "").split(",") == ["time", *outputs]
     assert rows[-1].startswith(f"{stop},")
 
 
 @pytest.mark.parametrize("name", list(FMUS))
-def test_the_icon_is_a_png_drawn_from_the_model(fmu_paths, name):
-    icon = Image.open(io.BytesIO(_entry(fmu_paths[name], "model.png")))
+def test_the_icon_is_a_png_drawn_from_the_model(built, name):
+    icon = Image.open(io.BytesIO(_entry(built[name], "model.png")))
     assert icon.format == "PNG" and icon.size == (256, 256)
     colours = {rgba[:3] for _, rgba in icon.convert("RGBA").getcolors(256 * 256)
                if rgba[3] == 255}
     assert (BLOCK in colours) == (name != "ship"), "the ship is a hull, the rest are blocks"
 
 
-def test_a_rebuild_of_unchanged_sources_is_byte_identical(fmu_paths, tmp_path):
-    first = build("ship", tmp_path / "a").read_bytes()
-    assert build("ship", tmp_path / "b").read_bytes() == first == fmu_paths["ship"].read_bytes()
+def test_a_rebuild_of_unchanged_sources_is_byte_identical(built, fmi, tmp_path):
+    first = build("ship", tmp_path / "a", fmi).read_bytes()
+    assert build("ship", tmp_path / "b", fmi).read_bytes() == first == built["ship"].read_bytes()
 
 
 def test_an_fmu_built_by_another_version_is_not_current(fmu_paths):

@@ -2,12 +2,14 @@
 
 A Python FMU's code runs in a host on Windows as it does on Linux but for what
 Windows lacks: ``ctypes.CDLL(None)`` (a TypeError there), the POSIX-only functions of
-``os`` and ``signal``, and modules such as ``fcntl`` and ``resource``. Each FMU is
-unpacked and its own code (``resources/``) instantiated and stepped, as pythonfmu
-does, in a child process that lacks all of these (``WINDOWS_HOST``), once as in a
-C++ host (Python embedded by pythonfmu) and once as in a Python host. The DLLs are
-read with objdump: pythonfmu's win64 binary, which every Python FMU carries, and
-the C autopilot's, cross-compiled with mingw-w64 (``fmubuild.cbuild``).
+``os`` and ``signal``, and modules such as ``fcntl`` and ``resource``. Each FMU, of
+either FMI version, is unpacked and its own code (``resources/``) instantiated and
+stepped, as pythonfmu and pythonfmu3 do, in a child process that lacks all of these
+(``WINDOWS_HOST``), once as in a C++ host (Python embedded by pythonfmu) and once as
+in a Python host. The DLLs are read with objdump: pythonfmu's win64 binary and
+pythonfmu3's x86_64-windows one, which every Python FMU of that version carries, and
+the C autopilot's of both versions, cross-compiled with mingw-w64
+(``fmubuild.cbuild``).
 """
 from __future__ import annotations
 
@@ -23,9 +25,11 @@ import pytest
 from fmpy.validation import validate_fmu
 
 import pythonfmu
+import pythonfmu3
 from fmubuild import cbuild
 from fmubuild.manifest import read
 from fmubuild.project import FMUS
+from test_c_fmi3 import FMI3_FUNCTIONS
 
 WINDOWS_HOST = r'''
 import ast, ctypes, importlib, json, os, signal, sys
@@ -33,7 +37,7 @@ from pathlib import Path
 
 import numpy
 
-resources, slave_class, host = sys.argv[1:]
+resources, slave_class, host, fmi = sys.argv[1:]
 c_calls = []
 POSIX_MODULES = ("fcntl", "resource", "pwd", "grp", "termios", "tty", "pty", "syslog", "crypt",
                  "spwd")
@@ -97,20 +101,26 @@ if host == "c++":
 
 sys.path.insert(0, resources)            # as pythonfmu does
 module = importlib.import_module(Path(resources, "slavemodule.txt").read_text().strip())
-logger = ctypes.create_string_buffer(16)     # a logger whose debug flag (byte 8) is off
+# A logger with the host's logging flag off where the binary's logger keeps it: pythonfmu's
+# at byte 8; pythonfmu3's in the first byte of Settings, which byte 16 points to.
+logger = ctypes.create_string_buffer(24)
+settings = ctypes.create_string_buffer(1)
+ctypes.c_void_p.from_buffer(logger, 16).value = ctypes.addressof(settings)
 slave = getattr(module, slave_class)(instance_name="win", resources=resources,
                                      visible=False, logger=ctypes.addressof(logger))
-slave.setup_experiment(0.0)
+if fmi == "2":
+    slave.setup_experiment(0.0)
 slave.enter_initialization_mode()
 slave.exit_initialization_mode()
-stepped = slave.do_step(0.0, 0.1)
+result = slave.do_step(0.0, 0.1)
+stepped = result is True if fmi == "2" else (result.status == 0 and not any(result[1:]))
 slave.terminate()
 print(json.dumps({"fmukit": sys.modules["fmukit.slave"].__file__, "c_calls": c_calls,
                   "sigint": type(signal.getsignal(signal.SIGINT)).__name__,
                   "stepped": stepped}))
 '''
-"""A child process's script: instantiate and step an FMU's slave class from its resources
-folder on a faked Windows; it prints what it saw as JSON."""
+"""A child process's script: instantiate and step an FMU's slave class (of FMI version
+sys.argv[4]) from its resources folder on a faked Windows; it prints what it saw as JSON."""
 
 FMI2_COMMON = (
     "fmi2GetTypesPlatform", "fmi2GetVersion", "fmi2SetDebugLogging", "fmi2Instantiate",
@@ -126,6 +136,10 @@ FMI2_CO_SIMULATION = (
     "fmi2GetBooleanStatus", "fmi2GetStringStatus")
 """The functions an FMI 2.0 co-simulation FMU exports (the standard, 2.1 and 4.2)."""
 
+C_EXPORTS = {2: set(FMI2_COMMON + FMI2_CO_SIMULATION), 3: set(FMI3_FUNCTIONS)}
+C_BINARIES = {2: ("linux64", "win64"), 3: ("x86_64-linux", "x86_64-windows")}
+"""FMI version: the folders of the C autopilot's Linux and Windows binaries."""
+
 PYTHONFMU_WIN64_IMPORTS = {
     "python3.dll", "MSVCP140.dll", "VCRUNTIME140.dll", "VCRUNTIME140_1.dll", "KERNEL32.dll",
     "api-ms-win-crt-runtime-l1-1-0.dll", "api-ms-win-crt-heap-l1-1-0.dll",
@@ -136,6 +150,14 @@ on PATH), the Visual C++ 2015-2022 runtime and the Universal CRT (what the host 
 
 PYTHONFMU_WIN64 = (Path(pythonfmu.__file__).parent / "resources" / "binaries" / "win64"
                    / "pythonfmu-export.dll")
+
+PYTHONFMU3_WIN64 = (Path(pythonfmu3.__file__).parent / "resources" / "binaries" /
+                    "x86_64-windows" / "pythonfmu-export.dll")
+"""pythonfmu3 0.3.4's binary for 64-bit Windows: it imports Python's stable ABI and
+KERNEL32 alone (its C++ runtime linked in)."""
+
+PYTHON_WIN64 = {2: ("win64", PYTHONFMU_WIN64), 3: ("x86_64-windows", PYTHONFMU3_WIN64)}
+"""FMI version: the Windows binary folder of the Python FMUs and the binary they carry."""
 
 
 def _objdump() -> str:
@@ -157,16 +179,25 @@ def _pe(dll: Path) -> tuple[set[str], set[str]]:
     return imports, exports
 
 
+@pytest.fixture(scope="module")
+def python_fmus(fmu_paths, fmi3_paths) -> dict[int, dict[str, Path]]:
+    """FMI version: the Python FMUs of that version, current."""
+    return {2: fmu_paths, 3: fmi3_paths}
+
+
 @pytest.mark.parametrize("host", ["c++", "python"])
 @pytest.mark.parametrize("name", list(FMUS))
-def test_each_python_fmu_instantiates_and_steps_on_windows(fmu_paths, tmp_path, name, host):
-    fmu = fmu_paths[name]
+@pytest.mark.parametrize("fmi", sorted(PYTHON_WIN64))
+def test_each_python_fmu_instantiates_and_steps_on_windows(python_fmus, tmp_path, fmi, name,
+                                                           host):
+    fmu = python_fmus[fmi][name]
     with zipfile.ZipFile(fmu) as package:
         package.extractall(tmp_path / "fmu")
     resources = tmp_path / "fmu" / "resources"
-    child = subprocess.run([sys.executable, "-c", WINDOWS_HOST, str(resources),
-                            read(fmu).slave_class, host], cwd=tmp_path, capture_output=True,
-                           text=True, timeout=120)
+    # Isolated (-I): this checkout's modules, on PYTHONPATH, would shadow the FMU's own.
+    child = subprocess.run([sys.executable, "-I", "-c", WINDOWS_HOST, str(resources),
+                            read(fmu).slave_class, host, str(fmi)], cwd=tmp_path,
+                           capture_output=True, text=True, timeout=120)
     assert child.returncode == 0, child.stderr
     seen = json.loads(child.stdout)
     assert Path(seen["fmukit"]).is_relative_to(resources)     # the FMU's code, not ours
@@ -180,10 +211,13 @@ def test_each_python_fmu_instantiates_and_steps_on_windows(fmu_paths, tmp_path, 
 
 
 @pytest.mark.parametrize("name", list(FMUS))
-def test_each_python_fmu_carries_pythonfmus_win64_binary(fmu_paths, name):
-    with zipfile.ZipFile(fmu_paths[name]) as package:
-        model = read(fmu_paths[name]).model_name
-        assert package.read(f"binaries/win64/{model}.dll") == PYTHONFMU_WIN64.read_bytes()
+@pytest.mark.parametrize("fmi", sorted(PYTHON_WIN64))
+def test_each_python_fmu_carries_its_pythonfmus_windows_binary(python_fmus, fmi, name):
+    folder, binary = PYTHON_WIN64[fmi]
+    fmu = python_fmus[fmi][name]
+    with zipfile.ZipFile(fmu) as package:
+        model = read(fmu).model_name
+        assert package.read(f"binaries/{folder}/{model}.dll") == binary.read_bytes()
 
 
 def test_pythonfmus_win64_binary_needs_python_and_the_vc_runtime():
@@ -192,41 +226,56 @@ def test_pythonfmus_win64_binary_needs_python_and_the_vc_runtime():
     assert set(FMI2_COMMON + FMI2_CO_SIMULATION) <= exports
 
 
-@pytest.fixture(scope="module")
-def c_fmu(tmp_path_factory) -> Path:
-    """The C autopilot, built here with its win64 binary; skipped where it cannot be."""
+def test_pythonfmu3s_windows_binary_needs_python_alone():
+    imports, exports = _pe(PYTHONFMU3_WIN64)
+    assert imports == {"python3.dll", "KERNEL32.dll"}
+    assert set(FMI3_FUNCTIONS) <= exports
+
+
+@pytest.fixture(scope="module", params=sorted(C_BINARIES))
+def c_fmu(request, tmp_path_factory) -> tuple[int, Path]:
+    """The C autopilot of each FMI version, built here with its Windows binary; skipped
+    where it cannot be."""
     if cbuild.c_compiler() is None or shutil.which(cbuild.WIN64_COMPILER) is None:
         pytest.skip(f"needs a C compiler and {cbuild.WIN64_COMPILER} "
                     "(apt-get install gcc-mingw-w64-x86-64)")
-    return cbuild.build_c("pd_autopilot_c", tmp_path_factory.mktemp("c"))
+    fmi = request.param
+    return fmi, cbuild.build_c("pd_autopilot_c", tmp_path_factory.mktemp(f"c{fmi}"), fmi=fmi)
 
 
-def test_the_c_autopilots_win64_dll_exports_fmi2_and_needs_only_windows(c_fmu, tmp_path):
-    with zipfile.ZipFile(c_fmu) as package:
-        assert {"binaries/linux64/pd_autopilot_c.so",
-                "binaries/win64/pd_autopilot_c.dll"} <= set(package.namelist())
+def test_the_c_autopilots_windows_dll_exports_fmi_and_needs_only_windows(c_fmu, tmp_path):
+    fmi, fmu = c_fmu
+    linux, windows = C_BINARIES[fmi]
+    with zipfile.ZipFile(fmu) as package:
+        assert {n for n in package.namelist() if n.startswith("binaries/")} == {
+            f"binaries/{linux}/pd_autopilot_c.so", f"binaries/{windows}/pd_autopilot_c.dll"}
         description = package.read("modelDescription.xml").decode()
         dll = tmp_path / "pd_autopilot_c.dll"
-        dll.write_bytes(package.read("binaries/win64/pd_autopilot_c.dll"))
+        dll.write_bytes(package.read(f"binaries/{windows}/pd_autopilot_c.dll"))
+    assert f'fmiVersion="{fmi}.0"' in description
     assert "<CoSimulation" in description and "<ModelExchange" not in description
     imports, exports = _pe(dll)
-    assert exports == set(FMI2_COMMON + FMI2_CO_SIMULATION)
+    assert exports == C_EXPORTS[fmi]
     system = [i for i in imports if i.upper() in ("KERNEL32.DLL", "MSVCRT.DLL")
               or i.lower().startswith("api-ms-win-crt-")]
     assert sorted(imports) == sorted(system), f"not only Windows' own DLLs: {imports}"
-    assert validate_fmu(str(c_fmu)) == []
+    assert validate_fmu(str(fmu)) == []
 
 
+@pytest.mark.parametrize("fmi", sorted(C_BINARIES))
 def test_without_mingw_the_c_autopilot_is_built_for_linux_alone_with_a_note(
-        monkeypatch, tmp_path, capsys):
+        monkeypatch, tmp_path, capsys, fmi):
     if cbuild.c_compiler() is None:
         pytest.skip("no C compiler on this machine (set CC or install gcc)")
     which = shutil.which
     monkeypatch.setattr(shutil, "which",
                         lambda name, *a, **k: None if name == cbuild.WIN64_COMPILER
                         else which(name, *a, **k))
-    fmu = cbuild.build_c("pd_autopilot_c", tmp_path)
+    fmu = cbuild.build_c("pd_autopilot_c", tmp_path, fmi=fmi)
+    linux, windows = C_BINARIES[fmi]
     with zipfile.ZipFile(fmu) as package:
-        assert not [n for n in package.namelist() if n.startswith("binaries/win64/")]
+        assert {n for n in package.namelist() if n.startswith("binaries/")} == {
+            f"binaries/{linux}/pd_autopilot_c.so"}
     assert (f"note: {cbuild.WIN64_COMPILER} not found (apt-get install gcc-mingw-w64-x86-64): "
-            "pd_autopilot_c.fmu is built without a win64 binary") in capsys.readouterr().err
+            f"pd_autopilot_c.fmu (FMI {fmi}.0) is built without its Windows binary "
+            f"(binaries/{windows})") in capsys.readouterr().err

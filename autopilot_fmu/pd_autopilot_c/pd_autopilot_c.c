@@ -2,9 +2,10 @@
 
        delta_c = Kp wrap(psi - psi_d) + Kd r,   wrap: to (-pi, pi]
 
-   The same law as autopilot_fmu/pd.py, to show that an autopilot in any language that
+   The same law as autopilot_fmu/pd.py (pd_law.h, which its FMI 3.0 twin
+   pd_autopilot_c_fmi3.c includes too), to show that an autopilot in any language that
    can export the FMI 2.0 C API drops into the co-simulation (docs/own_autopilot.md).
-   Built by fmukit.cbuild against the FMI 2.0 headers fmpy ships in fmpy/c-code.
+   Built by fmubuild.cbuild against the FMI 2.0 headers fmpy ships in fmpy/c-code.
 
    Value references: 0 psi, 1 r, 2 psi_d (inputs), 3 delta_c (output), 4 Kp, 5 Kd.
 
@@ -18,6 +19,7 @@
 #include <string.h>
 
 #include "fmi2Functions.h"
+#include "pd_law.h"
 
 enum { PSI, R, PSI_D, DELTA_C, KP, KD, N_VARIABLES };
 enum Phase { INSTANTIATED, INITIALIZATION, STEP, TERMINATED };
@@ -54,16 +56,9 @@ static void say(Instance *c, fmi2Status status, const char *category, const char
 /* Log an error (always) and return the status the call ends with. */
 #define REFUSE(c, status, ...) (say((c), (status), "logStatusError", __VA_ARGS__), (status))
 
-static const fmi2Real PI = 3.141592653589793;      /* the double nearest pi, as math.pi */
-
-static fmi2Real wrap(fmi2Real angle) {              /* the short way round, (-pi, pi] */
-    fmi2Real wrapped = remainder(angle, 2.0 * PI);
-    return wrapped == -PI ? PI : wrapped;
-}
-
 static fmi2Real rudder_command(const Instance *c) {  /* eq (20) */
     const fmi2Real *v = c->value;
-    return v[KP] * wrap(v[PSI] - v[PSI_D]) + v[KD] * v[R];
+    return pd_rudder_command(v[KP], v[KD], v[PSI], v[R], v[PSI_D]);
 }
 
 const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }

@@ -1,11 +1,14 @@
 """The master's in-process backend: the FMUs' Python classes, called without FMI.
 
 An ``InProcessInstance`` has the same interface as ``cosim.core.fmi.FmuInstance`` but
-instantiates the slave class an FMU built with fmukit was made from (its manifest,
-``fmubuild.manifest``) in this process and calls its methods directly; the FMU must
-be current here: the modules it carries are the ones this process imports. A run on this backend differs from a
-co-simulation only by the FMI layer (C wrapper, fmpy, ctypes), which is what the
-equality tests compare: every column of every row is the same, bit for bit.
+instantiates the class an FMU built with fmukit was made from in this process and
+calls its methods directly: the model's class (its manifest, ``fmubuild.manifest``)
+composed with the adapter of the FMU's FMI version, 2.0 or 3.0, as the FMU's entry
+module composes it (``fmukit.compose.fmu_class``), so that an FMI 3.0 twin runs as
+FMI 3.0 (its value references, its calls, its refusals). The FMU must be current
+here: the modules it carries are the ones this process imports. A run on this backend
+differs from a co-simulation only by the FMI layer (C wrapper, fmpy, ctypes), which is
+what the equality tests compare: every column of every row is the same, bit for bit.
 
 What FMI imposes and Python need not is dropped; what makes a run trustworthy is
 kept. The master's loop gets, per component, the slave's own plans for its lists
@@ -30,13 +33,17 @@ from xml.etree import ElementTree
 
 from fmubuild.manifest import Manifest, read, staleness
 from fmubuild.project import FMUS
-from fmukit.pythonfmu07.entry import unguarded
+from fmukit.compose import fmu_class
+from fmukit.entry import unguarded
 from fmukit.refusals import Refused, explain, naming
 from fmukit.slave import ModelSlave
 
+from .fmi3 import CALLS
 from .instance import FmuCallError, Instance, LogRecord, logged_error
 
 _FMI_TYPE = {float: "Real", int: "Integer", str: "String"}
+"""The master's type names (FMI 2.0's), whichever version the class is of."""
+_FAILED = frozenset({"discard", "error", "fatal"})
 
 
 @dataclass(frozen=True)
@@ -49,9 +56,10 @@ class VariableInfo:
 
 
 def slave_class(manifest: Manifest) -> type[ModelSlave]:
-    """The slave class an FMU's manifest names, imported in this process."""
+    """The class of the FMU a manifest describes, in this process: the model's class it
+    names, composed for the FMU's FMI version (``fmukit.compose.fmu_class``)."""
     module = importlib.import_module(manifest.slave_module)
-    return getattr(module, manifest.slave_class)
+    return fmu_class(getattr(module, manifest.slave_class), manifest.fmi)
 
 
 def in_process_refusal(path: str | Path) -> str | None:
@@ -108,6 +116,9 @@ def _refusal(path: Path) -> str | None:
         stale = None if refusal else staleness(manifest)
         if stale is not None:
             refusal = Reason.of(stale, manifest.slave_module in _PROJECT_SLAVES)
+        if refusal is None and manifest.fmi != _version(declared):
+            return (f"its model description is of FMI {declared.get('fmiVersion')}, its "
+                    f"manifest says FMI {manifest.fmi}")
         if refusal is None:
             ours = slave_class(manifest)(instance_name=manifest.model_name).to_xml()
             for section in _DECLARATIONS:
@@ -121,10 +132,13 @@ def _refusal(path: Path) -> str | None:
 
 
 def _contents_refusal(fmu: zipfile.ZipFile, manifest: Manifest) -> str | None:
-    """Why the FMU does not hold exactly the Python modules its manifest lists, or None."""
+    """Why the FMU does not hold exactly the Python modules its manifest lists (its entry
+    module among them, where it has one), or None."""
     listed = {c["file"]: c["sha256"] for c in manifest.modules.values()}
+    entry = manifest.entry or manifest.modules[manifest.slave_module]
+    listed[entry["file"]] = entry["sha256"]
     carried = {n for n in fmu.namelist() if n.startswith("resources/") and n.endswith(".py")
-               and not n.startswith("resources/pythonfmu/")}     # pythonfmu's own
+               and not n.startswith(_PYTHONFMU)}
     for name in sorted(carried - set(listed)):
         return f"it carries {name.removeprefix('resources/')}, which its manifest does not list"
     for name, digest in sorted(listed.items()):
@@ -132,11 +146,15 @@ def _contents_refusal(fmu: zipfile.ZipFile, manifest: Manifest) -> str | None:
             return f"it lacks {name.removeprefix('resources/')}, which its manifest lists"
         if hashlib.sha256(fmu.read(name)).hexdigest() != digest:
             return f"its {name.removeprefix('resources/')} is not the source its manifest lists"
-    slave = manifest.modules[manifest.slave_module]["file"]
     module = fmu.read("resources/slavemodule.txt").decode().strip()
-    if f"resources/{module}.py" != slave:
-        return f"its slave is {module}.py, not {slave.removeprefix('resources/')} (its manifest)"
+    if f"resources/{module}.py" != entry["file"]:
+        return (f"its slave module is {module}.py, not "
+                f"{entry['file'].removeprefix('resources/')} (its manifest)")
     return None
+
+
+_PYTHONFMU = ("resources/pythonfmu/", "resources/pythonfmu3/")
+"""What pythonfmu 0.7 and pythonfmu3 carry of their own."""
 
 
 _DECLARATIONS = ("ModelVariables", "UnitDefinitions", "ModelStructure")
@@ -164,6 +182,7 @@ class InProcessInstance(Instance):
             raise ValueError(f"FMU '{name}' ({self.path.name}) cannot run in-process: "
                              f"{refusal}")
         self.slave = slave_class(manifest)(instance_name=name)
+        self.fmi_version = manifest.fmi
         self.variables = {}
         for vr, var in self.slave.registry.by_vr.items():
             self.variables[var.name] = VariableInfo(var.name, vr, _FMI_TYPE[var.kind],
@@ -185,15 +204,16 @@ class InProcessInstance(Instance):
             self._judge(what, time, result, strict)
         return result
 
-    def _failure(self, what: str, time: float | None, error: Exception) -> FmuCallError:
-        """The refusal as FMI reports it: fatal (as pythonfmu does) with the FMU's log; a
-        refusal the FMU did not log itself (a step called past the FMI entry's wrapper)
-        as a message of its own, with its cause."""
+    def _failure(self, what: str, time: float | None, error: Exception,
+                 status: str = "fatal") -> FmuCallError:
+        """The refusal as FMI reports it: ``status`` (fatal, as pythonfmu does; error for a
+        step of FMI 3.0) with the FMU's log; a refusal the FMU did not log itself (a step
+        called past the FMI entry's wrapper) as a message of its own, with its cause."""
         records = self._drain()
         if not any(r.cause for r in records):
             category = error.category if isinstance(error, Refused) else None
-            records.append(LogRecord("fatal", category, naming(self.name, explain(error))))
-        return FmuCallError(self.name, what, time, "fatal", records)
+            records.append(LogRecord(status, category, naming(self.name, explain(error))))
+        return FmuCallError(self.name, what, time, status, records)
 
     def _judge(self, what: str, time: float | None, result: Any, strict: bool) -> None:
         """FmuCallError if a call refused (returned False) or, ``strict``, logged an error;
@@ -201,16 +221,23 @@ class InProcessInstance(Instance):
         messages = self._drain()
         if result is False:
             raise FmuCallError(self.name, what, time, "discard", messages)
+        status = getattr(result, "status", None)           # FMI 3.0's Fmi3StepResult
+        if status is not None and status.name in _FAILED:
+            raise FmuCallError(self.name, what, time, status.name, messages)
         if strict and logged_error(messages):
             raise FmuCallError(self.name, what, time, "OK but logged an error", messages)
 
     def _drain(self) -> list[LogRecord]:
-        records = [LogRecord(m.status.name, m.category, m.msg) for m in self.slave.log_queue]
+        records = [LogRecord(m.status.name, m.category or None, m.msg)    # pythonfmu3's: ""
+                   for m in self.slave.log_queue]
         self.slave.log_queue.clear()
         return records
 
     def fmi(self, name: str):
-        """The slave method behind an FMI call name: setReal -> set_real."""
+        """The slave method behind the master's (FMI 2.0) call name: setReal -> set_real,
+        or set_float64 for an FMI 3.0 class (``cosim.core.fmi3.CALLS``)."""
+        if self.fmi_version == 3:
+            name = CALLS.get(name, name)
         return getattr(self.slave, _method_name(name))
 
     # Prepared calls: the slave's own plans, valid until ``reset`` makes a new slave.
@@ -240,18 +267,23 @@ class InProcessInstance(Instance):
 
     def stepper(self):
         do_step, queue = unguarded(self.slave.do_step), self.slave.log_queue
+        # the status of a refused step through FMI: fmi2Fatal; FMI 3.0's is fmi3Error
+        refused = "error" if self.fmi_version == 3 else "fatal"
 
         def step(t: float, h: float) -> None:
             try:
                 done = do_step(t, h)
             except Exception as error:
-                raise self._failure("doStep", t, error) from error
-            if done is not True or queue:
+                raise self._failure("doStep", t, error, refused) from error
+            if done is not True or queue:          # FMI 3.0's: a Fmi3StepResult
                 self._judge("doStep", t, done, False)
         return step
 
     def enter_initialization(self, start_time: float = 0.0) -> None:
-        self.call("setupExperiment", self.slave.setup_experiment, start_time)
+        """As through FMI: FMI 2.0's setupExperiment gives the start time; pythonfmu3 takes
+        none (it drops fmi3EnterInitializationMode's)."""
+        if self.fmi_version == 2:
+            self.call("setupExperiment", self.slave.setup_experiment, start_time)
         self.call("enterInitializationMode", self.slave.enter_initialization_mode)
 
     def reset(self) -> None:
@@ -262,6 +294,12 @@ class InProcessInstance(Instance):
         """Terminate, if the slave was initialised (as fmi2FreeInstance may follow any call)."""
         if self.slave.sequence.phase == "step":
             self.slave.terminate()
+
+
+def _version(description: ElementTree.Element) -> int | None:
+    """The major FMI version of a model description's root, None if it names none."""
+    major = (description.get("fmiVersion") or "").partition(".")[0]
+    return int(major) if major.isdigit() else None
 
 
 def _description(path: Path) -> ElementTree.Element:

@@ -1,7 +1,8 @@
 """What the master needs of a component, whichever backend runs it.
 
 A backend supplies ``call`` (run a function, turning failure into FmuCallError),
-``fmi(name)`` (the function behind an FMI 2.0 call name such as "setReal"),
+``fmi(name)`` (the function behind the master's call name, FMI 2.0's such as "setReal",
+whichever FMI version the component is of),
 ``enter_initialization``, ``reset`` and ``free``, and may replace the prepared
 calls (``reader``, ``integer_reader``, ``writer``, ``stepper``) that the master's
 loop uses with faster ones; everything else is shared here.
@@ -86,7 +87,7 @@ class Instance:
         raise NotImplementedError
 
     def reset(self) -> None:
-        """Back to the state after instantiation (fmi2Reset)."""
+        """Back to the state after instantiation (fmi2Reset, fmi3Reset)."""
         raise NotImplementedError
 
     def free(self) -> None:

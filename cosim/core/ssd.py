@@ -13,13 +13,14 @@ units, ...) or not well formed, naming the file, the element and the attribute.
 """
 from __future__ import annotations
 
+import copy
 import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from fmubuild.project import FMU_DIR, FMUS
+from fmubuild.project import C_FMUS, FMU_DIR, FMU_DIRS, FMUS
 from fmukit.timebase import MAX_TIME, on_time_base, step_count
 
 from .errors import FmuNotFound
@@ -42,8 +43,10 @@ FMU_TYPE = "application/x-fmu-sharedlibrary"
 CONNECTOR_KINDS = ("input", "output", "inout", "parameter", "calculatedParameter")
 
 FMU_SEARCH_PATH = [FMU_DIR]
-"""Folders searched, by file name, for an FMU not found where its .ssd points: the
-project's fmus/, so that a scenario copied anywhere still finds the project's FMUs."""
+"""Folders searched for an FMU not found where its .ssd points, by its path after its last
+``fmus`` folder (``fmi3/ship.fmu`` for ``../../fmus/fmi3/ship.fmu``), else by its file
+name: the project's fmus/, so that a scenario copied anywhere still finds the project's
+FMUs, of the FMI version it names."""
 
 for _prefix, _uri in NS.items():
     ET.register_namespace(_prefix, _uri)
@@ -108,7 +111,10 @@ class SystemDescription:
         source is only itself (another file of its name would run in its place unseen)."""
         source = Path(self.components[component].source)
         base = self.path.parent if self.path else Path.cwd()
-        elsewhere = [] if source.is_absolute() else [d / source.name for d in FMU_SEARCH_PATH]
+        parts = source.parts
+        tail = Path(*parts[len(parts) - parts[::-1].index("fmus"):]) if "fmus" in parts[:-1] \
+            else Path(source.name)
+        elsewhere = [] if source.is_absolute() else [d / tail for d in FMU_SEARCH_PATH]
         candidates = [(base / source).resolve(), *elsewhere]
         return list(dict.fromkeys(candidates))
 
@@ -120,10 +126,35 @@ class SystemDescription:
                 return path
         source = Path(self.components[component].source)
         ours = source.stem in FMUS
-        hint = ("one of this project's FMUs, not built" if ours
+        twin = 3 in map(project_fmi, candidates)
+        hint = (f"one of this project's {'FMI 3.0 ' if twin else ''}FMUs, not built" if ours
                 else f"check the source of component '{component}' in {self.path or 'the system'}")
         raise FmuNotFound(f"FMU for '{component}' not found; tried "
                           f"{', '.join(map(str, candidates))}; {hint}", ours)
+
+
+def project_fmi(path: Path) -> int | None:
+    """The FMI version of the folder of this project's built FMUs that ``path`` is in
+    (``fmubuild.project.FMU_DIRS``), if it is one of them by name; None for any other."""
+    if path.stem not in FMUS and path.stem not in C_FMUS:
+        return None
+    return next((fmi for fmi, folder in FMU_DIRS.items() if path.parent == folder), None)
+
+
+def with_fmi(system: SystemDescription, fmi: int) -> SystemDescription:
+    """A copy of ``system`` whose components that run this project's FMUs (found in, or
+    missing from, one of its build folders) take those of FMI version ``fmi``: fmus/ for
+    2, fmus/fmi3/ for 3 (``fmubuild.project.FMU_DIRS``); other FMUs stay as they are."""
+    if fmi not in FMU_DIRS:
+        raise ValueError(f"FMI {fmi}: this project's FMUs are built for FMI "
+                         f"{' and '.join(f'{v}.0' for v in FMU_DIRS)}")
+    new = copy.deepcopy(system)
+    for name, component in new.components.items():
+        candidates = system.fmu_candidates(name)
+        found = next((p for p in candidates if p.is_file()), None)
+        if any(project_fmi(p) for p in ([found] if found else candidates)):
+            component.source = str(FMU_DIRS[fmi] / Path(component.source).name)
+    return new
 
 
 def _q(prefix: str, tag: str) -> str:

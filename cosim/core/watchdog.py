@@ -263,7 +263,7 @@ def _idle(number: int, frame: object) -> None:
     """Python's handler of SIGINT and SIGTERM while a watchdog takes them: nothing to do."""
 
 
-_idle.safe_in_fmu_code = True      # fmukit need not defer it (fmukit.pythonfmu07.signals)
+_idle.safe_in_fmu_code = True      # fmukit need not defer it (fmukit.hostsignals)
 
 
 def _raise_in(thread_id: int, exception: type[BaseException] | None) -> None:

@@ -19,10 +19,15 @@ By default each run happens in a child process, because neither engine can be
 trusted with its caller: libcosimpy 0.0.6 aborts the process (std::terminate
 from a worker thread) when an FMU call fails during initialisation, and ecos
 0.7.2 ignores FMI status codes and discards FMU log messages. Our FMUs write an
-error to standard error when the host does not listen (``fmukit.pythonfmu07.hostlog``) and
+error to standard error when the host does not listen (``fmukit.hostlog`` and each adapter's ``hostlog``) and
 read NaN once they have failed; a crash, a failed step, or outputs that read NaN
 becomes an ``EngineError`` that carries the child's output, with the FMU's
 message and the time. A package is checked first (``check_package``).
+
+libcosim and fmpy's runner take FMI 2.0 FMUs only (``cosim.interop.ssp.FMI2_ONLY``):
+a package of FMI 3.0 FMUs (``cosim.export --fmi 3``) is refused before either starts,
+naming its FMI 3.0 components, where libcosim would say only 'Unable to create
+execution from path'; ecos runs it.
 
 The command line: ``python -m cosim.engines ENGINE PACKAGE.ssp --out trace.npz``
 (``libcosim`` also takes the OSP folder or its OspSystemStructure.xml).
@@ -36,6 +41,7 @@ import sys
 import tempfile
 import zipfile
 from pathlib import Path
+from xml.etree import ElementTree
 
 import numpy as np
 
@@ -46,7 +52,7 @@ from ..core.interrupt import STOP_SIGNALS, Interrupted, StopSignals
 from ..core.ssd import SystemDescription, split_name
 
 from .osp import read_osp
-from .ssp import read_package, unapplied_strings
+from .ssp import FMI2_ONLY, fmi_versions, read_package, unapplied_strings
 
 ENGINES = ("libcosim", "ecos", "fmpy")
 TRACED = ("ship.psi", "ship.r", "ship.delta")
@@ -153,16 +159,25 @@ def _fmpy(ssp: Path, signals: tuple[str, ...], stop: StopSignals) -> dict[str, n
 RUNNERS = {"libcosim": _libcosim, "ecos": _ecos, "fmpy": _fmpy}
 
 
-def check_package(ssp: Path) -> None:
-    """EngineError naming the file or the parameter if the package cannot be run as it is:
-    not an SSP package (or OSP system structure), or a parameter value that is not finite
-    (which engines reject with messages of their own, such as libcosim's 'Unable to create
-    execution from path')."""
+def check_package(ssp: Path, engine: str | None = None) -> None:
+    """EngineError naming the file, the parameter or the components if the package cannot
+    be run as it is (by ``engine``, if given): not an SSP package (or OSP system
+    structure), a parameter value that is not finite, or FMUs of an FMI version the engine
+    does not take (which engines reject with messages of their own, such as libcosim's
+    'Unable to create execution from path')."""
     try:
         system = read_system(ssp)
-    except (OSError, KeyError, ValueError, zipfile.BadZipFile) as error:
+        versions = fmi_versions(ssp)
+    except (OSError, KeyError, ValueError, zipfile.BadZipFile, ElementTree.ParseError) \
+            as error:
         raise EngineError(f"{ssp} is not an SSP package this project can run ({error})") \
             from None
+    newer = [f"{name} (FMI {version})" for name, version in versions.items()
+             if version != "2.0"]
+    if engine in FMI2_ONLY and newer:
+        raise EngineError(f"{FMI2_ONLY[engine]} runs FMI 2.0 FMUs only; {ssp.name} holds "
+                          f"{', '.join(newer)}: run it with ecos or OMSimulator, or export "
+                          "the FMI 2.0 package (python -m cosim.export without --fmi 3)")
     for name, component in system.components.items():
         for variable, value in component.parameters.items():
             if isinstance(value, float) and not math.isfinite(value):
@@ -183,7 +198,7 @@ def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = TRACED,
     ssp = Path(ssp).resolve()
     if is_osp(ssp) and engine != "libcosim":
         raise ValueError(f"{engine} reads SSP packages, not OSP's {ssp.name}; give the .ssp")
-    check_package(ssp)
+    check_package(ssp, engine)
     if not isolate:
         with StopSignals() as stop:
             result = RUNNERS[engine](ssp, tuple(signals), stop)

@@ -10,13 +10,20 @@ unchanged (docs/interop.md). The guidance's route is written in its numeric form
 apply no String binding; ``unapplied_strings`` names any String binding left that
 such a tool would silently drop. Each is written whole or not at all: a full disk or
 a kill leaves no package, or the previous one (``cosim.core.files``).
+
+``export(..., fmi=3)`` packs this project's FMI 3.0 twins (fmus/fmi3/) in place of the
+FMUs the scenario names; SSP 1.0 types their Float64 connectors as ssc:Real, as
+FMI 2.0's. ecos and OMSimulator run such a package; libcosim and fmpy's SSP runner take
+FMI 2.0 FMUs only (``fmi_versions`` says which a package holds; ``FMI2_ONLY``).
 """
 from __future__ import annotations
 
+import io
 import shutil
 import tempfile
 import zipfile
 from pathlib import Path
+from xml.etree import ElementTree
 
 from autopilot_fmu.guidance import ROUTE_PARAMETERS, numeric_route, route
 
@@ -24,9 +31,13 @@ from .. import scenarios
 from ..core.files import fresh_folder, whole_file
 from ..core.fmi import read_description
 from ..core.ssd import SystemDescription, Units, read_ssd, write_ssd
-from .osp import OSP_FILE, write_osp
+from .osp import OSP_FILE, read_osp, write_osp
 
 SSD_NAME = "SystemStructure.ssd"
+FMI2_ONLY = {"libcosim": "OSP libcosim", "fmpy": "fmpy's SSP runner"}
+"""The engines (``cosim.interop.engines``) that run FMI 2.0 FMUs only: libcosimpy 0.0.6's
+libcosim, and fmpy's SSP runner (its FMU2Slave); ecos and OMSimulator take FMI 2.0 and
+3.0."""
 
 
 def _with_numeric_route(system: SystemDescription, fmus: dict[str, Path]) -> None:
@@ -72,11 +83,12 @@ def connector_units(system: SystemDescription, fmus: dict[str, Path]) -> Units:
 
 def export(scenario: str | Path, out: Path, overrides: dict[str, dict] | None = None,
            autopilot: str | Path | None = None, port_map: dict[str, str] | None = None,
-           name: str | None = None) -> Path:
+           name: str | None = None, fmi: int | None = None) -> Path:
     """Write out/<label>.ssp (``scenarios.label``) and out/<label>/ with OSP's
-    OspSystemStructure.xml and the FMUs: the scenario, with ``autopilot`` in place of
-    its own if given, and ``overrides`` changing parameter values by component."""
-    system = scenarios.load(scenario, autopilot, port_map, name)
+    OspSystemStructure.xml and the FMUs: the scenario, with this project's FMUs of FMI
+    version ``fmi`` if given (``scenarios.load``), ``autopilot`` in place of its own if
+    given, and ``overrides`` changing parameter values by component."""
+    system = scenarios.load(scenario, autopilot, port_map, name, fmi)
     for component, values in system.parameters(overrides).items():
         system.components[component].parameters = values
     fmus = {c: system.fmu_path(c) for c in system.components}     # FileNotFoundError
@@ -102,6 +114,29 @@ def export(scenario: str | Path, out: Path, overrides: dict[str, dict] | None = 
             shutil.copyfile(path, folder / path.name)
         write_osp(system, folder / OSP_FILE, {c: path.name for c, path in fmus.items()})
     return target
+
+
+def fmi_version(fmu: zipfile.ZipFile) -> str:
+    """The fmiVersion of an FMU ("2.0", "3.0"), from its modelDescription.xml."""
+    return ElementTree.fromstring(fmu.read("modelDescription.xml")).get("fmiVersion", "")
+
+
+def fmi_versions(path: Path) -> dict[str, str]:
+    """Each component's FMI version, from its FMU in an SSP package or in an OSP folder
+    (a .ssp, else the folder or its OspSystemStructure.xml)."""
+    if path.suffix.lower() == ".ssp":
+        with zipfile.ZipFile(path) as package:
+            sources = {name: io.BytesIO(package.read(component.source))
+                       for name, component in read_package(path).components.items()}
+    else:
+        folder = path if path.is_dir() else path.parent
+        sources = {name: folder / component.source
+                   for name, component in read_osp(path).components.items()}
+    versions = {}
+    for name, source in sources.items():
+        with zipfile.ZipFile(source) as fmu:
+            versions[name] = fmi_version(fmu)
+    return versions
 
 
 def read_package(ssp: Path) -> SystemDescription:

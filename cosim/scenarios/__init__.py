@@ -3,14 +3,16 @@
 Every command that takes a scenario takes its name (a file here, e.g.
 ``calm_pd``) or a path to a .ssd file. ``PAPER`` lists the paper's four runs, the
 ones behind its Tables 1-2. ``autopilot`` puts a user's autopilot FMU into a
-course-keeping scenario.
+course-keeping scenario. A scenario runs the FMUs its .ssd names (this package's name
+fmus/, FMI 2.0); ``load(..., fmi=3)`` gives it this project's FMI 3.0 twins from
+fmus/fmi3/ in their place (``cosim.core.ssd.with_fmi``).
 """
 from __future__ import annotations
 
 from pathlib import Path
 
 from ..core.files import plain_name
-from ..core.ssd import SystemDescription, read_ssd
+from ..core.ssd import SystemDescription, read_ssd, with_fmi
 from ..core.values import close_matches, did_you_mean
 from .autopilot import with_autopilot
 
@@ -52,8 +54,13 @@ def label(scenario: str | Path, autopilot: str | Path | None = None,
 
 
 def load(scenario: str | Path, autopilot: str | Path | None = None,
-         port_map: dict[str, str] | None = None, name: str | None = None) -> SystemDescription:
-    """The system description of a scenario (a name or a .ssd path, as ``path``), with
-    ``autopilot``, an FMU, in place of its own (``cosim.scenarios.autopilot``)."""
+         port_map: dict[str, str] | None = None, name: str | None = None,
+         fmi: int | None = None) -> SystemDescription:
+    """The system description of a scenario (a name or a .ssd path, as ``path``), this
+    project's FMUs of FMI version ``fmi`` (2 or 3) in place of those it names if given,
+    with ``autopilot``, an FMU of either version, in place of its own
+    (``cosim.scenarios.autopilot``)."""
     system = read_ssd(path(scenario))
+    if fmi is not None:
+        system = with_fmi(system, fmi)
     return system if autopilot is None else with_autopilot(system, autopilot, port_map, name)

@@ -1,6 +1,7 @@
 """Your own autopilot in the paper's scenarios: the port contract, checked, and the substitution.
 
-An autopilot is any FMI 2.0 co-simulation FMU with these ports (SI units, radians):
+An autopilot is any FMI 2.0 or 3.0 co-simulation FMU with these ports (SI units, radians),
+Real in FMI 2.0, Float64 in FMI 3.0:
 
 | port | causality | unit | meaning |
 |---|---|---|---|
@@ -38,6 +39,8 @@ from ..core.values import close_matches, did_you_mean
 COMPONENT = "autopilot"
 PORTS = {v.name: (v.causality, v.unit) for v in fmukit.autopilot.PORTS}
 DESCRIPTIONS = {v.name: v.description for v in fmukit.autopilot.PORTS}
+PORT_TYPES = {"2.0": "Real", "3.0": "Float64"}
+"""FMI version an autopilot may be of: the type of its ports."""
 
 
 class AutopilotError(ValueError):
@@ -58,30 +61,32 @@ def _mapped(port: str, port_map: dict[str, str]) -> str:
     return f"'{name}' (for {port})" if name != port else f"'{port}'"
 
 
-def _contract() -> str:
-    """'Real inputs psi (rad), r (rad/s), psi_d (rad) and a Real output delta_c (rad)'."""
+def _contract(real: str) -> str:
+    """'Real inputs psi (rad), r (rad/s), psi_d (rad) and a Real output delta_c (rad)', with
+    ``real`` the version's type name."""
     def ports(causality: str) -> str:
         return ", ".join(f"{n} ({unit})" for n, (c, unit) in PORTS.items() if c == causality)
-    return f"Real inputs {ports('input')} and a Real output {ports('output')}"
+    return f"{real} inputs {ports('input')} and a {real} output {ports('output')}"
 
 
 def port_problems(description: ModelDescription, port_map: dict[str, str]) -> list[str]:
     """Every way the FMU's variables break the port contract, each with what it expects: a
-    port missing (with the names closest to it), of the wrong causality or type, or in
-    another unit."""
+    port missing (with the names closest to it), of the wrong causality or type (Real in
+    FMI 2.0, Float64 in FMI 3.0: the description as fmpy reads it), or in another unit."""
     variables = {v.name: v for v in description.modelVariables}
+    real = PORT_TYPES[description.fmiVersion]
     problems = []
     for port, (causality, unit) in PORTS.items():
         name, mapped = port_map.get(port, port), _mapped(port, port_map)
         variable = variables.get(name)
         if variable is None:
             close = close_matches(name, variables)
-            problems.append(f"no port {mapped}: expected a Real {causality} in {unit} "
+            problems.append(f"no port {mapped}: expected a {real} {causality} in {unit} "
                             f"({DESCRIPTIONS[port]}){did_you_mean(close)}")
             continue
-        if variable.causality != causality or variable.type != "Real":
+        if variable.causality != causality or variable.type != real:
             problems.append(f"port {mapped} is of causality {variable.causality} and type "
-                            f"{variable.type}: expected a Real {causality} in {unit}")
+                            f"{variable.type}: expected a {real} {causality} in {unit}")
         declared = variable.unit or (variable.declaredType.unit if variable.declaredType
                                      else None)
         if declared and declared != unit:
@@ -114,12 +119,13 @@ def check_autopilot(fmu: str | Path, port_map: dict[str, str] | None = None,
     except Exception as error:
         raise AutopilotError(f"{fmu} is not an FMU, or not a readable one "
                              f"({type(error).__name__}: {error})") from None
-    if description.fmiVersion != "2.0":
+    kinds = " or ".join(PORT_TYPES)
+    if description.fmiVersion not in PORT_TYPES:
         raise AutopilotError(f"{fmu} is an FMI {description.fmiVersion} FMU; an autopilot "
-                             "must be an FMI 2.0 co-simulation FMU")
+                             f"must be an FMI {kinds} co-simulation FMU")
     if description.coSimulation is None:
         raise AutopilotError(f"{fmu} is a model-exchange FMU only; an autopilot must be an "
-                             "FMI 2.0 co-simulation FMU")
+                             f"FMI {kinds} co-simulation FMU")
     platforms = [p for p in fmpy.supported_platforms(str(fmu)) if p != "c-code"]
     if fmpy.platform not in platforms:
         raise AutopilotError(f"{fmu} has no binary for this platform ({fmpy.platform}); it has "
@@ -132,8 +138,10 @@ def check_autopilot(fmu: str | Path, port_map: dict[str, str] | None = None,
                              f"of an autopilot ({', '.join(PORTS)}){did_you_mean(close)}")
     problems = port_problems(description, port_map)
     if problems:
-        raise AutopilotError(f"{fmu} does not keep the autopilot contract ("
-                             f"{_contract()}):\n" + "".join(f"  - {p}\n" for p in problems)
+        raise AutopilotError(f"{fmu} does not keep the autopilot contract of an FMI "
+                             f"{description.fmiVersion} FMU ("
+                             f"{_contract(PORT_TYPES[description.fmiVersion])}):\n"
+                             + "".join(f"  - {p}\n" for p in problems)
                              + f"It has {_listing(description)}. Map other names with --map "
                              "PORT=NAME (--map psi=heading)")
     if trial:

@@ -1,22 +1,23 @@
-"""Everything fmukit owes to pythonfmu 0.7.0, behind one version gate.
+"""FMI 2.0 through pythonfmu 0.7.0: the adapter, and what fmukit owes to that version's defects.
 
-The runtime is written against pythonfmu's ``Fmi2Slave`` (FMI 2.0 co-simulation);
-this folder is the only place that imports pythonfmu, and it holds the compensations
-for pythonfmu 0.7.0's defects, each active only under ``ACTIVE``:
+This folder is the only place that imports pythonfmu. The compensations for
+pythonfmu 0.7.0's defects are active only under ``ACTIVE``:
 
-- ``entry``: every FMI entry point; pythonfmu releases an instance's references once
-  per Python exception, a use-after-free that crashes the host (extra references);
+- ``slave``: ``Fmi2Entry``, the FMI 2.0 half of an FMU's class (``on_fmi2``); its
+  binary releases an instance's references once per Python exception, a
+  use-after-free that crashes the host (``fmukit.entry`` takes extra references);
 - ``hostlog``: pythonfmu forwards log messages only while the host has debug
   logging on; the host's flag is read, and errors go to standard error when it is off;
-- ``signals``: the host's Ctrl-C is handled in the host's own code, not in FMU code
-  that pythonfmu runs inside the host's interpreter;
 - ``binary``: pythonfmu 0.7.0's linux64 binary as fmukit knows it (its exit-time heap
-  corruption is patched when an FMU is built: ``fmubuild.exit_fix``).
+  corruption is patched when an FMU is built: ``fmubuild.exit_fix``);
+- ``model_description``: what pythonfmu 0.7 leaves out of modelDescription.xml.
 
-Replacing pythonfmu is adding a folder like this one beside it and importing it in
-``fmukit.slave`` and ``fmukit.registry``; retiring it, deleting this one.
+The host's Ctrl-C is ``fmukit.hostsignals``', the same for both pythonfmu versions.
+Replacing pythonfmu is adding a folder like this one beside it (as
+``fmukit.pythonfmu3_03`` is for FMI 3.0) and naming it in ``fmukit.compose``;
+retiring it, deleting this one.
 """
-from pythonfmu import DefaultExperiment, Fmi2Causality, Fmi2Initial, Fmi2Slave
+from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave
 from pythonfmu import Fmi2Variability, Integer, Real, String
 from pythonfmu import __version__ as PYTHONFMU_VERSION
 from pythonfmu.enums import Fmi2Status
@@ -24,5 +25,5 @@ from pythonfmu.enums import Fmi2Status
 ACTIVE = PYTHONFMU_VERSION == "0.7.0"
 """Whether the compensations apply: to pythonfmu 0.7.0, whose defects they are for."""
 
-__all__ = ["ACTIVE", "PYTHONFMU_VERSION", "DefaultExperiment", "Fmi2Causality", "Fmi2Initial",
-           "Fmi2Slave", "Fmi2Status", "Fmi2Variability", "Integer", "Real", "String"]
+__all__ = ["ACTIVE", "PYTHONFMU_VERSION", "Fmi2Causality", "Fmi2Initial", "Fmi2Slave",
+           "Fmi2Status", "Fmi2Variability", "Integer", "Real", "String"]

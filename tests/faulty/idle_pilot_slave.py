@@ -1,8 +1,9 @@
 """An autopilot that keeps the rudder amidships: it has the ports, and does not steer.
 
-With ``fail_time`` set it fails every step from then on (an exception: fmi2Fatal);
-with ``hang_time`` its step at that time never returns (a loop in Python); with
-``hang_terminate`` = 1, fmi2Terminate never returns.
+With ``fail_time`` set it fails every step from then on (an exception: fmi2Fatal, or
+fmi3Error as an FMI 3.0 twin); with ``hang_time`` its step at that time never returns (a
+loop in Python); with ``hang_terminate`` = 1, Terminate never returns. Built as either FMI
+version from this one script.
 """
 from fmukit.autopilot import INPUTS, rudder_command
 from fmukit.slave import ModelSlave, Var
@@ -23,7 +24,7 @@ class IdlePilotSlave(ModelSlave):
                  Var.parameter("fail_time", 1e9, "s", "fail every step from then on"),
                  Var.parameter("hang_time", 1e9, "s", "loop for ever in the step at this time"),
                  Var.parameter("hang_terminate", 0, description="1: loop for ever in "
-                               "fmi2Terminate", min=0, max=1))
+                               "Terminate", min=0, max=1))
 
     def build_model(self) -> Idle:
         return Idle()

@@ -1,13 +1,13 @@
 """Ctrl-C while an FMU computes: the host's signal handler runs in the host's code, not ours.
 
-A pythonfmu FMU runs in its host's Python interpreter, and Python runs a signal
-handler in the main thread at the next bytecode it executes: inside the FMU, if
-the host called it from the main thread (fmpy, ecospy, our master). The
+A pythonfmu FMU (of either FMI version) runs in its host's Python interpreter, and
+Python runs a signal handler in the main thread at the next bytecode it executes:
+inside the FMU, if the host called it from the main thread (fmpy, ecospy, our master). The
 KeyboardInterrupt would surface in FMU code, where it can only fail the FMU (a
 host that ignores statuses, ecos, would step on), or, raised at the first
 instruction of an FMI entry point before any ``try``, escape to pythonfmu's C++
 layer, which loses it and releases the instance once too often
-(``fmukit.pythonfmu07.entry``).
+(``fmukit.entry``).
 
 So FMU code is a critical section for the host's Python handlers of SIGINT and
 SIGTERM. ``defer_host_handlers`` wraps each (once per process, from the main
@@ -20,8 +20,8 @@ run anywhere (an attribute ``safe_in_fmu_code``, true: it raises nothing, as our
 master's run watchdog's) is left as it is.
 
 A C or C++ host (the ``ecos`` program) has no Python code of its own; pythonfmu
-starts Python in a thread of its own, which becomes Python's main thread and
-never runs Python again, so Python's SIGINT handler would never run and Ctrl-C
+(pythonfmu3 too) starts Python in a thread of its own, which becomes Python's main
+thread and never runs Python again, so Python's SIGINT handler would never run and Ctrl-C
 would not stop the host. There SIGINT gets its default action back, in the C
 runtime Python installed its handler with: the process's own on POSIX systems;
 on Windows the Universal CRT (``ucrtbase``) that CPython links, whose console

@@ -1,0 +1,108 @@
+"""``Fmi2Entry``: what makes a ``ModelSlave`` an FMI 2.0 co-simulation FMU of pythonfmu 0.7.
+
+An FMU's class is ``class <Model>(Fmi2Entry, <Model>, Fmi2Slave)``: this mixin first,
+the model's class next, pythonfmu's ``Fmi2Slave`` last (pythonfmu picks, of the
+classes in the FMU's entry module, the one with the longest MRO: this one). The entry
+module the build writes defines it; ``on_fmi2`` composes it in code.
+
+FMI 2.0's own here: Real, Integer and String variables; getReal, setReal, getInteger,
+setInteger; fmi2SetupExperiment (the start time the messages name); doStep's result
+(True; every refusal is an exception, fmi2Fatal); the host's debug-logging flag
+(``hostlog``); the model description's completion (``model_description``); the entry
+module's namespace kept alive (``hold_namespace``).
+"""
+from __future__ import annotations
+
+import ctypes
+import functools
+from typing import Any, Callable
+from xml.etree.ElementTree import Element
+
+from ..entry import fmi_entry
+from ..slave import CATEGORIES, ModelSlave
+from ..variables import Var
+from ..hostlog import HostLog
+from . import (ACTIVE, Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Status, Fmi2Variability,
+               Integer, Real, String, hostlog, model_description)
+
+_TYPE = {float: Real, int: Integer, str: String}
+
+
+class Fmi2Entry:
+    """FMI 2.0 through pythonfmu 0.7: the version's half of an FMU's class."""
+
+    API, FMI_VERSION = "fmi2", 2
+    TYPE_NAMES = {float: "Real", int: "Integer", str: "String"}
+    STATUS_ERROR, STATUS_FATAL = Fmi2Status.error, Fmi2Status.fatal
+    RELEASES_ON_EXCEPTION = ACTIVE
+    log_categories = {**Fmi2Slave.log_categories, **CATEGORIES}
+
+    def _host_log(self, kwargs: dict[str, Any]) -> HostLog:
+        return hostlog.host_log(kwargs)
+
+    def fmi_variable(self, var: Var, getter: Callable[[], Any] | None) -> Any:
+        """pythonfmu's Real, Integer or String for ``var``."""
+        kind = _TYPE[var.kind]
+        if var.causality == "output":
+            return kind(var.name, causality=Fmi2Causality.output,
+                        variability=(Fmi2Variability.continuous if var.is_real
+                                     else Fmi2Variability.discrete),
+                        initial=Fmi2Initial.calculated, description=var.description,
+                        getter=getter)
+        variability = (Fmi2Variability.fixed if var.causality == "parameter"
+                       else Fmi2Variability.continuous)
+        return kind(var.name, causality=Fmi2Causality[var.causality], variability=variability,
+                    description=var.description)
+
+    @fmi_entry
+    def setup_experiment(self, start_time: float, stop_time: float | None = None,
+                         tolerance: float | None = None) -> None:
+        self.sequence.require("SetupExperiment", "instantiated")
+        self.start_time = start_time
+
+    @fmi_entry
+    def do_step(self, current_time: float, step_size: float) -> bool:
+        self._step(current_time, step_size)
+        return True
+
+    @fmi_entry
+    def set_real(self, vrs: list[int], values: list[float]) -> None:
+        self._set_floats(vrs, values)
+
+    @fmi_entry
+    def set_integer(self, vrs: list[int], values: list[int]) -> None:
+        self._set(vrs, values, int)
+
+    @fmi_entry
+    def get_real(self, vrs: list[int]) -> list[float]:
+        read = self.plans.real_reader(vrs)
+        return super().get_real(vrs) if read is None else read()   # pythonfmu names a problem
+
+    @fmi_entry
+    def get_integer(self, vrs: list[int]) -> list[int]:
+        read = self.plans.integer_reader(vrs)
+        return super().get_integer(vrs) if read is None else read()
+
+    def to_xml(self, model_options: dict[str, str] = dict()) -> Element:
+        return model_description.complete(super().to_xml(model_options), self.variables)
+
+
+@functools.cache
+def on_fmi2(model: type[ModelSlave]) -> type[ModelSlave]:
+    """The FMI 2.0 FMU class of ``model``, as its FMU's entry module defines it."""
+    return type(model.__name__, (Fmi2Entry, model, Fmi2Slave),
+                {"__module__": model.__module__, "__qualname__": model.__qualname__})
+
+
+def hold_namespace(namespace: dict[str, Any]) -> None:
+    """One more reference on an FMU entry module's namespace, each time its code runs.
+
+    pythonfmu 0.7's C++ finds the FMU's class by running the entry module's code again at
+    every instantiation, in the module's namespace (``findClass``), and then releases
+    that namespace, a reference it never took (``PyModule_GetDict`` lends it): the second
+    FMU instantiated in a process would find the namespace freed (a segfault, or "module
+    has no attribute"). The entry module calls this on its ``globals()``: at import (one
+    reference more, never released) and at each of those runs, whose release it balances.
+    """
+    if ACTIVE:
+        ctypes.pythonapi.Py_IncRef(ctypes.py_object(namespace))

@@ -1,0 +1,132 @@
+"""``Fmi3Entry``: what makes a ``ModelSlave`` an FMI 3.0 co-simulation FMU of pythonfmu3 0.3.4.
+
+An FMU's class is ``class <Model>(Fmi3Entry, <Model>, Fmi3Slave)``: this mixin first,
+the model's class next, pythonfmu3's ``Fmi3Slave`` last. The entry module the build
+writes defines it (pythonfmu3 finds it by a regular expression that wants the word
+Fmi3Slave between the parentheses of its ``class`` line); ``on_fmi3`` composes it in code.
+
+FMI 3.0's own here: Float64, Int32 and String variables and the independent variable
+``time`` (value reference 0, so that a declared variable's value reference is its FMI
+2.0 twin's plus one); getFloat64, setFloat64, getInt32, setInt32; no
+setupExperiment (pythonfmu3 drops fmi3EnterInitializationMode's start time, so the
+messages name none); doStep's result, ``Fmi3StepResult``, whose status is fmi3Error for
+a refused step (every other refusal is an exception: fmi3Fatal); the host's logging
+flag (``hostlog``); the description, author and default experiment, set on the instance
+where pythonfmu3 reads them; the model description's completion (``model_description``).
+"""
+from __future__ import annotations
+
+import functools
+from typing import Any, Callable
+from xml.etree.ElementTree import Element
+
+from .. import state
+from ..entry import fmi_entry
+from ..hostlog import HostLog
+from ..slave import CATEGORIES, ModelSlave
+from ..variables import Var
+from . import (ACTIVE, Fmi3Causality, Fmi3Initial, Fmi3Slave, Fmi3Status, Fmi3StepResult,
+               Fmi3Variability, Float64, Int32, String, hostlog, model_description)
+
+_TYPE = {float: Float64, int: Int32, str: String}
+_FROM_CLASS = ("description", "author", "license", "version", "copyright",
+               "default_experiment")
+"""What pythonfmu3 writes from the instance only, which its __init__ sets to None."""
+
+
+def _refused_step() -> Fmi3StepResult:
+    return Fmi3StepResult(status=Fmi3Status.error)
+
+
+class Fmi3Entry:
+    """FMI 3.0 through pythonfmu3 0.3.4: the version's half of an FMU's class."""
+
+    API, FMI_VERSION = "fmi3", 3
+    TYPE_NAMES = {float: "Float64", int: "Int32", str: "String"}
+    STATUS_ERROR, STATUS_FATAL = Fmi3Status.error, Fmi3Status.fatal
+    RELEASES_ON_EXCEPTION = ACTIVE
+    log_categories = {**Fmi3Slave.log_categories, **CATEGORIES}
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        for attribute in _FROM_CLASS:
+            setattr(self, attribute, getattr(type(self), attribute, None))
+        self.start_time = None                 # not given by pythonfmu3
+
+    def _host_log(self, kwargs: dict[str, Any]) -> HostLog:
+        return hostlog.host_log(kwargs)
+
+    def _before_variables(self) -> None:
+        """``time``, registered first: value reference 0 (``model_description`` writes it
+        last)."""
+        self.time = 0.0
+        self.register_variable(Float64("time", causality=Fmi3Causality.independent,
+                                       variability=Fmi3Variability.continuous,
+                                       description="simulation time",
+                                       getter=lambda: self.time))
+
+    def fmi_variable(self, var: Var, getter: Callable[[], Any] | None) -> Any:
+        """pythonfmu3's Float64, Int32 or String for ``var``."""
+        kind = _TYPE[var.kind]
+        unit = {"unit": var.unit} if var.is_real else {}
+        if var.causality == "output":
+            return kind(var.name, causality=Fmi3Causality.output,
+                        variability=(Fmi3Variability.continuous if var.is_real
+                                     else Fmi3Variability.discrete),
+                        initial=Fmi3Initial.calculated, description=var.description,
+                        getter=getter, **unit)
+        variability = (Fmi3Variability.fixed if var.causality == "parameter"
+                       else Fmi3Variability.continuous)
+        return kind(var.name, causality=Fmi3Causality[var.causality], variability=variability,
+                    description=var.description, **unit)
+
+    def log(self, msg: str, status: Fmi3Status = Fmi3Status.ok, category: str | None = None,
+            debug: bool = False) -> None:
+        """pythonfmu3's log, kept off the host's callback while its logging is off (FMI
+        3.0's rule; ``host_log.tell`` writes the errors to standard error then)."""
+        if self.host_log.hears():
+            super().log(msg, status, category, debug)
+
+    @fmi_entry(error_result=_refused_step)
+    def do_step(self, current_time: float, step_size: float) -> Fmi3StepResult:
+        self._step(current_time, step_size)
+        self.time = current_time + step_size
+        return Fmi3StepResult()
+
+    @fmi_entry
+    def set_float64(self, vrs: list[int], values: list[float]) -> None:
+        self._set_floats(vrs, values)
+
+    @fmi_entry
+    def set_int32(self, vrs: list[int], values: list[int]) -> None:
+        self._set(vrs, values, int)
+
+    @fmi_entry
+    def get_float64(self, vrs: list[int]) -> list[float]:
+        read = self.plans.real_reader(vrs)
+        return super().get_float64(vrs) if read is None else read()  # pythonfmu3 names a problem
+
+    @fmi_entry
+    def get_int32(self, vrs: list[int]) -> list[int]:
+        read = self.plans.integer_reader(vrs)
+        return super().get_int32(vrs) if read is None else read()
+
+    @fmi_entry
+    def _get_fmu_state(self) -> dict[str, Any]:
+        return {**state.capture(self), "time": self.time}
+
+    @fmi_entry
+    def _set_fmu_state(self, saved: dict[str, Any]) -> None:
+        state.restore(self, saved)
+        self.time = saved["time"]
+
+    def to_xml(self, model_options: dict[str, str] = dict()) -> Element:
+        vr = {var.name: vr for vr, var in self.registry.by_vr.items()}
+        return model_description.complete(super().to_xml(model_options), self.variables, vr)
+
+
+@functools.cache
+def on_fmi3(model: type[ModelSlave]) -> type[ModelSlave]:
+    """The FMI 3.0 FMU class of ``model``, as its FMU's entry module defines it."""
+    return type(model.__name__, (Fmi3Entry, model, Fmi3Slave),
+                {"__module__": model.__module__, "__qualname__": model.__qualname__})
