@@ -73,8 +73,10 @@ docs/interop.md)."""
 FMI3_FAULTS = tuple(f for f in FAULTS if f != "corrupt")
 """The faults repeated with the FMI 3.0 twins: all but a corrupt file, which every host fails
 to unzip before it could read the FMI version."""
-CELLS = [(h, f, fmi) for fmi, hosts, faults in ((2, HOSTS, FAULTS), (3, FMI3_HOSTS, FMI3_FAULTS))
-         for h in hosts for f in faults if (h, f) not in NOT_APPLICABLE]
+MATRIX = {2: (HOSTS, FAULTS), 3: (FMI3_HOSTS, FMI3_FAULTS)}
+"""FMI version: its hosts and faults."""
+CELLS = [(h, f, fmi) for fmi, (hosts, faults) in MATRIX.items() for h in hosts
+         for f in faults if (h, f) not in NOT_APPLICABLE]
 IDS = [f"{h}-{f}" if fmi == 2 else f"fmi3-{h}-{f}" for h, f, fmi in CELLS]
 KIND = {"nan": 1, "range": 2, "parameter": 0, "exception": 3, "sigint": 4, "sigterm": 5,
         "loop": 6, "block": 7}
@@ -203,9 +205,11 @@ def _files(ship: Path, root: Path, fmi: int) -> Files:
     for fault in KIND:
         write_ssd(_system(ship, fault_fmu, fault), root / f"{fault}.ssd")
         export(root / f"{fault}.ssd", root / "packages")
-    corrupt_ship = _truncated(ship, root / "corrupt_ship.fmu")
-    write_ssd(_system(corrupt_ship, fault_fmu, "exception"), root / "corrupt.ssd")
-    _truncated(root / "packages" / "exception.ssp", root / "packages" / "corrupt.ssp")
+    fmus = {"ship": ship, "fault": fault_fmu}
+    if "corrupt" in MATRIX[fmi][1]:
+        fmus["corrupt"] = _truncated(ship, root / "corrupt_ship.fmu")
+        write_ssd(_system(fmus["corrupt"], fault_fmu, "exception"), root / "corrupt.ssd")
+        _truncated(root / "packages" / "exception.ssp", root / "packages" / "corrupt.ssp")
     for fault, column, value in (("nan", "delta_c", "nan"), ("range", "n1", "100")):
         row = {"delta_c": "0.1", "n1": "8.13"}
         lines = ["time,delta_c,n1"]
@@ -215,7 +219,7 @@ def _files(ship: Path, root: Path, fmi: int) -> Files:
         for t in (FAULT_TIME, 10.0):
             lines.append(f"{t},{row['delta_c']},{row['n1']}")
         (root / f"{fault}.csv").write_text("\n".join(lines) + "\n")
-    return Files(root, {"ship": ship, "fault": fault_fmu, "corrupt": corrupt_ship}, fmi)
+    return Files(root, fmus, fmi)
 
 
 @pytest.fixture(scope="session")
