@@ -11,6 +11,7 @@ energy properties on exactly these vectors.
 from __future__ import annotations
 
 import math
+from typing import Callable
 
 import numpy as np
 
@@ -19,9 +20,13 @@ from .data import Hull
 Vector3 = tuple[float, float, float]
 
 
-def kinematics(psi: float, u: float, v: float, r: float) -> Vector3:
-    """Earth-fixed velocity eta_dot = R(psi) nu, eqs (1)-(2)."""
-    c, s = math.cos(psi), math.sin(psi)
+def kinematics(psi: float, u: float, v: float, r: float,
+               cos: Callable = math.cos, sin: Callable = math.sin) -> Vector3:
+    """Earth-fixed velocity eta_dot = R(psi) nu, eqs (1)-(2).
+
+    ``cos`` and ``sin``: numpy's, for states that are arrays (``cosim.ensemble``).
+    """
+    c, s = cos(psi), sin(psi)
     return u * c - v * s, u * s + v * c, r
 
 

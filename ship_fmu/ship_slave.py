@@ -13,6 +13,9 @@ from ship_fmu.vessel import N_PROPELLER, Vessel, VesselParameters
 _P = VesselParameters()
 N_MAX = 50.0
 """Largest shaft speed an input may ask for, rev/s (8.13 gives 0.3 m/s)."""
+ANGLE_MAX = 1e6
+"""Largest |psi0| and |psi_w|, rad (160,000 turns): beyond about 1e307 the wave moment's
+sin(2 beta) has no finite argument."""
 _SEA = ("Hs", "T0", "psi_w", "wave_seed", "wave_components", "psi0")
 
 
@@ -39,7 +42,7 @@ class ShipSlave(ModelSlave):
         Var.output("N_w", "N.m", "wave yaw moment, eq (16)", depends=_SEA),
         Var.parameter("x0", _P.x0, "m", "initial north position"),
         Var.parameter("y0", _P.y0, "m", "initial east position"),
-        Var.parameter("psi0", _P.psi0, "rad", "initial heading"),
+        Var.parameter("psi0", _P.psi0, "rad", "initial heading", -ANGLE_MAX, ANGLE_MAX),
         Var.parameter("u0", _P.u0, "m/s", "initial surge velocity", -5.0, 5.0),
         Var.parameter("v0", _P.v0, "m/s", "initial sway velocity", -5.0, 5.0),
         Var.parameter("r0", _P.r0, "rad/s", "initial yaw rate", -5.0, 5.0),
@@ -49,7 +52,7 @@ class ShipSlave(ModelSlave):
         Var.parameter("Hs", _P.Hs, "m", "significant wave height; 0 = calm water (0.1 m is "
                       "7 m at full scale)", 0.0, 0.1),
         Var.parameter("T0", _P.T0, "s", "modal period of the wave spectrum", 0.1, 10.0),
-        Var.parameter("psi_w", _P.psi_w, "rad", "wave direction"),
+        Var.parameter("psi_w", _P.psi_w, "rad", "wave direction", -ANGLE_MAX, ANGLE_MAX),
         Var.parameter("wave_seed", _P.wave_seed, description="seed of the wave realisation",
                       min=0, max=2**31 - 1),
         Var.parameter("wave_components", _P.wave_components,

@@ -168,10 +168,10 @@ class Vessel:
             tau1 = tau0 if delta1 == delta0 != 0.0 else forces(delta1)
             tau2 = tau1 if delta2 == delta1 != 0.0 else forces(delta2)
             k1 = rates(ts, y, tau0)
-            k2 = rates(ts + hh, _axpy(hh, k1, y), tau1)
-            k3 = rates(ts + hh, _axpy(hh, k2, y), tau1)
-            k4 = rates(ts + hs, _axpy(hs, k3, y), tau2)
-            y = _rk4(c, y, k1, k2, k3, k4)
+            k2 = rates(ts + hh, axpy(hh, k1, y), tau1)
+            k3 = rates(ts + hh, axpy(hh, k2, y), tau1)
+            k4 = rates(ts + hs, axpy(hs, k3, y), tau2)
+            y = rk4_update(c, y, k1, k2, k3, k4)
         return y
 
     def _cut_of(self, length: float) -> tuple[int, float]:
@@ -195,13 +195,13 @@ def _calm_water(t: float, xi: float, psi: float) -> tuple[float, float, float]:
     return (0.0, 0.0, 0.0)
 
 
-def _axpy(a: float, x: State, y: State) -> State:
+def axpy(a: float, x: State, y: State) -> State:
     """y + a x for the 7 states, written out: it runs three times a step."""
     return (y[0] + a * x[0], y[1] + a * x[1], y[2] + a * x[2], y[3] + a * x[3],
             y[4] + a * x[4], y[5] + a * x[5], y[6] + a * x[6])
 
 
-def _rk4(c: float, y: State, k1: State, k2: State, k3: State, k4: State) -> State:
+def rk4_update(c: float, y: State, k1: State, k2: State, k3: State, k4: State) -> State:
     """The RK4 update y + h/6 (k1 + 2 k2 + 2 k3 + k4), with c = h/6."""
     return (y[0] + c * (k1[0] + 2.0 * k2[0] + 2.0 * k3[0] + k4[0]),
             y[1] + c * (k1[1] + 2.0 * k2[1] + 2.0 * k3[1] + k4[1]),
