@@ -158,25 +158,12 @@ class Master:
         the initialisation and each step; a limit passed ends the run with an error
         (``cosim.core.watchdog``), as an FMU failure does.
         """
-        system = self.system
-        t0, h = system.start_time, seconds(nanoseconds(system.step_size))
-        n_steps = step_count(t0, system.stop_time if stop_time is None else stop_time, h)
-        meta = {"system": system.name, "description": system.description,
-                "scenario_file": str(system.path) if system.path else None,
-                "backend": self.backend, "backends": self.backends, "notes": self.notes,
-                "coupling": self.coupling, "start_time": t0,
-                "step_size": h, "stop_time": communication_point(t0, n_steps, h),
-                "scenario_stop_time": system.stop_time,
-                "settings": self.parameters, "overrides": self.overrides,
-                "fmus": {name: {"file": str(i.path), "guid": getattr(i, "guid", None)}
-                         for name, i in self.instances.items()}}
+        t0, h, n_steps = self.steps(stop_time)
+        meta = self.run_meta(n_steps)
         recorder = Recorder(self.columns, n_steps + 1, csv_path, chunk_rows, meta=meta,
                             units=self.units)
         exchange, nodes, values = COUPLINGS[self.coupling], self.nodes, [0.0] * len(self.columns)
         k, t, error, started = 0, t0, None, time.perf_counter()
-        meta["parameter_units"] = {
-            name: {n: i.unit(n) for n, v in i.variables.items() if v.causality == "parameter"}
-            for name, i in self.instances.items()}
         self.parameter_values = {}
         self._recorder = recorder
         beat = watchdog.beat if watchdog is not None else _no_watchdog
@@ -212,6 +199,32 @@ class Master:
             meta["wall_time_s"] = time.perf_counter() - started
             recording = recorder.close(error)
         return recording
+
+    def steps(self, stop_time: float | None = None) -> tuple[float, float, int]:
+        """(t0, h, number of steps) of a run to ``stop_time`` (default: the system's), h on
+        the FMUs' time base; ValueError unless the stop time is a whole number of steps."""
+        system = self.system
+        t0, h = system.start_time, seconds(nanoseconds(system.step_size))
+        return t0, h, step_count(t0, system.stop_time if stop_time is None else stop_time, h)
+
+    def run_meta(self, n_steps: int) -> dict[str, Any]:
+        """What a run of ``n_steps`` records about itself before it starts: the system, the
+        backends, the time grid, the settings and the FMUs (``parameters`` and
+        ``wall_time_s`` are added as it ends)."""
+        system, t0, h = self.system, self.system.start_time, self.steps()[1]
+        return {"system": system.name, "description": system.description,
+                "scenario_file": str(system.path) if system.path else None,
+                "backend": self.backend, "backends": self.backends, "notes": self.notes,
+                "coupling": self.coupling, "start_time": t0,
+                "step_size": h, "stop_time": communication_point(t0, n_steps, h),
+                "scenario_stop_time": system.stop_time,
+                "settings": self.parameters, "overrides": self.overrides,
+                "fmus": {name: {"file": str(i.path), "guid": getattr(i, "guid", None)}
+                         for name, i in self.instances.items()},
+                "parameter_units": {
+                    name: {n: i.unit(n) for n, v in i.variables.items()
+                           if v.causality == "parameter"}
+                    for name, i in self.instances.items()}}
 
     def abandon(self, reason: str) -> Recording | None:
         """The rows of the run under way, closed with ``reason`` as its error, for a

@@ -5,20 +5,21 @@ Simulink model and the master's Gauss-Seidel coupling. The models are built by
 the same ``build_model`` code the FMUs use (as this checkout has it, whatever the FMUs
 were built from), from the parameters of a course-keeping system description
 (components named guidance, autopilot and ship). This is the
-in-process limit the benchmark measures and the reference the equality tests use.
+in-process limit the benchmark measures and the reference the equality tests use
+(the loop itself: ``cosim.ensemble.reference.step_models``).
 """
 from __future__ import annotations
 
 import numpy as np
 
-from fmukit.timebase import communication_point, step_count
+from fmukit.timebase import step_count
 from ship_fmu.vessel import N_PROPELLER
 
 from ..core.inprocess import InProcessInstance
 from ..core.ssd import SystemDescription
+from ..ensemble.reference import SIGNALS, step_models
 
-COMPARED = ("guidance.psi_d", "autopilot.delta_c", "ship.x", "ship.y", "ship.psi", "ship.u",
-            "ship.v", "ship.r", "ship.delta")
+COMPARED = SIGNALS
 """The signals compared between the co-simulation and the modules wired by hand."""
 
 
@@ -46,21 +47,7 @@ def shaft_speeds(system: SystemDescription) -> tuple[float, float, float]:
 def run_direct(system: SystemDescription, stop_time: float | None = None) -> dict[str, np.ndarray]:
     """Simulate; each signal sampled at t_k = k h, k = 0 .. N, like the master's rows."""
     models = build_models(system)
-    guidance, autopilot, ship = (models[n] for n in ("guidance", "autopilot", "ship"))
-    n1, n2, n3 = shaft_speeds(system)
-    stepping_pilot = hasattr(autopilot, "step")
     h, t0 = system.step_size, system.start_time
     n_steps = step_count(t0, system.stop_time if stop_time is None else stop_time, h)
-    out = np.empty((n_steps + 1, len(COMPARED)))
-    for k in range(n_steps + 1):
-        t = communication_point(t0, k, h)
-        psi_d = guidance.psi_d(ship.x, ship.y)
-        delta_c = autopilot.command(ship.psi, ship.r, psi_d)
-        out[k] = (psi_d, delta_c, ship.x, ship.y, ship.psi, ship.u, ship.v, ship.r, ship.delta)
-        if k == n_steps:
-            break
-        guidance.update(ship.x, ship.y)
-        if stepping_pilot:
-            autopilot.step(t, h, psi_d)
-        ship.step(t, h, delta_c, n1, n2, n3)
-    return dict(zip(COMPARED, out.T))
+    return step_models(*(models[n] for n in ("guidance", "autopilot", "ship")),
+                       shaft_speeds(system), t0, h, n_steps)

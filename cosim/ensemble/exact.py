@@ -1,0 +1,53 @@
+"""The scalar models' functions on arrays, each element to the bit of the scalar call.
+
+The scalar models call ``math.hypot`` (CPython's own algorithm, not the C library's),
+``math.tanh`` and ``math.remainder`` (through ``fmukit.numerics.wrap``); numpy's
+``np.hypot`` and ``np.tanh`` round differently on a share of inputs. Here ``hypot`` and
+``tanh`` call the math functions element by element (at a few hundred members that costs
+no more than a dozen array operations would), and ``wrap`` rebuilds CPython's
+``math.remainder`` from ``np.fmod``, which is exact, with the same case analysis.
+
+What numpy computes on arrays as the C library does (``np.sin``, ``np.cos``, ``+ - * /``,
+``np.sqrt``) is used as is; ``cosim.ensemble.selftest`` checks on each machine that it
+does.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+TWO_PI = 2.0 * math.pi
+
+_hypot = np.frompyfunc(math.hypot, 2, 1)
+_tanh = np.frompyfunc(math.tanh, 1, 1)
+
+
+def hypot(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """``math.hypot`` of each pair of elements."""
+    return _hypot(x, y).astype(float)
+
+
+def tanh(x: np.ndarray) -> np.ndarray:
+    """``math.tanh`` of each element."""
+    return _tanh(x).astype(float)
+
+
+def remainder(x: np.ndarray, y: float) -> np.ndarray:
+    """``math.remainder(x, y)`` of each element, for a finite y > 0: x - n y with n the
+    integer nearest x / y (ties to even), as CPython computes it (``m_remainder``)."""
+    absx = np.abs(x)
+    m = np.fmod(absx, y)
+    c = y - m
+    r = np.where(m < c, m, -c)
+    tie = m == c
+    if tie.any():                        # half way: the even multiple of y
+        r = np.where(tie, m - 2.0 * np.fmod(0.5 * (absx - m), y), r)
+    r = np.copysign(1.0, x) * r
+    return np.where(np.isfinite(x), r, np.nan)
+
+
+def wrap(angle: np.ndarray) -> np.ndarray:
+    """``fmukit.numerics.wrap`` of each element: the angle mod 2 pi in (-pi, pi]."""
+    wrapped = remainder(angle, TWO_PI)
+    return np.where(wrapped == -math.pi, math.pi, wrapped)

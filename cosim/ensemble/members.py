@@ -1,0 +1,82 @@
+"""Which systems and members the batch kernel runs, and each member's initial models.
+
+A member is initialised by the in-process master exactly as a run of it would be
+(parameters checked and set, initial outputs propagated, the models built by the FMUs'
+own slave classes); the kernel then takes over the stepping from the models it built.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from fmubuild.manifest import read as read_manifest
+
+from ..core.inprocess import fallback_note
+from ..core.instance import FmuCallError
+from ..core.master import Master
+from ..core.ssd import SystemDescription
+from .control import KINDS
+
+COMPONENTS = ("guidance", "autopilot", "ship")
+WIRING = frozenset({("guidance", "psi_d", "autopilot", "psi_d"),
+                    ("ship", "psi", "autopilot", "psi"), ("ship", "r", "autopilot", "r"),
+                    ("autopilot", "delta_c", "ship", "delta_c"),
+                    ("ship", "x", "guidance", "x"), ("ship", "y", "guidance", "y")})
+"""The course-keeping loop of cosim/scenarios: the only wiring the kernel steps."""
+MODELS = {"guidance": ("guidance",), "ship": ("ship",),
+          "autopilot": ("pd_autopilot", "pid_autopilot", "smc_autopilot")}
+"""The FMUs, by model name, whose models the kernel has array forms of."""
+
+
+def coverage(system: SystemDescription) -> str | None:
+    """Why the batch kernel cannot run ``system`` at all, or None if it can: this
+    project's guidance, ship and PD, PID or sliding-mode autopilot, current in this
+    process, wired as the course-keeping scenarios are."""
+    names = set(system.components)
+    if names != set(COMPONENTS):
+        return (f"the batch route runs course keeping (guidance, autopilot, ship), not "
+                f"{', '.join(sorted(names))}")
+    wiring = {(c.start_element, c.start_connector, c.end_element, c.end_connector)
+              for c in system.connections}
+    if wiring != WIRING:
+        return "its connections are not the course-keeping loop of cosim/scenarios"
+    for name in COMPONENTS:
+        path = system.fmu_path(name)
+        note = fallback_note(name, path)
+        if note is not None:
+            return str(note)
+        model = read_manifest(path).model_name
+        if model not in MODELS[name]:
+            return (f"{name} ({path.name}) is the model '{model}', which the batch kernel has "
+                    f"no array form of (it has: {', '.join(MODELS[name])})")
+    return None
+
+
+@dataclass
+class Member:
+    """One member as the in-process master initialised it."""
+
+    models: dict[str, Any]              # component: its model (Vessel, WaypointGuidance, ...)
+    shafts: tuple[float, float, float]  # the ship's n1, n2, n3
+    meta: dict[str, Any]                # what Master.run records about the run
+
+
+def initialise(master: Master, overrides: dict[str, dict[str, Any]],
+               n_steps: int) -> Member | None:
+    """The member of ``overrides`` initialised by ``master`` (an in-process master of a
+    covered system, reset here), or None if its initialisation fails (its run on the
+    in-process route then records why)."""
+    master.reset()
+    master.configure(overrides)
+    try:
+        master.initialize()
+    except FmuCallError:
+        return None
+    slaves = {name: master.instances[name].slave for name in COMPONENTS}
+    if type(slaves["autopilot"].model).__name__ not in KINDS:
+        return None
+    meta = master.run_meta(n_steps)
+    meta["parameters"] = master.parameter_values
+    ship = slaves["ship"]
+    return Member({name: slave.model for name, slave in slaves.items()},
+                  (ship.n1, ship.n2, ship.n3), meta)

@@ -1,0 +1,45 @@
+"""The scalar models stepped as the master steps them: the reference the batch kernel is
+pinned to.
+
+guidance -> autopilot -> ship at each communication point, in the Gauss-Seidel order the
+master derives from the declared feedthrough, each signal sampled at t_k = t_0 + k h
+(``fmukit.timebase``), as the master records its rows.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from fmukit.timebase import communication_point
+
+SIGNALS = ("guidance.psi_d", "guidance.wp_index", "autopilot.delta_c", "ship.x", "ship.y",
+           "ship.psi", "ship.u", "ship.v", "ship.r", "ship.delta")
+"""Every signal of the course-keeping loop that the scalar reference and the kernel
+record (the ship's wave loads aside)."""
+
+
+def step_models(guidance: Any, autopilot: Any, ship: Any, shafts: tuple[float, float, float],
+                t0: float, h: float, n_steps: int) -> dict[str, np.ndarray]:
+    """Step initialised scalar models ``n_steps`` steps of h from t0 with the shaft speeds
+    ``shafts`` (n1, n2, n3); each of ``SIGNALS`` at t_0 .. t_N."""
+    n1, n2, n3 = shafts
+    stepping_pilot = hasattr(autopilot, "step")
+    pid = type(autopilot).__name__ == "PIDAutopilot"      # steps with its inputs, as its slave
+    out = np.empty((n_steps + 1, len(SIGNALS)))
+    for k in range(n_steps + 1):
+        t = communication_point(t0, k, h)
+        psi_d = guidance.psi_d(ship.x, ship.y)
+        wp_index = guidance.wp_index(ship.x, ship.y)
+        delta_c = autopilot.command(ship.psi, ship.r, psi_d)
+        out[k] = (psi_d, wp_index, delta_c, ship.x, ship.y, ship.psi, ship.u, ship.v, ship.r,
+                  ship.delta)
+        if k == n_steps:
+            break
+        guidance.update(ship.x, ship.y)
+        if pid:
+            autopilot.step(h, ship.psi, ship.r, psi_d)
+        elif stepping_pilot:
+            autopilot.step(t, h, psi_d)
+        ship.step(t, h, delta_c, n1, n2, n3)
+    return dict(zip(SIGNALS, out.T))

@@ -1,0 +1,139 @@
+"""``simulate_members``: the members of one system, in lockstep where the kernel covers
+them, alone on the in-process route where it does not."""
+from __future__ import annotations
+
+import time
+from collections import defaultdict
+from typing import Any, Sequence
+
+import numpy as np
+
+from fmukit.timebase import communication_point
+
+from ..core.master import Master
+from ..core.recording import Recording
+from ..core.ssd import SystemDescription
+from .control import GuidanceArrays, autopilot_arrays
+from .members import Member, coverage, initialise
+from .reference import SIGNALS as ALL_SIGNALS
+from .selftest import selftest
+from .vessel import VesselArrays
+
+SIGNALS = ("guidance.psi_d", "guidance.wp_index", "ship.x", "ship.y", "ship.psi",
+           "ship.delta")
+"""What the figures of merit of a run need (``cosim.studies.sweep_task.run_metrics``)."""
+
+R_MAX = 100.0
+"""The autopilots' declared range of their yaw-rate input, rad/s: beyond it they refuse."""
+
+
+def simulate_members(system: SystemDescription, overrides: Sequence[dict[str, dict[str, Any]]],
+                     stop_time: float | None = None,
+                     signals: Sequence[str] = SIGNALS) -> list[Recording]:
+    """One recording per member of ``system`` with ``overrides[i]`` (as
+    ``Master(system, backend="inprocess").run(stop_time)`` records it, holding the columns
+    ``signals``, any of ``reference.SIGNALS``). ValueError naming the member whose settings
+    are refused, before anything runs."""
+    unknown = [s for s in signals if s not in ALL_SIGNALS]
+    if unknown:
+        raise ValueError(f"signals {', '.join(unknown)}: the batch route records only "
+                         f"{', '.join(ALL_SIGNALS)}")
+    with Master(system, backend="inprocess") as master:
+        for i, member in enumerate(overrides):
+            try:
+                master.configure(member)
+            except ValueError as error:
+                raise ValueError(f"member {i}: {error}") from None
+        _, h, n_steps = master.steps(stop_time)
+        reason = coverage(system) or selftest()
+        recordings: dict[int, Recording] = {}
+        groups: dict[tuple, list[tuple[int, Member]]] = defaultdict(list)
+        for i, member_overrides in enumerate(overrides):
+            member = None if reason else initialise(master, member_overrides, n_steps)
+            why = reason or _outside(member, h)
+            if why:
+                recordings[i] = _alone(master, member_overrides, stop_time, signals, why)
+            else:
+                groups[_group(member)].append((i, member))
+        for members in groups.values():
+            for i, recording in _lockstep(members, system.start_time, h, n_steps, signals,
+                                          master.units):
+                recordings[i] = recording or _alone(
+                    master, overrides[i], stop_time, signals,
+                    "it failed in the batch kernel, and ran alone to say why")
+    return [recordings[i] for i in range(len(overrides))]
+
+
+def _outside(member: Member | None, h: float) -> str | None:
+    """Why the kernel does not step this member (None: it does)."""
+    if member is None:
+        return "its initialisation failed"
+    ship = member.models["ship"]
+    if ship._cut_of(h)[0] != 1:
+        return (f"ship.h_max = {ship.params.h_max} s cuts the {h} s step into RK4 sub-steps, "
+                "which the batch kernel does not")
+    return None
+
+
+def _group(member: Member) -> tuple:
+    """What members stepped together must share: calm water or waves, and how many
+    wave components."""
+    waves = member.models["ship"].waves
+    return (0,) if waves is None else (len(waves.components.omega),)
+
+
+def _alone(master: Master, overrides: dict[str, dict[str, Any]], stop_time: float | None,
+           signals: Sequence[str], why: str) -> Recording:
+    """The member run on the in-process route, its recording cut to ``signals``."""
+    master.reset()
+    master.configure(overrides)
+    recording = master.run(stop_time)
+    recording.meta["notes"] = [*recording.meta.get("notes", []),
+                               f"ran on the in-process route, not in the batch: {why}"]
+    columns = [recording.columns.index(s) for s in signals]
+    return Recording(list(signals), recording.time, recording.data[:, columns], recording.rows,
+                     recording.error, recording.interrupted, recording.meta,
+                     units={s: recording.units.get(s, "") for s in signals})
+
+
+def _lockstep(members: list[tuple[int, Member]], t0: float, h: float, n_steps: int,
+              signals: Sequence[str], units: dict[str, str]
+              ) -> list[tuple[int, Recording | None]]:
+    """The members stepped together; (index, recording), None for a member that failed
+    (a signal not finite, or a yaw rate outside the autopilot's range)."""
+    started = time.perf_counter()
+    models = [m.models for _, m in members]
+    ship = VesselArrays([m["ship"] for m in models], h)
+    ship.set_shaft_speeds(*(np.array(column) for column in zip(*(m.shafts for _, m in members))))
+    guidance = GuidanceArrays([m["guidance"] for m in models])
+    pilot = autopilot_arrays([m["autopilot"] for m in models])
+    block = np.empty((len(signals), len(members), n_steps + 1))
+    rows = [ALL_SIGNALS.index(s) for s in signals]
+    failed = np.zeros(len(members), dtype=bool)
+    with np.errstate(all="ignore"):                # a failing member's lanes only
+        for k in range(n_steps + 1):
+            t = communication_point(t0, k, h)
+            psi_d, wp_index = guidance.outputs(ship.x, ship.y)
+            delta_c = pilot.command(ship.psi, ship.r, psi_d)
+            values = (psi_d, wp_index, delta_c, ship.x, ship.y, ship.psi, ship.u, ship.v,
+                      ship.r, ship.delta)
+            for row, signal in enumerate(rows):
+                block[row, :, k] = values[signal]
+            failed |= ~np.isfinite(np.add.reduce(values[2:]) + ship.xi) | (np.abs(ship.r) > R_MAX)
+            if k == n_steps:
+                break
+            pilot.step(t, h, ship.psi, ship.r, psi_d)
+            ship.step(t, h, delta_c)
+    times = np.array([communication_point(t0, k, h) for k in range(n_steps + 1)])
+    share = (time.perf_counter() - started) / len(members)
+    out = []
+    for j, (i, member) in enumerate(members):
+        if failed[j]:
+            out.append((i, None))
+            continue
+        meta = {**member.meta, "backend": "batch",
+                "backends": {name: "batch" for name in member.meta["backends"]},
+                "wall_time_s": share}
+        out.append((i, Recording(list(signals), times, block[:, j, :].T, n_steps + 1,
+                                 meta=meta, units={s: units[s] for s in signals})))
+    return out
