@@ -4,6 +4,7 @@
     python -m cosim.sweep SPEC --scheduler tcp://host:8786       # an existing Dask cluster
     python -m cosim.sweep SPEC --workers 2 --csv --out results/sweeps
     python -m cosim.sweep SPEC --backend inprocess               # our FMUs without FMI: faster
+    python -m cosim.sweep SPEC --backend batch                   # many runs per task: fastest
 
 SPEC is a TOML file (see docs/sweeps/example.toml):
 
@@ -36,6 +37,16 @@ Each Dask task is one whole co-simulation with our master (``sweep_task``). The
 client sends every FMU once, by content (``bundle``): a worker needs the project
 installed, nothing else, and runs the client's code or is refused. A worker keeps
 each system's FMUs per thread and resets them (fmi2Reset) between tasks.
+
+--backend batch runs the runs of each PD, PID or SMC course-keeping system as batches,
+one task each (``cosim.ensemble``: the members stepped together as numpy arrays), with
+every row's columns the in-process route's, bit for bit, but backend, seconds and
+sim_seconds (the run's share of its batch). --batch-size caps a batch's runs (default:
+enough batches to keep every worker busy, of 32 to 256 runs where there are that many).
+A system the kernel does not cover (a foreign autopilot FMU) runs in-process, one run per
+task, with a note; so does every run of a batch that fails as a whole, and of a worker
+whose self-test refuses the route (said once), each row saying why in its backend. A
+batch's time limits are the per-run limits times its runs.
 
 A run's id hashes everything that determines its result (the system and its FMUs'
 contents, the settings, the stop time, the axis values). Combinations that differ
@@ -71,14 +82,13 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ..core.master import RUN_BACKENDS
 from ..core.watchdog import Limits
 from .cluster import CONNECT_TIMEOUT, connect
 from .journal import Journal, JournalLocked, read_rows
 from .sweep_client import NoWorkers, SweepError, check_workers, run_on_cluster
 from .sweep_spec import Spec, controller_entry
 from .sweep_tables import comparison, write_tables
-from .sweep_task import METRICS, run_one
+from .sweep_task import BATCH, METRICS, SWEEP_BACKENDS, run_batch, run_one
 
 __all__ = ["execute", "completed", "run_locally", "NO_WORKER_TIMEOUT",
            # from the modules above, for the scorecard and the tests
@@ -92,29 +102,41 @@ NO_WORKER_TIMEOUT = 60.0
 def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | None = None,
             progress: bool = True, task=None, scheduler_file: str | None = None,
             backend: str = "fmi", no_worker_timeout: float = NO_WORKER_TIMEOUT,
-            connect_timeout: float = CONNECT_TIMEOUT, limits: Limits = Limits()) -> list[dict]:
+            connect_timeout: float = CONNECT_TIMEOUT, limits: Limits = Limits(),
+            batch_size: int | None = None, batch_task=None) -> list[dict]:
     """Run every run of ``spec`` without an ok row in the journal (failed rows are run
     again); return every row of the sweep.
 
-    ``backend``: the master's, "fmi" or "inprocess" (this project's FMUs as Python
-    classes: the same results, faster; any other FMU runs through FMI,
-    ``Spec.backend_notes`` says which). The backend is not part of a run's identity: a
-    sweep may be resumed with the other. ``limits``: each run's step and run time limits
-    (``cosim.core.watchdog``): a run past them is recorded failed, saying which.
+    ``backend``: "fmi" or "inprocess", the master's ("inprocess": this project's FMUs as
+    Python classes: the same results, faster; any other FMU runs through FMI,
+    ``Spec.backend_notes`` says which), or "batch": the runs of each system the batch
+    kernel covers in batches of at most ``batch_size`` runs (default: ``batches``), one
+    task each (``batch_task(jobs, blobs) -> rows``, default ``sweep_task.run_batch``),
+    the others in-process. The backend is not part of a run's identity: a sweep may be
+    resumed with another. ``limits``: each run's step and run time limits
+    (``cosim.core.watchdog``; a batch's are these times its runs): a run past them is
+    recorded failed, saying which.
 
-    ``task(job, blobs) -> row`` is what each run executes (default ``run_one``). Each
-    distinct FMU goes to the cluster once (``cosim.studies.bundle``); each run's future
-    is released as soon as its row is journaled, so a lost worker costs only the runs
+    ``task(job, blobs) -> row`` is what each run alone executes (default ``run_one``). Each
+    distinct FMU goes to the cluster once (``cosim.studies.bundle``); each task's future
+    is released as soon as its rows are journaled, so a lost worker costs only the runs
     it had in flight. On Ctrl-C or SIGTERM (``Interrupted``, raised again once the
     cluster is closed) the runs completed so far stay in the journal (``completed``);
     the same call then resumes. A cluster with no worker for ``no_worker_timeout``
     seconds ends the sweep the same way, with ``NoWorkers``. SweepError if a worker runs
     other code than the client or another sweep writes the journal; ``cluster.ClusterError``
     (a ValueError) if the scheduler cannot be found or reached within ``connect_timeout``
-    seconds, or ``workers`` makes no sense.
+    seconds, or ``workers`` makes no sense; ValueError for another backend, or a
+    ``batch_size`` that is not a whole number >= 1 of the batch backend.
     """
-    if backend not in RUN_BACKENDS:
-        raise ValueError(f"backend must be fmi or inprocess, got {backend!r}")
+    if backend not in SWEEP_BACKENDS:
+        raise ValueError(f"backend must be {', '.join(SWEEP_BACKENDS[:-1])} or "
+                         f"{SWEEP_BACKENDS[-1]}, got {backend!r}")
+    if batch_size is not None and backend != BATCH:
+        raise ValueError(f"batch_size is the batch backend's, not the {backend} backend's")
+    if batch_size is not None and (isinstance(batch_size, bool)
+                                   or not isinstance(batch_size, int) or batch_size < 1):
+        raise ValueError(f"batch_size must be a whole number >= 1, got {batch_size!r}")
     if not 0 < no_worker_timeout < float("inf"):
         raise ValueError(f"no_worker_timeout must be a number of seconds > 0, got "
                          f"{no_worker_timeout!r}")
@@ -130,7 +152,7 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
                 run_on_cluster(spec, todo, journal,
                                connect(scheduler, workers, scheduler_file, connect_timeout),
                                progress, task or run_one, backend, no_worker_timeout,
-                               limits.check())
+                               limits.check(), batch_task or run_batch, batch_size)
     except JournalLocked as locked:
         raise SweepError(str(locked)) from None
     return completed(spec, out)
@@ -169,6 +191,8 @@ def _as_row_of(spec: Spec, run: dict, result: dict) -> dict:
 
 def run_locally(spec: Spec, run: dict[str, Any], backend: str = "fmi",
                 limits: Limits = Limits()) -> dict[str, Any]:
-    """One run of ``spec`` in this process, as a worker would do it."""
-    job = spec.job(run, "local", backend, limits)
-    return run_one(job, {sha: spec.files()[sha].read_bytes() for sha in job.bundle.fmu_hashes()})
+    """One run of ``spec`` in this process, as a worker would do it (on "batch", as a batch
+    of one)."""
+    job = spec.job(run, "local", "inprocess" if backend == BATCH else backend, limits)
+    blobs = {sha: spec.files()[sha].read_bytes() for sha in job.bundle.fmu_hashes()}
+    return run_batch([job], blobs)[0] if backend == BATCH else run_one(job, blobs)

@@ -1,16 +1,21 @@
 """A sweep's client side: its runs submitted to a Dask cluster, each row journaled as it
 completes, and the cluster watched for workers that run other code, or none at all.
 
+On the batch backend the runs of each system and stop time go in batches (``plan``,
+``batches``), one task each; a batch whose worker died on every retry has its runs
+submitted again one per task, so that only a run that kills its worker fails.
 ``sweep_task`` is the other side: what a worker runs.
 """
 from __future__ import annotations
 
 import logging
+import math
 import queue
 import sys
 import time
 import uuid
 from contextlib import contextmanager
+from dataclasses import dataclass
 from typing import Iterator
 
 from ..core.interrupt import Interrupted, StopSignals
@@ -19,7 +24,8 @@ from ..core.watchdog import Limits
 from .bundle import UnsafeCache, fmu_cache
 from .journal import Journal
 from .sweep_spec import Spec
-from .sweep_task import SweepTeardown, blank_row, fmu_bytes, worker_facts
+from .sweep_task import (BATCH, Job, SweepTeardown, batch_refusal, blank_row, fmu_bytes, noted,
+                         run_batch, worker_facts)
 
 
 # -- the client side --------------------------------------------------------------------
@@ -81,20 +87,30 @@ class _WorkerWatch:
                 self.check()
 
 
-def _as_completed(futures: list, watch: _WorkerWatch) -> Iterator:
-    """Each future as it completes, from its done callback (run by the future's own client,
-    not the newest one); while none completes, ``watch`` is checked. Dask's ``as_completed``
-    cannot do this: its timeout is a deadline for the whole iteration."""
-    done: queue.SimpleQueue = queue.SimpleQueue()
-    for future in futures:
-        future.add_done_callback(done.put)
-    for _ in futures:
-        while True:
+class _Completions:
+    """Futures as they complete, from their done callbacks (run by the future's own client,
+    not the newest one); more may be added while they are taken. While none completes,
+    the watch is checked. Dask's ``as_completed`` cannot do this: its timeout is a deadline
+    for the whole iteration."""
+
+    def __init__(self) -> None:
+        self.done: queue.SimpleQueue = queue.SimpleQueue()
+        self.waiting = 0
+
+    def add(self, future) -> None:
+        self.waiting += 1
+        future.add_done_callback(self.done.put)
+
+    def each(self, watch: _WorkerWatch) -> Iterator:
+        """Each future added, before or while iterating, as it completes."""
+        while self.waiting:
             try:
-                yield done.get(timeout=watch.interval)
-                break
+                future = self.done.get(timeout=watch.interval)
             except queue.Empty:
                 watch.check()
+                continue
+            self.waiting -= 1
+            yield future
 
 
 def _say(message: str) -> None:
@@ -156,18 +172,55 @@ def _worker_saturation(dask_scheduler=None) -> float:
     return float(dask_scheduler.WORKER_SATURATION)
 
 
+MAX_BATCH = 256
+"""The most runs a batch gets unless told otherwise (``--batch-size``)."""
+MIN_BATCH = 32
+"""The fewest runs a batch gets where its system has that many: a batch's cost per step
+is shared by its runs."""
+
+
+def batches(jobs: list[Job], workers: int, size: int | None = None) -> list[list[Job]]:
+    """``jobs`` (of one system) cut into batches of near-equal size, in their order: of at
+    most ``size`` runs, or by default as many as keep ``workers`` busy, of at least
+    ``MIN_BATCH`` runs where there are that many and at most ``MAX_BATCH``."""
+    if size is None:
+        count = max(math.ceil(len(jobs) / MAX_BATCH), min(workers, len(jobs) // MIN_BATCH), 1)
+    else:
+        count = math.ceil(len(jobs) / size)
+    cuts = [round(k * len(jobs) / count) for k in range(count + 1)]
+    return [jobs[a:b] for a, b in zip(cuts, cuts[1:])]
+
+
+def plan(spec: Spec, jobs: list[Job], workers: int, size: int | None = None
+         ) -> tuple[list[list[Job]], list[Job]]:
+    """(the batches, the runs to run alone) of a sweep on the batch backend: the runs of
+    each system (``Bundle.digest``) and stop time in ``batches``, those of a controller
+    the kernel does not cover (``Spec.batch_coverage``) one by one."""
+    covered = spec.batch_coverage()
+    groups: dict[tuple[str, float | None], list[Job]] = {}
+    alone = []
+    for job in jobs:
+        if covered[job.run["controller"]] is None:
+            groups.setdefault((job.bundle.digest, job.stop_time), []).append(job)
+        else:
+            alone.append(job)
+    return [batch for group in groups.values() for batch in batches(group, workers, size)], alone
+
+
 def run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, progress: bool,
-                   task, backend: str, no_worker_timeout: float, limits: Limits) -> None:
+                   task, backend: str, no_worker_timeout: float, limits: Limits,
+                   batch_task=run_batch, batch_size: int | None = None) -> None:
     """Run ``todo`` (runs of ``spec``) as ``task`` on the cluster of ``connection`` (a
     client and the local cluster it made, or None), journaling each row as it completes;
-    the client, and a local cluster, closed on every path (``execute`` documents the rest).
-    When the sweep stops early, the cluster closes quietly (``_stopping``)."""
+    on the batch backend, in batches as ``batch_task``; the client, and a local cluster,
+    closed on every path (``execute`` documents the rest). When the sweep stops early, the
+    cluster closes quietly (``_stopping``)."""
     client, cluster = connection
     teardown = SweepTeardown(uuid.uuid4().hex[:12])
     stopped = None
     try:
         _submit_and_journal(spec, todo, journal, client, progress, task, backend,
-                            no_worker_timeout, limits, teardown)
+                            no_worker_timeout, limits, teardown, batch_task, batch_size)
     except BaseException as error:
         stopped = error
         raise
@@ -176,9 +229,17 @@ def run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, p
             _close(client, cluster, teardown)
 
 
+@dataclass
+class _Task:
+    """What a future computes: one run, or a batch of runs."""
+    jobs: list[Job]
+    batch: bool
+    why: str = ""                       # why its run is not in a batch (said in its backend)
+
+
 def _submit_and_journal(spec: Spec, todo: list[dict], journal: Journal, client, progress: bool,
                         task, backend: str, no_worker_timeout: float, limits: Limits,
-                        teardown: SweepTeardown) -> None:
+                        teardown: SweepTeardown, batch_task, batch_size: int | None) -> None:
     """Check the workers, send the FMUs and ``todo``, and journal each row as it completes."""
     token = teardown.sweep
     if client.run_on_scheduler(_has_dashboard):
@@ -191,12 +252,29 @@ def _submit_and_journal(spec: Spec, todo: list[dict], journal: Journal, client, 
     shipped = {sha: client.submit(fmu_bytes, path.read_bytes(), key=f"fmu-{token}-{sha}",
                                   pure=False)
                for sha, path in spec.files().items()}
-    futures = {}
-    for run in todo:
-        job = spec.job(run, token, backend, limits)
-        blobs = {sha: shipped[sha] for sha in job.bundle.fmu_hashes()}
-        futures[client.submit(task, job, blobs, retries=2, pure=False,
-                              key=f"run-{token}-{run['run_id']}")] = run
+    tasks: dict = {}
+    completions = _Completions()
+
+    def submit(jobs: list[Job], batch: bool, why: str = "") -> None:
+        blobs = {sha: shipped[sha] for sha in jobs[0].bundle.fmu_hashes()}
+        kind, what = ("batch", batch_task) if batch else ("run", task)
+        future = client.submit(what, jobs if batch else jobs[0], blobs, retries=2, pure=False,
+                               key=f"{kind}-{token}-{jobs[0].run['run_id']}")
+        tasks[future] = _Task(jobs, batch, why)
+        completions.add(future)
+
+    route = "inprocess" if backend == BATCH else backend      # a batch's runs alone: in-process
+    jobs = [spec.job(run, token, route, limits) for run in todo]
+    if backend == BATCH:
+        _say_batch_refusals(client)
+        together, alone = plan(spec, jobs, sum(client.nthreads().values()) or 1, batch_size)
+        for batch in together:
+            submit(batch, True)
+        for job in alone:
+            submit([job], False)
+    else:
+        for job in jobs:
+            submit([job], False)
     bar = None
     if progress:
         from tqdm import tqdm
@@ -204,25 +282,50 @@ def _submit_and_journal(spec: Spec, todo: list[dict], journal: Journal, client, 
                    disable=None)                # None: only on a terminal
     watch = _WorkerWatch(client, no_worker_timeout)
     try:
-        for future in _as_completed(list(futures), watch):
+        for future in completions.each(watch):
+            done = tasks.pop(future)
             try:
-                row = watch.result(future)
+                result = watch.result(future)
             except NoWorkers:
                 raise
             except Exception as error:      # the worker died on every retry
-                row = {**blank_row(futures[future], f"{type(error).__name__}: {error}"),
-                       "backend": backend}
-            journal.add({**row, "command": spec.replay(futures[future])})
-            del futures[future]
+                died = f"{type(error).__name__}: {error}"
+                if done.batch:              # each run alone: only a run that kills fails
+                    future.release()
+                    for job in done.jobs:
+                        submit([job], False, f"its batch's worker died, {died}")
+                    continue
+                result = {**blank_row(done.jobs[0].run, died), "backend": done.jobs[0].backend}
+            rows = result if done.batch else [result]
+            for job, row in zip(done.jobs, rows, strict=True):
+                journal.add({**(noted(row, done.why) if done.why else row),
+                             "command": spec.replay(job.run)})
             future.release()                # done: nothing to recompute if a worker dies
             if bar is not None:
-                bar.update()
+                bar.update(len(rows))
     except NoWorkers:
-        client.cancel([*futures, *shipped.values()])
+        client.cancel([*tasks, *shipped.values()])
         raise
     finally:
         if bar is not None:
             bar.close()                     # its line ended before any message
+
+
+def _say_batch_refusals(client) -> None:
+    """A note for each reason a worker gives to refuse the batch route (``batch_refusal``),
+    once, naming the workers that give it."""
+    try:
+        refusals = client.run(batch_refusal, on_error="return")
+    except Exception:                       # a worker gone: its runs' rows will say
+        return
+    said: dict[str, list[str]] = {}
+    for address, reason in sorted(refusals.items()):
+        if reason is not None:
+            said.setdefault(str(reason), []).append(address)
+    for reason, addresses in said.items():
+        _say(f"note: the batch route is refused on {len(addresses)} worker"
+                 f"{'s' if len(addresses) > 1 else ''} ({', '.join(addresses)}): {reason}; "
+                 "their batches run one run at a time on the in-process route")
 
 
 def _close(client, cluster, teardown: SweepTeardown) -> None:

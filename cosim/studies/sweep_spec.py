@@ -19,6 +19,7 @@ files in the output folder.
 """
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import itertools
 import json
@@ -39,6 +40,7 @@ from ..core.files import plain_name, read_small_text
 from ..core.fmi import read_description
 from ..core.inprocess import fallback_note, in_process_refusal
 from ..core.provenance import code_version
+from ..core.ssd import SystemDescription
 from ..core.values import Declaration, checked, declarations
 from ..core.watchdog import Limits
 from ..scenarios.autopilot import check_autopilot
@@ -95,6 +97,7 @@ class Spec:
     _descriptions: dict[tuple[str, str], Any] = field(default_factory=dict, repr=False,
                                                        compare=False)
     _ships: dict[tuple[str, str], bool] = field(default_factory=dict, repr=False, compare=False)
+    _coverage: dict[str, str | None] | None = field(default=None, repr=False, compare=False)
 
     def wants_track(self, run: dict[str, Any]) -> bool:
         """Whether ``run`` is one of the runs whose tracks are drawn ([plots] tracks)."""
@@ -384,16 +387,40 @@ class Spec:
 
     def backend_notes(self, backend: str) -> list[str]:
         """Which components of which controllers will run through FMI although ``backend``
-        is "inprocess" (an FMU not of this project, or not built from this checkout)."""
-        if backend != "inprocess":
+        is "inprocess" or "batch" (an FMU not of this project, or not built from this
+        checkout), and, on "batch", which controllers' runs run alone on the in-process
+        route, and why (``batch_coverage``)."""
+        if backend not in ("inprocess", "batch"):
             return []
         notes = []
+        if backend == "batch":
+            notes = [f"controller {controller!r} runs on the in-process route, one run per "
+                     f"task, not in batches: {why}"
+                     for controller, why in self.batch_coverage().items() if why]
         for controller, shipped in self.bundles().items():
             for name, component in shipped.system.components.items():
                 note = fallback_note(name, self.files()[Path(component.source).stem])
                 if note:
                     notes.append(f"controller {controller!r}: {note}")
         return notes
+
+    def batch_coverage(self) -> dict[str, str | None]:
+        """Each controller: why the batch kernel cannot run its system
+        (``cosim.ensemble.members.coverage``), None if it can (asked once)."""
+        if self._coverage is None:
+            from ..ensemble.members import coverage
+
+            self._coverage = {controller: coverage(self.local_system(controller))
+                              for controller in self.controllers}
+        return self._coverage
+
+    def local_system(self, controller: str) -> SystemDescription:
+        """A controller's system as its bundle holds it, each FMU the file here."""
+        shipped = self.bundles()[controller].system
+        return dataclasses.replace(shipped, components={
+            name: dataclasses.replace(component,
+                                      source=str(self.files()[Path(component.source).stem]))
+            for name, component in shipped.components.items()})
 
     def settings(self, run: dict[str, Any]) -> tuple[str, dict[str, dict[str, Any]]]:
         """(scenario, overrides by component) of one run."""

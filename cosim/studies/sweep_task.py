@@ -1,7 +1,10 @@
-"""A sweep's task, on a worker: one whole co-simulation, from a ``Job`` and the FMUs' bytes.
+"""A sweep's tasks, on a worker: one whole co-simulation from a ``Job`` and the FMUs' bytes
+(``run_one``), or a batch of runs of one system as one array program (``run_batch``).
 
-A worker keeps one master per sweep, thread, system (``Bundle.digest``) and backend,
-and resets it (fmi2Reset) between tasks. Each sweep registers its own ``SweepTeardown`` worker
+Both make a run's row from its recording with one function (``result_row``), so a run's
+row is the same, every column but ``backend``, ``seconds`` and ``sim_seconds``, whichever
+task ran it. A worker keeps one master per sweep, thread, system (``Bundle.digest``) and
+backend, and resets it (fmi2Reset) between tasks. Each sweep registers its own ``SweepTeardown`` worker
 plugin, named after the sweep's token: when the sweep ends (or the worker closes) it
 frees that sweep's masters only, so two sweeps on one cluster do not free each
 other's FMUs.
@@ -22,6 +25,7 @@ from ..analysis.cost import cost
 from ..analysis.metrics import (cross_track_error, fraction_at_stops, heading_error,
                                 mean_abs_rate, peak, rms, route_completion,
                                 rudder_reversals_per_minute)
+from ..core.master import RUN_BACKENDS
 from ..core.provenance import code_version
 from ..core.watchdog import Limits, TimeLimit, Watchdog
 from .bundle import Bundle, materialise
@@ -141,12 +145,12 @@ class SweepTeardown(WorkerPlugin):
         free_masters(self.sweep)
 
 
-def ran_on(master, asked: str) -> str:
-    """How a run's components ran: "inprocess" or "fmi" if all alike, else each named
+def ran_on(kinds: dict[str, str] | None, asked: str) -> str:
+    """How a run's components ran (``kinds``: each component's backend, as
+    ``Master.backends``): "inprocess" or "fmi" if all alike, else each named
     ("inprocess; autopilot: fmi"); ``asked`` where no master was made."""
-    if master is None:
+    if not kinds:
         return asked
-    kinds = master.backends
     if len(set(kinds.values())) == 1:
         return next(iter(kinds.values()))
     others = [f"{name}: {kind}" for name, kind in kinds.items() if kind != asked]
@@ -175,10 +179,8 @@ def run_one(job: Job, blobs: dict[str, bytes]) -> dict[str, Any]:
     limits fails (``core.watchdog``; one whose FMU runs no Python ends the worker, and
     the sweep retries it, then records it failed, as any run that kills its worker)."""
     started = time.perf_counter()
-    row = blank_row(job.run)
     if job.code != code_version():          # a worker that joined after the client's check
-        return blank_row(job.run, f"worker runs {code_version()}, the client {job.code}: "
-                                  "install the client's version on every worker")
+        return _other_code(job)
     master, watchdog = None, Watchdog(job.limits)
     try:
         with watchdog:                          # a hung FMU fails its run, not the worker
@@ -187,7 +189,7 @@ def run_one(job: Job, blobs: dict[str, bytes]) -> dict[str, Any]:
             master.configure(job.overrides)
             simulating = time.perf_counter()
             recording = master.run(job.stop_time, watchdog=watchdog)
-        row["sim_seconds"] = time.perf_counter() - simulating
+        sim_seconds = time.perf_counter() - simulating
     except (Exception, TimeLimit) as error:  # a bad setting: not worth retrying
         _drop_master(job)
         reason = watchdog.expired if watchdog.expired else f"{type(error).__name__}: {error}"
@@ -195,14 +197,128 @@ def run_one(job: Job, blobs: dict[str, bytes]) -> dict[str, Any]:
     else:
         if recording.error:
             _drop_master(job)               # its FMUs may be in an error state
-            row = blank_row(job.run, recording.error)
-        else:
-            row.update(run_metrics(recording))
-            if job.track:
-                row["track"] = _track(recording)
-    row["backend"] = ran_on(master, job.backend)   # the results are the same either way
+        row = result_row(job, recording)
+        if not recording.error:
+            row["sim_seconds"] = sim_seconds
+    row["backend"] = ran_on(master and master.backends, job.backend)   # same results either way
     row["seconds"] = time.perf_counter() - started
     return row
+
+
+def _other_code(job: Job) -> dict[str, Any]:
+    """The failed row of a run sent by a client that runs other code than this worker."""
+    return blank_row(job.run, f"worker runs {code_version()}, the client {job.code}: "
+                              "install the client's version on every worker")
+
+
+def result_row(job: Job, recording) -> dict[str, Any]:
+    """The row of ``job``'s run from its recording, whichever route made it: failed with the
+    recording's error, else every figure of merit (``run_metrics``) and, if the job asks,
+    the track; the times and the backend are the caller's to fill in."""
+    if recording.error:
+        return blank_row(job.run, recording.error)
+    row = {**blank_row(job.run), **run_metrics(recording)}
+    if job.track:
+        row["track"] = _track(recording)
+    return row
+
+
+BATCH = "batch"
+"""The sweep backend that runs the runs of one system as batches (``run_batch``)."""
+SWEEP_BACKENDS = (*RUN_BACKENDS, BATCH)
+"""The backends a sweep may take: a master's (``RUN_BACKENDS``), or batches."""
+
+
+def batch_refusal() -> str | None:
+    """Why this worker would not give the in-process route's bits on the batch route
+    (``cosim.ensemble.selftest``, run once per process), None if it would."""
+    from ..ensemble import selftest
+
+    try:
+        return selftest()
+    except Exception as error:          # a self-test that cannot run refuses the route
+        return f"its self-test failed: {type(error).__name__}: {error}"
+
+
+def batch_limits(limits: Limits, members: int) -> Limits:
+    """A batch's time limits: each per-run limit times its ``members``."""
+    return Limits(None if limits.step is None else limits.step * members,
+                  None if limits.run is None else limits.run * members, limits.grace)
+
+
+def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
+    """The rows of ``jobs`` (runs of one system and stop time, in-process jobs) in their
+    order, computed together by the batch kernel (``cosim.ensemble.simulate_members``);
+    never raises for a failed run.
+
+    Each row is the row ``run_one`` makes of the job but for ``backend`` ("batch", or
+    what the member ran on and why), ``seconds`` and ``sim_seconds`` (the member's share
+    of the batch). A member ``Master.configure`` refuses is run by ``run_one`` (which
+    refuses it the same way); every member is, saying why in its backend, where
+    ``batch_refusal`` refuses the route on this worker or the batch fails as a whole (an
+    exception, or its time limits, ``batch_limits``, passed). The kernel cannot be
+    interrupted: a batch still running past its step limit (the whole batch counts as one
+    step) ends the worker, as an FMU that runs no Python does, and the sweep retries it."""
+    from ..ensemble import simulate_members
+
+    started = time.perf_counter()
+    if any(job.code != code_version() for job in jobs):
+        return [_other_code(job) for job in jobs]
+    refusal = batch_refusal()
+    if refusal:
+        return _one_by_one(jobs, blobs, f"the batch route is refused on this worker: {refusal}")
+    watchdog = Watchdog(batch_limits(jobs[0].limits, len(jobs)))
+    try:
+        with watchdog:
+            watchdog.beat("instantiating the FMUs")
+            master = _master(jobs[0], blobs)
+            members = [job for job in jobs if _configures(master, job)]
+            watchdog.beat(f"the batch of {len(members)} runs")
+            recordings = simulate_members(master.system, [job.overrides for job in members],
+                                          jobs[0].stop_time) if members else []
+        if watchdog.expired:
+            raise TimeLimit(watchdog.expired)
+    except (Exception, TimeLimit) as error:
+        reason = watchdog.expired if watchdog.expired else f"{type(error).__name__}: {error}"
+        return _one_by_one(jobs, blobs, f"the batch failed, {reason}; run alone")
+    share = (time.perf_counter() - started) / max(1, len(members))
+    rows = {}
+    for job, recording in zip(members, recordings, strict=True):
+        row = result_row(job, recording)
+        if not recording.error:
+            row["sim_seconds"] = recording.meta["wall_time_s"]
+        rows[job.run["run_id"]] = {**row, "backend": member_backend(recording.meta),
+                                   "seconds": share}
+    return [rows.get(job.run["run_id"]) or run_one(job, blobs) for job in jobs]
+
+
+def _configures(master, job: Job) -> bool:
+    """Whether ``Master.configure`` takes ``job``'s settings."""
+    try:
+        master.configure(job.overrides)
+    except Exception:                   # run_one records why
+        return False
+    return True
+
+
+def _one_by_one(jobs: list[Job], blobs: dict[str, bytes], why: str) -> list[dict[str, Any]]:
+    """``run_one`` of each job, its backend saying ``why`` it did not run in a batch."""
+    return [noted(run_one(job, blobs), why) for job in jobs]
+
+
+def noted(row: dict[str, Any], why: str) -> dict[str, Any]:
+    """``row`` with ``why`` its run did not run in a batch added to its backend."""
+    return {**row, "backend": f"{row.get('backend', 'inprocess')} (not in a batch: {why})"}
+
+
+def member_backend(meta: dict[str, Any]) -> str:
+    """A batch member's backend column, from its recording's meta: "batch", or how it ran
+    alone and why (the kernel's notes)."""
+    if meta.get("backend") == BATCH:
+        return BATCH
+    ran = ran_on(meta.get("backends"), meta.get("backend", "inprocess"))
+    notes = "; ".join(meta.get("notes") or [])
+    return f"{ran} (not in a batch: {notes})" if notes else ran
 
 
 def _track(recording, every: float = 1.0) -> dict:
