@@ -7,16 +7,23 @@
 The recording holds every exchanged signal by ``component.variable`` (every FMU
 output and every connected input) at every communication point, and the unit of
 each. ``cosim.testing`` turns this into pytest checks.
+
+Many runs of one scenario, a list of settings in, a list of recordings out, stepped
+together as arrays where the batch kernel covers the scenario (``cosim.ensemble``):
+
+    from cosim import simulate_many
+    runs = simulate_many("waves_pd", [{"ship.wave_seed": s} for s in range(100)])
 """
 from __future__ import annotations
 
+import dataclasses
 import warnings
 from pathlib import Path
-from typing import Any, Iterable, Mapping
+from typing import Any, Iterable, Mapping, Sequence
 
 from . import scenarios
 from .core.master import Master
-from .core.ssd import split_name
+from .core.ssd import SystemDescription, split_name
 from .core.recording import Recording
 
 
@@ -87,3 +94,89 @@ def simulate(scenario: str | Path, autopilot: str | Path | None = None,
     if recording.error:
         raise SimulationError(recording.error, recording)
     return recording
+
+
+def simulate_many(scenario: str | Path, sets: Sequence[Mapping[str, Any]],
+                  autopilot: str | Path | None = None, stop_time: float | None = None,
+                  backend: str = "batch", port_map: dict[str, str] | None = None,
+                  fmi: int | None = None, signals: Sequence[str] | None = None
+                  ) -> list[Recording]:
+    """Run a scenario once for each of ``sets`` (each what ``simulate`` takes as ``set``)
+    and return their recordings, in order; the other arguments as ``simulate``'s.
+
+    ``backend="batch"`` (the default) steps the runs of a PD, PID or SMC course-keeping
+    scenario together as numpy arrays (``cosim.ensemble.simulate_members``): each
+    recording is the in-process route's, bit for bit, holding the columns ``signals``
+    (default: every signal of the loop, ``cosim.ensemble.reference.SIGNALS``; the wave
+    loads are not among them). A scenario the kernel does not cover (your autopilot, a
+    manoeuvre), a run that fails, and every run on a machine whose numpy the self-test
+    refuses run on the in-process route, one at a time, saying so in their
+    ``meta["notes"]`` (each note warned once). ``"fmi"`` or ``"inprocess"``: one run after
+    another, every signal recorded (only ``signals``, if given).
+
+    A run that fails raises nothing: its recording's ``error`` says why, and it holds the
+    rows up to the failure. ValueError naming the run (``member i``, its index in
+    ``sets``) for a setting refused before anything runs, or FileNotFoundError, as
+    ``simulate``.
+    """
+    from .core.master import RUN_BACKENDS
+
+    if backend not in (*RUN_BACKENDS, "batch"):
+        raise ValueError(f"backend must be fmi, inprocess or batch, got {backend!r}")
+    overrides = []
+    for i, settings in enumerate(sets):
+        try:
+            overrides.append(overrides_of(settings))
+        except ValueError as error:
+            raise ValueError(f"member {i}: {error}") from None
+    system = scenarios.load(scenario, autopilot, port_map, fmi=fmi)
+    if backend == "batch":
+        from .ensemble import simulate_members
+        from .ensemble.reference import SIGNALS
+
+        recordings = simulate_members(system, overrides, stop_time,
+                                      SIGNALS if signals is None else signals)
+    else:
+        recordings = _one_at_a_time(system, overrides, stop_time, backend, signals)
+    for note in dict.fromkeys(n for r in recordings for n in r.meta.get("notes", [])):
+        warnings.warn(note, stacklevel=2)
+    return recordings
+
+
+def _one_at_a_time(system: SystemDescription, overrides: list[dict[str, dict[str, Any]]],
+                   stop_time: float | None, backend: str, signals: Sequence[str] | None
+                   ) -> list[Recording]:
+    """Each member's run with one master, reset between runs (made again after a failed
+    one); every member's settings checked before the first runs."""
+    master = Master(system, backend=backend)
+    recordings = []
+    try:
+        for i, member in enumerate(overrides):
+            try:
+                master.configure(member)
+            except ValueError as error:
+                raise ValueError(f"member {i}: {error}") from None
+        for i, member in enumerate(overrides):
+            if i:
+                master.reset()
+            master.configure(member)
+            recording = master.run(stop_time)
+            if recording.error:             # its FMUs may be in an error state
+                master.free()
+                master = Master(system, backend=backend)
+            recordings.append(recording if signals is None else _holding(recording, signals))
+    finally:
+        master.free()
+    return recordings
+
+
+def _holding(recording: Recording, signals: Sequence[str]) -> Recording:
+    """``recording`` with only the columns ``signals``; ValueError naming one it lacks."""
+    missing = [s for s in signals if s not in recording.columns]
+    if missing:
+        raise ValueError(f"signals {', '.join(missing)}: the run records "
+                         f"{', '.join(recording.columns)}")
+    columns = [recording.columns.index(s) for s in signals]
+    return dataclasses.replace(recording, columns=list(signals),
+                               data=recording.data[:, columns],
+                               units={s: recording.units.get(s, "") for s in signals})

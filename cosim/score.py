@@ -1,7 +1,7 @@
 """Score your autopilot against the paper's PD and sliding-mode autopilots and the PID.
 
     python -m cosim.score my.fmu [--name NAME] [--seeds N] [--map PORT=NAME] [--set ...]
-                                 [--backend inprocess]
+                                 [--backend inprocess|batch]
 
 Runs the paper's route in calm water and waves, a 40 deg course change, and two
 N-seed wave ensembles (the paper's waves and WMO sea state 4) on a local Dask cluster
@@ -23,11 +23,11 @@ from ._cli import (add_port_options, checked_autopilot, entry, say_error, say_no
                    setting_option, writable_folder)
 from .api import overrides_of
 from .core.files import FolderBusy, OutputError
-from .core.master import RUN_BACKENDS
 from .outputs import TimedOut
 from .studies.scorecard import BASELINES, SEAS, backend_notes, score
 from .studies.sweep_client import NoWorkers, SweepError
 from .studies.sweep_spec import MAX_RUNS
+from .studies.sweep_task import SWEEP_BACKENDS
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -51,12 +51,16 @@ def main(argv: list[str] | None = None) -> int:
                              "cluster)")
     parser.add_argument("--workers", type=int, help="local Dask worker processes "
                                                     "(default: one per core)")
-    parser.add_argument("--backend", choices=RUN_BACKENDS, default="fmi",
+    parser.add_argument("--backend", choices=SWEEP_BACKENDS, default="fmi",
                         help="fmi: every run through the FMUs (default); inprocess: this "
                              "project's FMUs as Python classes, without FMI: the same results, "
                              "about 1.3-2 times faster. Yours runs in-process only if it is one "
                              "of ours built from this checkout; any FMU that runs through FMI "
-                             "instead is noted before the scorecard starts")
+                             "instead is noted before the scorecard starts. batch: the single "
+                             "runs in-process, the ensembles' PD, SMC and PID runs in batches "
+                             "stepped together as arrays (the same results again, many times "
+                             "faster); yours too if it is our PD, PID or SMC, else "
+                             "in-process, one run per task, with a note")
     parser.add_argument("--out", type=Path, help="output folder (default: results/score/NAME)")
     args = parser.parse_args(argv)
     if not 1 <= args.seeds <= MAX_RUNS // 4:

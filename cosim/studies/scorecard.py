@@ -10,7 +10,8 @@ criterion is won or lost on its own.
 - **a course change**: 40 deg from steady straight running in calm water, 300 s:
   settling time to 2 % (0.8 deg), overshoot, rudder activity, cross-track error;
 - **two wave ensembles**: the route over N wave seeds in the paper's waves and in WMO sea
-  state 4, on Dask through the sweep machinery: each criterion's median and IQR, and,
+  state 4, on Dask through the sweep machinery (on its batch backend with
+  ``backend="batch"``): each criterion's median and IQR, and,
   seed-paired against the PD (the same sea for both), wins, losses and ties out of the N
   seeds with the median paired ratio or difference.
 
@@ -45,7 +46,7 @@ from ..core.recording import Recording
 from ..outputs import Options, run_and_write
 from .sweep import Spec, controller_entry, execute
 from .sweep_figures import STATISTICS, distribution, paired_figure, tracks
-from .sweep_task import CRITERIA, Criterion, route_of, run_metrics
+from .sweep_task import BATCH, CRITERIA, Criterion, route_of, run_metrics
 
 BASELINES = {"PD": "pd", "SMC": "smc", "PID": "pid"}
 """The project's autopilots by display name: scenarios <sea>_<suffix>."""
@@ -200,15 +201,19 @@ def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | Non
     A run that fails (an FMU error) is reported in the tables as failed, with its message,
     and the scorecard goes on. ``backend="inprocess"`` runs this project's FMUs without
     FMI (the same results, faster); ``fmu`` then still runs through FMI unless it is one
-    of ours (``cosim.core.inprocess.in_process_refusal``).
+    of ours (``cosim.core.inprocess.in_process_refusal``). ``backend="batch"`` runs the
+    ensembles on the sweeps' batch backend (``cosim.studies.sweep.execute``: the same rows
+    as in-process; ``fmu``'s runs alone in-process unless the batch kernel covers it) and
+    the single runs in-process.
     """
     contenders = _contenders(fmu, name, port_map, settings)
     failures: dict[tuple[str, str], str] = {}
+    single = "inprocess" if backend == BATCH else backend
 
     def attempt(contender: Contender, test: str, label: str, **kwargs) -> Recording | None:
         progress(f"{test}, {contender.name}")
         try:
-            return contender.run(label, out / "runs", **kwargs, backend=backend)
+            return contender.run(label, out / "runs", **kwargs, backend=single)
         except SimulationError as error:
             failures[contender.name, test] = str(error).splitlines()[0]
             return None
@@ -277,7 +282,9 @@ def _run_ensemble(contenders: list[Contender], seeds: int, sea: Sea, out: Path,
 
 def backend_notes(fmu: Path, name: str, port_map: dict | None, backend: str) -> list[str]:
     """Which FMUs of the scorecard (the project's and ``fmu``) run through FMI although
-    ``backend`` is "inprocess": the ensemble's systems hold every FMU the scorecard runs."""
+    ``backend`` is "inprocess" or "batch", and on "batch" which contenders' ensemble runs
+    run alone in-process (``Spec.backend_notes``): the ensemble's systems hold every FMU
+    the scorecard runs."""
     return _ensemble(_contenders(fmu, name, port_map, None), 1, fmu.parent).backend_notes(
         backend)
 

@@ -313,12 +313,12 @@ def noted(row: dict[str, Any], why: str) -> dict[str, Any]:
 
 def member_backend(meta: dict[str, Any]) -> str:
     """A batch member's backend column, from its recording's meta: "batch", or how it ran
-    alone and why (the kernel's notes)."""
+    alone and why (the kernel's notes: "ran on the in-process route, not in the batch: ...")."""
     if meta.get("backend") == BATCH:
         return BATCH
     ran = ran_on(meta.get("backends"), meta.get("backend", "inprocess"))
     notes = "; ".join(meta.get("notes") or [])
-    return f"{ran} (not in a batch: {notes})" if notes else ran
+    return f"{ran} ({notes})" if notes else ran
 
 
 def _track(recording, every: float = 1.0) -> dict:
