@@ -32,6 +32,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from decimal import Decimal, localcontext
+from functools import lru_cache
 
 import numpy as np
 
@@ -75,6 +76,15 @@ def frequency_at_fraction(fraction: float, T0: float) -> float:
         return float(quotient.sqrt().sqrt())
 
 
+@lru_cache(maxsize=64)
+def _bins(T0: float, n: int, band_fraction: float) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """The n + 1 bin edges of the band, as variance fractions and as frequencies (rad/s):
+    the same for every seed, and slow to compute in decimal, so computed once."""
+    tail = 0.5 * (1.0 - band_fraction)
+    fractions = np.linspace(tail, 1.0 - tail, n + 1).tolist()
+    return tuple(fractions), tuple(frequency_at_fraction(f, T0) for f in fractions)
+
+
 @dataclass(frozen=True)
 class WaveComponents:
     """N regular components of one sea-state realisation."""
@@ -88,9 +98,7 @@ class WaveComponents:
     def from_spectrum(cls, Hs: float, T0: float, n: int, seed: int,
                       band_fraction: float = 0.98) -> WaveComponents:
         """Equal-variance discretisation of eq (17); see the module docstring."""
-        tail = 0.5 * (1.0 - band_fraction)
-        edges_fraction = np.linspace(tail, 1.0 - tail, n + 1)
-        edges = np.array([frequency_at_fraction(float(f), T0) for f in edges_fraction])
+        edges_fraction, edges = map(np.array, _bins(T0, n, band_fraction))
         rng = np.random.default_rng(seed)
         omega = rng.uniform(edges[:-1], edges[1:])
         phase = rng.uniform(0.0, 2.0 * math.pi, n)

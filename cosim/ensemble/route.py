@@ -103,8 +103,7 @@ def _lockstep(members: list[tuple[int, Member]], t0: float, h: float, n_steps: i
     (a signal not finite, or a yaw rate outside the autopilot's range)."""
     started = time.perf_counter()
     models = [m.models for _, m in members]
-    ship = VesselArrays([m["ship"] for m in models], h)
-    ship.set_shaft_speeds(*(np.array(column) for column in zip(*(m.shafts for _, m in members))))
+    ship = VesselArrays([m["ship"] for m in models], h, [m.shafts for _, m in members])
     guidance = GuidanceArrays([m["guidance"] for m in models])
     pilot = autopilot_arrays([m["autopilot"] for m in models])
     block = np.empty((len(signals), len(members), n_steps + 1))

@@ -23,7 +23,7 @@ from ship_fmu.vessel import N_PROPELLER, Vessel, VesselParameters
 
 from .reference import SIGNALS, step_models
 
-STEPS, H = 300, 0.1
+STEPS, H = 400, 0.1
 ROUTE = [(0.0, 0.0), (-3.0, 0.3), (-4.0, 4.0), (1.0, 4.5)]
 """A short route with turns beyond 90 deg, from a start heading near 180 deg."""
 

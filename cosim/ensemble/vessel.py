@@ -38,10 +38,19 @@ class RudderArrays:
     def __call__(self, s: np.ndarray | float) -> np.ndarray:
         return np.where(s >= self.reach, self.target, self.delta0 + self.velocity * s)
 
+    def take(self, lanes: np.ndarray) -> RudderArrays:
+        """The gear of the members ``lanes`` (indices) only."""
+        part = object.__new__(RudderArrays)
+        for name in ("delta0", "target", "velocity", "reach"):
+            setattr(part, name, getattr(self, name)[lanes])
+        return part
+
 
 class WaveArrays:
     """``ship_fmu.waves.WaveLoads`` of every member: (X_w, Y_w, N_w) from (M, N) components,
     eqs (14)-(16), each sum over a member's N components in numpy's order for N values."""
+
+    FIELDS = ("omega", "k", "phase", "slope_amplitude", "psi_w", "c_force", "c_moment")
 
     def __init__(self, vessels: Sequence[Vessel]):
         loads = [v.waves for v in vessels]
@@ -53,9 +62,16 @@ class WaveArrays:
         self.c_force = np.array([w._c_force for w in loads])
         self.c_moment = np.array([w._c_moment for w in loads])
 
+    def take(self, lanes: np.ndarray) -> WaveArrays:
+        """The waves of the members ``lanes`` (indices) only."""
+        part = object.__new__(WaveArrays)
+        for name in self.FIELDS:
+            setattr(part, name, getattr(self, name)[lanes])
+        return part
+
     def __call__(self, t: np.ndarray | float, xi: np.ndarray, psi: np.ndarray) -> Arrays:
-        omega_t = self.omega * (t[:, None] if isinstance(t, np.ndarray) else t)
-        s = np.subtract(omega_t, self.k * xi[:, None], omega_t)
+        s = np.multiply(self.omega, t[:, None] if isinstance(t, np.ndarray) else t)
+        np.subtract(s, np.multiply(self.k, xi[:, None]), s)
         np.add(s, self.phase, s)
         np.sin(s, s)
         np.multiply(self.slope_amplitude, s, s)               # s_i = A_i k_i sin(theta_i)
@@ -70,45 +86,22 @@ def _calm(t: np.ndarray | float, xi: np.ndarray, psi: np.ndarray) -> Arrays:
     return (0.0, 0.0, 0.0)
 
 
-class VesselArrays:
-    """M vessels, stepped together with their inputs held; built from the scalar vessels
-    as the in-process route initialised them (their parameters, sea and initial state)."""
+class Lanes:
+    """What each member's vessel is made of (its waves, its actuators' forces) and
+    ``Vessel.rates`` and ``Vessel._integrate`` over them, for all members or some."""
 
-    STATES = ("x", "y", "psi", "u", "v", "r", "xi")
+    def __init__(self, hull, minv: tuple, m11_inv: float, waves: WaveArrays | None,
+                 forces: list[tuple[np.ndarray | None, Callable]]):
+        self.hull, self.minv, self.m11_inv, self.waves = hull, minv, m11_inv, waves
+        self.wave_loads = waves if waves is not None else _calm
+        self.psi_w = waves.psi_w if waves is not None else None
+        self._forces = forces          # (members or None for all, tau_th of delta)
 
-    def __init__(self, vessels: Sequence[Vessel], h: float):
-        first = vessels[0]
-        self.hull = first.hull
-        for vessel in vessels:
-            if vessel.hull != self.hull or vessel.actuators != first.actuators:
-                raise ValueError("the members' vessels differ in hull or actuators")
-            if vessel._cut_of(h)[0] != 1:
-                raise ValueError(f"a member's h_max = {vessel.params.h_max} s cuts the "
-                                 f"{h} s step")
-        self.actuators = first.actuators
-        self.m11_inv = first._m11_inv
-        self.minv = first._minv
-        self.delta_max = np.array([v.params.delta_max for v in vessels])
-        self.delta_rate_max = np.array([v.params.delta_rate_max for v in vessels])
-        waves = [v.waves is not None for v in vessels]
-        if any(waves) and not all(waves):
-            raise ValueError("the members mix calm water and waves")
-        self.waves = WaveArrays(vessels) if all(waves) else None
-        self.wave_loads = self.waves if self.waves is not None else _calm
-        self.psi_w = self.waves.psi_w if self.waves is not None else None
-        for name in self.STATES:
-            setattr(self, name, np.array([getattr(v, name) for v in vessels]))
-        self.delta = np.array([v.delta for v in vessels])
-        self._shaft_speeds: tuple = ()
-        self._forces: list[tuple[np.ndarray | None, Callable]] = []
-
-    def set_shaft_speeds(self, n1: np.ndarray, n2: np.ndarray, n3: np.ndarray) -> None:
-        """The actuators' forces as a function of the rudder angle, for each distinct set
-        of shaft speeds among the members (``thrusters.actuator_model``, on arrays)."""
-        speeds = np.stack([n1, n2, n3], axis=1)
-        distinct = np.unique(speeds, axis=0)
-        self._forces = [(None if len(distinct) == 1 else np.all(speeds == row, axis=1),
-                         actuator_model(self.actuators, *map(float, row))) for row in distinct]
+    def take(self, lanes: np.ndarray) -> Lanes:
+        """The members ``lanes`` (indices) only."""
+        return Lanes(self.hull, self.minv, self.m11_inv,
+                     None if self.waves is None else self.waves.take(lanes),
+                     [(None if m is None else m[lanes], f) for m, f in self._forces])
 
     def forces(self, delta: np.ndarray) -> Arrays:
         """tau_th of every member at rudder angles ``delta``."""
@@ -137,22 +130,8 @@ class VesselArrays:
         return (x_dot, y_dot, psi_dot, fX * self.m11_inv,
                 i22 * fY + i23 * fN, i32 * fY + i33 * fN, xi_dot)
 
-    def step(self, t: float, h: float, delta_c: np.ndarray) -> None:
-        """``Vessel.step`` of every member from t to t + h: one RK4 step, or two where the
-        rudder reaches its command or its stop within the step."""
-        gear = RudderArrays(self.delta, delta_c, self.delta_max, self.delta_rate_max)
-        y = tuple(getattr(self, name) for name in self.STATES)
-        split = (0.0 < gear.reach) & (gear.reach < h)
-        whole = self._rk4(t, 0.0, np.where(split, gear.reach, h), y, gear)
-        if split.any():
-            rest = self._rk4(t, gear.reach, h - gear.reach, whole, gear)
-            whole = tuple(np.where(split, b, a) for a, b in zip(whole, rest))
-        for name, value in zip(self.STATES, whole):
-            setattr(self, name, value)
-        self.delta = gear(h)
-
-    def _rk4(self, t: float, start: np.ndarray | float, length: np.ndarray, y: Arrays,
-             gear: RudderArrays) -> Arrays:
+    def rk4(self, t: float, start: np.ndarray | float, length: np.ndarray, y: Arrays,
+            gear: RudderArrays) -> Arrays:
         """``Vessel._integrate`` over one RK4 step of ``length`` from t + start."""
         hs = length
         hh, c = 0.5 * hs, hs / 6.0
@@ -168,3 +147,59 @@ class VesselArrays:
         k4 = self.rates(ts + hs, axpy(hs, k3, y), tau2)
         return rk4_update(c, y, k1, k2, k3, k4)
 
+
+class VesselArrays:
+    """M vessels, stepped together with their inputs held; built from the scalar vessels
+    as the in-process route initialised them (their parameters, sea and initial state)."""
+
+    STATES = ("x", "y", "psi", "u", "v", "r", "xi")
+
+    def __init__(self, vessels: Sequence[Vessel], h: float,
+                 shafts: Sequence[tuple[float, float, float]]):
+        first = vessels[0]
+        for vessel in vessels:
+            if vessel.hull != first.hull or vessel.actuators != first.actuators:
+                raise ValueError("the members' vessels differ in hull or actuators")
+            if vessel._cut_of(h)[0] != 1:
+                raise ValueError(f"a member's h_max = {vessel.params.h_max} s cuts the "
+                                 f"{h} s step")
+        waves = [v.waves is not None for v in vessels]
+        if any(waves) and not all(waves):
+            raise ValueError("the members mix calm water and waves")
+        self.lanes = Lanes(first.hull, first._minv, first._m11_inv,
+                           WaveArrays(vessels) if all(waves) else None,
+                           _actuators(first.actuators, np.array(shafts, dtype=float)))
+        self.delta_max = np.array([v.params.delta_max for v in vessels])
+        self.delta_rate_max = np.array([v.params.delta_rate_max for v in vessels])
+        for name in self.STATES:
+            setattr(self, name, np.array([getattr(v, name) for v in vessels]))
+        self.delta = np.array([v.delta for v in vessels])
+
+    def step(self, t: float, h: float, delta_c: np.ndarray) -> None:
+        """``Vessel.step`` of every member from t to t + h: one RK4 step, or two where the
+        rudder reaches its command or its stop within the step (those members only)."""
+        gear = RudderArrays(self.delta, delta_c, self.delta_max, self.delta_rate_max)
+        y = tuple(getattr(self, name) for name in self.STATES)
+        split = (0.0 < gear.reach) & (gear.reach < h)
+        y = self.lanes.rk4(t, 0.0, np.where(split, gear.reach, h), y, gear)
+        lanes = np.flatnonzero(split)
+        if len(lanes) == len(split):
+            y = self.lanes.rk4(t, gear.reach, h - gear.reach, y, gear)
+        elif len(lanes):
+            part = gear.take(lanes)
+            rest = self.lanes.take(lanes).rk4(t, part.reach, h - part.reach,
+                                              tuple(a[lanes] for a in y), part)
+            for whole, value in zip(y, rest):
+                whole[lanes] = value
+        for name, value in zip(self.STATES, y):
+            setattr(self, name, value)
+        self.delta = gear(h)
+
+
+def _actuators(actuators, shafts: np.ndarray) -> list[tuple[np.ndarray | None, Callable]]:
+    """The actuators' forces as a function of the rudder angle (``thrusters.actuator_model``,
+    which takes arrays of angles), for each distinct (n1, n2, n3) among the members, with the
+    members that have it (None: all have)."""
+    distinct = np.unique(shafts, axis=0)
+    return [(None if len(distinct) == 1 else np.all(shafts == row, axis=1),
+             actuator_model(actuators, *map(float, row))) for row in distinct]
