@@ -9,12 +9,13 @@ from typing import Sequence
 import numpy as np
 
 from autopilot_fmu.guidance import WaypointGuidance
-from fmukit.numerics import wrap
+from ..ensemble.exact import wrap
 
 
 def heading_error(psi_d: np.ndarray, psi: np.ndarray) -> np.ndarray:
-    """Delta psi_i = psi_d - psi, wrapped to (-pi, pi], rad."""
-    return np.array([wrap(a - b) for a, b in zip(psi_d, psi)])
+    """Delta psi_i = psi_d - psi, wrapped to (-pi, pi], rad (``fmukit.numerics.wrap`` of
+    each sample, to the bit)."""
+    return wrap(np.asarray(psi_d, dtype=float) - np.asarray(psi, dtype=float))
 
 
 def cost_terms(psi_d: np.ndarray, psi: np.ndarray, delta: np.ndarray) -> tuple[float, float]:

@@ -37,7 +37,8 @@ def remainder(x: np.ndarray, y: float) -> np.ndarray:
     """``math.remainder(x, y)`` of each element, for a finite y > 0: x - n y with n the
     integer nearest x / y (ties to even), as CPython computes it (``m_remainder``)."""
     absx = np.abs(x)
-    m = np.fmod(absx, y)
+    with np.errstate(invalid="ignore"):          # an infinite x: NaN, as math.remainder
+        m = np.fmod(absx, y)
     c = y - m
     r = np.where(m < c, m, -c)
     tie = m == c
