@@ -389,18 +389,18 @@ class Spec:
         """Which components of which controllers will run through FMI although ``backend``
         is "inprocess" or "batch" (an FMU not of this project, or not built from this
         checkout), and, on "batch", which controllers' runs run alone on the in-process
-        route, and why (``batch_coverage``)."""
+        route, and why (``batch_coverage``; the FMU it names is not named twice)."""
         if backend not in ("inprocess", "batch"):
             return []
         notes = []
-        if backend == "batch":
-            notes = [f"controller {controller!r} runs on the in-process route, one run per "
-                     f"task, not in batches: {why}"
-                     for controller, why in self.batch_coverage().items() if why]
         for controller, shipped in self.bundles().items():
+            why = self.batch_coverage()[controller] if backend == "batch" else None
+            if why:
+                notes.append(f"controller {controller!r} runs on the in-process route, one "
+                             f"run per task, not in batches: {why}")
             for name, component in shipped.system.components.items():
                 note = fallback_note(name, self.files()[Path(component.source).stem])
-                if note:
+                if note and note != why:
                     notes.append(f"controller {controller!r}: {note}")
         return notes
 
