@@ -201,3 +201,15 @@ def test_many_refusals_leave_the_host_alive(fmu_paths):
             instance.set({"x": 1.0})
         instance.free()
         gc.collect()
+
+
+@pytest.mark.parametrize("name", ["psi0", "psi_w"])
+def test_a_heading_beyond_its_range_is_refused_by_name(name):
+    """9e307 rad made sin(2 beta) of the wave moment fail with a bare 'math domain error' at
+    exitInitializationMode; the declared range refuses it before any FMU call."""
+    from cosim import simulate
+
+    with pytest.raises(ValueError, match=rf"ship\.{name} = 8\.98846567431158e\+307 is outside "
+                                         "its declared range"):
+        simulate("waves_pd", set={f"ship.{name}": 8.98846567431158e+307, "ship.Hs": 0.0625},
+                 stop_time=1.0)
