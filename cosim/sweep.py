@@ -79,7 +79,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--batch-size", type=count, metavar="N",
                         help="with --backend batch: at most N runs a batch (default: enough "
                              f"batches to keep every worker busy, {MIN_BATCH} to {MAX_BATCH} "
-                             "runs each where there are that many; memory: about 0.25 MB a "
+                             "runs each where there are that many; memory: about 0.2 MB a "
                              "run of 400 s)")
     parser.add_argument("--no-worker-timeout", type=positive_seconds, metavar="SECONDS",
                         default=sweep.NO_WORKER_TIMEOUT,
