@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Any, Iterable, Mapping, Sequence
 
 from . import scenarios
-from .core.master import Master
+from .core.master import RUN_BACKENDS, Master
 from .core.ssd import SystemDescription, split_name
 from .core.recording import Recording
 
@@ -119,8 +119,6 @@ def simulate_many(scenario: str | Path, sets: Sequence[Mapping[str, Any]],
     ``sets``) for a setting refused before anything runs, or FileNotFoundError, as
     ``simulate``.
     """
-    from .core.master import RUN_BACKENDS
-
     if backend not in (*RUN_BACKENDS, "batch"):
         raise ValueError(f"backend must be fmi, inprocess or batch, got {backend!r}")
     overrides = []

@@ -217,7 +217,7 @@ def test_members_that_fail_are_the_in_process_failures_and_change_no_other(membe
     monkeypatch.setattr(route, "R_MAX", 0.01)
     together = sweep_task.run_batch(jobs, blobs)
     assert [r["run_id"] for r in together] == [j.run["run_id"] for j in jobs]
-    for ours, theirs in zip(together, alone):
+    for ours, theirs in zip(together, alone, strict=True):
         assert_same_row(ours, theirs)
     by = {(r["run_id"] if r["run_id"] in ("steep", "refused") else r["route"], r["wave_seed"]): r
           for r in together}
@@ -243,7 +243,7 @@ def test_a_batch_that_fails_as_a_whole_runs_each_member_alone(members, monkeypat
         raise RuntimeError("the kernel broke")
     monkeypatch.setattr(cosim.ensemble, "simulate_members", broken)
     together = sweep_task.run_batch(jobs, blobs)
-    for ours, theirs in zip(together, alone):
+    for ours, theirs in zip(together, alone, strict=True):
         assert_same_row(ours, theirs)
         assert ours["backend"] == (f"{theirs['backend']} (not in a batch: the batch failed, "
                                    "RuntimeError: the kernel broke; run alone)")
@@ -256,7 +256,7 @@ def test_a_worker_whose_self_test_refuses_runs_its_batches_alone(members, monkey
     assert [r["backend"] for r in rows] == ["inprocess (not in a batch: the batch route is "
                                             "refused on this worker: numpy rounds otherwise "
                                             "here)"] * 2
-    for ours, job in zip(rows, jobs):
+    for ours, job in zip(rows, jobs[:2], strict=True):
         assert_same_row(ours, sweep_task.run_one(job, blobs))
 
     class Client:                                   # what the client hears from its workers
@@ -273,7 +273,7 @@ def test_a_batch_of_a_time_that_is_no_whole_step_fails_each_run_as_in_process(me
     jobs, blobs = members
     jobs = [dataclasses.replace(job, stop_time=20.05) for job in jobs[:2]]
     alone = [sweep_task.run_one(job, blobs) for job in jobs]
-    for ours, theirs in zip(sweep_task.run_batch(jobs, blobs), alone):
+    for ours, theirs in zip(sweep_task.run_batch(jobs, blobs), alone, strict=True):
         assert_same_row(ours, theirs)
         assert ours["status"] == "failed" and "whole number" in ours["error"]
 
@@ -312,7 +312,7 @@ def test_simulate_many_gives_the_in_process_recordings(fmu_paths):
     inprocess = cosim.simulate_many("waves_pd", sets, stop_time=30, backend="inprocess")
     assert [r.meta["backend"] for r in batch] == ["batch", "batch", "inprocess", "batch"]
     from cosim.ensemble.reference import SIGNALS
-    for ours, theirs in zip(batch, inprocess):
+    for ours, theirs in zip(batch, inprocess, strict=True):
         assert ours.columns == list(SIGNALS) and set(SIGNALS) < set(theirs.columns)
         assert ours.error == theirs.error and ours.rows == theirs.rows
         np.testing.assert_array_equal(ours.t, theirs.t)

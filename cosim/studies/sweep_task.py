@@ -4,10 +4,10 @@
 Both make a run's row from its recording with one function (``result_row``), so a run's
 row is the same, every column but ``backend``, ``seconds`` and ``sim_seconds``, whichever
 task ran it. A worker keeps one master per sweep, thread, system (``Bundle.digest``) and
-backend, and resets it (fmi2Reset) between tasks. Each sweep registers its own ``SweepTeardown`` worker
-plugin, named after the sweep's token: when the sweep ends (or the worker closes) it
-frees that sweep's masters only, so two sweeps on one cluster do not free each
-other's FMUs.
+backend, and resets it (fmi2Reset) between tasks. Each sweep registers its own
+``SweepTeardown`` worker plugin, named after the sweep's token: when the sweep ends (or
+the worker closes) it frees that sweep's masters only, so two sweeps on one cluster do not
+free each other's FMUs.
 """
 from __future__ import annotations
 
