@@ -3,8 +3,11 @@
     python -m cosim.bench                 engines side by side, calm_pd and waves_pd, 400 s
     python -m cosim.bench overhead        the masters' own work, with the ship's step idle
     python -m cosim.bench memory          a 24 h run of calm_pd streamed to disk: peak memory
-    python -m cosim.bench sweep           runs per second of a sweep: FMI and in-process
-                                          backends, 1 and 2 workers
+    python -m cosim.bench sweep           sweeps on a local cluster: runs per second on the
+                                          FMI, in-process and batch backends with 1 and 2
+                                          workers, in waves and calm water; 1,000 waves_pd
+                                          runs on the batch route on 2 workers; the batch
+                                          route's memory (about 10 min; --parts for some)
 
 The default benchmark measures, for each scenario, (a) the plain Python modules
 wired by hand (cosim.studies.direct), our master (b) on its in-process backend and
@@ -12,6 +15,11 @@ wired by hand (cosim.studies.direct), our master (b) on its in-process backend a
 same scenario, timed in turn round after round (the median of each), and (f) the
 floor of any FMI route: (a) plus the FMI calls per step times the measured cost of
 one call. One table per scenario, with the ratios.
+
+The sweep benchmark prints each goal of the batch route (issue 29) beside its figure: runs/s
+per core at least 5x the in-process route's in waves, 10x in calm water; 1,000 waves_pd
+runs of 400 s in under 30 s on 2 workers (``--parts campaign`` alone); a worker's memory
+flat in the sweep's size.
 """
 from __future__ import annotations
 
@@ -20,6 +28,20 @@ import sys
 
 from ._cli import entry, say_error
 from .studies import bench, bench_sweep
+
+SWEEP_PARTS = ("throughput", "campaign", "memory")
+
+
+def _counts(text: str) -> tuple[int, ...]:
+    """A comma-separated list of whole numbers >= 1."""
+    try:
+        counts = tuple(int(part) for part in text.split(","))
+    except ValueError:
+        counts = ()
+    if not counts or min(counts) < 1:
+        raise argparse.ArgumentTypeError(f"expected whole numbers >= 1 separated by commas, "
+                                         f"got {text!r}")
+    return counts
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -36,15 +58,31 @@ def main(argv: list[str] | None = None) -> int:
     mem = commands.add_parser("memory", help="peak memory of a long run streamed to disk, "
                                              "both backends")
     mem.add_argument("--hours", type=float, default=24.0, help="simulated hours (default 24)")
-    sweep = commands.add_parser("sweep", help="runs per second of a sweep, both backends, with 1 "
-                                             "and 2 workers")
-    sweep.add_argument("--runs", type=int, default=16, help="runs per measurement (even)")
+    sweep = commands.add_parser("sweep", help="sweeps on every backend with 1 and 2 workers, "
+                                             "the batch route's campaign and memory")
+    sweep.add_argument("--parts", nargs="+", choices=SWEEP_PARTS, default=list(SWEEP_PARTS),
+                       help="what to measure (default: all, in this order)")
+    sweep.add_argument("--runs", type=int, default=16,
+                       help="runs per FMI or in-process sweep (even; default 16)")
+    sweep.add_argument("--batch-runs", type=int, default=1024,
+                       help="runs per batch sweep (even; default 1024: batches of 256)")
+    sweep.add_argument("--sea", choices=("waves", "calm", "both"), default="both",
+                       help="the throughput's sweeps: waves_pd and waves_smc, calm_pd and "
+                            "calm_smc, or both (default)")
+    sweep.add_argument("--rounds", type=int, default=1,
+                       help="throughput sweeps of each backend, in turn (default 1); medians")
+    sweep.add_argument("--campaign-runs", type=int, default=bench_sweep.CAMPAIGN_RUNS,
+                       help=f"waves_pd runs of the campaign (default "
+                            f"{bench_sweep.CAMPAIGN_RUNS}, the issue's)")
+    sweep.add_argument("--memory-members", type=_counts, default=bench_sweep.MEMORY_MEMBERS,
+                       help="members of the memory measurement, comma-separated (default "
+                            + ",".join(map(str, bench_sweep.MEMORY_MEMBERS)) + ")")
     args = parser.parse_args(argv)
     try:
         if args.command == "memory":
             bench.memory(args.hours)
         elif args.command == "sweep":
-            bench_sweep.sweep_throughput(args.runs)
+            _sweep(args)
         elif args.command == "overhead":
             bench.overhead(args.repeats)
         else:
@@ -53,6 +91,17 @@ def main(argv: list[str] | None = None) -> int:
         say_error(error)
         return 2
     return 0
+
+
+def _sweep(args: argparse.Namespace) -> None:
+    """The parts of the sweep benchmark asked for, in their order."""
+    if "throughput" in args.parts:
+        seas = ("waves", "calm") if args.sea == "both" else (args.sea,)
+        bench_sweep.sweep_throughput(args.runs, args.batch_runs, seas, rounds=args.rounds)
+    if "campaign" in args.parts:
+        bench_sweep.campaign(args.campaign_runs)
+    if "memory" in args.parts:
+        bench_sweep.batch_memory(args.memory_members)
 
 
 if __name__ == "__main__":
