@@ -62,8 +62,8 @@ def main(argv: list[str] | None = None) -> int:
                                              "the batch route's campaign and memory")
     sweep.add_argument("--parts", nargs="+", choices=SWEEP_PARTS, default=list(SWEEP_PARTS),
                        help="what to measure (default: all, in this order)")
-    sweep.add_argument("--runs", type=int, default=16,
-                       help="runs per FMI or in-process sweep (even; default 16)")
+    sweep.add_argument("--runs", type=int, default=32,
+                       help="runs per FMI or in-process sweep (even; default 32)")
     sweep.add_argument("--batch-runs", type=int, default=1024,
                        help="runs per batch sweep (even; default 1024: batches of 256)")
     sweep.add_argument("--sea", choices=("waves", "calm", "both"), default="both",

@@ -76,7 +76,7 @@ class Measure:
         return self.wall * self.workers / self.runs - self.simulated - self.in_task
 
 
-def sweep_throughput(runs: int = 16, batch_runs: int = 1024,
+def sweep_throughput(runs: int = 32, batch_runs: int = 1024,
                      seas: tuple[str, ...] = tuple(SEAS), worker_counts: tuple[int, ...] = (1, 2),
                      backends: tuple[str, ...] = SWEEP_BACKENDS, rounds: int = 1,
                      stop_time: float = 400.0) -> dict[tuple[str, str, int], float]:
