@@ -278,6 +278,16 @@ def test_a_batch_of_a_time_that_is_no_whole_step_fails_each_run_as_in_process(me
         assert ours["status"] == "failed" and "whole number" in ours["error"]
 
 
+def test_a_run_in_this_process_is_the_same_as_a_batch_of_one(fmu_paths, tmp_path):
+    spec = sweep.Spec.read(write_spec(tmp_path, 'stop_time = 10\n[controllers]\n'
+                                                'smc = "waves_smc"\n[axes]\nwave_seed = [3]\n'))
+    run = spec.runs()[0]
+    alone = sweep.run_locally(spec, run, "batch")
+    assert alone["backend"] == "batch" and alone["status"] == "ok"
+    assert_same_row(alone, sweep.run_locally(spec, run, "inprocess"))
+    sweep_task.free_masters()
+
+
 # -- a batch whose worker dies ---------------------------------------------------------------
 def killing_batch(jobs, blobs):
     """A batch of more than one run ends its worker; runs alone run."""

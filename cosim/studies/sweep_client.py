@@ -266,8 +266,9 @@ def _submit_and_journal(spec: Spec, todo: list[dict], journal: Journal, client, 
     route = "inprocess" if backend == BATCH else backend      # a batch's runs alone: in-process
     jobs = [spec.job(run, token, route, limits) for run in todo]
     if backend == BATCH:
-        _say_batch_refusals(client)
         together, alone = plan(spec, jobs, sum(client.nthreads().values()) or 1, batch_size)
+        if together:
+            _say_batch_refusals(client)
         for batch in together:
             submit(batch, True)
         for job in alone:
