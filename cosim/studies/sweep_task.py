@@ -256,9 +256,9 @@ def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
     of the batch). A member ``Master.configure`` refuses is run by ``run_one`` (which
     refuses it the same way); every member is, saying why in its backend, where
     ``batch_refusal`` refuses the route on this worker or the batch fails as a whole (an
-    exception, or its time limits, ``batch_limits``, passed). The kernel cannot be
-    interrupted: a batch still running past its step limit (the whole batch counts as one
-    step) ends the worker, as an FMU that runs no Python does, and the sweep retries it."""
+    exception, or its time limits, ``batch_limits``, passed: the whole batch counts as one
+    step). The kernel's numpy code cannot be interrupted: a batch past its limits there
+    ends the worker, as an FMU that runs no Python does, and the sweep retries it."""
     from ..ensemble import simulate_members
 
     started = time.perf_counter()
