@@ -130,6 +130,13 @@ def test_batch_sizes_keep_every_worker_busy():
     assert sum(batches(list(range(23)), 3, size=5), []) == list(range(23))   # in order
 
 
+def test_a_batch_has_the_time_limits_of_its_runs_together():
+    from cosim.core.watchdog import Limits
+
+    assert sweep_task.batch_limits(Limits(2.0, 10.0, 3.0), 5) == Limits(10.0, 50.0, 3.0)
+    assert sweep_task.batch_limits(Limits(None, None), 7) == Limits(None, None)
+
+
 @pytest.mark.timeout(240, method="thread")
 def test_a_foreign_autopilot_runs_alone_in_process_with_a_note(fmu_paths, cluster, tmp_path,
                                                               capsys):
