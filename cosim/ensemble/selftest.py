@@ -23,8 +23,8 @@ from ship_fmu.vessel import N_PROPELLER, Vessel, VesselParameters
 
 from .reference import SIGNALS, step_models
 
-STEPS, H = 400, 0.1
-ROUTE = [(0.0, 0.0), (-3.0, 0.3), (-4.0, 4.0), (1.0, 4.5)]
+STEPS, H = 200, 0.1
+ROUTE = [(0.0, 0.0), (-1.5, 0.2), (-2.5, 2.5), (0.5, 3.0)]
 """A short route with turns beyond 90 deg, from a start heading near 180 deg."""
 
 
@@ -45,7 +45,7 @@ def _members(kind: str, Hs: float) -> list[dict]:
         psi0 = (-1.0) ** member * (math.pi - 0.01 * member)
         ship = Vessel(VesselParameters(psi0=psi0, Hs=Hs, wave_seed=member, T0=0.7 + 0.1 * member,
                                        delta_rate_max=math.radians(10.0 + 5.0 * member)))
-        out.append({"guidance": WaypointGuidance(ROUTE, 1.0), "ship": ship,
+        out.append({"guidance": WaypointGuidance(ROUTE, 0.5), "ship": ship,
                     "autopilot": _pilot(kind, psi0, member)})
     return out
 

@@ -22,7 +22,7 @@ from .sweep_task import METRICS
 
 TIMES = {"seconds": "s", "sim_seconds": "s"}
 """The wall-clock times of a row (``sweep_task.run_one``): the task's, and the master's run
-alone."""
+alone; a batch's run (``sweep_task.run_batch``) has its share of its batch's."""
 
 MONTE_CARLO = "wave_seed"
 """The axis the statistics are taken over, and that pairs runs (the same sea)."""
