@@ -428,3 +428,18 @@ def test_an_fmu_that_hangs_in_terminate_keeps_the_finished_run(fmu_paths, tmp_pa
     out = tmp_path / "out"
     assert sorted(_folder(out)) == ["calm_pd-idle_pilot.csv", "calm_pd-idle_pilot.json"]
     assert json.loads((out / "calm_pd-idle_pilot.json").read_text())["rows"] == 101
+
+
+def test_steps_each_shorter_than_the_limit_never_expire_it():
+    """The watchdog waited until the deadline of the step it saw and then judged that one:
+    a step begun meanwhile was flagged at once (0.15 s steps under a 0.2 s limit)."""
+    import time
+
+    from cosim.core.watchdog import Limits, Watchdog
+
+    watchdog = Watchdog(Limits(step=0.2))
+    with watchdog:
+        for k in range(14):
+            watchdog.beat(float(k))
+            time.sleep(0.15)
+    assert watchdog.expired is None

@@ -201,6 +201,7 @@ class Watchdog:
                     continue
             elif self._done.wait(wait):
                 return
+            deadline, reason = self._deadline()    # a beat while it waited moves the limit
             if time.monotonic() >= deadline and not self._done.is_set():
                 if not reason:          # the run limit: the loop stops at its next beat
                     self.expired = (f"the run did not end within its time limit of "
