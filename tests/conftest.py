@@ -1,4 +1,10 @@
-"""Shared fixtures: FMUs built from the current sources."""
+"""Shared fixtures: FMUs built from the current sources; the quick suite and the whole one.
+
+``pytest`` runs the quick suite, which CI runs: every test but those marked ``long``, and
+the tests that ask for ``long_run`` (the fuzzing campaigns) shortened. ``pytest --long``
+runs the whole suite, every test at full length. A marker expression of one's own chooses
+alone: ``pytest -m long`` runs only the tests the quick suite leaves out. Each test file
+with long tests says which it keeps quick, and why they still cover what it tests."""
 from __future__ import annotations
 
 import gc
@@ -17,16 +23,63 @@ pytest_plugins = ["pytester"]       # to run the example test file for each auto
 
 HARD_LIMIT = 1200
 """Seconds any test may take, its fixtures' setup included, unless it has a limit of its own:
-more than the whole suite's budget (15 min), so only a hang reaches it."""
+more than the whole suite takes, so only a hang reaches it."""
+LONG = "pytest --long"
+"""The command that runs the whole suite."""
+_LEFT_OUT = pytest.StashKey[int]()
+_SHORTENED = pytest.StashKey[int]()
 
 
-def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """Every test without ``@pytest.mark.timeout`` gets HARD_LIMIT (pytest-timeout's thread
-    method: it prints every thread's stack and ends the session, wherever the test is stuck,
-    instead of waiting for ever)."""
+def pytest_addoption(parser: pytest.Parser) -> None:
+    parser.addoption("--long", action="store_true", dest="long_run",
+                     help="run the whole suite: the tests marked long too, and the fuzzing "
+                          "campaigns at full length (without it: the quick suite, as CI "
+                          "runs it)")
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Without --long or -m, the tests marked ``long`` are deselected. Every test without
+    ``@pytest.mark.timeout`` gets HARD_LIMIT (pytest-timeout's thread method: it prints every
+    thread's stack and ends the session, wherever the test is stuck, instead of waiting for
+    ever)."""
+    if not config.getoption("long_run") and not config.option.markexpr:
+        left_out = [item for item in items if item.get_closest_marker("long") is not None]
+        if left_out:
+            config.hook.pytest_deselected(items=left_out)
+            items[:] = [item for item in items if item.get_closest_marker("long") is None]
+        config.stash[_LEFT_OUT] = len(left_out)
     for item in items:
         if item.get_closest_marker("timeout") is None:
             item.add_marker(pytest.mark.timeout(HARD_LIMIT, method="thread"))
+
+
+def pytest_report_collectionfinish(config: pytest.Config, items: list[pytest.Item]) -> list[str]:
+    """In the quick suite, the header says what it leaves out and how to run it all."""
+    if config.getoption("long_run"):
+        return []
+    config.stash[_SHORTENED] = sum("long_run" in item.fixturenames for item in items)
+    note = _quick_suite_note(config)
+    return [note] if note else []
+
+
+def pytest_terminal_summary(terminalreporter, config: pytest.Config) -> None:
+    """And so does the summary."""
+    note = _quick_suite_note(config)
+    if note:
+        terminalreporter.write_line(note)
+
+
+def _quick_suite_note(config: pytest.Config) -> str | None:
+    counts = {"tests marked long deselected": config.stash.get(_LEFT_OUT, 0),
+              "run shortened": config.stash.get(_SHORTENED, 0)}
+    said = ", ".join(f"{n} {what}" for what, n in counts.items() if n)
+    return f"quick suite: {said}; the whole suite: {LONG}" if said else None
+
+
+@pytest.fixture(scope="session")
+def long_run(request) -> bool:
+    """Whether this session runs the whole suite (--long), not the quick one."""
+    return request.config.getoption("long_run")
 
 
 @pytest.fixture(scope="session", autouse=True)
