@@ -1,4 +1,7 @@
-"""Our FMUs in other FMI engines: one SSP package, identical traces, visible errors."""
+"""Our FMUs in other FMI engines: one SSP package, identical traces, visible errors.
+
+The quick suite (without ``pytest --long``) compares each paper scenario in one engine, the
+engines in turn (``TRACES``): every scenario and every engine at least once."""
 from __future__ import annotations
 
 import subprocess
@@ -17,8 +20,12 @@ from fmukit.timebase import nanoseconds
 from helpers import ecos_missing
 
 PAPER = ["calm_pd", "calm_smc", "waves_pd", "waves_smc"]
-ENGINES = ["libcosim", pytest.param("ecos", marks=pytest.mark.skipif(
-    ecos_missing() is not None, reason=str(ecos_missing()))), "fmpy"]
+NEEDS_ECOS = pytest.mark.skipif(ecos_missing() is not None, reason=str(ecos_missing()))
+ENGINES = ["libcosim", pytest.param("ecos", marks=NEEDS_ECOS), "fmpy"]
+TRACES = [pytest.param(name, engine, marks=[NEEDS_ECOS] * (engine == "ecos")
+                       + [pytest.mark.long] * (j != i % 3))
+          for i, name in enumerate(PAPER) for j, engine in enumerate(("libcosim", "ecos", "fmpy"))]
+"""Each paper scenario in each engine; in the quick suite, scenario i in engine i mod 3."""
 
 
 @pytest.fixture(scope="module")
@@ -52,8 +59,7 @@ def _compare(engine_trace: dict, name: str) -> tuple[float, int]:
     return worst, beyond
 
 
-@pytest.mark.parametrize("engine", ENGINES)
-@pytest.mark.parametrize("name", PAPER)
+@pytest.mark.parametrize("name, engine", TRACES)
 def test_same_package_same_traces_as_our_master_in_jacobi(packages, engine, name):
     trace = run(engine, packages[name])
     worst, beyond = _compare(trace, name)

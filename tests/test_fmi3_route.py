@@ -1,6 +1,11 @@
 """The master on FMI 3.0: every scenario through the FMI 3.0 twins equals the FMI 2.0 route bit
 for bit, on both couplings and both backends; mixed versions, .ssd files naming the twins,
-the command line, and a user's FMI 3.0 autopilot checked against the same contract."""
+the command line, and a user's FMI 3.0 autopilot checked against the same contract.
+
+The quick suite (without ``pytest --long``) runs each scenario through the twins once, on the
+couplings and backends in turn (``ROUTES``, shifted by one at each round, so that a
+controller's calm and waves runs take different backends): every scenario once, and every
+coupling on every backend at least twice."""
 from __future__ import annotations
 
 import re
@@ -26,6 +31,8 @@ from fmubuild.project import FMU_DIRS, FMUS
 from helpers import fmu_variant
 
 _runs: dict = {}
+ROUTES = [(c, b) for c in ("gauss-seidel", "jacobi") for b in ("fmi", "inprocess")]
+"""Each coupling on each backend."""
 
 
 @pytest.fixture(scope="module", autouse=True)
@@ -56,9 +63,10 @@ def assert_same_bits(a, b) -> None:
     assert a.meta["parameters"] == b.meta["parameters"]
 
 
-@pytest.mark.parametrize("backend", ["fmi", "inprocess"])
-@pytest.mark.parametrize("coupling", ["gauss-seidel", "jacobi"])
-@pytest.mark.parametrize("name", scenarios.names())
+@pytest.mark.parametrize("name, coupling, backend", [
+    pytest.param(name, *route, marks=() if j == (i + i // len(ROUTES)) % len(ROUTES)
+                 else pytest.mark.long)
+    for i, name in enumerate(scenarios.names()) for j, route in enumerate(ROUTES)])
 def test_every_scenario_through_fmi3_equals_fmi2_bit_for_bit(name, coupling, backend):
     fmi3 = run(name, 3, coupling, backend)
     assert_same_bits(fmi3, run(name, 2, coupling, "fmi"))

@@ -1,6 +1,10 @@
 """The FMI 3.0 twins in other tools: `cosim.export --fmi 3` writes an SSP package of them, which
 ecos and OMSimulator run with the FMI 2.0 package's results; libcosim and fmpy's SSP runner
-(FMI 2.0 only) refuse it by name."""
+(FMI 2.0 only) refuse it by name.
+
+The quick suite (without ``pytest --long``) runs ecos on waves_smc alone (the waves and the
+chattering SMC: the most code), and each scenario through one of OMSimulator's interfaces,
+command line and API in turn: every scenario once, every interface at least once."""
 from __future__ import annotations
 
 import os
@@ -69,7 +73,8 @@ def test_the_export_command_writes_it_and_says_who_cannot_run_it(fmi3_paths, tmp
 
 
 @needs_ecos
-@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("name", [
+    pytest.param(name, marks=() if name == "waves_smc" else pytest.mark.long) for name in NAMES])
 def test_ecos_runs_the_fmi3_package_as_the_fmi2_one_bit_for_bit(packages, name):
     three, two = run("ecos", packages[name, 3]), run("ecos", packages[name, 2])
     assert sorted(three) == sorted(two) and len(three["time"]) > 3000
@@ -81,8 +86,9 @@ def test_ecos_runs_the_fmi3_package_as_the_fmi2_one_bit_for_bit(packages, name):
 
 
 @needs_oms
-@pytest.mark.parametrize("interface", ["cli", "api"])
-@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("name, interface", [
+    pytest.param(name, interface, marks=() if j == i % 2 else pytest.mark.long)
+    for i, name in enumerate(NAMES) for j, interface in enumerate(["cli", "api"])])
 def test_omsimulator_runs_the_fmi3_package_as_the_fmi2_one(packages, name, interface):
     """Its CSV holds 12 significant digits: the FMI 3.0 package gives the FMI 2.0 one's
     columns, and our Gauss-Seidel run rounded to them; and each twin's independent

@@ -1,5 +1,9 @@
 """OMSimulator runs our SSP packages unchanged, and every parameter a scenario sets reaches the
-FMU there: the guidance's route in its numeric form, since OMSimulator applies no String."""
+FMU there: the guidance's route in its numeric form, since OMSimulator applies no String.
+
+The quick suite (without ``pytest --long``) runs each scenario through one of OMSimulator's
+interfaces, command line and API in turn: every scenario once, every interface at least
+once."""
 from __future__ import annotations
 
 import os
@@ -55,8 +59,10 @@ def _same_to_12_digits(trace: dict, recording) -> int:
 
 
 @needs_oms
-@pytest.mark.parametrize("interface", ["cli", "api"])
-@pytest.mark.parametrize("name", ["calm_pd", "waves_pd", "turning_circle"])
+@pytest.mark.parametrize("name, interface", [
+    pytest.param(name, interface, marks=() if j == i % 2 else pytest.mark.long)
+    for i, name in enumerate(["calm_pd", "waves_pd", "turning_circle"])
+    for j, interface in enumerate(["cli", "api"])])
 def test_omsimulator_runs_the_package_as_our_gauss_seidel_master_to_12_digits(
         packages, name, interface):
     """turning_circle ends at 300 s, where OMSimulator's float time makes a last step of

@@ -1,5 +1,9 @@
 """Failure behaviour: saved states, determinism, a failing FMU in the master, long runs,
-and hosts that survive loading our FMUs."""
+and hosts that survive loading our FMUs.
+
+The day at sea is long (a minute) and left out of the quick suite (without ``pytest --long``):
+it is the only test of what a day does to the numbers; every model it runs is run by the
+quick suite's other tests."""
 from __future__ import annotations
 
 import math
@@ -153,6 +157,7 @@ def test_a_failing_fmu_stops_the_run_cleanly(fmu_paths, fault_fmu, tmp_path, fau
     assert _zombies() == []
 
 
+@pytest.mark.long
 def test_24_hours_in_waves_stay_finite_bounded_and_phase_accurate(fmu_paths):
     """A day at sea under the PD autopilot, in-process; the wave phases at t = 86400 s."""
     from cosim.studies.direct import build_models

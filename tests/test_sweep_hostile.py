@@ -1,5 +1,9 @@
 """Sweeps under hostile input: every bad spec, option, cache or trial ends in one clear
-message naming the input, before anything runs, with no partial output file."""
+message naming the input, before anything runs, with no partial output file.
+
+The quick suite (without ``pytest --long``) interrupts the stage after the runs in one of
+the three places only (writing the tables): the other two are the same path to the same
+message, with another stage's name."""
 from __future__ import annotations
 
 import errno
@@ -477,9 +481,10 @@ def test_ctrl_c_during_the_runs_prints_one_line_that_says_how_to_resume(fmu_path
 
 
 @pytest.mark.timeout(300, method="thread")
-@pytest.mark.parametrize("step, stage", [("write_tables", "writing the tables"),
-                                         ("save_figures", "drawing the figures"),
-                                         ("_comparison", "writing comparison.md")])
+@pytest.mark.parametrize("step, stage", [
+    ("write_tables", "writing the tables"),
+    pytest.param("save_figures", "drawing the figures", marks=pytest.mark.long),
+    pytest.param("_comparison", "writing comparison.md", marks=pytest.mark.long)])
 def test_ctrl_c_after_the_runs_says_they_are_kept_and_how_to_finish(fmu_paths, tmp_path, step,
                                                                    stage):
     """The stage is made to take the signal: it signals its own process, then waits."""
