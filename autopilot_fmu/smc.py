@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Callable
 
 
 from fmukit.numerics import require_finite, substeps, wrap
@@ -60,6 +61,27 @@ def reference_step_bound(omega_n: float, zeta: float) -> float:
     """
     fastest = omega_n * (zeta + math.sqrt(max(zeta * zeta - 1.0, 0.0)))
     return H_MAX if fastest * H_MAX <= 1.0 else 1.0 / fastest
+
+
+def reference_acceleration(psi_d: float, psi_z: float, r_z: float, omega_n: float,
+                           zeta: float, wrap: Callable = wrap) -> float:
+    """r_z_dot of the reference model, eq (44): omega_n^2 (psi_d - psi_z, wrapped) -
+    2 zeta omega_n r_z. Floats, or arrays with an array ``wrap`` (``cosim.ensemble``)."""
+    return omega_n * omega_n * wrap(psi_d - psi_z) - 2.0 * zeta * omega_n * r_z
+
+
+def reference_rk4(psi_d: float, psi_z: float, r_z: float, hs: float, omega_n: float,
+                  zeta: float, wrap: Callable = wrap) -> tuple[float, float]:
+    """(psi_z, r_z) after one RK4 step of hs of the reference model (44), psi_d held."""
+    a1, b1 = r_z, reference_acceleration(psi_d, psi_z, r_z, omega_n, zeta, wrap)
+    a2 = r_z + 0.5 * hs * b1
+    b2 = reference_acceleration(psi_d, psi_z + 0.5 * hs * a1, a2, omega_n, zeta, wrap)
+    a3 = r_z + 0.5 * hs * b2
+    b3 = reference_acceleration(psi_d, psi_z + 0.5 * hs * a2, a3, omega_n, zeta, wrap)
+    a4 = r_z + hs * b3
+    b4 = reference_acceleration(psi_d, psi_z + hs * a3, a4, omega_n, zeta, wrap)
+    return (psi_z + hs / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4),
+            r_z + hs / 6.0 * (b1 + 2.0 * b2 + 2.0 * b3 + b4))
 
 
 @dataclass(frozen=True)
@@ -159,10 +181,8 @@ class SlidingModeAutopilot:
     def r_z_dot(self, psi_d: float, psi_z: float | None = None,
                 r_z: float | None = None) -> float:
         """Desired yaw acceleration from the reference model, eq (44)."""
-        psi_z = self.psi_z if psi_z is None else psi_z
-        r_z = self.r_z if r_z is None else r_z
-        w = self.omega_n
-        return w * w * wrap(psi_d - psi_z) - 2.0 * self.zeta * w * r_z
+        return reference_acceleration(psi_d, self.psi_z if psi_z is None else psi_z,
+                                      self.r_z if r_z is None else r_z, self.omega_n, self.zeta)
 
     def sigma(self, psi: float, r: float) -> float:
         """Sliding surface sigma_h, eq (37)."""
@@ -184,14 +204,7 @@ class SlidingModeAutopilot:
         hs = h / n
         psi_z, r_z = self.psi_z, self.r_z
         for _ in range(n):
-            a1, b1 = r_z, self.r_z_dot(psi_d, psi_z, r_z)
-            a2, b2 = r_z + 0.5 * hs * b1, self.r_z_dot(psi_d, psi_z + 0.5 * hs * a1,
-                                                       r_z + 0.5 * hs * b1)
-            a3, b3 = r_z + 0.5 * hs * b2, self.r_z_dot(psi_d, psi_z + 0.5 * hs * a2,
-                                                       r_z + 0.5 * hs * b2)
-            a4, b4 = r_z + hs * b3, self.r_z_dot(psi_d, psi_z + hs * a3, r_z + hs * b3)
-            psi_z += hs / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
-            r_z += hs / 6.0 * (b1 + 2.0 * b2 + 2.0 * b3 + b4)
+            psi_z, r_z = reference_rk4(psi_d, psi_z, r_z, hs, self.omega_n, self.zeta)
         self.psi_z, self.r_z = psi_z, r_z
 
     def snapshot(self) -> dict[str, float]:

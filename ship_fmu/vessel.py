@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields
+from typing import Callable
 
 from fmukit.numerics import require_finite, substeps
 
@@ -112,23 +113,12 @@ class Vessel:
         self.X_w, self.Y_w, self.N_w = self._wave_loads(self.t, self.xi, self.psi)
 
     def rates(self, t: float, state: State, tau_th: tuple[float, float, float]) -> State:
-        """Time derivative of (x, y, psi, u, v, r, xi), eqs (1)-(17).
+        """Time derivative of (x, y, psi, u, v, r, xi), eqs (1)-(17) (``state_rates``).
 
         tau_th: the actuator forces, from ``thrusters.actuator_model``.
         """
-        _, _, psi, u, v, r, xi = state
-        cX, cY, cN = coriolis_forces(self.hull, u, v, r)
-        dX, dY, dN = damping_forces(self.hull, u, v, r)
-        tX, tY, tN = tau_th
-        wX, wY, wN = self._wave_loads(t, xi, psi)
-        fX = tX + wX - cX - dX
-        fY = tY + wY - cY - dY
-        fN = tN + wN - cN - dN
-        i22, i23, i32, i33 = self._minv
-        x_dot, y_dot, psi_dot = kinematics(psi, u, v, r)
-        xi_dot = math.hypot(u, v) * math.cos(self.params.psi_w - psi)
-        return (x_dot, y_dot, psi_dot, fX * self._m11_inv,
-                i22 * fY + i23 * fN, i32 * fY + i33 * fN, xi_dot)
+        return state_rates(self.hull, self._minv, self._m11_inv, self._wave_loads,
+                           self.params.psi_w, t, state, tau_th)
 
     def step(self, t: float, h: float, delta_c: float,
              n1: float = N_PROPELLER, n2: float = N_PROPELLER, n3: float = 0.0) -> None:
@@ -188,6 +178,29 @@ class Vessel:
         for name in self.STATE:
             setattr(self, name, float(snapshot[name]))
         self.X_w, self.Y_w, self.N_w = self._wave_loads(self.t, self.xi, self.psi)
+
+
+def state_rates(hull: Hull, minv: tuple[float, float, float, float], m11_inv: float,
+                wave_loads: Callable, psi_w: float, t: float, state: State,
+                tau_th: tuple[float, float, float], hypot: Callable = math.hypot,
+                cos: Callable = math.cos, sin: Callable = math.sin) -> State:
+    """Time derivative of (x, y, psi, u, v, r, xi), eqs (1)-(17), for the sway-yaw inverse
+    inertia ``minv`` (M^-1 rows 2-3) and surge ``m11_inv``, the ``wave_loads`` (X_w, Y_w,
+    N_w) of (t, xi, psi) and the wave direction psi_w. Floats, or arrays of states with
+    numpy's cos and sin and an exact hypot (``cosim.ensemble``)."""
+    _, _, psi, u, v, r, xi = state
+    cX, cY, cN = coriolis_forces(hull, u, v, r)
+    dX, dY, dN = damping_forces(hull, u, v, r)
+    tX, tY, tN = tau_th
+    wX, wY, wN = wave_loads(t, xi, psi)
+    fX = tX + wX - cX - dX
+    fY = tY + wY - cY - dY
+    fN = tN + wN - cN - dN
+    i22, i23, i32, i33 = minv
+    x_dot, y_dot, psi_dot = kinematics(psi, u, v, r, cos, sin)
+    xi_dot = hypot(u, v) * cos(psi_w - psi)
+    return (x_dot, y_dot, psi_dot, fX * m11_inv,
+            i22 * fY + i23 * fN, i32 * fY + i33 * fN, xi_dot)
 
 
 def _calm_water(t: float, xi: float, psi: float) -> tuple[float, float, float]:

@@ -15,7 +15,7 @@ import numpy as np
 
 from autopilot_fmu.guidance import WaypointGuidance
 from autopilot_fmu.pd import PDAutopilot
-from autopilot_fmu.smc import SlidingModeAutopilot
+from autopilot_fmu.smc import SlidingModeAutopilot, reference_acceleration, reference_rk4
 from fmukit.numerics import substeps
 
 from .exact import hypot, tanh, wrap
@@ -119,8 +119,7 @@ class SMCArrays:
         self._cuts: tuple[float, np.ndarray] | None = None
 
     def r_z_dot(self, psi_d: np.ndarray, psi_z: np.ndarray, r_z: np.ndarray) -> np.ndarray:
-        w = self.omega_n
-        return w * w * wrap(psi_d - psi_z) - 2.0 * self.zeta * w * r_z
+        return reference_acceleration(psi_d, psi_z, r_z, self.omega_n, self.zeta, wrap)
 
     def command(self, psi: np.ndarray, r: np.ndarray, psi_d: np.ndarray) -> np.ndarray:
         error = wrap(self.psi_z - psi)
@@ -140,15 +139,9 @@ class SMCArrays:
         hs = h / n
         psi_z, r_z = self.psi_z, self.r_z
         for j in range(int(n.max())):
-            a1, b1 = r_z, self.r_z_dot(psi_d, psi_z, r_z)
-            a2, b2 = r_z + 0.5 * hs * b1, self.r_z_dot(psi_d, psi_z + 0.5 * hs * a1,
-                                                       r_z + 0.5 * hs * b1)
-            a3, b3 = r_z + 0.5 * hs * b2, self.r_z_dot(psi_d, psi_z + 0.5 * hs * a2,
-                                                       r_z + 0.5 * hs * b2)
-            a4, b4 = r_z + hs * b3, self.r_z_dot(psi_d, psi_z + hs * a3, r_z + hs * b3)
+            stepped = reference_rk4(psi_d, psi_z, r_z, hs, self.omega_n, self.zeta, wrap)
             active = j < n
-            psi_z = np.where(active, psi_z + hs / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4), psi_z)
-            r_z = np.where(active, r_z + hs / 6.0 * (b1 + 2.0 * b2 + 2.0 * b3 + b4), r_z)
+            psi_z, r_z = (np.where(active, new, old) for new, old in zip(stepped, (psi_z, r_z)))
         self.psi_z, self.r_z = psi_z, r_z
 
 

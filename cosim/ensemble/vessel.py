@@ -14,9 +14,8 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from ship_fmu.hull import coriolis_forces, damping_forces, kinematics
 from ship_fmu.thrusters import actuator_model
-from ship_fmu.vessel import Vessel, axpy, rk4_update
+from ship_fmu.vessel import Vessel, axpy, rk4_update, state_rates
 
 from . import exact
 
@@ -86,21 +85,28 @@ def _calm(t: np.ndarray | float, xi: np.ndarray, psi: np.ndarray) -> Arrays:
     return (0.0, 0.0, 0.0)
 
 
+def _no_travel(u: np.ndarray, v: np.ndarray) -> float:
+    """Calm water: no load depends on the travel xi along the waves, so its rate is left at
+    0 (``hypot`` element by element is the costliest call of a calm step)."""
+    return 0.0
+
+
 class Lanes:
     """What each member's vessel is made of (its waves, its actuators' forces) and
     ``Vessel.rates`` and ``Vessel._integrate`` over them, for all members or some."""
 
     def __init__(self, hull, minv: tuple, m11_inv: float, waves: WaveArrays | None,
-                 forces: list[tuple[np.ndarray | None, Callable]]):
+                 psi_w: np.ndarray, forces: list[tuple[np.ndarray | None, Callable]]):
         self.hull, self.minv, self.m11_inv, self.waves = hull, minv, m11_inv, waves
-        self.wave_loads = waves if waves is not None else _calm
-        self.psi_w = waves.psi_w if waves is not None else None
+        self.wave_loads, self.hypot = (waves, exact.hypot) if waves is not None else (_calm,
+                                                                                     _no_travel)
+        self.psi_w = psi_w
         self._forces = forces          # (members or None for all, tau_th of delta)
 
     def take(self, lanes: np.ndarray) -> Lanes:
         """The members ``lanes`` (indices) only."""
         return Lanes(self.hull, self.minv, self.m11_inv,
-                     None if self.waves is None else self.waves.take(lanes),
+                     None if self.waves is None else self.waves.take(lanes), self.psi_w[lanes],
                      [(None if m is None else m[lanes], f) for m, f in self._forces])
 
     def forces(self, delta: np.ndarray) -> Arrays:
@@ -114,21 +120,9 @@ class Lanes:
         return tuple(out)
 
     def rates(self, t: np.ndarray | float, state: Arrays, tau_th: Arrays) -> Arrays:
-        """``Vessel.rates`` of every member."""
-        _, _, psi, u, v, r, xi = state
-        cX, cY, cN = coriolis_forces(self.hull, u, v, r)
-        dX, dY, dN = damping_forces(self.hull, u, v, r)
-        tX, tY, tN = tau_th
-        wX, wY, wN = self.wave_loads(t, xi, psi)
-        fX = tX + wX - cX - dX
-        fY = tY + wY - cY - dY
-        fN = tN + wN - cN - dN
-        i22, i23, i32, i33 = self.minv
-        x_dot, y_dot, psi_dot = kinematics(psi, u, v, r, np.cos, np.sin)
-        xi_dot = (exact.hypot(u, v) * np.cos(self.psi_w - psi) if self.waves is not None
-                  else 0.0)                      # calm water: no load depends on xi
-        return (x_dot, y_dot, psi_dot, fX * self.m11_inv,
-                i22 * fY + i23 * fN, i32 * fY + i33 * fN, xi_dot)
+        """``Vessel.rates`` of every member (``vessel.state_rates`` on arrays)."""
+        return state_rates(self.hull, self.minv, self.m11_inv, self.wave_loads, self.psi_w, t,
+                           state, tau_th, self.hypot, np.cos, np.sin)
 
     def rk4(self, t: float, start: np.ndarray | float, length: np.ndarray, y: Arrays,
             gear: RudderArrays) -> Arrays:
@@ -168,6 +162,7 @@ class VesselArrays:
             raise ValueError("the members mix calm water and waves")
         self.lanes = Lanes(first.hull, first._minv, first._m11_inv,
                            WaveArrays(vessels) if all(waves) else None,
+                           np.array([v.params.psi_w for v in vessels]),
                            _actuators(first.actuators, np.array(shafts, dtype=float)))
         self.delta_max = np.array([v.params.delta_max for v in vessels])
         self.delta_rate_max = np.array([v.params.delta_rate_max for v in vessels])
