@@ -70,10 +70,12 @@ def test_memory_counts_the_results_and_judges_full_batches(fmu_paths, capsys):
         .endswith(f": {verdict}")
 
 
-def test_the_command_refuses_an_odd_number_of_runs_before_any_cluster(capsys):
+def test_the_command_refuses_bad_counts_before_any_cluster(capsys):
     assert command.main(["sweep", "--parts", "throughput", "--runs", "3"]) == 2
     assert "runs must be an even number of runs >= 2 (half for each autopilot), got 3" in \
         capsys.readouterr().err
+    assert command.main(["sweep", "--parts", "campaign", "--campaign-runs", "0"]) == 2
+    assert "the campaign's runs must be at least 1, got 0" in capsys.readouterr().err
     with pytest.raises(SystemExit):
         command.main(["sweep", "--memory-members", "64,0"])
     assert "expected whole numbers >= 1 separated by commas, got '64,0'" in \

@@ -121,6 +121,8 @@ def campaign(runs: int = CAMPAIGN_RUNS, workers: int = CAMPAIGN_WORKERS,
     """``runs`` waves_pd runs of ``stop_time`` on the batch route on a local cluster of
     ``workers``: the wall time from submission to the last row, and with the cluster's
     start-up, against the issue's goal where it is the issue's campaign."""
+    if runs < 1:
+        raise ValueError(f"the campaign's runs must be at least 1, got {runs}")
     print(f"campaign: {runs} waves_pd runs of {stop_time:g} s on the batch route, a local "
           f"cluster of {_workers(workers)}, on {machine()}; {load()}")
     with tempfile.TemporaryDirectory() as tmp:
