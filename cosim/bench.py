@@ -65,7 +65,7 @@ def main(argv: list[str] | None = None) -> int:
     sweep.add_argument("--runs", type=int, default=32,
                        help="runs per FMI or in-process sweep (even; default 32)")
     sweep.add_argument("--batch-runs", type=int, default=1024,
-                       help="runs per batch sweep (even; default 1024: batches of 256)")
+                       help="runs per batch sweep (even; default 1024)")
     sweep.add_argument("--sea", choices=("waves", "calm", "both"), default="both",
                        help="the throughput's sweeps: waves_pd and waves_smc, calm_pd and "
                             "calm_smc, or both (default)")

@@ -8,8 +8,8 @@ backend side by side, and the batch route's goals (issue 29), each printed besid
 - ``campaign``: 1,000 waves_pd runs of 400 s on the batch route on 2 workers, from
   submission to the last row, and with the cluster's start-up;
 - ``batch_memory``: the peak memory of ``simulate_members`` against its number of members,
-  and of a worker against the size of the sweep it ran (in batches of at most
-  ``MAX_BATCH`` runs).
+  and of a worker against the size of the sweep it ran (cut into batches as the sweep cuts
+  them, ``sweep_client.plan``).
 
 The machines are shared: each part prints the load average before and after it.
 """
@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .bench import machine, require_in_process
-from .sweep_client import MAX_BATCH, batches
+from .sweep_client import plan
 from .sweep_task import BATCH, SWEEP_BACKENDS
 
 SEAS = {"waves": ("waves_pd", "waves_smc"), "calm": ("calm_pd", "calm_smc")}
@@ -148,11 +148,12 @@ def campaign(runs: int = CAMPAIGN_RUNS, workers: int = CAMPAIGN_WORKERS,
 
 
 def batch_memory(members: tuple[int, ...] = MEMORY_MEMBERS,
-                 stop_time: float = MEMORY_STOP_TIME, batch_size: int = MAX_BATCH) -> dict:
+                 stop_time: float = MEMORY_STOP_TIME, batch_size: int | None = None) -> dict:
     """Peak memory (MB) of waves_pd runs of ``stop_time`` on the batch route: of a
     ``simulate_members`` call in a fresh process for each number of ``members`` (with what
     its results take), and of the one worker of a sweep of as many runs in batches of at
-    most ``batch_size``; whether the worker's is flat in the sweep's size."""
+    most ``batch_size`` (default: the sweep's); whether the worker's is flat in the sweep's
+    size."""
     print(f"batch route memory: waves_pd runs of {stop_time:g} s, on {machine()}; {load()}")
     calls = {m: _members_call(m, stop_time) for m in members}
     for m, (wall, before, peak, results) in calls.items():
@@ -178,7 +179,7 @@ def batch_memory(members: tuple[int, ...] = MEMORY_MEMBERS,
     else:
         low, high = sweeps[min(full)].peak_rss[0], sweeps[max(full)].peak_rss[0]
         growth = high / low - 1.0
-        print(f"  goal: memory flat in the sweep's size (batches of at most {batch_size} runs): "
+        print(f"  goal: memory flat in the sweep's size (batches of at most {largest} runs): "
               f"worker peak RSS {low:.1f} MB at {min(full)} runs, {high:.1f} MB at "
               f"{max(full)} runs ({growth:+.1%}; flat: within {FLAT:.0%}): "
               f"{_verdict(growth <= FLAT)}")
@@ -300,10 +301,9 @@ def _sweep(spec, workers: int, backend: str, batch_size: int | None = None) -> M
         if alone:
             raise RuntimeError(f"{len(alone)} of {len(rows)} runs of the batch sweep ran "
                                f"alone: {alone[0]['backend']}")
-    per_system = [sum(r["controller"] == c for r in rows) for c in spec.controllers]
-    sizes = tuple(len(b) for n in per_system
-                  for b in batches(list(range(n)), workers, batch_size)) if backend == BATCH \
-        else ()
+    sizes = tuple(len(b) for b in plan(spec, [spec.job(g[0], "bench", "inprocess")
+                                              for g in spec.shared_runs()],
+                                       workers, batch_size)[0]) if backend == BATCH else ()
     simulated = math.fsum(r["sim_seconds"] for r in rows) / len(rows)
     in_task = math.fsum(r["seconds"] - r["sim_seconds"] for r in rows) / len(rows)
     return Measure(len(rows), workers, done - ready, ready - started, simulated, in_task,
