@@ -121,13 +121,29 @@ def test_a_sweep_resumes_on_the_other_backend(mixed, cluster, tmp_path, first, t
         assert_same_row(row, reference[run_id])
 
 
-def test_batch_sizes_keep_every_worker_busy():
-    assert [len(b) for b in batches(list(range(1000)), 2)] == [250] * 4    # at most 256
-    assert [len(b) for b in batches(list(range(100)), 2)] == [50, 50]
-    assert [len(b) for b in batches(list(range(40)), 2)] == [40]          # a few dozen each
-    assert [len(b) for b in batches(list(range(10)), 4)] == [10]
-    assert [len(b) for b in batches(list(range(20)), 2, size=7)] == [7, 6, 7]
-    assert sum(batches(list(range(23)), 3, size=5), []) == list(range(23))   # in order
+def test_batch_sizes_keep_every_worker_busy_within_the_memory_of_their_recordings(tmp_path):
+    from dataclasses import replace
+
+    from cosim.studies.sweep_client import BATCH_MEMORY, MAX_BATCH, batch_limit
+
+    spec = sweep.Spec.read(write_spec(tmp_path, 'name = "b"\n[axes]\n'
+                                      'wave_seed = { start = 1, count = 2 }\n'))
+    long = spec.job(spec.runs()[0], "t", "inprocess")              # the scenario's 400 s
+    short = replace(long, stop_time=20.0)
+    assert batch_limit(long) == BATCH_MEMORY // (6 * 8 * 4001) == 698
+    assert batch_limit(short) == MAX_BATCH
+
+    def sizes(n, workers, size=None, job=long):
+        return [len(b) for b in batches([job] * n, workers, size)]
+    assert sizes(1000, 2) == [500, 500]
+    assert sizes(3000, 2) == [600] * 5                     # at most 698 runs of 400 s
+    assert sizes(3000, 2, job=short) == [1000] * 3         # at most MAX_BATCH
+    assert sizes(100, 2) == [50, 50]
+    assert sizes(40, 2) == [40]                            # a few dozen each
+    assert sizes(10, 4) == [10]
+    assert sizes(20, 2, size=7) == [7, 6, 7]
+    jobs = [replace(long, run={**long.run, "run_id": str(i)}) for i in range(23)]
+    assert sum(batches(jobs, 3, size=5), []) == jobs       # in order
 
 
 def test_a_batch_has_the_time_limits_of_its_runs_together():
