@@ -124,30 +124,24 @@ class Instance:
                       [self.vr(name)], [exact], time=time)
 
     def get(self, names: Iterable[str]) -> dict[str, Any]:
-        """Current values of variables by name."""
-        out = {}
-        for name in names:
-            kind = self.variable(name).type
-            getter = self.fmi(f"get{_CALL_TYPE.get(kind, kind)}")
-            value = self.call(f"get {name}", getter, [self.vr(name)])[0]
-            out[name] = value.decode("utf-8") if isinstance(value, bytes) else value
-        return out
-
-    def parameter_values(self) -> dict[str, Any]:
-        """Every parameter's value as the FMU holds it: defaults and what was set; one FMI
-        call per type (a call per parameter cost 2 ms of a run's initialisation)."""
-        names = [n for n, v in self.variables.items() if v.causality == "parameter"]
+        """Current values of variables by name, one FMI call per type (a call per variable
+        cost 2 ms of a run's initialisation, where every parameter is read)."""
+        names = list(names)
         by_type: dict[str, list[str]] = {}
         for name in names:
             kind = self.variable(name).type
             by_type.setdefault(_CALL_TYPE.get(kind, kind), []).append(name)
         values = {}
         for kind, group in by_type.items():
-            read = self.call(f"get the {kind} parameters", self.fmi(f"get{kind}"),
+            read = self.call(f"get {', '.join(group)}", self.fmi(f"get{kind}"),
                              [self.vr(name) for name in group])
             values.update(zip(group, read))
         return {name: values[name].decode("utf-8") if isinstance(values[name], bytes)
                 else values[name] for name in names}
+
+    def parameter_values(self) -> dict[str, Any]:
+        """Every parameter's value as the FMU holds it: defaults and what was set."""
+        return self.get([n for n, v in self.variables.items() if v.causality == "parameter"])
 
     def initialize(self, parameters: dict[str, Any] | None = None,
                    start_time: float = 0.0) -> None:
