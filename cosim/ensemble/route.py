@@ -8,6 +8,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from fmukit.autopilot import INPUTS
 from fmukit.timebase import communication_point
 
 from ..core.master import Master
@@ -23,7 +24,7 @@ SIGNALS = ("guidance.psi_d", "guidance.wp_index", "ship.x", "ship.y", "ship.psi"
            "ship.delta")
 """What the figures of merit of a run need (``cosim.studies.sweep_task.run_metrics``)."""
 
-R_MAX = 100.0
+R_MAX = next(var.max for var in INPUTS if var.name == "r")
 """The autopilots' declared range of their yaw-rate input, rad/s: beyond it they refuse."""
 
 
