@@ -60,17 +60,27 @@ class WaveArrays:
         self.psi_w = np.array([w.psi_w for w in loads])
         self.c_force = np.array([w._c_force for w in loads])
         self.c_moment = np.array([w._c_moment for w in loads])
+        self._work = (np.empty_like(self.omega), np.empty_like(self.omega))
+        self._part = {name: np.empty_like(getattr(self, name)) for name in self.FIELDS}
 
     def take(self, lanes: np.ndarray) -> WaveArrays:
-        """The waves of the members ``lanes`` (indices) only."""
+        """The waves of the members ``lanes`` (indices) only, held in this object's spare
+        arrays (so valid until the next ``take``) and computed in its work arrays."""
         part = object.__new__(WaveArrays)
         for name in self.FIELDS:
-            setattr(part, name, getattr(self, name)[lanes])
+            setattr(part, name, np.take(getattr(self, name), lanes, axis=0,
+                                        out=self._part[name][:len(lanes)]))
+        part._work, part._part = self._work, None
         return part
 
     def __call__(self, t: np.ndarray | float, xi: np.ndarray, psi: np.ndarray) -> Arrays:
-        s = np.multiply(self.omega, t[:, None] if isinstance(t, np.ndarray) else t)
-        np.subtract(s, np.multiply(self.k, xi[:, None]), s)
+        # The (M, N) intermediates are written into arrays made once: made afresh, a few
+        # hundred members' would each be a fresh mmap (128 kB and over) on every call
+        # where glibc's mmap threshold is fixed, as Dask's workers fix it.
+        m = len(xi)
+        s, ks = self._work[0][:m], self._work[1][:m]
+        np.multiply(self.omega, t[:, None] if isinstance(t, np.ndarray) else t, s)
+        np.subtract(s, np.multiply(self.k, xi[:, None], ks), s)
         np.add(s, self.phase, s)
         np.sin(s, s)
         np.multiply(self.slope_amplitude, s, s)               # s_i = A_i k_i sin(theta_i)
