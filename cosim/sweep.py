@@ -77,10 +77,10 @@ def main(argv: list[str] | None = None) -> int:
                              "arrays: the in-process route's rows, bit for bit, many times "
                              "faster (a system it does not cover runs in-process, with a note)")
     parser.add_argument("--batch-size", type=count, metavar="N",
-                        help="with --backend batch: at most N runs a batch (default: enough "
-                             f"batches to keep every worker busy, {MIN_BATCH} to {MAX_BATCH} "
-                             "runs each where there are that many; memory: about 0.2 MB a "
-                             "run of 400 s)")
+                        help="with --backend batch: at most N runs a batch (default: as few "
+                             f"batches as keep every worker busy, of at most {MAX_BATCH} runs "
+                             f"and at least {MIN_BATCH} where there are that many; memory: "
+                             "about 0.2 MB a run of 400 s)")
     parser.add_argument("--no-worker-timeout", type=positive_seconds, metavar="SECONDS",
                         default=sweep.NO_WORKER_TIMEOUT,
                         help="stop when the cluster has had no worker for this long, keeping "

@@ -124,7 +124,7 @@ def test_a_sweep_resumes_on_the_other_backend(mixed, cluster, tmp_path, first, t
 def test_batch_sizes_keep_every_worker_busy_within_the_memory_of_their_recordings(tmp_path):
     from dataclasses import replace
 
-    from cosim.studies.sweep_client import BATCH_MEMORY, MAX_BATCH, batch_limit
+    from cosim.studies.sweep_client import BATCH_MEMORY, MAX_BATCH, batch_counts, batch_limit
 
     spec = sweep.Spec.read(write_spec(tmp_path, 'name = "b"\n[axes]\n'
                                       'wave_seed = { start = 1, count = 2 }\n'))
@@ -144,6 +144,11 @@ def test_batch_sizes_keep_every_worker_busy_within_the_memory_of_their_recording
     assert sizes(20, 2, size=7) == [7, 6, 7]
     jobs = [replace(long, run={**long.run, "run_id": str(i)}) for i in range(23)]
     assert sum(batches(jobs, 3, size=5), []) == jobs       # in order
+    # A sweep of several systems: as few batches as keep the workers busy, in all.
+    assert batch_counts([[long] * 512, [long] * 512], 2) == [1, 1]
+    assert batch_counts([[long] * 600, [long] * 100], 4) == [3, 1]
+    assert batch_counts([[long] * 40, [long] * 10], 4) == [1, 1]
+    assert batch_counts([[long] * 800, [short] * 3000], 2) == [2, 3]
 
 
 def test_a_batch_has_the_time_limits_of_its_runs_together():

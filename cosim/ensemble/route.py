@@ -107,7 +107,7 @@ def _lockstep(members: list[tuple[int, Member]], t0: float, h: float, n_steps: i
     ship = VesselArrays([m["ship"] for m in models], h, [m.shafts for _, m in members])
     guidance = GuidanceArrays([m["guidance"] for m in models])
     pilot = autopilot_arrays([m["autopilot"] for m in models])
-    block = np.empty((len(signals), len(members), n_steps + 1))
+    block = np.empty((n_steps + 1, len(signals), len(members)))   # a step's values together
     rows = [ALL_SIGNALS.index(s) for s in signals]
     failed = np.zeros(len(members), dtype=bool)
     with np.errstate(all="ignore"):                # a failing member's lanes only
@@ -118,7 +118,7 @@ def _lockstep(members: list[tuple[int, Member]], t0: float, h: float, n_steps: i
             values = (psi_d, wp_index, delta_c, ship.x, ship.y, ship.psi, ship.u, ship.v,
                       ship.r, ship.delta)
             for row, signal in enumerate(rows):
-                block[row, :, k] = values[signal]
+                block[k, row] = values[signal]
             failed |= ~np.isfinite(np.add.reduce(values[2:]) + ship.xi) | (np.abs(ship.r) > R_MAX)
             if k == n_steps:
                 break
@@ -134,6 +134,6 @@ def _lockstep(members: list[tuple[int, Member]], t0: float, h: float, n_steps: i
         meta = {**member.meta, "backend": "batch",
                 "backends": {name: "batch" for name in member.meta["backends"]},
                 "wall_time_s": share}
-        out.append((i, Recording(list(signals), times, block[:, j, :].T, n_steps + 1,
+        out.append((i, Recording(list(signals), times, block[:, :, j], n_steps + 1,
                                  meta=meta, units={s: units[s] for s in signals})))
     return out

@@ -183,8 +183,7 @@ BATCH_MEMORY = 128 << 20
 """Bytes a batch's recorded signals may take on its worker (the figures of merit need every
 sample): a batch of 400 s runs holds at most 698 runs."""
 MIN_BATCH = 32
-"""The fewest runs a batch gets where its system has that many: a batch's cost per step
-is shared by its runs."""
+"""The fewest runs a batch is cut down to for keeping workers busy (``batch_counts``)."""
 
 
 def batch_limit(job: Job) -> int:
@@ -197,14 +196,30 @@ def batch_limit(job: Job) -> int:
 
 
 def batches(jobs: list[Job], workers: int, size: int | None = None) -> list[list[Job]]:
-    """``jobs`` (of one system and stop time) cut into batches of near-equal size, in their
-    order: of at most ``size`` runs, or by default as many as keep ``workers`` busy, of at
-    least ``MIN_BATCH`` runs where there are that many and at most ``batch_limit``."""
-    if size is None:
-        count = max(math.ceil(len(jobs) / batch_limit(jobs[0])),
-                    min(workers, len(jobs) // MIN_BATCH), 1)
-    else:
-        count = math.ceil(len(jobs) / size)
+    """``jobs`` (of one system and stop time) cut into batches as ``plan`` cuts a sweep of
+    them alone."""
+    count = math.ceil(len(jobs) / size) if size else batch_counts([jobs], workers)[0]
+    return _cut(jobs, count)
+
+
+def batch_counts(groups: list[list[Job]], workers: int) -> list[int]:
+    """How many batches each group (runs of one system and stop time) is cut into by
+    default: as few as its ``batch_limit`` allows; then, while the sweep has fewer batches
+    than ``workers``, the group with the largest batches gets one batch more, as long as its
+    batches keep ``MIN_BATCH`` runs. A batch's cost per step is largely shared by its runs
+    (numpy's cost per call, about 0.6 ms a step), so batches are made no smaller than
+    keeping every worker busy needs."""
+    counts = [math.ceil(len(group) / batch_limit(group[0])) for group in groups]
+    while sum(counts) < workers:
+        largest = max(range(len(groups)), key=lambda g: len(groups[g]) / counts[g])
+        if len(groups[largest]) // (counts[largest] + 1) < MIN_BATCH:
+            break
+        counts[largest] += 1
+    return counts
+
+
+def _cut(jobs: list[Job], count: int) -> list[list[Job]]:
+    """``jobs`` in ``count`` batches of near-equal size, in their order."""
     cuts = [round(k * len(jobs) / count) for k in range(count + 1)]
     return [jobs[a:b] for a, b in zip(cuts, cuts[1:])]
 
@@ -212,8 +227,9 @@ def batches(jobs: list[Job], workers: int, size: int | None = None) -> list[list
 def plan(spec: Spec, jobs: list[Job], workers: int, size: int | None = None
          ) -> tuple[list[list[Job]], list[Job]]:
     """(the batches, the runs to run alone) of a sweep on the batch backend: the runs of
-    each system (``Bundle.digest``) and stop time in ``batches``, those of a controller
-    the kernel does not cover (``Spec.batch_coverage``) one by one."""
+    each system (``Bundle.digest``) and stop time cut into batches of at most ``size`` runs
+    or by default as ``batch_counts`` says, those of a controller the kernel does not cover
+    (``Spec.batch_coverage``) one by one."""
     covered = spec.batch_coverage()
     groups: dict[tuple[str, float | None], list[Job]] = {}
     alone = []
@@ -222,7 +238,10 @@ def plan(spec: Spec, jobs: list[Job], workers: int, size: int | None = None
             groups.setdefault((job.bundle.digest, job.stop_time), []).append(job)
         else:
             alone.append(job)
-    return [batch for group in groups.values() for batch in batches(group, workers, size)], alone
+    cut = list(groups.values())
+    counts = ([math.ceil(len(group) / size) for group in cut] if size
+              else batch_counts(cut, workers))
+    return [batch for group, count in zip(cut, counts) for batch in _cut(group, count)], alone
 
 
 def run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, progress: bool,
