@@ -346,18 +346,18 @@ def parameters(system: SystemDescription, paths: dict[str, Path],
             raise no_component(system.components, component)
     connected = {(c.end_element, c.end_connector): f"{c.start_element}.{c.start_connector}"
                  for c in system.connections}
+    settable = {c: [n for n, d in theirs.items() if d.settable] for c, theirs in declared.items()}
     result: dict[str, dict[str, Value]] = {}
     for component, values in system.parameters(given).items():
         result[component] = {}
+        elsewhere = {c: names for c, names in settable.items() if c != component}
         for name, value in values.items():
             try:
                 if (component, name) in connected:
                     raise ValueError(f"{component}.{name} is an input that the connection "
                                      f"from {connected[component, name]} sets")
-                result[component][name] = setting(
-                    component, paths[component], declared[component], name, value,
-                    {c: [n for n, d in theirs.items() if d.settable]
-                     for c, theirs in declared.items() if c != component})
+                result[component][name] = setting(component, paths[component],
+                                                  declared[component], name, value, elsewhere)
             except ValueError as error:
                 if name in given.get(component, {}):
                     raise
