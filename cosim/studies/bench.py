@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import os
 import platform
+import resource
 import statistics
 import subprocess
 import sys
@@ -25,6 +26,19 @@ from typing import Callable
 from ..core.master import RUN_BACKENDS
 
 STEPS = 4000
+
+
+def peak_rss_mb() -> float:
+    """This process's peak resident memory, MB (run on each worker): Linux's VmHWM, which
+    starts afresh with the process's program. (``ru_maxrss`` does not: a child started by
+    fork and exec keeps its parent's peak at the fork.)"""
+    try:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("VmHWM:"):
+                return int(line.split()[1]) / 1024
+    except OSError:
+        pass
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 
 
 def machine() -> str:
@@ -218,8 +232,9 @@ def memory(hours: float, backends: tuple[str, ...] = RUN_BACKENDS) -> None:
     backend."""
     print(f"Memory: calm_pd streamed to CSV in chunks of 10,000 rows, on {machine()}")
     for backend, duration in ((b, d) for b in backends for d in (3600.0, hours * 3600.0)):
-        code = ("import resource, time, tempfile, os\n"
+        code = ("import time, tempfile, os\n"
                 "from cosim import scenarios\nfrom cosim.core.master import Master\n"
+                "from cosim.studies.bench import peak_rss_mb\n"
                 f"m = Master(scenarios.load('calm_pd'), backend={backend!r})\n"
                 "out = os.path.join(tempfile.mkdtemp(), 'run.csv')\n"
                 "t = time.perf_counter()\n"
@@ -227,11 +242,10 @@ def memory(hours: float, backends: tuple[str, ...] = RUN_BACKENDS) -> None:
                 "wall = time.perf_counter() - t\n"
                 "m.free()\n"
                 "assert rec.error is None, rec.error\n"
-                "print(rec.rows, wall, os.path.getsize(out),"
-                " resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)\n"
+                "print(rec.rows, wall, os.path.getsize(out), peak_rss_mb())\n"
                 "os.remove(out)\n")
         out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                              check=True).stdout.split()
-        rows, wall, size, peak_kb = int(out[0]), float(out[1]), int(out[2]), int(out[3])
+        rows, wall, size, peak = int(out[0]), float(out[1]), int(out[2]), float(out[3])
         print(f"  {backend:9} {duration / 3600:5.1f} h simulated: {rows:>8} rows, "
-              f"{wall:6.1f} s wall, CSV {size / 1e6:7.1f} MB, peak RSS {peak_kb / 1024:6.1f} MB")
+              f"{wall:6.1f} s wall, CSV {size / 1e6:7.1f} MB, peak RSS {peak:6.1f} MB")

@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import math
 import os
-import resource
 import statistics
 import subprocess
 import sys
@@ -26,7 +25,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from .bench import machine, require_in_process
+from .bench import machine, peak_rss_mb, require_in_process
 from .sweep_client import plan
 from .sweep_task import BATCH, SWEEP_BACKENDS
 
@@ -310,19 +309,6 @@ def _sweep(spec, workers: int, backend: str, batch_size: int | None = None) -> M
                    sizes, peaks, os.getloadavg()[0])
 
 
-def peak_rss_mb() -> float:
-    """This process's peak resident memory, MB (run on each worker): Linux's VmHWM, which
-    starts afresh with the process's program. (``ru_maxrss`` does not: a child started by
-    fork and exec keeps its parent's peak at the fork.)"""
-    try:
-        for line in Path("/proc/self/status").read_text().splitlines():
-            if line.startswith("VmHWM:"):
-                return int(line.split()[1]) / 1024
-    except OSError:
-        pass
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-
-
 def _members_call(members: int, stop_time: float) -> tuple[float, float, float, float]:
     """(wall s, peak RSS before the call MB, peak RSS MB, results MB) of ``simulate_members``
     of ``members`` waves_pd runs of ``stop_time`` (wave seeds 1, 2, ...) in a fresh process;
@@ -330,7 +316,7 @@ def _members_call(members: int, stop_time: float) -> tuple[float, float, float, 
     code = ("import sys, time\n"
             "from cosim import scenarios\n"
             "from cosim.ensemble import selftest, simulate_members\n"
-            "from cosim.studies.bench_sweep import peak_rss_mb\n"
+            "from cosim.studies.bench import peak_rss_mb\n"
             "system = scenarios.load('waves_pd')\n"
             "selftest()\n"
             "before = peak_rss_mb()\n"
