@@ -9,6 +9,7 @@ import dataclasses
 import json
 import math
 import os
+import time
 from pathlib import Path
 
 import numpy as np
@@ -275,6 +276,35 @@ def test_a_batch_that_fails_as_a_whole_runs_each_member_alone(members, monkeypat
         assert_same_row(ours, theirs)
         assert ours["backend"] == (f"{theirs['backend']} (not in a batch: the batch failed, "
                                    "RuntimeError: the kernel broke; run alone)")
+
+
+def test_a_batch_past_its_time_limit_in_the_kernel_stops_and_runs_each_member_alone(
+        members, monkeypatch):
+    """The kernel asks the watchdog at every step: past the batch's run limit (its runs'
+    limits together) it stops at the next step, and the runs run alone within theirs."""
+    from cosim.core.watchdog import Limits
+    from cosim.ensemble.vessel import VesselArrays
+
+    jobs, blobs = members
+    jobs = [dataclasses.replace(job, limits=Limits(run=0.25)) for job in jobs[:2]]
+    alone = [sweep_task.run_one(job, blobs) for job in jobs]
+    assert sweep_task.batch_refusal() is None       # the self-test, before the kernel is slowed
+    step, steps = VesselArrays.step, []
+
+    def slow(self, *args):                  # 300 steps of 5 ms: 1.5 s, past 2 x 0.25 s
+        steps.append(time.monotonic())
+        time.sleep(0.005)
+        return step(self, *args)
+    monkeypatch.setattr(VesselArrays, "step", slow)
+    started = time.monotonic()
+    together = sweep_task.run_batch(jobs, blobs)
+    assert steps[-1] - started < 0.5 + 0.1         # stopped at the step after its limit
+    assert len(steps) < 300
+    for ours, theirs in zip(together, alone, strict=True):
+        assert_same_row(ours, theirs)
+        assert ours["backend"] == (f"{theirs['backend']} (not in a batch: the batch failed, "
+                                   "the run did not end within its time limit of 0.5 s; "
+                                   "run alone)")
 
 
 def test_a_worker_whose_self_test_refuses_runs_its_batches_alone(members, monkeypatch, capsys):

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import time
 from collections import defaultdict
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 import numpy as np
 
@@ -14,6 +14,7 @@ from fmukit.timebase import communication_point
 from ..core.master import Master
 from ..core.recording import Recording
 from ..core.ssd import SystemDescription
+from ..core.watchdog import TimeLimit
 from .control import GuidanceArrays, autopilot_arrays
 from .members import Member, coverage, initialise
 from .reference import SIGNALS as ALL_SIGNALS
@@ -28,13 +29,21 @@ R_MAX = next(var.max for var in INPUTS if var.name == "r")
 """The autopilots' declared range of their yaw-rate input, rad/s: beyond it they refuse."""
 
 
+def _no_limit(what: str | float) -> None:
+    """A ``beat`` that never stops the batch."""
+
+
 def simulate_members(system: SystemDescription, overrides: Sequence[dict[str, dict[str, Any]]],
-                     stop_time: float | None = None,
-                     signals: Sequence[str] = SIGNALS) -> list[Recording]:
+                     stop_time: float | None = None, signals: Sequence[str] = SIGNALS,
+                     beat: Callable[[str | float], str | None] = _no_limit) -> list[Recording]:
     """One recording per member of ``system`` with ``overrides[i]`` (as
     ``Master(system, backend="inprocess").run(stop_time)`` records it, holding the columns
     ``signals``, any of ``reference.SIGNALS``). ValueError naming the member whose settings
-    are refused, before anything runs."""
+    are refused, before anything runs.
+
+    ``beat`` (``Watchdog.beat``) is called as each member's initialisation and each step
+    of the members together begins, with a phrase or the step's time; where it returns a
+    reason (a time limit passed), the batch stops there: TimeLimit with that reason."""
     unknown = [s for s in signals if s not in ALL_SIGNALS]
     if unknown:
         raise ValueError(f"signals {', '.join(unknown)}: the batch route records only "
@@ -50,6 +59,7 @@ def simulate_members(system: SystemDescription, overrides: Sequence[dict[str, di
         recordings: dict[int, Recording] = {}
         groups: dict[tuple, list[tuple[int, Member]]] = defaultdict(list)
         for i, member_overrides in enumerate(overrides):
+            _check(beat(f"initialising member {i} of the batch"))
             member = None if reason else initialise(master, member_overrides, n_steps)
             why = reason or _outside(member, h)
             if why:
@@ -58,11 +68,17 @@ def simulate_members(system: SystemDescription, overrides: Sequence[dict[str, di
                 groups[_group(member)].append((i, member))
         for members in groups.values():
             for i, recording in _lockstep(members, system.start_time, h, n_steps, signals,
-                                          master.units):
+                                          master.units, beat):
                 recordings[i] = recording or _alone(
                     master, overrides[i], stop_time, signals,
                     "it failed in the batch kernel, and ran alone to say why")
     return [recordings[i] for i in range(len(overrides))]
+
+
+def _check(expired: str | None) -> None:
+    """TimeLimit if a ``beat`` said a limit passed."""
+    if expired:
+        raise TimeLimit(expired)
 
 
 def _outside(member: Member | None, h: float) -> str | None:
@@ -98,7 +114,8 @@ def _alone(master: Master, overrides: dict[str, dict[str, Any]], stop_time: floa
 
 
 def _lockstep(members: list[tuple[int, Member]], t0: float, h: float, n_steps: int,
-              signals: Sequence[str], units: dict[str, str]
+              signals: Sequence[str], units: dict[str, str],
+              beat: Callable[[str | float], str | None] = _no_limit
               ) -> list[tuple[int, Recording | None]]:
     """The members stepped together; (index, recording), None for a member that failed
     (a signal not finite, or a yaw rate outside the autopilot's range)."""
@@ -113,6 +130,7 @@ def _lockstep(members: list[tuple[int, Member]], t0: float, h: float, n_steps: i
     with np.errstate(all="ignore"):                # a failing member's lanes only
         for k in range(n_steps + 1):
             t = communication_point(t0, k, h)
+            _check(beat(t))
             psi_d, wp_index = guidance.outputs(ship.x, ship.y)
             delta_c = pilot.command(ship.psi, ship.r, psi_d)
             values = (psi_d, wp_index, delta_c, ship.x, ship.y, ship.psi, ship.u, ship.v,

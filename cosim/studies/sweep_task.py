@@ -256,9 +256,9 @@ def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
     of the batch). A member ``Master.configure`` refuses is run by ``run_one`` (which
     refuses it the same way); every member is, saying why in its backend, where
     ``batch_refusal`` refuses the route on this worker or the batch fails as a whole (an
-    exception, or its time limits, ``batch_limits``, passed: the whole batch counts as one
-    step). The kernel's numpy code cannot be interrupted: a batch past its limits there
-    ends the worker, as an FMU that runs no Python does, and the sweep retries it."""
+    exception, or its time limits passed, ``batch_limits``: each member's initialisation
+    and each step of the members together within N times the step limit, the batch
+    within N times the run limit; the kernel stops at the step after a limit passed)."""
     from ..ensemble import simulate_members
 
     started = time.perf_counter()
@@ -275,7 +275,8 @@ def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
             members = [job for job in jobs if _configures(master, job)]
             watchdog.beat(f"the batch of {len(members)} runs")
             recordings = simulate_members(master.system, [job.overrides for job in members],
-                                          jobs[0].stop_time) if members else []
+                                          jobs[0].stop_time, beat=watchdog.beat
+                                          ) if members else []
         if watchdog.expired:
             raise TimeLimit(watchdog.expired)
     except (Exception, TimeLimit) as error:
