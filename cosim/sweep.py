@@ -79,8 +79,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--batch-size", type=count, metavar="N",
                         help="with --backend batch: at most N runs a batch (default: as few "
                              f"batches as keep every worker busy, of at most {MAX_BATCH} runs "
-                             f"and at least {MIN_BATCH} where there are that many; memory: "
-                             "about 0.2 MB a run of 400 s)")
+                             f"and at least {MIN_BATCH} where there are that many, and in "
+                             "waves a share of each system for every worker; memory: about "
+                             "0.2 MB a run of 400 s)")
     parser.add_argument("--no-worker-timeout", type=positive_seconds, metavar="SECONDS",
                         default=sweep.NO_WORKER_TIMEOUT,
                         help="stop when the cluster has had no worker for this long, keeping "

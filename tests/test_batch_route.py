@@ -145,10 +145,16 @@ def test_batch_sizes_keep_every_worker_busy_within_the_memory_of_their_recording
     assert sizes(20, 2, size=7) == [7, 6, 7]
     jobs = [replace(long, run={**long.run, "run_id": str(i)}) for i in range(23)]
     assert sum(batches(jobs, 3, size=5), []) == jobs       # in order
-    # A sweep of several systems: as few batches as keep the workers busy, in all.
-    assert batch_counts([[long] * 512, [long] * 512], 2) == [1, 1]
-    assert batch_counts([[long] * 600, [long] * 100], 4) == [3, 1]
-    assert batch_counts([[long] * 40, [long] * 10], 4) == [1, 1]
+    # A sweep of several systems: in calm water as few batches as keep the workers busy,
+    # in all; in waves each system shared among the workers, down to WAVES_SHARE runs.
+    calm = replace(long, overrides={**long.overrides, "ship": {**long.overrides.get("ship", {}),
+                                                               "Hs": 0.0}})
+    assert batch_counts([[calm] * 512, [calm] * 512], 2) == [1, 1]
+    assert batch_counts([[long] * 512, [long] * 512], 2) == [2, 2]
+    assert batch_counts([[calm] * 600, [calm] * 100], 4) == [3, 1]
+    assert batch_counts([[long] * 600, [long] * 100], 4) == [4, 1]
+    assert batch_counts([[long] * 255, [long] * 256], 2) == [1, 2]
+    assert batch_counts([[calm] * 40, [long] * 10], 4) == [1, 1]
     assert batch_counts([[long] * 800, [short] * 3000], 2) == [2, 3]
 
 

@@ -42,7 +42,8 @@ each system's FMUs per thread and resets them (fmi2Reset) between tasks.
 one task each (``cosim.ensemble``: the members stepped together as numpy arrays), with
 every row's columns the in-process route's, bit for bit, but backend, seconds and
 sim_seconds (the run's share of its batch). --batch-size caps a batch's runs (default:
-enough batches to keep every worker busy, of 32 to 256 runs where there are that many).
+as few batches as keep every worker busy, of 32 to 1,024 runs where there are that many,
+and in waves a share of each system for every worker; ``sweep_client.batch_counts``).
 A system the kernel does not cover (a foreign autopilot FMU) runs in-process, one run per
 task, with a note; so does every run of a batch that fails as a whole, and of a worker
 whose self-test refuses the route (said once), each row saying why in its backend. A

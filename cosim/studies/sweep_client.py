@@ -184,6 +184,9 @@ BATCH_MEMORY = 128 << 20
 sample): a batch of 400 s runs holds at most 698 runs."""
 MIN_BATCH = 32
 """The fewest runs a batch is cut down to for keeping workers busy (``batch_counts``)."""
+WAVES_SHARE = 128
+"""The fewest runs a batch in waves is cut down to for giving every worker a share of its
+system (``batch_counts``): at 128 runs the shared cost of a step is about a quarter of it."""
 
 
 def batch_limit(job: Job) -> int:
@@ -204,18 +207,32 @@ def batches(jobs: list[Job], workers: int, size: int | None = None) -> list[list
 
 def batch_counts(groups: list[list[Job]], workers: int) -> list[int]:
     """How many batches each group (runs of one system and stop time) is cut into by
-    default: as few as its ``batch_limit`` allows; then, while the sweep has fewer batches
-    than ``workers``, the group with the largest batches gets one batch more, as long as its
-    batches keep ``MIN_BATCH`` runs. A batch's cost per step is largely shared by its runs
-    (numpy's cost per call, about 0.6 ms a step), so batches are made no smaller than
-    keeping every worker busy needs."""
+    default: as few as its ``batch_limit`` allows, and in waves one per worker where they
+    keep ``WAVES_SHARE`` runs; then, while the sweep has fewer batches than ``workers``, the
+    group with the largest batches gets one batch more, as long as its batches keep
+    ``MIN_BATCH`` runs.
+
+    A batch's cost per step is partly shared by its runs (numpy's cost per call, about
+    0.5 ms a step) and partly each run's own. In calm water the shared part is most of it,
+    and the runs of one controller cost about what another's do: there batches are made no
+    smaller than keeping every worker busy needs. In waves each run's own part (the sines
+    of the wave loads) is most of it, and it differs between controllers (a waves_pd run
+    costs 1.4 times a waves_smc run): a system there gives every worker a share, so that
+    none waits at the end for another's costlier batch."""
     counts = [math.ceil(len(group) / batch_limit(group[0])) for group in groups]
+    counts = [max(count, min(workers, len(group) // WAVES_SHARE)) if _in_waves(group[0])
+              else count for count, group in zip(counts, groups)]
     while sum(counts) < workers:
         largest = max(range(len(groups)), key=lambda g: len(groups[g]) / counts[g])
         if len(groups[largest]) // (counts[largest] + 1) < MIN_BATCH:
             break
         counts[largest] += 1
     return counts
+
+
+def _in_waves(job: Job) -> bool:
+    """Whether ``job``'s ship sails in waves (ship.Hs > 0, as set or as its system binds it)."""
+    return float(job.bundle.system.parameters(job.overrides).get("ship", {}).get("Hs", 0.0)) > 0.0
 
 
 def _cut(jobs: list[Job], count: int) -> list[list[Job]]:
