@@ -23,7 +23,10 @@ from ship_fmu.vessel import N_PROPELLER, Vessel, VesselParameters
 
 from .reference import SIGNALS, step_models
 
-STEPS, H = 200, 0.1
+STEPS, H = 100, 0.1
+"""10 s: within it the members of every autopilot switch legs and cross +-180 deg, and in
+waves some of every autopilot's reach a rudder stop (in calm water the PD's). The
+self-test's time (about 0.6 s; 1.0 s over 20 s) is each worker's before its first batch."""
 ROUTE = [(0.0, 0.0), (-1.5, 0.2), (-2.5, 2.5), (0.5, 3.0)]
 """A short route with turns beyond 90 deg, from a start heading near 180 deg."""
 
