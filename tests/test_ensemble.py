@@ -48,6 +48,26 @@ def test_exact_functions_give_the_math_modules_bits():
         assert ours.tobytes() == np.array(theirs).tobytes()
 
 
+def test_the_acceptance_circle_is_decided_as_math_hypot_decides():
+    """np.hypot decides far from the circle, math.hypot near it: the same booleans on
+    points at, an ulp or two off and well off circles, Pythagorean triples, the specials."""
+    from cosim.ensemble.control import _within
+
+    rng = np.random.default_rng(18)
+    radius = rng.uniform(1e-3, 1e3, 100_000)
+    angle = rng.uniform(0.0, 2.0 * math.pi, radius.size)
+    off = rng.choice([0.0, 1e-16, -1e-16, 3e-16, -3e-16, 1e-13, -1e-13, 1e-3, -1e-3], radius.size)
+    dx, dy = radius * (1.0 + off) * np.cos(angle), radius * (1.0 + off) * np.sin(angle)
+    triples = np.arange(1.0, 2001.0)
+    specials = [(math.nan, 1.0, 1.0), (math.inf, math.nan, 1.0), (0.0, 0.0, 0.0),
+                (-0.0, 5e-324, 5e-324), (1e308, 1e308, 1e308), (-math.inf, 0.0, 1e308)]
+    dx = np.concatenate([dx, 3.0 * triples, [s[0] for s in specials]])
+    dy = np.concatenate([dy, 4.0 * triples, [s[1] for s in specials]])
+    radius = np.concatenate([radius, 5.0 * triples, [s[2] for s in specials]])
+    expected = [math.hypot(a, b) <= r for a, b, r in zip(dx, dy, radius)]
+    assert _within(dx, dy, radius).tolist() == expected
+
+
 def test_remainder_ties_go_to_the_even_multiple():
     y = 2.0
     x = np.array([1.0, 3.0, -1.0, -3.0, 5.0, 7.0])

@@ -54,7 +54,7 @@ class GuidanceArrays:
         dx, dy = self.delta[i, leg].T
         length = self.length[i, leg]
         along = ((x - x0) * dx + (y - y0) * dy) / length
-        return (hypot(x1 - x, y1 - y) <= self.R_accept) | (along >= length)
+        return _within(x1 - x, y1 - y, self.R_accept) | (along >= length)
 
     def active_leg(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(leg, finished) of every member at (x, y), from the committed legs onward."""
@@ -74,6 +74,22 @@ class GuidanceArrays:
         self.leg, self.finished = self.active_leg(x, y)
         psi_d = self.course[self.members, self.leg]
         return psi_d, np.where(self.finished, self.points, self.leg + 1)
+
+
+NEAR = 1e-12
+"""Relative distance from the circle within which ``_within`` asks ``math.hypot``."""
+
+
+def _within(dx: np.ndarray, dy: np.ndarray, radius: np.ndarray) -> np.ndarray:
+    """``math.hypot(dx, dy) <= radius`` of each member. ``np.hypot`` (the C library's,
+    a tenth of the cost) and ``math.hypot`` both round to within an ulp or two, so they
+    decide alike but within ``NEAR`` of the circle, where ``math.hypot`` decides."""
+    distance = np.hypot(dx, dy)
+    inside = distance <= radius
+    near = np.abs(distance - radius) <= NEAR * radius
+    if near.any():
+        inside[near] = hypot(dx[near], dy[near]) <= radius[near]
+    return inside
 
 
 class PDArrays:
