@@ -3,16 +3,22 @@ traffic after the FMU's exit code (late_malloc.so) and a heap laid out so that t
 block pythonfmu 0.7.0 frees at exit sits at the start of a free chunk.
 
     python host.py FMU LATE_MALLOC_SO      exit status 0, or killed by SIGABRT
+
+The FMU is unpacked in /tmp whatever TMPDIR says: the layout depends on the length of the
+folder's path (under a long TMPDIR, such as the test session's own, the corruption went
+undetected).
 """
 import ctypes
 import shutil
 import sys
+import tempfile
 
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
 fmu, late_malloc = sys.argv[1], sys.argv[2]
-description, folder = read_model_description(fmu), extract(fmu)
+description = read_model_description(fmu)
+folder = extract(fmu, unzipdir=tempfile.mkdtemp(dir="/tmp"))
 slave = FMU2Slave(guid=description.guid, unzipDirectory=folder, instanceName="host",
                   modelIdentifier=description.coSimulation.modelIdentifier)
 ctypes.CDLL(late_malloc)                  # after the FMU library: its destructor runs later
