@@ -201,16 +201,15 @@ def batch_limit(job: Job) -> int:
 def batches(jobs: list[Job], workers: int, size: int | None = None) -> list[list[Job]]:
     """``jobs`` (of one system and stop time) cut into batches as ``plan`` cuts a sweep of
     them alone."""
-    count = math.ceil(len(jobs) / size) if size else batch_counts([jobs], workers)[0]
-    return _cut(jobs, count)
+    return _cut(jobs, batch_counts([jobs], workers, size)[0])
 
 
-def batch_counts(groups: list[list[Job]], workers: int) -> list[int]:
-    """How many batches each group (runs of one system and stop time) is cut into by
-    default: as few as its ``batch_limit`` allows, and in waves one per worker where they
-    keep ``WAVES_SHARE`` runs; then, while the sweep has fewer batches than ``workers``, the
-    group with the largest batches gets one batch more, as long as its batches keep
-    ``MIN_BATCH`` runs.
+def batch_counts(groups: list[list[Job]], workers: int, size: int | None = None) -> list[int]:
+    """How many batches each group (runs of one system and stop time) is cut into: with
+    ``size``, as many as hold at most ``size`` runs each; by default, as few as its
+    ``batch_limit`` allows, and in waves one per worker where they keep ``WAVES_SHARE``
+    runs; then, while the sweep has fewer batches than ``workers``, the group with the
+    largest batches gets one batch more, as long as its batches keep ``MIN_BATCH`` runs.
 
     A batch's cost per step is partly shared by its runs (numpy's cost per call, about
     0.5 ms a step) and partly each run's own. In calm water the shared part is most of it,
@@ -219,6 +218,8 @@ def batch_counts(groups: list[list[Job]], workers: int) -> list[int]:
     of the wave loads) is most of it, and it differs between controllers (a waves_pd run
     costs 1.4 times a waves_smc run): a system there gives every worker a share, so that
     none waits at the end for another's costlier batch."""
+    if size:
+        return [math.ceil(len(group) / size) for group in groups]
     counts = [math.ceil(len(group) / batch_limit(group[0])) for group in groups]
     counts = [max(count, min(workers, len(group) // WAVES_SHARE)) if _in_waves(group[0])
               else count for count, group in zip(counts, groups)]
@@ -232,7 +233,8 @@ def batch_counts(groups: list[list[Job]], workers: int) -> list[int]:
 
 def _in_waves(job: Job) -> bool:
     """Whether ``job``'s ship sails in waves (ship.Hs > 0, as set or as its system binds it)."""
-    return float(job.bundle.system.parameters(job.overrides).get("ship", {}).get("Hs", 0.0)) > 0.0
+    ship = job.bundle.system.parameters(job.overrides).get("ship", {})
+    return float(ship.get("Hs", 0.0)) > 0.0
 
 
 def _cut(jobs: list[Job], count: int) -> list[list[Job]]:
@@ -256,8 +258,7 @@ def plan(spec: Spec, jobs: list[Job], workers: int, size: int | None = None
         else:
             alone.append(job)
     cut = list(groups.values())
-    counts = ([math.ceil(len(group) / size) for group in cut] if size
-              else batch_counts(cut, workers))
+    counts = batch_counts(cut, workers, size)
     return [batch for group, count in zip(cut, counts) for batch in _cut(group, count)], alone
 
 
