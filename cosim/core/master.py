@@ -31,7 +31,7 @@ from .null import NullInstance
 from .recording import Recorder, Recording
 from .ssd import SystemDescription, split_name
 from .values import declarations, parameters
-from .watchdog import TimeLimit, Watchdog
+from .watchdog import TimeLimit, Watchdog, no_limit
 from .wiring import check_connections, feedthrough_order, layout
 
 
@@ -43,10 +43,6 @@ is not current in this process runs through FMI, with a note:
 but the FMUs' interfaces, to measure the master's own cost (``cosim.core.null``)."""
 RUN_BACKENDS = ("fmi", "inprocess")
 """The backends a run of a scenario may take (null measures the master only)."""
-
-
-def _no_watchdog(what: object) -> None:
-    """What ``Watchdog.beat`` does when a run has none: no limit expires."""
 
 
 class Master:
@@ -166,7 +162,7 @@ class Master:
         k, t, error, started = 0, t0, None, time.perf_counter()
         self.parameter_values = {}
         self._recorder = recorder
-        beat = watchdog.beat if watchdog is not None else _no_watchdog
+        beat = watchdog.beat if watchdog is not None else no_limit
         try:
             beat("the initialisation")
             self.initialize()

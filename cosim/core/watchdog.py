@@ -68,6 +68,10 @@ class Limits(NamedTuple):
         return self
 
 
+def no_limit(what: str | float) -> None:
+    """What ``Watchdog.beat`` does where there is no watchdog: no limit expires."""
+
+
 class TimeLimit(BaseException):
     """Raised in the loop's thread when a limit is passed (a BaseException, so that no
     ``except Exception`` in the way swallows it; ``Watchdog.expired`` says which)."""

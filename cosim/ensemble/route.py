@@ -14,7 +14,7 @@ from fmukit.timebase import communication_point
 from ..core.master import Master
 from ..core.recording import Recording
 from ..core.ssd import SystemDescription
-from ..core.watchdog import TimeLimit
+from ..core.watchdog import TimeLimit, no_limit
 from .control import GuidanceArrays, autopilot_arrays
 from .members import Member, coverage, initialise
 from .reference import SIGNALS as ALL_SIGNALS
@@ -29,13 +29,9 @@ R_MAX = next(var.max for var in INPUTS if var.name == "r")
 """The autopilots' declared range of their yaw-rate input, rad/s: beyond it they refuse."""
 
 
-def _no_limit(what: str | float) -> None:
-    """A ``beat`` that never stops the batch."""
-
-
 def simulate_members(system: SystemDescription, overrides: Sequence[dict[str, dict[str, Any]]],
                      stop_time: float | None = None, signals: Sequence[str] = SIGNALS,
-                     beat: Callable[[str | float], str | None] = _no_limit) -> list[Recording]:
+                     beat: Callable[[str | float], str | None] = no_limit) -> list[Recording]:
     """One recording per member of ``system`` with ``overrides[i]`` (as
     ``Master(system, backend="inprocess").run(stop_time)`` records it, holding the columns
     ``signals``, any of ``reference.SIGNALS``). ValueError naming the member whose settings
@@ -115,7 +111,7 @@ def _alone(master: Master, overrides: dict[str, dict[str, Any]], stop_time: floa
 
 def _lockstep(members: list[tuple[int, Member]], t0: float, h: float, n_steps: int,
               signals: Sequence[str], units: dict[str, str],
-              beat: Callable[[str | float], str | None] = _no_limit
+              beat: Callable[[str | float], str | None] = no_limit
               ) -> list[tuple[int, Recording | None]]:
     """The members stepped together; (index, recording), None for a member that failed
     (a signal not finite, or a yaw rate outside the autopilot's range)."""
