@@ -8,7 +8,6 @@ with long tests says which it keeps quick, and why they still cover what it test
 from __future__ import annotations
 
 import gc
-import os
 import shutil
 import tempfile
 from pathlib import Path
@@ -91,14 +90,10 @@ def session_tmpdir(tmp_path_factory) -> Iterator[Path]:
     user's (Dask's scratch space, the FMUs ecos unpacks and does not remove, those of a
     host killed on purpose by the fault matrix: about 470 MB a run of the quick suite)."""
     folder = tmp_path_factory.mktemp("tmpdir")
-    previous = os.environ.get("TMPDIR"), tempfile.tempdir
-    os.environ["TMPDIR"] = tempfile.tempdir = str(folder)
-    yield folder
-    if previous[0] is None:
-        os.environ.pop("TMPDIR", None)
-    else:
-        os.environ["TMPDIR"] = previous[0]
-    tempfile.tempdir = previous[1]
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("TMPDIR", str(folder))
+        patch.setattr(tempfile, "tempdir", str(folder))
+        yield folder
     shutil.rmtree(folder, ignore_errors=True)
 
 
@@ -109,13 +104,9 @@ def fmu_cache(tmp_path_factory) -> Iterator[Path]:
     starts, so that its workers inherit it."""
     folder = tmp_path_factory.mktemp("fmu_cache")
     folder.chmod(0o700)
-    previous = os.environ.get("COSIM_FMU_CACHE")
-    os.environ["COSIM_FMU_CACHE"] = str(folder)
-    yield folder
-    if previous is None:
-        os.environ.pop("COSIM_FMU_CACHE", None)
-    else:
-        os.environ["COSIM_FMU_CACHE"] = previous
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("COSIM_FMU_CACHE", str(folder))
+        yield folder
 
 
 def _stale(path: Path) -> bool:
