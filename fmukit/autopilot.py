@@ -1,11 +1,7 @@
-"""The autopilot port contract, declared once: the ports every autopilot FMU here has, and yours.
-
-Inputs ``psi`` (rad), ``r`` (rad/s), ``psi_d`` (rad); output ``delta_c`` (rad),
-positive turning the ship to port. The co-simulation checks a user's FMU against
-these declarations (``cosim.scenarios.autopilot``); an autopilot written with
-fmukit lists them in its variables:
-
-    variables = (*INPUTS, rudder_command(depends=..., get=...), Var.parameter(...), ...)
+"""The autopilot port contract: inputs ``psi`` (rad), ``r`` (rad/s), ``psi_d`` (rad); output
+``delta_c`` (rad), positive turning the ship to port. ``cosim.scenarios.autopilot`` checks a
+user's FMU against ``PORTS``; an autopilot written with fmukit declares
+``variables = (*INPUTS, rudder_command(depends=..., get=...), ...)``.
 """
 from __future__ import annotations
 

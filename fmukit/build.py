@@ -1,7 +1,4 @@
-"""``python -m fmukit.build``: the build command's published name (``fmubuild.cli``).
-
-Host-only, like all of ``fmubuild``: no FMU carries this module.
-"""
+"""``python -m fmukit.build``: the build command's published name (``fmubuild.cli``); host-only."""
 import sys
 
 from fmubuild.cli import main

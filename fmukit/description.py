@@ -1,13 +1,7 @@
-"""What a variable's declaration says in modelDescription.xml, the same in FMI 2.0 and 3.0.
-
-Each adapter's ``model_description`` completes what its pythonfmu writes from these:
-the attributes of a numeric variable's type (start in its shortest exact form, for
-pythonfmu3 writes 16 digits, and 0.1 + 0.2 as 0.3; unit and display unit; min and max),
-the ``<UnitDefinitions>`` of the units used (``fmukit.units``), and the variables each
-output depends on, at every step and at initialisation. Only where they go differs:
-FMI 2.0 puts the attributes on a variable's ``<Real>`` or ``<Integer>`` and lists
-dependencies by 1-based index; FMI 3.0 puts them on its ``<Float64>`` or ``<Int32>``
-and lists dependencies by value reference.
+"""What a variable's declaration says in modelDescription.xml, the same in FMI 2.0 and 3.0:
+its type's attributes (start in its shortest exact form, unit and display unit, min and
+max), the units used and each output's dependencies. Each adapter's ``model_description``
+puts them where its version wants them.
 """
 from __future__ import annotations
 

@@ -1,20 +1,12 @@
-"""Every FMI entry point of a slave passes through ``fmi_entry``: pythonfmu's error path made safe.
+"""``fmi_entry``, through which every FMI entry point of a slave passes: pythonfmu's error path
+made safe.
 
-Both pythonfmu 0.7.0 and pythonfmu3 0.3.4 turn every Python exception into a fatal
-status. Their C++ layers also release the instance, its class and its log queue once
-per exception and again when the instance is freed (pythonfmu3:
-``PySlaveInstance::handle_py_exception`` calls ``cleanPyObject``), a use-after-free
-that crashes the host later. ``fmi_entry`` takes one extra reference on those three
-objects before any exception leaves Python, where the adapter says its binary needs
-it (``RELEASES_ON_EXCEPTION``), so the host survives; and it tells the user why,
-through the host's logger (a message whose category, ``fmukit.<cause>``, says what was
-refused) or on standard error (the adapter's ``hostlog``). A KeyboardInterrupt (or
-any other BaseException) raised in FMU code fails the FMU like a refusal does
-(``ModelSlave.interrupted``).
-
-FMI 3.0's doStep is the one call whose refusal can be non-fatal (pythonfmu3 passes on
-the status of the result ``do_step`` returns): given ``error_result``, a refusal
-returns that result, logged with the adapter's ``STATUS_ERROR``, instead of raising.
+Both pythonfmus turn every exception into a fatal status, and their C++ layers release the
+instance, its class and its log queue once per exception (a use-after-free that crashes the
+host later): where the adapter says so (``RELEASES_ON_EXCEPTION``) one extra reference is
+taken on each. The refusal is logged under its category (``fmukit.<cause>``), or written to
+standard error when the host does not listen. With ``error_result`` (FMI 3.0's doStep) a
+refusal returns that result, logged as an error, instead of raising.
 """
 from __future__ import annotations
 

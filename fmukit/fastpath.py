@@ -1,24 +1,11 @@
-"""Plans for reading Reals and Integers and setting Reals: a call's work decided once per list.
+"""Plans for reading Reals and Integers and setting Real inputs, made once per list of value
+references (a master asks for the same lists at every step).
 
-The calls are getReal, getInteger and setReal in FMI 2.0, getFloat64, getInt32 and
-setFloat64 in FMI 3.0; "Real" below is either version's 64-bit float.
-
-A master asks for the same value references at every step. The first call with a
-list works out how to serve it and caches that plan; the next calls only execute
-it. A plan is complete: it gives what the FMI call gives in every state of the
-slave (NaN outputs once it has failed or where an output cannot be evaluated), so
-the slave's read of Reals is its plan, and a host in the same process (cosim's
-in-process backend) may call the plan itself. A list that is not of the plan's
-kind gets ``None`` and the slave lets pythonfmu serve it (and name any problem).
-
-- Reals that are all model attributes (the ship's states): one
-  ``operator.attrgetter`` call on the model;
-- other Reals and Integers (feedthrough outputs, evaluated from the inputs; inputs and
-  parameters read back): each one's value read from the slave within one
-  ``try``; where one fails, every one is read again through its own getter,
-  which gives NaN for that one alone;
-- Real inputs: set as attributes of the slave (refused after terminate, as FMI
-  wants).
+A plan gives what the FMI call gives in every state of the slave (NaN once it has failed),
+so a host in the same process may call it itself; a list the plans do not serve gets
+``None``, and pythonfmu serves it. Model attributes are read with one
+``operator.attrgetter``; other values each through their reader within one ``try``, and
+again one by one where that fails.
 """
 from __future__ import annotations
 

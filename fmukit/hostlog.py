@@ -1,33 +1,36 @@
 """Whether the host hears an FMU's log messages, and standard error when it does not.
 
-pythonfmu 0.7 forwards an FMU's log messages, errors included, only while the host
-has debug logging on, and pythonfmu3 0.3.4 forwards them whether or not the host
-asked for them (``loggingOn``): a host that leaves logging off (fmpy's command line)
-would never learn why a call failed, or would get messages it did not ask for. The
-FMU's Python side is handed the address of pythonfmu's C++ logger (keyword
-``logger``), which holds the host's flag; where it lies is the adapter's to say
-(``hostlog`` of ``fmukit.pythonfmu07`` and ``fmukit.pythonfmu3_03``), in the binary
-fmukit builds, recognised by its SHA-256 (``known_binary``). An error goes to the
-host's logger when it listens, and to standard error when it does not, never to both.
-Where the flag cannot be found, the adapter says whether its pythonfmu forwards.
+pythonfmu 0.7 forwards messages only while the host has debug logging on; pythonfmu3 0.3.4
+forwards them whatever the host asked. The adapter finds the host's flag in pythonfmu's
+C++ logger (its ``binary.host_log``), in a binary it knows by SHA-256 (``known_binary``); an
+error then reaches the host's logger or standard error, never both.
 """
 from __future__ import annotations
 
 import ctypes
 import hashlib
 import sys
+from dataclasses import dataclass
 from pathlib import Path
-from typing import TypeVar
 
 from .refusals import naming
 
-Known = TypeVar("Known")
+
+@dataclass(frozen=True)
+class Binary:
+    """A pythonfmu binary fmukit knows inside out."""
+
+    offset: int                 # file offset of onLibraryUnload
+    code: bytes                 # its first instructions
+    patched: bytes              # what they become (fmubuild.exit_fix)
+    fixed_sha256: str           # the binary once patched
+    logger_offset: int          # where the adapter's hostlog finds the flag, from the logger
 
 
 def known_binary(logger: int | None, resources: str | None,
-                 fixed: dict[str, Known]) -> Known | None:
-    """What ``fixed`` (SHA-256: what fmukit knows of that binary) says of the FMU's binary
-    beside ``resources``; None without a logger or a known binary."""
+                 fixed: dict[str, Binary]) -> Binary | None:
+    """The binary of ``fixed`` (by SHA-256, as fmukit builds it) beside ``resources``; None
+    without a logger or a known binary."""
     if not logger or not resources:
         return None
     for binary in (Path(resources).parent / "binaries").glob("*/*"):

@@ -1,31 +1,13 @@
 """Ctrl-C while an FMU computes: the host's signal handler runs in the host's code, not ours.
 
-A pythonfmu FMU (of either FMI version) runs in its host's Python interpreter, and
-Python runs a signal handler in the main thread at the next bytecode it executes:
-inside the FMU, if the host called it from the main thread (fmpy, ecospy, our master). The
-KeyboardInterrupt would surface in FMU code, where it can only fail the FMU (a
-host that ignores statuses, ecos, would step on), or, raised at the first
-instruction of an FMI entry point before any ``try``, escape to pythonfmu's C++
-layer, which loses it and releases the instance once too often
-(``fmukit.entry``).
-
-So FMU code is a critical section for the host's Python handlers of SIGINT and
-SIGTERM. ``defer_host_handlers`` wraps each (once per process, from the main
-thread): a signal that arrives while FMU code runs is kept pending and
-signalled again each millisecond, from a helper thread, until the main thread
-runs host code, where the host's own handler takes it as if no FMU had been
-there: fmpy and ecospy scripts get their KeyboardInterrupt between two FMI
-calls, our master its request to stop between steps. A handler that says it may
-run anywhere (an attribute ``safe_in_fmu_code``, true: it raises nothing, as our
-master's run watchdog's) is left as it is.
-
-A C or C++ host (the ``ecos`` program) has no Python code of its own; pythonfmu
-(pythonfmu3 too) starts Python in a thread of its own, which becomes Python's main
-thread and never runs Python again, so Python's SIGINT handler would never run and Ctrl-C
-would not stop the host. There SIGINT gets its default action back, in the C
-runtime Python installed its handler with: the process's own on POSIX systems;
-on Windows the Universal CRT (``ucrtbase``) that CPython links, whose console
-control handler then lets Ctrl-C end the host as it would without Python.
+A pythonfmu FMU runs in its host's interpreter, where a KeyboardInterrupt would surface in
+FMU code (failing the FMU) or escape to pythonfmu's C++ layer (which loses it and releases
+the instance once too often). So ``defer_host_handlers`` wraps the host's Python handlers
+of SIGINT and SIGTERM: a signal that arrives in FMU code is kept pending and signalled
+again each millisecond until the main thread runs host code. A handler with a true
+``safe_in_fmu_code`` attribute is left as it is. In a host that is not Python (pythonfmu
+started the interpreter in a thread of its own), SIGINT gets its default action back in
+the C runtime Python installed its handler with (``ucrtbase`` on Windows).
 """
 from __future__ import annotations
 

@@ -1,10 +1,5 @@
-"""Numerical rules every model here follows: finite inputs, bounded sub-stepping, wrapped angles.
-
-Plain modules (``ship_fmu``, ``autopilot_fmu``) and your own autopilot use these as
-much as the FMUs do: a model refuses a non-finite input by name; a communication
-step is cut into equal integration steps no longer than the model's largest, with
-a bound on how many, so that a huge step is refused instead of hanging the host;
-angle differences are wrapped to (-pi, pi], the short way round.
+"""Numerical rules every model here follows: finite inputs, bounded sub-stepping (a huge
+step is refused instead of hanging the host), angle differences wrapped the short way round.
 """
 from __future__ import annotations
 

@@ -1,11 +1,8 @@
-"""How an FMU refuses a call: ``Refused``, with a message for the user and its cause as data.
+"""``Refused``: how an FMU refuses a call, with a message and its cause as data.
 
-The cause travels to the host as the log message's category, ``fmukit.<cause>``
-(declared in the model description's LogCategories), so that a host tells a bad
-parameter from an input its neighbour made NaN without reading the message. An
-exception of the model's own code is told by the file and line it came from
-(``located``): the innermost frame outside fmukit, the standard library and the
-installed packages, that is, in the user's script or the modules it carries.
+The cause reaches the host as the log category ``fmukit.<cause>``, so a host tells a bad
+parameter from a NaN input without reading the message. An exception of the model's own
+code is located at its innermost frame in the user's code (``located``).
 """
 from __future__ import annotations
 

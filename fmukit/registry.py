@@ -1,12 +1,6 @@
-"""The slave's variables registered with pythonfmu and indexed by value reference.
-
-The pythonfmu variable of each declaration is the adapter's (``ModelSlave.fmi_variable``:
-a Real of pythonfmu 0.7, a Float64 of pythonfmu3); its value reference is pythonfmu's.
-
-Parameters and inputs live as attributes of the slave, starting at their start
-values; outputs are read through ``evaluate(get, undefined)``, which the slave
-supplies (it builds the model when needed and turns what cannot be evaluated
-into NaN, or 0 for an Integer).
+"""The slave's variables registered with pythonfmu (through the adapter's ``fmi_variable``)
+and indexed by value reference. Parameters and inputs are attributes of the slave; outputs
+are read through the slave's ``evaluate(get, undefined)``.
 """
 from __future__ import annotations
 

@@ -1,10 +1,5 @@
-"""The co-simulation call sequence, FMI 2.0's and FMI 3.0's alike: which call is allowed when.
-
-    instantiated --EnterInitializationMode--> initialization
-                 --ExitInitializationMode--> step --Terminate--> terminated
-
-Reset returns to instantiated (pythonfmu and pythonfmu3 make a new slave object for
-it). Calls are named as the version's standard names them: fmi2Terminate, fmi3Terminate.
+"""The co-simulation call sequence of FMI 2.0 and 3.0 alike: instantiated -> initialization
+-> step -> terminated (reset makes a new slave). Calls are named as the version names them.
 """
 from __future__ import annotations
 

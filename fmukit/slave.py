@@ -1,64 +1,18 @@
 """``ModelSlave``: the base of every FMU in this project, the same for FMI 2.0 and FMI 3.0.
 
-An FMU class lists its variables once, as ``Var`` entries (``fmukit.variables``)
-with unit, causality, start value, valid range and, for outputs, the variables
-they depend on, and supplies ``build_model`` (a model from the parameter
-attributes alone), ``step_model`` and, if the initial state depends on inputs,
-``start_model``; the model supplies ``snapshot``/``restore``. The parts, one job each:
+An FMU class lists its ``variables`` (``fmukit.variables.Var``) and supplies
+``build_model`` (from the parameters alone), ``step_model`` and, if the initial state
+depends on inputs, ``start_model``; the model supplies ``snapshot``/``restore``. The FMI
+version and pythonfmu are the adapter's, a mixin composed by the FMU's entry module or
+``fmukit.compose.fmu_class``.
 
-- ``fmukit.registry``: the variables registered with pythonfmu, by value reference;
-- ``fmukit.sequence``: the call sequence, which refuses calls out of order;
-- ``fmukit.variables``: the range checks of every parameter (at
-  exitInitializationMode) and input (at each doStep);
-- ``fmukit.fastpath``: reading Reals and Integers and setting Real inputs planned once
-  per list of value references (``plans``, which a host in the same process may call);
-- ``fmukit.state``: saving and restoring the whole state (serialisable);
-- ``fmukit.refusals``: how a call is refused, and the message that says why;
-- ``fmukit.entry``: every FMI entry point made safe against pythonfmu's error path;
-  ``fmukit.hostsignals``: the host's Ctrl-C handled in the host's code, not inside the FMU.
-
-A ``ModelSlave`` is no FMU by itself: which FMI version, and which pythonfmu, is the
-adapter's, a mixin composed with the model's class and pythonfmu's slave class by the
-FMU's entry module (written by the build) or by ``fmukit.compose.fmu_class``:
-``fmukit.pythonfmu07`` (FMI 2.0, pythonfmu 0.7.0) and ``fmukit.pythonfmu3_03`` (FMI 3.0,
-pythonfmu3 0.3.4). Each supplies the typed getters and setters, doStep's result,
-the pythonfmu variable of a ``Var`` (``fmi_variable``), the statuses, where errors reach
-the user when the host does not listen (``_host_log``), and the completion of
-modelDescription.xml, with what is owed to its pythonfmu's defects.
-
-What a host sees. pythonfmu 0.7 can return fmi2OK, fmi2Fatal (any Python
-exception) and fmi2Discard with fmi2Terminated true (do_step returning False),
-which hosts such as fmpy take for the model's normal end: a refused step would
-pass for a short, successful run. So every FMI 2.0 refusal raises, and is fmi2Fatal,
-the only failure status there is to give (docs/robustness.md argues it). pythonfmu3
-passes on the status doStep returns: an FMI 3.0 refused step is fmi3Error, which
-allows fmi3Reset; every other FMI 3.0 refusal is fmi3Fatal, as pythonfmu3 makes
-every exception.
-
-- invalid parameters: exitInitializationMode reports them (an error
-  message naming the parameter) and the FMU has failed; the first doStep
-  then fails with that message. Not exitInitializationMode itself: OSP
-  libcosim terminates its host process when that call fails;
-- invalid inputs or step sizes, or an exception in the model: doStep fails
-  naming the cause (for an exception other than a ValueError, the file and line of the
-  model's code it came from: ``fmukit.refusals.explain``), and the FMU has failed;
-- once failed, every output reads NaN and every step is refused with the first
-  reason, until reset, so that a host that ignores statuses (ecos) still
-  cannot pass the rest of the run off as results;
-- calls out of sequence (doStep included), setting an output or a fixed
-  parameter after initialisation: refused naming the call or variable; nothing
-  is applied, and the FMU goes on as before;
-- reading an output never fails: what cannot be evaluated reads NaN (and, from valid
-  inputs while stepping, fails the FMU, the next doStep refusing with where it came
-  from).
-
-The reason, beginning with the FMU's instance name (libcosim's log shows neither the
-instance nor the call), reaches the user through the host's logger when it listens,
-under the category ``fmukit.<cause>`` that says what was refused
-(``fmukit.refusals.CAUSES``), and on standard error when it does not (the adapter's
-``hostlog``).
-
-Time is rounded to whole nanoseconds before the model sees it (``fmukit.timebase``).
+Refusals (docs/robustness.md): invalid parameters are reported at exitInitializationMode
+(libcosim ends its process if that call fails) and refused at the first doStep; an
+invalid input or step, or the model's exception, fails the FMU. A failed FMU reads NaN and
+refuses every step with the first reason until reset, so a host that ignores statuses
+cannot pass the run off as results. Calls out of sequence are refused and change nothing.
+Every FMI 2.0 refusal is fmi2Fatal (pythonfmu 0.7's fmi2Discard would pass for a normal
+end); an FMI 3.0 refused step is fmi3Error, every other refusal fmi3Fatal.
 """
 from __future__ import annotations
 
@@ -96,8 +50,7 @@ class ModelSlave:
     model_name: ClassVar[str]
     variables: ClassVar[tuple[Var, ...]]
     default_experiment = DefaultExperiment(start_time=0.0, stop_time=400.0, step_size=0.1)
-    # The adapter's: "fmi2" or "fmi3"; the statuses of an error and of a fatal refusal;
-    # whether its binary releases the instance once per exception (``fmukit.entry``).
+    # The adapter's: "fmi2" or "fmi3", its statuses, and ``fmukit.entry``'s compensation.
     API: ClassVar[str]
     STATUS_ERROR: ClassVar[Any]
     STATUS_FATAL: ClassVar[Any]
@@ -123,8 +76,7 @@ class ModelSlave:
 
     # -- the adapter's -----------------------------------------------------------
     def _host_log(self, kwargs: dict[str, Any]) -> Any:
-        """Where errors reach the user (the adapter's ``hostlog.HostLog``), from pythonfmu's
-        keywords: without ``logger`` the host is in this process."""
+        """The adapter's ``fmukit.hostlog.HostLog``, from pythonfmu's keywords."""
         raise NotImplementedError
 
     def fmi_variable(self, var: Var, getter: Callable[[], Any] | None) -> Any:
@@ -144,11 +96,8 @@ class ModelSlave:
         raise NotImplementedError
 
     def start_model(self, model: Any) -> None:
-        """Set a model's initial state from the inputs seen at initialisation (default: none).
-
-        Kept apart from build_model, which depends on parameters only: restoring a saved
-        state rebuilds the model, and must not depend on the inputs of the moment.
-        """
+        """Set a model's initial state from the inputs at initialisation (default: none);
+        apart from build_model, since restoring a state must not depend on the inputs."""
 
     def _started_model(self) -> Any:
         model = self.build_model()
@@ -157,17 +106,8 @@ class ModelSlave:
 
     def _output(self, get: Callable[[Any], Any], undefined: Any) -> Any:
         """An output's value, or NaN (0 if Integer) when it cannot be evaluated or the FMU
-        has failed.
-
-        A read never fails: a failed getReal aborts some hosts (libcosim throws
-        from a worker thread). Masters read outputs during initialisation, when
-        parameters may still be invalid, and feedthrough outputs are evaluated from
-        inputs that may be invalid; then the output is undefined, and the call
-        that commits (exitInitializationMode, doStep) refuses with a message. A
-        master that ignores those statuses still sees NaN outputs. An output that
-        its model cannot evaluate from valid inputs while stepping fails the FMU
-        (``_unevaluable``).
-        """
+        has failed: a read never fails (a failed getReal aborts libcosim); the call that
+        commits (exitInitializationMode, doStep) refuses instead."""
         if self.failure:
             return undefined
         try:
@@ -180,20 +120,21 @@ class ModelSlave:
             return undefined
 
     def _unevaluable(self, get: Callable[[Any], Any], error: Exception) -> None:
-        """Fail the FMU, saying where in the model's code, for an output it cannot evaluate
-        from valid inputs (a ZeroDivisionError in the user's law): the read gives NaN,
-        the next doStep refuses with this reason. With an invalid input, that doStep
-        refuses naming the input instead."""
+        """Fail the FMU for an output it cannot evaluate from valid inputs (with an invalid
+        input, the next doStep names the input instead)."""
         try:
             self._check_inputs(self)
         except ValueError:
             return
         output = next((f"output {v.name}" for v in self.variables if v.get is get), "an output")
-        self.failure = (f"{output} could not be evaluated from valid inputs: "
-                        f"{explain(error)}; the FMU has failed")
-        self.failure_cause = "model"
-        self.log(naming(self.instance_name, self.failure), self.STATUS_ERROR, "fmukit.model")
-        self.host_log.tell(self.instance_name, self.failure)
+        self._report(f"{output} could not be evaluated from valid inputs: {explain(error)}; "
+                     "the FMU has failed", "model")
+
+    def _report(self, failure: str, cause: str) -> None:
+        """Fail the FMU for ``failure`` and tell the user now; the next doStep refuses."""
+        self.failure, self.failure_cause = failure, cause
+        self.log(naming(self.instance_name, failure), self.STATUS_ERROR, f"fmukit.{cause}")
+        self.host_log.tell(self.instance_name, failure)
 
     @property
     def model(self) -> Any:
@@ -218,11 +159,8 @@ class ModelSlave:
             self._model = self._started_model()   # ValueError names a bad parameter or input
         except Exception as error:            # reported now, refused at the first step
             at = "" if self.start_time is None else f" at t = {self.start_time}"
-            self.failure = (f"exitInitializationMode{at}: {reason(error)}; the FMU has failed")
-            self.failure_cause = _cause(error, "parameter")
-            self.log(naming(self.instance_name, self.failure), self.STATUS_ERROR,
-                     f"fmukit.{self.failure_cause}")
-            self.host_log.tell(self.instance_name, self.failure)
+            self._report(f"exitInitializationMode{at}: {reason(error)}; the FMU has failed",
+                         _cause(error, "parameter"))
 
     @fmi_entry
     def terminate(self) -> None:
@@ -242,9 +180,7 @@ class ModelSlave:
                        f"step must be positive, and both within +-{MAX_TIME:g} s", "step")
         try:
             self._check_inputs(self)
-            # The time base of fmukit.timebase: whole nanoseconds, whatever the master. A
-            # step under half a nanosecond (the last of a master that adds floats:
-            # OMSimulator's 2.8e-13 s at 300 s) is none on that base: nothing changes.
+            # On the nanosecond time base a step under 0.5 ns (OMSimulator's last) is none.
             if step_size != self._step_size[0]:
                 self._step_size = (step_size, on_time_base(step_size))
             if self._step_size[1] > 0.0:
@@ -259,8 +195,7 @@ class ModelSlave:
 
     def interrupted(self, where: str, error: BaseException) -> Refused:
         """Fail the FMU for a KeyboardInterrupt (or any BaseException) raised in its code
-        while the host called ``where``, and return the refusal to raise. (Rare: the
-        host's signal handlers wait until FMU code returns, ``fmukit.hostsignals``.)"""
+        during ``where``; the refusal to raise."""
         number = hostsignals.interrupt_signal(error)
         cause = f"interrupted by {number.name}" if number else explain(error)
         if not self.failure:
@@ -269,8 +204,7 @@ class ModelSlave:
         return Refused(self.failure, self.failure_cause)
 
     def _fail(self, reason: str, cause: str, error: BaseException | None = None) -> NoReturn:
-        """Fail the FMU for ``reason`` (its ``cause``): refuse this call and every step until
-        reset."""
+        """Fail the FMU for ``reason`` (its ``cause``): refuse this call and every step."""
         self.failure, self.failure_cause = reason, cause
         raise Refused(reason, cause) from error
 

@@ -1,12 +1,6 @@
-"""Saved FMU states: get and set FMU state (fmi2GetFMUstate, fmi3GetFMUState, ...) and their
-serialised form.
-
-A state is a plain dict that pythonfmu (and pythonfmu3) serialises as JSON: the phase of
-the call sequence, the value of every parameter and input, the model's own
-``snapshot()`` (None while there is no model), and why the FMU failed, if it has
-(FMI 3.0's adapter adds its independent variable ``time``). Restoring rebuilds the
-model from the restored parameters and hands it the snapshot, so a restored run
-continues bit for bit.
+"""Saved FMU states as plain dicts (pythonfmu serialises them as JSON): the phase, every
+parameter and input, the model's ``snapshot()`` and the failure, if any. Restoring rebuilds
+the model from the parameters and hands it the snapshot: the run continues bit for bit.
 """
 from __future__ import annotations
 

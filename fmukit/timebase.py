@@ -1,12 +1,9 @@
 """The time base: communication points and steps in whole nanoseconds.
 
-Masters form time differently: OSP libcosim counts integer nanoseconds, fmpy's SSP
-runner adds 0.1 to a float at every step, ours multiplies. The results differ in
-the last bits, and a chattering controller or an unstable hull amplifies such
-differences until runs of the same system disagree. Every FMU here therefore
-rounds the time and step it is given to whole nanoseconds before using them, and
-the master computes t_k = (t_0 + k h) in integer nanoseconds: any two masters that
-agree on the time to within half a nanosecond drive the FMUs bit for bit alike.
+Masters form time differently (libcosim counts nanoseconds, fmpy adds floats), and chaotic
+models amplify the last bits. Every FMU here rounds time and step to whole nanoseconds, and
+the master computes t_k = t_0 + k h in integer nanoseconds: masters that agree to within
+half a nanosecond drive the FMUs bit for bit alike.
 """
 NANOSECONDS = 1_000_000_000
 MAX_TIME = 1e15

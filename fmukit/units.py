@@ -1,7 +1,5 @@
-"""SI units used at the FMU interfaces, as <UnitDefinitions> (the same in FMI 2.0 and 3.0).
-
-Each unit maps to its SI base-unit exponents (kg, m, s, rad) and an optional
-conversion factor; angles offer degrees as display units.
+"""SI units at the FMU interfaces, as <UnitDefinitions>: each unit's base-unit exponents (kg,
+m, s, rad), factor and display units.
 """
 from __future__ import annotations
 

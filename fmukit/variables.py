@@ -1,8 +1,5 @@
-"""FMU variables, declared once: ``Var`` with unit, causality, start, valid range, dependencies.
-
-A variable's declaration is the single source for its pythonfmu registration
-(``fmukit.registry``), its entry in modelDescription.xml (``fmukit.description``)
-and the range check its values must pass (``Var.check``).
+"""``Var``: an FMU variable declared once, the source of its pythonfmu registration, its
+modelDescription.xml entry and the range check its values must pass.
 """
 from __future__ import annotations
 

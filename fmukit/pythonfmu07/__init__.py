@@ -1,21 +1,14 @@
-"""FMI 2.0 through pythonfmu 0.7.0: the adapter, and what fmukit owes to that version's defects.
+"""FMI 2.0 through pythonfmu 0.7.0: the only package that imports pythonfmu, and what fmukit
+owes to that version's defects, each active only under ``ACTIVE``:
 
-This folder is the only place that imports pythonfmu. The compensations for
-pythonfmu 0.7.0's defects are active only under ``ACTIVE``:
+- its binary releases an instance's references once per Python exception (``fmukit.entry``
+  takes extra ones) and the entry module's namespace once per instantiation
+  (``slave.hold_namespace``);
+- it forwards log messages only while the host has debug logging on (``binary.host_log``);
+- its linux64 binary corrupts the heap at exit (``binary``, patched by ``fmubuild.exit_fix``);
+- it leaves units, ranges and dependencies out of modelDescription.xml (``model_description``).
 
-- ``slave``: ``Fmi2Entry``, the FMI 2.0 half of an FMU's class (``on_fmi2``); its
-  binary releases an instance's references once per Python exception, a
-  use-after-free that crashes the host (``fmukit.entry`` takes extra references);
-- ``hostlog``: pythonfmu forwards log messages only while the host has debug
-  logging on; the host's flag is read, and errors go to standard error when it is off;
-- ``binary``: pythonfmu 0.7.0's linux64 binary as fmukit knows it (its exit-time heap
-  corruption is patched when an FMU is built: ``fmubuild.exit_fix``);
-- ``model_description``: what pythonfmu 0.7 leaves out of modelDescription.xml.
-
-The host's Ctrl-C is ``fmukit.hostsignals``', the same for both pythonfmu versions.
-Replacing pythonfmu is adding a folder like this one beside it (as
-``fmukit.pythonfmu3_03`` is for FMI 3.0) and naming it in ``fmukit.compose``;
-retiring it, deleting this one.
+Retiring it is deleting this folder and its entry in ``fmukit.compose``.
 """
 from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave
 from pythonfmu import Fmi2Variability, Integer, Real, String

@@ -1,24 +1,14 @@
-"""pythonfmu 0.7.0's linux64 binary as fmukit knows it: where to fix it, and its logger's layout.
-
-``fmubuild.exit_fix`` patches the binary when an FMU is built (its exit-time heap
-corruption); ``hostlog`` reads the host's debug-logging flag where this layout says
-it is, in a binary it recognises by SHA-256.
+"""pythonfmu 0.7.0's linux64 binary as fmukit knows it: where ``fmubuild.exit_fix`` patches
+its exit-time heap corruption, and where its logger keeps the host's debug-logging flag,
+which alone decides what the host hears. With another binary the flag cannot be trusted,
+and the host is taken not to hear: errors go to standard error too.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+import ctypes
+from typing import Any
 
-
-@dataclass(frozen=True)
-class Binary:
-    """A pythonfmu binary fmukit knows inside out."""
-
-    offset: int                 # file offset of onLibraryUnload
-    code: bytes                 # its first instructions
-    patched: bytes              # what they become
-    fixed_sha256: str           # the binary once patched
-    debug_flag_offset: int      # of PyLogger::debugLogging_, from the logger's address
-
+from ..hostlog import Binary, HostLog, known_binary
 
 # endbr64; jmp finalizePythonInterpreter  ->  endbr64; ret. PyLogger::log tests
 # ``cmpb $0x0, 0x8(%rdi)``: the debug-logging flag sits 8 bytes into the logger.
@@ -29,3 +19,12 @@ KNOWN_BINARIES = {
 }
 FIXED = {b.fixed_sha256: b for b in KNOWN_BINARIES.values()}
 """The binaries as fmukit builds them, by their SHA-256."""
+
+
+def host_log(kwargs: dict[str, Any]) -> HostLog:
+    """The slave's ``HostLog`` from pythonfmu's keywords (no ``logger``: a host in this
+    process)."""
+    logger = kwargs.get("logger")
+    known = known_binary(logger, kwargs.get("resources"), FIXED)
+    flag = None if known is None else ctypes.c_bool.from_address(logger + known.logger_offset)
+    return HostLog(flag, in_process="logger" not in kwargs, unknown=False)

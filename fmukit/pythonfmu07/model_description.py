@@ -1,9 +1,6 @@
-"""What pythonfmu 0.7 leaves out of modelDescription.xml, added from the variables' declarations.
-
-Units (with degree display units for angles), ``min``/``max``, start values in
-their shortest exact form (``fmukit.description``), ``<UnitDefinitions>``, and a
-complete ``<ModelStructure>``: outputs with their ``dependencies`` (so masters see which
-outputs are not direct feedthrough) and ``<InitialUnknowns>``, by 1-based index.
+"""What pythonfmu 0.7 leaves out of modelDescription.xml, added from the declarations: units,
+display units, min/max, exact starts, ``<UnitDefinitions>`` and a complete
+``<ModelStructure>`` (dependencies by 1-based index).
 """
 from __future__ import annotations
 

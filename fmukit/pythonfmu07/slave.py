@@ -1,15 +1,6 @@
-"""``Fmi2Entry``: what makes a ``ModelSlave`` an FMI 2.0 co-simulation FMU of pythonfmu 0.7.
-
-An FMU's class is ``class <Model>(Fmi2Entry, <Model>, Fmi2Slave)``: this mixin first,
-the model's class next, pythonfmu's ``Fmi2Slave`` last (pythonfmu picks, of the
-classes in the FMU's entry module, the one with the longest MRO: this one). The entry
-module the build writes defines it; ``on_fmi2`` composes it in code.
-
-FMI 2.0's own here: Real, Integer and String variables; getReal, setReal, getInteger,
-setInteger; fmi2SetupExperiment (the start time the messages name); doStep's result
-(True; every refusal is an exception, fmi2Fatal); the host's debug-logging flag
-(``hostlog``); the model description's completion (``model_description``); the entry
-module's namespace kept alive (``hold_namespace``).
+"""``Fmi2Entry``: the mixin that makes a ``ModelSlave`` an FMI 2.0 FMU of pythonfmu 0.7
+(``class <Model>(Fmi2Entry, <Model>, Fmi2Slave)``: pythonfmu takes the class with the
+longest MRO). Every refusal is an exception: fmi2Fatal.
 """
 from __future__ import annotations
 
@@ -23,7 +14,7 @@ from ..slave import CATEGORIES, ModelSlave
 from ..variables import Var
 from ..hostlog import HostLog
 from . import (ACTIVE, Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Status, Fmi2Variability,
-               Integer, Real, String, hostlog, model_description)
+               Integer, Real, String, binary, model_description)
 
 _TYPE = {float: Real, int: Integer, str: String}
 
@@ -38,7 +29,7 @@ class Fmi2Entry:
     log_categories = {**Fmi2Slave.log_categories, **CATEGORIES}
 
     def _host_log(self, kwargs: dict[str, Any]) -> HostLog:
-        return hostlog.host_log(kwargs)
+        return binary.host_log(kwargs)
 
     def fmi_variable(self, var: Var, getter: Callable[[], Any] | None) -> Any:
         """pythonfmu's Real, Integer or String for ``var``."""
@@ -95,14 +86,8 @@ def on_fmi2(model: type[ModelSlave]) -> type[ModelSlave]:
 
 
 def hold_namespace(namespace: dict[str, Any]) -> None:
-    """One more reference on an FMU entry module's namespace, each time its code runs.
-
-    pythonfmu 0.7's C++ finds the FMU's class by running the entry module's code again at
-    every instantiation, in the module's namespace (``findClass``), and then releases
-    that namespace, a reference it never took (``PyModule_GetDict`` lends it): the second
-    FMU instantiated in a process would find the namespace freed (a segfault, or "module
-    has no attribute"). The entry module calls this on its ``globals()``: at import (one
-    reference more, never released) and at each of those runs, whose release it balances.
-    """
+    """One more reference on an FMU entry module's namespace, each time its code runs:
+    pythonfmu 0.7's ``findClass`` reruns the module at every instantiation and releases
+    the namespace ``PyModule_GetDict`` only lent it (the second instance would segfault)."""
     if ACTIVE:
         ctypes.pythonapi.Py_IncRef(ctypes.py_object(namespace))

@@ -1,29 +1,19 @@
-"""pythonfmu3 0.3.4's x86_64-linux binary as fmukit knows it: where to fix it, its logger's layout.
-
-``fmubuild.exit_fix`` patches the binary when an FMU is built (its exit-time heap
-corruption, as pythonfmu 0.7.0's); ``hostlog`` reads the host's logging flag where
-this layout says it is, in a binary it recognises by SHA-256.
+"""pythonfmu3 0.3.4's x86_64-linux binary as fmukit knows it: where ``fmubuild.exit_fix``
+patches its exit-time use-after-free, and where its logger keeps the host's logging flag,
+which the logger itself never reads (``cppfmu::Logger::Log`` forwards every message; FMI 3.0
+says not while logging is off). With another binary the flag is unknown, and the host is
+taken to hear: pythonfmu3 forwards.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+import ctypes
+from typing import Any
 
-
-@dataclass(frozen=True)
-class Binary:
-    """A pythonfmu3 binary fmukit knows inside out."""
-
-    offset: int                 # file offset of onLibraryUnload
-    code: bytes                 # its first instruction
-    patched: bytes              # what it becomes
-    fixed_sha256: str           # the binary once patched
-    settings_offset: int        # of the pointer to the logger's Settings, from the logger's
-                                # address; Settings::debugLoggingEnabled is its first byte
-
+from ..hostlog import Binary, HostLog, known_binary
 
 # jmp finalizePythonInterpreter@plt  ->  ret. cppfmu::Logger holds its environment, its
 # callback and a shared_ptr<Settings>, whose pointer is 16 bytes into the logger;
-# fmi3InstantiateCoSimulation sets debugLoggingEnabled from loggingOn.
+# Settings::debugLoggingEnabled, its first byte, is set from loggingOn.
 KNOWN_BINARIES = {
     "53fd71ba834c18dea2df15d7e67b3a42441e7a607757cb5ac825ff98b505b580": Binary(  # 0.3.4
         0x16B80, bytes.fromhex("e9ebbfffff"), bytes.fromhex("c3ebbfffff"),
@@ -31,3 +21,14 @@ KNOWN_BINARIES = {
 }
 FIXED = {b.fixed_sha256: b for b in KNOWN_BINARIES.values()}
 """The binaries as fmukit builds them, by their SHA-256."""
+
+
+def host_log(kwargs: dict[str, Any]) -> HostLog:
+    """The slave's ``HostLog`` from pythonfmu3's keywords (no ``logger``: a host in this
+    process)."""
+    logger, flag = kwargs.get("logger"), None
+    known = known_binary(logger, kwargs.get("resources"), FIXED)
+    if known is not None:
+        settings = ctypes.c_void_p.from_address(logger + known.logger_offset).value
+        flag = ctypes.c_bool.from_address(settings) if settings else None
+    return HostLog(flag, in_process="logger" not in kwargs, unknown=True)

@@ -1,17 +1,8 @@
-"""What pythonfmu3 0.3.4 leaves out of an FMI 3.0 modelDescription.xml, from the declarations.
-
-pythonfmu3 writes a Float64 with a unit only (no ``<UnitDefinitions>``, so that fmpy's
-validator refuses the unit; no display unit, min or max), start values with 16
-significant digits (not always the double: 0.1 + 0.2 is written 0.3), an Int32 without
-min and max, and a ``<ModelStructure>`` of bare ``<Output>`` and ``<InitialUnknown>``
-elements, which say that every output depends on every input: our master, for one,
-then finds an algebraic loop in a loop of autopilot and ship. Each is completed from
-the declarations (``fmukit.description``), dependencies by value reference.
-
-The independent variable FMI 3.0 requires, ``time`` (``slave.Fmi3Entry``), has value
-reference 0 and is moved to the end of ``<ModelVariables>``: the declared variables'
-value references are then their 1-based positions, and an importer that reads FMI 3.0
-dependencies as FMI 2.0's 1-based indices (OMSimulator) reads them right.
+"""What pythonfmu3 0.3.4 leaves out of modelDescription.xml, added from the declarations:
+``<UnitDefinitions>`` (else fmpy refuses the units), display units, min/max, exact starts
+(it writes 16 digits), and dependencies (its bare ``<Output>`` says every output depends on
+every input: an algebraic loop to a master). ``time`` (value reference 0) is moved last,
+so an importer reading dependencies as 1-based indices (OMSimulator) reads them right.
 """
 from __future__ import annotations
 

@@ -1,18 +1,8 @@
-"""``Fmi3Entry``: what makes a ``ModelSlave`` an FMI 3.0 co-simulation FMU of pythonfmu3 0.3.4.
-
-An FMU's class is ``class <Model>(Fmi3Entry, <Model>, Fmi3Slave)``: this mixin first,
-the model's class next, pythonfmu3's ``Fmi3Slave`` last. The entry module the build
-writes defines it (pythonfmu3 finds it by a regular expression that wants the word
-Fmi3Slave between the parentheses of its ``class`` line); ``on_fmi3`` composes it in code.
-
-FMI 3.0's own here: Float64, Int32 and String variables and the independent variable
-``time`` (value reference 0, so that a declared variable's value reference is its FMI
-2.0 twin's plus one); getFloat64, setFloat64, getInt32, setInt32; no
-setupExperiment (pythonfmu3 drops fmi3EnterInitializationMode's start time, so the
-messages name none); doStep's result, ``Fmi3StepResult``, whose status is fmi3Error for
-a refused step (every other refusal is an exception: fmi3Fatal); the host's logging
-flag (``hostlog``); the description, author and default experiment, set on the instance
-where pythonfmu3 reads them; the model description's completion (``model_description``).
+"""``Fmi3Entry``: the mixin that makes a ``ModelSlave`` an FMI 3.0 FMU of pythonfmu3 0.3.4
+(``class <Model>(Fmi3Entry, <Model>, Fmi3Slave)``: pythonfmu3 finds it by a regular
+expression on the ``class`` line). It adds the independent variable ``time`` (value
+reference 0, so a variable's reference is its FMI 2.0 twin's plus one); pythonfmu3 drops
+the start time, so messages name none.
 """
 from __future__ import annotations
 
@@ -26,7 +16,7 @@ from ..hostlog import HostLog
 from ..slave import CATEGORIES, ModelSlave
 from ..variables import Var
 from . import (ACTIVE, Fmi3Causality, Fmi3Initial, Fmi3Slave, Fmi3Status, Fmi3StepResult,
-               Fmi3Variability, Float64, Int32, String, hostlog, model_description)
+               Fmi3Variability, Float64, Int32, String, binary, model_description)
 
 _TYPE = {float: Float64, int: Int32, str: String}
 _FROM_CLASS = ("description", "author", "license", "version", "copyright",
@@ -54,7 +44,7 @@ class Fmi3Entry:
         self.start_time = None                 # not given by pythonfmu3
 
     def _host_log(self, kwargs: dict[str, Any]) -> HostLog:
-        return hostlog.host_log(kwargs)
+        return binary.host_log(kwargs)
 
     def _before_variables(self) -> None:
         """``time``, registered first: value reference 0 (``model_description`` writes it
