@@ -1,20 +1,8 @@
-"""Building FMUs written in C: compiled against the FMI headers fmpy ships, then zipped.
-
-Each C FMU is a folder with, for FMI 2.0, ``<name>.c`` (the FMI 2.0 co-simulation API)
-and a hand-written ``modelDescription.xml``; for its FMI 3.0 twin, ``<name>_fmi3.c`` and
-``modelDescription_fmi3.xml``; and the headers (``*.h``) both include, which hold what
-the two share (the model's law). The system C compiler (``$CC``, else ``cc`` or ``gcc``)
-builds the shared library for this platform, and where mingw-w64 is installed (Debian's
-gcc-mingw-w64-x86-64) it cross-compiles the 64-bit Windows DLL beside it: one that
-needs only Windows' own DLLs (KERNEL32, msvcrt), with no time stamp and a fixed image
-base, so that the FMU stays the same byte for byte. Binaries go where each version
-wants them: ``binaries/linux64``, ``binaries/win64`` (FMI 2.0);
-``binaries/x86_64-linux``, ``binaries/x86_64-windows`` (FMI 3.0's platform tuples). The
-FMU carries the libraries, the model description and the sources (for FMI 3.0 with
-the ``sources/buildDescription.xml`` a source FMU needs), and must pass fmpy's
-validation. Without a C compiler the build says so (``NoCompiler``) and the Python
-FMUs are unaffected; without mingw-w64 the FMU is built without its Windows binary,
-with a note.
+"""FMUs written in C: compiled against fmpy's FMI headers with the system compiler (``$CC``,
+else cc or gcc) and, where mingw-w64 is installed, cross-compiled for 64-bit Windows (no
+time stamp, a fixed image base: the same bytes each build); zipped with their sources
+(FMI 3.0: and ``sources/buildDescription.xml``) and validated. Without a compiler:
+``NoCompiler``, and the Python FMUs are unaffected.
 """
 from __future__ import annotations
 
@@ -36,14 +24,13 @@ FILES = {2: ("{name}.c", "modelDescription.xml"),
 WINDOWS = {2: "win64", 3: "x86_64-windows"}
 """FMI version: the name of its folder for 64-bit Windows binaries."""
 
-C_HOSTS = {
-    2: {"linux64": "any FMI 2.0 co-simulation host; the library needs only libc and libm.",
-        "win64": "any FMI 2.0 co-simulation host; the DLL needs only KERNEL32 and msvcrt."},
-    3: {"x86_64-linux": "any FMI 3.0 co-simulation host; the library needs only libc and libm.",
-        "x86_64-windows": "any FMI 3.0 co-simulation host; the DLL needs only KERNEL32 and "
-                          "msvcrt."}}
-"""FMI version: what a host needs for the C FMU, by platform (no Python:
-tests/test_windows.py reads the DLL's imports)."""
+C_HOSTS = {fmi: {linux: f"any FMI {fmi}.0 co-simulation host; the library needs only libc "
+                        "and libm.",
+                 WINDOWS[fmi]: f"any FMI {fmi}.0 co-simulation host; the DLL needs only "
+                               "KERNEL32 and msvcrt."}
+           for fmi, linux in ((2, "linux64"), (3, "x86_64-linux"))}
+"""FMI version: what a host needs for the C FMU, by platform (tests/test_windows.py reads
+the DLL's imports)."""
 
 _LIBRARY = {"linux64": ".so", "darwin64": ".dylib"}
 """fmpy's platform: the suffix of a shared library there."""
@@ -68,17 +55,15 @@ def c_compiler() -> str | None:
 
 
 def sources(name: str, fmi: int = 2) -> list[Path]:
-    """The files the C FMU ``name``'s FMI ``fmi`` twin is built from: its entry-point source,
-    the headers of its folder (shared by both versions), its model description."""
+    """The C FMU ``name``'s FMI ``fmi`` source, headers and model description."""
     folder = ROOT / C_FMUS[name]
     source, description = (folder / f.format(name=name) for f in FILES[fmi])
     return [source, *sorted(folder.glob("*.h")), description]
 
 
 def build_c(name: str, dest: Path | None = None, fmi: int = 2) -> Path:
-    """Compile the C FMU ``name`` as FMI ``fmi`` (2 or 3) into dest/name.fmu (default: that
-    version's folder, ``FMU_DIRS``), for this platform and, with mingw-w64, 64-bit
-    Windows, and validate it; its path."""
+    """Compile the C FMU ``name`` as FMI ``fmi`` into dest/name.fmu (default: ``FMU_DIRS``)
+    for this platform and, with mingw-w64, 64-bit Windows; validated; its path."""
     import fmpy
     from fmpy.validation import validate_fmu
 
@@ -128,8 +113,7 @@ def build_c(name: str, dest: Path | None = None, fmi: int = 2) -> Path:
 
 
 def build_description(model_identifier: str, source: str) -> bytes:
-    """sources/buildDescription.xml of an FMI 3.0 FMU compiled from the one C file
-    ``source`` (which includes the others beside it) and the C math library."""
+    """sources/buildDescription.xml of an FMI 3.0 FMU compiled from ``source`` and libm."""
     return ('<?xml version="1.0" encoding="UTF-8"?>\n<fmiBuildDescription fmiVersion="3.0">\n'
             f'  <BuildConfiguration modelIdentifier="{model_identifier}">\n'
             '    <SourceFileSet language="C99">\n'

@@ -5,20 +5,11 @@
     python -m fmukit.build ship                     # only some
     python -m fmukit.build my_autopilot.py --out DIR   # your script -> DIR/<model_name>.fmu
 
-The FMUs are FMI 2.0 co-simulation FMUs unless --fmi 3 asks for FMI 3.0: the same
-scripts and declarations give both (``fmubuild.routes``). The project's FMUs are
-Python (``fmubuild.packaging``) and one in C (``fmubuild.cbuild``), which needs a C
-compiler: without one it is skipped, with a note, and the rest is built. A script's
-FMU carries what it imports of fmukit, and the modules or packages given with
---include, in its resources; the host needs Python with numpy (``fmubuild.packaging``).
-Its FMU is named after its slave's model_name and written beside the script (an FMI 3.0
-one in the folder fmi3 there) unless --out says where. docs/own_autopilot.md walks
-through writing one.
-
-A script is refused, with one message naming it and no FMU written, if it does
-not parse (the file, the line and the line itself), if it imports a module of your own
-without --include (the module, where it is, and the command with --include), or if it
-exits when imported (sys.exit at import, the line that did).
+The same scripts give FMI 2.0 and 3.0 FMUs. The C FMU needs a C compiler (else it is
+skipped, with a note). A script's FMU carries what it imports of fmukit and what --include
+names, and is written beside the script (FMI 3.0: in its folder fmi3) unless --out says
+where; a script that does not parse, imports a module of your own without --include, or
+exits when imported is refused with one message. See docs/own_autopilot.md.
 """
 from __future__ import annotations
 
@@ -44,7 +35,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("names", nargs="*", metavar="NAME|SCRIPT.py",
                         help=f"FMUs of the project (default: all of {', '.join(project)}), or "
                              "paths of your own scripts")
-    parser.add_argument("--out", "--dest", dest="out", type=Path,
+    parser.add_argument("--out", type=Path,
                         help=f"output folder (default: {FMU_DIRS[2]} for the project's FMUs, "
                              f"{FMU_DIRS[3]} for their FMI 3.0 twins, the script's folder for "
                              "a script, its folder fmi3 for its FMI 3.0 FMU)")
@@ -77,9 +68,7 @@ def main(argv: list[str] | None = None) -> int:
 
 def _build_script(script: Path, includes: list[Path], out: Path | None, fmi: int) -> Path:
     """A user's script built as FMI ``fmi`` into ``out`` (default: its folder, for FMI 3.0
-    its folder fmi3); ValueError naming the script, and what is wrong with it, if it
-    cannot be: a module it imports that its FMU would not carry, or its exiting when
-    imported (a missing script or include is ``build_script``'s to name)."""
+    its folder fmi3); ValueError naming what its FMU would not carry, or its sys.exit."""
     if script.is_file() and script.suffix == ".py" and all(p.exists() for p in includes):
         missing = uncarried(script, includes, ("fmukit",))
         if missing:

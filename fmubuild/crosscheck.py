@@ -1,23 +1,11 @@
-"""FMI cross-check reference files for every Python FMU and its FMI 3.0 twin, in the
-fmi-cross-check layout.
+"""FMI cross-check reference files for every Python FMU and its FMI 3.0 twin (docs/interop.md).
 
     python -m fmubuild.crosscheck            # both versions: fmus/crosscheck/2.0/..., 3.0/...
     python -m fmubuild.crosscheck --fmi 3    # only the FMI 3.0 twins (fmus/fmi3/)
 
-For each FMU: <name>_in.csv (inputs), <name>_ref.csv (reference outputs),
-<name>_ref.opt (start, stop, step, tolerance), ReadMe.txt, and a copy of the FMU
-(not kept in git), in fmus/crosscheck/<FMI version>/cs/<platform>/<tool>/<version>/<name>/.
-The cross-check rules (4.1) and fmpy's validator of that repository name only FMI 1.0
-and 2.0, with FMI 2.0's platform names (linux64); the FMI 3.0 files follow the same
-layout under 3.0/ with the platform as FMI 3.0 names its binaries folders, by platform
-tuple (x86_64-linux). The references are simulated with fmpy from the built FMU, in a
-child process as a host would, isolated from this checkout (its modules, on the path
-or imported by the parent, would be taken in place of those the FMU carries), and
-committed: tests/test_crosscheck.py
-replays every FMU with ``fmpy simulate`` and compares, so they catch both a broken FMI
-layer and any change of behaviour. The two
-versions of an FMU give the same references to the last digit. Regenerate them, and
-say why in the commit, when a change of results is intended.
+The references are simulated with fmpy in a child process isolated from this checkout, and
+committed: tests/test_crosscheck.py replays them. Regenerate them, saying why in the
+commit, only when a change of results is intended.
 """
 from __future__ import annotations
 
@@ -33,12 +21,11 @@ from pathlib import Path
 from cosim.core.files import fresh_folder
 
 from .project import FMU_DIR, FMU_DIRS
+from .routes import ROUTES
 
 TOOL, VERSION = "ship_autopilot_cosim", "0.1.0"
 PLATFORMS = {2: "linux64", 3: "x86_64-linux"}
 """FMI version: the cross-check platform folder of the references (made on 64-bit Linux)."""
-BUILDERS = {2: "pythonfmu", 3: "pythonfmu3"}
-"""FMI version: the package that builds the Python FMUs of that version."""
 CROSSCHECK_DIRS = {fmi: FMU_DIR / "crosscheck" / f"{fmi}.0" / "cs" / platform / TOOL / VERSION
                    for fmi, platform in PLATFORMS.items()}
 
@@ -120,7 +107,7 @@ def generate(name: str, fmi: int = 2) -> Path:
         if simulated.returncode != 0:
             raise RuntimeError(f"fmpy could not simulate {FMU_DIRS[fmi] / name}.fmu "
                                f"(exit status {simulated.returncode}):\n{simulated.stderr}")
-        builder = BUILDERS[fmi]
+        builder = ROUTES[fmi].pythonfmu
         (folder / "ReadMe.txt").write_text(
             f"{name}.fmu, FMI {fmi}.0 co-simulation, built with {builder} {version(builder)} "
             f"by {TOOL} {VERSION}.\n"

@@ -1,19 +1,7 @@
-"""What an FMU says of itself: who made it and how to use it, from its model description.
-
-``describe`` completes an FMU's entries (name: bytes) on their way to its archive:
-
-- modelDescription.xml gets the generation tool, and the author, version, copyright and
-  license the model does not declare itself (its class may: pythonfmu writes them);
-- documentation/index.html: the model and its sources (the docstrings of the modules it
-  carries, with their equation numbers), every variable with its unit, start value and
-  range as the model description gives them, the default experiment, what a host needs
-  on each platform the FMU has a binary for, and a worked example with fmpy;
-- model.png, its icon (``icon``).
-
-Everything is derived from the entries and the docstrings given, so the same sources give
-the same bytes (``reproducible``). The page is plain HTML5 with no external asset, and
-well-formed XML as well. FMI 2.0 and FMI 3.0 model descriptions alike: a variable's type is
-its ``<Real>`` child in FMI 2.0, the variable's own element (``<Float64>``) in FMI 3.0.
+"""What an FMU says of itself (``describe``): its model description's generation tool and the
+identity the model does not declare, documentation/index.html (its sources' docstrings,
+every variable, the default experiment, what a host needs, a worked example with fmpy) and
+model.png (``icon``). Derived from the entries alone, so the same sources give the same bytes.
 """
 from __future__ import annotations
 
@@ -34,38 +22,32 @@ PAPER = ("Tomera, M. (2010). <i>Nonlinear controller design of a ship autopilot<
          "Int. J. Appl. Math. Comput. Sci. 20(2), 271-280.")
 """The paper whose equation numbers the project's docstrings cite as Tomera 2010."""
 
+_PRELOAD = ("a C or C++ program) must load libpython before the FMU: <code>LD_PRELOAD="
+            "/path/to/libpython3.X.so</code>, with <code>PYTHONPATH</code> naming a "
+            "site-packages that has numpy if that Python's own has none.")
+_HOME = ("Set <code>PYTHONHOME</code> to that folder if Python cannot find its standard "
+         "library, <code>PYTHONPATH</code> to a site-packages with numpy if its own has none.")
 PYTHON_HOSTS = {
     "linux64": "CPython {python} (64-bit) with numpy. A Python host (fmpy, libcosimpy, "
                "ecospy) needs nothing else. A host that is not Python (ecos, cosim-cli, "
-               "OMSimulator, a C or C++ program) must load libpython before the FMU: "
-               "<code>LD_PRELOAD=/path/to/libpython3.X.so</code>, with "
-               "<code>PYTHONPATH</code> naming a site-packages that has numpy if that "
-               "Python's own has none.",
+               "OMSimulator, " + _PRELOAD,
     "x86_64-linux": "CPython {python} (64-bit) with numpy. A Python host that runs FMI 3.0 "
                     "(fmpy, ecospy) needs nothing else. A host that is not Python (ecos, "
-                    "OMSimulator, a C or C++ program) must load libpython before the FMU: "
-                    "<code>LD_PRELOAD=/path/to/libpython3.X.so</code>, with "
-                    "<code>PYTHONPATH</code> naming a site-packages that has numpy if that "
-                    "Python's own has none.",
+                    "OMSimulator, " + _PRELOAD,
     "x86_64-windows": "A 64-bit CPython {python} with numpy, whose installation folder (the "
                       "one with <code>python3.dll</code>) is on <code>PATH</code> of every "
-                      "host: the binary imports python3.dll and KERNEL32 only. Set "
-                      "<code>PYTHONHOME</code> to that folder if Python cannot find its "
-                      "standard library, <code>PYTHONPATH</code> to a site-packages with "
-                      "numpy if its own has none. (Not tested on a Windows host.)",
+                      "host: the binary imports python3.dll and KERNEL32 only. " + _HOME
+                      + " (Not tested on a Windows host.)",
     "win64": "A 64-bit CPython {python} with numpy, whose installation folder (the one "
              "with <code>python3.dll</code>, not a venv's <code>Scripts</code>) is on "
              "<code>PATH</code> of every host, Python or not (Simulink, Dymola, "
              "OMSimulator, cosim-cli), and the Microsoft Visual C++ 2015-2022 "
              "Redistributable (x64) for <code>MSVCP140.dll</code>: the binary imports "
              "python3.dll, MSVCP140, VCRUNTIME140(_1), the Universal C runtime and KERNEL32. "
-             "Set <code>PYTHONHOME</code> to that folder if Python cannot find its "
-             "standard library, <code>PYTHONPATH</code> to a site-packages with numpy if "
-             "its own has none. (Tested on Linux with the platform faked and the DLL's "
-             "imports read, not on a Windows host.)",
+             + _HOME + " (Tested on Linux with the platform faked and the DLL's imports read, "
+             "not on a Windows host.)",
 }
-"""What a host needs to run a Python FMU, by platform (FMI 2.0's linux64 and win64, FMI
-3.0's x86_64-linux and x86_64-windows); {python}: the Python versions."""
+"""What a host needs to run a Python FMU, by platform; {python}: the Python versions."""
 
 _STYLE = ("body{font-family:sans-serif;max-width:60em;margin:1em auto;padding:0 1em}"
           "table{border-collapse:collapse}th,td{border:1px solid #bbb;padding:2px 6px;"

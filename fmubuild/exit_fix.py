@@ -1,24 +1,11 @@
 """A fix for pythonfmu's Linux binaries, which corrupt their host's heap at process exit.
 
-Both pythonfmu 0.7.0's linux64 binary and pythonfmu3 0.3.4's x86_64-linux one keep
-their Python state in a global ``std::shared_ptr<PyState>``. At exit, the C++ static
-destructors destroy it first (freeing its control block); only afterwards, from
-``.fini_array``, its ``__attribute__((destructor))`` ``onLibraryUnload`` assigns
-``pyState = nullptr`` to the dead pointer, which decrements a counter inside the
-freed block, by then often one of malloc's free-list pointers. A later malloc or free
-at exit (numpy's libgfortran, the OpenBLAS thread) then aborts with "corrupted
-double-linked list". The library is never really unloaded before exit (its
-STB_GNU_UNIQUE symbols make it NODELETE), so every host process that loaded an FMU is
-exposed, Python or not: seen as an intermittent SIGABRT of ``fmpy simulate`` and of
-pytest at exit (pythonfmu3's: 20 aborts in 20 runs of a C host).
-
-The static destructor already shuts the Python state down, so the fix turns
-``onLibraryUnload`` into a plain return. It is applied to a built FMU's Linux binary
-only when that binary is the exact build its adapter knows (by SHA-256: the
-``KNOWN_BINARIES`` of ``fmukit.pythonfmu07.binary`` and ``fmukit.pythonfmu3_03.binary``)
-and the expected instructions are where the symbol table puts them; any other binary
-fails the build, so that a pythonfmu upgrade is looked at again. The upstream fix:
-drop ``onLibraryUnload``, or never destroy ``pyState``.
+pythonfmu 0.7.0's and pythonfmu3 0.3.4's binaries keep their Python state in a global
+``std::shared_ptr<PyState>``; at exit its static destructor frees it, and only afterwards
+``onLibraryUnload`` (``.fini_array``) assigns to the dead pointer, corrupting malloc's
+free lists (an intermittent SIGABRT of every host that loaded an FMU). The destructor
+already shuts Python down, so ``onLibraryUnload`` becomes a plain return, in a binary the
+adapter knows by SHA-256 only (``KNOWN_BINARIES`` of its ``binary``); any other fails the build.
 """
 from __future__ import annotations
 

@@ -1,13 +1,6 @@
-"""model.png, the icon an FMU shows in a diagram tool, drawn from its model description.
-
-A model whose outputs are a position and heading (``x``, ``y``, ``psi``) is a vessel,
-drawn as CyberShip II's waterline to scale (``ship_fmu.data.Hull``: the one vessel of this
-project), bow up, named below; any other (an autopilot, the guidance, a rudder program) as a
-block with its name, its inputs entering on the left and its outputs leaving on the right.
-
-256 x 256 pixels, transparent, drawn with matplotlib's default style and font (not the
-user's settings) and no software or time in the file: the same description gives the same
-bytes on one installation (``reproducible``).
+"""model.png, an FMU's icon drawn from its model description: a vessel (outputs x, y, psi) as
+CyberShip II's waterline to scale, any other model as a block with its ports; 256 x 256,
+matplotlib's default style, no software or time in the file.
 """
 from __future__ import annotations
 

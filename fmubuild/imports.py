@@ -1,12 +1,5 @@
-"""Which modules a slave script needs: its imports of the given packages, followed through.
-
-Read from the sources (``ast``), not by importing them: ``import a.b``, ``from a.b
-import c`` (``c`` a module or a name), and relative imports; each module comes with
-the ``__init__`` files of the packages above it. Imports of anything else (the
-standard library, numpy, pythonfmu) are the host's, and not followed; ``uncarried``
-finds those a host would not have either (a module of the user's own beside the
-script), before anything is built. A source that does not parse is refused by file,
-line and the line itself.
+"""Which modules a slave script needs: its imports of the given packages, read from the sources
+(``ast``) and followed through; ``uncarried`` finds those a host would not have either.
 """
 from __future__ import annotations
 

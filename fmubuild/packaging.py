@@ -1,27 +1,14 @@
-"""Building FMUs: this project's FMUs (``project.FMUS``) and any slave script written with fmukit.
+"""Building a slave script written with fmukit into an FMU that carries exactly its model.
 
-An FMU carries exactly its model: the slave script, the modules of fmukit and of this
-project's packages that it imports (followed through, ``imports``), a user's modules
-given with ``--include``, a requirements.txt (a host needs only Python with numpy:
-``pythonfmu deploy -f fmus/ship.fmu`` installs it), its manifest (``manifest``) and
-its entry module, which makes the slave class an FMU of the FMI version built
-(``routes``: FMI 2.0 with pythonfmu 0.7.0, or FMI 3.0 with pythonfmu3 0.3.4, each
-through its adapter, which the FMU carries too). After building, the Linux binary gets
-``exit_fix`` (both pythonfmu versions corrupt their host's heap at exit) and the FMU
-says what it is (``documentation``: its generation tool, fmukit; for this project's
-FMUs the project's author, version, copyright and license, ``project_identity``;
-documentation/index.html and model.png, from its model description and the docstrings
-of what it carries); the archive is written again in a fixed order with fixed times
-and a GUID (FMI 3.0: instantiation token) derived from its contents (``reproducible``),
-so the same sources give the same bytes; the model description is checked with fmpy's
-validator and the FMU is instantiated once without this checkout (``trial``). A problem
-fails the build.
+The FMU carries the script, what it imports of fmukit and this project (``imports``), the
+modules given with ``--include``, a requirements.txt (numpy), its manifest and its entry
+module (``routes``). The Linux binary gets ``exit_fix``, the FMU its documentation
+(``documentation``), and the archive is written again reproducibly (``reproducible``);
+it must validate with fmpy and instantiate without this checkout (``instantiate``).
 
-A package whose __init__.py holds nothing but a docstring is carried without it, as a
-namespace package. A host that is not Python (ecos, OMSimulator) runs all its Python
-FMUs in one interpreter, where the first FMU to import a package would otherwise own
-it: the guidance carries ship_fmu's data alone, and the ship, loaded after it, would
-find no vessel there. A namespace package spans every FMU's folder on sys.path.
+A package whose __init__.py holds only a docstring is carried as a namespace package: a
+non-Python host runs all its Python FMUs in one interpreter, where the first FMU to import
+a package would otherwise own it (the guidance carries ship_fmu.data alone).
 """
 from __future__ import annotations
 
@@ -40,9 +27,9 @@ from pathlib import Path
 from . import documentation, exit_fix, reproducible
 from .imports import needed_modules
 from .manifest import DISTRIBUTION, Manifest, digest_of, project_identity, sha256, version
-from .project import FMUS, ROOT
+from .project import FMU_DIRS, FMUS, ROOT
 from .routes import ROUTES
-from .trial import TrialFailed, trial
+from .instantiate import InstantiationFailed, instantiate_in_child
 
 RUNTIME_REQUIREMENTS = "numpy\n"
 PROJECT_PACKAGES = ("fmukit", "ship_fmu", "autopilot_fmu")
@@ -52,12 +39,11 @@ def build(name: str, dest: Path | None = None, fmi: int = 2) -> Path:
     """Build one FMU of this project as FMI ``fmi`` (2 or 3) to dest/name.fmu (default:
     the version's folder, ``project.FMU_DIRS``), validate it, and return its path."""
     return build_script(ROOT / FMUS[name], PROJECT_PACKAGES,
-                        (dest or ROUTES[fmi].dest) / f"{name}.fmu", project_identity(), fmi)
+                        (dest or FMU_DIRS[fmi]) / f"{name}.fmu", project_identity(), fmi)
 
 
 def python_hosts() -> dict[str, str]:
-    """What a host needs to run a Python FMU, by platform (``documentation.PYTHON_HOSTS``,
-    with the Python versions this project runs on)."""
+    """``documentation.PYTHON_HOSTS`` with the Python versions this project runs on."""
     needed = metadata.metadata(DISTRIBUTION)["Requires-Python"]
     python = f"{needed[2:]} or later" if needed.startswith(">=") else needed
     return {platform: needs.format(python=python)
@@ -66,17 +52,11 @@ def python_hosts() -> dict[str, str]:
 
 def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
                  identity: Mapping[str, str] | None = None, fmi: int = 2) -> Path:
-    """Build the slave in ``script`` as an FMI ``fmi`` (2 or 3) FMU into ``dest`` (a .fmu
-    path, or a folder where the FMU is named after the slave's model_name). ``packages``:
-    names of this project's packages (fmukit among them), of which the FMU carries what
-    the script imports, and paths of a user's modules and packages, which it carries
-    whole. ``identity``: the author, version, copyright or license to declare where the
-    slave declares none. Returns the FMU's path.
-
-    ValueError naming the script if it cannot be built (no ModelSlave in it, or it
-    does not import), or for an FMI version fmukit does not build; RuntimeError if the
-    installed pythonfmu is not the one fmukit knows, or the result does not validate.
-    """
+    """Build the slave in ``script`` as an FMI ``fmi`` FMU into ``dest`` (a .fmu path, or a
+    folder: named after its model_name); its path. ``packages``: names of project packages,
+    of which it carries what the script imports, and paths, which it carries whole;
+    ``identity``: what to declare where the slave declares none. ValueError naming the
+    script if it cannot be built; RuntimeError for another pythonfmu or an invalid FMU."""
     from fmpy.validation import validate_fmu
 
     if fmi not in ROUTES:
@@ -142,8 +122,8 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
     if problems:
         raise RuntimeError(f"{fmu} does not validate:\n" + "\n".join(problems))
     try:
-        trial(fmu, isolated=True)
-    except TrialFailed as failed:
+        instantiate_in_child(fmu, isolated=True)
+    except InstantiationFailed as failed:
         fmu.unlink()
         why = (f"it did not instantiate within {failed.timed_out:g} s (does its class, or a "
                "module it imports, loop or wait at start?)" if failed.timed_out else
@@ -155,9 +135,8 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
 
 
 def _slave_class(module_name: str) -> type:
-    """The slave class of the script imported as ``module_name``: of the ModelSlave
-    subclasses it holds, the one with the longest MRO (as pythonfmu chooses); ValueError
-    if there is none, or no single one."""
+    """The script's ModelSlave subclass with the longest MRO (as pythonfmu chooses);
+    ValueError if there is none, or no single one."""
     module = importlib.import_module(module_name)
     model_slave = importlib.import_module("fmukit.slave").ModelSlave   # the script's fmukit
     classes = [c for _, c in inspect.getmembers(module, inspect.isclass)
@@ -176,9 +155,8 @@ def _slave_class(module_name: str) -> type:
 
 def _stage(script: Path, packages: list[str], includes: list[Path],
            stage: Path) -> dict[str, dict[str, str]]:
-    """Copy into ``stage`` what the FMU carries besides its manifest and entry module;
-    return the manifest's modules: the script, what it imports of ``packages``, and every
-    module of ``includes``."""
+    """Copy into ``stage`` the script, what it imports of ``packages`` and ``includes``;
+    the manifest's modules."""
     shutil.copy2(script, stage)
     modules = {_module_name(script): _carried(script, script.name),
                **_carry(script, packages, stage)}
@@ -197,8 +175,8 @@ def _stage(script: Path, packages: list[str], includes: list[Path],
 
 
 def _carry(file: Path, packages: list[str], stage: Path) -> dict[str, dict[str, str]]:
-    """Copy into ``stage`` the modules of ``packages`` that ``file`` imports (followed
-    through); return them as the manifest lists them."""
+    """Copy into ``stage`` the modules of ``packages`` that ``file`` imports; the manifest's
+    entries."""
     modules = {}
     for module, found in needed_modules(file, {p: ROOT for p in packages}).items():
         if _only_documents(found):
@@ -229,8 +207,7 @@ def _carried(file: Path, relative: str) -> dict[str, str]:
 
 
 def _module_name(script: Path) -> str:
-    """How this project imports a slave script: by its package path where it lies in one
-    of the project's packages (ship_fmu.ship_slave), else by its name (a user's script)."""
+    """How this project imports a slave script: ship_fmu.ship_slave, or a user's by name."""
     try:
         relative = script.resolve().relative_to(ROOT)
     except ValueError:
@@ -242,11 +219,8 @@ def _module_name(script: Path) -> str:
 
 @contextlib.contextmanager
 def _imports_undone(stage: str):
-    """Forget what building imported from ``stage`` or from pythonfmu's own temporary
-    folders (whose files are gone): pythonfmu imports the script and the packages it
-    carries from there, and leaves that on sys.path. Left there, the next build in this
-    process (or an in-process run) would find those stale modules. Modules imported from
-    elsewhere (numpy, say) stay: they cannot be reloaded."""
+    """Forget what building imported from ``stage`` or pythonfmu's temporary folders (and
+    its sys.path), so the next build or in-process run finds no stale module."""
     path, modules = list(sys.path), set(sys.modules)
     try:
         yield

@@ -1,11 +1,6 @@
-"""The same sources give the same FMU, byte for byte.
-
-pythonfmu writes its archive in the order the file system lists the files, with
-their modification times, a time-based GUID (FMI 3.0: instantiation token) and the
-time of the build. An FMU is written again here: its entries in name order, each with
-one fixed time and mode, no generation time, and a GUID or instantiation token derived
-from the contents (a version-5 UUID of their SHA-256), so that a changed FMU gets a new
-one and an unchanged one keeps its own.
+"""The same sources give the same FMU, byte for byte: entries in name order with one fixed time
+and mode, no generation time, and a GUID (FMI 3.0: instantiation token) derived from the
+contents.
 """
 from __future__ import annotations
 

@@ -1,28 +1,13 @@
-"""The FMI versions fmubuild builds, each with its pythonfmu through its fmukit adapter.
-
-A ``Route`` says, for one FMI version, which pythonfmu builds it (pythonfmu 0.7.0 for
-FMI 2.0, pythonfmu3 0.3.4 for FMI 3.0: the one version its adapter knows, the
-adapter's ``ACTIVE``; the build refuses any other), the options its builder gets, where
-its FMU keeps the Linux binary (which ``exit_fix`` patches), where the FMUs of the
-project go, and the entry module the build writes into each FMU.
-
-The slave scripts are the same for both versions: a ``ModelSlave`` is no pythonfmu
-class (``fmukit.slave``). The entry module, ``<model_name>_fmi<N>.py`` beside the
-script in the FMU's resources and named in ``slavemodule.txt``, defines the FMU's class:
-the slave class composed with the adapter's mixin and pythonfmu's slave class, under
-the slave class's own name (``fmukit.compose.fmu_class`` composes the same in code).
-It is what each pythonfmu looks for: pythonfmu 0.7 takes the module's Fmi2Slave
-subclass with the longest MRO, pythonfmu3 the first class whose ``class`` line names
-Fmi3Slave between its parentheses (a regular expression, in its builder and again in
-its C++ at instantiation), which a slave script's ``class X(ModelSlave)`` is not.
+"""The FMI versions fmubuild builds: for each, the pythonfmu that builds it (the one version
+its fmukit adapter knows), its builder's options, its Linux binary's folder, and the entry
+module written into each FMU (``<model_name>_fmi<N>.py``, named in ``slavemodule.txt``),
+which composes the slave class with the adapter's mixin and pythonfmu's slave class, as
+``fmukit.compose.fmu_class`` does in code.
 """
 from __future__ import annotations
 
 import importlib
 from dataclasses import dataclass
-from pathlib import Path
-
-from .project import FMU_DIRS
 
 _ENTRY = '''"""The FMI {fmi}.0 entry of the FMU {model_name}, written by fmubuild.routes: {cls}
 of {module} as an FMI {fmi}.0 co-simulation FMU of {pythonfmu} {known}."""
@@ -50,14 +35,9 @@ class Route:
     namespace_calls: tuple[str, ...] = ()   # functions of the adapter's slave module that
                                             # the entry module calls on its globals()
 
-    @property
-    def dest(self) -> Path:
-        """Where this project's FMUs of this version are built."""
-        return FMU_DIRS[self.fmi]
-
     def gate(self) -> str:
-        """The installed version of this route's pythonfmu; RuntimeError unless it is the
-        one the adapter knows, whose defects it compensates."""
+        """The installed version of this route's pythonfmu; RuntimeError unless the adapter
+        knows it."""
         adapter = importlib.import_module(self.adapter)
         installed = adapter.PYTHONFMU_VERSION
         if not adapter.ACTIVE:
@@ -73,8 +53,7 @@ class Route:
         return f"{model_name}_fmi{self.fmi}"
 
     def entry_source(self, model_name: str, module: str, cls: str) -> str:
-        """The entry module's source: ``cls`` of ``module`` (as the FMU imports it) composed
-        for this version."""
+        """The entry module's source: ``cls`` of ``module`` composed for this version."""
         mixin = f"Fmi{self.fmi}Entry"
         return _ENTRY.format(fmi=self.fmi, model_name=model_name, module=module, cls=cls,
                              pythonfmu=self.pythonfmu, known=self.known, adapter=self.adapter,

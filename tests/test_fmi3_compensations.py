@@ -27,7 +27,7 @@ from autopilot_fmu.pd_autopilot_slave import PDAutopilotSlave
 from fmubuild.exit_fix import patch
 from fmubuild.packaging import build_script
 from fmubuild.project import FMUS, ROOT
-from fmubuild.trial import TrialFailed, trial
+from fmubuild.instantiate import InstantiationFailed, instantiate_in_child
 from fmukit.compose import fmu_class
 from fmukit.pythonfmu3_03.binary import KNOWN_BINARIES
 from fmukit.pythonfmu3_03.slave import Fmi3Entry
@@ -300,8 +300,8 @@ def test_an_fmu_that_cannot_import_kills_its_host_so_the_build_tries_it_in_a_chi
     broken = _variant(pd3, tmp_path / "pd.fmu", "resources/pd_autopilot_fmi3.py",
                       "from pythonfmu3 import Fmi3Slave\n",
                       "import not_in_this_fmu\nfrom pythonfmu3 import Fmi3Slave\n")
-    with pytest.raises(TrialFailed) as failed:
-        trial(broken, isolated=True, timeout=TIMEOUT)
+    with pytest.raises(InstantiationFailed) as failed:
+        instantiate_in_child(broken, isolated=True, timeout=TIMEOUT)
     assert failed.value.crashed == "SIGSEGV"                   # the child, not this process
 
 

@@ -27,17 +27,18 @@ from cosim.studies import journal, sweep, sweep_task
 from cosim.studies.bundle import UnsafeCache, file_hash, fmu_cache
 from cosim.studies.cluster import ClusterError, connect, local_cluster, local_workers
 from cosim.studies.journal import Journal, JournalLocked
-from fmubuild.trial import TrialFailed, trial
+from fmubuild.instantiate import InstantiationFailed, instantiate_in_child
 
 
 @pytest.mark.timeout(60, method="thread")
 def test_a_trial_that_runs_out_of_time_names_the_fmu_and_the_limit(fmu_paths, monkeypatch):
     fmu = fmu_paths["pd_autopilot"]
     said = f"{fmu}: instantiating the FMU did not end within 0.01 s (the child was killed)"
-    with pytest.raises(TrialFailed, match=re.escape(said)):
-        trial(fmu, timeout=0.01)            # no Python starts in 10 ms
+    with pytest.raises(InstantiationFailed, match=re.escape(said)):
+        instantiate_in_child(fmu, timeout=0.01)            # no Python starts in 10 ms
     # checking a user's autopilot: the same words, as the contract's refusal
-    monkeypatch.setattr(autopilot, "instantiate_in_child", functools.partial(trial, timeout=0.01))
+    monkeypatch.setattr(autopilot, "instantiate_in_child",
+                        functools.partial(instantiate_in_child, timeout=0.01))
     with pytest.raises(autopilot.AutopilotError, match=re.escape(said)):
         autopilot.check_autopilot(fmu, trial=True)
 

@@ -29,8 +29,8 @@ from fmpy import read_model_description
 from fmpy.model_description import ModelDescription
 
 import fmukit.autopilot
-from fmubuild.trial import TrialFailed
-from fmubuild.trial import trial as instantiate_in_child
+from fmubuild.instantiate import InstantiationFailed
+from fmubuild.instantiate import instantiate_in_child
 from fmukit.units import UNITS
 
 from ..core.ssd import Connection, SystemDescription
@@ -109,7 +109,7 @@ def check_autopilot(fmu: str | Path, port_map: dict[str, str] | None = None,
                     trial: bool = False) -> ModelDescription:
     """The FMU's model description if it keeps the port contract; AutopilotError if not.
 
-    ``trial`` also instantiates it once in a child process (``fmubuild.trial``).
+    ``trial`` also instantiates it once in a child process (``fmubuild.instantiate``).
     """
     fmu, port_map = Path(fmu), port_map or {}
     if not fmu.is_file():
@@ -147,7 +147,7 @@ def check_autopilot(fmu: str | Path, port_map: dict[str, str] | None = None,
     if trial:
         try:
             instantiate_in_child(fmu)
-        except TrialFailed as failed:
+        except InstantiationFailed as failed:
             raise AutopilotError(str(failed)) from None
     return description
 

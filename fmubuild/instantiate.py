@@ -1,11 +1,6 @@
-"""An FMU instantiated once in a child process: does it start, here or away from the checkout?
-
-Some FMUs take their host down when they cannot instantiate (pythonfmu 0.7's C++
-dereferences a NULL class when its Python script fails to import, and pythonfmu3
-0.3.4's segfaults alike), so the try is a child's, and the caller lives to say what
-happened. An FMI 2.0 FMU is tried with fmpy's FMU2Slave, an FMI 3.0 one with FMU3Slave. ``isolated`` leaves this checkout
-off the child's import path, as on a host that has only the FMU: a module the FMU
-forgot to carry is missing there.
+"""An FMU instantiated once in a child process (pythonfmu's C++ takes its host down when the
+script fails to import), with fmpy; ``isolated`` leaves this checkout off the child's path,
+as on a host that has only the FMU.
 """
 from __future__ import annotations
 
@@ -36,7 +31,7 @@ slave.freeInstance()
 """
 
 
-class TrialFailed(RuntimeError):
+class InstantiationFailed(RuntimeError):
     """The FMU did not instantiate, took its host down, or did not end in time: ``crashed``
     names the signal (None otherwise), ``timed_out`` the limit in seconds (None unless it
     ran out), ``last_words`` are the child's last lines (the FMU's first)."""
@@ -58,8 +53,8 @@ def _last_lines(text: str | bytes | None) -> list[str]:
     return [line for line in (text or "").splitlines() if line.strip()][-3:]
 
 
-def trial(fmu: str | Path, isolated: bool = False, timeout: float = 120.0) -> None:
-    """Instantiate and free ``fmu`` in a child process; TrialFailed if that fails, or if it
+def instantiate_in_child(fmu: str | Path, isolated: bool = False, timeout: float = 120.0) -> None:
+    """Instantiate and free ``fmu`` in a child process; InstantiationFailed if that fails, or if it
     has not ended after ``timeout`` seconds (the child is killed then)."""
     fmu = Path(fmu).resolve()
     with tempfile.TemporaryDirectory() as elsewhere:
@@ -69,8 +64,8 @@ def trial(fmu: str | Path, isolated: bool = False, timeout: float = 120.0) -> No
                                    cwd=elsewhere, capture_output=True, text=True,
                                    timeout=timeout)
         except subprocess.TimeoutExpired as expired:
-            raise TrialFailed(fmu, None, _last_lines(expired.stdout) or _last_lines(
+            raise InstantiationFailed(fmu, None, _last_lines(expired.stdout) or _last_lines(
                 expired.stderr), timed_out=timeout) from None
     if child.returncode != 0:
-        raise TrialFailed(fmu, child.returncode,    # the FMU's words, else Python's
+        raise InstantiationFailed(fmu, child.returncode,    # the FMU's words, else Python's
                           _last_lines(child.stdout) or _last_lines(child.stderr))
