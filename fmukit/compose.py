@@ -9,18 +9,22 @@ defines: ``class <Model>(Fmi<N>Entry, <Model>, Fmi<N>Slave)``. Without pythonfmu
 """
 from __future__ import annotations
 
+import functools
 import importlib
 
 from .slave import ModelSlave
 
 ADAPTERS = {2: "fmukit.pythonfmu07.slave", 3: "fmukit.pythonfmu3_03.slave"}
-"""FMI version: the adapter module whose ``on_fmi<version>`` composes the class."""
+"""FMI version: the adapter module that defines ``Fmi<version>Entry`` and ``Fmi<version>Slave``."""
 
 
+@functools.cache
 def fmu_class(model: type[ModelSlave], fmi: int) -> type[ModelSlave]:
     """The FMI ``fmi`` (2 or 3) FMU class of ``model``; ValueError for another version."""
     if fmi not in ADAPTERS:
         raise ValueError(f"FMI {fmi} is not one fmukit builds; it builds "
                          f"{' and '.join(f'FMI {v}.0' for v in ADAPTERS)}")
     adapter = importlib.import_module(ADAPTERS[fmi])
-    return getattr(adapter, f"on_fmi{fmi}")(model)
+    bases = (getattr(adapter, f"Fmi{fmi}Entry"), model, getattr(adapter, f"Fmi{fmi}Slave"))
+    return type(model.__name__, bases, {"__module__": model.__module__,
+                                        "__qualname__": model.__qualname__})

@@ -52,3 +52,15 @@ class Registry:
         if var is None:
             raise ValueError(f"no variable has value reference {vr}")
         return var
+
+
+def pythonfmu_variable(var: Var, getter: Callable[[], Any] | None, kind: type,
+                       causality: Any, variability: Any, initial: Any, **extra: Any) -> Any:
+    """The pythonfmu(3) variable of ``kind`` for ``var``, given that version's enums."""
+    if var.causality == "output":
+        return kind(var.name, causality=causality.output, variability=(
+            variability.continuous if var.is_real else variability.discrete),
+            initial=initial.calculated, description=var.description, getter=getter, **extra)
+    return kind(var.name, causality=causality[var.causality], variability=(
+        variability.fixed if var.causality == "parameter" else variability.continuous),
+        description=var.description, **extra)

@@ -5,12 +5,12 @@ longest MRO). Every refusal is an exception: fmi2Fatal.
 from __future__ import annotations
 
 import ctypes
-import functools
 from typing import Any, Callable
 from xml.etree.ElementTree import Element
 
 from ..entry import fmi_entry
-from ..slave import CATEGORIES, ModelSlave
+from ..registry import pythonfmu_variable
+from ..slave import CATEGORIES
 from ..variables import Var
 from ..hostlog import HostLog
 from . import (ACTIVE, Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Status, Fmi2Variability,
@@ -32,18 +32,8 @@ class Fmi2Entry:
         return binary.host_log(kwargs)
 
     def fmi_variable(self, var: Var, getter: Callable[[], Any] | None) -> Any:
-        """pythonfmu's Real, Integer or String for ``var``."""
-        kind = _TYPE[var.kind]
-        if var.causality == "output":
-            return kind(var.name, causality=Fmi2Causality.output,
-                        variability=(Fmi2Variability.continuous if var.is_real
-                                     else Fmi2Variability.discrete),
-                        initial=Fmi2Initial.calculated, description=var.description,
-                        getter=getter)
-        variability = (Fmi2Variability.fixed if var.causality == "parameter"
-                       else Fmi2Variability.continuous)
-        return kind(var.name, causality=Fmi2Causality[var.causality], variability=variability,
-                    description=var.description)
+        return pythonfmu_variable(var, getter, _TYPE[var.kind], Fmi2Causality,
+                                  Fmi2Variability, Fmi2Initial)
 
     @fmi_entry
     def setup_experiment(self, start_time: float, stop_time: float | None = None,
@@ -77,12 +67,6 @@ class Fmi2Entry:
     def to_xml(self, model_options: dict[str, str] = dict()) -> Element:
         return model_description.complete(super().to_xml(model_options), self.variables)
 
-
-@functools.cache
-def on_fmi2(model: type[ModelSlave]) -> type[ModelSlave]:
-    """The FMI 2.0 FMU class of ``model``, as its FMU's entry module defines it."""
-    return type(model.__name__, (Fmi2Entry, model, Fmi2Slave),
-                {"__module__": model.__module__, "__qualname__": model.__qualname__})
 
 
 def hold_namespace(namespace: dict[str, Any]) -> None:

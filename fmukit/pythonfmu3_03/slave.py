@@ -6,14 +6,14 @@ the start time, so messages name none.
 """
 from __future__ import annotations
 
-import functools
 from typing import Any, Callable
 from xml.etree.ElementTree import Element
 
 from .. import state
 from ..entry import fmi_entry
+from ..registry import pythonfmu_variable
 from ..hostlog import HostLog
-from ..slave import CATEGORIES, ModelSlave
+from ..slave import CATEGORIES
 from ..variables import Var
 from . import (ACTIVE, Fmi3Causality, Fmi3Initial, Fmi3Slave, Fmi3Status, Fmi3StepResult,
                Fmi3Variability, Float64, Int32, String, binary, model_description)
@@ -56,19 +56,9 @@ class Fmi3Entry:
                                        getter=lambda: self.time))
 
     def fmi_variable(self, var: Var, getter: Callable[[], Any] | None) -> Any:
-        """pythonfmu3's Float64, Int32 or String for ``var``."""
-        kind = _TYPE[var.kind]
-        unit = {"unit": var.unit} if var.is_real else {}
-        if var.causality == "output":
-            return kind(var.name, causality=Fmi3Causality.output,
-                        variability=(Fmi3Variability.continuous if var.is_real
-                                     else Fmi3Variability.discrete),
-                        initial=Fmi3Initial.calculated, description=var.description,
-                        getter=getter, **unit)
-        variability = (Fmi3Variability.fixed if var.causality == "parameter"
-                       else Fmi3Variability.continuous)
-        return kind(var.name, causality=Fmi3Causality[var.causality], variability=variability,
-                    description=var.description, **unit)
+        return pythonfmu_variable(var, getter, _TYPE[var.kind], Fmi3Causality,
+                                  Fmi3Variability, Fmi3Initial,
+                                  **({"unit": var.unit} if var.is_real else {}))
 
     def log(self, msg: str, status: Fmi3Status = Fmi3Status.ok, category: str | None = None,
             debug: bool = False) -> None:
@@ -113,10 +103,3 @@ class Fmi3Entry:
     def to_xml(self, model_options: dict[str, str] = dict()) -> Element:
         vr = {var.name: vr for vr, var in self.registry.by_vr.items()}
         return model_description.complete(super().to_xml(model_options), self.variables, vr)
-
-
-@functools.cache
-def on_fmi3(model: type[ModelSlave]) -> type[ModelSlave]:
-    """The FMI 3.0 FMU class of ``model``, as its FMU's entry module defines it."""
-    return type(model.__name__, (Fmi3Entry, model, Fmi3Slave),
-                {"__module__": model.__module__, "__qualname__": model.__qualname__})
