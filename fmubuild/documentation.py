@@ -57,13 +57,9 @@ _STYLE = ("body{font-family:sans-serif;max-width:60em;margin:1em auto;padding:0 
 def describe(entries: Mapping[str, bytes], generation_tool: str, identity: Mapping[str, str],
              overview: str, sources: Mapping[str, str],
              hosts: Mapping[str, str]) -> dict[str, bytes]:
-    """An FMU's ``entries`` completed: its model description's ``generation_tool`` and
-    ``identity`` (``IDENTITY``: value), its documentation page and its icon.
-
-    ``overview``: what the model is (its module's docstring); ``sources``: module name:
-    docstring of each model module the FMU carries; ``hosts``: platform: what a host needs
-    there (HTML), for the platforms the FMU has a binary for.
-    """
+    """``entries`` with the model description's ``generation_tool`` and ``identity``, the
+    page (``overview``: the model's docstring; ``sources``: module: docstring; ``hosts``:
+    platform: HTML) and the icon."""
     xml = identified(entries["modelDescription.xml"], generation_tool, identity)
     platforms = sorted({name.split("/")[1] for name in entries
                         if name.startswith("binaries/") and name.count("/") == 2})

@@ -14,9 +14,8 @@ from .project import ROOT
 
 
 def needed_modules(script: Path, packages: dict[str, Path]) -> dict[str, Path]:
-    """Module name: file, for every module of ``packages`` (top-level name: the folder
-    that holds it) that ``script`` imports, directly or through another. ValueError
-    naming the file and the module if an import of one of them finds no file."""
+    """Module: file, for every module of ``packages`` (name: its folder) that ``script``
+    imports, directly or not; ValueError if one has no file."""
     found: dict[str, Path] = {}
     todo = [(None, script)]
     while todo:
@@ -75,9 +74,7 @@ def _file(module: str, packages: dict[str, Path]) -> Path | None:
 
 
 def parsed(path: Path) -> ast.Module:
-    """The syntax tree of the Python file ``path``; ValueError naming the file, the line and
-    what is wrong there, the line shown with a caret under the fault, if it does not
-    parse."""
+    """The syntax tree of ``path``; ValueError naming the file and line, with a caret."""
     try:
         return ast.parse(path.read_bytes(), str(path))
     except SyntaxError as error:
@@ -97,9 +94,7 @@ def _quoted(error: SyntaxError) -> str:
 
 @dataclass(frozen=True)
 class Uncarried:
-    """A module that ``importer`` imports and its FMU would neither carry nor find on a
-    host: ``found`` is where this build sees it (a file, or a package's folder), None if
-    nowhere."""
+    """A module ``importer`` imports that a host would not have; ``found``: where it is here."""
 
     module: str
     importer: Path
@@ -108,12 +103,9 @@ class Uncarried:
 
 def uncarried(script: Path, includes: Iterable[Path], carried: Iterable[str]
               ) -> list[Uncarried]:
-    """The top-level modules that ``script`` or the Python files of ``includes`` import
-    which a host would not have: not in the standard library, not installed in this
-    Python (numpy and pythonfmu are the host's; this checkout and the folders of the
-    script, the includes and the working directory are not), not ``carried`` (fmukit)
-    and not provided by ``includes``. An import inside a ``try`` that catches ImportError is
-    optional, and not counted. ValueError if a file does not parse (``parsed``)."""
+    """The top-level modules ``script`` or ``includes`` import (outside a try that catches
+    ImportError) that a host would not have: not standard, not installed in this Python
+    (this checkout and the local folders do not count), not ``carried``, not included."""
     includes = [Path(p) for p in includes]
     provided = {*carried, *(p.stem if p.is_file() else p.name for p in includes)}
     local = [script.resolve().parent, Path.cwd().resolve(), ROOT,

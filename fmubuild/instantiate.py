@@ -32,9 +32,8 @@ slave.freeInstance()
 
 
 class InstantiationFailed(RuntimeError):
-    """The FMU did not instantiate, took its host down, or did not end in time: ``crashed``
-    names the signal (None otherwise), ``timed_out`` the limit in seconds (None unless it
-    ran out), ``last_words`` are the child's last lines (the FMU's first)."""
+    """The FMU did not instantiate: ``crashed`` names the signal, ``timed_out`` the limit
+    (s), ``last_words`` are the child's last lines."""
 
     def __init__(self, fmu: Path, returncode: int | None, last_words: list[str],
                  timed_out: float | None = None):

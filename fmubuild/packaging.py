@@ -52,11 +52,9 @@ def python_hosts() -> dict[str, str]:
 
 def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
                  identity: Mapping[str, str] | None = None, fmi: int = 2) -> Path:
-    """Build the slave in ``script`` as an FMI ``fmi`` FMU into ``dest`` (a .fmu path, or a
-    folder: named after its model_name); its path. ``packages``: names of project packages,
-    of which it carries what the script imports, and paths, which it carries whole;
-    ``identity``: what to declare where the slave declares none. ValueError naming the
-    script if it cannot be built; RuntimeError for another pythonfmu or an invalid FMU."""
+    """The slave in ``script`` built as FMI ``fmi`` into ``dest`` (a .fmu, or a folder);
+    ``packages``: project package names (carried as imported) and paths (carried whole).
+    ValueError naming the script if it cannot be built; RuntimeError if invalid."""
     from fmpy.validation import validate_fmu
 
     if fmi not in ROUTES:

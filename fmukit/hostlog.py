@@ -44,11 +44,8 @@ def known_binary(logger: int | None, resources: str | None,
 
 
 class HostLog:
-    """Where an FMU's errors reach its user: the host's logger, or standard error.
-
-    ``flag``: the host's logging flag, where the adapter found it; ``unknown``: whether
-    the host hears the FMU where it did not; ``in_process``: a Python host that drains
-    the log queue itself."""
+    """Where an FMU's errors reach its user: the host's logger (``flag``, where found;
+    else ``unknown``; always ``in_process``), or standard error."""
 
     def __init__(self, flag: ctypes.c_bool | None, in_process: bool, unknown: bool):
         self._flag, self._in_process, self._unknown = flag, in_process, unknown

@@ -55,9 +55,8 @@ class _DeferringHandler:
 
 
 def _signal_again() -> None:
-    """Signal the main thread again, each millisecond, until its handler has run in host
-    code. (Signalled from the handler itself, the handler would run again at once,
-    inside itself.)"""
+    """Signal the main thread again each millisecond until its handler has run in host
+    code (from the handler itself, it would run again at once, inside itself)."""
     while _pending:
         time.sleep(0.001)
         for number in tuple(_pending):
@@ -78,9 +77,8 @@ def defer_host_handlers() -> None:
 
 
 def _c_runtime() -> ctypes.CDLL:
-    """The C library whose ``signal`` installed Python's handlers: on Windows the Universal
-    CRT (``ctypes.CDLL(None)`` is a TypeError there, and ``msvcrt.dll`` is another CRT,
-    with a signal table of its own), elsewhere the process's."""
+    """The C library whose ``signal`` installed Python's handlers: the Universal CRT on
+    Windows (``msvcrt.dll`` has a signal table of its own), elsewhere the process's."""
     return ctypes.CDLL("ucrtbase") if sys.platform == "win32" else ctypes.CDLL(None)
 
 

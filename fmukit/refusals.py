@@ -40,9 +40,8 @@ class Refused(ValueError):
 
 
 def explain(error: BaseException) -> str:
-    """What went wrong, for the user: a refusal's own message, or where in the model's code
-    the exception was raised, its type and message ('my_autopilot.py:42 in step:
-    ZeroDivisionError: float division by zero')."""
+    """A refusal's message, or where the model's exception was raised, its type and message
+    ('my_autopilot.py:42 in step: ZeroDivisionError: float division by zero')."""
     if isinstance(error, Refused):
         return str(error)
     where = located(error)
@@ -50,16 +49,14 @@ def explain(error: BaseException) -> str:
 
 
 def reason(error: BaseException) -> str:
-    """``explain``, except for a ValueError, whose message alone is the reason: by this
-    project's convention a model raises ValueError to name the value it refuses
-    ('parameter Kp = nan is not finite')."""
+    """``explain``, but a ValueError's message alone: a model raises ValueError to name the
+    value it refuses ('parameter Kp = nan is not finite')."""
     return str(error) if isinstance(error, ValueError) else explain(error)
 
 
 def located(error: BaseException) -> str:
-    """'file.py:42 in function' for the innermost frame of ``error``'s traceback in the
-    user's code, else the innermost frame of all; '' without a traceback. The file is
-    named relative to the folder on sys.path it is imported from (an FMU's resources)."""
+    """'file.py:42 in function' of the innermost frame in the user's code (else of all; ''
+    without a traceback), the file relative to its folder on sys.path."""
     frames = traceback.extract_tb(error.__traceback__)
     if not frames:
         return ""

@@ -38,11 +38,8 @@ def restore(slave: Any, state: dict[str, Any]) -> None:
 
 
 def decode(data: bytes) -> dict[str, Any]:
-    """A serialised state, or ``{"invalid": why}`` for ``restore`` to refuse.
-
-    pythonfmu calls the decoder on the class, where an exception cannot be made
-    safe (``fmukit.entry``): the problem travels in the state instead.
-    """
+    """A serialised state, or ``{"invalid": why}`` for ``restore`` to refuse (pythonfmu
+    calls this on the class, where an exception cannot be made safe)."""
     try:
         decoded = json.loads(data.decode("utf-8"))
         if not _KEYS <= set(decoded):

@@ -50,11 +50,8 @@ class Var:
     def output(cls, name: str, unit: str = "1", description: str = "",
                depends: tuple[str, ...] = (), initial_depends: tuple[str, ...] = (),
                get: Callable[[Any], Any] | None = None, kind: type = float) -> Var:
-        """An output read from the slave by ``get`` (default: the model's attribute).
-
-        ``depends``: the inputs (direct feedthrough) and parameters it depends on;
-        ``initial_depends``: inputs it depends on only at initialisation.
-        """
+        """An output read from the slave by ``get`` (default: the model's attribute),
+        depending on ``depends`` and, at initialisation only, ``initial_depends``."""
         return cls(name, "output", unit, description, None, kind, depends, initial_depends,
                    get)
 
@@ -76,13 +73,9 @@ class Var:
 
 
 def range_check(variables: tuple[Var, ...]) -> Callable[[Any], None]:
-    """A function checking the numeric ``variables`` as attributes of an object at once:
-    Refused from the first one's ``Var.check`` that fails.
-
-    What every step checks of its inputs, so the test is compiled to one expression,
-    ``low <= obj.name <= high and ...``, each range clipped to the finite doubles,
-    which no NaN or infinity passes; only a failure goes through ``Var.check``.
-    """
+    """A check of the numeric ``variables`` as attributes of an object, compiled to one
+    expression (ranges clipped to the finite doubles, which no NaN passes); a failure is
+    Refused by ``Var.check``. Every step checks its inputs so."""
     tests = [f"{max(v.min, -sys.float_info.max)!r} <= obj.{v.name} <= "
              f"{min(v.max, sys.float_info.max)!r}" for v in variables]
 
