@@ -18,16 +18,13 @@ _GUID = re.compile(rb'\s(guid|instantiationToken)="[^"]*"')
 _GENERATED = re.compile(rb'\sgenerationDateAndTime="[^"]*"')
 
 
-def rewrite(fmu: Path,
-            transform: Callable[[dict[str, bytes]], dict[str, bytes]] | None = None,
-            to: Path | None = None) -> str:
-    """Write ``fmu`` again reproducibly, in place or ``to`` another path (whole or not at
-    all), its entries (name: bytes) passed through ``transform`` first; its new GUID."""
+def rewrite(fmu: Path, transform: Callable[[dict[str, bytes]], dict[str, bytes]],
+            to: Path) -> None:
+    """Write ``fmu`` again reproducibly ``to`` another path (whole or not at all), its
+    entries (name: bytes) passed through ``transform`` first."""
     with zipfile.ZipFile(fmu) as package:
-        entries = {info.filename: package.read(info) for info in package.infolist()
-                   if not info.is_dir()}
-    if transform is not None:
-        entries = transform(entries)
+        entries = transform({info.filename: package.read(info)
+                             for info in package.infolist() if not info.is_dir()})
     description = _GENERATED.sub(b"", entries["modelDescription.xml"])
     found = _GUID.search(description)
     attribute = found.group(1) if found else b"guid"
@@ -38,8 +35,7 @@ def rewrite(fmu: Path,
     guid = str(uuid.uuid5(uuid.NAMESPACE_OID, contents.hexdigest()))
     entries["modelDescription.xml"] = entries["modelDescription.xml"].replace(
         b' ' + attribute + b'=""', b' ' + attribute + f'="{{{guid}}}"'.encode(), 1)
-    write(to or fmu, entries)
-    return guid
+    write(to, entries)
 
 
 def write(fmu: Path, entries: dict[str, bytes]) -> None:
