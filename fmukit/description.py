@@ -6,8 +6,9 @@ puts them where its version wants them.
 from __future__ import annotations
 
 import math
+from xml.etree.ElementTree import Element
 
-from .units import DISPLAY_UNIT
+from .units import DISPLAY_UNIT, unit_definitions
 from .variables import Var
 
 
@@ -37,6 +38,15 @@ def dependencies(output: Var, variables: tuple[Var, ...]) -> tuple[list[str], li
             list(output.depends + output.initial_depends))
 
 
-def units_used(variables: tuple[Var, ...]) -> set[str]:
-    """The units of the Real variables."""
-    return {v.unit for v in variables if v.is_real}
+def complete(root: Element, variables: tuple[Var, ...],
+             typed: list[Element | None]) -> tuple[Element, list[Var]]:
+    """Add each numeric variable's attributes to its ``typed`` element and the
+    <UnitDefinitions> to ``root``; the emptied <ModelStructure>, and the outputs."""
+    for element, var in zip(typed, variables):
+        if var.kind is not str:
+            element.attrib.update(typed_attributes(var))
+    root.insert(list(root).index(root.find("CoSimulation")) + 1,
+                unit_definitions({v.unit for v in variables if v.is_real}))
+    structure = root.find("ModelStructure")
+    structure.clear()
+    return structure, [v for v in variables if v.causality == "output"]

@@ -6,33 +6,22 @@ from __future__ import annotations
 
 from xml.etree.ElementTree import Element, SubElement
 
-from ..description import dependencies, typed_attributes, units_used
-from ..units import unit_definitions
+from .. import description
+from ..description import dependencies
 from ..variables import Var
 
 
 def complete(root: Element, variables: tuple[Var, ...]) -> Element:
     """Complete pythonfmu's model description ``root`` of a slave with these variables."""
     index = {v.name: i + 1 for i, v in enumerate(variables)}
-    for element, var in zip(root.find("ModelVariables"), variables):
-        if var.kind is not str:
-            element.find("Real" if var.is_real else "Integer").attrib.update(
-                typed_attributes(var))
-    root.insert(list(root).index(root.find("CoSimulation")) + 1,
-                unit_definitions(units_used(variables)))
-
-    structure = root.find("ModelStructure")
-    structure.clear()
-    outputs = [v for v in variables if v.causality == "output"]
-    if outputs:
-        listed = SubElement(structure, "Outputs")
+    structure, outputs = description.complete(root, variables, [
+        e.find("Real" if v.is_real else "Integer")
+        for e, v in zip(root.find("ModelVariables"), variables)])
+    for tag, when in (("Outputs", 0), ("InitialUnknowns", 1)) if outputs else ():
+        listed = SubElement(structure, tag)
         for v in outputs:
             SubElement(listed, "Unknown", index=str(index[v.name]),
-                       dependencies=_indices(dependencies(v, variables)[0], index))
-        initial = SubElement(structure, "InitialUnknowns")
-        for v in outputs:
-            SubElement(initial, "Unknown", index=str(index[v.name]),
-                       dependencies=_indices(dependencies(v, variables)[1], index))
+                       dependencies=_indices(dependencies(v, variables)[when], index))
     return root
 
 

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 from xml.etree.ElementTree import Element, SubElement
 
-from ..description import dependencies, typed_attributes, units_used
-from ..units import unit_definitions
+from .. import description
+from ..description import dependencies
 from ..variables import Var
 
 
@@ -21,20 +21,11 @@ def complete(root: Element, variables: tuple[Var, ...], vr: dict[str, int]) -> E
     for independent in [e for e in listed if e.get("causality") == "independent"]:
         listed.remove(independent)
         listed.append(independent)
-    for var in variables:
-        if var.kind is not str:
-            elements[var.name].attrib.update(typed_attributes(var))
-    cosimulation = root.find("CoSimulation")
-    root.insert(list(root).index(cosimulation) + 1, unit_definitions(units_used(variables)))
-
-    structure = root.find("ModelStructure")
-    structure.clear()
-    outputs = [v for v in variables if v.causality == "output"]
-    for v in outputs:
-        SubElement(structure, "Output", _unknown(vr[v.name], dependencies(v, variables)[0], vr))
-    for v in outputs:
-        SubElement(structure, "InitialUnknown",
-                   _unknown(vr[v.name], dependencies(v, variables)[1], vr))
+    structure, outputs = description.complete(root, variables,
+                                              [elements[v.name] for v in variables])
+    for tag, when in (("Output", 0), ("InitialUnknown", 1)):
+        for v in outputs:
+            SubElement(structure, tag, _unknown(vr[v.name], dependencies(v, variables)[when], vr))
     return root
 
 
