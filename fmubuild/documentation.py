@@ -183,8 +183,7 @@ def _example(name: str, inputs: list[Element], experiment: Element | None) -> st
 
 
 def _typed(variable: Element) -> Element:
-    """The element of a variable's type: FMI 2.0's child of ScalarVariable, FMI 3.0's the
-    variable itself."""
+    """The element of a variable's type (FMI 2.0: its child; FMI 3.0: itself)."""
     return variable[0] if variable.tag == "ScalarVariable" else variable
 
 

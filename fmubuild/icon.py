@@ -21,8 +21,7 @@ _FONT = "DejaVu Sans"               # matplotlib's own
 
 
 def model_png(xml: bytes) -> bytes:
-    """The icon of the model described by ``xml`` (modelDescription.xml, FMI 2.0 or 3.0) as
-    PNG bytes."""
+    """The icon of the model described by ``xml`` (FMI 2.0 or 3.0) as PNG bytes."""
     root = fromstring(xml)
     ports = {c: [v.get("name") for v in root.find("ModelVariables")
                  if v.get("causality") == c] for c in ("input", "output")}

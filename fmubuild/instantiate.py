@@ -53,8 +53,8 @@ def _last_lines(text: str | bytes | None) -> list[str]:
 
 
 def instantiate_in_child(fmu: str | Path, isolated: bool = False, timeout: float = 120.0) -> None:
-    """Instantiate and free ``fmu`` in a child process; InstantiationFailed if that fails, or if it
-    has not ended after ``timeout`` seconds (the child is killed then)."""
+    """Instantiate and free ``fmu`` in a child process; InstantiationFailed if that fails,
+    or if it has not ended after ``timeout`` seconds (the child is killed then)."""
     fmu = Path(fmu).resolve()
     with tempfile.TemporaryDirectory() as elsewhere:
         try:

@@ -36,8 +36,7 @@ PROJECT_PACKAGES = ("fmukit", "ship_fmu", "autopilot_fmu")
 
 
 def build(name: str, dest: Path | None = None, fmi: int = 2) -> Path:
-    """Build one FMU of this project as FMI ``fmi`` (2 or 3) to dest/name.fmu (default:
-    the version's folder, ``project.FMU_DIRS``), validate it, and return its path."""
+    """One FMU of this project built as FMI ``fmi`` to dest/name.fmu (default: FMU_DIRS)."""
     return build_script(ROOT / FMUS[name], PROJECT_PACKAGES,
                         (dest or FMU_DIRS[fmi]) / f"{name}.fmu", project_identity(), fmi)
 
