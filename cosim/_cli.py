@@ -13,7 +13,7 @@ import tempfile
 from pathlib import Path
 from typing import Callable
 
-from fmubuild.project import BUILD_HINT, FMU_DIRS
+from fmubuild.project import BUILD_HINT, FMU_DIRS, SLAVE_MODULES
 
 from . import scenarios
 from .api import parse_setting
@@ -133,7 +133,7 @@ def say_note(note: str) -> None:
     """``note: ...`` on standard error, and how to build our FMUs where the note says one
     was built before a change (``cosim.core.inprocess.Reason``)."""
     print(f"note: {note}", file=sys.stderr)
-    if getattr(note, "rebuild", False):
+    if getattr(note, "stale_module", None) in SLAVE_MODULES:
         print(f"  {BUILD_HINT}", file=sys.stderr)
 
 

@@ -23,7 +23,7 @@ from typing import Any, Iterable, Mapping, Sequence
 
 from . import scenarios
 from .core.master import RUN_BACKENDS, Master
-from .core.ssd import SystemDescription, split_name
+from .core.system import SystemDescription, split_name
 from .core.recording import Recording
 
 

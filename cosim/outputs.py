@@ -2,7 +2,7 @@
 
 ``run_and_write`` runs a system description with the master (freed however the run
 ends) and writes, as ``label`` in a folder: the CSV of every signal at every step
-(streamed as the run goes with ``stream``), the metadata JSON (``core.provenance``)
+(streamed as the run goes with ``stream``), the metadata JSON (``cosim.provenance``)
 and, for a finished run, its figure (``analysis.kinds``) and an animation if asked.
 
 Nothing of a previous run is touched until the new outputs are complete: they are
@@ -28,7 +28,7 @@ from .analysis.kinds import Analysis, analysis
 from .core.files import FolderLock, Outputs
 from .core.interrupt import StopSignals
 from .core.master import Master
-from .core.provenance import write_metadata
+from .provenance import write_metadata
 from .core.recording import Recording
 from .core.ssd import SystemDescription
 from .core.watchdog import Limits, TimeLimit, Watchdog

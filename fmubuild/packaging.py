@@ -37,9 +37,11 @@ from collections.abc import Mapping
 from importlib import metadata
 from pathlib import Path
 
+from fmukit.manifest import DISTRIBUTION, Manifest, digest_of, sha256, version
+
 from . import documentation, exit_fix, reproducible
 from .imports import needed_modules
-from .manifest import DISTRIBUTION, Manifest, digest_of, project_identity, sha256, version
+from .manifest import project_identity
 from .project import FMUS, ROOT
 from .routes import ROUTES
 from .trial import TrialFailed, trial

@@ -16,9 +16,10 @@ from typing import Iterator
 import pytest
 
 from fmubuild.cbuild import build_c, c_compiler, sources
-from fmubuild.manifest import read, staleness
+from fmubuild.manifest import entry_source
 from fmubuild.packaging import build
 from fmubuild.project import C_FMUS, FMU_DIRS, FMUS, ROOT
+from fmukit.manifest import read, staleness
 
 pytest_plugins = ["pytester"]       # to run the example test file for each autopilot
 
@@ -113,7 +114,7 @@ def _stale(path: Path) -> bool:
     """Missing, built without a manifest, or not current: a module it carries differs
     from this checkout's."""
     manifest = read(path) if path.exists() else None
-    return manifest is None or staleness(manifest) is not None
+    return manifest is None or staleness(manifest, entry_source) is not None
 
 
 def _older(fmu: Path, sources: list[Path]) -> bool:

@@ -18,10 +18,10 @@ from cosim import scenarios
 from cosim.analysis.cost import LAMBDA
 from cosim.analysis.metrics import cost_terms
 from cosim.core.master import Master
-from cosim.core import ssd
-from cosim.core.ssd import read_ssd, write_ssd
+from cosim.core.ssd import write_ssd
 from cosim.core.wiring import WiringError
 from cosim.studies.direct import COMPARED, run_direct
+from fmubuild import project
 from fmubuild.project import ROOT
 from helpers import fmu_variant
 
@@ -31,7 +31,7 @@ _cache: dict = {}
 
 
 def system(name: str):
-    return read_ssd(SCENARIOS / f"{name}.ssd")
+    return scenarios.load(name)
 
 
 def run(name: str, coupling: str = "gauss-seidel", backend: str = "fmi", **kwargs):
@@ -302,12 +302,12 @@ def test_missing_fmu_names_the_paths_tried_and_says_how_to_build_it(tmp_path, mo
                                                                     capsys):
     """The core says what is missing and that it is ours (as data); the command says how
     to build it."""
-    monkeypatch.setattr(ssd, "FMU_SEARCH_PATH", [tmp_path / "empty"])
+    monkeypatch.setattr(project, "FMU_DIRS", {2: tmp_path / "empty", 3: tmp_path / "fmi3"})
 
     def edit(d):                        # relative: beside the .ssd, then by name
         d.components["ship"].source = "nowhere/ship.fmu"
     with pytest.raises(FileNotFoundError, match="one of this project's FMUs, not built") as missing:
-        Master(read_ssd(_variant(tmp_path, "calm_pd", edit)))
+        Master(scenarios.load(_variant(tmp_path, "calm_pd", edit)))
     beside = (SCENARIOS / "nowhere" / "ship.fmu").resolve()
     assert f"tried {beside}, {tmp_path / 'empty' / 'ship.fmu'}" in str(missing.value)
     assert missing.value.ours and "python -m" not in str(missing.value)
@@ -324,7 +324,7 @@ def test_a_missing_fmu_of_the_user_is_not_a_build_problem(tmp_path):
     def edit(d):
         d.components["autopilot"].source = "my_pilot.fmu"
     with pytest.raises(FileNotFoundError, match="check the source of component 'autopilot'"):
-        Master(read_ssd(_variant(tmp_path, "calm_pd", edit)))
+        Master(scenarios.load(_variant(tmp_path, "calm_pd", edit)))
 
 
 def test_a_scenario_copied_anywhere_finds_the_project_fmus(tmp_path):
@@ -342,7 +342,7 @@ def test_corrupt_fmu_says_how_to_build_it(tmp_path):
     def edit(d):
         d.components["ship"].source = str(corrupt)
     with pytest.raises(ValueError, match="not a readable FMU") as unreadable:
-        Master(read_ssd(_variant(tmp_path, "calm_pd", edit)))
+        Master(scenarios.load(_variant(tmp_path, "calm_pd", edit)))
     assert unreadable.value.ours
 
 
@@ -350,7 +350,7 @@ def test_connection_to_a_missing_variable_is_refused_by_name(tmp_path):
     def edit(d):
         d.connections[0] = type(d.connections[0])("guidance", "psi_desired", "autopilot", "psi_d")
     with pytest.raises(WiringError, match="guidance.psi_desired.*no variable 'psi_desired'"):
-        Master(read_ssd(_variant(tmp_path, "calm_pd", edit)))
+        Master(scenarios.load(_variant(tmp_path, "calm_pd", edit)))
 
 
 def test_unwritable_output_folder_is_refused_before_simulating(tmp_path, monkeypatch, capsys):

@@ -57,3 +57,14 @@ def jacobi(nodes: list[Node], values: list[float], t: float, h: float, step: boo
 
 
 COUPLINGS: dict[str, Coupling] = {"gauss-seidel": gauss_seidel, "jacobi": jacobi}
+
+
+def settle(nodes: list[Node], columns: int) -> None:
+    """Initial outputs propagated along the connections: enough passes for any acyclic chain."""
+    values = [0.0] * columns
+    for _ in nodes:
+        for node in nodes:
+            if node.read_outputs:
+                values[node.outputs] = node.read_outputs()
+            if node.apply_inputs:
+                node.apply_inputs(values)

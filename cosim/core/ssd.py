@@ -1,29 +1,22 @@
 """Read and write SSP 1.0 system structure descriptions (.ssd) of a flat system.
 
-The subset used here is the one OSP libcosim, ecos and fmpy all read: one system of
-FMU components with connectors, inline parameter sets (ssv:Real, Integer, Boolean,
-String), connections, and a DefaultExperiment whose OSP annotation gives the fixed
-step. ``write_ssd`` also gives the step in OpenModelica's annotation on the System,
-the only place OMSimulator's command line learns the system's type and step from
-(without it, it aborts with '[NewSystem] internal error'). This project adds one
-annotation of its own (type ``REPORT_ANNOTATION``) naming the kind of analysis a run of
-the system gets (``cosim.analysis.kinds``); other tools ignore it. ``read_ssd`` refuses what is not in this subset (nested
-systems, connectors of the system itself, parameter values in .ssv files or with
-units, ...) or not well formed, naming the file, the element and the attribute.
+The subset OSP libcosim, ecos and fmpy all read: one system of FMU components with
+connectors, inline parameter values (ssv:Real, Integer, Boolean, String), connections, and
+a DefaultExperiment whose OSP annotation gives the fixed step. ``write_ssd`` also gives the
+step in OpenModelica's annotation on the System, where OMSimulator's command line looks for
+it, and one annotation of our own (``REPORT_ANNOTATION``) naming the kind of analysis a run
+gets. ``read_ssd`` refuses anything else, naming the file, the element and the attribute.
 """
 from __future__ import annotations
 
-import copy
 import math
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
-from fmubuild.project import C_FMUS, FMU_DIR, FMU_DIRS, FMUS
 from fmukit.timebase import MAX_TIME, on_time_base, step_count
 
-from .errors import FmuNotFound
+from .system import Component, Connection, FmuFolders, SystemDescription
 from .values import fmi_value
 
 NS = {
@@ -42,119 +35,8 @@ _TYPES = ("Real", "Integer", "Boolean", "String")
 FMU_TYPE = "application/x-fmu-sharedlibrary"
 CONNECTOR_KINDS = ("input", "output", "inout", "parameter", "calculatedParameter")
 
-FMU_SEARCH_PATH = [FMU_DIR]
-"""Folders searched for an FMU not found where its .ssd points, by its path after its last
-``fmus`` folder (``fmi3/ship.fmu`` for ``../../fmus/fmi3/ship.fmu``), else by its file
-name: the project's fmus/, so that a scenario copied anywhere still finds the project's
-FMUs, of the FMI version it names."""
-
 for _prefix, _uri in NS.items():
     ET.register_namespace(_prefix, _uri)
-
-
-
-def split_name(name: str) -> tuple[str, str]:
-    """'ship.psi' -> ('ship', 'psi'): a variable by its component; ValueError naming ``name``
-    if it is not of the form component.variable."""
-    component, dot, variable = name.partition(".") if isinstance(name, str) else ("", "", "")
-    if not (dot and component and variable):
-        raise ValueError(f"{name!r} is not 'component.variable'")
-    return component, variable
-
-@dataclass
-class Component:
-    name: str
-    source: str                                  # FMU path, relative to the .ssd
-    connectors: dict[str, tuple[str, str]] = field(default_factory=dict)   # name: (kind, type)
-    parameters: dict[str, float | int | bool | str] = field(default_factory=dict)
-
-
-@dataclass(frozen=True)
-class Connection:
-    start_element: str
-    start_connector: str
-    end_element: str
-    end_connector: str
-
-    def __str__(self) -> str:
-        return (f"{self.start_element}.{self.start_connector} -> "
-                f"{self.end_element}.{self.end_connector}")
-
-
-@dataclass
-class SystemDescription:
-    name: str
-    components: dict[str, Component]
-    connections: list[Connection]
-    start_time: float = 0.0
-    stop_time: float = 400.0
-    step_size: float = 0.1
-    report: str = "none"
-    description: str = ""
-    path: Path | None = None                     # the .ssd this was read from
-
-    def parameters(self, overrides: dict[str, dict[str, Any]] | None = None
-                   ) -> dict[str, dict[str, Any]]:
-        """Each component's parameter values, updated by ``overrides`` (by component);
-        ValueError naming a component the system does not have."""
-        parameters = {name: dict(c.parameters) for name, c in self.components.items()}
-        for component, values in (overrides or {}).items():
-            if component not in parameters:
-                raise ValueError(f"--set names the component '{component}'; the system has "
-                                 f"{', '.join(parameters)}")
-            parameters[component].update(values)
-        return parameters
-
-    def fmu_candidates(self, component: str) -> list[Path]:
-        """Where a component's FMU may be: its source relative to the .ssd (or the current
-        folder), then a file of that name in each of ``FMU_SEARCH_PATH``; an absolute
-        source is only itself (another file of its name would run in its place unseen)."""
-        source = Path(self.components[component].source)
-        base = self.path.parent if self.path else Path.cwd()
-        parts = source.parts
-        tail = Path(*parts[len(parts) - parts[::-1].index("fmus"):]) if "fmus" in parts[:-1] \
-            else Path(source.name)
-        elsewhere = [] if source.is_absolute() else [d / tail for d in FMU_SEARCH_PATH]
-        candidates = [(base / source).resolve(), *elsewhere]
-        return list(dict.fromkeys(candidates))
-
-    def fmu_path(self, component: str) -> Path:
-        """The first of ``fmu_candidates`` that exists; FileNotFoundError naming all tried."""
-        candidates = self.fmu_candidates(component)
-        for path in candidates:
-            if path.is_file():
-                return path
-        source = Path(self.components[component].source)
-        ours = source.stem in FMUS
-        twin = 3 in map(project_fmi, candidates)
-        hint = (f"one of this project's {'FMI 3.0 ' if twin else ''}FMUs, not built" if ours
-                else f"check the source of component '{component}' in {self.path or 'the system'}")
-        raise FmuNotFound(f"FMU for '{component}' not found; tried "
-                          f"{', '.join(map(str, candidates))}; {hint}", ours)
-
-
-def project_fmi(path: Path) -> int | None:
-    """The FMI version of the folder of this project's built FMUs that ``path`` is in
-    (``fmubuild.project.FMU_DIRS``), if it is one of them by name; None for any other."""
-    if path.stem not in FMUS and path.stem not in C_FMUS:
-        return None
-    return next((fmi for fmi, folder in FMU_DIRS.items() if path.parent == folder), None)
-
-
-def with_fmi(system: SystemDescription, fmi: int) -> SystemDescription:
-    """A copy of ``system`` whose components that run this project's FMUs (found in, or
-    missing from, one of its build folders) take those of FMI version ``fmi``: fmus/ for
-    2, fmus/fmi3/ for 3 (``fmubuild.project.FMU_DIRS``); other FMUs stay as they are."""
-    if fmi not in FMU_DIRS:
-        raise ValueError(f"FMI {fmi}: this project's FMUs are built for FMI "
-                         f"{' and '.join(f'{v}.0' for v in FMU_DIRS)}")
-    new = copy.deepcopy(system)
-    for name, component in new.components.items():
-        candidates = system.fmu_candidates(name)
-        found = next((p for p in candidates if p.is_file()), None)
-        if any(project_fmi(p) for p in ([found] if found else candidates)):
-            component.source = str(FMU_DIRS[fmi] / Path(component.source).name)
-    return new
 
 
 def _q(prefix: str, tag: str) -> str:
@@ -171,15 +53,14 @@ def _local(element: ET.Element) -> str:
 class _Reader:
     """Reads one .ssd; every error names the file, the element and the attribute."""
 
-    def __init__(self, path: Path):
-        self.path = path
+    def __init__(self, path: Path, fmus: FmuFolders | None):
+        self.path, self.fmus = path, fmus
 
     def error(self, where: str, problem: str) -> ValueError:
         return ValueError(f"{self.path}: {where}: {problem}")
 
     def required(self, element: ET.Element, attribute: str, where: str,
                  hint: str = "") -> str:
-        """The attribute's value; an error if it is missing or blank."""
         value = element.get(attribute)
         if value is None or not value.strip():
             raise self.error(where, f"{'no' if value is None else 'an empty'} {attribute} "
@@ -199,7 +80,6 @@ class _Reader:
 
     def number(self, element: ET.Element, attribute: str, where: str,
                default: float) -> float:
-        """A finite number from an attribute, ``default`` where it is absent."""
         text = element.get(attribute)
         if text is None:
             return default
@@ -241,7 +121,7 @@ class _Reader:
         description = SystemDescription(name=name, components=components,
                                         connections=connections,
                                         description=system.get("description", ""),
-                                        path=self.path)
+                                        path=self.path, fmus=self.fmus)
         experiment = root.find("ssd:DefaultExperiment", NS)
         if experiment is not None:
             self.experiment(experiment, description)
@@ -345,7 +225,7 @@ class _Reader:
         for name, t in (("startTime", description.start_time),
                         ("stopTime", description.stop_time),
                         ("baseStepSize", description.step_size)):
-            if abs(t) > MAX_TIME:           # beyond what the FMUs take (and 2^63 ns)
+            if abs(t) > MAX_TIME:
                 raise self.error(where, f"{name} {t!r} s is beyond +-{MAX_TIME:g} s, the "
                                         "times an FMU takes (fmukit.timebase)")
             if on_time_base(t) != t:
@@ -357,11 +237,11 @@ class _Reader:
             raise self.error(where, str(error)) from None
 
 
-def read_ssd(path: str | Path) -> SystemDescription:
-    """Parse a .ssd file of the subset this module reads; ValueError naming the file, the
-    element and the attribute for anything else (a parameter's value read by the rules
-    of ``cosim.core.values.fmi_value``)."""
-    return _Reader(Path(path)).system()
+def read_ssd(path: str | Path, fmus: FmuFolders | None = None) -> SystemDescription:
+    """Parse a .ssd file of the subset this module reads (its FMUs looked for also in
+    ``fmus``); ValueError naming the file, the element and the attribute for anything else
+    (a parameter's value read as ``cosim.core.values.fmi_value`` reads it)."""
+    return _Reader(Path(path), fmus).system()
 
 
 def ssv_value(value: float | int | bool | str) -> tuple[str, str]:
@@ -377,9 +257,8 @@ def ssv_value(value: float | int | bool | str) -> tuple[str, str]:
 
 @dataclass(frozen=True)
 class Units:
-    """The units of a system's connectors, as its FMUs declare them: component: connector:
-    unit name, and each unit's definition (BaseUnit exponents kg m s A K mol cd rad, factor,
-    offset: the same attributes in FMI 2.0 and SSP 1.0)."""
+    """The units of a system's connectors (component: connector: unit) and each unit's
+    definition (BaseUnit exponents, factor, offset: the same attributes in FMI 2.0 and SSP)."""
     connectors: dict[str, dict[str, str]]
     definitions: dict[str, dict[str, float]]
 
@@ -387,11 +266,8 @@ class Units:
 def write_ssd(system: SystemDescription, path: str | Path,
               sources: dict[str, str] | None = None, units: Units | None = None) -> None:
     """Write ``system`` as a .ssd; ``sources`` replaces component sources by name; with
-    ``units``, each connector carries its unit, defined in the file's ssd:Units.
-
-    The fixed step goes into two annotations (SSP 1.0, 'Annotations'): OSP's
-    FixedStepAlgorithm on the DefaultExperiment, and OpenModelica's FixedStepMaster
-    ('oms-ma', its weakly coupled master) on the System, as OMSimulator writes it."""
+    ``units``, each connector carries its unit, defined in the file's ssd:Units. The step
+    goes into OSP's FixedStepAlgorithm and OpenModelica's FixedStepMaster ('oms-ma')."""
     root = ET.Element(_q("ssd", "SystemStructureDescription"), version="1.0", name=system.name)
     sys_el = ET.SubElement(root, _q("ssd", "System"), name=system.name,
                            description=system.description)

@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from fmubuild.manifest import read as read_manifest
+from fmukit.manifest import read as read_manifest
 
 from ..core.inprocess import fallback_note
 from ..core.instance import FmuCallError

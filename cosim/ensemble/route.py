@@ -50,7 +50,7 @@ def simulate_members(system: SystemDescription, overrides: Sequence[dict[str, di
                 master.configure(member)
             except ValueError as error:
                 raise ValueError(f"member {i}: {error}") from None
-        _, h, n_steps = master.steps(stop_time)
+        _, h, n_steps = master.system.steps(stop_time)
         reason = coverage(system) or selftest()
         recordings: dict[int, Recording] = {}
         groups: dict[tuple, list[tuple[int, Member]]] = defaultdict(list)

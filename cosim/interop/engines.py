@@ -49,7 +49,7 @@ from fmukit.timebase import communication_point, step_count
 
 from ..core.files import write_atomically
 from ..core.interrupt import STOP_SIGNALS, Interrupted, StopSignals
-from ..core.ssd import SystemDescription, split_name
+from ..core.system import SystemDescription, split_name
 
 from .osp import read_osp
 from .ssp import FMI2_ONLY, fmi_versions, read_package, unapplied_strings

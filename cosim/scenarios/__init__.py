@@ -4,21 +4,29 @@ Every command that takes a scenario takes its name (a file here, e.g.
 ``calm_pd``) or a path to a .ssd file. ``PAPER`` lists the paper's four runs, the
 ones behind its Tables 1-2. ``autopilot`` puts a user's autopilot FMU into a
 course-keeping scenario. A scenario runs the FMUs its .ssd names (this package's name
-fmus/, FMI 2.0); ``load(..., fmi=3)`` gives it this project's FMI 3.0 twins from
-fmus/fmi3/ in their place (``cosim.core.ssd.with_fmi``).
+fmus/, FMI 2.0; ``fmus``); ``load(..., fmi=3)`` gives it this project's FMI 3.0 twins
+from fmus/fmi3/ in their place (``cosim.core.system.with_fmi``).
 """
 from __future__ import annotations
 
 from pathlib import Path
 
+from fmubuild import project
+
+from ..core.errors import close_matches, did_you_mean
 from ..core.files import plain_name
-from ..core.ssd import SystemDescription, read_ssd, with_fmi
-from ..core.values import close_matches, did_you_mean
+from ..core.ssd import read_ssd
+from ..core.system import FmuFolders, SystemDescription, with_fmi
 from .autopilot import with_autopilot
 
 SCENARIO_DIR = Path(__file__).resolve().parent
 PAPER = ("calm_pd", "calm_smc", "waves_pd", "waves_smc")
 """Tomera (2010), Tables 1-2 and Figs 2-3: PD and sliding mode, calm water and waves."""
+
+
+def fmus() -> FmuFolders:
+    """Where this project builds its FMUs (``fmubuild.project``), for the core to find them."""
+    return FmuFolders(dict(project.FMU_DIRS), frozenset({*project.FMUS, *project.C_FMUS}))
 
 
 def names() -> list[str]:
@@ -60,7 +68,7 @@ def load(scenario: str | Path, autopilot: str | Path | None = None,
     project's FMUs of FMI version ``fmi`` (2 or 3) in place of those it names if given,
     with ``autopilot``, an FMU of either version, in place of its own
     (``cosim.scenarios.autopilot``)."""
-    system = read_ssd(path(scenario))
+    system = read_ssd(path(scenario), fmus())
     if fmi is not None:
         system = with_fmi(system, fmi)
     return system if autopilot is None else with_autopilot(system, autopilot, port_map, name)

@@ -33,8 +33,8 @@ from fmubuild.trial import TrialFailed
 from fmubuild.trial import trial as instantiate_in_child
 from fmukit.units import UNITS
 
+from ..core.errors import close_matches, did_you_mean
 from ..core.ssd import Connection, SystemDescription
-from ..core.values import close_matches, did_you_mean
 
 COMPONENT = "autopilot"
 PORTS = {v.name: (v.causality, v.unit) for v in fmukit.autopilot.PORTS}

@@ -21,7 +21,7 @@ from typing import Iterator
 from fmukit.timebase import step_count
 
 from ..core.interrupt import Interrupted, StopSignals
-from ..core.provenance import PACKAGE, code_version
+from ..provenance import PACKAGE, code_version
 from ..core.watchdog import Limits
 from ..ensemble import SIGNALS
 from .bundle import UnsafeCache, fmu_cache

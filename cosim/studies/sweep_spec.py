@@ -31,7 +31,7 @@ from typing import Any
 
 import tomllib
 
-from fmubuild.manifest import read as read_manifest
+from fmukit.manifest import read as read_manifest
 
 from .. import scenarios
 from ..analysis.seastate import model_scale
@@ -39,7 +39,7 @@ from ..core.errors import FmuNotFound, FmuUnreadable
 from ..core.files import plain_name, read_small_text
 from ..core.fmi import read_description
 from ..core.inprocess import fallback_note, in_process_refusal
-from ..core.provenance import code_version
+from ..provenance import code_version
 from ..core.ssd import SystemDescription
 from ..core.values import Declaration, checked, declarations
 from ..core.watchdog import Limits

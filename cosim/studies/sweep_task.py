@@ -26,7 +26,7 @@ from ..analysis.metrics import (cross_track_error, fraction_at_stops, heading_er
                                 mean_abs_rate, peak, rms, route_completion,
                                 rudder_reversals_per_minute)
 from ..core.master import RUN_BACKENDS
-from ..core.provenance import code_version
+from ..provenance import code_version
 from ..core.watchdog import Limits, TimeLimit, Watchdog
 from .bundle import Bundle, materialise
 
