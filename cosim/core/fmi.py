@@ -93,8 +93,7 @@ class FmuInstance(Instance):
     cannot be instantiated (its extracted files are removed)."""
 
     slave: Any                         # fmpy's FMU2Slave or FMU3Slave
-    VERSION = 0
-    PREFIX = ""
+    VERSION, PREFIX, REAL, INTEGER = 0, "", "", ""    # FMI 2.0's names or FMI 3.0's
     TYPES: tuple = ()                  # ctypes of the value references, Reals, Integers
 
     def __new__(cls, path: str | Path, name: str, unzip_dir: str | Path | None = None):
@@ -186,11 +185,9 @@ class FmuInstance(Instance):
         return (n,) if self.VERSION == 2 else (n, n)    # FMI 3.0 also takes the value count
 
     def _getter(self, kind: str, ctype, vrs: list[int]):
-        function = f"{self.PREFIX}Get{kind}"
-        get, component = getattr(self.slave.dll, function), self.slave.component
-        n = len(vrs)
-        refs, values = (self.TYPES[0] * n)(*vrs), (ctype * n)()
-        counts = self._counts(n)
+        get, component = getattr(self.slave.dll, f"{self.PREFIX}Get{kind}"), self.slave.component
+        refs, values = (self.TYPES[0] * len(vrs))(*vrs), (ctype * len(vrs))()
+        counts = self._counts(len(vrs))
 
         def read() -> list:
             before = self.logged
@@ -201,17 +198,16 @@ class FmuInstance(Instance):
         return read
 
     def reader(self, vrs: list[int]):
-        return self._getter("Real" if self.VERSION == 2 else "Float64", self.TYPES[1], vrs)
+        return self._getter(self.REAL, self.TYPES[1], vrs)
 
     def integer_reader(self, vrs: list[int]):
-        return self._getter("Integer" if self.VERSION == 2 else "Int32", self.TYPES[2], vrs)
+        return self._getter(self.INTEGER, self.TYPES[2], vrs)
 
     def writer(self, vrs: list[int]):
-        kind = "Real" if self.VERSION == 2 else "Float64"
+        kind = self.REAL
         set_, component = getattr(self.slave.dll, f"{self.PREFIX}Set{kind}"), self.slave.component
-        n = len(vrs)
-        refs, values = (self.TYPES[0] * n)(*vrs), (self.TYPES[1] * n)()
-        counts = self._counts(n)
+        refs, values = (self.TYPES[0] * len(vrs))(*vrs), (self.TYPES[1] * len(vrs))()
+        counts = self._counts(len(vrs))
 
         def write(new: list[float]) -> None:
             values[:] = new
@@ -225,7 +221,8 @@ class FmuInstance(Instance):
 class Fmu2Instance(FmuInstance):
     """An FMI 2.0 co-simulation FMU through fmpy's FMU2Slave."""
 
-    VERSION, PREFIX, TYPES = 2, "fmi2", (fmi2ValueReference, fmi2Real, fmi2Integer)
+    VERSION, PREFIX, REAL, INTEGER = 2, "fmi2", "Real", "Integer"
+    TYPES = (fmi2ValueReference, fmi2Real, fmi2Integer)
 
     def _instantiate(self) -> None:
         self._callbacks = fmi2CallbackFunctions()
@@ -261,7 +258,8 @@ class Fmu2Instance(FmuInstance):
 class Fmu3Instance(FmuInstance):
     """An FMI 3.0 co-simulation FMU through fmpy's FMU3Slave."""
 
-    VERSION, PREFIX, TYPES = 3, "fmi3", (fmi3ValueReference, fmi3Float64, fmi3Int32)
+    VERSION, PREFIX, REAL, INTEGER = 3, "fmi3", "Float64", "Int32"
+    TYPES = (fmi3ValueReference, fmi3Float64, fmi3Int32)
 
     def _instantiate(self) -> None:
         self.slave = FMU3Slave(guid=self.description.guid, unzipDirectory=self.unzip_dir,

@@ -1,20 +1,16 @@
 """Read and write SSP 1.0 system structure descriptions (.ssd) of a flat system.
 
-The subset OSP libcosim, ecos and fmpy all read: one system of FMU components with
-connectors, inline parameter values (ssv:Real, Integer, Boolean, String), connections, and
-a DefaultExperiment whose OSP annotation gives the fixed step. ``write_ssd`` also gives the
-step in OpenModelica's annotation on the System, where OMSimulator's command line looks for
-it, and one annotation of our own (``REPORT_ANNOTATION``) naming the kind of analysis a run
-gets. ``read_ssd`` refuses anything else, naming the file, the element and the attribute.
-"""
+The subset OSP libcosim, ecos and fmpy all read: FMU components with connectors, inline
+parameter values, connections, and a DefaultExperiment whose OSP annotation gives the step
+(``write_ssd`` gives it OpenModelica's annotation too, and ours, ``REPORT_ANNOTATION``, the
+kind of analysis a run gets). ``read_ssd`` refuses anything else, naming the file, the
+element and the attribute."""
 from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
-
-from fmukit.timebase import MAX_TIME, on_time_base, step_count
 
 from .system import Component, Connection, FmuFolders, SystemDescription
 from .values import fmi_value
@@ -59,8 +55,7 @@ class _Reader:
     def error(self, where: str, problem: str) -> ValueError:
         return ValueError(f"{self.path}: {where}: {problem}")
 
-    def required(self, element: ET.Element, attribute: str, where: str,
-                 hint: str = "") -> str:
+    def required(self, element: ET.Element, attribute: str, where: str, hint: str = "") -> str:
         value = element.get(attribute)
         if value is None or not value.strip():
             raise self.error(where, f"{'no' if value is None else 'an empty'} {attribute} "
@@ -68,8 +63,7 @@ class _Reader:
         return value
 
     def typed(self, element: ET.Element, prefix: str, where: str) -> tuple[str, ET.Element]:
-        """The one Real, Integer, Boolean or String child of a Connector (ssc) or a
-        Parameter (ssv), by its type's name."""
+        """The one Real, Integer, Boolean or String child of a Connector or a Parameter."""
         children = [c for c in element if c.tag.startswith(f"{{{NS[prefix]}}}")]
         known = [c for c in children if c.tag.rpartition("}")[2] in _TYPES]
         if len(children) != 1 or len(known) != 1:
@@ -78,8 +72,7 @@ class _Reader:
                                     f" (found: {found})")
         return known[0].tag.rpartition("}")[2], known[0]
 
-    def number(self, element: ET.Element, attribute: str, where: str,
-               default: float) -> float:
+    def number(self, element: ET.Element, attribute: str, where: str, default: float) -> float:
         text = element.get(attribute)
         if text is None:
             return default
@@ -102,8 +95,8 @@ class _Reader:
         name = self.required(root, "name", "SystemStructureDescription")
         systems = root.findall("ssd:System", NS)
         if len(systems) != 1:
-            raise self.error("SystemStructureDescription", f"needs one System element, has "
-                                                           f"{len(systems)}")
+            raise self.error("SystemStructureDescription",
+                             f"needs one System element, has {len(systems)}")
         system = systems[0]
         components: dict[str, Component] = {}
         for i, element in enumerate(system.findall("ssd:Elements/*", NS), 1):
@@ -146,8 +139,7 @@ class _Reader:
                                      f"{', '.join(CONNECTOR_KINDS)}")
             if connector_name in component.connectors:
                 raise self.error(at, "declared twice")
-            component.connectors[connector_name] = (causality,
-                                                    self.typed(connector, "ssc", at)[0])
+            component.connectors[connector_name] = causality, self.typed(connector, "ssc", at)[0]
         for binding in element.findall("ssd:ParameterBindings/ssd:ParameterBinding", NS):
             self.binding(binding, component, f"{where}, ParameterBinding")
         return component
@@ -163,8 +155,8 @@ class _Reader:
         values = binding.find("ssd:ParameterValues", NS)
         if values is None:
             raise self.error(where, "no ParameterValues")
-        for k, p in enumerate(values.findall("ssv:ParameterSet/ssv:Parameters/ssv:Parameter",
-                                             NS), 1):
+        parameters = values.findall("ssv:ParameterSet/ssv:Parameters/ssv:Parameter", NS)
+        for k, p in enumerate(parameters, 1):
             name = self.required(p, "name", f"{where}, Parameter {k}")
             at = f"Component '{component.name}', Parameter '{name}'"
             if name in component.parameters:
@@ -175,13 +167,11 @@ class _Reader:
                 raise self.error(f"{at}, ssv:{type_name}", f"unit={value.get('unit')!r} is "
                                  "not read; give the value in the FMU's unit, without unit=")
             try:
-                component.parameters[name] = fmi_value(f"{component.name}.{name}", type_name,
-                                                       text)
+                component.parameters[name] = fmi_value(f"{component.name}.{name}", type_name, text)
             except ValueError as error:
                 raise self.error(f"{at}, ssv:{type_name}", str(error)) from None
 
-    def connections(self, system: ET.Element, components: dict[str, Component]
-                    ) -> list[Connection]:
+    def connections(self, system: ET.Element, components: dict[str, Component]) -> list[Connection]:
         connections, fed = [], {}
         hint = " (connectors of the system itself are not read)"
         for i, c in enumerate(system.findall("ssd:Connections/ssd:Connection", NS), 1):
@@ -192,9 +182,8 @@ class _Reader:
             where = f"Connection {i} ({connection})"
             for element in (connection.start_element, connection.end_element):
                 if element not in components:
-                    raise self.error(where, f"names the component '{element}', which the "
-                                            f"system does not have; it has "
-                                            f"{', '.join(components)}")
+                    raise self.error(where, f"names the component '{element}', which the system "
+                                            f"does not have; it has {', '.join(components)}")
             end = (connection.end_element, connection.end_connector)
             if end in fed:
                 raise self.error(where, f"{'.'.join(end)} is fed already by Connection "
@@ -206,8 +195,7 @@ class _Reader:
     def experiment(self, experiment: ET.Element, description: SystemDescription) -> None:
         where = "DefaultExperiment"
         description.start_time = self.number(experiment, "startTime", where, 0.0)
-        description.stop_time = self.number(experiment, "stopTime", where,
-                                            description.stop_time)
+        description.stop_time = self.number(experiment, "stopTime", where, description.stop_time)
         if not description.stop_time > description.start_time:
             raise self.error(where, f"stopTime {description.stop_time!r} is not after "
                                     f"startTime {description.start_time!r}")
@@ -222,25 +210,15 @@ class _Reader:
         report = experiment.find(f"{annotations}sap:Report", NS)
         if report is not None:
             description.report = self.required(report, "kind", f"{where}, sap:Report")
-        for name, t in (("startTime", description.start_time),
-                        ("stopTime", description.stop_time),
-                        ("baseStepSize", description.step_size)):
-            if abs(t) > MAX_TIME:
-                raise self.error(where, f"{name} {t!r} s is beyond +-{MAX_TIME:g} s, the "
-                                        "times an FMU takes (fmukit.timebase)")
-            if on_time_base(t) != t:
-                raise self.error(where, f"{name} {t!r} s is not a whole number of "
-                                        "nanoseconds, the time base (fmukit.timebase)")
         try:
-            step_count(description.start_time, description.stop_time, description.step_size)
+            description.check_times()
         except ValueError as error:
             raise self.error(where, str(error)) from None
 
 
 def read_ssd(path: str | Path, fmus: FmuFolders | None = None) -> SystemDescription:
-    """Parse a .ssd file of the subset this module reads (its FMUs looked for also in
-    ``fmus``); ValueError naming the file, the element and the attribute for anything else
-    (a parameter's value read as ``cosim.core.values.fmi_value`` reads it)."""
+    """The system of a .ssd file (its FMUs looked for also in ``fmus``); ValueError naming the
+    file, the element and the attribute for anything this module does not read."""
     return _Reader(Path(path), fmus).system()
 
 
@@ -257,10 +235,17 @@ def ssv_value(value: float | int | bool | str) -> tuple[str, str]:
 
 @dataclass(frozen=True)
 class Units:
-    """The units of a system's connectors (component: connector: unit) and each unit's
-    definition (BaseUnit exponents, factor, offset: the same attributes in FMI 2.0 and SSP)."""
+    """Connector units (component: connector: unit) and their BaseUnit attributes."""
     connectors: dict[str, dict[str, str]]
     definitions: dict[str, dict[str, float]]
+
+
+def _el(parent: ET.Element, path: str, **attributes: str) -> ET.Element:
+    """New elements under ``parent``, one in the other ("ssd:A/ssc:B"), attributes on the last."""
+    *chain, last = path.split("/")
+    for tag in chain:
+        parent = ET.SubElement(parent, _q(*tag.split(":")))
+    return ET.SubElement(parent, _q(*last.split(":")), **attributes)
 
 
 def write_ssd(system: SystemDescription, path: str | Path,
@@ -269,56 +254,45 @@ def write_ssd(system: SystemDescription, path: str | Path,
     ``units``, each connector carries its unit, defined in the file's ssd:Units. The step
     goes into OSP's FixedStepAlgorithm and OpenModelica's FixedStepMaster ('oms-ma')."""
     root = ET.Element(_q("ssd", "SystemStructureDescription"), version="1.0", name=system.name)
-    sys_el = ET.SubElement(root, _q("ssd", "System"), name=system.name,
-                           description=system.description)
-    elements = ET.SubElement(sys_el, _q("ssd", "Elements"))
+    sys_el = _el(root, "ssd:System", name=system.name, description=system.description)
+    elements = _el(sys_el, "ssd:Elements")
     for c in system.components.values():
-        source = (sources or {}).get(c.name, c.source)
-        comp = ET.SubElement(elements, _q("ssd", "Component"), name=c.name, source=source,
-                             type=FMU_TYPE)
-        connectors = ET.SubElement(comp, _q("ssd", "Connectors"))
+        comp = _el(elements, "ssd:Component", name=c.name,
+                   source=(sources or {}).get(c.name, c.source), type=FMU_TYPE)
+        connectors = _el(comp, "ssd:Connectors")
         for name, (kind, type_name) in c.connectors.items():
-            connector = ET.SubElement(connectors, _q("ssd", "Connector"), name=name, kind=kind)
             unit = units.connectors.get(c.name, {}).get(name) if units else None
-            ET.SubElement(connector, _q("ssc", type_name), **({"unit": unit} if unit else {}))
+            _el(_el(connectors, "ssd:Connector", name=name, kind=kind), f"ssc:{type_name}",
+                **({"unit": unit} if unit else {}))
         if c.parameters:
-            binding = ET.SubElement(ET.SubElement(comp, _q("ssd", "ParameterBindings")),
-                                    _q("ssd", "ParameterBinding"))
-            values = ET.SubElement(binding, _q("ssd", "ParameterValues"))
-            pset = ET.SubElement(values, _q("ssv", "ParameterSet"), version="1.0",
-                                 name=PARAMETER_SET)
-            params = ET.SubElement(pset, _q("ssv", "Parameters"))
+            pset = _el(comp, "ssd:ParameterBindings/ssd:ParameterBinding/ssd:ParameterValues/"
+                             "ssv:ParameterSet", version="1.0", name=PARAMETER_SET)
+            params = _el(pset, "ssv:Parameters")
             for name, value in c.parameters.items():
                 type_name, text = ssv_value(value)
-                p = ET.SubElement(params, _q("ssv", "Parameter"), name=name)
-                ET.SubElement(p, _q("ssv", type_name), value=text)
-    connections = ET.SubElement(sys_el, _q("ssd", "Connections"))
+                _el(_el(params, "ssv:Parameter", name=name), f"ssv:{type_name}", value=text)
+    connections = _el(sys_el, "ssd:Connections")
     for k in system.connections:
-        ET.SubElement(connections, _q("ssd", "Connection"), startElement=k.start_element,
-                      startConnector=k.start_connector, endElement=k.end_element,
-                      endConnector=k.end_connector)
-    oms = ET.SubElement(ET.SubElement(sys_el, _q("ssd", "Annotations")), _q("ssc", "Annotation"),
-                        type=OMS_ANNOTATION)
-    information = ET.SubElement(ET.SubElement(oms, _q("oms", "Annotations")),
-                                _q("oms", "SimulationInformation"))
-    ET.SubElement(information, _q("oms", "FixedStepMaster"), description="oms-ma",
-                  stepSize=repr(system.step_size))
+        _el(connections, "ssd:Connection", startElement=k.start_element,
+            startConnector=k.start_connector, endElement=k.end_element,
+            endConnector=k.end_connector)
+    oms = _el(sys_el, "ssd:Annotations/ssc:Annotation", type=OMS_ANNOTATION)
+    _el(oms, "oms:Annotations/oms:SimulationInformation/oms:FixedStepMaster",
+        description="oms-ma", stepSize=repr(system.step_size))
     used = sorted({u for by_name in (units.connectors if units else {}).values()
                    for u in by_name.values()})
     if used:                              # SSP 1.0: Units after System, before the experiment
-        definitions = ET.SubElement(root, _q("ssd", "Units"))
+        definitions = _el(root, "ssd:Units")
         for unit in used:
-            ET.SubElement(ET.SubElement(definitions, _q("ssc", "Unit"), name=unit),
-                          _q("ssc", "BaseUnit"),
-                          **{k: repr(v) if isinstance(v, float) else str(v)
-                             for k, v in units.definitions[unit].items()})
-    experiment = ET.SubElement(root, _q("ssd", "DefaultExperiment"),
-                               startTime=repr(system.start_time), stopTime=repr(system.stop_time))
-    annotations = ET.SubElement(experiment, _q("ssd", "Annotations"))
-    osp = ET.SubElement(annotations, _q("ssc", "Annotation"), type=OSP_ANNOTATION)
-    ET.SubElement(ET.SubElement(osp, _q("osp", "Algorithm")), _q("osp", "FixedStepAlgorithm"),
-                  baseStepSize=repr(system.step_size))
-    ours = ET.SubElement(annotations, _q("ssc", "Annotation"), type=REPORT_ANNOTATION)
-    ET.SubElement(ours, _q("sap", "Report"), kind=system.report)
+            _el(_el(definitions, "ssc:Unit", name=unit), "ssc:BaseUnit",
+                **{k: repr(v) if isinstance(v, float) else str(v)
+                   for k, v in units.definitions[unit].items()})
+    experiment = _el(root, "ssd:DefaultExperiment", startTime=repr(system.start_time),
+                     stopTime=repr(system.stop_time))
+    annotations = _el(experiment, "ssd:Annotations")
+    _el(_el(annotations, "ssc:Annotation", type=OSP_ANNOTATION),
+        "osp:Algorithm/osp:FixedStepAlgorithm", baseStepSize=repr(system.step_size))
+    _el(_el(annotations, "ssc:Annotation", type=REPORT_ANNOTATION), "sap:Report",
+        kind=system.report)
     ET.indent(root)
     ET.ElementTree(root).write(path, encoding="UTF-8", xml_declaration=True)

@@ -10,9 +10,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from fmukit.timebase import nanoseconds, seconds, step_count
+from fmukit.timebase import MAX_TIME, nanoseconds, on_time_base, seconds, step_count
 
-from .errors import FmuNotFound
+from .errors import FmuNotFound, close_matches, did_you_mean
 
 
 def split_name(name: str) -> tuple[str, str]:
@@ -75,12 +75,13 @@ class SystemDescription:
     def parameters(self, overrides: dict[str, dict[str, Any]] | None = None
                    ) -> dict[str, dict[str, Any]]:
         """Each component's parameter values, updated by ``overrides`` (by component);
-        ValueError naming a component the system does not have."""
+        ValueError naming a component the system does not have, and the closest."""
         parameters = {name: dict(c.parameters) for name, c in self.components.items()}
         for component, values in (overrides or {}).items():
             if component not in parameters:
                 raise ValueError(f"--set names the component '{component}'; the system has "
-                                 f"{', '.join(parameters)}")
+                                 f"{', '.join(parameters)}"
+                                 f"{did_you_mean(close_matches(component, parameters))}")
             parameters[component].update(values)
         return parameters
 
@@ -90,6 +91,19 @@ class SystemDescription:
         h = seconds(nanoseconds(self.step_size))
         return self.start_time, h, step_count(
             self.start_time, self.stop_time if stop_time is None else stop_time, h)
+
+    def check_times(self) -> None:
+        """ValueError unless start, stop and step are times an FMU takes, on the time base
+        (``fmukit.timebase``), with a whole number of steps from start to stop."""
+        for name, t in (("startTime", self.start_time), ("stopTime", self.stop_time),
+                        ("baseStepSize", self.step_size)):
+            if abs(t) > MAX_TIME:
+                raise ValueError(f"{name} {t!r} s is beyond +-{MAX_TIME:g} s, the times an FMU "
+                                 "takes (fmukit.timebase)")
+            if on_time_base(t) != t:
+                raise ValueError(f"{name} {t!r} s is not a whole number of nanoseconds, the "
+                                 "time base (fmukit.timebase)")
+        step_count(self.start_time, self.stop_time, self.step_size)
 
     def ours(self, path: str | Path) -> bool:
         """Whether ``path`` is named as one of the FMUs of ``fmus``."""

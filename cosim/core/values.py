@@ -1,18 +1,14 @@
 """Values for FMU variables, checked against what the FMU declares before any FMU call.
 
-Every value the master sets (a ``--set`` text, a .ssd binding, a caller's override) passes
-through ``checked`` on every backend: it returns the exact value to set, or ValueError
-naming the component, the variable, the value and what the variable takes.
-
-- ``fmi_value``: what the FMI 2.0 call of the type carries exactly (section 2.1.2): nothing
-  rounded or wrapped (an Integer is a whole number in [-2^31, 2^31 - 1]: 7, 7.0, "+7",
-  "1e3" are, 1.5 is not; a Boolean a bool, 0, 1 or true/false/1/0 in any case; a String
-  UTF-8 text without NUL). Text is read as the type declares (ASCII digits, sign,
-  fraction, exponent, blanks around; a Real's may be inf or nan, not beyond a double).
-- ``checked``: that value against the declaration (section 2.2.7): a Real finite (+-inf
-  only where max="INF" / min="-INF"), within min and max; an Enumeration one of its items.
-- ``setting``: also refuses a variable the FMU lacks (with the closest names) or that a
-  master may not set in initialisation mode (section 4.2.4).
+Every value the master sets passes ``checked`` on every backend: the exact value to set, or
+ValueError naming the component, the variable, the value and what the variable takes.
+``fmi_value``: what the FMI 2.0 call of the type carries exactly (section 2.1.2): nothing
+rounded or wrapped (an Integer a whole number of 32 bits: "7", 7.0, "1e3", not 1.5; a
+Boolean a bool, 0, 1 or true/false in any case; a String UTF-8 without NUL; text read as
+the type declares). ``checked``: that value against the declaration (section 2.2.7): a
+Real finite (+-inf only where max="INF" / min="-INF"), within min and max; an Enumeration
+one of its items. ``setting`` also refuses a variable the FMU lacks or that a master may
+not set in initialisation mode (section 4.2.4).
 """
 from __future__ import annotations
 
@@ -29,8 +25,7 @@ from fmpy.model_description import ModelDescription
 from .errors import close_matches, did_you_mean
 from .system import SystemDescription
 
-INTEGER_RANGE = (-2**31, 2**31 - 1)
-"""What fmi2Integer, a C int, holds (FMI 2.0, section 2.1.2)."""
+INTEGER_RANGE = (-2**31, 2**31 - 1)                 # fmi2Integer, a C int
 
 Value = bool | int | float | str
 
@@ -53,8 +48,7 @@ class Declaration:
     items: tuple[tuple[str, int], ...] = ()
 
     @property
-    def settable(self) -> bool:
-        """Whether a master may set it in initialisation mode (FMI 2.0, section 4.2.4)."""
+    def settable(self) -> bool:                     # in initialisation mode (section 4.2.4)
         return self.causality == "input" or (self.variability != "constant"
                                              and self.initial == "exact")
 
@@ -171,13 +165,6 @@ def no_variable(component: str, path: str | Path, names: Iterable[str], name: st
                       f"{did_you_mean(close_matches(name, names) or others)}")
 
 
-def no_component(components: Iterable[str], name: str) -> ValueError:
-    """The error for a component a system does not have: those it has, and the closest."""
-    components = list(components)
-    return ValueError(f"--set names the component '{name}'; the system has "
-                      f"{', '.join(components)}{did_you_mean(close_matches(name, components))}")
-
-
 def _article(word: str) -> str:
     return "an" if word[0] in "aeiou" else "a"
 
@@ -290,9 +277,6 @@ def parameters(system: SystemDescription, paths: dict[str, Path],
             raise ValueError(f"set: the values for '{component}' must map variable names to "
                              f"values, got {values!r}")
         given[component] = dict(values)
-    for component in given:
-        if component not in system.components:
-            raise no_component(system.components, component)
     connected = {(c.end_element, c.end_connector): f"{c.start_element}.{c.start_connector}"
                  for c in system.connections}
     settable = {c: [n for n, d in theirs.items() if d.settable] for c, theirs in declared.items()}
