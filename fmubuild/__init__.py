@@ -7,8 +7,8 @@
 - ``packaging``: a slave script written with fmukit into a validated FMU of either
   version that carries exactly its model: what the script imports (``imports``), with
   its ``manifest``; the same bytes from the same sources (``reproducible``);
-- ``manifest``: what an FMU carries and a digest of it, and whether it is current; who
-  made it (``project_identity``);
+- ``manifest``: the build's side of an FMU's manifest (``fmukit.manifest`` reads it): who
+  made it (``project_identity``) and the entry module this build writes;
 - ``documentation``: what an FMU says of itself (its model description's author, version,
   copyright, license and generation tool; documentation/index.html); ``icon``: its model.png;
 - ``trial``: an FMU instantiated once in a child process, here or away from the checkout;
