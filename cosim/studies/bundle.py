@@ -64,7 +64,7 @@ def bundle(controller: dict[str, Any]) -> tuple[Bundle, dict[str, Path]]:
         sha = file_hash(path)
         files[sha] = path
         components[name] = dataclasses.replace(component, source=f"{sha}.fmu")
-    shipped = dataclasses.replace(system, components=components, path=None)
+    shipped = dataclasses.replace(system, components=components, path=None, fmus=None)
     content = json.dumps(dataclasses.asdict(shipped), sort_keys=True, default=str)
     return Bundle(shipped, hashlib.sha256(content.encode()).hexdigest()), files
 
