@@ -5,20 +5,20 @@ import difflib
 from typing import Iterable
 
 
-class FmuNotFound(FileNotFoundError):
-    """No FMU file where a component's source says; ``ours``: named as one the caller builds."""
+class _FmuFileError(Exception):
+    """``ours``: the file is named as one of the FMUs the caller builds (a command may say how)."""
 
     def __init__(self, message: str, ours: bool):
         super().__init__(message)
         self.ours = ours
 
 
-class FmuUnreadable(ValueError):
-    """A file that is not a readable FMU; ``ours``: named as one the caller builds."""
+class FmuNotFound(_FmuFileError, FileNotFoundError):
+    """No FMU file where a component's source says."""
 
-    def __init__(self, message: str, ours: bool):
-        super().__init__(message)
-        self.ours = ours
+
+class FmuUnreadable(_FmuFileError, ValueError):
+    """A file that is not a readable FMU."""
 
 
 CLOSE = 0.7

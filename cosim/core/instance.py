@@ -73,7 +73,7 @@ class Instance:
     variables: dict[str, Any]          # name: object with valueReference, type, causality
     feedthrough: dict[str, frozenset[str]]   # output name: the inputs it depends on
 
-    def __new__(cls, path: str | Path, name: str, *args: Any, **kwargs: Any):
+    def __new__(cls, path: str | Path = "", name: str = "", *args: Any, **kwargs: Any):
         instance = super().__new__(cls)
         instance.path, instance.name = Path(path), name
         return instance
