@@ -24,7 +24,7 @@ from pathlib import Path
 from ._cli import entry, writable_folder
 from .core.files import whole_file
 from .scenarios import names
-from .studies import accuracy, cpu_variants, integration_error
+from .studies import coupling_error, cpu_variants, integration_error
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -50,25 +50,25 @@ def main(argv: list[str] | None = None) -> int:
         print(f"wrote {out / 'cpus.md'} ({time.perf_counter() - started:.0f} s)")
         return 0
     open_end, closed_end = (60.0, 120.0) if args.quick else (400.0, None)
-    runs = accuracy.PAPER_RUNS[:2] if args.quick else accuracy.PAPER_RUNS
-    steps = (0.1, 0.05, 0.025) if args.quick else accuracy.STEPS
+    runs = coupling_error.PAPER_RUNS[:2] if args.quick else coupling_error.PAPER_RUNS
+    steps = (0.1, 0.05, 0.025) if args.quick else coupling_error.STEPS
 
     tables = ["## Integration error, open loop (calm water)\n",
               integration_error.open_loop_table([integration_error.open_loop(p, open_end)
                                                  for p in ("step", "sine", "zigzag")])]
     print("".join(tables[-2:]), flush=True)
-    closed = {name: accuracy.closed_loop(name, closed_end) for name in runs}
+    closed = {name: coupling_error.closed_loop(name, closed_end) for name in runs}
     tables += ["\n## Co-simulation at 0.1 s against the monolithic reference\n",
-               accuracy.closed_loop_table(closed)]
+               coupling_error.closed_loop_table(closed)]
     print("".join(tables[-2:]), flush=True)
     references = {name: result["monolithic"] for name, result in closed.items()}
-    converging = {name: accuracy.convergence(name, references[name], steps, closed_end)
+    converging = {name: coupling_error.convergence(name, references[name], steps, closed_end)
                   for name in runs}
     tables += ["\n## J against the communication step\n",
-               accuracy.convergence_table(converging, references)]
+               coupling_error.convergence_table(converging, references)]
     print("".join(tables[-2:]), flush=True)
     _write(out / "accuracy.md", "\n".join(tables))
-    figure = accuracy.convergence_figure(converging, out / "convergence.png")
+    figure = coupling_error.convergence_figure(converging, out / "convergence.png")
     print(f"wrote {out / 'accuracy.md'}, {figure} ({time.perf_counter() - started:.0f} s)")
     return 0
 

@@ -27,7 +27,7 @@ import argparse
 import sys
 
 from ._cli import entry, say_error
-from .studies import bench, bench_sweep
+from .studies import sweep_timing, timing
 
 SWEEP_PARTS = ("throughput", "campaign", "memory")
 
@@ -71,22 +71,22 @@ def main(argv: list[str] | None = None) -> int:
                             "calm_smc, or both (default)")
     sweep.add_argument("--rounds", type=int, default=1,
                        help="throughput sweeps of each backend, in turn (default 1); medians")
-    sweep.add_argument("--campaign-runs", type=int, default=bench_sweep.CAMPAIGN_RUNS,
+    sweep.add_argument("--campaign-runs", type=int, default=sweep_timing.CAMPAIGN_RUNS,
                        help=f"waves_pd runs of the campaign (default "
-                            f"{bench_sweep.CAMPAIGN_RUNS}, the issue's)")
-    sweep.add_argument("--memory-members", type=_counts, default=bench_sweep.MEMORY_MEMBERS,
+                            f"{sweep_timing.CAMPAIGN_RUNS}, the issue's)")
+    sweep.add_argument("--memory-members", type=_counts, default=sweep_timing.MEMORY_MEMBERS,
                        help="members of the memory measurement, comma-separated (default "
-                            + ",".join(map(str, bench_sweep.MEMORY_MEMBERS)) + ")")
+                            + ",".join(map(str, sweep_timing.MEMORY_MEMBERS)) + ")")
     args = parser.parse_args(argv)
     try:
         if args.command == "memory":
-            bench.memory(args.hours)
+            timing.memory(args.hours)
         elif args.command == "sweep":
             _sweep(args)
         elif args.command == "overhead":
-            bench.overhead(args.repeats)
+            timing.overhead(args.repeats)
         else:
-            bench.engines(args.repeats)
+            timing.engines(args.repeats)
     except (RuntimeError, ValueError, FileNotFoundError) as error:   # e.g. stale FMUs
         say_error(error)
         return 2
@@ -97,11 +97,11 @@ def _sweep(args: argparse.Namespace) -> None:
     """The parts of the sweep benchmark asked for, in their order."""
     if "throughput" in args.parts:
         seas = ("waves", "calm") if args.sea == "both" else (args.sea,)
-        bench_sweep.sweep_throughput(args.runs, args.batch_runs, seas, rounds=args.rounds)
+        sweep_timing.sweep_throughput(args.runs, args.batch_runs, seas, rounds=args.rounds)
     if "campaign" in args.parts:
-        bench_sweep.campaign(args.campaign_runs)
+        sweep_timing.campaign(args.campaign_runs)
     if "memory" in args.parts:
-        bench_sweep.batch_memory(args.memory_members)
+        sweep_timing.batch_memory(args.memory_members)
 
 
 if __name__ == "__main__":

@@ -410,11 +410,11 @@ def test_the_null_backend_runs_a_scenario(fmu_paths):
 def test_the_overhead_benchmark_runs_and_restores_the_ship(fmu_paths, capsys):
     """A smoke test of one benchmark (figures are printed, never asserted): it idles the
     ship's step while it measures, and must give it back."""
-    from cosim.studies import bench
+    from cosim.studies import timing
     from ship_fmu.vessel import Vessel
 
     step = Vessel.step
-    per_step = bench.overhead(1)
+    per_step = timing.overhead(1)
     assert Vessel.step is step
     assert set(per_step) == {"direct", "null", "inprocess"}
     out = capsys.readouterr().out

@@ -13,7 +13,7 @@ from cosim import score as cli
 from cosim import simulate
 from cosim.analysis.cost import cost
 from cosim.studies import scorecard
-from cosim.studies.sweep_task import CRITERIA
+from cosim.studies.merit import CRITERIA
 
 MINE = ["--set", "autopilot.Kp=1", "--set", "autopilot.Kd=30"]
 """The PD with other gains: on the paper's route in waves it moves the rudder less and

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..core.files import write_atomically
 from .sweep_spec import Spec
-from .sweep_task import METRICS
+from .merit import METRICS
 
 TIMES = {"seconds": "s", "sim_seconds": "s"}
 """The wall-clock times of a row (``sweep_task.run_one``): the task's, and the master's run

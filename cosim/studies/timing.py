@@ -234,7 +234,7 @@ def memory(hours: float, backends: tuple[str, ...] = RUN_BACKENDS) -> None:
     for backend, duration in ((b, d) for b in backends for d in (3600.0, hours * 3600.0)):
         code = ("import time, tempfile, os\n"
                 "from cosim import scenarios\nfrom cosim.core.master import Master\n"
-                "from cosim.studies.bench import peak_rss_mb\n"
+                "from cosim.studies.timing import peak_rss_mb\n"
                 f"m = Master(scenarios.load('calm_pd'), backend={backend!r})\n"
                 "out = os.path.join(tempfile.mkdtemp(), 'run.csv')\n"
                 "t = time.perf_counter()\n"

@@ -25,7 +25,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from .bench import machine, peak_rss_mb, require_in_process
+from .timing import machine, peak_rss_mb, require_in_process
 from .sweep_client import plan
 from .sweep_task import BATCH, SWEEP_BACKENDS
 
@@ -277,7 +277,7 @@ def _sweep(spec, workers: int, backend: str, batch_size: int | None = None) -> M
     from dask.distributed import Client
 
     from .cluster import local_cluster
-    from .sweep import execute
+    from .campaign import execute
 
     with tempfile.TemporaryDirectory() as tmp:
         started = time.perf_counter()
@@ -316,7 +316,7 @@ def _members_call(members: int, stop_time: float) -> tuple[float, float, float, 
     code = ("import sys, time\n"
             "from cosim import scenarios\n"
             "from cosim.ensemble import selftest, simulate_members\n"
-            "from cosim.studies.bench import peak_rss_mb\n"
+            "from cosim.studies.timing import peak_rss_mb\n"
             "system = scenarios.load('waves_pd')\n"
             "selftest()\n"
             "before = peak_rss_mb()\n"
