@@ -1,18 +1,15 @@
 """How large are the set-up's own numerical errors? RK4 against DOP853, co-simulation
 against a monolithic model with the controller inside the solver.
 
-    python -m cosim.accuracy            # the full study, about a minute on 2 cores
+    python -m cosim.accuracy            # the full study
     python -m cosim.accuracy --quick    # shorter runs and fewer steps (CI)
-    python -m cosim.accuracy --cpus     # every scenario as other CPUs would run it, about
-                                        # 25 s: numpy, OpenBLAS and libm variants, bit for bit
+    python -m cosim.accuracy --cpus     # every scenario as other CPUs would run it: numpy,
+                                        # OpenBLAS and libm variants, bit for bit
 
-Prints three tables (integration error open loop; co-simulation against the
-monolithic reference; convergence in the communication step) and writes them, with
-a convergence figure, to results/accuracy/. The quick mode's figures cover shorter
-runs in calm water only: they differ from docs/reproduction.md's, which are the full
-study's. With --cpus it writes cpus.md instead: each scenario run in a child process
-under each variant of ``cosim.studies.cpu_variants`` and compared bit for bit with
-this machine's own run.
+Prints three tables (integration error open loop; co-simulation against the monolithic
+reference; convergence in the communication step) and writes them, with a convergence
+figure, to results/accuracy/. The quick mode's figures cover shorter runs in calm water
+only: docs/reproduction.md's are the full study's. With --cpus it writes cpus.md instead.
 """
 from __future__ import annotations
 

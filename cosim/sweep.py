@@ -14,7 +14,8 @@ from .core.interrupt import Interrupted
 from .core.watchdog import STEP_LIMIT_S, Limits
 from .studies import campaign
 from .studies.cluster import CONNECT_TIMEOUT
-from .studies.sweep_client import MAX_BATCH, MIN_BATCH, NoWorkers, SweepError
+from .studies.cluster import NoWorkers, SweepError
+from .studies.sweep_client import MAX_BATCH, MIN_BATCH
 from .studies.sweep_figures import save_figures
 from .studies.sweep_spec import MAX_RUNS, Spec
 from .studies.sweep_task import BATCH, SWEEP_BACKENDS

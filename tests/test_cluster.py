@@ -20,7 +20,7 @@ from pathlib import Path
 import pytest
 
 from cosim.studies import campaign
-from cosim.studies.sweep_client import SweepError, check_workers
+from cosim.studies.cluster import SweepError, check_workers
 from cosim.studies.sweep_spec import Spec
 from cosim.studies.sweep_task import run_one
 from fmubuild.project import ROOT

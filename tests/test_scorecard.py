@@ -204,7 +204,7 @@ def test_an_autopilot_that_fails_is_scored_as_failed_and_the_rest_goes_on(tmp_pa
 
 def test_a_scorecard_left_without_workers_says_so_and_exits_3(fmu_paths, tmp_path, capsys,
                                                               monkeypatch):
-    from cosim.studies.sweep import NoWorkers
+    from cosim.studies.cluster import NoWorkers
 
     def no_workers(*args, **kwargs):
         raise NoWorkers("no worker in the cluster for 60 s (none has joined since 12:00:00)")

@@ -17,7 +17,7 @@ from cosim.core.files import FolderLock
 from cosim.core.master import Master
 from cosim.core.ssd import write_ssd
 from cosim.studies import campaign, sweep_task
-from cosim.studies.sweep_client import NoWorkers, SweepError
+from cosim.studies.cluster import NoWorkers, SweepError
 from cosim.studies.merit import METRICS
 from cosim.studies.sweep_spec import Spec
 from cosim.studies.sweep_tables import comparison, write_tables

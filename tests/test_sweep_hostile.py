@@ -24,11 +24,10 @@ import cosim.scenarios.autopilot as autopilot
 from cosim import scenarios
 from cosim.core.ssd import write_ssd
 from cosim.studies import campaign, sweep_task
-from cosim.studies.sweep_client import SweepError
 from cosim.studies.merit import METRICS
 from cosim.studies.sweep_spec import Spec
 from cosim.studies.bundle import UnsafeCache, file_hash, fmu_cache
-from cosim.studies.cluster import ClusterError, connect, local_cluster, local_workers
+from cosim.studies.cluster import ClusterError, SweepError, connect, local_cluster, local_workers
 from fmubuild.trial import TrialFailed, trial
 
 

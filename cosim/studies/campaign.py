@@ -10,7 +10,8 @@ from ..core.files import FolderBusy, FolderLock
 from ..core.watchdog import Limits
 from .cluster import CONNECT_TIMEOUT, connect
 from .journal import Journal, read_rows
-from .sweep_client import SweepError, run_on_cluster
+from .cluster import SweepError
+from .sweep_client import run_on_cluster
 from .sweep_spec import Spec
 from .sweep_task import BATCH, SWEEP_BACKENDS, run_batch, run_one
 

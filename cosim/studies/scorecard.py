@@ -45,7 +45,8 @@ from ..core.files import fresh_folder, write_atomically
 from ..core.recording import Recording
 from ..outputs import Options, run_and_write
 from .campaign import execute
-from .sweep_spec import Spec, controller_entry
+from .spec_file import controller_entry
+from .sweep_spec import Spec
 from .sweep_figures import STATISTICS, distribution, paired_figure, tracks
 from .merit import CRITERIA, Merit, route_of, run_metrics
 from .sweep_task import BATCH

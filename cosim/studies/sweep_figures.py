@@ -35,10 +35,8 @@ STATISTICS = ("box: median and IQR (25-75 %) of the runs, whiskers: min-max; the
 
 def distribution(spec, rows: list[dict], path: Path,
                  criteria: Sequence[Merit] = CRITERIA[:1]) -> Path:
-    """Box plots of each criterion (J alone by default) per controller, grouped by sea state
-    when that is an axis: one panel per criterion, each on a log scale where its values
-    span more than a decade (said on its axis). A run shared by several combinations
-    (calm water over the wave seeds) counts once."""
+    """Box plots of each criterion (J alone by default) per controller and sea state, one
+    panel each, on a log scale where it spans decades; each run counted once."""
     ok = [r for r in distinct(rows) if r["status"] == "ok"]
     sea = _sea_axis(spec)
     groups = spec.axes[sea] if sea else [None]
@@ -100,9 +98,8 @@ def _boxes(ax, spec, ok: list[dict], criterion: Merit, sea: str | None,
 
 def paired_figure(title: str, changes: dict[Merit, dict[str, np.ndarray]], baseline: str,
                   path: Path) -> Path:
-    """Each criterion's paired ratios (or differences) of every controller to ``baseline``,
-    one dot per seed and a bar at their median, the side that is better shaded; ratios on
-    a log scale (a ratio of 0 is left out of it)."""
+    """Each criterion's paired ratios (log scale) or differences of every controller to
+    ``baseline``: a dot per seed, a bar at their median, the better side shaded."""
     columns = min(4, len(changes))
     rows = math.ceil(len(changes) / columns)
     fig = Figure(figsize=(3.6 * columns, 3.6 * rows), layout="constrained")
@@ -190,8 +187,8 @@ def ratio_map(spec, rows: list[dict], path: Path, numerator: str = "smc",
 
 
 def tracks(spec, rows: list[dict], path: Path) -> Path | None:
-    """The tracks of the runs [plots] tracks selects, overlaid, one colour per controller:
-    every run a thin line, so the spread over seeds shows; the route dashed."""
+    """The tracks of the runs [plots] tracks selects, one colour per controller, the route
+    dashed."""
     chosen = [r for r in rows if r.get("track")]
     if not chosen:
         return None
@@ -220,8 +217,7 @@ def tracks(spec, rows: list[dict], path: Path) -> Path | None:
 
 
 def _route(ax, points: np.ndarray, R_accept: float | None) -> None:
-    """The route dashed, its waypoints numbered from 1 (the start), and their circles of
-    acceptance (dotted) where the row recorded the radius."""
+    """The route dashed, its waypoints named, and their circles of acceptance dotted."""
     ax.plot(points[:, 1], points[:, 0], "--o", color="0.3", linewidth=0.8, markersize=3,
             label="route" + (f", circles of acceptance {R_accept:g} m" if R_accept else ""))
     for k, (x, y) in enumerate(points):

@@ -101,11 +101,6 @@ def ran_on(kinds: dict[str, str] | None, asked: str) -> str:
     return "; ".join([asked, *others])
 
 
-def worker_facts() -> dict[str, Any]:
-    """What the client checks of a worker before it sends work."""
-    return {"code": code_version()}
-
-
 def fmu_bytes(data: bytes) -> bytes:
     """An FMU's file as a task's result (a lost worker's copy is computed again)."""
     return data
