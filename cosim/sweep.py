@@ -78,10 +78,9 @@ def main(argv: list[str] | None = None) -> int:
                              "with a note)")
     parser.add_argument("--batch-size", type=count, metavar="N",
                         help="with --backend batch: at most N runs a batch (default: as few "
-                             f"batches as keep every worker busy, of at most {MAX_BATCH} runs "
-                             f"and at least {MIN_BATCH} where there are that many, and in "
-                             "waves a share of each system for every worker; memory: about "
-                             "0.2 MB a run of 400 s)")
+                             "batches as keep every worker busy, of at most "
+                             f"{MAX_BATCH} runs and at least {MIN_BATCH} where there are that "
+                             "many; docs/sweeps.md)")
     parser.add_argument("--no-worker-timeout", type=positive_seconds, metavar="SECONDS",
                         default=campaign.NO_WORKER_TIMEOUT,
                         help="stop when the cluster has had no worker for this long, keeping "
@@ -119,11 +118,12 @@ def main(argv: list[str] | None = None) -> int:
         for note in [*spec.backend_notes(args.backend), *spec.sharing_notes()]:
             say_note(note)
         rows = campaign.execute(spec, out, args.scheduler, args.workers,
-                             progress=not args.no_progress, scheduler_file=args.scheduler_file,
-                             backend=args.backend, no_worker_timeout=args.no_worker_timeout,
-                             connect_timeout=args.connect_timeout,
-                             limits=Limits(args.step_timeout, args.run_timeout),
-                             batch_size=args.batch_size)
+                                progress=not args.no_progress,
+                                scheduler_file=args.scheduler_file, backend=args.backend,
+                                no_worker_timeout=args.no_worker_timeout,
+                                connect_timeout=args.connect_timeout,
+                                limits=Limits(args.step_timeout, args.run_timeout),
+                                batch_size=args.batch_size)
         stage = "writing the tables"
         written = write_tables(rows, out, args.csv, spec)
         stage = "drawing the figures"
@@ -169,8 +169,7 @@ def _comparison(spec: Spec, rows: list[dict]) -> str:
 
 def _stopped(stopped: Interrupted | NoWorkers, stage: str, spec: Spec, out: Path, csv: bool,
              resume: str) -> int:
-    """Say what an interrupted or workerless sweep keeps, at whatever stage it stopped, and
-    how to resume it; its exit status."""
+    """Say what an interrupted or workerless sweep keeps and how to resume it; its status."""
     rows = campaign.completed(spec, out)
     written = []
     if stage == "running the sweep" and rows:

@@ -141,7 +141,7 @@ def test_a_win_is_the_better_value_on_the_same_sea_and_a_tie_within_one_percent(
 def test_the_spread_of_a_criterion_over_decades_is_drawn_on_a_log_scale(tmp_path,
                                                                        monkeypatch):
     from cosim.studies import sweep_figures
-    from cosim.studies.sweep import Spec
+    from cosim.studies.sweep_spec import Spec
 
     drawn = {}
     monkeypatch.setattr(sweep_figures, "save", lambda fig, path: drawn.setdefault("fig", fig)

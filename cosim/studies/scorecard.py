@@ -1,7 +1,7 @@
 """The scorecard: your autopilot beside the paper's PD and sliding-mode ones and the PID.
 
 Every controller runs the same tests and is scored on several criteria, each with its unit
-and the side that is better (``sweep_task.CRITERIA``: J of eq (19), RMS heading error,
+and the side that is better (``merit.CRITERIA``: J of eq (19), RMS heading error,
 rudder reversals per minute and mean |rudder rate| of the actual rudder, time on the stops,
 RMS and largest cross-track error, waypoints reached). There is no overall rank: each
 criterion is won or lost on its own.
@@ -122,7 +122,7 @@ SEAS = (Sea("waves", "the paper's waves", "Hs 5 mm, T0 0.8 s"), _heavy_sea())
 class CourseChange:
     settling_time: float          # s, inf if it never settles within the run
     overshoot: float              # rad
-    metrics: dict[str, float]     # sweep_task.run_metrics of the run
+    metrics: dict[str, float]     # merit.run_metrics of the run
 
 
 def course_change(run: Recording) -> CourseChange:

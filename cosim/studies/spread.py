@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any
 
 from ..analysis.cost import LAMBDA, Cost, cost
 from ..core.master import Master
@@ -55,8 +55,7 @@ class Spread:
 
 def spread(system: SystemDescription, overrides: dict[str, dict[str, Any]] | None = None,
            ulps: int = 20, lam: float = LAMBDA, coupling: str = "gauss-seidel",
-           stop_time: float | None = None,
-           progress: Callable[[int, int], None] | None = None) -> Spread:
+           stop_time: float | None = None) -> Spread:
     """The run and 2 ulps runs for each of ``PERTURBED`` (in-process), moved by -ulps ...
     +ulps; ValueError if ulps < 1 or the system lacks a perturbed parameter; RuntimeError
     naming the member if a run fails."""
@@ -73,7 +72,7 @@ def spread(system: SystemDescription, overrides: dict[str, dict[str, Any]] | Non
                 raise ValueError(f"spread: the system {system.name!r} has no "
                                  f"{component}.{name} to perturb")
         held: dict[str, dict[str, Any]] = {}     # the values the unperturbed run used
-        for i, (parameter, k) in enumerate(members):
+        for parameter, k in members:
             if parameter is not None:
                 component, name = parameter
                 value = nudged(float(held[component][name]), k)
@@ -87,8 +86,6 @@ def spread(system: SystemDescription, overrides: dict[str, dict[str, Any]] | Non
             if parameter is None:
                 held = master.parameter_values
             costs.append(cost(recording, lam))
-            if progress is not None:
-                progress(i + 1, len(members))
     nominal = {f: getattr(costs[0], f) for f in FIGURES}
     deviation = {f: max(abs(getattr(c, f) - nominal[f]) for c in costs) for f in FIGURES}
     return Spread(len(costs), ulps, nominal, deviation)

@@ -151,17 +151,14 @@ def _submit_and_journal(spec: Spec, todo: list[dict], journal: Journal, client, 
 
     route = "inprocess" if backend == BATCH else backend      # a batch's runs alone: in-process
     jobs = [spec.job(run, token, route, limits) for run in todo]
-    if backend == BATCH:
-        together, alone = plan(spec, jobs, sum(client.nthreads().values()) or 1, batch_size)
-        if together:
-            _say_batch_refusals(client)
-        for batch in together:
-            submit(batch, True)
-        for job in alone:
-            submit([job], False)
-    else:
-        for job in jobs:
-            submit([job], False)
+    together, alone = (plan(spec, jobs, sum(client.nthreads().values()) or 1, batch_size)
+                       if backend == BATCH else ([], jobs))
+    if together:
+        _say_batch_refusals(client)
+    for batch in together:
+        submit(batch, True)
+    for job in alone:
+        submit([job], False)
     bar = None
     if progress:
         from tqdm import tqdm
@@ -210,8 +207,8 @@ def _say_batch_refusals(client) -> None:
             said.setdefault(str(reason), []).append(address)
     for reason, addresses in said.items():
         say(f"note: the batch route is refused on {len(addresses)} worker"
-                 f"{'s' if len(addresses) > 1 else ''} ({', '.join(addresses)}): {reason}; "
-                 "their batches run one run at a time on the in-process route")
+            f"{'s' if len(addresses) > 1 else ''} ({', '.join(addresses)}): {reason}; "
+            "their batches run one run at a time on the in-process route")
 
 
 def _close(client, cluster, teardown: SweepTeardown) -> None:
