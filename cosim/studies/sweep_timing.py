@@ -13,16 +13,15 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from .timing import machine, peak_rss_mb, require_in_process
 from .sweep_client import plan
 from .sweep_task import BATCH, SWEEP_BACKENDS
+from .timing import machine, peak_rss_mb, require_in_process
 
 SEAS = {"waves": ("waves_pd", "waves_smc"), "calm": ("calm_pd", "calm_smc")}
 GOALS = {"waves": 5.0, "calm": 10.0}
 """The batch route's goal: its runs per second per core over the in-process route's."""
 CAMPAIGN_RUNS, CAMPAIGN_STOP_TIME, CAMPAIGN_WORKERS, CAMPAIGN_GOAL = 1000, 400.0, 2, 30.0
 """The campaign's goal: these runs of this stop time on these workers within this many s."""
-
 
 
 def load() -> str:
@@ -258,10 +257,9 @@ def _print_rates(rates: dict[tuple[str, str, int], float], seas: tuple[str, ...]
           + "".join(f"{f'efficiency {base}->{w}':>17}" for w in others))
     for sea in seas:
         for backend in backends:
-            print(f"    {sea:5} {backend:9}"
-                  + "".join(f"{rates[sea, backend, w] / w:11.2f}" for w in worker_counts)
-                  + "".join(f"{rates[sea, backend, w] / rates[sea, backend, base] * base / w:17.2f}"
-                            for w in others))
+            rate = {w: rates[sea, backend, w] for w in worker_counts}
+            print(f"    {sea:5} {backend:9}" + "".join(f"{rate[w] / w:11.2f}" for w in rate)
+                  + "".join(f"{rate[w] / rate[base] * base / w:17.2f}" for w in others))
     print("    (efficiency 1.00: each worker as fast as one alone)")
     for sea in seas:
         for backend in backends:
