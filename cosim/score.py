@@ -25,7 +25,7 @@ from .api import overrides_of
 from .core.files import FolderBusy, OutputError
 from .outputs import TimedOut
 from .studies.scorecard import BASELINES, SEAS, backend_notes, score
-from .studies.sweep_client import NoWorkers, SweepError
+from .studies.cluster import NoWorkers, SweepError
 from .studies.sweep_spec import MAX_RUNS
 from .studies.sweep_task import SWEEP_BACKENDS
 

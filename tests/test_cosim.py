@@ -20,7 +20,8 @@ from cosim.analysis.metrics import cost_terms
 from cosim.core.master import Master
 from cosim.core.ssd import write_ssd
 from cosim.core.wiring import WiringError
-from cosim.studies.direct import COMPARED, run_direct
+from cosim.ensemble.reference import SIGNALS
+from cosim.studies.direct import run_direct
 from fmubuild import project
 from fmubuild.project import ROOT
 from helpers import fmu_variant
@@ -90,7 +91,7 @@ def test_psi_d_is_eq_18_of_the_active_leg():
 @pytest.mark.parametrize("name", PAPER)
 def test_cosimulation_equals_the_plain_modules_wired_by_hand(name):
     rec, direct = run(name), run_direct(system(name))
-    worst = max(np.abs(rec[s] - direct[s]).max() for s in COMPARED)
+    worst = max(np.abs(rec[s] - direct[s]).max() for s in SIGNALS)
     assert worst <= 1e-9
 
 
@@ -410,11 +411,11 @@ def test_the_null_backend_runs_a_scenario(fmu_paths):
 def test_the_overhead_benchmark_runs_and_restores_the_ship(fmu_paths, capsys):
     """A smoke test of one benchmark (figures are printed, never asserted): it idles the
     ship's step while it measures, and must give it back."""
-    from cosim.studies import bench
+    from cosim.studies import timing
     from ship_fmu.vessel import Vessel
 
     step = Vessel.step
-    per_step = bench.overhead(1)
+    per_step = timing.overhead(1)
     assert Vessel.step is step
     assert set(per_step) == {"direct", "null", "inprocess"}
     out = capsys.readouterr().out

@@ -273,16 +273,17 @@ def test_a_watchdog_without_signals_leaves_the_handlers_alone():
 def test_a_sweep_records_a_hung_run_as_failed_and_goes_on(fmu_paths, tmp_path):
     """A run whose autopilot loops in its step fails at the step time limit, saying so;
     the worker (here, this process) is free for the next run."""
-    from cosim.studies import sweep, sweep_task
+    from cosim.studies import campaign, sweep_task
+    from cosim.studies.sweep_spec import Spec
 
     pilot = build_script(ROOT / "tests" / "faulty" / "idle_pilot_slave.py", ("fmukit",),
                          tmp_path / "idle_pilot.fmu")
     spec_path = tmp_path / "spec.toml"
     spec_path.write_text(f'stop_time = 10\n[controllers]\nidle = {{ autopilot = "{pilot}" }}\n'
                          '[axes]\n"autopilot.hang_time" = [5.0, 1e9]\n')
-    spec = sweep.Spec.read(spec_path)
+    spec = Spec.read(spec_path)
     started = time.monotonic()
-    rows = [sweep.run_locally(spec, run, limits=Limits(step=1)) for run in spec.runs()]
+    rows = [campaign.run_locally(spec, run, limits=Limits(step=1)) for run in spec.runs()]
     sweep_task.free_masters()
     assert [r["status"] for r in rows] == ["failed", "ok"]
     assert rows[0]["error"].startswith("the step at t = 5 s did not end within the step time "

@@ -23,7 +23,7 @@ from .vessel import VesselArrays
 
 SIGNALS = ("guidance.psi_d", "guidance.wp_index", "ship.x", "ship.y", "ship.psi",
            "ship.delta")
-"""What the figures of merit of a run need (``cosim.studies.sweep_task.run_metrics``)."""
+"""What the figures of merit of a run need (``cosim.studies.merit.run_metrics``)."""
 
 R_MAX = next(var.max for var in INPUTS if var.name == "r")
 """The autopilots' declared range of their yaw-rate input, rad/s: beyond it they refuse."""

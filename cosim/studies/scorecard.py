@@ -1,7 +1,7 @@
 """The scorecard: your autopilot beside the paper's PD and sliding-mode ones and the PID.
 
 Every controller runs the same tests and is scored on several criteria, each with its unit
-and the side that is better (``sweep_task.CRITERIA``: J of eq (19), RMS heading error,
+and the side that is better (``merit.CRITERIA``: J of eq (19), RMS heading error,
 rudder reversals per minute and mean |rudder rate| of the actual rudder, time on the stops,
 RMS and largest cross-track error, waypoints reached). There is no overall rank: each
 criterion is won or lost on its own.
@@ -44,9 +44,12 @@ from ..api import SimulationError, overrides_of
 from ..core.files import fresh_folder, write_atomically
 from ..core.recording import Recording
 from ..outputs import Options, run_and_write
-from .sweep import Spec, controller_entry, execute
+from .campaign import execute
+from .spec_file import controller_entry
+from .sweep_spec import Spec
 from .sweep_figures import STATISTICS, distribution, paired_figure, tracks
-from .sweep_task import BATCH, CRITERIA, Criterion, route_of, run_metrics
+from .merit import CRITERIA, Merit, route_of, run_metrics
+from .sweep_task import BATCH
 
 BASELINES = {"PD": "pd", "SMC": "smc", "PID": "pid"}
 """The project's autopilots by display name: scenarios <sea>_<suffix>."""
@@ -119,7 +122,7 @@ SEAS = (Sea("waves", "the paper's waves", "Hs 5 mm, T0 0.8 s"), _heavy_sea())
 class CourseChange:
     settling_time: float          # s, inf if it never settles within the run
     overshoot: float              # rad
-    metrics: dict[str, float]     # sweep_task.run_metrics of the run
+    metrics: dict[str, float]     # merit.run_metrics of the run
 
 
 def course_change(run: Recording) -> CourseChange:
@@ -159,7 +162,7 @@ class Paired:
         return "even" if 2 * self.ties > self.seeds else "mixed"
 
 
-def pairs(criterion: Criterion, rows: list[dict], controller: str,
+def pairs(criterion: Merit, rows: list[dict], controller: str,
           baseline: str = BASELINE) -> tuple[np.ndarray, np.ndarray]:
     """(controller's, baseline's) values of ``criterion`` on the seeds both ran ok, seed by
     seed (the rows of one ensemble, paired by wave_seed)."""
@@ -171,14 +174,14 @@ def pairs(criterion: Criterion, rows: list[dict], controller: str,
             np.array([values[baseline][s] for s in seeds], dtype=float))
 
 
-def change(criterion: Criterion, mine: np.ndarray, base: np.ndarray) -> np.ndarray:
+def change(criterion: Merit, mine: np.ndarray, base: np.ndarray) -> np.ndarray:
     """The paired ratios mine / base (where base is not 0) or differences mine - base."""
     if criterion.paired == "ratio":
         return mine[base != 0] / base[base != 0]
     return mine - base
 
 
-def paired(criterion: Criterion, rows: list[dict], controller: str,
+def paired(criterion: Merit, rows: list[dict], controller: str,
            baseline: str = BASELINE) -> Paired:
     """``controller`` against ``baseline`` on ``criterion`` over the seeds of one ensemble:
     a win is the better value on the same sea, by more than ``TIE`` of the baseline's."""
@@ -202,7 +205,7 @@ def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | Non
     and the scorecard goes on. ``backend="inprocess"`` runs this project's FMUs without
     FMI (the same results, faster); ``fmu`` then still runs through FMI unless it is one
     of ours (``cosim.core.inprocess.in_process_refusal``). ``backend="batch"`` runs the
-    ensembles on the sweeps' batch backend (``cosim.studies.sweep.execute``: the same rows
+    ensembles on the sweeps' batch backend (``cosim.studies.campaign.execute``: the same rows
     as in-process; ``fmu``'s runs alone in-process unless the batch kernel covers it) and
     the single runs in-process.
     """
@@ -289,13 +292,13 @@ def backend_notes(fmu: Path, name: str, port_map: dict | None, backend: str) -> 
         backend)
 
 
-def _cell(criterion: Criterion, row: dict) -> str:
+def _cell(criterion: Merit, row: dict) -> str:
     """A run's value of ``criterion``, '3 of 4' for a count."""
     total = f" of {row[criterion.out_of]:.0f}" if criterion.out_of else ""
     return criterion.format(row[criterion.column]) + total
 
 
-def _heading(criterion: Criterion) -> str:
+def _heading(criterion: Merit) -> str:
     unit = f" ({criterion.unit})" if criterion.unit else ""
     return f"{criterion.label}{unit}, {criterion.better}"
 
@@ -388,7 +391,7 @@ def _never_finished(sea: Sea, names: list[str], rows: list[dict]) -> list[str]:
     return lines
 
 
-def _verdict(criterion: Criterion, p: Paired) -> str:
+def _verdict(criterion: Merit, p: Paired) -> str:
     """'**better**: won 18, lost 2, tied 0 of 20; median ratio 0.13'."""
     if not p.seeds:
         return "no seed ran for both"
@@ -397,7 +400,7 @@ def _verdict(criterion: Criterion, p: Paired) -> str:
             f"{_change(criterion, p.median)}")
 
 
-def _change(criterion: Criterion, median: float) -> str:
+def _change(criterion: Merit, median: float) -> str:
     """The median paired ratio or difference, with its unit."""
     if criterion.paired == "ratio":
         return f"median ratio {median:.2f}" if math.isfinite(median) else "no ratio"
@@ -503,7 +506,7 @@ def _ensemble_section(sea: Sea, names: list[str], seeds: int, rows: list[dict]) 
                     f"![tracks of every seed](tracks_{sea.key}.png)", ""]
 
 
-def _spread(criterion: Criterion, rows: list[dict]) -> str:
+def _spread(criterion: Merit, rows: list[dict]) -> str:
     """'median [25 % - 75 %]' of the rows' values (' of N' for a count), '-' if none."""
     if not rows:
         return "-"
