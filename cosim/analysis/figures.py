@@ -1,17 +1,7 @@
-"""Figures of a run, in degrees for display: where the ship went, and how it got there.
-
-Every course-keeping and manoeuvre figure has a track panel, north up and east
-right at equal scale, framed on the ship's track with a margin: the track, the
-route with its circles of acceptance and its waypoints named WP1, WP2, ...
-(``waypoint_name``), where each leg switched, the ship's outline at regular times
-(enlarged where to scale it could not be seen, and labelled with the factor:
-``outline_scale``) and the direction the waves travel to. Beside it, the signals
-over time; a rudder axis says which way a positive rudder turns the ship. A
-course-keeping figure carries eq (19)'s figures of merit, and the paper's beside
-them for the paper's own runs. Legends and notes sit outside the axes, over no
-data. The figures take what they show from the recording: its columns, and the
-parameter values the run used (``Recording.meta``), never from what a scenario is
-supposed to be.
+"""Figures of a run, in degrees: a track panel (north up, equal scale, the route with its
+circles of acceptance and named waypoints, leg switches, ship outlines, wave direction)
+beside the signals over time. What they show comes from the recording, never from what a
+scenario is supposed to be. Drawn by Agg without pyplot, so importing this picks no backend.
 """
 from __future__ import annotations
 
@@ -22,50 +12,44 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import matplotlib
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.patches import Circle, Polygon
+from matplotlib.path import Path as Shape
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
-from matplotlib.lines import Line2D  # noqa: E402
-from matplotlib.patches import Circle, Polygon  # noqa: E402
-from matplotlib.path import Path as Shape  # noqa: E402
+from autopilot_fmu.guidance import route as followed_route
+from ship_fmu.data import Hull
 
-from autopilot_fmu.guidance import route as followed_route  # noqa: E402
-from ship_fmu.data import Hull  # noqa: E402
-
-from ..core.files import whole_file  # noqa: E402
-from ..core.recording import Recording  # noqa: E402
-from .cost import LAMBDA, cost  # noqa: E402
-from .describe import paper_row, title  # noqa: E402
-from .metrics import heading_error  # noqa: E402
+from ..core.files import whole_file
+from ..core.recording import Recording
+from .cost import LAMBDA, cost
+from .describe import paper_row, title
+from .metrics import heading_error
 
 FORMATS = ("png", "svg", "pdf")
-OUTLINES = 12
-"""Ship outlines drawn along a track, about."""
-RUDDER_LABEL = "rudder delta (deg)\n+ turns to port"
-"""Every rudder axis: in this model a positive rudder turns the ship to port (r < 0)."""
-TRACK = "track"
-"""The label of a track panel's axes (``track_panel``), which ``legend_if_any`` looks for."""
+OUTLINES = 12                                   # ship outlines along a track, about
+RUDDER_LABEL = "rudder delta (deg)\n+ turns to port"     # a positive rudder turns to port
+TRACK = "track"                                 # a track panel's label, for legend_if_any
 _DIRECTIONS = [(math.cos(a), math.sin(a)) for a in np.radians(np.arange(0, 360, 45))]
 
 
-def waypoint_name(i: int) -> str:
-    """The name of route point ``i`` (0-based, as the guidance's ``wp_index``): 'WP1' is
-    the start.
+def new_figure(**options: Any) -> Figure:
+    """A figure on an Agg canvas, made without pyplot: no backend chosen, nothing kept."""
+    fig = Figure(**options)
+    FigureCanvasAgg(fig)
+    return fig
 
-    Eq (18) calls the waypoint passed k and the next one k + 1, without saying where k
-    starts; Fossen's guidance chapter (Handbook of Marine Craft Hydrodynamics and Motion
-    Control, 2011, ch. 10) numbers a route's waypoints from 1, and so do we: on its first
-    leg the ship has passed WP1 and steers for WP2.
-    """
+
+def waypoint_name(i: int) -> str:
+    """Route point ``i`` (0-based, as ``wp_index``) by name: numbered from 1 as in Fossen
+    (2011, ch. 10), so the start is 'WP1' and the first leg steers for WP2."""
     return f"WP{i + 1}"
 
 
 def hull_outline(x: float, y: float, psi: float, scale: float = 1.0) -> np.ndarray:
-    """The ship's waterline, pointed bow, as (east, north) corners at (x, y, psi): to scale,
-    or ``scale`` times that about (x, y)."""
+    """The ship's waterline as (east, north) corners at (x, y, psi), ``scale`` times enlarged."""
     L, B = scale * Hull.L, scale * Hull.B
     body = np.array([(L / 2, 0.0), (L / 4, B / 2), (-L / 2, B / 2), (-L / 2, -B / 2),
                      (L / 4, -B / 2)])                  # x forward, y starboard
@@ -76,10 +60,8 @@ def hull_outline(x: float, y: float, psi: float, scale: float = 1.0) -> np.ndarr
 
 
 def outline_scale(spacing: float, extent: float) -> int:
-    """How many times enlarged the ship's outline is drawn on a track, so it can be seen:
-    the largest factor of one significant digit (1, 2, ... 9, 10, 20, ...) that keeps an
-    outline within 0.8 of ``spacing`` (m between two outlines) and 1/12 of ``extent``
-    (the track's size, m); 1 if the ship to scale is already that large."""
+    """The largest one-digit factor (1 ... 9, 10, 20, ...) that keeps an enlarged outline
+    within 0.8 of ``spacing`` and 1/12 of ``extent`` (m); 1 if to scale is large enough."""
     limit = min(0.8 * spacing, extent / 12.0) / Hull.L
     if limit < 1.0:
         return 1
@@ -97,13 +79,11 @@ class Outlines:
 
     @property
     def size(self) -> str:
-        """'to scale', or the factor of enlargement: 'x5, true heading'."""
         return "to scale" if self.scale == 1 else f"x{self.scale}, true heading"
 
 
 def outlines(run: Recording) -> Outlines:
-    """The outlines of a run's track: about ``OUTLINES`` at round times, none on top of one
-    drawn a lap earlier, as enlarged as ``outline_scale`` allows."""
+    """About ``OUTLINES`` outlines at round times, none on top of an earlier one."""
     x, y, t = run["ship.x"], run["ship.y"], run.t
     every = max(1.0, round((t[-1] - t[0]) / OUTLINES / 10.0) * 10.0)
     stride = max(1, round(every / run.meta.get("step_size", t[1] - t[0])))
@@ -128,18 +108,12 @@ def _arrow(direction: float) -> Shape:
 
 
 def _in_view(tracks: list[np.ndarray], points: np.ndarray) -> np.ndarray:
-    """Which route points (rows (east, north)) a track panel frames with the tracks: those
-    within half the tracks' size of the box around them."""
+    """The route points within half the tracks' size of the box around them."""
     seen = np.concatenate(tracks)
     low, high = seen.min(axis=0), seen.max(axis=0)
     size = max(*(high - low), 4 * Hull.L)
     gap = np.linalg.norm(np.maximum(0.0, np.maximum(low - points, points - high)), axis=1)
     return gap <= size / 2
-
-
-def _clearance(avoid: np.ndarray, where: np.ndarray) -> float:
-    """The distance from ``where`` to the nearest of the points ``avoid``."""
-    return float(np.min(np.hypot(*(avoid - where).T))) if len(avoid) else math.inf
 
 
 def _dense(points: np.ndarray, pieces: int = 40) -> np.ndarray:
@@ -151,12 +125,12 @@ def _dense(points: np.ndarray, pieces: int = 40) -> np.ndarray:
 
 def _label_waypoints(ax: Any, points: np.ndarray, avoid: np.ndarray, reach: float,
                      size: float) -> None:
-    """Name each route point (``waypoint_name``) beside its circle of acceptance, on the
-    side farthest from the tracks and the route (``avoid``, (east, north) rows) in a frame
-    of ``size`` m."""
+    """Name each route point beside its circle, on the side farthest from ``avoid``."""
+    def clearance(where: np.ndarray) -> float:
+        return float(np.min(np.hypot(*(avoid - where).T))) if len(avoid) else math.inf
     for i, point in enumerate(points):
-        away = np.array(max(_DIRECTIONS, key=lambda d: _clearance(
-            avoid, point + np.array(d) * (reach + 0.04 * size))))
+        away = np.array(max(_DIRECTIONS, key=lambda d: clearance(
+            point + np.array(d) * (reach + 0.04 * size))))
         ax.annotate(waypoint_name(i), tuple(point), xytext=tuple(point + away * reach * 1.1),
                     textcoords="data", fontsize=8, fontweight="bold", color="tab:blue",
                     ha="left" if away[0] > 0.3 else "right" if away[0] < -0.3 else "center",
@@ -165,9 +139,8 @@ def _label_waypoints(ax: Any, points: np.ndarray, avoid: np.ndarray, reach: floa
 
 
 def _route(ax: Any, guidance: dict[str, Any], tracks: list[np.ndarray]) -> None:
-    """The route with its circles of acceptance and named waypoints. The panel frames the
-    tracks and the route points near them; a route running on out of view is cut at the
-    frame, and its label says where it goes."""
+    """The route, its circles and named waypoints; framed on the tracks and the points near
+    them, a route going on out of view says where to."""
     points = np.array(followed_route(guidance))[:, ::-1]              # (east, north)
     reach = guidance["R_accept"]
     near = _in_view(tracks, points)
@@ -176,8 +149,7 @@ def _route(ax: Any, guidance: dict[str, Any], tracks: list[np.ndarray]) -> None:
         last = int(np.flatnonzero(~near)[-1])
         label += (f", continuing out of view to {waypoint_name(last)} "
                   f"({points[last][1]:g}, {points[last][0]:g}) m")
-    # add_artist, not plot or add_patch: what it adds leaves the data limits, and so the
-    # frame, alone; the frame takes the points in view, with their circles, instead.
+    # add_artist leaves the data limits (the frame) alone: the points in view set them.
     ax.add_artist(Line2D(points[:, 0], points[:, 1], linestyle="--", marker="o",
                          color="tab:blue", linewidth=0.8, markersize=4, label=label,
                          zorder=2))
@@ -192,9 +164,8 @@ def _route(ax: Any, guidance: dict[str, Any], tracks: list[np.ndarray]) -> None:
 
 def track_panel(ax: Any, run: Recording, ship: bool = True,
                 others: Iterable[Recording] = ()) -> None:
-    """The route with its circles of acceptance and named waypoints, the wave direction
-    and, with ``ship``, the track, where each leg switched and the ship's outline at
-    regular times; framed on the tracks of ``run`` and ``others`` (which the caller draws)."""
+    """The route, the wave direction and, with ``ship``, the track, leg switches and outlines;
+    framed on the tracks of ``run`` and ``others`` (which the caller draws)."""
     p = run.meta.get("parameters", {})
     x, y, psi = run["ship.x"], run["ship.y"], run["ship.psi"]
     tracks = [np.column_stack([r["ship.y"], r["ship.x"]]) for r in (run, *others)]
@@ -225,9 +196,8 @@ def track_panel(ax: Any, run: Recording, ship: bool = True,
 
 
 def legend_if_any(ax: Any, **kwargs: Any) -> None:
-    """A legend, if anything in the axes has a label to show, outside the axes over no
-    data: a track panel's below the figure's panels (replacing any earlier one), any
-    other's in a row above the axes, right."""
+    """A legend of what has a label, over no data: a track panel's below the panels, any
+    other's in a row above its axes."""
     handles, labels = ax.get_legend_handles_labels()
     if not handles:
         return
@@ -244,9 +214,8 @@ def legend_if_any(ax: Any, **kwargs: Any) -> None:
 
 def _layout(panels: int, heights: tuple[float, ...] | None = None
             ) -> tuple[Figure, Any, list[Any]]:
-    """A track panel on the left, ``panels`` time panels sharing the time axis on the right,
-    as high as ``heights`` says relative to each other (equal if not given)."""
-    fig = plt.figure(figsize=(13, 8), constrained_layout=True)
+    """A track panel on the left, ``panels`` time panels sharing the time axis on the right."""
+    fig = new_figure(figsize=(13, 8), layout="constrained")
     grid = fig.add_gridspec(panels, 2, width_ratios=(1.0, 1.25), height_ratios=heights)
     track = fig.add_subplot(grid[:, 0])
     right = [fig.add_subplot(grid[0, 1])]
@@ -268,8 +237,7 @@ def _degrees(ax: Any, run: Recording, column: str, label: str) -> None:
 
 
 def _rudder(ax: Any, run: Recording, commanded: str) -> None:
-    """Actual rudder in black over the command, thin and light behind it; the scale is the
-    stops', a larger command is clipped, which the panel's title says."""
+    """Actual rudder over the command; a command far beyond the stops is clipped, and said."""
     command = np.degrees(run[commanded])
     ax.plot(run.t, command, color="tab:orange", linewidth=0.5, alpha=0.55, zorder=1,
             label="commanded delta_c")
@@ -288,8 +256,7 @@ def _rudder(ax: Any, run: Recording, commanded: str) -> None:
 
 
 def merit_table(run: Recording, lam: float = LAMBDA) -> str:
-    """Eq (19) of the run, as ``cost`` gives it (and ``cosim.run`` prints it), and for one
-    of the paper's own runs (``describe.paper_row``) the paper's values beside: a table."""
+    """Eq (19) of the run as a table, the paper's values beside for one of its own runs."""
     c = cost(run, lam)
     rows = [("eq (19), rad^2", "psi_E", "delta_E", "J"),
             ("this run", f"{c.psi_E:.2f}", f"{c.delta_E:.2f}", f"{c.J:.2f}")]
@@ -302,8 +269,7 @@ def merit_table(run: Recording, lam: float = LAMBDA) -> str:
 
 
 def course_keeping_figure(run: Recording, lam: float = LAMBDA) -> Figure:
-    """Track with eq (19)'s figures of merit; surge speed, heading, heading error, yaw rate,
-    commanded and actual rudder. ``lam``: the weight of eq (19)."""
+    """Track with eq (19); surge speed, heading, heading error, yaw rate and rudder."""
     fig, track, (u, heading, error, r, rudder) = _layout(5, heights=(1, 1, 1, 1, 1.5))
     track_panel(track, run)
     track.set_title(merit_table(run, lam), loc="left", family="monospace", fontsize=8)
@@ -336,22 +302,22 @@ def save(fig: Figure, path: Path, formats: tuple[str, ...] = ("png",)) -> list[P
                 fig.savefig(tmp, dpi=120, format=fmt)
             written.append(target)
     finally:
-        plt.close(fig)
+        if fig.canvas.manager is not None:     # made by pyplot (the studies' figures)
+            import matplotlib.pyplot as plt
+            plt.close(fig)
     return written
 
 
 def save_figure(run: Recording, draw: Callable[..., Figure], path: Path, label: str,
                 formats: tuple[str, ...] = ("png",), **draw_options: Any) -> list[Path]:
-    """Draw a run's figure (``draw(run, **draw_options)``), title it from what the run used,
-    write it in each format."""
+    """Draw a run's figure, title it from what the run used, write it in each format."""
     fig = draw(run, **draw_options)
     fig.suptitle(title(label, run.meta), fontsize=8)
     return save(fig, path, formats)
 
 
 def comparison(runs: dict[str, Recording], caption: str) -> Figure:
-    """Several controllers on one scenario: their tracks, headings and rudders, overlaid; the
-    track panel framed on the tracks, the figure titled ``caption``."""
+    """Several controllers on one scenario: their tracks, headings and rudders, overlaid."""
     fig, track, (heading, rudder) = _layout(2)
     first = next(iter(runs.values()))
     track_panel(track, first, ship=False, others=runs.values())    # the route and the waves

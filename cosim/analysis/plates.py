@@ -14,13 +14,12 @@ import math
 import textwrap
 from typing import Any
 
-import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
-from matplotlib.patches import Polygon
+from matplotlib.patches import Circle, Polygon
 
 from ..core.recording import Recording
-from .figures import hull_outline, legend_if_any, outlines, track_panel
+from .figures import hull_outline, legend_if_any, new_figure, outlines, track_panel
 from .manoeuvres import (Assessment, TurningCircle, ZigZagResult, approach_frame,
                          at_heading_change, steady_circle, turning_circle_of, zigzag_of)
 from .reports import turning_circle_lines, zigzag_lines
@@ -36,7 +35,7 @@ _WRAP = 150
 
 def _grid(width_ratios: tuple[float, float], rows: int, text_lines: int) -> tuple[Figure, Any]:
     """A figure and its grid: ``rows`` rows of panels above one row of text."""
-    fig = plt.figure(figsize=(13, 8.5 + 0.14 * text_lines), constrained_layout=True)
+    fig = new_figure(figsize=(13, 8.5 + 0.14 * text_lines), layout="constrained")
     panel = (8.0 - 0.3 * rows) / rows
     grid = fig.add_gridspec(rows + 1, 2, width_ratios=width_ratios,
                             height_ratios=(*[panel] * rows, 0.16 * text_lines + 0.2))
@@ -301,7 +300,7 @@ def _steady(ax: Any, run: Recording, tc: TurningCircle, L: float) -> None:
     centre_x, centre_y, diameter = steady_circle(run["ship.x"], run["ship.y"], run["ship.psi"])
     if math.isnan(diameter):
         return
-    ax.add_patch(plt.Circle((centre_y, centre_x), diameter / 2, fill=False, linestyle="--",
+    ax.add_patch(Circle((centre_y, centre_x), diameter / 2, fill=False, linestyle="--",
                             color="tab:orange", linewidth=0.9, zorder=4))
     east = (centre_y - diameter / 2, centre_y + diameter / 2)
     ax.annotate("", xy=(east[1], centre_x), xytext=(east[0], centre_x),
