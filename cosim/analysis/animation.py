@@ -1,7 +1,7 @@
 """An animation of a run: the ship moving along its track, its heading, rudder and leg.
 
 A GIF (Pillow), or an MP4 where ffmpeg is installed, about 25 s at 10 frames per second.
-The track panel is the figure's (``figures.track_panel``), drawn once as a background;
+The track panel is the figure's (``track.track_panel``), drawn once as a background;
 each frame redraws only what moves (outline, wake, active leg, readout, time cursors).
 """
 from __future__ import annotations
@@ -19,8 +19,8 @@ from autopilot_fmu.guidance import route as followed_route
 from ..core.files import whole_file
 from ..core.recording import Recording
 from .describe import title
-from .figures import (RUDDER_LABEL, hull_outline, legend_if_any, new_figure, outlines,
-                      track_panel, waypoint_name)
+from .figures import RUDDER_LABEL, new_figure
+from .track import hull_outline, legend_if_any, outlines, track_panel, waypoint_name
 
 FPS = 10
 VIDEO_SECONDS = 25.0
@@ -48,7 +48,7 @@ def frame_times(t: np.ndarray, fps: int = FPS, seconds: float = VIDEO_SECONDS) -
 
 def leg_text(wp_index: int, points: np.ndarray) -> str:
     """The leg the guidance steers along, its waypoints named as on the figures
-    (``figures.waypoint_name``): 'leg WP1 -> WP2 (30, 0) m' while steering for point
+    (``track.waypoint_name``): 'leg WP1 -> WP2 (30, 0) m' while steering for point
     ``wp_index`` (the guidance's 0-based index, (x, y) in ``points``), or, past the last
     point (``wp_index`` = the number of points), that it holds the last leg's course."""
     if wp_index >= len(points):

@@ -18,7 +18,8 @@ import numpy as np  # noqa: E402
 
 from autopilot_fmu.guidance import parse_waypoints  # noqa: E402
 
-from ..analysis.figures import save, waypoint_name  # noqa: E402
+from ..analysis.figures import save  # noqa: E402
+from ..analysis.track import waypoint_name  # noqa: E402
 from ..analysis.seastate import model_scale  # noqa: E402
 from .sweep_tables import distinct  # noqa: E402
 from .sweep_task import CRITERIA, Criterion  # noqa: E402
