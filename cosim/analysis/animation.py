@@ -47,10 +47,8 @@ def frame_times(t: np.ndarray, fps: int = FPS, seconds: float = VIDEO_SECONDS) -
 
 
 def leg_text(wp_index: int, points: np.ndarray) -> str:
-    """The leg the guidance steers along, its waypoints named as on the figures
-    (``track.waypoint_name``): 'leg WP1 -> WP2 (30, 0) m' while steering for point
-    ``wp_index`` (the guidance's 0-based index, (x, y) in ``points``), or, past the last
-    point (``wp_index`` = the number of points), that it holds the last leg's course."""
+    """'leg WP1 -> WP2 (30, 0) m' while steering for point ``wp_index`` of ``points``, or,
+    past the last, that the guidance holds the last leg's course."""
     if wp_index >= len(points):
         return f"past {waypoint_name(len(points) - 1)}, the last: holding its course"
     north, east = points[wp_index]
@@ -59,11 +57,8 @@ def leg_text(wp_index: int, points: np.ndarray) -> str:
 
 
 def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> Path:
-    """Write the animation of a run to ``path`` with the suffix of ``fmt``; its path.
-
-    ValueError naming what is missing if the run has no track to show. The file is
-    written whole or not at all.
-    """
+    """Write the animation of a run, whole or not at all, to ``path`` with the suffix of
+    ``fmt``; its path. ValueError naming what is missing if the run has no track."""
     require_track(run.columns)
     fmt = fmt or video_format()
     rows = frame_times(run.t)

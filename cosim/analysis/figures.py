@@ -5,6 +5,7 @@ Agg canvases without pyplot, so importing this picks no backend.
 from __future__ import annotations
 
 import math
+import textwrap
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -22,6 +23,8 @@ from .track import legend_if_any, track_panel
 
 FORMATS = ("png", "svg", "pdf")
 RUDDER_LABEL = "rudder delta (deg)\n+ turns to port"     # a positive rudder turns to port
+_VERDICT_COLOURS = {"PASS": "tab:green", "FAIL": "tab:red", "OPEN": "tab:orange"}
+_WRAP = 150                     # characters per line of a figure's text
 
 
 def new_figure(**options: Any) -> Figure:
@@ -54,6 +57,35 @@ def time_axes(fig: Figure, cells: list[Any]) -> list[Any]:
     for a in axes:
         a.grid(alpha=0.3)
     return axes
+
+
+def text_grid(width_ratios: tuple[float, float], rows: int, text: list[str]
+          ) -> tuple[Figure, Any]:
+    """A figure and its grid: ``rows`` rows of panels above one row of ``text``."""
+    text_lines = sum(line.count("\n") + 1 for line in _wrapped(text))
+    fig = new_figure(figsize=(13, 8.5 + 0.14 * text_lines), layout="constrained")
+    panel = (8.0 - 0.3 * rows) / rows
+    grid = fig.add_gridspec(rows + 1, 2, width_ratios=width_ratios,
+                            height_ratios=(*[panel] * rows, 0.16 * text_lines + 0.2))
+    return fig, grid
+
+
+def _wrapped(lines: list[str]) -> list[str]:
+    return [textwrap.fill(line, _WRAP, subsequent_indent="      ", break_on_hyphens=False)
+            for line in lines]
+
+
+def text_panel(ax: Any, lines: list[str]) -> None:
+    """The report's lines, wrapped, one under the other; a verdict in its colour."""
+    ax.set_axis_off()
+    shown = _wrapped(lines)
+    rows = sum(line.count("\n") + 1 for line in shown)
+    row = 0
+    for line in shown:
+        colour = _VERDICT_COLOURS.get(line.split(" ", 1)[0], "black")
+        ax.text(0.0, 1.0 - row / rows, line, transform=ax.transAxes, va="top", ha="left",
+                fontsize=8, family="monospace", color=colour)
+        row += line.count("\n") + 1
 
 
 def _degrees(ax: Any, run: Recording, column: str, label: str) -> None:

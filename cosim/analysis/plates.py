@@ -6,7 +6,6 @@ as -delta, with the heading's sign sense (a positive delta turns this ship to po
 from __future__ import annotations
 
 import math
-import textwrap
 from typing import Any
 
 import numpy as np
@@ -14,44 +13,16 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle, Polygon
 
 from ..core.recording import Recording
-from .figures import new_figure, time_axes
-from .manoeuvres import (Assessment, TurningCircle, ZigZagResult, approach_frame,
-                         at_heading_change, steady_circle, turning_circle_of, zigzag_of)
+from .figures import text_grid, text_panel, time_axes
+from .criteria import Assessment, turning_circle_of, zigzag_of
+from .manoeuvres import (TurningCircle, ZigZagResult, approach_frame, at_heading_change,
+                         steady_circle)
 from .reports import turning_circle_lines, zigzag_lines
 from .track import hull_outline, legend_if_any, outlines, track_panel
 
 RUDDER = "rudder -delta (deg, + turns to starboard)"
 _ORDINALS = ("1st", "2nd", "3rd", "4th")
-_VERDICT_COLOURS = {"PASS": "tab:green", "FAIL": "tab:red", "OPEN": "tab:orange"}
 _BOX = dict(boxstyle="round,pad=0.15", facecolor="white", alpha=0.85, edgecolor="none")
-_WRAP = 150                     # characters per line of a plate's text
-
-
-def _grid(width_ratios: tuple[float, float], rows: int, text_lines: int) -> tuple[Figure, Any]:
-    """A figure and its grid: ``rows`` rows of panels above one row of text."""
-    fig = new_figure(figsize=(13, 8.5 + 0.14 * text_lines), layout="constrained")
-    panel = (8.0 - 0.3 * rows) / rows
-    grid = fig.add_gridspec(rows + 1, 2, width_ratios=width_ratios,
-                            height_ratios=(*[panel] * rows, 0.16 * text_lines + 0.2))
-    return fig, grid
-
-
-def _wrapped(lines: list[str]) -> list[str]:
-    return [textwrap.fill(line, _WRAP, subsequent_indent="      ", break_on_hyphens=False)
-            for line in lines]
-
-
-def text_panel(ax: Any, lines: list[str]) -> None:
-    """The report's lines, wrapped, one under the other; a verdict in its colour."""
-    ax.set_axis_off()
-    shown = _wrapped(lines)
-    rows = sum(line.count("\n") + 1 for line in shown)
-    row = 0
-    for line in shown:
-        colour = _VERDICT_COLOURS.get(line.split(" ", 1)[0], "black")
-        ax.text(0.0, 1.0 - row / rows, line, transform=ax.transAxes, va="top", ha="left",
-                fontsize=8, family="monospace", color=colour)
-        row += line.count("\n") + 1
 
 
 def _rudder(ax: Any, run: Recording) -> None:
@@ -157,7 +128,7 @@ def zigzag_plate(run: Recording, **_: Any) -> Figure:
     a = zigzag_of(run)
     zz = a.figures
     lines = zigzag_lines(a, run)
-    fig, grid = _grid((2.2, 1.0), 3, sum(s.count("\n") + 1 for s in _wrapped(lines)))
+    fig, grid = text_grid((2.2, 1.0), 3, lines)
     heading, r = time_axes(fig, [grid[0:2, 0], grid[2, 0]])
     track_panel(fig.add_subplot(grid[0:3, 1]), run)
     heading.plot(run.t, np.degrees(run["ship.psi"]), color="k", linewidth=1.4,
@@ -214,55 +185,37 @@ def _extension(ax: Any, run: Recording, start: tuple[float, float],
 
 
 def _turning_track(ax: Any, run: Recording, a: Assessment) -> None:
-    """The track with the approach course, the diameters the run reached, the ship at 90 and
-    180 deg heading change."""
+    """The track with the approach course, the advance (outside the turn), transfer and
+    tactical diameter the run reached, the steady circle, the ship at 90 and 180 deg."""
     track_panel(ax, run)
-    psi = run["ship.psi"]
-    along, across = approach_frame(run["ship.x"], run["ship.y"], float(psi[0]))
+    tc, L = a.figures, a.length
+    x, y, psi = run["ship.x"], run["ship.y"], run["ship.psi"]
+    along, across = approach_frame(x, y, float(psi[0]))
     side = math.copysign(1.0, across[np.argmax(np.abs(across))])     # the turn's side
-    top, gap = along.max(), 0.08 * max(np.ptp(across), a.length)
+    top, gap = along.max(), 0.08 * max(np.ptp(across), L)
     outside = -side * (max(-side * across.min(), -side * across.max(), 0.0) + gap)
     _extension(ax, run, (-gap, 0.0), (top + 2 * gap, 0.0))
     ax.annotate("approach course", _earth(run, -gap, 0.0), fontsize=7, color="0.4",
                 ha="center", va="top", bbox=_BOX, zorder=7)
     a90 = tuple(at_heading_change(psi, math.pi / 2, along, across))
-    if not math.isnan(a.figures.advance):
-        _advance_and_transfer(ax, run, a, a90, outside, side * 3.5 * gap, gap)
+    if not math.isnan(tc.advance):
+        _extension(ax, run, (0.0, 0.0), (0.0, outside))
+        _extension(ax, run, a90, (a90[0], outside))
+        _dimension(ax, run, (0.0, outside), (tc.advance, outside),
+                   f"advance\n{tc.advance:.2f} m\n{tc.advance / L:.2f} L", "tab:green")
+        _dimension(ax, run, (a90[0], 0.0), a90,
+                   f"transfer {tc.transfer:.2f} m = {tc.transfer / L:.2f} L (at 90 deg)",
+                   "tab:purple", label_at=(a90[0] - 1.5 * gap, side * 3.5 * gap))
     a180 = tuple(at_heading_change(psi, math.pi, along, across))
-    if not math.isnan(a.figures.tactical_diameter):
-        _tactical(ax, run, a, a180, top + gap)
-    _steady(ax, run, a.figures, a.length)
-    _ship_at_heading_changes(ax, run)
-
-
-def _advance_and_transfer(ax: Any, run: Recording, a: Assessment, a90: tuple[float, float],
-                          outside: float, inside: float, gap: float) -> None:
-    """The advance outside the turn, the transfer at 90 deg, labelled ``inside`` the circle."""
-    tc, L = a.figures, a.length
-    _extension(ax, run, (0.0, 0.0), (0.0, outside))
-    _extension(ax, run, a90, (a90[0], outside))
-    _dimension(ax, run, (0.0, outside), (tc.advance, outside),
-               f"advance\n{tc.advance:.2f} m\n{tc.advance / L:.2f} L", "tab:green")
-    _dimension(ax, run, (a90[0], 0.0), a90,
-               f"transfer {tc.transfer:.2f} m = {tc.transfer / L:.2f} L (at 90 deg)",
-               "tab:purple", label_at=(a90[0] - 1.5 * gap, inside))
-
-
-def _tactical(ax: Any, run: Recording, a: Assessment, a180: tuple[float, float],
-              level: float) -> None:
-    """The tactical diameter across the approach course, ``level`` m along it."""
-    tc = a.figures
-    _extension(ax, run, (a180[0], 0.0), (level, 0.0))
-    _extension(ax, run, a180, (level, a180[1]))
-    _dimension(ax, run, (level, 0.0), (level, a180[1]),
-               f"tactical diameter {tc.tactical_diameter:.2f} m = "
-               f"{tc.tactical_diameter / a.length:.2f} L (at 180 deg)", "tab:brown")
-
-
-def _ship_at_heading_changes(ax: Any, run: Recording) -> None:
-    """The ship where its heading has changed 90 and 180 deg: its drift shows."""
-    x, y, psi = run["ship.x"], run["ship.y"], run["ship.psi"]
-    scale = outlines(run).scale
+    if not math.isnan(tc.tactical_diameter):
+        level = top + gap
+        _extension(ax, run, (a180[0], 0.0), (level, 0.0))
+        _extension(ax, run, a180, (level, a180[1]))
+        _dimension(ax, run, (level, 0.0), (level, a180[1]),
+                   f"tactical diameter {tc.tactical_diameter:.2f} m = "
+                   f"{tc.tactical_diameter / L:.2f} L (at 180 deg)", "tab:brown")
+    _steady(ax, run, tc, L)
+    scale = outlines(run).scale          # the ship where its heading changed 90 and 180 deg
     for target in (math.pi / 2, math.pi):
         xs, ys, ps = at_heading_change(psi, target, x, y, psi)
         if math.isnan(xs):
@@ -304,7 +257,7 @@ def turning_circle_plate(run: Recording, **_: Any) -> Figure:
     a = turning_circle_of(run)
     tc: TurningCircle = a.figures
     lines = turning_circle_lines(a)
-    fig, grid = _grid((1.15, 1.0), 5, sum(s.count("\n") + 1 for s in _wrapped(lines)))
+    fig, grid = text_grid((1.15, 1.0), 5, lines)
     _turning_track(fig.add_subplot(grid[0:5, 0]), run, a)
     heading, speed, drift, r, rudder = time_axes(fig, [grid[i, 1] for i in range(5)])
     t, u, v = run.t, run["ship.u"], run["ship.v"]
