@@ -43,7 +43,6 @@ from .scenarios.autopilot import COMPONENT
 from .studies.spread import PERTURBED, spread
 
 
-
 def run_scenario(system: SystemDescription, label: str, out: Path, overrides: dict,
                  options: Options) -> tuple[int, Cost | None]:
     """Simulate one system, write its outputs as ``label`` and print its report; the status

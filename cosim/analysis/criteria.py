@@ -47,7 +47,6 @@ class Criterion:
         return self.verdict == "PASS"
 
 
-
 def length_over_speed(length: float, speed: float, scale: float = SCALE) -> float:
     """L/V at full scale, s, of a model of ``length`` m at ``speed`` m/s (Froude)."""
     return math.sqrt(scale) * length / speed

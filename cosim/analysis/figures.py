@@ -88,12 +88,6 @@ def text_panel(ax: Any, lines: list[str]) -> None:
         row += line.count("\n") + 1
 
 
-def _degrees(ax: Any, run: Recording, column: str, label: str) -> None:
-    """One signal over time, in degrees, black, labelled."""
-    ax.plot(run.t, np.degrees(run[column]), color="k")
-    ax.set_ylabel(label)
-
-
 def _rudder(ax: Any, run: Recording, commanded: str) -> None:
     """Actual rudder over the command; a command far beyond the stops is clipped, and said."""
     command = np.degrees(run[commanded])
@@ -143,7 +137,8 @@ def course_keeping_figure(run: Recording, lam: float = LAMBDA) -> Figure:
     legend_if_any(heading)
     error.plot(t, np.degrees(heading_error(run["guidance.psi_d"], run["ship.psi"])), color="k")
     error.set_ylabel("psi_d - psi (deg)")
-    _degrees(r, run, "ship.r", "yaw rate r (deg/s)")
+    r.plot(t, np.degrees(run["ship.r"]), color="k")
+    r.set_ylabel("yaw rate r (deg/s)")
     _rudder(rudder, run, "ship.delta_c")
     return fig
 
