@@ -80,11 +80,6 @@ def add_fmi_option(parser: argparse.ArgumentParser) -> None:
                              "scenarios here name the FMI 2.0 ones)")
 
 
-def build_hint(error: BaseException) -> str:
-    """How to build the FMUs of ours an error says are missing (the FMI 3.0 ones if named)."""
-    return BUILD_HINT + (" --fmi 3" if str(FMU_DIRS[3]) in str(error) else "")
-
-
 def add_autopilot_options(parser: argparse.ArgumentParser, also: str) -> None:
     """--autopilot FMU, --map and --name; ``also`` says what --all does with it."""
     parser.add_argument("--autopilot", type=Path, metavar="FMU",
@@ -116,8 +111,9 @@ def file_name_option(text: str) -> str:
 def say_error(error: BaseException) -> None:
     """``error: ...`` on standard error, with advice where the error says what mends it."""
     print(f"error: {error}", file=sys.stderr)
-    if getattr(error, "ours", False):
-        print(f"  {build_hint(error)}", file=sys.stderr)
+    if getattr(error, "ours", False):        # an FMU of ours not built: how to build it
+        fmi3 = " --fmi 3" if str(FMU_DIRS[3]) in str(error) else ""
+        print(f"  {BUILD_HINT}{fmi3}", file=sys.stderr)
     if isinstance(error, TooManyRows):
         print("  cosim.run --stream writes the rows to the CSV as the run goes", file=sys.stderr)
 
