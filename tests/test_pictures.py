@@ -14,7 +14,8 @@ from matplotlib.patches import Circle, Polygon
 from cosim import run as cli
 from cosim import simulate
 from cosim.analysis.animation import animate, frame_times
-from cosim.analysis.figures import RUDDER_LABEL, course_keeping_figure, outlines, save
+from cosim.analysis.figures import RUDDER_LABEL, course_keeping_figure, save
+from cosim.analysis.track import outlines
 from cosim.analysis.manoeuvres import zigzag
 from cosim.provenance import write_metadata
 from cosim.core.recording import Recording

@@ -16,7 +16,8 @@ from matplotlib.patches import Circle
 
 from autopilot_fmu.guidance import parse_waypoints
 
-from ..analysis.figures import save, waypoint_name
+from ..analysis.figures import save
+from ..analysis.track import waypoint_name
 from ..analysis.seastate import model_scale
 from .merit import CRITERIA, Merit
 from .sweep_tables import distinct
