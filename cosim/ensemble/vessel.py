@@ -10,7 +10,7 @@ from typing import Callable, Sequence
 import numpy as np
 
 from ship_fmu.thrusters import actuator_model
-from ship_fmu.vessel import Vessel, axpy, rk4_update, state_rates
+from ship_fmu.vessel import Vessel, axpy, calm_water, rk4_update, state_rates
 
 from . import exact
 
@@ -84,10 +84,6 @@ class WaveArrays:
                 self.c_moment * np.sin(2.0 * beta) * sum_s2)
 
 
-def _calm(t: np.ndarray | float, xi: np.ndarray, psi: np.ndarray) -> Arrays:
-    return (0.0, 0.0, 0.0)
-
-
 def _no_travel(u: np.ndarray, v: np.ndarray) -> float:
     """Calm water: no load depends on xi, so its rate is left at 0 (saves ``hypot``)."""
     return 0.0
@@ -100,8 +96,8 @@ class Lanes:
     def __init__(self, hull, minv: tuple, m11_inv: float, waves: WaveArrays | None,
                  psi_w: np.ndarray, forces: list[tuple[np.ndarray | None, Callable]]):
         self.hull, self.minv, self.m11_inv, self.waves = hull, minv, m11_inv, waves
-        self.wave_loads, self.hypot = (waves, exact.hypot) if waves is not None else (_calm,
-                                                                                     _no_travel)
+        self.wave_loads, self.hypot = (waves, exact.hypot) if waves is not None else (
+            calm_water, _no_travel)
         self.psi_w = psi_w
         self._forces = forces          # (members or None for all, tau_th of delta)
 
