@@ -173,7 +173,12 @@ def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = TRACED) -> dict
             raise EngineError(f"{engine} failed on {ssp.name} ({how}):\n{log}")
         with np.load(out) as data:
             result = {key: data[key] for key in data.files}
-    _check_defined(engine, result, log)
+    for name, values in result.items():
+        bad = np.flatnonzero(~np.isfinite(values))
+        if bad.size:
+            raise EngineError(f"{engine} reported success, but {name} is undefined from "
+                              f"t = {result['time'][bad[0]]:.6g} s: an FMU refused to run "
+                              f"and the engine did not stop.\n{log}")
     return result
 
 
@@ -214,11 +219,3 @@ def log_summary(log: str, head: int = 20, tail: int = 5) -> str:
     return "\n".join(lines[:head] + [f"... ({len(lines) - head - tail} more lines) ..."]
                      + lines[-tail:])
 
-
-def _check_defined(engine: str, result: dict[str, np.ndarray], log: str) -> None:
-    for name, values in result.items():
-        bad = np.flatnonzero(~np.isfinite(values))
-        if bad.size:
-            raise EngineError(f"{engine} reported success, but {name} is undefined from "
-                              f"t = {result['time'][bad[0]]:.6g} s: an FMU refused to run "
-                              f"and the engine did not stop.\n{log}")
