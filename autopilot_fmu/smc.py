@@ -20,7 +20,6 @@ import math
 from dataclasses import dataclass
 from typing import Callable
 
-
 from fmukit.numerics import require_finite, substeps, wrap
 
 from .design import NomotoModel, SwayYawModel

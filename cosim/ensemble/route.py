@@ -25,8 +25,7 @@ from ..core.ssd import SystemDescription
 from ..core.watchdog import TimeLimit, no_limit
 from .control import GuidanceArrays, autopilot_arrays
 from .members import Member, coverage, initialise
-from .reference import SIGNALS as ALL_SIGNALS
-from .reference import step_models
+from .reference import SIGNALS as ALL_SIGNALS, step_models
 from .vessel import VesselArrays
 
 SIGNALS = ("guidance.psi_d", "guidance.wp_index", "ship.x", "ship.y", "ship.psi",
