@@ -21,6 +21,7 @@ from cosim.studies.cluster import NoWorkers, SweepError
 from cosim.studies.merit import METRICS
 from cosim.studies.sweep_spec import Spec
 from cosim.studies.sweep_tables import comparison, write_tables
+from helpers import reference_seconds
 
 EXAMPLE = Path(__file__).resolve().parent.parent / "docs" / "sweeps" / "example.toml"
 
@@ -205,21 +206,20 @@ def test_a_journal_has_one_writer(fmu_paths, tmp_path):
             campaign.execute(spec, tmp_path, workers=1, progress=False)
 
 
-@pytest.mark.timeout(120, method="thread")
+@pytest.mark.timeout(600, method="thread")
 def test_a_worker_killed_on_every_retry_is_recorded_as_failed(fmu_paths, tmp_path):
     """The nanny restarts the worker each time; were it to fail to (as it once did in CI, on
     another machine), the sweep stops for want of a worker and the test fails, naming that."""
     from sweep_faults import killing_task
     spec = Spec.read(write_spec(tmp_path, 'stop_time = 5\n[axes]\nwave_seed = [1, 2]\n'))
-    rows = campaign.execute(spec, tmp_path, workers=1, progress=False, task=killing_task,
-                         no_worker_timeout=30)
+    rows = campaign.execute(spec, tmp_path, workers=1, progress=False, task=killing_task)
     by_seed = {(r["controller"], r["wave_seed"]): r for r in rows}
     assert by_seed[("pd", 1)]["status"] == "ok"
     assert by_seed[("pd", 2)]["status"] == "failed"
     assert "KilledWorker" in by_seed[("pd", 2)]["error"]
 
 
-@pytest.mark.timeout(40, method="thread")
+@pytest.mark.timeout(300, method="thread")
 def test_a_sweep_left_without_a_worker_stops_keeps_its_rows_and_says_why(
         fmu_paths, tmp_path, capsys, monkeypatch):
     """The only worker is killed and not replaced (its nanny told not to restart it, as one
@@ -253,7 +253,7 @@ def test_a_sweep_left_without_a_worker_stops_keeps_its_rows_and_says_why(
     journal = [json.loads(line) for line in (out / "runs.jsonl").read_text().splitlines()]
     assert [r["status"] for r in journal] == ["ok"]
     assert pq.read_table(out / "results.parquet").num_rows == 1
-    assert took < 25                        # the run done, 2 s without a worker, the closing
+    assert took < 2 + 10 * reference_seconds(tmp_path / "reference")   # a run, 2 s, closing
 
 
 @pytest.mark.timeout(30, method="thread")
