@@ -1,14 +1,10 @@
-"""Linear design models of the sliding-mode autopilot, eqs (22)-(32) and (45)-(46).
+"""Linear design models of the sliding-mode autopilot, eqs (22)-(32) and (45)-(46), of the
+sway-yaw model M nu_dot + N(u0) nu = b delta, nu = [v, r]:
 
-Two sources for the sway-yaw model M nu_dot + N(u0) nu = b delta, nu = [v, r]:
-
-- ``PAPER_EQ45``: eq (45) as printed, to reproduce the paper. Its M and n_11, n_12,
-  n_21 follow from the hull data at u0 = 0.3 m/s; its n_22 lacks the factor u0 on
-  the Coriolis term and its b_1 does not follow from the rudder constants (see
-  ../shared/cybership2.md, erratum 4). Eq (46) follows from it exactly.
-- ``linearised_ship(u0)``: the Jacobian of our own ship model at nu = [u0, 0, 0],
-  zero rudder and the paper's propeller speed. It is taken numerically from the
-  same functions the vessel integrates, so it cannot drift from the physics.
+- ``PAPER_EQ45``: eq (45) as printed, to reproduce the paper (its n_22 and b_1 do not
+  follow from the hull data: ../shared/cybership2.md, erratum 4);
+- ``linearised_ship(u0)``: the Jacobian of our own ship model at nu = [u0, 0, 0], taken
+  numerically from the functions the vessel integrates.
 """
 from __future__ import annotations
 
@@ -40,12 +36,8 @@ PAPER_EQ45 = SwayYawModel(
 
 
 def _derivative(f: Callable[[float], np.ndarray], x: float, step: float = 1e-3) -> np.ndarray:
-    """df/dx by central differences with one Richardson step.
-
-    The model's nonlinear terms are of the form |a| b; their central difference at
-    a = 0 carries an error proportional to the step, which the Richardson step
-    removes exactly.
-    """
+    """df/dx by central differences with one Richardson step, which removes exactly the
+    error, proportional to the step, of the |a| b terms at a = 0."""
     def central(h: float) -> np.ndarray:
         return (f(x + h) - f(x - h)) / (2.0 * h)
     return 2.0 * central(step / 2.0) - central(step)

@@ -1,24 +1,13 @@
-"""Waypoint guidance, eq (18): the desired course is the bearing of the active leg.
+"""Waypoint guidance, eq (18): the desired course is the bearing of the active leg,
 
-    psi_d = atan2(y_{k+1} - y_k, x_{k+1} - x_k)
+    psi_d = atan2(y_{k+1} - y_k, x_{k+1} - x_k)         (x north, y east)
 
-(x north, y east; atan2 resolves the quadrant that the printed arctan leaves open.)
-
-Leg switching: the ship moves on to the next leg once it is inside the circle of
-acceptance around the waypoint it is heading for, *or* once it has passed that
-waypoint along the track (its along-track distance exceeds the leg's length).
-A circle-only rule strands the ship whenever a turn leaves its cross-track offset
-larger than R_accept: it never enters the circle and steers back to a waypoint
-behind it. After the last waypoint the ship holds the last leg's course.
-
-The guidance is memoryless apart from the index of the active leg, which only
-moves forward. ``active_leg`` evaluates the switching rule without committing
-it, so the output at a communication point is a pure function of the inputs there.
-
-The route has two forms, because some FMI hosts set no String parameter (OMSimulator
-applies no ssv:String binding): the String ``waypoints`` 'x0,y0;x1,y1;...', and the
-numbers ``n_waypoints`` with ``wp<i>_x``, ``wp<i>_y`` for i < n_waypoints (at most
-``MAX_WAYPOINTS``). ``route`` decides which one holds (docs/interop.md, "The route").
+The ship moves on to the next leg inside the circle of acceptance around the waypoint it
+heads for, *or* once past that waypoint along the track (a circle-only rule strands a
+ship whose turn leaves it wide of the circle); after the last it holds the last course.
+``active_leg`` evaluates the rule without committing it. The route is the String
+``waypoints`` 'x0,y0;x1,y1;...' or, for hosts that set no String parameter (OMSimulator),
+the numbers ``n_waypoints``, ``wp<i>_x``, ``wp<i>_y`` (``route``; docs/interop.md).
 """
 from __future__ import annotations
 
@@ -34,8 +23,6 @@ PAPER_ROUTE = "0,0;30,0;60,25;90,25"
 
 R_ACCEPT = 2.0 * Hull.L
 """Radius of the circle of acceptance, m: two ship lengths."""
-
-
 MAX_WAYPOINTS = 16
 """Points the numeric form of the route holds: wp0_x, wp0_y ... wp15_x, wp15_y."""
 
@@ -51,8 +38,8 @@ ROUTE_PARAMETERS = ("waypoints", "n_waypoints", *COORDINATES)
 
 
 def _checked(points: list[tuple[float, float]], what: str) -> list[tuple[float, float]]:
-    """The rules of a route: finite points, no two consecutive alike, at least two;
-    ValueError naming ``what`` (the parameter or parameters giving it)."""
+    """``points`` if finite, no two consecutive alike; ValueError naming ``what`` (the
+    parameters giving them)."""
     for i, (x, y) in enumerate(points):
         if not (math.isfinite(x) and math.isfinite(y)):
             raise ValueError(f"parameter {what}: point {i} ({x}, {y}) is not finite")
@@ -81,9 +68,8 @@ def parse_waypoints(text: str) -> list[tuple[float, float]]:
 
 
 def numeric_route(text: str) -> dict[str, int | float]:
-    """The route 'x0,y0;...' in the numeric form: n_waypoints and wp<i>_x, wp<i>_y of each
-    point (the others keep their default, 0); ValueError if it has more than
-    ``MAX_WAYPOINTS`` points."""
+    """The route 'x0,y0;...' as n_waypoints and wp<i>_x, wp<i>_y (the others at their
+    default, 0); ValueError beyond ``MAX_WAYPOINTS`` points."""
     points = parse_waypoints(text)
     if len(points) > MAX_WAYPOINTS:
         raise ValueError(f"the route {text!r} has {len(points)} points; its numeric form "
@@ -95,13 +81,10 @@ def numeric_route(text: str) -> dict[str, int | float]:
 
 
 def route(parameters: Mapping[str, Any]) -> list[tuple[float, float]]:
-    """The route the guidance follows, from its parameters by name (those absent at their
+    """The route the guidance follows, from its parameters by name (absent: at their
     defaults); ValueError naming the parameters if it is not well defined.
-
-    ``n_waypoints`` = 0 (its default): the String ``waypoints``, and every wp<i>_x, wp<i>_y
-    must be 0 (unset). ``n_waypoints`` = n >= 2: the points wp0 .. wp<n-1>; wp<i> from n on
-    must be unset, and ``waypoints`` must be at its default (the paper's route, taken as
-    not given) or name the same points: two different routes are refused, not ranked.
+    ``n_waypoints`` = 0: the String ``waypoints``, every wp<i> unset (0). n >= 2: wp0 ..
+    wp<n-1>, the others unset, and ``waypoints`` at its default or the same points.
     """
     text = parameters.get("waypoints", PAPER_ROUTE)
     count = parameters.get("n_waypoints", 0)
@@ -138,7 +121,7 @@ class WaypointGuidance:
         self.R_accept = R_accept
         self.leg = 0                      # active leg: from points[leg] to points[leg + 1]
         self.finished = False
-        self._last: tuple = (None, None)  # the rule's last evaluation (an FMU asks 3 times)
+        self._last: tuple = (None, None)  # the last evaluation (an FMU asks 3 times)
 
     def _reached(self, leg: int, x: float, y: float) -> bool:
         """Whether the ship is done with ``leg``: inside the circle or past its end."""

@@ -1,9 +1,6 @@
-"""Waypoint guidance as an FMI 2.0 co-simulation FMU (fmus/guidance.fmu), eq (18).
-
-psi_d and wp_index are direct feedthrough from the position: evaluated when read,
-with the leg switch committed at the end of each step. The route is the String
-``waypoints`` or, for hosts that set no String parameter, the numbers ``n_waypoints``,
-``wp<i>_x``, ``wp<i>_y`` (``autopilot_fmu.guidance.route`` says which holds).
+"""Waypoint guidance as an FMI 2.0 co-simulation FMU (fmus/guidance.fmu), eq (18): psi_d and
+wp_index are direct feedthrough from the position, the leg switch committed at each step's
+end. The route: the String ``waypoints`` or its numeric form (``guidance.route``).
 """
 from autopilot_fmu.guidance import (
     MAX_WAYPOINTS,

@@ -1,9 +1,7 @@
 """PD autopilot, eq (20): delta_c = K_P (psi - psi_d) + K_D r.
 
-With this ship a positive rudder turns to port (r < 0), so a heading short of the
-desired one (psi < psi_d) asks for a negative rudder, and a positive yaw rate for a
-positive rudder: eq (20) as printed is a stabilising feedback. The heading error
-is wrapped to (-pi, pi], so the ship turns the short way across north.
+A positive rudder turns this ship to port (r < 0), so eq (20) as printed is a stabilising
+feedback. The heading error is wrapped to (-pi, pi]: the ship turns the short way.
 """
 from __future__ import annotations
 
@@ -28,8 +26,7 @@ class PDAutopilot:
         return self.Kp * wrap(psi - psi_d) + self.Kd * r
 
     def snapshot(self) -> dict:
-        """The dynamic state: none, the law is memoryless."""
-        return {}
+        return {}                          # memoryless
 
     def restore(self, snapshot: dict) -> None:
-        """Nothing to restore."""
+        pass

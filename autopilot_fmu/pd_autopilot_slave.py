@@ -1,7 +1,5 @@
-"""The PD autopilot as an FMI 2.0 co-simulation FMU (fmus/pd_autopilot.fmu).
-
-delta_c is direct feedthrough from psi, r and psi_d: it is evaluated when read.
-"""
+"""The PD autopilot as an FMI 2.0 co-simulation FMU (fmus/pd_autopilot.fmu); delta_c is
+direct feedthrough from psi, r and psi_d."""
 from autopilot_fmu.pd import PDAutopilot
 from fmukit.autopilot import INPUTS, rudder_command
 from fmukit.slave import ModelSlave, Var
@@ -24,4 +22,4 @@ class PDAutopilotSlave(ModelSlave):
         return PDAutopilot(self.Kp, self.Kd)
 
     def step_model(self, t: float, h: float) -> None:
-        """Nothing to advance: the law is memoryless (do_step has checked the inputs)."""
+        pass                               # memoryless (do_step has checked the inputs)

@@ -1,40 +1,18 @@
 """Sliding-mode autopilot, eqs (35)-(44).
 
-Design (computed, never typed in): sway-yaw model -> Nomoto model (33) ->
-pole placement of A_c = A_h - B_h K^T at lambda_1, lambda_2 (38) -> h, the
-eigenvector of A_c^T for the eigenvalue of smaller magnitude -> N from (40)-(41).
+Design (computed, never typed in): sway-yaw model -> Nomoto model (33) -> pole placement of
+A_c = A_h - B_h K^T at lambda_1, lambda_2 (38) -> h, the eigenvector of A_c^T for the
+eigenvalue of smaller magnitude -> N from (40)-(41). Control law, x = [psi, r]:
 
-Control law, delta_c = u_eq + u_sw (43), with x = [psi, r] and the reference
-state [psi_z, r_z] of eq (44):
-
+    delta_c = u_eq + u_sw                                    (43)
     u_eq  = N psi_z - K^T x                                  (39), stabilising reading
     u_sw  = h^T [r_z, r_z_dot] - eta_h tanh(sigma_h / phi_h)  (42)
     sigma_h = h_1 (psi_z - psi) + h_2 (r_z - r)              (37)
 
-Eq (39) prints u_eq = -N psi_z + K x. A_c = A_h - B_h K^T is the closed loop of
-delta = -K^T x, and for this ship b_2 < 0, so K = [k_1, k_2] comes out negative
-(about [-0.987, -2000]): taken literally, +K x feeds the heading back with the
-wrong sign and the loop diverges. The reading that makes A_c the closed loop is
-u_eq = N psi_z - K^T x. Since A_h has a free integrator, eq (41) gives N_x = [1, 0]
-and N_u = 0, so N = k_1 and u_eq = k_1 (psi_z - psi) - k_2 r: the same sign
-structure as the PD law (20), K_P (psi - psi_d) + K_D r, with K_P -> -k_1 and
-K_D -> -k_2. Heading differences are wrapped to (-pi, pi].
-
-Eq (39) scales only psi_z, so u_eq damps the yaw rate itself, not its error: with
-k_2 ~ -2000 it holds r near zero, and the switching term (at most eta_h) has to
-overpower it to turn the ship. ``equivalent_control='tracking'`` offers the
-full-state reading u_eq = -K^T (x - x_z) = k_1 (psi_z - psi) + k_2 (r_z - r),
-which tracks the reference yaw rate too; it is not the paper's law, and exists to
-show where the difference between the paper's figures and ours comes from
-(docs/reproduction.md).
-
-The switching term is taken as printed. With sigma_h = h^T (x_z - x) and b_2 < 0,
--eta_h tanh(sigma_h / phi_h) pushes the heading toward psi_z; the feed-forward
-h^T x_z_dot is small (h_1 r_z is about 0.01 rad in a 40 deg turn).
-
-The reference model (44) follows psi_d through the wrapped error
-psi_d - psi_z, so a course change across +-180 deg takes the short way; psi_z is
-continuous. It is integrated by RK4 with psi_d held over the step.
+Eq (39) as printed (-N psi_z + K x) feeds the heading back with the wrong sign;
+``equivalent_control='tracking'`` is u_eq = -K^T (x - x_z), not the paper's law
+(docs/reproduction.md). Heading differences are wrapped to (-pi, pi]; the reference
+model (44) is integrated by RK4 with psi_d held over the step.
 """
 from __future__ import annotations
 
@@ -42,23 +20,19 @@ import math
 from dataclasses import dataclass
 from typing import Callable
 
-
 from fmukit.numerics import require_finite, substeps, wrap
 
 from .design import NomotoModel, SwayYawModel
 
 H_MAX = 0.1
-"""Largest RK4 step of the reference model, s (shorter for a faster reference model)."""
+"""Largest RK4 step of the reference model, s."""
 
 EQUIVALENT_CONTROLS = ("paper", "tracking")
 
 
 def reference_step_bound(omega_n: float, zeta: float) -> float:
-    """The largest RK4 step of the reference model (44), s.
-
-    RK4 stays accurate and stable with |lambda| h <= 1 on the model's fastest eigenvalue;
-    with the paper's omega_n and zeta that is H_MAX itself.
-    """
+    """The largest RK4 step of the reference model (44), s: |lambda| h <= 1 on its fastest
+    eigenvalue, and at most H_MAX."""
     fastest = omega_n * (zeta + math.sqrt(max(zeta * zeta - 1.0, 0.0)))
     return H_MAX if fastest * H_MAX <= 1.0 else 1.0 / fastest
 
@@ -122,9 +96,8 @@ class SlidingModeDesign:
                    K=(k1, k2), h=(h1 * scale, h2 * scale), N=N)
 
 
-# The design's linear algebra, written out for 2 x 2 and 3 x 3 in +, -, *, / and sqrt
-# (exactly rounded), not by LAPACK, whose BLAS kernels round differently on different
-# CPUs: the chattering loop turns a last bit of h into a visibly different run.
+# The design's linear algebra written out in exactly rounded operations, not by LAPACK,
+# whose last bits vary by CPU: the chattering loop turns a last bit into another run.
 def _eigenvalues(M: list[list[float]]) -> tuple[float, float]:
     """The real eigenvalues of a 2 x 2 matrix, from its characteristic polynomial."""
     trace, det = M[0][0] + M[1][1], M[0][0] * M[1][1] - M[0][1] * M[1][0]
@@ -180,7 +153,7 @@ class SlidingModeAutopilot:
 
     def r_z_dot(self, psi_d: float, psi_z: float | None = None,
                 r_z: float | None = None) -> float:
-        """Desired yaw acceleration from the reference model, eq (44)."""
+        """r_z_dot of the reference model, eq (44)."""
         return reference_acceleration(psi_d, self.psi_z if psi_z is None else psi_z,
                                       self.r_z if r_z is None else r_z, self.omega_n, self.zeta)
 

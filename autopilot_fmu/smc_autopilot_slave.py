@@ -1,8 +1,7 @@
 """The sliding-mode autopilot as an FMI 2.0 co-simulation FMU (fmus/smc_autopilot.fmu).
 
-The reference model (44) is the FMU's state; it starts at the heading and yaw
-rate the FMU sees at initialisation. delta_c and sigma are direct feedthrough
-from the inputs and are evaluated when read; psi_z and r_z are states.
+The reference model (44) is the FMU's state, started at the heading and yaw rate seen at
+initialisation; delta_c and sigma are direct feedthrough from the inputs.
 """
 from autopilot_fmu.design import design_model
 from autopilot_fmu.smc import SlidingModeAutopilot, SlidingModeDesign

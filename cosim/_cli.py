@@ -1,8 +1,5 @@
-"""What the command-line modules share: scenario and autopilot arguments, output folders,
-the progress bar.
-
-Only the commands (``cosim.run``, ``cosim.sweep``, ``cosim.export``, ...) import this.
-"""
+"""What the commands share: scenario and autopilot options, output folders, messages, the
+progress bar. Only the commands import this."""
 from __future__ import annotations
 
 import argparse
@@ -13,7 +10,7 @@ import tempfile
 from pathlib import Path
 from typing import Callable
 
-from fmubuild.project import BUILD_HINT, FMU_DIRS
+from fmubuild.project import BUILD_HINT, FMU_DIRS, SLAVE_MODULES
 
 from . import scenarios
 from .api import parse_setting
@@ -26,8 +23,7 @@ from .scenarios.autopilot import AutopilotError, check_autopilot
 
 def chosen_scenarios(parser: argparse.ArgumentParser, scenario: str | None,
                      paper: bool) -> list[str]:
-    """One SCENARIO (a name or a .ssd path) or --all (the paper's four); checked, or the
-    parser exits naming the problem."""
+    """One SCENARIO (a name or a .ssd path) or --all (the paper's four), checked."""
     if paper == bool(scenario):
         parser.error("give one SCENARIO or --all")
     names = list(scenarios.PAPER) if paper else [scenario]
@@ -48,8 +44,7 @@ def setting_option(text: str) -> tuple[str, str]:
 
 
 def number_option(text: str) -> float:
-    """A finite number, for argparse, read as a Real parameter is (``core.values``: ASCII
-    digits, no '5_0', no 'inf')."""
+    """A finite number, for argparse, read as a Real parameter is (no '5_0', no 'inf')."""
     try:
         value = fmi_value("the option", "Real", text)
     except ValueError:
@@ -85,14 +80,8 @@ def add_fmi_option(parser: argparse.ArgumentParser) -> None:
                              "scenarios here name the FMI 2.0 ones)")
 
 
-def build_hint(error: BaseException) -> str:
-    """How to build the FMUs an error says are ours and missing: the FMI 3.0 twins where
-    it names their folder."""
-    return BUILD_HINT + (" --fmi 3" if str(FMU_DIRS[3]) in str(error) else "")
-
-
 def add_autopilot_options(parser: argparse.ArgumentParser, also: str) -> None:
-    """--autopilot FMU, --map PORT=NAME, --name NAME; ``also`` says what --all does with it."""
+    """--autopilot FMU, --map and --name; ``also`` says what --all does with it."""
     parser.add_argument("--autopilot", type=Path, metavar="FMU",
                         help="your own autopilot, an FMI 2.0 or 3.0 co-simulation FMU with "
                              "inputs psi "
@@ -120,26 +109,25 @@ def file_name_option(text: str) -> str:
 
 
 def say_error(error: BaseException) -> None:
-    """``error: ...`` on standard error, with the command line's advice where the error
-    says what would mend it (an FMU of ours not built; a run too long to hold in memory)."""
+    """``error: ...`` on standard error, with advice where the error says what mends it."""
     print(f"error: {error}", file=sys.stderr)
-    if getattr(error, "ours", False):
-        print(f"  {build_hint(error)}", file=sys.stderr)
+    if getattr(error, "ours", False):        # an FMU of ours not built: how to build it
+        fmi3 = " --fmi 3" if str(FMU_DIRS[3]) in str(error) else ""
+        print(f"  {BUILD_HINT}{fmi3}", file=sys.stderr)
     if isinstance(error, TooManyRows):
         print("  cosim.run --stream writes the rows to the CSV as the run goes", file=sys.stderr)
 
 
 def say_note(note: str) -> None:
-    """``note: ...`` on standard error, and how to build our FMUs where the note says one
-    was built before a change (``cosim.core.inprocess.Reason``)."""
+    """``note: ...`` on standard error, and how to rebuild where the note says so."""
     print(f"note: {note}", file=sys.stderr)
-    if getattr(note, "rebuild", False):
+    if getattr(note, "stale_module", None) in SLAVE_MODULES:
         print(f"  {BUILD_HINT}", file=sys.stderr)
 
 
 def checked_autopilot(parser: argparse.ArgumentParser, args: argparse.Namespace) -> bool:
-    """Check --autopilot against the port contract before anything runs; False (and the
-    reason on standard error) if it fails."""
+    """Check --autopilot against the port contract before anything runs; False (the reason
+    on standard error) if it fails."""
     if args.autopilot is None:
         if args.map or args.name:
             parser.error("--map and --name describe an --autopilot FMU; give one")
@@ -153,9 +141,8 @@ def checked_autopilot(parser: argparse.ArgumentParser, args: argparse.Namespace)
 
 
 def entry(main: Callable[[], int]) -> int:
-    """Run a command's main as Unix tools end: quietly when its output pipe closes
-    (``| head``); on Ctrl-C or SIGTERM with "interrupted" and status 130 or 143, not a
-    traceback. (A run in progress takes these signals itself: ``cosim.core.interrupt``.)"""
+    """Run a command's main as Unix tools end: quietly when its output pipe closes; on
+    Ctrl-C or SIGTERM with "interrupted" and status 130 or 143, not a traceback."""
     signal.signal(signal.SIGPIPE, signal.SIG_DFL)
     try:
         with raise_on_signals():

@@ -1,18 +1,15 @@
 """How large are the set-up's own numerical errors? RK4 against DOP853, co-simulation
 against a monolithic model with the controller inside the solver.
 
-    python -m cosim.accuracy            # the full study, about a minute on 2 cores
+    python -m cosim.accuracy            # the full study
     python -m cosim.accuracy --quick    # shorter runs and fewer steps (CI)
-    python -m cosim.accuracy --cpus     # every scenario as other CPUs would run it, about
-                                        # 25 s: numpy, OpenBLAS and libm variants, bit for bit
+    python -m cosim.accuracy --cpus     # every scenario as other CPUs would run it: numpy,
+                                        # OpenBLAS and libm variants, bit for bit
 
-Prints three tables (integration error open loop; co-simulation against the
-monolithic reference; convergence in the communication step) and writes them, with
-a convergence figure, to results/accuracy/. The quick mode's figures cover shorter
-runs in calm water only: they differ from docs/reproduction.md's, which are the full
-study's. With --cpus it writes cpus.md instead: each scenario run in a child process
-under each variant of ``cosim.studies.cpu_variants`` and compared bit for bit with
-this machine's own run.
+Prints three tables (integration error open loop; co-simulation against the monolithic
+reference; convergence in the communication step) and writes them, with a convergence
+figure, to results/accuracy/. The quick mode's figures cover shorter runs in calm water
+only: docs/reproduction.md's are the full study's. With --cpus it writes cpus.md instead.
 """
 from __future__ import annotations
 
@@ -24,7 +21,7 @@ from pathlib import Path
 from ._cli import entry, writable_folder
 from .core.files import whole_file
 from .scenarios import names
-from .studies import accuracy, cpu_variants, integration_error
+from .studies import coupling_error, cpu_variants, integration_error
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -50,25 +47,25 @@ def main(argv: list[str] | None = None) -> int:
         print(f"wrote {out / 'cpus.md'} ({time.perf_counter() - started:.0f} s)")
         return 0
     open_end, closed_end = (60.0, 120.0) if args.quick else (400.0, None)
-    runs = accuracy.PAPER_RUNS[:2] if args.quick else accuracy.PAPER_RUNS
-    steps = (0.1, 0.05, 0.025) if args.quick else accuracy.STEPS
+    runs = coupling_error.PAPER_RUNS[:2] if args.quick else coupling_error.PAPER_RUNS
+    steps = (0.1, 0.05, 0.025) if args.quick else coupling_error.STEPS
 
     tables = ["## Integration error, open loop (calm water)\n",
               integration_error.open_loop_table([integration_error.open_loop(p, open_end)
                                                  for p in ("step", "sine", "zigzag")])]
     print("".join(tables[-2:]), flush=True)
-    closed = {name: accuracy.closed_loop(name, closed_end) for name in runs}
+    closed = {name: coupling_error.closed_loop(name, closed_end) for name in runs}
     tables += ["\n## Co-simulation at 0.1 s against the monolithic reference\n",
-               accuracy.closed_loop_table(closed)]
+               coupling_error.closed_loop_table(closed)]
     print("".join(tables[-2:]), flush=True)
     references = {name: result["monolithic"] for name, result in closed.items()}
-    converging = {name: accuracy.convergence(name, references[name], steps, closed_end)
+    converging = {name: coupling_error.convergence(name, references[name], steps, closed_end)
                   for name in runs}
     tables += ["\n## J against the communication step\n",
-               accuracy.convergence_table(converging, references)]
+               coupling_error.convergence_table(converging, references)]
     print("".join(tables[-2:]), flush=True)
     _write(out / "accuracy.md", "\n".join(tables))
-    figure = accuracy.convergence_figure(converging, out / "convergence.png")
+    figure = coupling_error.convergence_figure(converging, out / "convergence.png")
     print(f"wrote {out / 'accuracy.md'}, {figure} ({time.perf_counter() - started:.0f} s)")
     return 0
 

@@ -4,12 +4,9 @@
     run = simulate("waves_pd", autopilot="my.fmu", set={"ship.Hs": 0.01}, stop_time=200)
     run["ship.psi"], run.t, run.units["ship.psi"]        # heading (rad) at every 0.1 s
 
-The recording holds every exchanged signal by ``component.variable`` (every FMU
-output and every connected input) at every communication point, and the unit of
-each. ``cosim.testing`` turns this into pytest checks.
-
-Many runs of one scenario, a list of settings in, a list of recordings out, stepped
-together as arrays where the batch kernel covers the scenario (``cosim.ensemble``):
+The recording holds every exchanged signal by ``component.variable`` at every
+communication point, with its unit. Many runs of one scenario, stepped together as arrays
+where the batch kernel covers it (``cosim.ensemble``):
 
     from cosim import simulate_many
     runs = simulate_many("waves_pd", [{"ship.wave_seed": s} for s in range(100)])
@@ -23,7 +20,7 @@ from typing import Any, Iterable, Mapping, Sequence
 
 from . import scenarios
 from .core.master import RUN_BACKENDS, Master
-from .core.ssd import SystemDescription, split_name
+from .core.system import SystemDescription, split_name
 from .core.recording import Recording
 
 
@@ -36,10 +33,8 @@ class SimulationError(RuntimeError):
 
 
 def parse_setting(text: str) -> tuple[str, str]:
-    """'component.variable=value' -> ('component.variable', 'value'). The value stays text:
-    the master reads it as the type the FMU declares for the variable, once, and refuses
-    what that type cannot hold exactly (``cosim.core.values``). ValueError naming the
-    text if it is not of that form."""
+    """'component.variable=value' -> ('component.variable', 'value'); the value stays text,
+    for the master to read as the variable's type. ValueError naming the text."""
     target, sep, raw = text.partition("=")
     try:
         if not sep:
@@ -52,9 +47,8 @@ def parse_setting(text: str) -> tuple[str, str]:
 
 def overrides_of(settings: Mapping[str, Any] | Iterable[tuple[str, Any]]
                  ) -> dict[str, dict[str, Any]]:
-    """{'ship.Hs': 0.01} (or pairs, as ``parse_setting`` gives them) -> {'ship': {'Hs':
-    0.01}}; ValueError for a key that is not 'component.variable' or a variable given
-    twice."""
+    """{'ship.Hs': 0.01} (or pairs) -> {'ship': {'Hs': 0.01}}; ValueError for a key that is
+    not 'component.variable' or a variable given twice."""
     pairs = settings.items() if isinstance(settings, Mapping) else settings
     overrides: dict[str, dict[str, Any]] = {}
     for target, value in pairs:
@@ -75,16 +69,11 @@ def simulate(scenario: str | Path, autopilot: str | Path | None = None,
              port_map: dict[str, str] | None = None, fmi: int | None = None) -> Recording:
     """Run a scenario (a name or a .ssd path) and return its recording.
 
-    ``autopilot``: an FMU in place of the scenario's (``cosim.scenarios.autopilot``),
-    its ports renamed by ``port_map``; ``set``: parameter values by
-    ``"component.variable"`` (SI units, radians); ``stop_time`` in s (default: the
-    scenario's). ``fmi=3`` runs this project's FMI 3.0 twins (fmus/fmi3/) in place of the
-    FMUs the scenario names (``fmi=2``: fmus/), with the same results bit for bit; an
-    ``autopilot`` may be of either version. ``backend="inprocess"`` runs this project's
-    FMUs as Python classes, without FMI: the same results bit for bit, about 1.5-2.5
-    times faster (an FMU not built from this checkout's classes runs through FMI, with a
-    warning). ValueError or FileNotFoundError for bad input, naming it; SimulationError if
-    an FMU fails during the run.
+    ``autopilot``: an FMU in place of the scenario's, its ports renamed by ``port_map``;
+    ``set``: parameter values by ``"component.variable"`` (SI units, radians). ``fmi=3``
+    runs this project's FMI 3.0 twins, ``backend="inprocess"`` its FMUs as Python classes
+    (a foreign FMU through FMI, with a warning): the same results bit for bit.
+    ValueError or FileNotFoundError for bad input; SimulationError if an FMU fails.
     """
     with Master(scenarios.load(scenario, autopilot, port_map, fmi=fmi), coupling=coupling,
                 backend=backend, overrides=overrides_of(set or {})) as master:
@@ -101,23 +90,14 @@ def simulate_many(scenario: str | Path, sets: Sequence[Mapping[str, Any]],
                   backend: str = "batch", port_map: dict[str, str] | None = None,
                   fmi: int | None = None, signals: Sequence[str] | None = None
                   ) -> list[Recording]:
-    """Run a scenario once for each of ``sets`` (each what ``simulate`` takes as ``set``)
-    and return their recordings, in order; the other arguments as ``simulate``'s.
+    """Run a scenario once for each of ``sets`` (each a ``simulate`` ``set``); the recordings
+    in order, the other arguments as ``simulate``'s.
 
-    ``backend="batch"`` (the default) steps the runs of a PD, PID or SMC course-keeping
-    scenario together as numpy arrays (``cosim.ensemble.simulate_members``): each
-    recording is the in-process route's, bit for bit, holding the columns ``signals``
-    (default: every signal of the loop, ``cosim.ensemble.reference.SIGNALS``; the wave
-    loads are not among them). A scenario the kernel does not cover (your autopilot, a
-    manoeuvre), a run that fails, and every run on a machine whose numpy the self-test
-    refuses run on the in-process route, one at a time, saying so in their
-    ``meta["notes"]`` (each note warned once). ``"fmi"`` or ``"inprocess"``: one run after
-    another, every signal recorded (only ``signals``, if given).
-
-    A run that fails raises nothing: its recording's ``error`` says why, and it holds the
-    rows up to the failure. ValueError naming the run (``member i``, its index in
-    ``sets``) for a setting refused before anything runs, or FileNotFoundError, as
-    ``simulate``.
+    ``backend="batch"`` steps the runs of a PD, PID or SMC course-keeping scenario together
+    as arrays, bit for bit the in-process route's, holding the columns ``signals`` (default
+    ``cosim.ensemble.reference.SIGNALS``); what the kernel does not cover runs in-process,
+    saying so in ``meta["notes"]``. A failed run raises nothing: its ``error`` says why.
+    ValueError naming ``member i`` for a setting refused before anything runs.
     """
     if backend not in (*RUN_BACKENDS, "batch"):
         raise ValueError(f"backend must be fmi, inprocess or batch, got {backend!r}")
@@ -144,8 +124,8 @@ def simulate_many(scenario: str | Path, sets: Sequence[Mapping[str, Any]],
 def _one_at_a_time(system: SystemDescription, overrides: list[dict[str, dict[str, Any]]],
                    stop_time: float | None, backend: str, signals: Sequence[str] | None
                    ) -> list[Recording]:
-    """Each member's run with one master, reset between runs (made again after a failed
-    one); every member's settings checked before the first runs."""
+    """Each member's run on one master, reset between runs (made anew after a failed one);
+    every member's settings checked before the first runs."""
     master = Master(system, backend=backend)
     recordings = []
     try:

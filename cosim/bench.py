@@ -1,4 +1,4 @@
-"""Benchmarks that print figures (no timed assertions in the tests).
+"""Benchmarks that print figures, with the machine and the load (docs/performance.md).
 
     python -m cosim.bench                 engines side by side, calm_pd and waves_pd, 400 s
     python -m cosim.bench overhead        the masters' own work, with the ship's step idle
@@ -7,19 +7,13 @@
                                           FMI, in-process and batch backends with 1 and 2
                                           workers, in waves and calm water; 1,000 waves_pd
                                           runs on the batch route on 2 workers; the batch
-                                          route's memory (about 10 min; --parts for some)
+                                          route's memory (--parts for some)
 
-The default benchmark measures, for each scenario, (a) the plain Python modules
-wired by hand (cosim.studies.direct), our master (b) on its in-process backend and
-(c) through the FMUs, (d) OSP libcosim and (e) ecos on the exported SSP package of the
-same scenario, timed in turn round after round (the median of each), and (f) the
-floor of any FMI route: (a) plus the FMI calls per step times the measured cost of
-one call. One table per scenario, with the ratios.
-
-The sweep benchmark prints each goal of the batch route (issue 29) beside its figure: runs/s
-per core at least 5x the in-process route's in waves, 10x in calm water; 1,000 waves_pd
-runs of 400 s in under 30 s on 2 workers (``--parts campaign`` alone); a worker's memory
-flat in the sweep's size.
+The default benchmark times (a) the plain Python modules wired by hand, our master (b)
+in-process and (c) through the FMUs, (d) OSP libcosim and (e) ecos on the exported SSP
+package, in turn round after round, and (f) the floor of any FMI route: (a) plus the FMI
+calls per step times the measured cost of one. The sweep benchmark prints each goal of the
+batch route beside its figure.
 """
 from __future__ import annotations
 
@@ -27,7 +21,7 @@ import argparse
 import sys
 
 from ._cli import entry, say_error
-from .studies import bench, bench_sweep
+from .studies import memory, sweep_timing, timing
 
 SWEEP_PARTS = ("throughput", "campaign", "memory")
 
@@ -71,22 +65,22 @@ def main(argv: list[str] | None = None) -> int:
                             "calm_smc, or both (default)")
     sweep.add_argument("--rounds", type=int, default=1,
                        help="throughput sweeps of each backend, in turn (default 1); medians")
-    sweep.add_argument("--campaign-runs", type=int, default=bench_sweep.CAMPAIGN_RUNS,
+    sweep.add_argument("--campaign-runs", type=int, default=sweep_timing.CAMPAIGN_RUNS,
                        help=f"waves_pd runs of the campaign (default "
-                            f"{bench_sweep.CAMPAIGN_RUNS}, the issue's)")
-    sweep.add_argument("--memory-members", type=_counts, default=bench_sweep.MEMORY_MEMBERS,
+                            f"{sweep_timing.CAMPAIGN_RUNS})")
+    sweep.add_argument("--memory-members", type=_counts, default=memory.MEMORY_MEMBERS,
                        help="members of the memory measurement, comma-separated (default "
-                            + ",".join(map(str, bench_sweep.MEMORY_MEMBERS)) + ")")
+                            + ",".join(map(str, memory.MEMORY_MEMBERS)) + ")")
     args = parser.parse_args(argv)
     try:
         if args.command == "memory":
-            bench.memory(args.hours)
+            memory.memory(args.hours)
         elif args.command == "sweep":
             _sweep(args)
         elif args.command == "overhead":
-            bench.overhead(args.repeats)
+            timing.overhead(args.repeats)
         else:
-            bench.engines(args.repeats)
+            timing.engines(args.repeats)
     except (RuntimeError, ValueError, FileNotFoundError) as error:   # e.g. stale FMUs
         say_error(error)
         return 2
@@ -97,11 +91,11 @@ def _sweep(args: argparse.Namespace) -> None:
     """The parts of the sweep benchmark asked for, in their order."""
     if "throughput" in args.parts:
         seas = ("waves", "calm") if args.sea == "both" else (args.sea,)
-        bench_sweep.sweep_throughput(args.runs, args.batch_runs, seas, rounds=args.rounds)
+        sweep_timing.sweep_throughput(args.runs, args.batch_runs, seas, rounds=args.rounds)
     if "campaign" in args.parts:
-        bench_sweep.campaign(args.campaign_runs)
+        sweep_timing.campaign(args.campaign_runs)
     if "memory" in args.parts:
-        bench_sweep.batch_memory(args.memory_members)
+        memory.batch_memory(args.memory_members)
 
 
 if __name__ == "__main__":

@@ -2,9 +2,8 @@
 
     python -m cosim.engines libcosim results/ssp/calm_pd.ssp --out trace.npz
 
-Runs the engine in a child process (an engine that aborts does not take this
-command with it), checks what it recorded, and saves the signals; a failure is
-exit status 1 with the engine's and the FMU's messages.
+Runs the engine in a child process (one that aborts does not take this command with it)
+and saves the signals; a failure is status 1 with the engine's and the FMU's messages.
 """
 from __future__ import annotations
 

@@ -5,16 +5,9 @@
     python -m cosim.export waves_pd --autopilot my.fmu   -> results/ssp/waves_pd-my.ssp
     python -m cosim.export calm_pd --fmi 3         -> results/ssp/fmi3/calm_pd.ssp
 
-The package is a zip holding SystemStructure.ssd (components, connections, the
-scenario's parameter values, the fixed step as OSP's and OpenModelica's annotations)
-and resources/<fmu>.fmu for every FMU it uses; beside it, DIR/<label>/ holds OSP's
-OspSystemStructure.xml and the FMUs (``cosim.interop.ssp``). OSP libcosim, ecos,
-fmpy, OMSimulator and OSP's tools load them unchanged (docs/interop.md). A String
-parameter value that OMSimulator and fmpy's SSP runner would not apply is named in a
-warning (the guidance's route is written as numbers, which they do apply). With
-``--fmi 3`` the package holds this project's FMI 3.0 twins (fmus/fmi3/): ecos and
-OMSimulator run it, libcosim and fmpy's SSP runner cannot (FMI 2.0 only), and the
-command says so.
+The package (``cosim.interop.ssp``, docs/interop.md) holds SystemStructure.ssd and every
+FMU; beside it, DIR/<label>/ holds OSP's OspSystemStructure.xml and the FMUs. What another
+tool would not apply (a String value; FMI 3.0 FMUs for FMI 2.0 tools) is said.
 """
 from __future__ import annotations
 

@@ -1,18 +1,11 @@
-"""A run and what it writes: the one lifecycle behind ``cosim.run`` and any caller of the library.
+"""A run and what it writes: the one lifecycle behind ``cosim.run`` and any library caller.
 
-``run_and_write`` runs a system description with the master (freed however the run
-ends) and writes, as ``label`` in a folder: the CSV of every signal at every step
-(streamed as the run goes with ``stream``), the metadata JSON (``core.provenance``)
-and, for a finished run, its figure (``analysis.kinds``) and an animation if asked.
-
-Nothing of a previous run is touched until the new outputs are complete: they are
-written into a hidden folder beside them and put in place together
-(``core.files.Outputs``), and only then are the previous run's other files of that
-label (``SUFFIXES``, by exact name) removed, so that none is left to mislead. A
-refused run, a full disk or a second Ctrl-C leaves the folder as it was. One process
-writes into a folder at a time (``core.files.FolderLock``). The run has time limits
-(``core.watchdog``). It prints nothing: the ``Outcome`` says what happened, and the
-report.
+``run_and_write`` runs a system with the master and writes, as ``label`` in a folder, the
+CSV (streamed with ``stream``), the metadata JSON and, for a finished run, its figure and
+animation. The new outputs are staged in a hidden folder and put in place together; only
+then are the previous run's files of that label removed, so a refused run, a full disk or
+a second Ctrl-C leaves the folder as it was. One process writes into a folder at a time.
+It prints nothing: the ``Outcome`` says what happened.
 """
 from __future__ import annotations
 
@@ -28,13 +21,12 @@ from .analysis.kinds import Analysis, analysis
 from .core.files import FolderLock, Outputs
 from .core.interrupt import StopSignals
 from .core.master import Master
-from .core.provenance import write_metadata
+from .provenance import write_metadata
 from .core.recording import Recording
 from .core.ssd import SystemDescription
 from .core.watchdog import Limits, TimeLimit, Watchdog
 
-SUFFIXES = (".csv", ".json", ".png", ".svg", ".pdf", ".gif", ".mp4")
-"""What a run writes, by suffix: a previous run's files of these are removed first."""
+SUFFIXES = (".csv", ".json", ".png", ".svg", ".pdf", ".gif", ".mp4")   # a run's files
 
 
 @dataclass(frozen=True)
@@ -66,7 +58,6 @@ class Outcome:
     report: list[str] = field(default_factory=list)   # the report's lines, for a finished run
     cost: Cost | None = None                          # eq (19), for course keeping
     status: int = 0             # 0, 1 if an FMU failed, 130 / 143 if a signal stopped it
-    # (a run that failed before its first row writes nothing: ``written`` is empty)
     late_signal: bool = False   # a signal came after the last step: the outputs are whole
 
 
@@ -76,14 +67,12 @@ def run_and_write(system: SystemDescription, label: str, out: Path,
                   progress: Callable[[int, int], None] | None = None,
                   stop: StopSignals | None = None,
                   notes: Callable[[str], None] | None = None) -> Outcome:
-    """Run ``system`` and write its outputs as ``label`` in ``out``; see the module docstring.
+    """Run ``system`` and write its outputs as ``label`` in ``out``.
 
-    ``notes`` hears what the user should know of how it runs (a component through FMI,
-    say) as soon as the FMUs are instantiated; ``stop`` ends the run between two steps
-    once it has received a signal. ValueError or FileNotFoundError for bad input;
-    FmuCallError if an FMU cannot be instantiated; TimedOut if that takes longer than the
-    step time limit; ``core.files`` FolderBusy if another process writes into ``out``,
-    OutputError if a file cannot be written: in each case ``out`` is as it was.
+    ``notes`` hears how it runs (a component through FMI, say) once the FMUs are up;
+    ``stop`` ends the run between two steps once it has a signal. ValueError,
+    FileNotFoundError, FmuCallError, TimedOut, FolderBusy or OutputError leave ``out`` as
+    it was.
     """
     kind = analysis(system.report)
     stale = [out / f"{label}{suffix}" for suffix in SUFFIXES]

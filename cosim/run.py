@@ -43,12 +43,10 @@ from .scenarios.autopilot import COMPONENT
 from .studies.spread import PERTURBED, spread
 
 
-
 def run_scenario(system: SystemDescription, label: str, out: Path, overrides: dict,
                  options: Options) -> tuple[int, Cost | None]:
-    """Simulate one system and write its outputs as ``label`` (``cosim.outputs``); print
-    what it was and its report. The status is 0, 1 if an FMU failed, or 130 / 143 if
-    Ctrl-C or SIGTERM stopped the run (its rows are written all the same)."""
+    """Simulate one system, write its outputs as ``label`` and print its report; the status
+    0, 1 if an FMU failed, 130 / 143 if Ctrl-C or SIGTERM stopped it (its rows written)."""
     with StopSignals() as stop:           # from here on, a signal stops between steps
         progress = Progress(label)
         try:
@@ -92,8 +90,8 @@ class Run(NamedTuple):
 
 def runs_asked(names: list[str], paper: bool, autopilot: Path | None,
                name: str | None) -> list[Run]:
-    """Every run of the command line. With --all and --autopilot, the user's autopilot also
-    runs in calm_pd's and waves_pd's place: same route, ship and sea, another controller."""
+    """Every run of the command line; with --all and --autopilot, the user's autopilot also
+    in calm_pd's and waves_pd's place."""
     if not paper:
         return [Run(names[0], scenarios.label(names[0], autopilot, name), autopilot, None)]
     runs = [Run(scenario, scenario, None, tuple(scenario.split("_"))) for scenario in names]
@@ -129,11 +127,9 @@ def main(argv: list[str] | None = None) -> int:
                         help=f"weight of eq (19) (default {LAMBDA:.4f}, calibrated on calm_pd)")
     parser.add_argument("--backend", choices=RUN_BACKENDS, default="fmi",
                         help="fmi: load the FMUs through FMI (default); inprocess: call the "
-                             "FMUs' Python classes directly, without FMI: the same results "
-                             "bit for bit, about 1.5-2.5 times faster. An FMU that is not "
-                             "one of ours, or was built from other sources than this "
-                             "checkout's (rebuild: python -m fmukit.build), runs through FMI, "
-                             "with a note")
+                             "FMUs' Python classes, without FMI, with the same results bit for "
+                             "bit (an FMU not built from this checkout's sources runs through "
+                             "FMI, with a note)")
     add_fmi_option(parser)
     add_autopilot_options(parser, "with --all it also runs in calm_pd's and waves_pd's "
                                   "place, as an extra row of Tables 1-2")
@@ -147,15 +143,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--spread", nargs="?", type=int, const=20, metavar="ULPS",
                         help="also run each course-keeping scenario with "
                              f"{' and then '.join('.'.join(p) for p in PERTURBED)} moved by "
-                             "1 ... ULPS units in the last place either way (4 ULPS more "
-                             "runs, in-process; ULPS = 20 if not given, as in the published "
-                             "tables) and print how far that moves psi_E, delta_E and J "
-                             "(the largest change), where it shows at the printed digits")
+                             "1 ... ULPS units in the last place either way (20 if not "
+                             "given) and print how far that moves psi_E, delta_E and J")
     parser.add_argument("--stream", action="store_true",
                         help="write rows to the CSV in chunks as the run goes: flat memory "
-                             "for long runs (--stop-time 86400); no report or figure. (The "
-                             "CSV grows in a hidden folder .partial-SCENARIO-* beside it, and "
-                             "takes its name when the run ends)")
+                             "for long runs; no report or figure")
     parser.add_argument("--step-timeout", type=positive_seconds, default=STEP_LIMIT_S,
                         metavar="S",
                         help="end the run with an error if one step of the FMUs (or their "

@@ -25,7 +25,7 @@ from .api import overrides_of
 from .core.files import FolderBusy, OutputError
 from .outputs import TimedOut
 from .studies.scorecard import BASELINES, SEAS, backend_notes, score
-from .studies.sweep_client import NoWorkers, SweepError
+from .studies.cluster import NoWorkers, SweepError
 from .studies.sweep_spec import MAX_RUNS
 from .studies.sweep_task import SWEEP_BACKENDS
 
@@ -53,14 +53,14 @@ def main(argv: list[str] | None = None) -> int:
                                                     "(default: one per core)")
     parser.add_argument("--backend", choices=SWEEP_BACKENDS, default="fmi",
                         help="fmi: every run through the FMUs (default); inprocess: this "
-                             "project's FMUs as Python classes, without FMI: the same results, "
-                             "about 1.3-2 times faster. Yours runs in-process only if it is one "
-                             "of ours built from this checkout; any FMU that runs through FMI "
-                             "instead is noted before the scorecard starts. batch: the single "
-                             "runs in-process, the ensembles' PD, SMC and PID runs in batches "
-                             "stepped together as arrays (the same results again, many times "
-                             "faster); yours too if it is our PD, PID or SMC, else "
-                             "in-process, one run per task, with a note")
+                             "project's FMUs as Python classes, without FMI, with the same "
+                             "results. Yours runs in-process only if it is one of ours built "
+                             "from this checkout; any FMU that runs through FMI instead is "
+                             "noted before the scorecard starts. batch: the single runs "
+                             "in-process, the ensembles' PD, SMC and PID runs in batches "
+                             "stepped together as arrays (the same results again); yours too "
+                             "if it is our PD, PID or SMC, else in-process, one run per task, "
+                             "with a note")
     parser.add_argument("--out", type=Path, help="output folder (default: results/score/NAME)")
     args = parser.parse_args(argv)
     if not 1 <= args.seeds <= MAX_RUNS // 4:

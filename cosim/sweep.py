@@ -1,4 +1,4 @@
-"""The command line of ``cosim.studies.sweep``: python -m cosim.sweep SPEC [options]."""
+"""python -m cosim.sweep SPEC [options]: a Monte Carlo sweep on Dask (docs/sweeps.md)."""
 from __future__ import annotations
 
 import argparse
@@ -12,24 +12,24 @@ from ._cli import entry, positive_seconds, say_error, say_note, writable_folder
 from .core.files import write_atomically
 from .core.interrupt import Interrupted
 from .core.watchdog import STEP_LIMIT_S, Limits
-from .studies import sweep
+from .studies import campaign
 from .studies.cluster import CONNECT_TIMEOUT
-from .studies.sweep_client import MAX_BATCH, MIN_BATCH, NoWorkers, SweepError
+from .studies.cluster import NoWorkers, SweepError
+from .studies.sweep_client import MAX_BATCH, MIN_BATCH
 from .studies.sweep_figures import save_figures
 from .studies.sweep_spec import MAX_RUNS, Spec
 from .studies.sweep_task import BATCH, SWEEP_BACKENDS
-from .studies.sweep_tables import (
-    MONTE_CARLO,
-    comparison,
-    distinct,
-    summary,
-    write_tables,
-)
+from .studies.sweep_tables import MONTE_CARLO, comparison, distinct, summary, write_tables
 
 RESULTS = Path("results/sweeps")
-USAGE = sweep.__doc__.partition("\n\nModules: ")[0]
-"""--help: the sweep's documentation, without its closing paragraph on the modules."""
+EXAMPLES = """\
+  python -m cosim.sweep docs/sweeps/smc_vs_pd.toml             # local cluster, 1 worker/core
+  python -m cosim.sweep SPEC --scheduler tcp://host:8786       # an existing Dask cluster
+  python -m cosim.sweep SPEC --workers 2 --csv --out results/sweeps
+  python -m cosim.sweep SPEC --backend batch                   # many runs per task
 
+SPEC is a TOML file of controllers, axes and plots: docs/sweeps.md documents it, the
+outputs, resuming and clusters; docs/sweeps/example.toml is a small one."""
 
 OUTPUTS = ("results.parquet", "results.json", "results.csv", "summary.csv", "J_distribution.png",
            "tracks.png", "J_*_over_pd.png", "comparison.md")
@@ -47,9 +47,9 @@ def count(text: str) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m cosim.sweep",
-                                     description=USAGE.split("\n\n")[0],
-                                     epilog="\n\n".join(USAGE.split("\n\n")[1:]),
+    parser = argparse.ArgumentParser(prog="python -m cosim.sweep", epilog=EXAMPLES,
+                                     description="Ensembles of co-simulations on Dask: Monte "
+                                                 "Carlo over seeds, sea states and settings.",
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("spec", type=Path, help="sweep file (TOML)")
     parser.add_argument("--scheduler", metavar="ADDRESS",
@@ -70,20 +70,19 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, default=RESULTS, help="parent folder of the results")
     parser.add_argument("--backend", choices=SWEEP_BACKENDS, default="fmi",
                         help="fmi: each run through the FMUs (default); inprocess: this "
-                             "project's FMUs as Python classes, without FMI: the same results, "
-                             "about 1.3-2 times faster per run (an FMU not of this checkout "
-                             "runs through FMI, with a note); batch: the runs of each PD, PID "
-                             "or SMC system in batches, one task each, stepped together as "
-                             "arrays: the in-process route's rows, bit for bit, many times "
-                             "faster (a system it does not cover runs in-process, with a note)")
+                             "project's FMUs as Python classes, without FMI, the same results "
+                             "(an FMU not of this checkout runs through FMI, with a note); "
+                             "batch: the runs of each PD, PID or SMC system in batches, one "
+                             "task each, stepped together as arrays: the in-process route's "
+                             "rows, bit for bit (a system it does not cover runs in-process, "
+                             "with a note)")
     parser.add_argument("--batch-size", type=count, metavar="N",
                         help="with --backend batch: at most N runs a batch (default: as few "
-                             f"batches as keep every worker busy, of at most {MAX_BATCH} runs "
-                             f"and at least {MIN_BATCH} where there are that many, and in "
-                             "waves a share of each system for every worker; memory: about "
-                             "0.2 MB a run of 400 s)")
+                             "batches as keep every worker busy, of at most "
+                             f"{MAX_BATCH} runs and at least {MIN_BATCH} where there are that "
+                             "many; docs/sweeps.md)")
     parser.add_argument("--no-worker-timeout", type=positive_seconds, metavar="SECONDS",
-                        default=sweep.NO_WORKER_TIMEOUT,
+                        default=campaign.NO_WORKER_TIMEOUT,
                         help="stop when the cluster has had no worker for this long, keeping "
                              "every row done (exit status "
                              f"{NoWorkers.exit_status}; default: %(default)g s)")
@@ -118,12 +117,13 @@ def main(argv: list[str] | None = None) -> int:
     try:
         for note in [*spec.backend_notes(args.backend), *spec.sharing_notes()]:
             say_note(note)
-        rows = sweep.execute(spec, out, args.scheduler, args.workers,
-                             progress=not args.no_progress, scheduler_file=args.scheduler_file,
-                             backend=args.backend, no_worker_timeout=args.no_worker_timeout,
-                             connect_timeout=args.connect_timeout,
-                             limits=Limits(args.step_timeout, args.run_timeout),
-                             batch_size=args.batch_size)
+        rows = campaign.execute(spec, out, args.scheduler, args.workers,
+                                progress=not args.no_progress,
+                                scheduler_file=args.scheduler_file, backend=args.backend,
+                                no_worker_timeout=args.no_worker_timeout,
+                                connect_timeout=args.connect_timeout,
+                                limits=Limits(args.step_timeout, args.run_timeout),
+                                batch_size=args.batch_size)
         stage = "writing the tables"
         written = write_tables(rows, out, args.csv, spec)
         stage = "drawing the figures"
@@ -169,9 +169,8 @@ def _comparison(spec: Spec, rows: list[dict]) -> str:
 
 def _stopped(stopped: Interrupted | NoWorkers, stage: str, spec: Spec, out: Path, csv: bool,
              resume: str) -> int:
-    """Say what an interrupted or workerless sweep keeps, at whatever stage it stopped, and
-    how to resume it; its exit status."""
-    rows = sweep.completed(spec, out)
+    """Say what an interrupted or workerless sweep keeps and how to resume it; its status."""
+    rows = campaign.completed(spec, out)
     written = []
     if stage == "running the sweep" and rows:
         written = write_tables(rows, out, csv, spec)

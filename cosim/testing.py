@@ -1,16 +1,10 @@
 """A pytest plugin for your autopilot: options, fixtures, and checks of the exchanged signals.
 
-Installed with the project (a ``pytest11`` entry point), so every test run in this
-environment has it:
+Installed as a ``pytest11`` entry point; importing it has no side effect on the process:
 
     pytest docs/own_autopilot/test_my_autopilot.py --autopilot my.fmu [--map psi=heading]
 
-Options: ``--autopilot FMU``, ``--map PORT=NAME``, ``--set COMPONENT.VAR=VALUE``,
-``--heading-bound DEG`` (default 5) and ``--settle-time S`` (default 60). Fixtures:
-``autopilot`` (the FMU, or None for the scenario's own), ``autopilot_map``,
-``cosim_simulate`` (``cosim.simulate`` with them applied) and
-``heading_requirement`` (bound in rad, settle time in s). The ``check_*`` functions
-raise AssertionError saying what is wrong, where and when.
+The ``check_*`` functions raise AssertionError saying what is wrong, where and when.
 """
 from __future__ import annotations
 
@@ -101,9 +95,7 @@ def _settled(run: Recording, within: float) -> np.ndarray:
 
 
 def check_rudder_within_stops(run: Recording, within: float = 60.0) -> None:
-    """Once a course change has settled (``within`` s), the autopilot asks for no more rudder
-    than the stops give: a command beyond them (the gear clips it) is a controller fighting
-    what it cannot have."""
+    """Once a course change has settled (``within`` s), no rudder command beyond the stops."""
     delta_max = run.meta["parameters"]["ship"]["delta_max"]
     command = np.where(_settled(run, within), np.abs(run["ship.delta_c"]), 0.0)
     k = int(np.argmax(command))
@@ -114,8 +106,7 @@ def check_rudder_within_stops(run: Recording, within: float = 60.0) -> None:
 
 
 def check_rudder_rate(run: Recording, share: float = 0.5) -> None:
-    """The rudder moves at the steering gear's full rate for at most ``share`` of the run: an
-    autopilot that keeps it there asks for more than the gear can give (it chatters)."""
+    """The rudder moves at the gear's full rate for at most ``share`` of the run (no chatter)."""
     rate_max = run.meta["parameters"]["ship"]["delta_rate_max"]
     rate = np.abs(np.diff(run["ship.delta"]) / np.diff(run.t))
     at_limit = float(np.mean(rate >= rate_max * (1 - 1e-9)))
@@ -125,11 +116,8 @@ def check_rudder_rate(run: Recording, share: float = 0.5) -> None:
 
 
 def check_heading_settles(run: Recording, bound: float, within: float) -> None:
-    """After each course change, |psi_d - psi| <= bound from ``within`` s on, to the leg's end.
-
-    A leg is the time between two switches of ``guidance.wp_index``; legs shorter
-    than ``within`` are not judged.
-    """
+    """After each course change (a switch of ``guidance.wp_index``), |psi_d - psi| <= bound
+    from ``within`` s on to the leg's end; shorter legs are not judged."""
     t, leg = run.t, run["guidance.wp_index"]
     error = np.abs(heading_error(run["guidance.psi_d"], run["ship.psi"]))
     starts = [0, *(np.flatnonzero(np.diff(leg)) + 1)]

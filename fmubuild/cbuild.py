@@ -13,8 +13,10 @@ import sys
 import tempfile
 from pathlib import Path
 
+from fmukit.manifest import version
+
 from . import documentation, reproducible
-from .manifest import project_identity, version
+from .manifest import project_identity
 from .project import C_FMUS, FMU_DIRS, ROOT
 
 FILES = {2: ("{name}.c", "modelDescription.xml"),

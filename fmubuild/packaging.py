@@ -24,9 +24,11 @@ from collections.abc import Mapping
 from importlib import metadata
 from pathlib import Path
 
+from fmukit.manifest import DISTRIBUTION, Manifest, digest_of, sha256, version
+
 from . import documentation, exit_fix, reproducible
 from .imports import needed_modules
-from .manifest import DISTRIBUTION, Manifest, digest_of, project_identity, sha256, version
+from .manifest import project_identity
 from .project import FMU_DIRS, FMUS, ROOT
 from .routes import ROUTES
 from .instantiate import InstantiationFailed, instantiate_in_child

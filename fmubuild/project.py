@@ -19,6 +19,8 @@ FMUS: dict[str, str] = {
     "pid_autopilot": "autopilot_fmu/pid_autopilot_slave.py",
 }
 """FMU name: its slave script. An FMU carries the project modules its script imports."""
+SLAVE_MODULES = frozenset(".".join(Path(script).with_suffix("").parts) for script in FMUS.values())
+"""The modules of those scripts, as a manifest names them."""
 
 C_FMUS = {"pd_autopilot_c": "autopilot_fmu/pd_autopilot_c"}
 """FMU name: the folder of its C source and model description."""

@@ -1,12 +1,10 @@
-"""Rigid-body and hydrodynamic terms of the 3-DOF manoeuvring model, eqs (1)-(6).
+"""Rigid-body and hydrodynamic terms of the 3-DOF manoeuvring model, eqs (1)-(6):
 
     eta_dot = R(psi) nu                              (1), (2)
     M nu_dot + C(nu) nu + D(nu) nu = tau             (3)
 
-with eta = [x, y, psi] (north, east, heading) and nu = [u, v, r] (surge, sway,
-yaw rate). The functions return the force vectors C(nu) nu and D(nu) nu rather
-than the matrices: that is what the integrator needs, and the tests check the
-energy properties on exactly these vectors.
+with eta = [x, y, psi] (north, east, heading) and nu = [u, v, r]. C(nu) nu and D(nu) nu are
+returned as force vectors, which is what the integrator needs.
 """
 from __future__ import annotations
 
@@ -22,10 +20,8 @@ Vector3 = tuple[float, float, float]
 
 def kinematics(psi: float, u: float, v: float, r: float,
                cos: Callable = math.cos, sin: Callable = math.sin) -> Vector3:
-    """Earth-fixed velocity eta_dot = R(psi) nu, eqs (1)-(2).
-
-    ``cos`` and ``sin``: numpy's, for states that are arrays (``cosim.ensemble``).
-    """
+    """Earth-fixed velocity eta_dot = R(psi) nu, eqs (1)-(2); numpy's ``cos`` and ``sin``
+    for arrays of states (``cosim.ensemble``)."""
     c, s = cos(psi), sin(psi)
     return u * c - v * s, u * s + v * c, r
 

@@ -1,9 +1,5 @@
-"""A rudder program as an FMI 2.0 co-simulation FMU (fmus/manoeuvre.fmu).
-
-Drives the ship alone through a turning circle (psi_switch = 0) or a zig-zag test.
-delta_c is direct feedthrough from the heading: evaluated when read, with a rudder
-reversal committed at the end of each step.
-"""
+"""A rudder program as an FMI 2.0 co-simulation FMU (fmus/manoeuvre.fmu): delta_c is direct
+feedthrough from the heading, a rudder reversal committed at the end of each step."""
 import math
 
 from fmukit.slave import DefaultExperiment, ModelSlave, Var

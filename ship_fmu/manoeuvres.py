@@ -1,25 +1,16 @@
-"""Standard manoeuvres (IMO MSC.137(76) definitions): the rudder program of a turning
-circle or a zig-zag test (the ship run alone under it: ``ship_fmu.trial``).
+"""The rudder program of a turning circle or a zig-zag test (IMO MSC.137(76)).
 
-The ship starts in steady straight running; a positive rudder turns it to port
-(see ``thrusters``), so headings here go negative first. The manoeuvre FMU
-(``manoeuvre_slave``) runs the program and carries nothing else of the ship; the
-figures of a run, recorded or from ``trial``, are post-processing:
-``cosim.analysis.manoeuvres``.
-"""
+A positive rudder turns the ship to port, so headings go negative first. The figures of a
+run are post-processing (``cosim.analysis.manoeuvres``)."""
 from __future__ import annotations
 
 import math
 
 
 class RudderProgram:
-    """Rudder command of a turning circle or a zig-zag test.
-
-    Executes ``delta`` at t = 0. With psi_switch > 0 the rudder is reversed each time
-    the heading deviation passes -+psi_switch (a delta/psi_switch zig-zag); with
-    psi_switch = 0 it is held (a turning circle). ``command`` evaluates the rule at
-    a heading without committing it; ``update`` commits it.
-    """
+    """Executes ``delta`` at t = 0; with psi_switch > 0 reverses it each time the heading
+    deviation passes -+psi_switch (a zig-zag), with psi_switch = 0 holds it (a turning
+    circle). ``command`` evaluates the rule at a heading, ``update`` commits it."""
 
     def __init__(self, delta: float = math.radians(20.0),
                  psi_switch: float = math.radians(20.0)):

@@ -1,8 +1,7 @@
 """The vessel as an FMI 2.0 co-simulation FMU (fmus/ship.fmu): wraps ship_fmu.vessel.
 
-Inputs are held over each communication step. No output depends on an input at
-the same instant (the rudder acts through the steering gear and the hull's
-inertia), so the model structure declares no direct feedthrough.
+Inputs are held over each step; no output depends on an input at the same instant (the
+rudder acts through the steering gear and the hull's inertia): no direct feedthrough.
 """
 import math
 from dataclasses import fields

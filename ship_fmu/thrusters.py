@@ -1,23 +1,15 @@
-"""Propellers, bow thruster and rudders: tau_th = T u, eqs (8)-(13).
+"""Propellers, bow thruster and rudders: tau_th = T u, eqs (8)-(13); n in rev/s, delta in rad.
 
-Shaft speeds n are in rev/s, rudder angles in rad. Both rudders sit in the
-slipstream of their propeller and take the same angle delta.
-
-The paper prints the first two rows of the actuator matrix T, eq (13), as zeros.
-The real matrix (Sveen 2003; Skjetne 2004) puts T_i - D_i of the main propellers
-into surge, the bow thruster and both rudder lifts into sway, and keeps the printed
-yaw row::
+The paper prints the first two rows of T, eq (13), as zeros; the real matrix (Sveen 2003;
+Skjetne 2004) puts T_i - D_i of the main propellers into surge, the bow thruster and both
+rudder lifts into sway::
 
         [ 1      1     0      0      0    ]
     T = [ 0      0     1      1      1    ]
         [ l_yT  -l_yT  l_xT3 -l_xR  -l_xR ]
 
-Which way a positive rudder turns the ship: with n > 0, a positive delta gives a
-positive lift L_i (eq 9, since k_Ld1 + k_Ld2 |delta| > 0 up to 95 deg), i.e. a
-force to starboard at the stern and a negative yaw moment -l_xR (L_1 + L_2). The
-ship turns to port: **positive rudder -> r < 0, psi decreasing**. The linear model
-of eq (45) agrees (b_1 > 0, b_2 < 0), and so does the PD law of eq (20), which
-commands a negative rudder to increase the heading.
+With n > 0 a positive rudder gives a positive lift (eq 9) and a negative yaw moment:
+**positive rudder -> r < 0, psi decreasing**, as eqs (20) and (45) agree.
 """
 from __future__ import annotations
 
@@ -33,13 +25,9 @@ def thrust(n: float, k_p: float, k_n: float) -> float:
 
 def actuator_model(act: Actuators, n1: float, n2: float,
                    n3: float) -> Callable[[float], tuple[float, float, float]]:
-    """tau_th as a function of the rudder angle, at fixed shaft speeds, eqs (8)-(13).
-
-    What depends on the shaft speeds only (thrust, and the slipstream factors
-    T_i (1 + k_Ln n_i), T_i (1 + k_Dn n_i) of eqs (9)-(10)) is computed here once;
-    the returned function adds the rudder's part. Both rudders take the angle delta;
-    a propeller turning astern (n_i < 0) gives its rudder no lift or drag.
-    """
+    """tau_th as a function of the rudder angle at fixed shaft speeds, eqs (8)-(13): the
+    thrusts and slipstream factors T_i (1 + k_Ln n_i), T_i (1 + k_Dn n_i) computed once. A
+    propeller turning astern (n_i < 0) gives its rudder no lift or drag."""
     T1 = thrust(n1, act.k_Tp, act.k_Tn)
     T2 = thrust(n2, act.k_Tp, act.k_Tn)
     T3 = thrust(n3, act.k_T3p, act.k_T3n)

@@ -1,18 +1,10 @@
 """The vessel: CyberShip II hull, actuators, steering gear and waves, integrated by RK4.
 
-This is the in-process model that ``ship_slave`` wraps as an FMU and that tests and
-the in-process master call directly. Its parameters carry the FMU's names.
-
-Integration: classical fixed-step RK4 over (x, y, psi, u, v, r, xi), with the
-inputs held over the communication step (zero-order hold, as a co-simulation
-master delivers them). A communication step h is cut into ceil(h / h_max) equal
-sub-steps. The rudder angle is the steering gear's exact piecewise-linear
-response, and the wave loads are evaluated at every RK4 stage. Where the rudder
-reaches its command or its stop within a step, the step is cut there too: the
-rudder angle has a kink at that instant, and RK4 keeps its fourth order only on
-pieces where the inputs are smooth, so with the cut the integration converges as
-fast as in between (``cosim.accuracy``). The heading psi
-is integrated continuously (not wrapped), so it shows full turns.
+Fixed-step RK4 over (x, y, psi, u, v, r, xi) with the inputs held over the communication
+step, cut into ceil(h / h_max) equal sub-steps, and cut where the rudder reaches its
+command or stop (its angle has a kink there, and RK4 keeps its order only on smooth
+pieces: ``cosim.accuracy``). The rudder angle is the steering gear's exact response, the
+wave loads are evaluated at every stage, psi is not wrapped. Parameters carry the FMU's names.
 """
 from __future__ import annotations
 
@@ -73,8 +65,7 @@ class VesselParameters:
         ):
             if not ok:
                 raise ValueError(f"parameter {name} must be {rule}, got {getattr(self, name)}")
-        # Waves steeper than Hs / lambda_p = 1/7 break (Stokes' limit); the block model's
-        # loads, which grow with the slope, are meaningless there and diverge.
+        # steeper waves break (Stokes' limit): the block model's loads would diverge
         peak_wavelength = G * self.T0 * self.T0 / (2.0 * math.pi)
         if self.Hs > peak_wavelength / MAX_STEEPNESS:
             raise ValueError(f"parameter Hs = {self.Hs} m with T0 = {self.T0} s: steepness "
@@ -98,7 +89,7 @@ class Vessel:
         self._m11_inv = 1.0 / M[0][0]
         self._minv = (M[2][2] / det, -M[1][2] / det, -M[2][1] / det, M[1][1] / det)
         self.waves = None
-        self._wave_loads = _calm_water
+        self._wave_loads = calm_water
         if params.Hs > 0.0:
             components = WaveComponents.from_spectrum(
                 params.Hs, params.T0, params.wave_components, params.wave_seed)
@@ -107,16 +98,12 @@ class Vessel:
         self._shaft_speeds, self._forces = None, None  # the last shaft speeds, their tau_th
         self.x, self.y, self.psi = params.x0, params.y0, params.psi0
         self.u, self.v, self.r = params.u0, params.v0, params.r0
-        self.delta = 0.0
-        self.xi = 0.0
-        self.t = 0.0
+        self.delta = self.xi = self.t = 0.0
         self.X_w, self.Y_w, self.N_w = self._wave_loads(self.t, self.xi, self.psi)
 
     def rates(self, t: float, state: State, tau_th: tuple[float, float, float]) -> State:
-        """Time derivative of (x, y, psi, u, v, r, xi), eqs (1)-(17) (``state_rates``).
-
-        tau_th: the actuator forces, from ``thrusters.actuator_model``.
-        """
+        """Time derivative of (x, y, psi, u, v, r, xi), eqs (1)-(17), under the actuator
+        forces tau_th (``thrusters.actuator_model``)."""
         return state_rates(self.hull, self._minv, self._m11_inv, self._wave_loads,
                            self.params.psi_w, t, state, tau_th)
 
@@ -170,11 +157,9 @@ class Vessel:
         return n_sub, length / n_sub
 
     def snapshot(self) -> dict[str, float]:
-        """The complete dynamic state, as plain floats."""
         return {name: getattr(self, name) for name in self.STATE}
 
     def restore(self, snapshot: dict[str, float]) -> None:
-        """Return to a state taken by ``snapshot``."""
         for name in self.STATE:
             setattr(self, name, float(snapshot[name]))
         self.X_w, self.Y_w, self.N_w = self._wave_loads(self.t, self.xi, self.psi)
@@ -184,10 +169,9 @@ def state_rates(hull: Hull, minv: tuple[float, float, float, float], m11_inv: fl
                 wave_loads: Callable, psi_w: float, t: float, state: State,
                 tau_th: tuple[float, float, float], hypot: Callable = math.hypot,
                 cos: Callable = math.cos, sin: Callable = math.sin) -> State:
-    """Time derivative of (x, y, psi, u, v, r, xi), eqs (1)-(17), for the sway-yaw inverse
-    inertia ``minv`` (M^-1 rows 2-3) and surge ``m11_inv``, the ``wave_loads`` (X_w, Y_w,
-    N_w) of (t, xi, psi) and the wave direction psi_w. Floats, or arrays of states with
-    numpy's cos and sin and an exact hypot (``cosim.ensemble``)."""
+    """Time derivative of (x, y, psi, u, v, r, xi), eqs (1)-(17), given the inverse inertia
+    (sway-yaw ``minv``, surge ``m11_inv``), the ``wave_loads`` (X_w, Y_w, N_w) of (t, xi,
+    psi) and psi_w. Floats, or arrays with numpy's cos, sin and an exact hypot."""
     _, _, psi, u, v, r, xi = state
     cX, cY, cN = coriolis_forces(hull, u, v, r)
     dX, dY, dN = damping_forces(hull, u, v, r)
@@ -203,7 +187,7 @@ def state_rates(hull: Hull, minv: tuple[float, float, float, float], m11_inv: fl
             i22 * fY + i23 * fN, i32 * fY + i33 * fN, xi_dot)
 
 
-def _calm_water(t: float, xi: float, psi: float) -> tuple[float, float, float]:
+def calm_water(t: float, xi: float, psi: float) -> tuple[float, float, float]:
     """The wave loads (X_w, Y_w, N_w) without waves."""
     return (0.0, 0.0, 0.0)
 

@@ -7,6 +7,8 @@ alone: ``pytest -m long`` runs only the tests the quick suite leaves out. Each t
 with long tests says which it keeps quick, and why they still cover what it tests."""
 from __future__ import annotations
 
+import contextlib
+import fcntl
 import gc
 import shutil
 import tempfile
@@ -16,9 +18,10 @@ from typing import Iterator
 import pytest
 
 from fmubuild.cbuild import build_c, c_compiler, sources
-from fmubuild.manifest import read, staleness
+from fmubuild.manifest import entry_source
 from fmubuild.packaging import build
 from fmubuild.project import C_FMUS, FMU_DIRS, FMUS, ROOT
+from fmukit.manifest import read, staleness
 
 pytest_plugins = ["pytester"]       # to run the example test file for each autopilot
 
@@ -113,7 +116,7 @@ def _stale(path: Path) -> bool:
     """Missing, built without a manifest, or not current: a module it carries differs
     from this checkout's."""
     manifest = read(path) if path.exists() else None
-    return manifest is None or staleness(manifest) is not None
+    return manifest is None or staleness(manifest, entry_source) is not None
 
 
 def _older(fmu: Path, sources: list[Path]) -> bool:
@@ -125,6 +128,24 @@ def _current(fmi: int) -> dict[str, Path]:
     current (its manifest against the sources; the C FMU, which has none, by file times,
     its build script's included, and only where there is a C compiler)."""
     folder = FMU_DIRS[fmi]
+    folder.mkdir(parents=True, exist_ok=True)
+    with _build_lock(folder):
+        return _current_locked(folder, fmi)
+
+
+@contextlib.contextmanager
+def _build_lock(folder: Path) -> Iterator[None]:
+    """One test process at a time checks and builds a folder's FMUs: pytest-xdist's workers
+    start together, and a worker must not load an FMU another one is writing."""
+    with open(folder / ".build.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(lock, fcntl.LOCK_UN)
+
+
+def _current_locked(folder: Path, fmi: int) -> dict[str, Path]:
     for name in FMUS:
         if _stale(folder / f"{name}.fmu"):
             build(name, fmi=fmi)

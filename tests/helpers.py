@@ -6,6 +6,7 @@ import ctypes.util
 import importlib.util
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 
@@ -65,3 +66,14 @@ def fmu_variant(source: Path, dest: Path, xml=None, drop: tuple[str, ...] = (),
                 data = edit[info.filename](data.decode("utf-8")).encode("utf-8")
             copy.writestr(info, data)
     return dest
+
+
+def reference_seconds(folder: Path) -> float:
+    """How long this machine takes now to start a child Python that runs calm_pd for 5 s
+    and writes it: what every child of a timing test does besides the fault it tests.
+    Bounds on wall time scale with it, so a busy machine widens them instead of failing."""
+    started = time.monotonic()
+    subprocess.run([sys.executable, "-m", "cosim.run", "calm_pd", "--stop-time", "5",
+                    "--no-plot", "--backend", "inprocess", "--out", str(folder)],
+                   check=True, capture_output=True, timeout=600)
+    return time.monotonic() - started

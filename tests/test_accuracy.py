@@ -1,10 +1,10 @@
 """The accuracy study's reference and RK4's convergence (cosim.studies.integration_error,
-monolithic and accuracy)."""
+monolithic and coupling_error)."""
 from __future__ import annotations
 
 import pytest
 
-from cosim.studies import accuracy, integration_error
+from cosim.studies import coupling_error, integration_error
 from cosim.studies.monolithic import monolithic
 
 
@@ -40,8 +40,8 @@ def test_cosimulation_converges_to_the_monolithic_model_as_the_step_shrinks():
     every halving of the communication step, for both couplings."""
     from cosim import scenarios
 
-    reference = accuracy.figures(monolithic(scenarios.load("calm_smc"), 120.0))
-    for rows in accuracy.convergence("calm_smc", reference, (0.1, 0.05, 0.025),
+    reference = coupling_error.figures(monolithic(scenarios.load("calm_smc"), 120.0))
+    for rows in coupling_error.convergence("calm_smc", reference, (0.1, 0.05, 0.025),
                                      120.0).values():
         errors = [row["J_error"] for row in rows]
         assert errors[0] > errors[1] > errors[2], errors

@@ -2,7 +2,10 @@
 from __future__ import annotations
 
 import math
+import os
 import re
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -111,3 +114,18 @@ def test_the_plugin_checks_say_what_is_wrong_and_when(fmu_paths):
     with pytest.raises(AssertionError, match=r"gear's limit of 20\.0 deg/s for 1\.8 % of the "
                                              r"run \(allowed 1 %\)"):
         check_rudder_rate(simulate("calm_pd"), share=0.01)
+
+
+def test_importing_cosim_and_its_pytest_plugin_picks_no_backend_and_takes_no_signal():
+    """An import has no side effects on the process: matplotlib's backend is left for the
+    caller to choose (the commands that draw do it without pyplot), and SIGINT and SIGTERM
+    keep Python's own handlers. A fresh interpreter, since this is about the process."""
+    probe = ("import signal, sys, cosim, cosim.testing, matplotlib\n"
+             "assert 'matplotlib.pyplot' not in sys.modules\n"
+             "assert matplotlib.rcParams._get_backend_or_none() is None\n"
+             "assert signal.getsignal(signal.SIGINT) is signal.default_int_handler\n"
+             "assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL\n")
+    env = {k: v for k, v in os.environ.items() if k != "MPLBACKEND"}
+    done = subprocess.run([sys.executable, "-c", probe], cwd=ROOT, env=env,
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr

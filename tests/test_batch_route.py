@@ -16,8 +16,9 @@ import numpy as np
 import pytest
 
 import cosim
-from cosim.studies import sweep, sweep_task
+from cosim.studies import campaign, sweep_task
 from cosim.studies.sweep_client import _say_batch_refusals, batches, plan
+from cosim.studies.sweep_spec import Spec
 
 from helpers import fmu_variant
 
@@ -75,14 +76,14 @@ def cluster():
 
 
 @pytest.fixture(scope="module")
-def mixed(fmu_paths, cluster, tmp_path_factory) -> tuple[sweep.Spec, dict, dict]:
+def mixed(fmu_paths, cluster, tmp_path_factory) -> tuple[Spec, dict, dict]:
     """MIXED run on both routes: (its spec, the in-process journal, the batch journal)."""
     folder = tmp_path_factory.mktemp("mixed")
-    spec = sweep.Spec.read(write_spec(folder, MIXED))
+    spec = Spec.read(write_spec(folder, MIXED))
     journals = {}
     for backend in ("inprocess", "batch"):
         (folder / backend).mkdir()
-        rows = sweep.execute(spec, folder / backend, scheduler=cluster.scheduler_address,
+        rows = campaign.execute(spec, folder / backend, scheduler=cluster.scheduler_address,
                              progress=False, backend=backend)
         assert [r["status"] for r in rows] == ["ok"] * 10
         journals[backend] = journal(folder / backend)
@@ -111,7 +112,7 @@ def test_a_sweep_resumes_on_the_other_backend(mixed, cluster, tmp_path, first, t
     done = dict(zip(("inprocess", "batch"), full))[first]
     kept = list(done.values())[:5]
     (tmp_path / "runs.jsonl").write_text("".join(json.dumps(r) + "\n" for r in kept))
-    rows = sweep.execute(spec, tmp_path, scheduler=cluster.scheduler_address, progress=False,
+    rows = campaign.execute(spec, tmp_path, scheduler=cluster.scheduler_address, progress=False,
                          backend=then)
     assert len(rows) == 10
     resumed = journal(tmp_path)
@@ -127,7 +128,7 @@ def test_batch_sizes_keep_every_worker_busy_within_the_memory_of_their_recording
 
     from cosim.studies.sweep_client import BATCH_MEMORY, MAX_BATCH, batch_counts, batch_limit
 
-    spec = sweep.Spec.read(write_spec(tmp_path, 'name = "b"\n[axes]\n'
+    spec = Spec.read(write_spec(tmp_path, 'name = "b"\n[axes]\n'
                                       'wave_seed = { start = 1, count = 2 }\n'))
     long = spec.job(spec.runs()[0], "t", "inprocess")              # the scenario's 400 s
     short = replace(long, stop_time=20.0)
@@ -176,7 +177,7 @@ def test_a_foreign_autopilot_runs_alone_in_process_with_a_note(fmu_paths, cluste
     spec_file = write_spec(tmp_path, f'name = "foreign"\nstop_time = 20\n[controllers]\n'
                                      f'pd = "waves_pd"\nmine = "{foreign}"\n'
                                      '[axes]\nwave_seed = [1, 2]\n')
-    spec = sweep.Spec.read(spec_file)
+    spec = Spec.read(spec_file)
     why = ("autopilot (foreign.fmu) runs through FMI, not in-process: it was not built with "
            "fmukit (it has no manifest)")
     assert spec.batch_coverage() == {"pd": None, "mine": why}
@@ -209,7 +210,7 @@ def test_batch_size_is_refused_without_the_batch_backend(capsys):
         capsys.readouterr().err
     with pytest.raises(ValueError, match="batch_size is the batch backend's, not the "
                                          "inprocess backend's"):
-        sweep.execute(None, Path("."), backend="inprocess", batch_size=3)
+        campaign.execute(None, Path("."), backend="inprocess", batch_size=3)
 
 
 # -- one batch in this process: its members' failures and its own --------------------------
@@ -218,7 +219,7 @@ def members(fmu_paths, tmp_path) -> tuple[list[sweep_task.Job], dict[str, bytes]
     """Six runs of waves_pd, 30 s: four seeds on two routes (the turning one also in calm
     water), one whose sea its ship refuses at initialisation (too steep), and one whose
     settings Master.configure refuses (Hs < 0: the spec would refuse it, a job need not)."""
-    spec = sweep.Spec.read(write_spec(tmp_path, f"""
+    spec = Spec.read(write_spec(tmp_path, f"""
         stop_time = 30
         [controllers]
         pd = "waves_pd"
@@ -343,12 +344,12 @@ def test_a_batch_of_a_time_that_is_no_whole_step_fails_each_run_as_in_process(me
 
 
 def test_a_run_in_this_process_is_the_same_as_a_batch_of_one(fmu_paths, tmp_path):
-    spec = sweep.Spec.read(write_spec(tmp_path, 'stop_time = 10\n[controllers]\n'
+    spec = Spec.read(write_spec(tmp_path, 'stop_time = 10\n[controllers]\n'
                                                 'smc = "waves_smc"\n[axes]\nwave_seed = [3]\n'))
     run = spec.runs()[0]
-    alone = sweep.run_locally(spec, run, "batch")
+    alone = campaign.run_locally(spec, run, "batch")
     assert alone["backend"] == "batch" and alone["status"] == "ok"
-    assert_same_row(alone, sweep.run_locally(spec, run, "inprocess"))
+    assert_same_row(alone, campaign.run_locally(spec, run, "inprocess"))
     sweep_task.free_masters()
 
 
@@ -363,15 +364,15 @@ def killing_batch(jobs, blobs):
 @pytest.mark.timeout(240, method="thread")
 def test_a_batch_whose_worker_dies_on_every_retry_runs_each_run_alone(fmu_paths, cluster,
                                                                      tmp_path):
-    spec = sweep.Spec.read(write_spec(tmp_path, "stop_time = 5\n[controllers]\n"
+    spec = Spec.read(write_spec(tmp_path, "stop_time = 5\n[controllers]\n"
                                                 'pd = "waves_pd"\n[axes]\nwave_seed = [1, 2]\n'))
-    rows = sweep.execute(spec, tmp_path, scheduler=cluster.scheduler_address, progress=False,
+    rows = campaign.execute(spec, tmp_path, scheduler=cluster.scheduler_address, progress=False,
                          backend="batch", batch_task=killing_batch, no_worker_timeout=60)
     assert [r["status"] for r in rows] == ["ok", "ok"]
     for row in rows:
         assert row["backend"].startswith("inprocess (not in a batch: its batch's worker died, "
                                          "KilledWorker: ")
-        assert_same_row(row, {**sweep.run_locally(spec, row, "inprocess"),
+        assert_same_row(row, {**campaign.run_locally(spec, row, "inprocess"),
                               "ran_as": row["ran_as"], "command": row["command"]})
     sweep_task.free_masters()
 

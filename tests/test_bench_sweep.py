@@ -8,7 +8,7 @@ import re
 import pytest
 
 from cosim import bench as command
-from cosim.studies import bench_sweep
+from cosim.studies import memory, sweep_timing
 
 
 def _figure(pattern: str, text: str) -> float:
@@ -20,7 +20,7 @@ def _figure(pattern: str, text: str) -> float:
 @pytest.mark.timeout(120, method="thread")
 def test_throughput_prints_per_core_rates_and_the_goal_from_what_it_measured(fmu_paths,
                                                                               capsys):
-    rates = bench_sweep.sweep_throughput(2, 4, ("calm",), (1, 2), ("inprocess", "batch"),
+    rates = sweep_timing.sweep_throughput(2, 4, ("calm",), (1, 2), ("inprocess", "batch"),
                                          stop_time=5.0)
     assert set(rates) == {("calm", b, w) for b in ("inprocess", "batch") for w in (1, 2)}
     assert all(math.isfinite(r) and r > 0 for r in rates.values())
@@ -46,7 +46,7 @@ def test_throughput_prints_per_core_rates_and_the_goal_from_what_it_measured(fmu
 
 @pytest.mark.timeout(60, method="thread")
 def test_campaign_times_the_sweep_and_judges_only_the_issues_campaign(fmu_paths, capsys):
-    measure = bench_sweep.campaign(4, 1, 2.0)
+    measure = sweep_timing.campaign(4, 1, 2.0)
     assert measure.runs == 4 and measure.batches == (4,) and len(measure.peak_rss) == 1
     assert 0 < measure.simulated and 0 < measure.startup and 0 < measure.wall
     out = capsys.readouterr().out
@@ -57,7 +57,7 @@ def test_campaign_times_the_sweep_and_judges_only_the_issues_campaign(fmu_paths,
 
 @pytest.mark.timeout(90, method="thread")
 def test_memory_counts_the_results_and_judges_full_batches(fmu_paths, capsys):
-    found = bench_sweep.batch_memory((2, 4), 2.0, batch_size=2)
+    found = memory.batch_memory((2, 4), 2.0, batch_size=2)
     samples = 21                                        # 2 s at 0.1 s, both ends
     for members, (wall, before, peak, results) in found["calls"].items():
         assert results * 2**20 == (members * 6 + 1) * samples * 8   # six signals and the time
@@ -65,7 +65,7 @@ def test_memory_counts_the_results_and_judges_full_batches(fmu_paths, capsys):
     assert [s.batches for s in found["sweeps"].values()] == [(2,), (2, 2)]
     out = capsys.readouterr().out
     low, high = (found["sweeps"][m].peak_rss[0] for m in (2, 4))
-    verdict = "met" if high / low - 1 <= bench_sweep.FLAT else "NOT met"
+    verdict = "met" if high / low - 1 <= memory.FLAT else "NOT met"
     assert f"at 2 runs, {high:.1f} MB at 4 runs" in out and out.rstrip().splitlines()[-2] \
         .endswith(f": {verdict}")
 

@@ -19,7 +19,9 @@ from pathlib import Path
 
 import pytest
 
-from cosim.studies import sweep
+from cosim.studies import campaign
+from cosim.studies.cluster import SweepError, check_workers
+from cosim.studies.sweep_spec import Spec
 from cosim.studies.sweep_task import run_one
 from fmubuild.project import ROOT
 
@@ -91,7 +93,7 @@ def test_a_wheel_cluster_runs_a_sweep_and_loses_only_the_runs_in_flight(
                          '[controllers]\npd = { scenario = "waves_pd" }\n'
                          'mine = { autopilot = "mine.fmu" }\n'
                          f'[axes]\nwave_seed = {{ start = 1, count = {RUNS // 2} }}\n')
-    spec = sweep.Spec.read(spec_path)
+    spec = Spec.read(spec_path)
     with Client(scheduler_file=str(scheduler_file)) as client:
         client.wait_for_workers(2, timeout=60)
         where = client.run(lambda: __import__("cosim").__file__)
@@ -108,7 +110,7 @@ def test_a_wheel_cluster_runs_a_sweep_and_loses_only_the_runs_in_flight(
     out = tmp_path / "out"
     out.mkdir()
     result = {}
-    running = threading.Thread(target=lambda: result.update(rows=sweep.execute(
+    running = threading.Thread(target=lambda: result.update(rows=campaign.execute(
         spec, out, scheduler_file=str(scheduler_file), progress=False,
         task=slow_counted_task, no_worker_timeout=30)), daemon=True)
     running.start()
@@ -130,7 +132,7 @@ def test_a_wheel_cluster_runs_a_sweep_and_loses_only_the_runs_in_flight(
     assert len(ran) - len(set(ran)) <= 1      # recomputed: at most the one run in flight
     local = tmp_path / "local"                             # the same sweep, LocalCluster
     local.mkdir()
-    here = sweep.execute(spec, local, workers=2, progress=False)
+    here = campaign.execute(spec, local, workers=2, progress=False)
     assert {r["run_id"]: r["J"] for r in rows} == {r["run_id"]: r["J"] for r in here}
 
 
@@ -140,8 +142,8 @@ def test_a_worker_running_other_code_is_refused_by_name():
             return {"tcp://10.0.0.7:4000": {"code": "0.0.9 (code 123456789abc)"},
                     "tcp://10.0.0.8:4000": function()}
 
-    with pytest.raises(sweep.SweepError) as refused:
-        sweep.check_workers(Client())
+    with pytest.raises(SweepError) as refused:
+        check_workers(Client())
     assert "tcp://10.0.0.7:4000 runs ship-autopilot-cosim 0.0.9 (code 123456789abc)" in str(
         refused.value)
     assert "tcp://10.0.0.8:4000" not in str(refused.value)

@@ -18,10 +18,11 @@ from cosim import scenarios
 from cosim.analysis.cost import LAMBDA
 from cosim.analysis.metrics import cost_terms
 from cosim.core.master import Master
-from cosim.core import ssd
-from cosim.core.ssd import read_ssd, write_ssd
+from cosim.core.ssd import write_ssd
 from cosim.core.wiring import WiringError
-from cosim.studies.direct import COMPARED, run_direct
+from cosim.ensemble.reference import SIGNALS
+from cosim.studies.direct import run_direct
+from fmubuild import project
 from fmubuild.project import ROOT
 from helpers import fmu_variant
 
@@ -31,7 +32,7 @@ _cache: dict = {}
 
 
 def system(name: str):
-    return read_ssd(SCENARIOS / f"{name}.ssd")
+    return scenarios.load(name)
 
 
 def run(name: str, coupling: str = "gauss-seidel", backend: str = "fmi", **kwargs):
@@ -90,7 +91,7 @@ def test_psi_d_is_eq_18_of_the_active_leg():
 @pytest.mark.parametrize("name", PAPER)
 def test_cosimulation_equals_the_plain_modules_wired_by_hand(name):
     rec, direct = run(name), run_direct(system(name))
-    worst = max(np.abs(rec[s] - direct[s]).max() for s in COMPARED)
+    worst = max(np.abs(rec[s] - direct[s]).max() for s in SIGNALS)
     assert worst <= 1e-9
 
 
@@ -302,12 +303,12 @@ def test_missing_fmu_names_the_paths_tried_and_says_how_to_build_it(tmp_path, mo
                                                                     capsys):
     """The core says what is missing and that it is ours (as data); the command says how
     to build it."""
-    monkeypatch.setattr(ssd, "FMU_SEARCH_PATH", [tmp_path / "empty"])
+    monkeypatch.setattr(project, "FMU_DIRS", {2: tmp_path / "empty", 3: tmp_path / "fmi3"})
 
     def edit(d):                        # relative: beside the .ssd, then by name
         d.components["ship"].source = "nowhere/ship.fmu"
     with pytest.raises(FileNotFoundError, match="one of this project's FMUs, not built") as missing:
-        Master(read_ssd(_variant(tmp_path, "calm_pd", edit)))
+        Master(scenarios.load(_variant(tmp_path, "calm_pd", edit)))
     beside = (SCENARIOS / "nowhere" / "ship.fmu").resolve()
     assert f"tried {beside}, {tmp_path / 'empty' / 'ship.fmu'}" in str(missing.value)
     assert missing.value.ours and "python -m" not in str(missing.value)
@@ -324,7 +325,7 @@ def test_a_missing_fmu_of_the_user_is_not_a_build_problem(tmp_path):
     def edit(d):
         d.components["autopilot"].source = "my_pilot.fmu"
     with pytest.raises(FileNotFoundError, match="check the source of component 'autopilot'"):
-        Master(read_ssd(_variant(tmp_path, "calm_pd", edit)))
+        Master(scenarios.load(_variant(tmp_path, "calm_pd", edit)))
 
 
 def test_a_scenario_copied_anywhere_finds_the_project_fmus(tmp_path):
@@ -342,7 +343,7 @@ def test_corrupt_fmu_says_how_to_build_it(tmp_path):
     def edit(d):
         d.components["ship"].source = str(corrupt)
     with pytest.raises(ValueError, match="not a readable FMU") as unreadable:
-        Master(read_ssd(_variant(tmp_path, "calm_pd", edit)))
+        Master(scenarios.load(_variant(tmp_path, "calm_pd", edit)))
     assert unreadable.value.ours
 
 
@@ -350,7 +351,7 @@ def test_connection_to_a_missing_variable_is_refused_by_name(tmp_path):
     def edit(d):
         d.connections[0] = type(d.connections[0])("guidance", "psi_desired", "autopilot", "psi_d")
     with pytest.raises(WiringError, match="guidance.psi_desired.*no variable 'psi_desired'"):
-        Master(read_ssd(_variant(tmp_path, "calm_pd", edit)))
+        Master(scenarios.load(_variant(tmp_path, "calm_pd", edit)))
 
 
 def test_unwritable_output_folder_is_refused_before_simulating(tmp_path, monkeypatch, capsys):
@@ -410,11 +411,11 @@ def test_the_null_backend_runs_a_scenario(fmu_paths):
 def test_the_overhead_benchmark_runs_and_restores_the_ship(fmu_paths, capsys):
     """A smoke test of one benchmark (figures are printed, never asserted): it idles the
     ship's step while it measures, and must give it back."""
-    from cosim.studies import bench
+    from cosim.studies import timing
     from ship_fmu.vessel import Vessel
 
     step = Vessel.step
-    per_step = bench.overhead(1)
+    per_step = timing.overhead(1)
     assert Vessel.step is step
     assert set(per_step) == {"direct", "null", "inprocess"}
     out = capsys.readouterr().out

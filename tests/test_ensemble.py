@@ -2,7 +2,6 @@
 bit for bit equal to the in-process master's run of it, in every course-keeping scenario."""
 from __future__ import annotations
 
-import importlib
 import math
 
 import numpy as np
@@ -181,7 +180,7 @@ def test_signals_outside_the_loop_are_refused_by_name():
 def test_the_selftest_passes_here_and_catches_a_different_rounding(monkeypatch):
     assert selftest() is None
     from cosim.ensemble import control
-    module = importlib.import_module("cosim.ensemble.selftest")
+    from cosim.ensemble import route as module
 
     monkeypatch.setattr(control, "tanh",                # one last bit up: what np.tanh
                         lambda x: np.nextafter(exact.tanh(x), np.inf))   # does on 27 % here

@@ -17,7 +17,7 @@ from fmpy.fmi3 import FMU3Slave
 from fmpy.validation import validate_fmu
 
 from fmubuild.crosscheck import CASES
-from fmubuild.manifest import read
+from fmukit.manifest import read
 from fmubuild.project import FMUS
 from fmukit.compose import fmu_class
 

@@ -20,13 +20,13 @@ import pytest
 from cosim import run as cli
 from cosim import scenarios, simulate
 from cosim import _cli
-from cosim.core.fmi import Fmu2Instance, FmuInstance, read_description
-from cosim.core.fmi3 import Fmu3Instance
+from cosim.core.fmi import Fmu2Instance, Fmu3Instance, FmuInstance, read_description
 from cosim.core.instance import FmuCallError
 from cosim.core.master import Master
-from cosim.core import ssd
-from cosim.core.ssd import read_ssd, with_fmi, write_ssd
+from cosim.core.ssd import read_ssd, write_ssd
+from cosim.core.system import with_fmi
 from cosim.scenarios.autopilot import AutopilotError, check_autopilot
+from fmubuild import project
 from fmubuild.project import FMU_DIRS, FMUS
 from helpers import fmu_variant
 
@@ -155,10 +155,10 @@ def test_an_ssd_that_names_fmi3_fmus_runs_them_also_when_copied_elsewhere(tmp_pa
     named = {c: f"../../fmus/fmi3/{Path(system.components[c].source).name}"
              for c in system.components}
     write_ssd(system, tmp_path / "calm_pd_fmi3.ssd", named)
-    with Master(read_ssd(tmp_path / "calm_pd_fmi3.ssd")) as master:
+    with Master(scenarios.load(tmp_path / "calm_pd_fmi3.ssd")) as master:
         assert {type(i) for i in master.instances.values()} == {Fmu3Instance}
         assert_same_bits(master.run(), run("calm_pd", 2))
-    back = with_fmi(read_ssd(tmp_path / "calm_pd_fmi3.ssd"), 2)
+    back = with_fmi(scenarios.load(tmp_path / "calm_pd_fmi3.ssd"), 2)
     assert {Path(back.fmu_path(c)).parent for c in back.components} == {FMU_DIRS[2]}
 
 
@@ -176,7 +176,7 @@ def test_with_fmi_leaves_a_users_own_fmu_alone(tmp_path, fmu_paths):
 
 def test_a_missing_twin_says_how_to_build_the_fmi3_fmus(tmp_path, monkeypatch, capsys):
     unbuilt = {**FMU_DIRS, 3: tmp_path / "fmi3"}
-    monkeypatch.setattr(ssd, "FMU_DIRS", unbuilt)
+    monkeypatch.setattr(project, "FMU_DIRS", unbuilt)
     monkeypatch.setattr(_cli, "FMU_DIRS", unbuilt)
     assert cli.main(["calm_pd", "--fmi", "3", "--out", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err

@@ -9,9 +9,10 @@ from pathlib import Path
 import pytest
 
 from fmubuild.cbuild import build_c
-from fmubuild.manifest import digest_of, read, staleness
+from fmubuild.manifest import entry_source
 from fmubuild.packaging import build
 from fmubuild.project import FMUS, ROOT
+from fmukit.manifest import digest_of, read, staleness
 
 PROJECT = {"cosim", "fmubuild", "fmukit", "ship_fmu", "autopilot_fmu"}
 ADAPTERS = {2: "pythonfmu07", 3: "pythonfmu3_03"}
@@ -52,7 +53,7 @@ def test_each_fmu_carries_exactly_its_model_and_says_so(fmu_paths, fmi3_paths, n
     assert python == {carried["file"] for carried in manifest.modules.values()} | {
         manifest.entry["file"]}                                   # the class pythonfmu loads
     assert digest_of({m: c["sha256"] for m, c in manifest.modules.items()}) == manifest.digest
-    assert staleness(manifest) is None
+    assert staleness(manifest, entry_source) is None
     # so no host-only module (fmubuild, cosim), edited or not, can make an FMU stale
     assert not any(m.split(".")[0] in ("fmubuild", "cosim") for m in manifest.modules)
 
@@ -60,9 +61,9 @@ def test_each_fmu_carries_exactly_its_model_and_says_so(fmu_paths, fmi3_paths, n
 def test_an_fmu_whose_entry_module_this_build_would_not_write_is_stale(fmu_paths, fmi3_paths):
     for fmu in (fmu_paths["pd_autopilot"], fmi3_paths["pd_autopilot"]):
         manifest = read(fmu)
-        assert staleness(manifest) is None
+        assert staleness(manifest, entry_source) is None
         other = dataclasses.replace(manifest, entry={**manifest.entry, "sha256": "0" * 64})
-        assert staleness(other) == (f"its entry module {manifest.entry['module']} is not the "
+        assert staleness(other, entry_source) == (f"its entry module {manifest.entry['module']} is not the "
                                     "one this build writes (built before a change of "
                                     "fmubuild.routes: rebuild it)")
 

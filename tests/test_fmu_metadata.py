@@ -17,7 +17,7 @@ from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 from PIL import Image
 
-from fmubuild.manifest import read, staleness
+from fmukit.manifest import read, staleness
 from fmubuild.packaging import build
 from fmubuild.project import FMUS, ROOT
 

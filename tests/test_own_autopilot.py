@@ -15,7 +15,8 @@ from cosim.core.master import Master
 from cosim.interop.engines import run as run_engine
 from cosim.interop.ssp import export
 from cosim.scenarios.autopilot import AutopilotError, check_autopilot
-from cosim.studies import sweep, sweep_task
+from cosim.studies import campaign, sweep_task
+from cosim.studies.sweep_spec import Spec
 from helpers import fmu_variant
 
 RENAMED = {"psi": "heading", "r": "yaw_rate", "psi_d": "course", "delta_c": "rudder"}
@@ -127,8 +128,8 @@ def test_sweep_takes_an_autopilot_fmu_and_an_ssd_path(fmu_paths, foreign, tmp_pa
         [axes]
         wave_seed = [3]
     """.replace("'", '"').replace(":", " ="))
-    spec = sweep.Spec.read(spec_path)
-    rows = {r["controller"]: sweep.run_locally(spec, r) for r in spec.runs()}
+    spec = Spec.read(spec_path)
+    rows = {r["controller"]: campaign.run_locally(spec, r) for r in spec.runs()}
     sweep_task.free_masters()
     assert rows["ssd"]["status"] == rows["fmu"]["status"] == "ok"
     assert rows["ssd"]["J"] == rows["fmu"]["J"]          # the same PID, the same sea
@@ -138,7 +139,7 @@ def test_sweep_refuses_a_controller_that_breaks_the_contract(foreign, tmp_path):
     spec_path = tmp_path / "spec.toml"
     spec_path.write_text(f'[controllers]\nbad = "{foreign["degrees"]}"\n')
     with pytest.raises(ValueError, match="(?s)controller 'bad': .*port 'psi' is in deg"):
-        sweep.Spec.read(spec_path)
+        Spec.read(spec_path)
 
 
 def test_exported_package_carries_the_autopilot_and_runs_in_libcosim(foreign, tmp_path):

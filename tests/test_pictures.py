@@ -14,9 +14,10 @@ from matplotlib.patches import Circle, Polygon
 from cosim import run as cli
 from cosim import simulate
 from cosim.analysis.animation import animate, frame_times
-from cosim.analysis.figures import RUDDER_LABEL, course_keeping_figure, outlines, save
+from cosim.analysis.figures import RUDDER_LABEL, course_keeping_figure, save
+from cosim.analysis.track import outlines
 from cosim.analysis.manoeuvres import zigzag
-from cosim.core.provenance import write_metadata
+from cosim.provenance import write_metadata
 from cosim.core.recording import Recording
 from ship_fmu.data import Hull
 
@@ -91,7 +92,7 @@ def test_next_to_every_csv_a_json_with_what_it_takes_to_reproduce_the_run(fmu_pa
     assert fmu["guid"] == read_model_description(fmu["file"]).guid
     with open(fmu["file"], "rb") as f:
         assert fmu["sha256"] == hashlib.sha256(f.read()).hexdigest()
-    from fmubuild.manifest import read          # the one notion of a current FMU
+    from fmukit.manifest import read          # the one notion of a current FMU
     assert fmu["current"] is True and fmu["sources_digest"] == read(fmu["file"]).digest
     assert (meta["coupling"], meta["step_size"], meta["stop_time"], meta["rows"]) == \
         ("gauss-seidel", 0.1, 20.0, 201)

@@ -1,4 +1,4 @@
-"""The scorecard's criteria (cosim.analysis.metrics, sweep_task.run_metrics), each on a
+"""The scorecard's criteria (cosim.analysis.metrics, merit.run_metrics), each on a
 synthetic recording whose answer is known by construction."""
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from cosim.analysis.metrics import (RUDDER_DEADBAND, cross_track_error, fraction
                                     mean_abs_rate, peak, rms, route_completion,
                                     rudder_reversals_per_minute)
 from cosim.core.recording import Recording
-from cosim.studies.sweep_task import METRICS, run_metrics
+from cosim.studies.merit import METRICS, run_metrics
 
 
 def _leg_track(start, course: float, offset: float, length: float, n: int = 201):

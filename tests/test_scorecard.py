@@ -13,7 +13,7 @@ from cosim import score as cli
 from cosim import simulate
 from cosim.analysis.cost import cost
 from cosim.studies import scorecard
-from cosim.studies.sweep_task import CRITERIA
+from cosim.studies.merit import CRITERIA
 
 MINE = ["--set", "autopilot.Kp=1", "--set", "autopilot.Kd=30"]
 """The PD with other gains: on the paper's route in waves it moves the rudder less and
@@ -141,7 +141,7 @@ def test_a_win_is_the_better_value_on_the_same_sea_and_a_tie_within_one_percent(
 def test_the_spread_of_a_criterion_over_decades_is_drawn_on_a_log_scale(tmp_path,
                                                                        monkeypatch):
     from cosim.studies import sweep_figures
-    from cosim.studies.sweep import Spec
+    from cosim.studies.sweep_spec import Spec
 
     drawn = {}
     monkeypatch.setattr(sweep_figures, "save", lambda fig, path: drawn.setdefault("fig", fig)
@@ -204,7 +204,7 @@ def test_an_autopilot_that_fails_is_scored_as_failed_and_the_rest_goes_on(tmp_pa
 
 def test_a_scorecard_left_without_workers_says_so_and_exits_3(fmu_paths, tmp_path, capsys,
                                                               monkeypatch):
-    from cosim.studies.sweep import NoWorkers
+    from cosim.studies.cluster import NoWorkers
 
     def no_workers(*args, **kwargs):
         raise NoWorkers("no worker in the cluster for 60 s (none has joined since 12:00:00)")

@@ -7,7 +7,7 @@ import pytest
 from cosim.analysis.manoeuvres import turning_circle, zigzag
 from ship_fmu.data import Actuators, Hull
 from ship_fmu.hull import coriolis_forces, damping_forces, mass_matrix
-from ship_fmu.steering_gear import RudderMotion, rudder_angle
+from ship_fmu.steering_gear import RudderMotion
 from ship_fmu.thrusters import actuator_forces
 from ship_fmu.vessel import N_PROPELLER, Vessel, VesselParameters
 from fmukit.timebase import communication_point
@@ -89,10 +89,10 @@ def test_thrust_balances_surge_damping_at_0_3_m_per_s():
 
 def test_steering_gear_rate_limit_and_stops():
     rate, stop = math.radians(20.0), math.radians(35.0)
-    assert rudder_angle(0.0, 1.0, 0.5, stop, rate) == pytest.approx(0.5 * rate)
-    assert rudder_angle(0.0, 1.0, 10.0, stop, rate) == stop
-    assert rudder_angle(0.0, -1.0, 10.0, stop, rate) == -stop
-    assert rudder_angle(0.1, 0.1 + 1e-3, 0.5, stop, rate) == 0.1 + 1e-3
+    assert RudderMotion(0.0, 1.0, stop, rate)(0.5) == pytest.approx(0.5 * rate)
+    assert RudderMotion(0.0, 1.0, stop, rate)(10.0) == stop
+    assert RudderMotion(0.0, -1.0, stop, rate)(10.0) == -stop
+    assert RudderMotion(0.1, 0.1 + 1e-3, stop, rate)(0.5) == 0.1 + 1e-3
 
 
 def test_steering_gear_kink_is_where_the_rudder_reaches_its_command_or_its_stop():

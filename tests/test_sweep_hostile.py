@@ -23,11 +23,13 @@ import pytest
 import cosim.scenarios.autopilot as autopilot
 from cosim import scenarios
 from cosim.core.ssd import write_ssd
-from cosim.studies import journal, sweep, sweep_task
+from cosim.studies import campaign, sweep_task
+from cosim.studies.merit import METRICS
+from cosim.studies.sweep_spec import Spec
 from cosim.studies.bundle import UnsafeCache, file_hash, fmu_cache
-from cosim.studies.cluster import ClusterError, connect, local_cluster, local_workers
-from cosim.studies.journal import Journal, JournalLocked
+from cosim.studies.cluster import ClusterError, SweepError, connect, local_cluster, local_workers
 from fmubuild.instantiate import InstantiationFailed, instantiate_in_child
+from helpers import reference_seconds
 
 
 @pytest.mark.timeout(60, method="thread")
@@ -128,24 +130,28 @@ def spec_file(tmp_path: Path, text: str) -> Path:
 def test_a_spec_that_would_run_something_else_is_refused_by_file_and_key(tmp_path, text, said):
     path = spec_file(tmp_path, text)
     with pytest.raises(ValueError, match=f"^{re.escape(str(path))}: {said}"):
-        sweep.Spec.read(path)
+        Spec.read(path)
 
 
 def test_a_sweep_is_counted_before_it_is_listed(tmp_path):
     """A range of 2^62 values is refused at once, without a list of them; so is a product
     of axes beyond max_runs, with the count."""
+    path = spec_file(tmp_path, "[axes]\nwave_seed = { start = 1, count = 1000 }")
+    started = time.perf_counter()
+    Spec.read(path, max_runs=2000)                  # a reference: a spec of 2,000 runs, read
+    reference = time.perf_counter() - started
     path = spec_file(tmp_path, "[axes]\nwave_seed = { start = 1, count = 4611686018427387904 }")
     started = time.perf_counter()
     with pytest.raises(ValueError, match="4611686018427387904 values, more than the 100000 runs "
                                          "a sweep may have \\(cosim.sweep --max-runs\\)"):
-        sweep.Spec.read(path)
-    assert time.perf_counter() - started < 1
+        Spec.read(path)
+    assert time.perf_counter() - started < 10 * reference     # not a list of 2^62 values
     path = spec_file(tmp_path, "[axes]\nwave_seed = { start = 1, count = 300 }\n"
                                "psi_w = { start = 0, count = 3 }")
     with pytest.raises(ValueError, match=re.escape(
             f"{path}: 2 controllers x 300 wave_seed x 3 psi_w = 1800 runs, more than the 1000")):
-        sweep.Spec.read(path, max_runs=1000)
-    assert len(sweep.Spec.read(path, max_runs=1800).runs()) == 1800
+        Spec.read(path, max_runs=1000)
+    assert len(Spec.read(path, max_runs=1800).runs()) == 1800
 
 
 def test_the_command_refuses_a_bad_spec_with_one_line_and_writes_nothing(tmp_path):
@@ -178,13 +184,15 @@ def test_a_scheduler_file_that_is_missing_empty_or_malformed_is_named(tmp_path):
             connect(scheduler_file=str(missing))
 
 
-@pytest.mark.timeout(30, method="thread")
-def test_an_unreachable_or_malformed_scheduler_address_is_named_within_the_timeout(tmp_path):
+@pytest.mark.timeout(120, method="thread")
+def test_an_unreachable_or_malformed_scheduler_address_is_named_within_the_timeout(tmp_path,
+                                                                                    fmu_paths):
+    reference = reference_seconds(tmp_path / "reference")     # a child's start, run, exit
     started = time.perf_counter()
     with pytest.raises(ClusterError, match="cannot reach the Dask scheduler at "
                                            "tcp://127.0.0.1:9 \\(from --scheduler\\) within 1 s"):
         connect("tcp://127.0.0.1:9", timeout=1)
-    assert time.perf_counter() - started < 10
+    assert time.perf_counter() - started < 1 + 5 * reference
     with pytest.raises(ClusterError, match="'nowhere' \\(from --scheduler\\) is not a Dask "
                                            "scheduler address"):
         connect("nowhere", timeout=1)
@@ -249,12 +257,12 @@ def test_the_fmu_cache_is_a_private_folder_of_this_user(tmp_path, monkeypatch):
 def test_a_corrupt_cached_fmu_is_written_again_and_said_to_be_the_cache(
         fmu_paths, tmp_path, monkeypatch, capsys):
     monkeypatch.setenv("COSIM_FMU_CACHE", str(tmp_path / "cache"))
-    spec = sweep.Spec.read(spec_file(tmp_path, "stop_time = 2\n[controllers]\npd = 'waves_pd'\n"
+    spec = Spec.read(spec_file(tmp_path, "stop_time = 2\n[controllers]\npd = 'waves_pd'\n"
                                                "[axes]\nwave_seed = [1]\n"))
     ship = next(sha for sha, path in spec.files().items() if path.name == "ship.fmu")
     cached = fmu_cache() / f"{ship}.fmu"
     cached.write_bytes(b"PK\x03\x04 not an FMU")          # a crash while it was written, say
-    row = sweep.run_locally(spec, spec.runs()[0])
+    row = campaign.run_locally(spec, spec.runs()[0])
     assert row["status"] == "ok", row["error"]
     assert f"the FMU cache's {cached} does not match its hash" in capsys.readouterr().err
     assert cached.read_bytes() == spec.files()[ship].read_bytes()
@@ -268,53 +276,18 @@ def test_a_sweep_on_workers_with_an_unsafe_cache_is_refused_before_any_run(
     cache.mkdir()
     cache.chmod(0o777)
     monkeypatch.setenv("COSIM_FMU_CACHE", str(cache))     # the local cluster's workers inherit it
-    spec = sweep.Spec.read(spec_file(tmp_path, "stop_time = 2\n[axes]\nwave_seed = [1]\n"))
+    spec = Spec.read(spec_file(tmp_path, "stop_time = 2\n[axes]\nwave_seed = [1]\n"))
     (tmp_path / "out").mkdir()
-    with pytest.raises(sweep.SweepError, match=f"workers whose FMU cache is not safe to run FMUs "
+    with pytest.raises(SweepError, match=f"workers whose FMU cache is not safe to run FMUs "
                                                f"from:\n  tcp://.*: the FMU cache {cache} may be "
                                                "written by others"):
-        sweep.execute(spec, tmp_path / "out", workers=1, progress=False)
+        campaign.execute(spec, tmp_path / "out", workers=1, progress=False)
     assert not (tmp_path / "out" / "runs.jsonl").exists() and not list(cache.iterdir())
 
 
-# -- outputs: whole or not at all; the journal's lock ------------------------------------
-def test_the_journal_lock_is_removed_at_the_end_and_never_shared(tmp_path, monkeypatch):
-    path = tmp_path / "runs.jsonl"
-    lock = tmp_path / "runs.jsonl.lock"
-    lock.write_text("process 1 on gone since 2026-01-01 00:00:00\n")   # left by a kill
-    with Journal(path):
-        assert "process" in lock.read_text() and "gone" not in lock.read_text()
-    assert not lock.exists()
-    # A second sweep that opened the lock file just before the first removed it holds a file
-    # no longer there: it must not count as the lock while a third sweep holds the new one.
-    first = Journal(path).__enter__()
-    stale = open(lock, "a+")
-    first.__exit__(None, None, None)
-    with Journal(path):
-        opened = iter([stale])
-        monkeypatch.setattr(journal, "open", lambda *a: next(opened, None) or open(*a),
-                            raising=False)
-        with pytest.raises(JournalLocked, match=f"being written by process {os.getpid()}"):
-            Journal(path).__enter__()
-    assert stale.closed
-
-
-def test_a_journal_removes_only_its_own_lock_file(tmp_path):
-    """A lock file that someone deleted while a sweep ran, and that another sweep then made
-    and holds, is that sweep's: the first sweep's end must not remove it."""
-    path, lock = tmp_path / "runs.jsonl", tmp_path / "runs.jsonl.lock"
-    first = Journal(path).__enter__()
-    lock.unlink()                                   # a user tidying up, say
-    with Journal(path):                             # another sweep: its own lock file
-        first.__exit__(None, None, None)
-        assert lock.exists() and f"process {os.getpid()}" in lock.read_text()
-        with pytest.raises(JournalLocked):
-            Journal(path).__enter__()               # still held, by the second
-    assert not lock.exists()                        # the second removed its own
-
-
+# -- outputs: whole or not at all ------------------------------------------------------
 def _rows(spec) -> list[dict]:
-    return [{**run, "status": "ok", "error": "", **{m: 1.0 + i for m in sweep.METRICS},
+    return [{**run, "status": "ok", "error": "", **{m: 1.0 + i for m in METRICS},
              "seconds": 0.1, "sim_seconds": 0.1, "backend": "fmi"}
             for i, run in enumerate(spec.runs())]
 
@@ -325,7 +298,7 @@ def test_a_figure_that_cannot_be_written_leaves_the_old_one(tmp_path, monkeypatc
     from cosim.core.files import OutputError
     from cosim.studies.sweep_figures import save_figures
 
-    spec = sweep.Spec.read(spec_file(tmp_path, "[axes]\nwave_seed = [1, 2]\n"))
+    spec = Spec.read(spec_file(tmp_path, "[axes]\nwave_seed = [1, 2]\n"))
     old = tmp_path / "J_distribution.png"
     old.write_bytes(b"the previous sweep's figure")
 
@@ -346,7 +319,7 @@ def test_a_comparison_that_cannot_be_written_leaves_the_old_one(tmp_path, monkey
     out = tmp_path / "out" / "full"
     out.mkdir(parents=True)
     (out / "comparison.md").write_text("the previous comparison\n")
-    monkeypatch.setattr(command.sweep, "execute",
+    monkeypatch.setattr(command.campaign, "execute",
                         lambda spec, *args, **options: _rows(spec))
     write_text = Path.write_text
 
@@ -383,17 +356,17 @@ def test_a_finished_sweep_resumed_after_a_rebuild_reruns_nothing(fmu_paths, tmp_
     for component in system.components.values():
         component.source = str(built / Path(component.source).name)
     write_ssd(system, tmp_path / "rebuilt.ssd")
-    spec = sweep.Spec.read(spec_file(tmp_path, "stop_time = 2\n[controllers]\n"
+    spec = Spec.read(spec_file(tmp_path, "stop_time = 2\n[controllers]\n"
                                                "pd = 'rebuilt.ssd'\n[axes]\nwave_seed = [1, 2]\n"))
     assert set(spec.files().values()) == {built / name for name in before}
     out = tmp_path / "out"
     out.mkdir()
-    rows = sweep.execute(spec, out, workers=1, progress=False)
+    rows = campaign.execute(spec, out, workers=1, progress=False)
     assert [r["status"] for r in rows] == ["ok", "ok"]
     journal = (out / "runs.jsonl").read_text()
     assert build() == before                                   # the same bytes
     capsys.readouterr()
-    again = sweep.execute(sweep.Spec.read(tmp_path / "spec.toml"), out, workers=1,
+    again = campaign.execute(Spec.read(tmp_path / "spec.toml"), out, workers=1,
                           progress=False)
     assert "2 of 2 runs already done" in capsys.readouterr().err
     assert (out / "runs.jsonl").read_text() == journal and again == rows
@@ -410,7 +383,7 @@ def test_a_spec_that_is_not_a_small_text_file_is_not_read(tmp_path, make, said):
     path = make(tmp_path)
     with pytest.raises(ValueError, match=f"^cannot read sweep spec {re.escape(str(path))}: .*"
                                          f"{said}"):
-        sweep.Spec.read(path)
+        Spec.read(path)
 
 
 def _written(path: Path, data: bytes) -> Path:
@@ -424,7 +397,7 @@ def test_a_controller_whose_runs_cannot_be_measured_is_refused(tmp_path):
             f"{path}: controller 'turn': its system 'turning_circle' has no output "
             "guidance.psi_d, guidance.wp_index; a run is measured by guidance.psi_d, "
             "guidance.wp_index, ship.psi")):
-        sweep.Spec.read(path)
+        Spec.read(path)
 
 
 # -- Ctrl-C: one message, at whatever stage, with the command that resumes ----------------

@@ -19,9 +19,10 @@ from cosim.analysis.cost import LAMBDA, Cost
 from cosim.analysis.metrics import cost_terms
 from cosim.analysis.seastate import model_scale
 from cosim.core.master import Master
-from cosim.studies import sweep, sweep_task
+from cosim.studies import campaign, sweep_task
+from cosim.studies.sweep_spec import Spec
 from cosim.studies.sweep_spec import CALM_WATER_INERT
-from cosim.studies.sweep_tables import METRICS, TIMES, summary, summary_table
+from cosim.studies.sweep_tables import METRICS, TIMES, summary, summary_table, write_tables
 
 EXAMPLE = Path(__file__).resolve().parent.parent / "docs" / "sweeps" / "example.toml"
 CHANGED = {"T0": 1.7, "psi_w": 0.6, "wave_seed": 77, "wave_components": 9}
@@ -57,7 +58,7 @@ def test_in_calm_water_the_wave_settings_change_no_bit_of_a_run(fmu_paths, scena
 
 
 def test_the_example_runs_calm_water_once_per_controller_and_says_so():
-    spec = sweep.Spec.read(EXAMPLE)
+    spec = Spec.read(EXAMPLE)
     groups = spec.shared_runs()
     assert len(spec.runs()) == 18 and len(groups) == 18 - 2 * 2
     shared = [g for g in groups if len(g) > 1]
@@ -68,7 +69,7 @@ def test_the_example_runs_calm_water_once_per_controller_and_says_so():
 
 
 def test_runs_are_shared_over_every_wave_setting_in_calm_water_and_only_there(tmp_path):
-    spec = sweep.Spec.read(spec_file(tmp_path, """
+    spec = Spec.read(spec_file(tmp_path, """
         [controllers]
         pd = "waves_pd"
         calm = "calm_pd"
@@ -89,7 +90,7 @@ def test_runs_are_shared_over_every_wave_setting_in_calm_water_and_only_there(tm
     assert spec.sharing_notes() == ["Hs 0.0 is calm water (Hs = 0): the psi_w and "
                                     "ship.wave_components axes do not apply there; 4 runs "
                                     "instead of 16"]
-    own = sweep.Spec.read(spec_file(tmp_path, '[controllers]\ncalm = "calm_pd"\n'
+    own = Spec.read(spec_file(tmp_path, '[controllers]\ncalm = "calm_pd"\n'
                                               '[axes]\nwave_seed = [1, 2]\n'))
     assert own.sharing_notes() == ["controller 'calm' (calm_pd) is calm water (Hs = 0): the "
                                    "wave_seed axis does not apply there; 1 run instead of 2"]
@@ -119,7 +120,7 @@ def _settings_of(command: str) -> tuple[list[str], dict[str, str]]:
 
 def test_a_row_s_command_gives_every_setting_exactly(fmu_paths, tmp_path):
     (tmp_path / "mine.fmu").write_bytes(fmu_paths["pid_autopilot"].read_bytes())
-    spec = sweep.Spec.read(spec_file(tmp_path, REPLAYED))
+    spec = Spec.read(spec_file(tmp_path, REPLAYED))
     for run in spec.runs():
         words, sets = _settings_of(spec.replay(run))
         scenario, overrides = spec.settings(run)
@@ -141,10 +142,10 @@ def test_running_a_row_s_command_gives_its_J_bit_for_bit(fmu_paths, tmp_path):
     a calm-water row that shares another seed's run, a controller with its own settings and
     a user's autopilot FMU."""
     (tmp_path / "mine.fmu").write_bytes(fmu_paths["pid_autopilot"].read_bytes())
-    spec = sweep.Spec.read(spec_file(tmp_path, REPLAYED))
+    spec = Spec.read(spec_file(tmp_path, REPLAYED))
     out = tmp_path / "out"
     out.mkdir()
-    rows = sweep.execute(spec, out, workers=2, progress=False)
+    rows = campaign.execute(spec, out, workers=2, progress=False)
     assert len(rows) == 24 and all(r["status"] == "ok" for r in rows), rows
     chosen = {(r["controller"], r["sea_state"], r["run_id"] != r["ran_as"]): r for r in rows
               if r["route"] == "0,0;40,10" and (r["wave_seed"] == 5 or r["controller"] == "pd")}
@@ -175,7 +176,7 @@ def _replay(command: str, out: Path) -> tuple[float, float, float]:
 
 
 # -- the tables -------------------------------------------------------------------------
-def _rows(spec: sweep.Spec) -> list[dict]:
+def _rows(spec: Spec) -> list[dict]:
     """Rows as a sweep's, each metric a distinct number, shared runs sharing them."""
     rows = []
     for g, group in enumerate(spec.shared_runs()):
@@ -189,9 +190,9 @@ def _rows(spec: sweep.Spec) -> list[dict]:
 
 
 def test_every_column_with_a_unit_names_it(tmp_path):
-    spec = sweep.Spec.read(spec_file(tmp_path, '[axes]\nwave_seed = [1, 2]\n'
+    spec = Spec.read(spec_file(tmp_path, '[axes]\nwave_seed = [1, 2]\n'
                                                'Hs = [0.0, 0.01]\n"ship.delta_rate_max" = [0.3]\n'))
-    written = sweep.write_tables(_rows(spec), tmp_path, csv=True, spec=spec)
+    written = write_tables(_rows(spec), tmp_path, csv=True, spec=spec)
     units = {**METRICS, **TIMES, "Hs": "m", "ship.delta_rate_max": "rad/s"}
     assert units["sim_seconds"] == "s"
     assert {p.name for p in written} == {"results.parquet", "results.json", "results.csv",
@@ -208,7 +209,7 @@ def test_every_column_with_a_unit_names_it(tmp_path):
 
 
 def test_the_summary_is_per_setting_and_counts_a_shared_run_once(tmp_path):
-    spec = sweep.Spec.read(spec_file(tmp_path, '[axes]\nwave_seed = [1, 2, 3]\n'
+    spec = Spec.read(spec_file(tmp_path, '[axes]\nwave_seed = [1, 2, 3]\n'
                                                'sea_state = [0, 2]\n'))
     rows = _rows(spec)
     header, *lines = summary_table(spec, rows)

@@ -27,7 +27,7 @@ from fmpy.validation import validate_fmu
 import pythonfmu
 import pythonfmu3
 from fmubuild import cbuild
-from fmubuild.manifest import read
+from fmukit.manifest import read
 from fmubuild.project import FMUS
 from test_c_fmi3 import FMI3_FUNCTIONS
 

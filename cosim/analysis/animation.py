@@ -1,15 +1,8 @@
 """An animation of a run: the ship moving along its track, its heading, rudder and leg.
 
-A GIF (Pillow, which comes with matplotlib), or an MP4 where ffmpeg is installed.
-The run plays at a speed that fits it into about 25 s of video at 10 frames per
-second (a 400 s run: 16 times real time, 250 frames). The route, its named
-waypoints, the circles of acceptance and the wave direction are drawn once, as on
-the run's figure (``figures.track_panel``); each frame moves the ship's outline
-(at its true heading, enlarged as on the figure and saying by how much), extends
-its wake, highlights the active leg, names it above the track as the figure names
-the waypoints (``leg_text``) and moves the time cursor on the heading and rudder
-panels: only those are redrawn, on top of a background rendered once, which keeps
-a 400 s run to a few seconds of work.
+A GIF (Pillow), or an MP4 where ffmpeg is installed, about 25 s at 10 frames per second.
+The track panel is the figure's (``track.track_panel``), drawn once as a background;
+each frame redraws only what moves (outline, wake, active leg, readout, time cursors).
 """
 from __future__ import annotations
 
@@ -18,20 +11,16 @@ import shutil
 import subprocess
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+from matplotlib.patches import Polygon
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.patches import Polygon  # noqa: E402
+from autopilot_fmu.guidance import route as followed_route
 
-from autopilot_fmu.guidance import route as followed_route  # noqa: E402
-
-from ..core.files import whole_file  # noqa: E402
-from ..core.recording import Recording  # noqa: E402
-from .describe import title  # noqa: E402
-from .figures import (RUDDER_LABEL, hull_outline, legend_if_any, outlines,  # noqa: E402
-                      track_panel, waypoint_name)
+from ..core.files import whole_file
+from ..core.recording import Recording
+from .describe import title
+from .figures import RUDDER_LABEL, new_figure
+from .track import hull_outline, legend_if_any, outlines, track_panel, waypoint_name
 
 FPS = 10
 VIDEO_SECONDS = 25.0
@@ -58,10 +47,8 @@ def frame_times(t: np.ndarray, fps: int = FPS, seconds: float = VIDEO_SECONDS) -
 
 
 def leg_text(wp_index: int, points: np.ndarray) -> str:
-    """The leg the guidance steers along, its waypoints named as on the figures
-    (``figures.waypoint_name``): 'leg WP1 -> WP2 (30, 0) m' while steering for point
-    ``wp_index`` (the guidance's 0-based index, (x, y) in ``points``), or, past the last
-    point (``wp_index`` = the number of points), that it holds the last leg's course."""
+    """'leg WP1 -> WP2 (30, 0) m' while steering for point ``wp_index`` of ``points``, or,
+    past the last, that the guidance holds the last leg's course."""
     if wp_index >= len(points):
         return f"past {waypoint_name(len(points) - 1)}, the last: holding its course"
     north, east = points[wp_index]
@@ -70,17 +57,14 @@ def leg_text(wp_index: int, points: np.ndarray) -> str:
 
 
 def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> Path:
-    """Write the animation of a run to ``path`` with the suffix of ``fmt``; its path.
-
-    ValueError naming what is missing if the run has no track to show. The file is
-    written whole or not at all.
-    """
+    """Write the animation of a run, whole or not at all, to ``path`` with the suffix of
+    ``fmt``; its path. ValueError naming what is missing if the run has no track."""
     require_track(run.columns)
     fmt = fmt or video_format()
     rows = frame_times(run.t)
     x, y, psi, delta, t = (run["ship.x"], run["ship.y"], run["ship.psi"], run["ship.delta"],
                            run.t)
-    fig = plt.figure(figsize=(10, 5.6), dpi=90, constrained_layout=True)
+    fig = new_figure(figsize=(10, 5.6), dpi=90, layout="constrained")
     grid = fig.add_gridspec(2, 2, width_ratios=(1.0, 1.1))
     track, heading, rudder = (fig.add_subplot(grid[:, 0]), fig.add_subplot(grid[0, 1]),
                               fig.add_subplot(grid[1, 1]))
@@ -134,18 +118,15 @@ def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> P
     background = fig.canvas.copy_from_bbox(fig.bbox)
     width, height = fig.canvas.get_width_height()
     target = path.with_suffix(f".{fmt}")
-    try:
-        frames = []
-        for k in rows:
-            readout.set_text(draw(k))
-            fig.canvas.restore_region(background)
-            for artist in dynamic:
-                artist.axes.draw_artist(artist)
-            frames.append(np.asarray(fig.canvas.buffer_rgba())[:, :, :3].copy())
-        with whole_file(target) as tmp:
-            _write(frames, tmp, fmt, width, height)
-    finally:
-        plt.close(fig)
+    frames = []
+    for k in rows:
+        readout.set_text(draw(k))
+        fig.canvas.restore_region(background)
+        for artist in dynamic:
+            artist.axes.draw_artist(artist)
+        frames.append(np.asarray(fig.canvas.buffer_rgba())[:, :, :3].copy())
+    with whole_file(target) as tmp:
+        _write(frames, tmp, fmt, width, height)
     return target
 
 

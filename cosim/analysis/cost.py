@@ -1,10 +1,8 @@
 """The cost of eq (19) over a recorded run: J = psi_E + lambda sum(delta^2).
 
-The weight lambda: the paper only says it brings the heading and rudder terms to
-the same level (its Table 1 has psi_E ~ delta_E). It is calibrated once, on
-calm_pd, so that psi_E = lambda * sum(delta^2) there, and held fixed for every
-other run; ``tests/test_cosim.py`` recomputes it and fails if the model no
-longer gives this value (recalibrate by setting it to psi_E / sum(delta^2) of calm_pd).
+The paper's lambda only brings both terms to the same level; it is calibrated once, on
+calm_pd (psi_E = lambda sum(delta^2) there), and held fixed; ``tests/test_cosim.py`` fails
+if the model no longer gives it.
 """
 from __future__ import annotations
 
@@ -13,8 +11,7 @@ from dataclasses import dataclass
 from ..core.recording import Recording
 from .metrics import cost_terms
 
-LAMBDA = 1.8649470947066942
-"""Weight of eq (19): psi_E / sum(delta^2) of calm_pd (100.175 rad^2 / 53.715 rad^2)."""
+LAMBDA = 1.8649470947066942     # psi_E / sum(delta^2) of calm_pd: 100.175 / 53.715 rad^2
 
 
 @dataclass(frozen=True)

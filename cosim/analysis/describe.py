@@ -1,10 +1,6 @@
-"""Words for a run, made from the parameter values it used: titles and printed headers.
-
-Nothing here is typed in per scenario: the sea state, the route, the steering gear,
-the autopilot's gains and the settings given on the command line are read from
-what the FMUs held (``Recording.meta``), so a label cannot describe a run that was
-not made. Angles are shown in degrees.
-"""
+"""Titles and printed headers of a run, made from the parameter values the FMUs held
+(``Recording.meta``), never typed in per scenario: a label cannot describe a run that was
+not made. Angles in degrees."""
 from __future__ import annotations
 
 import math
@@ -64,7 +60,7 @@ def overrides(meta: dict[str, Any]) -> str:
 
 
 def conditions(meta: dict[str, Any]) -> list[str]:
-    """What a run was, line by line: route, sea and gear, controller or rudder program, settings."""
+    """What a run was, line by line: route, sea, gear, controller or program, settings."""
     p, units = meta.get("parameters", {}), meta.get("parameter_units", {})
     lines = []
     if "stop_time" in meta:
@@ -76,8 +72,7 @@ def conditions(meta: dict[str, Any]) -> list[str]:
     if "ship" in p:
         lines.append(f"{sea(p['ship'])}; {gear(p['ship'])}; starting at "
                      f"{p['ship']['u0']:.3g} m/s")
-    # An autopilot's gains stay in the units it declares (eta_h = 10 rad, not 573 deg);
-    # a rudder program's angles read in degrees.
+    # An autopilot's gains stay in their units (eta_h = 10 rad); a program's angles in deg.
     for component, degrees in (("autopilot", False), ("program", True)):
         if component in p:
             fmu = meta.get("fmus", {}).get(component, {}).get("file", "")
@@ -89,8 +84,7 @@ def conditions(meta: dict[str, Any]) -> list[str]:
 
 
 def changes(meta: dict[str, Any]) -> str:
-    """How the run differs from its scenario, as the options that made it so: every --set,
-    and --stop-time if it ended elsewhere than the scenario's .ssd says ('' if neither)."""
+    """How the run differs from its scenario, as the --set and --stop-time options ('')."""
     changed = [overrides(meta)] if meta.get("overrides") else []
     stop = meta.get("scenario_stop_time")
     if stop is not None and meta.get("stop_time", stop) != stop:
@@ -99,8 +93,7 @@ def changes(meta: dict[str, Any]) -> str:
 
 
 def paper_row(meta: dict[str, Any]) -> tuple[str, tuple[float, float, float]] | None:
-    """The paper's table and its (psi_E, delta_E, J) for one of the paper's own runs: the
-    project's scenario file of that name, unchanged; None for any other run."""
+    """The paper's table and (psi_E, delta_E, J) for one of its own runs, unchanged; else None."""
     system = meta.get("system", "")
     if system not in PAPER_TABLES or changes(meta) or not meta.get("scenario_file"):
         return None
@@ -111,8 +104,7 @@ def paper_row(meta: dict[str, Any]) -> tuple[str, tuple[float, float, float]] | 
 
 
 def headline(label: str, meta: dict[str, Any]) -> str:
-    """The first line of a title or header: the run's label and its scenario's description,
-    or, for a run changed from its scenario, the scenario and what changed it."""
+    """The label and the scenario's description, or what changed the scenario."""
     changed = changes(meta)
     if not changed:
         return f"{label}: {meta.get('description', '')}"

@@ -1,275 +1,95 @@
-"""Figures of a run, in degrees for display: where the ship went, and how it got there.
-
-Every course-keeping and manoeuvre figure has a track panel, north up and east
-right at equal scale, framed on the ship's track with a margin: the track, the
-route with its circles of acceptance and its waypoints named WP1, WP2, ...
-(``waypoint_name``), where each leg switched, the ship's outline at regular times
-(enlarged where to scale it could not be seen, and labelled with the factor:
-``outline_scale``) and the direction the waves travel to. Beside it, the signals
-over time; a rudder axis says which way a positive rudder turns the ship. A
-course-keeping figure carries eq (19)'s figures of merit, and the paper's beside
-them for the paper's own runs. Legends and notes sit outside the axes, over no
-data. The figures take what they show from the recording: its columns, and the
-parameter values the run used (``Recording.meta``), never from what a scenario is
-supposed to be.
+"""Figures of a run, in degrees: the track panel (``track``) beside the signals over time;
+a course-keeping figure carries eq (19), and the paper's values for its own runs. Drawn on
+Agg canvases without pyplot, so importing this picks no backend.
 """
 from __future__ import annotations
 
-import itertools
 import math
-from collections.abc import Callable, Iterable
-from dataclasses import dataclass
+import textwrap
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-import matplotlib
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
-from matplotlib.lines import Line2D  # noqa: E402
-from matplotlib.patches import Circle, Polygon  # noqa: E402
-from matplotlib.path import Path as Shape  # noqa: E402
-
-from autopilot_fmu.guidance import route as followed_route  # noqa: E402
-from ship_fmu.data import Hull  # noqa: E402
-
-from ..core.files import whole_file  # noqa: E402
-from ..core.recording import Recording  # noqa: E402
-from .cost import LAMBDA, cost  # noqa: E402
-from .describe import paper_row, title  # noqa: E402
-from .metrics import heading_error  # noqa: E402
+from ..core.files import whole_file
+from ..core.recording import Recording
+from .cost import LAMBDA, cost
+from .describe import paper_row, title
+from .metrics import heading_error
+from .track import legend_if_any, track_panel
 
 FORMATS = ("png", "svg", "pdf")
-OUTLINES = 12
-"""Ship outlines drawn along a track, about."""
-RUDDER_LABEL = "rudder delta (deg)\n+ turns to port"
-"""Every rudder axis: in this model a positive rudder turns the ship to port (r < 0)."""
-TRACK = "track"
-"""The label of a track panel's axes (``track_panel``), which ``legend_if_any`` looks for."""
-_DIRECTIONS = [(math.cos(a), math.sin(a)) for a in np.radians(np.arange(0, 360, 45))]
+RUDDER_LABEL = "rudder delta (deg)\n+ turns to port"     # a positive rudder turns to port
+_VERDICT_COLOURS = {"PASS": "tab:green", "FAIL": "tab:red", "OPEN": "tab:orange"}
+_WRAP = 150                     # characters per line of a figure's text
 
 
-def waypoint_name(i: int) -> str:
-    """The name of route point ``i`` (0-based, as the guidance's ``wp_index``): 'WP1' is
-    the start.
-
-    Eq (18) calls the waypoint passed k and the next one k + 1, without saying where k
-    starts; Fossen's guidance chapter (Handbook of Marine Craft Hydrodynamics and Motion
-    Control, 2011, ch. 10) numbers a route's waypoints from 1, and so do we: on its first
-    leg the ship has passed WP1 and steers for WP2.
-    """
-    return f"WP{i + 1}"
-
-
-def hull_outline(x: float, y: float, psi: float, scale: float = 1.0) -> np.ndarray:
-    """The ship's waterline, pointed bow, as (east, north) corners at (x, y, psi): to scale,
-    or ``scale`` times that about (x, y)."""
-    L, B = scale * Hull.L, scale * Hull.B
-    body = np.array([(L / 2, 0.0), (L / 4, B / 2), (-L / 2, B / 2), (-L / 2, -B / 2),
-                     (L / 4, -B / 2)])                  # x forward, y starboard
-    c, s = math.cos(psi), math.sin(psi)
-    north = x + body[:, 0] * c - body[:, 1] * s
-    east = y + body[:, 0] * s + body[:, 1] * c
-    return np.column_stack([east, north])
-
-
-def outline_scale(spacing: float, extent: float) -> int:
-    """How many times enlarged the ship's outline is drawn on a track, so it can be seen:
-    the largest factor of one significant digit (1, 2, ... 9, 10, 20, ...) that keeps an
-    outline within 0.8 of ``spacing`` (m between two outlines) and 1/12 of ``extent``
-    (the track's size, m); 1 if the ship to scale is already that large."""
-    limit = min(0.8 * spacing, extent / 12.0) / Hull.L
-    if limit < 1.0:
-        return 1
-    decade = 10 ** math.floor(math.log10(limit))
-    return int(limit // decade * decade)
-
-
-@dataclass(frozen=True)
-class Outlines:
-    """Where a track shows the ship's outline: the rows, every how many s, how enlarged."""
-
-    rows: list[int]
-    every: float
-    scale: int
-
-    @property
-    def size(self) -> str:
-        """'to scale', or the factor of enlargement: 'x5, true heading'."""
-        return "to scale" if self.scale == 1 else f"x{self.scale}, true heading"
-
-
-def outlines(run: Recording) -> Outlines:
-    """The outlines of a run's track: about ``OUTLINES`` at round times, none on top of one
-    drawn a lap earlier, as enlarged as ``outline_scale`` allows."""
-    x, y, t = run["ship.x"], run["ship.y"], run.t
-    every = max(1.0, round((t[-1] - t[0]) / OUTLINES / 10.0) * 10.0)
-    stride = max(1, round(every / run.meta.get("step_size", t[1] - t[0])))
-    rows = list(range(0, len(t), stride))
-    steps = np.hypot(np.diff(x[rows]), np.diff(y[rows]))
-    extent = max(np.ptp(x), np.ptp(y))
-    scale = outline_scale(float(np.median(steps)) if len(steps) else extent, extent)
-    drawn: list[int] = []
-    for k in rows:
-        if all(math.hypot(x[k] - x[j], y[k] - y[j]) > scale * Hull.L for j in drawn):
-            drawn.append(k)
-    return Outlines(drawn, every, scale)
-
-
-def _arrow(direction: float) -> Shape:
-    """An arrow pointing to ``direction`` (rad, clockwise from north) on a north-up panel."""
-    shape = np.array([(0, 1), (0.5, 0.15), (0.17, 0.15), (0.17, -1), (-0.17, -1),
-                      (-0.17, 0.15), (-0.5, 0.15), (0, 1)])           # east, north
-    c, s = math.cos(direction), math.sin(direction)
-    return Shape(np.column_stack([shape[:, 0] * c + shape[:, 1] * s,
-                                  -shape[:, 0] * s + shape[:, 1] * c]), closed=True)
-
-
-def _in_view(tracks: list[np.ndarray], points: np.ndarray) -> np.ndarray:
-    """Which route points (rows (east, north)) a track panel frames with the tracks: those
-    within half the tracks' size of the box around them."""
-    seen = np.concatenate(tracks)
-    low, high = seen.min(axis=0), seen.max(axis=0)
-    size = max(*(high - low), 4 * Hull.L)
-    gap = np.linalg.norm(np.maximum(0.0, np.maximum(low - points, points - high)), axis=1)
-    return gap <= size / 2
-
-
-def _clearance(avoid: np.ndarray, where: np.ndarray) -> float:
-    """The distance from ``where`` to the nearest of the points ``avoid``."""
-    return float(np.min(np.hypot(*(avoid - where).T))) if len(avoid) else math.inf
-
-
-def _dense(points: np.ndarray, pieces: int = 40) -> np.ndarray:
-    """The polyline through ``points`` as many points along each of its segments."""
-    steps = np.linspace(0.0, 1.0, pieces, endpoint=False)[:, None]
-    legs = [a + steps * (b - a) for a, b in itertools.pairwise(points)]
-    return np.concatenate([*legs, points[-1:]])
-
-
-def _label_waypoints(ax: Any, points: np.ndarray, avoid: np.ndarray, reach: float,
-                     size: float) -> None:
-    """Name each route point (``waypoint_name``) beside its circle of acceptance, on the
-    side farthest from the tracks and the route (``avoid``, (east, north) rows) in a frame
-    of ``size`` m."""
-    for i, point in enumerate(points):
-        away = np.array(max(_DIRECTIONS, key=lambda d: _clearance(
-            avoid, point + np.array(d) * (reach + 0.04 * size))))
-        ax.annotate(waypoint_name(i), tuple(point), xytext=tuple(point + away * reach * 1.1),
-                    textcoords="data", fontsize=8, fontweight="bold", color="tab:blue",
-                    ha="left" if away[0] > 0.3 else "right" if away[0] < -0.3 else "center",
-                    va="bottom" if away[1] > 0.3 else "top" if away[1] < -0.3 else "center",
-                    zorder=5)
-
-
-def _route(ax: Any, guidance: dict[str, Any], tracks: list[np.ndarray]) -> None:
-    """The route with its circles of acceptance and named waypoints. The panel frames the
-    tracks and the route points near them; a route running on out of view is cut at the
-    frame, and its label says where it goes."""
-    points = np.array(followed_route(guidance))[:, ::-1]              # (east, north)
-    reach = guidance["R_accept"]
-    near = _in_view(tracks, points)
-    label = "route"
-    if not near.all():
-        last = int(np.flatnonzero(~near)[-1])
-        label += (f", continuing out of view to {waypoint_name(last)} "
-                  f"({points[last][1]:g}, {points[last][0]:g}) m")
-    # add_artist, not plot or add_patch: what it adds leaves the data limits, and so the
-    # frame, alone; the frame takes the points in view, with their circles, instead.
-    ax.add_artist(Line2D(points[:, 0], points[:, 1], linestyle="--", marker="o",
-                         color="tab:blue", linewidth=0.8, markersize=4, label=label,
-                         zorder=2))
-    for east, north in points[1:]:
-        ax.add_artist(Circle((east, north), reach, fill=False, linestyle=":",
-                             color="tab:blue", zorder=2))
-    framed = np.concatenate([*tracks, points[near] - reach, points[near] + reach])
-    ax.update_datalim(framed)
-    _label_waypoints(ax, points, np.concatenate([*(t[::10] for t in tracks), _dense(points)]),
-                     reach, float(np.ptp(framed, axis=0).max()))
-
-
-def track_panel(ax: Any, run: Recording, ship: bool = True,
-                others: Iterable[Recording] = ()) -> None:
-    """The route with its circles of acceptance and named waypoints, the wave direction
-    and, with ``ship``, the track, where each leg switched and the ship's outline at
-    regular times; framed on the tracks of ``run`` and ``others`` (which the caller draws)."""
-    p = run.meta.get("parameters", {})
-    x, y, psi = run["ship.x"], run["ship.y"], run["ship.psi"]
-    tracks = [np.column_stack([r["ship.y"], r["ship.x"]]) for r in (run, *others)]
-    ax.set_label(TRACK)
-    if ship:
-        ax.plot(y, x, color="k", linewidth=1.0, label="track", zorder=3)
-    if "guidance" in p:
-        _route(ax, p["guidance"], tracks)
-        if ship:
-            switched = np.flatnonzero(np.diff(run["guidance.wp_index"])) + 1
-            ax.plot(y[switched], x[switched], "x", color="tab:red", markersize=8, mew=2,
-                    label="leg switched", zorder=4)
-    if ship:
-        shown = outlines(run)
-        for k in shown.rows:
-            ax.add_patch(Polygon(hull_outline(x[k], y[k], psi[k], shown.scale), closed=True,
-                                 facecolor="0.8", edgecolor="0.3", linewidth=0.6, zorder=2.5))
-        ax.plot([], [], "s", color="0.8", markeredgecolor="0.3",
-                label=f"ship outline {shown.size}, every {shown.every:g} s")
-    sea = p.get("ship", {})
-    if sea.get("Hs", 0.0) > 0.0:
-        ax.plot([], [], linestyle="none", marker=_arrow(sea["psi_w"]), markersize=11,
-                color="tab:cyan", label=f"waves travel to "
-                f"{math.degrees(sea['psi_w']) % 360:.0f} deg")
-    ax.set(xlabel="east y (m)", ylabel="north x (m)")
-    ax.set_aspect("equal", adjustable="datalim")
-    legend_if_any(ax)
-
-
-def legend_if_any(ax: Any, **kwargs: Any) -> None:
-    """A legend, if anything in the axes has a label to show, outside the axes over no
-    data: a track panel's below the figure's panels (replacing any earlier one), any
-    other's in a row above the axes, right."""
-    handles, labels = ax.get_legend_handles_labels()
-    if not handles:
-        return
-    if ax.get_label() == TRACK:
-        for old in list(ax.figure.legends):
-            old.remove()
-        ax.figure.legend(handles, labels, **{"loc": "outside lower left", "fontsize": 7,
-                                             "ncol": min(3, len(handles)),
-                                             "handleheight": 1.8, **kwargs})
-        return
-    ax.legend(**{"loc": "lower right", "bbox_to_anchor": (1.0, 1.0), "fontsize": 7,
-                 "ncol": len(handles), "frameon": False, "borderaxespad": 0.1, **kwargs})
+def new_figure(**options: Any) -> Figure:
+    """A figure on an Agg canvas, made without pyplot: no backend chosen, nothing kept."""
+    fig = Figure(**options)
+    FigureCanvasAgg(fig)
+    return fig
 
 
 def _layout(panels: int, heights: tuple[float, ...] | None = None
             ) -> tuple[Figure, Any, list[Any]]:
-    """A track panel on the left, ``panels`` time panels sharing the time axis on the right,
-    as high as ``heights`` says relative to each other (equal if not given)."""
-    fig = plt.figure(figsize=(13, 8), constrained_layout=True)
+    """A track panel on the left, ``panels`` time panels sharing the time axis on the right."""
+    fig = new_figure(figsize=(13, 8), layout="constrained")
     grid = fig.add_gridspec(panels, 2, width_ratios=(1.0, 1.25), height_ratios=heights)
     track = fig.add_subplot(grid[:, 0])
-    right = [fig.add_subplot(grid[0, 1])]
-    right += [fig.add_subplot(grid[i, 1], sharex=right[0]) for i in range(1, panels)]
-    for a in right[:-1]:
-        a.tick_params(labelbottom=False)
-    right[-1].set_xlabel("time (s)")
-    for a in (track, *right):
-        a.grid(alpha=0.3)
+    track.grid(alpha=0.3)
+    right = time_axes(fig, [grid[i, 1] for i in range(panels)])
     for a in right:
         a.yaxis.label.set_size(9)
     return fig, track, right
 
 
-def _degrees(ax: Any, run: Recording, column: str, label: str) -> None:
-    """One signal over time, in degrees, black, labelled."""
-    ax.plot(run.t, np.degrees(run[column]), color="k")
-    ax.set_ylabel(label)
+def time_axes(fig: Figure, cells: list[Any]) -> list[Any]:
+    """Panels over time, one per grid cell, sharing the time axis, labelled at the bottom."""
+    axes = [fig.add_subplot(cells[0])]
+    axes += [fig.add_subplot(c, sharex=axes[0]) for c in cells[1:]]
+    for a in axes[:-1]:
+        a.tick_params(labelbottom=False)
+    axes[-1].set_xlabel("time (s)")
+    for a in axes:
+        a.grid(alpha=0.3)
+    return axes
+
+
+def text_grid(width_ratios: tuple[float, float], rows: int, text: list[str]
+          ) -> tuple[Figure, Any]:
+    """A figure and its grid: ``rows`` rows of panels above one row of ``text``."""
+    text_lines = sum(line.count("\n") + 1 for line in _wrapped(text))
+    fig = new_figure(figsize=(13, 8.5 + 0.14 * text_lines), layout="constrained")
+    panel = (8.0 - 0.3 * rows) / rows
+    grid = fig.add_gridspec(rows + 1, 2, width_ratios=width_ratios,
+                            height_ratios=(*[panel] * rows, 0.16 * text_lines + 0.2))
+    return fig, grid
+
+
+def _wrapped(lines: list[str]) -> list[str]:
+    return [textwrap.fill(line, _WRAP, subsequent_indent="      ", break_on_hyphens=False)
+            for line in lines]
+
+
+def text_panel(ax: Any, lines: list[str]) -> None:
+    """The report's lines, wrapped, one under the other; a verdict in its colour."""
+    ax.set_axis_off()
+    shown = _wrapped(lines)
+    rows = sum(line.count("\n") + 1 for line in shown)
+    row = 0
+    for line in shown:
+        colour = _VERDICT_COLOURS.get(line.split(" ", 1)[0], "black")
+        ax.text(0.0, 1.0 - row / rows, line, transform=ax.transAxes, va="top", ha="left",
+                fontsize=8, family="monospace", color=colour)
+        row += line.count("\n") + 1
 
 
 def _rudder(ax: Any, run: Recording, commanded: str) -> None:
-    """Actual rudder in black over the command, thin and light behind it; the scale is the
-    stops', a larger command is clipped, which the panel's title says."""
+    """Actual rudder over the command; a command far beyond the stops is clipped, and said."""
     command = np.degrees(run[commanded])
     ax.plot(run.t, command, color="tab:orange", linewidth=0.5, alpha=0.55, zorder=1,
             label="commanded delta_c")
@@ -288,8 +108,7 @@ def _rudder(ax: Any, run: Recording, commanded: str) -> None:
 
 
 def merit_table(run: Recording, lam: float = LAMBDA) -> str:
-    """Eq (19) of the run, as ``cost`` gives it (and ``cosim.run`` prints it), and for one
-    of the paper's own runs (``describe.paper_row``) the paper's values beside: a table."""
+    """Eq (19) of the run as a table, the paper's values beside for one of its own runs."""
     c = cost(run, lam)
     rows = [("eq (19), rad^2", "psi_E", "delta_E", "J"),
             ("this run", f"{c.psi_E:.2f}", f"{c.delta_E:.2f}", f"{c.J:.2f}")]
@@ -302,8 +121,7 @@ def merit_table(run: Recording, lam: float = LAMBDA) -> str:
 
 
 def course_keeping_figure(run: Recording, lam: float = LAMBDA) -> Figure:
-    """Track with eq (19)'s figures of merit; surge speed, heading, heading error, yaw rate,
-    commanded and actual rudder. ``lam``: the weight of eq (19)."""
+    """Track with eq (19); surge speed, heading, heading error, yaw rate and rudder."""
     fig, track, (u, heading, error, r, rudder) = _layout(5, heights=(1, 1, 1, 1, 1.5))
     track_panel(track, run)
     track.set_title(merit_table(run, lam), loc="left", family="monospace", fontsize=8)
@@ -319,7 +137,8 @@ def course_keeping_figure(run: Recording, lam: float = LAMBDA) -> Figure:
     legend_if_any(heading)
     error.plot(t, np.degrees(heading_error(run["guidance.psi_d"], run["ship.psi"])), color="k")
     error.set_ylabel("psi_d - psi (deg)")
-    _degrees(r, run, "ship.r", "yaw rate r (deg/s)")
+    r.plot(t, np.degrees(run["ship.r"]), color="k")
+    r.set_ylabel("yaw rate r (deg/s)")
     _rudder(rudder, run, "ship.delta_c")
     return fig
 
@@ -336,22 +155,22 @@ def save(fig: Figure, path: Path, formats: tuple[str, ...] = ("png",)) -> list[P
                 fig.savefig(tmp, dpi=120, format=fmt)
             written.append(target)
     finally:
-        plt.close(fig)
+        if fig.canvas.manager is not None:     # made by pyplot (the studies' figures)
+            import matplotlib.pyplot as plt
+            plt.close(fig)
     return written
 
 
 def save_figure(run: Recording, draw: Callable[..., Figure], path: Path, label: str,
                 formats: tuple[str, ...] = ("png",), **draw_options: Any) -> list[Path]:
-    """Draw a run's figure (``draw(run, **draw_options)``), title it from what the run used,
-    write it in each format."""
+    """Draw a run's figure, title it from what the run used, write it in each format."""
     fig = draw(run, **draw_options)
     fig.suptitle(title(label, run.meta), fontsize=8)
     return save(fig, path, formats)
 
 
 def comparison(runs: dict[str, Recording], caption: str) -> Figure:
-    """Several controllers on one scenario: their tracks, headings and rudders, overlaid; the
-    track panel framed on the tracks, the figure titled ``caption``."""
+    """Several controllers on one scenario: their tracks, headings and rudders, overlaid."""
     fig, track, (heading, rudder) = _layout(2)
     first = next(iter(runs.values()))
     track_panel(track, first, ship=False, others=runs.values())    # the route and the waves

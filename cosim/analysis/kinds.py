@@ -1,9 +1,5 @@
-"""The analyses a scenario can ask for, by the kind its .ssd names: what is printed and drawn.
-
-A scenario names its kind in its system description (``SystemDescription.report``,
-an annotation of this project that other tools ignore). Each kind has a report
-(lines of text) and, unless it has nothing to show, a figure.
-"""
+"""Which report and figure a scenario gets, by the kind its .ssd names
+(``SystemDescription.report``, an annotation other tools ignore)."""
 from __future__ import annotations
 
 from dataclasses import dataclass

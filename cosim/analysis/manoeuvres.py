@@ -1,28 +1,7 @@
-"""The figures of a standard manoeuvre and the IMO criteria they are judged by, from its
-recorded trajectory: a turning circle's advance, transfer, tactical and steady diameters, a
-zig-zag's executes, overshoots, initial turning, time to check yaw and period.
-
-Definitions and criteria: IMO Resolution MSC.137(76), "Standards for ship manoeuvrability"
-(2002), 4.2 (terms) and 5.3 (criteria), with its explanatory notes MSC/Circ.1053:
-
-- 5.3.1 turning ability: advance <= 4.5 L, tactical diameter <= 5 L (35 deg rudder, or the
-  largest permissible);
-- 5.3.2 initial turning ability: with 10 deg rudder, no more than 2.5 L travelled by the
-  time the heading has changed by 10 deg;
-- 5.3.3 yaw checking: the 10/10 zig-zag's first overshoot <= 10 deg if L/V < 10 s, 20 deg
-  if L/V >= 30 s, 5 + L/(2V) deg between; its second overshoot <= 25 deg, 40 deg, and
-  17.5 + 0.75 L/V deg between (not a fixed margin over the first: 15 deg at 10 s, 20 at
-  30 s); the 20/20 zig-zag's first overshoot <= 25 deg.
-
-The standard is for ships of 100 m and over. CyberShip II is a 1:70 model (L = 1.255 m), so
-the criteria apply here through Froude scaling: angles and lengths in ship lengths are the
-same at both scales, but L/V is a time, and times scale with sqrt(70): the model's
-L/V = 4.2 s is 35 s at full scale, and that is what sets the overshoot limits.
-
-A positive rudder turns the ship to port, so headings go negative first. The
-co-simulated scenarios (``cosim/scenarios/turning_circle.ssd``, ``zigzag_*.ssd``:
-``reports``, ``plates``) and the ship run alone in-process (``turning_circle``,
-``zigzag``, by ``ship_fmu.trial``) share these figures. SI units and radians throughout.
+"""The figures of a standard manoeuvre from its recorded trajectory: a turning circle's
+advance, transfer, tactical and steady diameters; a zig-zag's executes, overshoots, initial
+turning, time to check yaw and period (MSC.137(76) 4.2, MSC/Circ.1053; judged in
+``criteria``). A positive rudder turns the ship to port. SI units and radians.
 """
 from __future__ import annotations
 
@@ -31,47 +10,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ship_fmu.data import Hull
 from ship_fmu.manoeuvres import RudderProgram
 from ship_fmu.trial import DT, trial
 from ship_fmu.vessel import VesselParameters
 
-from ..core.recording import Recording
-from .seastate import SCALE
-
-STANDARD = "MSC.137(76)"
-ADVANCE_LIMIT = 4.5                   # ship lengths, 5.3.1
-TACTICAL_DIAMETER_LIMIT = 5.0         # ship lengths, 5.3.1
-INITIAL_TURNING_LIMIT = 2.5           # ship lengths, 5.3.2
-FIRST_OVERSHOOT_20_LIMIT = math.radians(25.0)   # 5.3.3.3
 TURNING_RUDDER = math.radians(35.0)   # 4.2.2: 35 deg, or the largest permissible
-_SAME_ANGLE = 1e-6                    # rad: a test's angles match the standard's within this
-
-
-@dataclass(frozen=True)
-class Criterion:
-    """One MSC.137(76) criterion: a figure of the run, its limit and the clause setting it."""
-
-    figure: str      # what is judged, in the standard's words
-    value: float     # in ``unit``; NaN if the run never produced it (a turn never checked)
-    limit: float     # the largest value that passes, in ``unit``
-    unit: str        # "L" (ship lengths) or "rad"
-    clause: str      # of MSC.137(76)
-    basis: str = ""  # what set the limit, if it depends on the ship (L/V)
-    missing: str = "not reached in the run"   # why ``value`` is NaN, when it is
-    at_least: bool = False   # ``value`` is a lower bound: the run ended before the figure
-
-    @property
-    def verdict(self) -> str:
-        """PASS, FAIL, or OPEN: a figure the run did not reach, or reached only a lower
-        bound of that is within the limit, decides nothing."""
-        if self.value > self.limit:
-            return "FAIL"
-        return "OPEN" if self.at_least or math.isnan(self.value) else "PASS"
-
-    @property
-    def passed(self) -> bool:
-        return self.verdict == "PASS"
 
 
 @dataclass(frozen=True)
@@ -91,7 +34,7 @@ class TurningCircle:
 
     @property
     def diameter_from_rates(self) -> float:
-        """2 U / |r| of the steady turn, m: the steady diameter if the turn has settled."""
+        """2 U / |r| of the steady turn, m."""
         return 2.0 * self.steady_speed / abs(self.steady_yaw_rate)
 
 
@@ -126,8 +69,8 @@ class ZigZagResult:
         return self.overshoots[n - 1].angle if len(self.overshoots) >= n else math.nan
 
     def overshoot_bound(self, n: int) -> tuple[float, bool]:
-        """(angle, at_least) of the n-th overshoot: measured, or the least it can be if the
-        run ended in that turn before it was checked; NaN if the turn never began."""
+        """(angle, at_least) of the n-th overshoot: measured, or a lower bound if the run
+        ended in that turn; NaN if the turn never began."""
         if len(self.overshoots) >= n:
             return self.overshoots[n - 1].angle, False
         if self.running is not None and len(self.overshoots) == n - 1:
@@ -160,14 +103,13 @@ class ZigZagResult:
         return self._between(1, 3)
 
     def _between(self, first: int, last: int) -> float:
-        """Time from execute ``first`` to execute ``last`` (0-based), s; NaN if not reached."""
+        """Time from execute ``first`` to ``last`` (0-based), s; NaN if not reached."""
         return self.executes[last] - self.executes[first] if len(self.executes) > last \
             else math.nan
 
 
 def _first_reaching(level: np.ndarray, target: float, *series: np.ndarray) -> list[float]:
-    """Each series, linearly interpolated where ``level`` first reaches ``target``; NaNs if
-    it never does."""
+    """Each series, interpolated where ``level`` first reaches ``target``; NaNs if never."""
     i = int(np.argmax(level >= target))
     if level[i] < target:
         return [math.nan] * len(series)
@@ -178,31 +120,20 @@ def _first_reaching(level: np.ndarray, target: float, *series: np.ndarray) -> li
 
 
 def at_heading_change(psi: np.ndarray, target: float, *series: np.ndarray) -> list[float]:
-    """Each series, linearly interpolated where the heading has first changed by ``target``
-    (rad) from psi[0]; NaNs if it never does."""
+    """Each series, interpolated where the heading first changed by ``target`` from psi[0]."""
     psi = np.asarray(psi)
     return _first_reaching(np.abs(psi - psi[0]), target, *map(np.asarray, series))
 
 
-def crossing(x: np.ndarray, y: np.ndarray, psi: np.ndarray,
-             target: float) -> tuple[float, float]:
-    """(x, y) where the heading has first changed by target from psi[0], interpolated;
-    NaNs if it never does."""
-    x_at, y_at = at_heading_change(psi, target, x, y)
-    return x_at, y_at
-
-
 def approach_frame(x: np.ndarray, y: np.ndarray, psi0: float) -> tuple[np.ndarray, np.ndarray]:
-    """(along, across) the approach course psi0 from the first point, m (across: to
-    starboard of it)."""
+    """(along, across to starboard of) the approach course psi0 from the first point, m."""
     dx, dy = np.asarray(x) - x[0], np.asarray(y) - y[0]
     c, s = math.cos(psi0), math.sin(psi0)
     return dx * c + dy * s, -dx * s + dy * c
 
 
 def fitted_circle(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
-    """(x, y) of the centre and the diameter of the circle fitted to the points by least
-    squares (Kasa's algebraic fit), m."""
+    """(x, y) of the centre and the diameter of the least-squares circle (Kasa's fit), m."""
     x, y = np.asarray(x), np.asarray(y)
     A = np.column_stack([2.0 * x, 2.0 * y, np.ones_like(x)])
     (cx, cy, c), *_ = np.linalg.lstsq(A, x * x + y * y, rcond=None)
@@ -210,8 +141,7 @@ def fitted_circle(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
 
 
 def steady_circle(x: np.ndarray, y: np.ndarray, psi: np.ndarray) -> tuple[float, float, float]:
-    """The steady turning circle: ``fitted_circle`` over the last 360 deg of heading; NaNs
-    unless the heading turned 540 deg (so that lap starts past the first 180 deg)."""
+    """``fitted_circle`` over the last 360 deg of heading; NaNs unless it turned 540 deg."""
     x, y, psi = map(np.asarray, (x, y, psi))
     if abs(psi[-1] - psi[0]) < 3.0 * math.pi:
         return math.nan, math.nan, math.nan
@@ -240,15 +170,10 @@ def turning_circle_figures(x, y, psi, u, v, r) -> TurningCircle:
 
 def zigzag_figures(psi, reversals, psi_switch: float, t=None, x=None,
                    y=None) -> ZigZagResult:
-    """A zig-zag's figures from its heading deviation psi (the rudder program's, from
-    psi = 0) and the program's reversal count, each sample.
+    """A zig-zag's figures from its heading deviation psi and the program's reversal count.
 
-    An overshoot is measured once the heading has turned back after a reversal (the turn
-    was checked); the first or second turn, if the run ended in it with the heading still
-    going away, is ``running``, its overshoot so far a lower bound (a straight-line unstable ship with
-    too little rudder never checks its turn). The times (executes, overshoots, initial turning, period) need ``t``, the
-    distance travelled to the switching angle needs ``x`` and ``y``: without them those
-    are empty or NaN.
+    An overshoot counts once the heading turned back; a first or second turn the run ended
+    in is ``running``, a lower bound. The times need ``t``, the distance ``x`` and ``y``.
     """
     psi, reversals = np.asarray(psi), np.asarray(reversals)
     times = np.asarray(t) if t is not None else np.full(len(psi), math.nan)
@@ -272,93 +197,6 @@ def zigzag_figures(psi, reversals, psi_switch: float, t=None, x=None,
         travelled = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(x), np.diff(y)))])
         distance, = _first_reaching(np.abs(psi), psi_switch, travelled)
     return ZigZagResult(reached, psi_switch, tuple(overshoots), executes, distance, running)
-
-
-def length_over_speed(length: float, speed: float, scale: float = SCALE) -> float:
-    """L/V at full scale, s, of a model of ``length`` m at ``speed`` m/s: Froude scaling
-    multiplies the model's L/V by sqrt(scale)."""
-    return math.sqrt(scale) * length / speed
-
-
-def overshoot_limits(lv: float) -> tuple[float, float]:
-    """(first, second) overshoot limits of the 10/10 zig-zag, rad, for L/V in s at full
-    scale (MSC.137(76) 5.3.3.1-2)."""
-    if lv < 10.0:
-        first, second = 10.0, 25.0
-    elif lv >= 30.0:
-        first, second = 20.0, 40.0
-    else:
-        first, second = 5.0 + 0.5 * lv, 17.5 + 0.75 * lv
-    return math.radians(first), math.radians(second)
-
-
-def _is(angle: float, degrees: float) -> bool:
-    return abs(angle - math.radians(degrees)) < _SAME_ANGLE
-
-
-def turning_circle_criteria(tc: TurningCircle, delta: float, delta_max: float,
-                            length: float = Hull.L) -> tuple[Criterion, ...]:
-    """MSC.137(76) 5.3.1, for a turning circle at 35 deg rudder or the largest the gear
-    allows; none for another rudder angle."""
-    if abs(delta - min(TURNING_RUDDER, delta_max)) >= _SAME_ANGLE:
-        return ()
-    return (Criterion("advance", tc.advance / length, ADVANCE_LIMIT, "L", "5.3.1",
-                      missing="none: the heading never changed by 90 deg"),
-            Criterion("tactical diameter", tc.tactical_diameter / length,
-                      TACTICAL_DIAMETER_LIMIT, "L", "5.3.1",
-                      missing="none: the heading never changed by 180 deg"))
-
-
-def zigzag_criteria(zz: ZigZagResult, delta: float, approach_speed: float,
-                    length: float = Hull.L, scale: float = SCALE) -> tuple[Criterion, ...]:
-    """MSC.137(76) 5.3.2-3 for a 10/10 or a 20/20 zig-zag; none for another test."""
-    if _is(delta, 10.0) and _is(zz.psi_switch, 10.0):
-        lv = length_over_speed(length, approach_speed, scale)
-        first, second = overshoot_limits(lv)
-        basis = (f"L/V = {lv:.1f} s at full scale (1:{scale:g}; "
-                 f"{length / approach_speed:.2f} s for the model)")
-        return (Criterion("initial turning: distance by 10 deg heading change",
-                          zz.initial_turning_distance / length, INITIAL_TURNING_LIMIT, "L",
-                          "5.3.2", missing="none: the heading never changed by 10 deg"),
-                _overshoot_criterion(zz, 1, first, "5.3.3.1", basis),
-                _overshoot_criterion(zz, 2, second, "5.3.3.2", basis))
-    if _is(delta, 20.0) and _is(zz.psi_switch, 20.0):
-        return (_overshoot_criterion(zz, 1, FIRST_OVERSHOOT_20_LIMIT, "5.3.3.3"),)
-    return ()
-
-
-def _overshoot_criterion(zz: ZigZagResult, n: int, limit: float, clause: str,
-                         basis: str = "") -> Criterion:
-    value, at_least = zz.overshoot_bound(n)
-    return Criterion(f"{('first', 'second')[n - 1]} overshoot", value, limit, "rad", clause,
-                     basis, "none: the run ended before that turn", at_least)
-
-
-@dataclass(frozen=True)
-class Assessment:
-    """A recorded manoeuvre: its figures and the criteria that apply to it."""
-
-    figures: TurningCircle | ZigZagResult
-    criteria: tuple[Criterion, ...]
-    delta: float                # rad, the test's rudder angle
-    length: float = Hull.L      # m, the ship's
-
-
-def turning_circle_of(run: Recording) -> Assessment:
-    """The turning circle of a recorded run, and its criteria."""
-    tc = turning_circle_figures(*(run[f"ship.{n}"] for n in ("x", "y", "psi", "u", "v", "r")))
-    p = run.meta["parameters"]
-    delta = p["program"]["delta"]
-    return Assessment(tc, turning_circle_criteria(tc, delta, p["ship"]["delta_max"]), delta)
-
-
-def zigzag_of(run: Recording) -> Assessment:
-    """The zig-zag of a recorded run, and its criteria."""
-    program = run.meta["parameters"]["program"]
-    zz = zigzag_figures(run["ship.psi"], run["program.reversals"], program["psi_switch"],
-                        run.t, run["ship.x"], run["ship.y"])
-    approach = math.hypot(run["ship.u"][0], run["ship.v"][0])
-    return Assessment(zz, zigzag_criteria(zz, program["delta"], approach), program["delta"])
 
 
 def turning_circle(delta: float = TURNING_RUDDER, t_end: float = 300.0,

@@ -13,8 +13,7 @@ from ..ensemble.exact import wrap
 
 
 def heading_error(psi_d: np.ndarray, psi: np.ndarray) -> np.ndarray:
-    """Delta psi_i = psi_d - psi, wrapped to (-pi, pi], rad (``fmukit.numerics.wrap`` of
-    each sample, to the bit)."""
+    """Delta psi_i = psi_d - psi wrapped to (-pi, pi], rad, to the bit as the FMUs wrap it."""
     return wrap(np.asarray(psi_d, dtype=float) - np.asarray(psi, dtype=float))
 
 
@@ -49,16 +48,13 @@ def overshoot(psi: np.ndarray, psi_start: float, psi_target: float) -> float:
     return max(0.0, float(np.max(direction * (np.asarray(psi) - psi_target))))
 
 
-RUDDER_DEADBAND = math.radians(0.5)
-"""How far past amidships the rudder must go for a crossing to count, rad: a rudder that
-dithers about zero by a rounding error (1e-15 rad in head seas, where sin(pi) leaves a
-residue in the wave side force) or by a fraction of a degree does not reverse."""
+RUDDER_DEADBAND = math.radians(0.5)   # past amidships for a crossing to count: no dither
 
 
 def rudder_reversals_per_minute(t: np.ndarray, delta: np.ndarray,
                                 deadband: float = RUDDER_DEADBAND) -> float:
-    """Rudder reversals per minute: how often the rudder crosses from one side to the other,
-    a crossing counted once the rudder is beyond ``deadband`` on the new side (hysteresis)."""
+    """Rudder crossings from one side to the other per minute, each counted once the rudder
+    is beyond ``deadband`` on the new side."""
     delta = np.asarray(delta)
     sides = np.sign(delta)[np.abs(delta) > deadband]
     reversals = int(np.count_nonzero(sides[1:] != sides[:-1]))
@@ -82,14 +78,9 @@ def fraction_at_stops(delta: np.ndarray, delta_max: float) -> float:
 
 def cross_track_error(x: np.ndarray, y: np.ndarray, wp_index: np.ndarray,
                       points: Sequence[tuple[float, float]]) -> np.ndarray:
-    """Signed distance of (x, y) from the line of the leg the guidance follows, m, positive
-    to starboard of it (Fossen 2011, ch 10: e = -(x - x_k) sin alpha_k + (y - y_k) cos
-    alpha_k, alpha_k the leg's course of eq 18).
-
-    ``wp_index`` is the guidance's output: the waypoint steered to, so the leg runs from
-    waypoint wp_index - 1 to wp_index; once past the last (wp_index = len(points)) the
-    guidance holds the last leg's course, and the error is measured from that leg's line.
-    """
+    """Signed distance of (x, y) from the line of the leg followed, m, positive to starboard
+    (Fossen 2011, ch 10: e = -(x - x_k) sin alpha_k + (y - y_k) cos alpha_k). The leg runs
+    to waypoint ``wp_index``; past the last, the last leg's line."""
     guidance = WaypointGuidance(points)
     leg = np.clip(np.asarray(wp_index, dtype=int) - 1, 0, len(points) - 2)
     alpha = np.array([guidance.course(k) for k in range(len(points) - 1)])[leg]
@@ -99,10 +90,8 @@ def cross_track_error(x: np.ndarray, y: np.ndarray, wp_index: np.ndarray,
 
 @dataclass(frozen=True)
 class RouteCompletion:
-    """How close the track came to each waypoint of the route, against the guidance's
-    circle of acceptance: a waypoint is reached if the ship came within R_accept of it.
-    (The guidance also moves on once a waypoint is passed along track, so a ship set off
-    its route can have every leg "done" without reaching a waypoint.)"""
+    """How close the track came to each waypoint: reached if within R_accept of it (the
+    guidance also moves on past a waypoint it never reached)."""
 
     points: tuple[tuple[float, float], ...]     # the route, m
     closest: tuple[float, ...]                  # the track's closest approach to each, m

@@ -1,76 +1,28 @@
-"""IMO-style plates of the standard manoeuvres: a zig-zag and a turning circle as MSC/Circ.1053
-draws them, with the standard's figures and the MSC.137(76) criteria, PASS or FAIL.
-
-The figures and criteria come from ``manoeuvres`` (one assessment of the run), the words
-from ``reports`` (the same lines ``cosim.run`` prints), so the plate and the report cannot
-disagree. Degrees for display only. On a zig-zag plate heading and rudder share one axis
-with one sign sense, the field's: the heading psi is positive to starboard, and the rudder
-is drawn as -delta, positive when it turns the ship to starboard (in this model a positive
-delta turns it to port), so the rudder leads the heading.
+"""IMO-style plates of a zig-zag and a turning circle, as MSC/Circ.1053 draws them, with the
+standard's figures and the MSC.137(76) criteria; the figures from ``manoeuvres``, the words
+from ``reports``, so plate and report cannot disagree. On a zig-zag plate the rudder is drawn
+as -delta, with the heading's sign sense (a positive delta turns this ship to port).
 """
 from __future__ import annotations
 
 import math
-import textwrap
 from typing import Any
 
-import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
-from matplotlib.patches import Polygon
+from matplotlib.patches import Circle, Polygon
 
 from ..core.recording import Recording
-from .figures import hull_outline, legend_if_any, outlines, track_panel
-from .manoeuvres import (Assessment, TurningCircle, ZigZagResult, approach_frame,
-                         at_heading_change, steady_circle, turning_circle_of, zigzag_of)
+from .figures import text_grid, text_panel, time_axes
+from .criteria import Assessment, turning_circle_of, zigzag_of
+from .manoeuvres import (TurningCircle, ZigZagResult, approach_frame, at_heading_change,
+                         steady_circle)
 from .reports import turning_circle_lines, zigzag_lines
+from .track import hull_outline, legend_if_any, outlines, track_panel
 
 RUDDER = "rudder -delta (deg, + turns to starboard)"
-"""The rudder on a plate: drawn with the heading's sign sense."""
 _ORDINALS = ("1st", "2nd", "3rd", "4th")
-_VERDICT_COLOURS = {"PASS": "tab:green", "FAIL": "tab:red", "OPEN": "tab:orange"}
 _BOX = dict(boxstyle="round,pad=0.15", facecolor="white", alpha=0.85, edgecolor="none")
-_WRAP = 150
-"""Characters per line of a plate's text, at its font size."""
-
-
-def _grid(width_ratios: tuple[float, float], rows: int, text_lines: int) -> tuple[Figure, Any]:
-    """A figure and its grid: ``rows`` rows of panels above one row of text."""
-    fig = plt.figure(figsize=(13, 8.5 + 0.14 * text_lines), constrained_layout=True)
-    panel = (8.0 - 0.3 * rows) / rows
-    grid = fig.add_gridspec(rows + 1, 2, width_ratios=width_ratios,
-                            height_ratios=(*[panel] * rows, 0.16 * text_lines + 0.2))
-    return fig, grid
-
-
-def _wrapped(lines: list[str]) -> list[str]:
-    return [textwrap.fill(line, _WRAP, subsequent_indent="      ", break_on_hyphens=False)
-            for line in lines]
-
-
-def text_panel(ax: Any, lines: list[str]) -> None:
-    """The report's lines, wrapped, one under the other; a verdict in its colour."""
-    ax.set_axis_off()
-    shown = _wrapped(lines)
-    rows = sum(line.count("\n") + 1 for line in shown)
-    row = 0
-    for line in shown:
-        colour = _VERDICT_COLOURS.get(line.split(" ", 1)[0], "black")
-        ax.text(0.0, 1.0 - row / rows, line, transform=ax.transAxes, va="top", ha="left",
-                fontsize=8, family="monospace", color=colour)
-        row += line.count("\n") + 1
-
-
-def _time_axes(fig: Figure, cells: list[Any]) -> list[Any]:
-    """Panels over time, one per grid cell, sharing the time axis, labelled at the bottom."""
-    axes = [fig.add_subplot(cells[0])]
-    axes += [fig.add_subplot(c, sharex=axes[0]) for c in cells[1:]]
-    for a in axes[:-1]:
-        a.tick_params(labelbottom=False)
-    axes[-1].set_xlabel("time (s)")
-    for a in axes:
-        a.grid(alpha=0.3)
-    return axes
 
 
 def _rudder(ax: Any, run: Recording) -> None:
@@ -117,8 +69,7 @@ def _overshoots(ax: Any, zz: ZigZagResult) -> None:
 
 
 def _spans(ax: Any, zz: ZigZagResult) -> None:
-    """Initial turning time, time to check yaw and period, as dimension lines in a band
-    below the curves."""
+    """Initial turning time, time to check yaw and period, as dimension lines below the curves."""
     low, high = ax.get_ylim()
     ticks = [tick for tick in ax.get_yticks() if low <= tick <= high]
     ax.set_ylim(low - 0.4 * (high - low), high)
@@ -148,8 +99,7 @@ def _runaway(ax: Any, run: Recording, zz: ZigZagResult, a: Assessment) -> None:
 
 
 def _zoom(ax: Any, run: Recording, zz: ZigZagResult) -> None:
-    """Time up to a little past the fifth execute, where the standard's figures are, if the
-    run goes on longer; the heading's range over it."""
+    """Time up to a little past the fifth execute, where the standard's figures are."""
     if len(zz.executes) < 6:
         return
     end = zz.executes[5] + 0.25 * (zz.executes[5] - zz.executes[4])
@@ -174,13 +124,12 @@ def _switching_angles(ax: Any, switch: float) -> None:
 
 
 def zigzag_plate(run: Recording, **_: Any) -> Figure:
-    """Heading and rudder on one axis with the executes, overshoots and the standard's times;
-    yaw rate; the track; the figures and criteria."""
+    """Heading and rudder with executes, overshoots and times; yaw rate; track; criteria."""
     a = zigzag_of(run)
     zz = a.figures
     lines = zigzag_lines(a, run)
-    fig, grid = _grid((2.2, 1.0), 3, sum(s.count("\n") + 1 for s in _wrapped(lines)))
-    heading, r = _time_axes(fig, [grid[0:2, 0], grid[2, 0]])
+    fig, grid = text_grid((2.2, 1.0), 3, lines)
+    heading, r = time_axes(fig, [grid[0:2, 0], grid[2, 0]])
     track_panel(fig.add_subplot(grid[0:3, 1]), run)
     heading.plot(run.t, np.degrees(run["ship.psi"]), color="k", linewidth=1.4,
                  label="heading psi")
@@ -211,8 +160,8 @@ def _earth(run: Recording, along: float, across: float) -> tuple[float, float]:
 
 def _dimension(ax: Any, run: Recording, start: tuple[float, float], end: tuple[float, float],
                label: str, colour: str, label_at: tuple[float, float] | None = None) -> None:
-    """A dimension line between two (along, across) points, labelled at its middle or, with
-    a leader, at ``label_at``; the line's gid is the label's first word."""
+    """A dimension line between two (along, across) points, labelled at its middle or at
+    ``label_at``; its gid is the label's first word."""
     p, q = _earth(run, *start), _earth(run, *end)
     ax.plot([p[0], q[0]], [p[1], q[1]], color=colour, linewidth=1.6, zorder=6,
             gid=label.split()[0])
@@ -236,56 +185,37 @@ def _extension(ax: Any, run: Recording, start: tuple[float, float],
 
 
 def _turning_track(ax: Any, run: Recording, a: Assessment) -> None:
-    """The track with the approach course, advance, transfer, tactical and steady diameter,
-    and the ship where its heading has changed 90 and 180 deg; what the run reached."""
+    """The track with the approach course, the advance (outside the turn), transfer and
+    tactical diameter the run reached, the steady circle, the ship at 90 and 180 deg."""
     track_panel(ax, run)
-    psi = run["ship.psi"]
-    along, across = approach_frame(run["ship.x"], run["ship.y"], float(psi[0]))
+    tc, L = a.figures, a.length
+    x, y, psi = run["ship.x"], run["ship.y"], run["ship.psi"]
+    along, across = approach_frame(x, y, float(psi[0]))
     side = math.copysign(1.0, across[np.argmax(np.abs(across))])     # the turn's side
-    top, gap = along.max(), 0.08 * max(np.ptp(across), a.length)
+    top, gap = along.max(), 0.08 * max(np.ptp(across), L)
     outside = -side * (max(-side * across.min(), -side * across.max(), 0.0) + gap)
     _extension(ax, run, (-gap, 0.0), (top + 2 * gap, 0.0))
     ax.annotate("approach course", _earth(run, -gap, 0.0), fontsize=7, color="0.4",
                 ha="center", va="top", bbox=_BOX, zorder=7)
     a90 = tuple(at_heading_change(psi, math.pi / 2, along, across))
-    if not math.isnan(a.figures.advance):
-        _advance_and_transfer(ax, run, a, a90, outside, side * 3.5 * gap, gap)
+    if not math.isnan(tc.advance):
+        _extension(ax, run, (0.0, 0.0), (0.0, outside))
+        _extension(ax, run, a90, (a90[0], outside))
+        _dimension(ax, run, (0.0, outside), (tc.advance, outside),
+                   f"advance\n{tc.advance:.2f} m\n{tc.advance / L:.2f} L", "tab:green")
+        _dimension(ax, run, (a90[0], 0.0), a90,
+                   f"transfer {tc.transfer:.2f} m = {tc.transfer / L:.2f} L (at 90 deg)",
+                   "tab:purple", label_at=(a90[0] - 1.5 * gap, side * 3.5 * gap))
     a180 = tuple(at_heading_change(psi, math.pi, along, across))
-    if not math.isnan(a.figures.tactical_diameter):
-        _tactical(ax, run, a, a180, top + gap)
-    _steady(ax, run, a.figures, a.length)
-    _ship_at_heading_changes(ax, run)
-
-
-def _advance_and_transfer(ax: Any, run: Recording, a: Assessment, a90: tuple[float, float],
-                          outside: float, inside: float, gap: float) -> None:
-    """The advance beside the track on the side away from the turn, the transfer at the
-    90 deg point, labelled ``inside`` the circle."""
-    tc, L = a.figures, a.length
-    _extension(ax, run, (0.0, 0.0), (0.0, outside))
-    _extension(ax, run, a90, (a90[0], outside))
-    _dimension(ax, run, (0.0, outside), (tc.advance, outside),
-               f"advance\n{tc.advance:.2f} m\n{tc.advance / L:.2f} L", "tab:green")
-    _dimension(ax, run, (a90[0], 0.0), a90,
-               f"transfer {tc.transfer:.2f} m = {tc.transfer / L:.2f} L (at 90 deg)",
-               "tab:purple", label_at=(a90[0] - 1.5 * gap, inside))
-
-
-def _tactical(ax: Any, run: Recording, a: Assessment, a180: tuple[float, float],
-              level: float) -> None:
-    """The tactical diameter across the approach course, ``level`` m along it."""
-    tc = a.figures
-    _extension(ax, run, (a180[0], 0.0), (level, 0.0))
-    _extension(ax, run, a180, (level, a180[1]))
-    _dimension(ax, run, (level, 0.0), (level, a180[1]),
-               f"tactical diameter {tc.tactical_diameter:.2f} m = "
-               f"{tc.tactical_diameter / a.length:.2f} L (at 180 deg)", "tab:brown")
-
-
-def _ship_at_heading_changes(ax: Any, run: Recording) -> None:
-    """The ship's outline where its heading has changed 90 and 180 deg: its drift shows."""
-    x, y, psi = run["ship.x"], run["ship.y"], run["ship.psi"]
-    scale = outlines(run).scale
+    if not math.isnan(tc.tactical_diameter):
+        level = top + gap
+        _extension(ax, run, (a180[0], 0.0), (level, 0.0))
+        _extension(ax, run, a180, (level, a180[1]))
+        _dimension(ax, run, (level, 0.0), (level, a180[1]),
+                   f"tactical diameter {tc.tactical_diameter:.2f} m = "
+                   f"{tc.tactical_diameter / L:.2f} L (at 180 deg)", "tab:brown")
+    _steady(ax, run, tc, L)
+    scale = outlines(run).scale          # the ship where its heading changed 90 and 180 deg
     for target in (math.pi / 2, math.pi):
         xs, ys, ps = at_heading_change(psi, target, x, y, psi)
         if math.isnan(xs):
@@ -301,7 +231,7 @@ def _steady(ax: Any, run: Recording, tc: TurningCircle, L: float) -> None:
     centre_x, centre_y, diameter = steady_circle(run["ship.x"], run["ship.y"], run["ship.psi"])
     if math.isnan(diameter):
         return
-    ax.add_patch(plt.Circle((centre_y, centre_x), diameter / 2, fill=False, linestyle="--",
+    ax.add_patch(Circle((centre_y, centre_x), diameter / 2, fill=False, linestyle="--",
                             color="tab:orange", linewidth=0.9, zorder=4))
     east = (centre_y - diameter / 2, centre_y + diameter / 2)
     ax.annotate("", xy=(east[1], centre_x), xytext=(east[0], centre_x),
@@ -323,14 +253,13 @@ def _wrapped_heading(ax: Any, run: Recording) -> None:
 
 
 def turning_circle_plate(run: Recording, **_: Any) -> Figure:
-    """Track with advance, transfer, tactical and steady diameter; heading 0-360 deg, speed,
-    drift angle, yaw rate and rudder; the figures and criteria."""
+    """Track with the diameters; heading, speed, drift, yaw rate and rudder; criteria."""
     a = turning_circle_of(run)
     tc: TurningCircle = a.figures
     lines = turning_circle_lines(a)
-    fig, grid = _grid((1.15, 1.0), 5, sum(s.count("\n") + 1 for s in _wrapped(lines)))
+    fig, grid = text_grid((1.15, 1.0), 5, lines)
     _turning_track(fig.add_subplot(grid[0:5, 0]), run, a)
-    heading, speed, drift, r, rudder = _time_axes(fig, [grid[i, 1] for i in range(5)])
+    heading, speed, drift, r, rudder = time_axes(fig, [grid[i, 1] for i in range(5)])
     t, u, v = run.t, run["ship.u"], run["ship.v"]
     _wrapped_heading(heading, run)
     for target in (math.pi / 2, math.pi):

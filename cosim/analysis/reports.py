@@ -6,8 +6,8 @@ import math
 
 from ..core.recording import Recording
 from .cost import LAMBDA, Cost, cost
-from .manoeuvres import (STANDARD, Assessment, Criterion, TurningCircle, ZigZagResult,
-                         turning_circle_of, zigzag_of)
+from .criteria import STANDARD, Assessment, Criterion, turning_circle_of, zigzag_of
+from .manoeuvres import TurningCircle, ZigZagResult
 from .metrics import RUDDER_DEADBAND, at_stops, rudder_reversals_per_minute
 from .seastate import SCALE
 
@@ -149,13 +149,9 @@ def _label(sea: str, controller: str) -> str:
 
 def tables(costs: dict[tuple[str, str], Cost],
            spreads: dict[tuple[str, str], str] | None = None, spreads_title: str = "") -> str:
-    """Tables 1 and 2 of the paper next to ours; ``costs`` by (sea, controller).
-
-    The sea is "calm" or "waves"; the controllers "pd" and "smc" are the paper's and
-    get its values beside ours, any other (a user's autopilot) gets a row of its own.
-    ``spreads``: what a perturbation ensemble says of each row (``cosim.studies.spread``),
-    printed below the tables under ``spreads_title``.
-    """
+    """Tables 1 and 2 of the paper beside ours; ``costs`` by (sea, controller), "pd" and
+    "smc" with the paper's values, any other a row of its own; ``spreads`` (what a
+    perturbation ensemble says of each row) below, under ``spreads_title``."""
     lines = []
     for title, sea in (("Table 1, calm water", "calm"), ("Table 2, waves", "waves")):
         lines += [f"{title}:", f"  {'':16}{'psi_E':>9}{'delta_E':>9}{'J':>9}   |"

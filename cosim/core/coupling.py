@@ -1,19 +1,13 @@
 """Coupling algorithms: how one communication step exchanges signals and steps the FMUs.
 
-Each takes the nodes (``cosim.core.wiring``), the list of current values (one per
-column), the communication point t_k and the step h. On return ``values`` holds
-every signal at t_k, and, if ``step`` is true, every FMU has stepped to t_k + h
-(the last communication point is only sampled).
+Each takes the nodes (``wiring``), the current values (one per column), t_k and h; on
+return ``values`` holds every signal at t_k and, if ``step``, every FMU is at t_k + h.
 
-- ``gauss_seidel`` visits the FMUs in the order given, along the signal flow
-  (``wiring.feedthrough_order``): outputs without feedthrough (the ship's states)
-  are read at t_k before anyone is visited; then each FMU gets its inputs, gives
-  its feedthrough outputs and steps, so the next one sees them at t_k. On the
-  paper's diagram: guidance -> autopilot -> ship, as in its Simulink model.
-- ``jacobi`` reads every FMU's outputs as they stand after the previous step,
-  then sets every input, then steps them all (what OSP libcosim and ecos do). A
-  direct-feedthrough signal (the rudder command) reaches its target one step
-  later than in Gauss-Seidel, for each feedthrough FMU on its way.
+- ``gauss_seidel``: outputs without feedthrough (the ship's states) read at t_k, then each
+  FMU in signal-flow order gets its inputs, gives its feedthrough outputs and steps (the
+  paper's guidance -> autopilot -> ship, as in its Simulink model);
+- ``jacobi``: every output as it stands, then every input, then every FMU steps (OSP
+  libcosim's and ecos's): a feedthrough signal arrives one step later per feedthrough FMU.
 """
 from __future__ import annotations
 
@@ -57,3 +51,14 @@ def jacobi(nodes: list[Node], values: list[float], t: float, h: float, step: boo
 
 
 COUPLINGS: dict[str, Coupling] = {"gauss-seidel": gauss_seidel, "jacobi": jacobi}
+
+
+def settle(nodes: list[Node], columns: int) -> None:
+    """Initial outputs propagated along the connections: enough passes for any acyclic chain."""
+    values = [0.0] * columns
+    for _ in nodes:
+        for node in nodes:
+            if node.read_outputs:
+                values[node.outputs] = node.read_outputs()
+            if node.apply_inputs:
+                node.apply_inputs(values)

@@ -1,18 +1,47 @@
-"""The core's errors about an FMU file, with what a command needs to advise its user."""
+"""The core's errors about an FMU file, and the advice a message ends with ("did you mean")."""
 from __future__ import annotations
 
-
-class FmuNotFound(FileNotFoundError):
-    """No FMU file where a component's source says; ``ours``: one this project builds."""
-
-    def __init__(self, message: str, ours: bool):
-        super().__init__(message)
-        self.ours = ours
+import difflib
+from typing import Iterable
 
 
-class FmuUnreadable(ValueError):
-    """A file that is not a readable FMU; ``ours``: named as one this project builds."""
+class _FmuFileError(Exception):
+    """``ours``: the file is named as one of the FMUs the caller builds (a command may say how)."""
 
     def __init__(self, message: str, ours: bool):
         super().__init__(message)
         self.ours = ours
+
+
+class FmuNotFound(_FmuFileError, FileNotFoundError):
+    """No FMU file where a component's source says."""
+
+
+class FmuUnreadable(_FmuFileError, ValueError):
+    """A file that is not a readable FMU."""
+
+
+CLOSE = 0.7
+"""How alike (``difflib``'s ratio) a name must be to be offered: 'ship' for 'shp' (0.86),
+not 'wave_seed' for 'wave_height' (0.6)."""
+
+
+def close_matches(name: str, names: Iterable[str]) -> list[str]:
+    """The names a user who typed ``name`` likely meant, best first: equal but for case,
+    then up to three ``CLOSE`` ones (ignoring case)."""
+    names = list(dict.fromkeys(names))
+    same = [n for n in names if n.lower() == name.lower() and n != name]
+    folded = {}
+    for n in names:
+        folded.setdefault(n.lower(), n)
+    close = [folded[n] for n in difflib.get_close_matches(name.lower(), list(folded), 3, CLOSE)]
+    return list(dict.fromkeys(n for n in [*same, *close] if n != name))
+
+
+def did_you_mean(matches: list[str]) -> str:
+    """"; did you mean 'Hs'?" for ``matches``; '' for none."""
+    quoted = [f"'{n}'" for n in matches]
+    if not quoted:
+        return ""
+    listed = quoted[0] if len(quoted) == 1 else f"{', '.join(quoted[:-1])} or {quoted[-1]}"
+    return f"; did you mean {listed}?"

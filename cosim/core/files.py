@@ -1,13 +1,10 @@
 """Output files written whole or not at all, and output folders written by one process at a time.
 
-``whole_file`` hands out a temporary name beside the target and renames it into
-place only when the writing succeeded: a reader finds the old file or the new one,
-never half of one, and a failed write (a full disk, a kill) leaves the old file
-as it was. ``Outputs`` does the same for a group of files (a run's CSV, JSON and
-figures): every file is written into a hidden folder first and the group is put
-in place only once all of them are complete. ``FolderLock`` holds an output folder
-for one process; a second is refused at once, with a message naming the folder.
-A failed write raises ``OutputError``, which names the file and says what was kept.
+``whole_file`` writes to a temporary name beside the target and renames it into place only
+once complete: a reader finds the old file or the new one, and a failed write leaves the old
+one. ``Outputs`` does the same for a group of files, ``fresh_folder`` for a folder;
+``FolderLock`` holds an output folder for one process. A failed write raises
+``OutputError``, naming the file and what was kept.
 """
 from __future__ import annotations
 
@@ -27,14 +24,11 @@ except ImportError:                     # Windows: msvcrt's byte-range lock inst
     import msvcrt
 
 TEMPORARY_PREFIX = ".partial-"
-"""Temporary files beside their targets start with this (a dot file: hidden, and never
-a name a command writes for good)."""
+"""Temporary files beside their targets start with this (hidden, never a final name)."""
 
 
 FILE_NAME = re.compile(r"\w(?:[\w .+-]{0,98}[\w+-])?")
-"""A name given for files in an output folder (a sweep's, a controller's, an autopilot's
-``--name``): one plain file name of letters, digits, _ . + - and inner spaces; no
-separator, no leading dot, at most 100 characters."""
+"""A name given for files in an output folder (``--name``): one plain file name."""
 
 
 def plain_name(value: object, what: str) -> str:
@@ -47,7 +41,7 @@ def plain_name(value: object, what: str) -> str:
 
 
 class OutputError(OSError):
-    """A file could not be written: names the file and the reason; earlier files are kept."""
+    """A file could not be written: names the file, the reason and what was kept."""
 
     def __init__(self, target: Path, error: OSError, kept: str = ""):
         reason = error.strerror or str(error)
@@ -62,8 +56,8 @@ class OutputError(OSError):
 
 
 def _writing(error: OSError, place: Path) -> bool:
-    """Whether ``error`` is of writing ``place`` or into it (a write names no file: ENOSPC,
-    EFBIG), not of reading some other file."""
+    """Whether ``error`` is of writing ``place`` or into it (ENOSPC, EFBIG name no file), not
+    of reading another file."""
     if not error.filename:
         return True
     return Path(error.filename).resolve().is_relative_to(place.resolve())
@@ -75,7 +69,7 @@ class FolderBusy(RuntimeError):
 
 def read_small_text(path: Path, limit: int) -> str:
     """The text of a small regular UTF-8 file; ValueError saying why not (missing, not a
-    regular file: /dev/zero would be read for ever; over ``limit`` bytes; not UTF-8)."""
+    regular file such as /dev/zero, over ``limit`` bytes, not UTF-8)."""
     path = Path(path)
     if not path.is_file():
         raise ValueError("no such file" if not path.exists() else "not a regular file")
@@ -99,9 +93,8 @@ def _temporary(target: Path) -> Path:
 
 @contextlib.contextmanager
 def whole_file(target: Path) -> Iterator[Path]:
-    """``with whole_file(target) as tmp``: write to ``tmp``; it becomes ``target`` if the
-    block succeeds and is removed if it fails (OutputError for an OSError of writing it;
-    the old ``target`` is kept either way)."""
+    """``with whole_file(target) as tmp``: ``tmp`` becomes ``target`` if the block succeeds,
+    and is removed if it fails (OutputError for an OSError of writing it), the old kept."""
     target = Path(target)
     if target.exists() and not target.is_file():
         raise OutputError(target, OSError(errno.EEXIST, "it exists and is not a regular file "
@@ -133,8 +126,8 @@ def write_atomically(target: Path, write: Callable[[Path], object]) -> Path:
 
 @contextlib.contextmanager
 def fresh_folder(target: Path) -> Iterator[Path]:
-    """``with fresh_folder(target) as folder``: fill an empty folder; it replaces ``target``
-    (and all in it) if the block succeeds, and is removed if it fails, ``target`` kept."""
+    """``with fresh_folder(target) as folder``: an empty folder that replaces ``target`` if
+    the block succeeds, and is removed if it fails."""
     target = Path(target)
     folder = Path(tempfile.mkdtemp(dir=target.parent, prefix=f"{TEMPORARY_PREFIX}{target.name}-"))
     try:
@@ -151,14 +144,10 @@ def fresh_folder(target: Path) -> Iterator[Path]:
 
 
 class Outputs:
-    """A group of output files put in place together, once all are complete.
-
-    ``with Outputs(folder, stale) as outputs``: write every file into ``outputs.stage``
-    (a hidden folder inside ``folder``; ``outputs.path(name)``). If the block succeeds,
-    each file written there is renamed to ``folder/name`` and then every ``stale`` path
-    not rewritten is removed (a previous run's figure that this one did not draw, say).
-    If it fails, or ``discard`` is called, the stage goes and the folder is as it was.
-    """
+    """``with Outputs(folder, stale) as outputs``: files written to ``outputs.path(name)``
+    (a hidden stage in ``folder``) are renamed into ``folder`` together if the block
+    succeeds, then every ``stale`` path not rewritten is removed; if it fails (or on
+    ``discard``) the stage goes and the folder is as it was."""
 
     def __init__(self, folder: Path, stale: list[Path] | tuple[Path, ...] = (),
                  label: str = "outputs"):
@@ -167,15 +156,14 @@ class Outputs:
 
     @staticmethod
     def remove_abandoned(folder: Path, label: str) -> None:
-        """Remove the stages of ``label`` that a killed process left in ``folder``: call it
-        holding the folder's ``FolderLock``, when no other process can be writing one."""
+        """Remove the stages of ``label`` a killed process left in ``folder`` (call it holding
+        the folder's ``FolderLock``)."""
         pattern = re.compile(re.escape(f"{TEMPORARY_PREFIX}{label}-") + r"[\w]{8}")
         for entry in Path(folder).iterdir():
             if entry.is_dir() and not entry.is_symlink() and pattern.fullmatch(entry.name):
                 shutil.rmtree(entry, ignore_errors=True)
 
     def path(self, name: str) -> Path:
-        """Where to write the file that becomes ``folder/name``."""
         return self.stage / name
 
     def final(self, path: Path) -> Path:
@@ -224,15 +212,13 @@ class Outputs:
         return placed
 
     def discard(self) -> None:
-        """Remove the stage and whatever is in it."""
         shutil.rmtree(self.stage, ignore_errors=True)
 
 
 class FolderLock:
-    """``with FolderLock(folder)``: this process alone writes into ``folder`` until the block
-    ends; FolderBusy at once if another holds it. The lock is the kernel's (released if
-    the process dies, however): on the folder itself where the system allows, so that no
-    file is left behind; on Windows on a file ``.cosim-lock`` in it."""
+    """``with FolderLock(folder)``: this process alone writes into ``folder``; FolderBusy at
+    once if another holds it. The kernel's lock (released if the process dies): on the
+    folder itself, or on Windows on a file ``.cosim-lock`` in it."""
 
     def __init__(self, folder: Path):
         self.folder = Path(folder)

@@ -1,17 +1,19 @@
-"""The master's FMI backend: one FMU instance driven through fmpy, its log captured, clear errors.
+"""The master's FMI backend: one FMU instance of FMI 2.0 or 3.0 driven through fmpy, its log kept.
 
-``FmuInstance(path, name)`` is an FMI 2.0 instance (``Fmu2Instance``, here) or an FMI 3.0
-one (``cosim.core.fmi3.Fmu3Instance``), by the fmiVersion of the FMU's model description.
-The master speaks FMI 2.0's type names: ``read_description`` gives an FMI 3.0 FMU's
-Float64 and Int32 variables as Real and Integer (``FMI3_TYPES``), and each instance maps
-the master's call names ("setReal", "getInteger", ...) to its version's. Components are
-wired by variable name; each instance keeps its own value references (an FMI 3.0 twin
-of ours numbers its variables one higher than its FMI 2.0 twin: ``time`` is its 0).
+``FmuInstance(path, name)`` is an ``Fmu2Instance`` or an ``Fmu3Instance`` by the FMU's
+fmiVersion. The master speaks FMI 2.0's names: ``read_description`` gives FMI 3.0's Float64
+and Int32 as Real and Integer, and each instance maps the master's calls ("setReal") to its
+version's (``CALLS``). FMI 3.0 differs besides: no setupExperiment (the start time goes to
+enterInitializationMode), get/set take a value count too, a step that asks to end the
+simulation (terminateSimulation) fails the run, and ``time`` (value reference 0) is no
+variable of the master's.
 """
 from __future__ import annotations
 
+import functools
 import shutil
 from collections import deque
+from ctypes import byref
 from pathlib import Path
 from typing import Any, Callable
 
@@ -20,17 +22,22 @@ from fmpy.fmi1 import FMICallException, calloc, free
 from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
                        fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, fmi2Integer, fmi2Real,
                        fmi2True, fmi2ValueReference)
+from fmpy.fmi3 import FMU3Slave, fmi3Boolean, fmi3Float64, fmi3Int32, fmi3ValueReference
 from fmpy.model_description import ModelDescription
 
-from fmubuild.project import FMUS
 from .errors import FmuNotFound, FmuUnreadable
 from .instance import FmuCallError, Instance, LogRecord, logged_error, one_account
 
 STATUS = ("ok", "warning", "discard", "error", "fatal", "pending")
 VERSIONS = (2, 3)
-"""The FMI versions the master runs."""
 FMI3_TYPES = {"Float64": "Real", "Int32": "Integer"}
-"""FMI 3.0 type names as the master's (FMI 2.0's); Boolean and String are the same in both."""
+"""FMI 3.0 type names as the master's; Boolean and String are the same in both."""
+CALLS = {"setReal": "setFloat64", "getReal": "getFloat64",
+         "setInteger": "setInt32", "getInteger": "getInt32",
+         "getFMUstate": "getFMUState", "setFMUstate": "setFMUState",
+         "freeFMUstate": "freeFMUState", "serializeFMUstate": "serializeFMUState",
+         "deSerializeFMUstate": "deserializeFMUState"}
+"""The master's (FMI 2.0) call names that FMI 3.0 names otherwise."""
 
 
 def fmi_version(description: ModelDescription) -> int:
@@ -42,14 +49,20 @@ def fmi_version(description: ModelDescription) -> int:
     return version
 
 
-def read_description(path: Path, name: str) -> ModelDescription:
-    """An FMU's model description, FMI 3.0 type names as FMI 2.0's (``FMI3_TYPES``);
-    FmuNotFound or FmuUnreadable naming the file (and whether it is named as one of this
-    project's FMUs) when it is missing or not readable, ValueError when it is not a
-    co-simulation FMU of FMI 2.0 or 3.0."""
-    ours = path.stem in FMUS
+def read_description(path: str | Path, name: str = "", ours: bool = False) -> ModelDescription:
+    """An FMU's model description, FMI 3.0 type names as FMI 2.0's, read once per file
+    version (cached on path, size and mtime: treat it as read-only). FmuNotFound or
+    FmuUnreadable naming the file (``ours``: named as one the caller builds) when it is
+    missing or unreadable, ValueError unless it is a co-simulation FMU of FMI 2.0 or 3.0."""
+    path = Path(path)
     if not path.is_file():
         raise FmuNotFound(f"FMU for '{name}' not found: {path}", ours)
+    stat = path.stat()
+    return _description(path.resolve(), stat.st_size, stat.st_mtime_ns, ours)
+
+
+@functools.lru_cache(maxsize=256)
+def _description(path: Path, size: int, mtime_ns: int, ours: bool) -> ModelDescription:
     try:
         description = read_model_description(str(path))
     except Exception as error:
@@ -75,26 +88,22 @@ def feedthrough(description: ModelDescription) -> dict[str, frozenset[str]]:
 
 
 class FmuInstance(Instance):
-    """An instantiated co-simulation FMU, FMI 2.0 or 3.0 (the class is chosen by the FMU's
-    fmiVersion).
-
-    Raises FmuNotFound, FmuUnreadable or ValueError, naming the file, when the FMU is
-    missing or not a readable co-simulation FMU, and FmuCallError when it cannot be
-    instantiated (its extracted files are removed).
-    """
+    """An instantiated co-simulation FMU, of the class its fmiVersion chooses. FmuNotFound,
+    FmuUnreadable or ValueError when the FMU is missing or unreadable; FmuCallError when it
+    cannot be instantiated (its extracted files are removed)."""
 
     slave: Any                         # fmpy's FMU2Slave or FMU3Slave
+    VERSION, PREFIX, REAL, INTEGER = 0, "", "", ""    # FMI 2.0's names or FMI 3.0's
+    TYPES: tuple = ()                  # ctypes of the value references, Reals, Integers
 
     def __new__(cls, path: str | Path, name: str, unzip_dir: str | Path | None = None):
         chosen = cls
         if cls is FmuInstance:
-            from .fmi3 import Fmu3Instance     # here: fmi3 builds on this module
-            version = fmi_version(read_description(Path(path), name))
+            version = fmi_version(read_description(path, name))
             chosen = Fmu3Instance if version == 3 else Fmu2Instance
-        return super().__new__(chosen)
+        return super().__new__(chosen, path, name)
 
     def __init__(self, path: str | Path, name: str, unzip_dir: str | Path | None = None):
-        self.path, self.name = Path(path), name
         self.description = read_description(self.path, name)
         self._owns_unzip_dir = unzip_dir is None
         self.unzip_dir = str(unzip_dir) if unzip_dir else extract(str(self.path))
@@ -115,7 +124,6 @@ class FmuInstance(Instance):
                                ) from error
 
     def _instantiate(self) -> None:
-        """Load the FMU's library and instantiate it, logging into ``_log``."""
         raise NotImplementedError
 
     @property
@@ -131,8 +139,6 @@ class FmuInstance(Instance):
 
     def call(self, what: str, function: Callable, *args, time: float | None = None,
              strict: bool = False, **kwargs) -> Any:
-        """Call an fmpy function; turn a failed status (or, ``strict``, an error logged) into
-        FmuCallError."""
         before = self.logged
         try:
             result = function(*args, **kwargs)
@@ -145,20 +151,20 @@ class FmuInstance(Instance):
         return result
 
     def _since(self, before: int) -> list[LogRecord]:
-        """The log of the call that began when ``before`` had been logged (the last 50
-        messages, as the log keeps no more), each failure told once."""
+        """The log of the call that began when ``before`` had been logged (of the last 50)."""
         new = self.logged - before
         return one_account(list(self.log)[-new:] if new else [])
 
-    def reset(self) -> None:
-        self.call("reset", self.slave.reset)
-
-    # Prepared calls: the raw FMI functions of the FMU's library (fmpy's ``dll``, their
-    # argument types set by fmpy) on preallocated ctypes arrays, without fmpy's per-call
-    # wrapping, which costs more than the call itself.
     def _status(self, what: str, status: int, before: int, time: float | None = None) -> None:
         if status > 1:                      # discard, error, fatal
             raise FmuCallError(self.name, what, time, STATUS[status], self._since(before))
+
+    def _terminated(self, t: float, before: int) -> FmuCallError:
+        return FmuCallError(self.name, "doStep", t, "OK but asked to end the simulation "
+                            "(terminateSimulation)", self._since(before))
+
+    def reset(self) -> None:
+        self.call("reset", self.slave.reset)
 
     def free(self) -> None:
         """Terminate, free the instance and remove the extracted files."""
@@ -173,13 +179,56 @@ class FmuInstance(Instance):
         if self._owns_unzip_dir:
             shutil.rmtree(self.unzip_dir, ignore_errors=True)
 
+    # Prepared calls: the raw FMI functions (fmpy's ``dll``) on preallocated ctypes arrays,
+    # without fmpy's per-call wrapping, which costs more than the call itself.
+    def _counts(self, n: int) -> tuple:
+        return (n,) if self.VERSION == 2 else (n, n)    # FMI 3.0 also takes the value count
+
+    def _getter(self, kind: str, ctype, vrs: list[int]):
+        get, component = getattr(self.slave.dll, f"{self.PREFIX}Get{kind}"), self.slave.component
+        refs, values = (self.TYPES[0] * len(vrs))(*vrs), (ctype * len(vrs))()
+        counts = self._counts(len(vrs))
+
+        def read() -> list:
+            before = self.logged
+            status = get(component, refs, counts[0], values, *counts[1:])
+            if status:
+                self._status(f"Get{kind}", status, before)
+            return values[:]
+        return read
+
+    def reader(self, vrs: list[int]):
+        return self._getter(self.REAL, self.TYPES[1], vrs)
+
+    def integer_reader(self, vrs: list[int]):
+        return self._getter(self.INTEGER, self.TYPES[2], vrs)
+
+    def writer(self, vrs: list[int]):
+        kind = self.REAL
+        set_, component = getattr(self.slave.dll, f"{self.PREFIX}Set{kind}"), self.slave.component
+        refs, values = (self.TYPES[0] * len(vrs))(*vrs), (self.TYPES[1] * len(vrs))()
+        counts = self._counts(len(vrs))
+
+        def write(new: list[float]) -> None:
+            values[:] = new
+            before = self.logged
+            status = set_(component, refs, counts[0], values, *counts[1:])
+            if status:
+                self._status(f"set{kind}", status, before)
+        return write
+
 
 class Fmu2Instance(FmuInstance):
     """An FMI 2.0 co-simulation FMU through fmpy's FMU2Slave."""
 
+    VERSION, PREFIX, REAL, INTEGER = 2, "fmi2", "Real", "Integer"
+    TYPES = (fmi2ValueReference, fmi2Real, fmi2Integer)
+
     def _instantiate(self) -> None:
         self._callbacks = fmi2CallbackFunctions()
-        self._callbacks.logger = fmi2CallbackLoggerTYPE(self._on_log)
+        self._callbacks.logger = fmi2CallbackLoggerTYPE(
+            lambda env, instance, status, category, message: self._log(status, category,
+                                                                       message))
         self._callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
         self._callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
         self.slave = FMU2Slave(guid=self.description.guid, unzipDirectory=self.unzip_dir,
@@ -188,48 +237,12 @@ class Fmu2Instance(FmuInstance):
         self.call("instantiate", self.slave.instantiate, callbacks=self._callbacks,
                   loggingOn=True)
 
-    def _on_log(self, env, instance, status, category, message) -> None:
-        self._log(status, category, message)
-
     def fmi(self, name: str):
         return getattr(self.slave, name)
 
     def enter_initialization(self, start_time: float = 0.0) -> None:
         self.call("setupExperiment", self.slave.setupExperiment, startTime=start_time)
         self.call("enterInitializationMode", self.slave.enterInitializationMode)
-
-    def reader(self, vrs: list[int]):
-        return self._getter("fmi2GetReal", fmi2Real, vrs)
-
-    def integer_reader(self, vrs: list[int]):
-        return self._getter("fmi2GetInteger", fmi2Integer, vrs)
-
-    def _getter(self, function: str, ctype, vrs: list[int]):
-        get, component = getattr(self.slave.dll, function), self.slave.component
-        n = len(vrs)
-        refs, values = (fmi2ValueReference * n)(*vrs), (ctype * n)()
-        what = function.removeprefix("fmi2")
-
-        def read() -> list:
-            before = self.logged
-            status = get(component, refs, n, values)
-            if status:
-                self._status(what, status, before)
-            return values[:]
-        return read
-
-    def writer(self, vrs: list[int]):
-        set_, component = self.slave.dll.fmi2SetReal, self.slave.component
-        n = len(vrs)
-        refs, values = (fmi2ValueReference * n)(*vrs), (fmi2Real * n)()
-
-        def write(new: list[float]) -> None:
-            values[:] = new
-            before = self.logged
-            status = set_(component, refs, n, values)
-            if status:
-                self._status("setReal", status, before)
-        return write
 
     def stepper(self):
         do_step, component = self.slave.dll.fmi2DoStep, self.slave.component
@@ -239,4 +252,48 @@ class Fmu2Instance(FmuInstance):
             status = do_step(component, t, h, fmi2True)
             if status:
                 self._status("doStep", status, before, t)
+        return step
+
+
+class Fmu3Instance(FmuInstance):
+    """An FMI 3.0 co-simulation FMU through fmpy's FMU3Slave."""
+
+    VERSION, PREFIX, REAL, INTEGER = 3, "fmi3", "Float64", "Int32"
+    TYPES = (fmi3ValueReference, fmi3Float64, fmi3Int32)
+
+    def _instantiate(self) -> None:
+        self.slave = FMU3Slave(guid=self.description.guid, unzipDirectory=self.unzip_dir,
+                               modelIdentifier=self.description.coSimulation.modelIdentifier,
+                               instanceName=self.name)
+        self.call("instantiate", self.slave.instantiate, loggingOn=True,   # pythonfmu3: b""
+                  logMessage=lambda env, status, category, message: self._log(
+                      status, category or None, message))
+
+    def fmi(self, name: str):
+        return getattr(self.slave, CALLS.get(name, name))
+
+    def do_step(self, t: float, h: float) -> None:
+        before = self.logged
+        _, terminate, _, _ = self.call("doStep", self.slave.doStep, t, h, time=t)
+        if terminate:
+            raise self._terminated(t, before)
+
+    def enter_initialization(self, start_time: float = 0.0) -> None:
+        self.call("enterInitializationMode", self.slave.enterInitializationMode,
+                  startTime=start_time)
+
+    def stepper(self):
+        do_step, instance = self.slave.dll.fmi3DoStep, self.slave.component
+        terminate = fmi3Boolean()
+        event, early, last = fmi3Boolean(), fmi3Boolean(), fmi3Float64()
+        pointers = byref(event), byref(terminate), byref(early), byref(last)
+        no_earlier_state = fmi3Boolean(True)
+
+        def step(t: float, h: float) -> None:
+            before = self.logged
+            status = do_step(instance, t, h, no_earlier_state, *pointers)
+            if status:
+                self._status("doStep", status, before, t)
+            if terminate.value:
+                raise self._terminated(t, before)
         return step

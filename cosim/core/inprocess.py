@@ -1,23 +1,13 @@
 """The master's in-process backend: the FMUs' Python classes, called without FMI.
 
-An ``InProcessInstance`` has the same interface as ``cosim.core.fmi.FmuInstance`` but
-instantiates the class an FMU built with fmukit was made from in this process and
-calls its methods directly: the model's class (its manifest, ``fmubuild.manifest``)
-composed with the adapter of the FMU's FMI version, 2.0 or 3.0, as the FMU's entry
-module composes it (``fmukit.compose.fmu_class``), so that an FMI 3.0 twin runs as
-FMI 3.0 (its value references, its calls, its refusals). The FMU must be current
-here: the modules it carries are the ones this process imports. A run on this backend
-differs from a co-simulation only by the FMI layer (C wrapper, fmpy, ctypes), which is
-what the equality tests compare: every column of every row is the same, bit for bit.
-
-What FMI imposes and Python need not is dropped; what makes a run trustworthy is
-kept. The master's loop gets, per component, the slave's own plans for its lists
-of value references (``fmukit.fastpath``: one attribute read for the ship's
-states, outputs evaluated under one ``try``, inputs set as attributes), resolved
-once per run instead of dispatched per call by name. Steps go through the
-slave's ``do_step``, with its checks of the call sequence, the step and every
-input, and parameters through ``exitInitializationMode``'s checks: an invalid
-value refuses the run with the same message as through FMI.
+An ``InProcessInstance`` has the interface of ``cosim.core.fmi.FmuInstance`` but instantiates
+in this process the class an FMU built with fmukit was made from (its manifest,
+``fmukit.manifest``), composed for the FMU's FMI version as its entry module composes it
+(``fmukit.compose.fmu_class``), and calls its methods directly. The FMU must be current
+here, so that a run differs from one through FMI only by the FMI layer: every column of every
+row is the same, bit for bit. The loop gets the slave's own plans for its value references
+(``fmukit.fastpath``); steps and parameters pass the slave's checks, so an invalid value is
+refused with the same message as through FMI.
 """
 from __future__ import annotations
 
@@ -31,19 +21,21 @@ from pathlib import Path
 from typing import Any
 from xml.etree import ElementTree
 
-from fmubuild.manifest import Manifest, read, staleness
-from fmubuild.project import FMUS
 from fmukit.compose import fmu_class
 from fmukit.entry import unguarded
+from fmukit.manifest import Manifest, read, staleness
 from fmukit.refusals import Refused, explain, naming
 from fmukit.slave import ModelSlave
 
-from .fmi3 import CALLS
+from .fmi import CALLS, read_description
 from .instance import FmuCallError, Instance, LogRecord, logged_error
 
 _FMI_TYPE = {float: "Real", int: "Integer", str: "String"}
 """The master's type names (FMI 2.0's), whichever version the class is of."""
 _FAILED = frozenset({"discard", "error", "fatal"})
+_PYTHONFMU = ("resources/pythonfmu/", "resources/pythonfmu3/")
+"""What pythonfmu 0.7 and pythonfmu3 carry of their own."""
+_DECLARATIONS = ("ModelVariables", "UnitDefinitions", "ModelStructure")
 
 
 @dataclass(frozen=True)
@@ -55,41 +47,31 @@ class VariableInfo:
     unit: str
 
 
+class Reason(str):
+    """Why an FMU runs through FMI; ``stale_module``: the slave module of an FMU built with
+    fmukit before a change of its sources (a rebuild mends it), else None."""
+
+    stale_module: str | None = None
+
+
 def slave_class(manifest: Manifest) -> type[ModelSlave]:
-    """The class of the FMU a manifest describes, in this process: the model's class it
-    names, composed for the FMU's FMI version (``fmukit.compose.fmu_class``)."""
+    """The FMU's class in this process: the model class its manifest names, composed for
+    its FMI version."""
     module = importlib.import_module(manifest.slave_module)
     return fmu_class(getattr(module, manifest.slave_class), manifest.fmi)
 
 
+@cache
+def _cached_refusal(path: Path, size: int, mtime_ns: int) -> str | None:
+    return _refusal(path)
+
+
 def in_process_refusal(path: str | Path) -> str | None:
-    """Why the FMU at ``path`` cannot run in-process, or None if it can: it must be built
-    with fmukit (a manifest), hold what its manifest lists, declare the variables, units
-    and dependencies its class declares, and be current here (the modules it carries
-    are those this process imports, ``fmubuild.manifest.staleness``), so that both
-    routes compute the same."""
-    path = Path(path)
-    stat = path.stat()
-    key = (path.resolve(), stat.st_size, stat.st_mtime_ns)
-    if key not in _refusals:
-        _refusals[key] = _refusal(path)
-    return _refusals[key]
-
-
-_refusals: dict[tuple, str | None] = {}
-
-
-class Reason(str):
-    """Why an FMU runs through FMI (or the note that says so); ``rebuild``: it is one of
-    this project's FMUs built before a change (a command may say how to build it)."""
-
-    rebuild: bool = False
-
-    @classmethod
-    def of(cls, text: str, rebuild: bool) -> Reason:
-        reason = cls(text)
-        reason.rebuild = rebuild
-        return reason
+    """Why the FMU at ``path`` cannot run in-process, or None: it must be built with fmukit,
+    hold what its manifest lists, declare what its class declares and be current here
+    (``fmukit.manifest.staleness``), so that both routes compute the same."""
+    stat = Path(path).stat()
+    return _cached_refusal(Path(path).resolve(), stat.st_size, stat.st_mtime_ns)
 
 
 def fallback_note(name: str, path: str | Path) -> Reason | None:
@@ -98,8 +80,9 @@ def fallback_note(name: str, path: str | Path) -> Reason | None:
     refusal = in_process_refusal(path)
     if refusal is None:
         return None
-    return Reason.of(f"{name} ({Path(path).name}) runs through FMI, not in-process: {refusal}",
-                     getattr(refusal, "rebuild", False))
+    note = Reason(f"{name} ({Path(path).name}) runs through FMI, not in-process: {refusal}")
+    note.stale_module = getattr(refusal, "stale_module", None)
+    return note
 
 
 def _refusal(path: Path) -> str | None:
@@ -107,25 +90,29 @@ def _refusal(path: Path) -> str | None:
         manifest = read(path)
         if manifest is None:
             return "it was not built with fmukit (it has no manifest)"
-        declared = _description(path)
-        if declared.get("modelName") != manifest.model_name:
-            return (f"its model description names the model '{declared.get('modelName')}', "
+        described = read_description(path)
+        if described.modelName != manifest.model_name:
+            return (f"its model description names the model '{described.modelName}', "
                     f"its manifest '{manifest.model_name}'")
         with zipfile.ZipFile(path) as fmu:
             refusal = _contents_refusal(fmu, manifest)
-        stale = None if refusal else staleness(manifest)
+            declared = ElementTree.fromstring(fmu.read("modelDescription.xml"))
+        if refusal:
+            return refusal
+        stale = staleness(manifest)
         if stale is not None:
-            refusal = Reason.of(stale, manifest.slave_module in _PROJECT_SLAVES)
-        if refusal is None and manifest.fmi != _version(declared):
-            return (f"its model description is of FMI {declared.get('fmiVersion')}, its "
+            refusal = Reason(stale)
+            refusal.stale_module = manifest.slave_module
+            return refusal
+        if manifest.fmi != int(described.fmiVersion.partition(".")[0]):
+            return (f"its model description is of FMI {described.fmiVersion}, its "
                     f"manifest says FMI {manifest.fmi}")
-        if refusal is None:
-            ours = slave_class(manifest)(instance_name=manifest.model_name).to_xml()
-            for section in _DECLARATIONS:
-                if _canonical(declared.find(section)) != _canonical(ours.find(section)):
-                    return (f"its {section} differ from those its class "
-                            f"{manifest.slave_module}.{manifest.slave_class} declares")
-        return refusal
+        ours = slave_class(manifest)(instance_name=manifest.model_name).to_xml()
+        for section in _DECLARATIONS:
+            if _canonical(declared.find(section)) != _canonical(ours.find(section)):
+                return (f"its {section} differ from those its class "
+                        f"{manifest.slave_module}.{manifest.slave_class} declares")
+        return None
     except (OSError, KeyError, UnicodeDecodeError, ValueError, ImportError, AttributeError,
             zipfile.BadZipFile, ElementTree.ParseError) as error:
         return f"it cannot be read as an FMU built with fmukit ({type(error).__name__}: {error})"
@@ -133,7 +120,7 @@ def _refusal(path: Path) -> str | None:
 
 def _contents_refusal(fmu: zipfile.ZipFile, manifest: Manifest) -> str | None:
     """Why the FMU does not hold exactly the Python modules its manifest lists (its entry
-    module among them, where it has one), or None."""
+    module among them), or None."""
     listed = {c["file"]: c["sha256"] for c in manifest.modules.values()}
     entry = manifest.entry or manifest.modules[manifest.slave_module]
     listed[entry["file"]] = entry["sha256"]
@@ -153,14 +140,6 @@ def _contents_refusal(fmu: zipfile.ZipFile, manifest: Manifest) -> str | None:
     return None
 
 
-_PYTHONFMU = ("resources/pythonfmu/", "resources/pythonfmu3/")
-"""What pythonfmu 0.7 and pythonfmu3 carry of their own."""
-
-
-_DECLARATIONS = ("ModelVariables", "UnitDefinitions", "ModelStructure")
-_PROJECT_SLAVES = {".".join(Path(script).with_suffix("").parts) for script in FMUS.values()}
-
-
 def _canonical(element: ElementTree.Element | None) -> str:
     return "" if element is None else ElementTree.canonicalize(ElementTree.tostring(element),
                                                                strip_text=True)
@@ -170,12 +149,10 @@ class InProcessInstance(Instance):
     """A slave class instantiated and driven in this process."""
 
     def __init__(self, path: str | Path, name: str, same_sources: bool = True):
-        """The class of the FMU at ``path``; ValueError if it cannot run in-process
-        (``in_process_refusal``), or, without ``same_sources``, only if it was not built
-        with fmukit (``cosim.studies.direct``: the modules as they are, whatever the FMU)."""
-        self.path, self.name = Path(path), name
-        description = _description(self.path)
-        self.model_name, self.guid = description.get("modelName"), description.get("guid")
+        """ValueError if the FMU cannot run in-process (``in_process_refusal``); without
+        ``same_sources``, only if it was not built with fmukit (``cosim.studies.direct``)."""
+        description = read_description(self.path, name)
+        self.model_name, self.guid = description.modelName, description.guid
         refusal = in_process_refusal(self.path)
         manifest = read(self.path)
         if refusal and (same_sources or manifest is None):
@@ -183,19 +160,15 @@ class InProcessInstance(Instance):
                              f"{refusal}")
         self.slave = slave_class(manifest)(instance_name=name)
         self.fmi_version = manifest.fmi
-        self.variables = {}
-        for vr, var in self.slave.registry.by_vr.items():
-            self.variables[var.name] = VariableInfo(var.name, vr, _FMI_TYPE[var.kind],
-                                                    var.causality,
-                                                    var.unit if var.is_real else "")
+        self.variables = {var.name: VariableInfo(var.name, vr, _FMI_TYPE[var.kind],
+                                                 var.causality, var.unit if var.is_real else "")
+                          for vr, var in self.slave.registry.by_vr.items()}
         inputs = {v.name for v in self.slave.variables if v.causality == "input"}
         self.feedthrough = {v.name: frozenset(v.depends) & inputs
                             for v in self.slave.variables if v.causality == "output"}
 
     def call(self, what: str, function, *args, time: float | None = None,
              strict: bool = False) -> Any:
-        """Call a slave method; an exception, a refused step or (``strict``) an error logged
-        becomes FmuCallError."""
         try:
             result = function(*args)
         except Exception as error:
@@ -206,9 +179,8 @@ class InProcessInstance(Instance):
 
     def _failure(self, what: str, time: float | None, error: Exception,
                  status: str = "fatal") -> FmuCallError:
-        """The refusal as FMI reports it: ``status`` (fatal, as pythonfmu does; error for a
-        step of FMI 3.0) with the FMU's log; a refusal the FMU did not log itself (a step
-        called past the FMI entry's wrapper) as a message of its own, with its cause."""
+        """The refusal as FMI reports it (fatal, as pythonfmu does; error for an FMI 3.0
+        step), with the FMU's log, or a message of its own where the FMU logged none."""
         records = self._drain()
         if not any(r.cause for r in records):
             category = error.category if isinstance(error, Refused) else None
@@ -216,12 +188,12 @@ class InProcessInstance(Instance):
         return FmuCallError(self.name, what, time, status, records)
 
     def _judge(self, what: str, time: float | None, result: Any, strict: bool) -> None:
-        """FmuCallError if a call refused (returned False) or, ``strict``, logged an error;
-        the log is drained either way."""
+        """FmuCallError if a call refused (returned False or a failed FMI 3.0 step result)
+        or, ``strict``, logged an error; the log is drained either way."""
         messages = self._drain()
         if result is False:
             raise FmuCallError(self.name, what, time, "discard", messages)
-        status = getattr(result, "status", None)           # FMI 3.0's Fmi3StepResult
+        status = getattr(result, "status", None)
         if status is not None and status.name in _FAILED:
             raise FmuCallError(self.name, what, time, status.name, messages)
         if strict and logged_error(messages):
@@ -234,13 +206,13 @@ class InProcessInstance(Instance):
         return records
 
     def fmi(self, name: str):
-        """The slave method behind the master's (FMI 2.0) call name: setReal -> set_real,
-        or set_float64 for an FMI 3.0 class (``cosim.core.fmi3.CALLS``)."""
+        """The slave method behind a call name: setReal -> set_real (set_float64 on FMI 3.0)."""
         if self.fmi_version == 3:
             name = CALLS.get(name, name)
         return getattr(self.slave, _method_name(name))
 
-    # Prepared calls: the slave's own plans, valid until ``reset`` makes a new slave.
+    # Prepared calls: the slave's own plans, valid until ``reset`` makes a new slave; through
+    # the FMI entry where it has none or where the plan raises (to report it as FMI would).
     def reader(self, vrs: list[int]):
         return self._prepared(self.slave.plans.real_reader(vrs), super().reader(vrs))
 
@@ -249,8 +221,6 @@ class InProcessInstance(Instance):
 
     @staticmethod
     def _prepared(plan, through_fmi):
-        """The slave's plan for a read; through the FMI entry where it has none (the slave
-        names the problem) or where the plan raises (to report it as FMI would)."""
         if plan is None:
             return through_fmi
 
@@ -267,8 +237,7 @@ class InProcessInstance(Instance):
 
     def stepper(self):
         do_step, queue = unguarded(self.slave.do_step), self.slave.log_queue
-        # the status of a refused step through FMI: fmi2Fatal; FMI 3.0's is fmi3Error
-        refused = "error" if self.fmi_version == 3 else "fatal"
+        refused = "error" if self.fmi_version == 3 else "fatal"   # as through FMI
 
         def step(t: float, h: float) -> None:
             try:
@@ -280,8 +249,8 @@ class InProcessInstance(Instance):
         return step
 
     def enter_initialization(self, start_time: float = 0.0) -> None:
-        """As through FMI: FMI 2.0's setupExperiment gives the start time; pythonfmu3 takes
-        none (it drops fmi3EnterInitializationMode's)."""
+        """As through FMI: FMI 2.0's setupExperiment gives the start time; pythonfmu3 drops
+        fmi3EnterInitializationMode's."""
         if self.fmi_version == 2:
             self.call("setupExperiment", self.slave.setup_experiment, start_time)
         self.call("enterInitializationMode", self.slave.enter_initialization_mode)
@@ -291,21 +260,9 @@ class InProcessInstance(Instance):
         self.slave = type(self.slave)(instance_name=self.name)
 
     def free(self) -> None:
-        """Terminate, if the slave was initialised (as fmi2FreeInstance may follow any call)."""
+        """Terminate, if the slave was initialised."""
         if self.slave.sequence.phase == "step":
             self.slave.terminate()
-
-
-def _version(description: ElementTree.Element) -> int | None:
-    """The major FMI version of a model description's root, None if it names none."""
-    major = (description.get("fmiVersion") or "").partition(".")[0]
-    return int(major) if major.isdigit() else None
-
-
-def _description(path: Path) -> ElementTree.Element:
-    """The root of an FMU's modelDescription.xml."""
-    with zipfile.ZipFile(path) as fmu:
-        return ElementTree.fromstring(fmu.read("modelDescription.xml"))
 
 
 @cache

@@ -1,14 +1,13 @@
 """What the master needs of a component, whichever backend runs it.
 
-A backend supplies ``call`` (run a function, turning failure into FmuCallError),
-``fmi(name)`` (the function behind the master's call name, FMI 2.0's such as "setReal",
-whichever FMI version the component is of),
-``enter_initialization``, ``reset`` and ``free``, and may replace the prepared
-calls (``reader``, ``integer_reader``, ``writer``, ``stepper``) that the master's
-loop uses with faster ones; everything else is shared here.
+A backend supplies ``call`` (run a function, failure as FmuCallError), ``fmi(name)`` (the
+function behind the master's FMI 2.0 call name, "setReal"), ``enter_initialization``,
+``reset`` and ``free``, and may replace the prepared calls of the master's loop
+(``reader``, ``integer_reader``, ``writer``, ``stepper``) with faster ones.
 """
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any, Callable, Iterable, NamedTuple
 
 from .values import fmi_value, no_variable
@@ -29,15 +28,14 @@ class LogRecord(NamedTuple):
 
     @property
     def cause(self) -> str | None:
-        """What an FMU built with fmukit refused (its category is fmukit.<cause>,
-        ``fmukit.refusals.CAUSES``); None for any other message."""
+        """What an FMU built with fmukit refused (category fmukit.<cause>); None otherwise."""
         prefix = "fmukit."
         return self.category[len(prefix):] if (self.category or "").startswith(prefix) else None
 
 
 class FmuCallError(RuntimeError):
-    """An FMI call returned discard, error or fatal; carries the FMU's own log, as records
-    and as lines (``messages``), and the cause of the refusal where the FMU says it."""
+    """An FMI call returned discard, error or fatal; carries the FMU's log (``records``, and
+    as lines, ``messages``) and the cause of the refusal where the FMU says it."""
 
     def __init__(self, instance: str, call: str, time: float | None, status: str,
                  records: Iterable[LogRecord]):
@@ -53,26 +51,32 @@ class FmuCallError(RuntimeError):
 
 
 def logged_error(records: Iterable[LogRecord]) -> bool:
-    """Whether a call's log includes an error (status error or fatal)."""
     return any(r.status in ("error", "fatal") for r in records)
 
 
 def one_account(records: list[LogRecord]) -> list[LogRecord]:
-    """The records of one call, each failure told once: where an FMU built with fmukit
-    logged its refusal (a cause), the message its FMI layer logs for the same exception
-    (pythonfmu's, with no category) is left out."""
+    """A call's records, each failure told once: where an FMU built with fmukit logged its
+    refusal (a cause), pythonfmu's own fatal message for it (no category) is left out."""
     if not any(r.cause for r in records):
         return records
     return [r for r in records if r.category is not None or r.status != "fatal"]
 
 
 class Instance:
-    """One instantiated component: its variables, its feedthrough, and FMI calls."""
+    """One instantiated component: its variables, its feedthrough, and FMI calls.
+
+    ``path`` and ``name`` are set in ``__new__``, before any code of the backend runs: a
+    watchdog that finds an instance on the loop's stack can always name it."""
 
     name: str
-    path: Any
+    path: Path
     variables: dict[str, Any]          # name: object with valueReference, type, causality
     feedthrough: dict[str, frozenset[str]]   # output name: the inputs it depends on
+
+    def __new__(cls, path: str | Path = "", name: str = "", *args: Any, **kwargs: Any):
+        instance = super().__new__(cls)
+        instance.path, instance.name = Path(path), name
+        return instance
 
     def call(self, what: str, function: Callable, *args, time: float | None = None,
              strict: bool = False) -> Any:
@@ -110,22 +114,16 @@ class Instance:
         return getattr(variable, "unit", None) or getattr(declared, "unit", None) or ""
 
     def set(self, values: dict[str, Any], time: float | None = None) -> None:
-        """Set variables by name, each through the FMI call of its declared type.
-
-        The FMU judges the values (its range checks, as a host without our master would
-        reach them); the master sets only values ``cosim.core.values.checked`` against the
-        declarations first. What the call could not carry exactly (1.5 or 2**32 for an
-        Integer, a NUL in a String: ``fmi_value``) is refused here too, as ValueError.
-        """
+        """Set variables by name, each through the FMI call of its type. The FMU judges
+        them; what the call could not carry exactly (``fmi_value``) is ValueError here."""
         for name, value in values.items():
-            kind = self.variable(name).type
-            exact = fmi_value(f"{self.name}.{name}", _CALL_TYPE.get(kind, kind), value)
-            self.call(f"set {name} = {exact!r}", self.fmi(f"set{_CALL_TYPE.get(kind, kind)}"),
-                      [self.vr(name)], [exact], time=time)
+            kind = _CALL_TYPE.get(self.variable(name).type, self.variable(name).type)
+            exact = fmi_value(f"{self.name}.{name}", kind, value)
+            self.call(f"set {name} = {exact!r}", self.fmi(f"set{kind}"), [self.vr(name)],
+                      [exact], time=time)
 
     def get(self, names: Iterable[str]) -> dict[str, Any]:
-        """Current values of variables by name, one FMI call per type (a call per variable
-        cost 2 ms of a run's initialisation, where every parameter is read)."""
+        """Current values of variables by name, one FMI call per type."""
         names = list(names)
         by_type: dict[str, list[str]] = {}
         for name in names:
@@ -145,34 +143,27 @@ class Instance:
 
     def initialize(self, parameters: dict[str, Any] | None = None,
                    start_time: float = 0.0) -> None:
-        """setupExperiment, enter initialisation, parameters, exit initialisation."""
         self.enter_initialization(start_time)
         self.set(parameters or {}, time=start_time)
         self.exit_initialization(start_time)
 
     def exit_initialization(self, start_time: float = 0.0) -> None:
-        """exitInitializationMode; strict, as our FMUs report invalid parameters in their log
-        here and fail at the first step (``fmukit.slave``)."""
+        """Strict: our FMUs log invalid parameters here (``fmukit.slave``)."""
         self.call("exitInitializationMode", self.fmi("exitInitializationMode"), time=start_time,
                   strict=True)
 
     def do_step(self, t: float, h: float) -> None:
         self.call("doStep", self.fmi("doStep"), t, h, time=t)
 
-    # Prepared calls for a fixed list of value references: what the master's loop uses,
-    # valid until ``reset``. A backend may override them with something faster.
+    # Prepared calls for a fixed list of value references, valid until ``reset``.
     def reader(self, vrs: list[int]) -> Callable[[], list[float]]:
-        """A function returning the current Real values of ``vrs``."""
         return lambda: self.call("getReal", self.fmi("getReal"), vrs)
 
     def integer_reader(self, vrs: list[int]) -> Callable[[], list[int]]:
-        """A function returning the current Integer values of ``vrs``."""
         return lambda: self.call("getInteger", self.fmi("getInteger"), vrs)
 
     def writer(self, vrs: list[int]) -> Callable[[list[float]], None]:
-        """A function setting the Real inputs ``vrs``."""
         return lambda values: self.call("setReal", self.fmi("setReal"), vrs, values)
 
     def stepper(self) -> Callable[[float, float], None]:
-        """A function taking one communication step from t of length h."""
         return self.do_step

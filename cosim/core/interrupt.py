@@ -1,14 +1,10 @@
 """Ctrl-C and SIGTERM: a request to stop between steps, or an exception where no FMU runs.
 
-Our FMUs' Python code runs in the master's own interpreter, so Python's default
-KeyboardInterrupt would be raised inside an FMU's call and turn into an FMU
-failure. Within ``StopSignals`` a SIGINT or SIGTERM only records itself; the
-master checks between steps, stops, and keeps every row computed
-(``Master.run``'s ``stop``). A second signal ends the process at once, saying
-what was kept (``StopSignals.receive``; while an FMU never returns, the run's
-``cosim.core.watchdog`` takes the signals). Within ``raise_on_signals`` either
-signal raises ``Interrupted`` wherever the program is: for code that runs no FMU,
-such as a sweep's client, or a command outside its runs.
+Our FMUs' Python runs in the master's interpreter, so a KeyboardInterrupt would land inside
+an FMU's call and fail it. Within ``StopSignals`` a signal only records itself; the master
+stops between steps and keeps every row (a second signal ends the process at once; while
+an FMU never returns, ``cosim.core.watchdog`` takes the signals). Within
+``raise_on_signals`` either signal raises ``Interrupted``, for code that runs no FMU.
 """
 from __future__ import annotations
 
@@ -24,7 +20,7 @@ STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 class StopSignals:
     """``with StopSignals() as stop``: ``stop.received`` is the first SIGINT or SIGTERM that
-    arrived, or None. Only the main thread can take signals; elsewhere this does nothing."""
+    arrived, or None (main thread only; elsewhere this does nothing)."""
 
     def __init__(self) -> None:
         self.received: signal.Signals | None = None
@@ -42,9 +38,8 @@ class StopSignals:
         self.receive(signal.Signals(number))
 
     def receive(self, number: signal.Signals) -> None:
-        """Take a signal: the first asks the run to stop between steps; a second ends the
-        process at once (status 130 or 143), after each ``keep`` callback has said (and
-        done) what is kept."""
+        """The first signal asks the run to stop between steps; a second ends the process at
+        once (status 130 or 143), after each ``keep`` callback has said what is kept."""
         if self.received is None:
             self.received = number
             return
@@ -61,8 +56,8 @@ class StopSignals:
         os._exit(128 + self.received)
 
     def keep(self, keeper: Callable[[], str]) -> Callable[[], None]:
-        """Have ``keeper`` run if a second signal ends the process (it tidies up and says
-        what is kept); returns the function that forgets it again."""
+        """Have ``keeper`` run (and say what it kept) if a second signal ends the process;
+        returns the function that forgets it."""
         self._keepers.append(keeper)
         return lambda: self._keepers.remove(keeper) if keeper in self._keepers else None
 
@@ -77,7 +72,7 @@ class StopSignals:
         return 128 + self.received if self.received else 0
 
     def check(self) -> None:
-        """Raise ``Interrupted`` if a signal has arrived: a loop's way to stop between steps."""
+        """Raise ``Interrupted`` if a signal has arrived."""
         if self.received is not None:
             raise Interrupted(self.received)
 

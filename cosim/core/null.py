@@ -1,11 +1,8 @@
-"""The master's null backend: components that cost nothing, to measure the master itself.
+"""The master's null backend: the FMUs' interfaces without their behaviour, to measure the master.
 
-A ``NullInstance`` has the variables and the feedthrough of the FMU at ``path``
-(read from its model description, without loading it) and does nothing: its
-outputs read 0.0, its inputs and parameters are ignored, a step returns at once.
-A master on this backend pays only for its own work (coupling, bookkeeping,
-recording), which is what ``cosim.bench`` reports as the master's cost. Its
-results mean nothing.
+A ``NullInstance`` has the variables and feedthrough of the FMU at ``path`` (its model
+description; the FMU is not loaded): outputs read 0.0, inputs and parameters are ignored, a
+step returns at once. ``cosim.bench overhead`` reports a run on it as the master's own cost.
 """
 from __future__ import annotations
 
@@ -16,31 +13,24 @@ from .fmi import feedthrough, read_description
 from .instance import Instance
 
 
+def _nothing(*args: Any, **kwargs: Any) -> None:
+    return None
+
+
 class NullInstance(Instance):
     """The interface of the FMU at ``path``; no behaviour."""
 
+    call = _nothing
+    enter_initialization = reset = free = _nothing
+
     def __init__(self, path: str | Path, name: str):
-        self.path, self.name = Path(path), name
         description = read_description(self.path, name)
         self.guid = description.guid
         self.variables = {v.name: v for v in description.modelVariables}
         self.feedthrough = feedthrough(description)
 
-    def call(self, what: str, function: Callable, *args, time: float | None = None,
-             strict: bool = False) -> Any:
-        return None
-
     def fmi(self, name: str) -> Callable:
-        return lambda *args: None
-
-    def enter_initialization(self, start_time: float = 0.0) -> None:
-        pass
-
-    def reset(self) -> None:
-        pass
-
-    def free(self) -> None:
-        pass
+        return _nothing
 
     def get(self, names: Iterable[str]) -> dict[str, Any]:
         """The start values of the model description: a null instance holds nothing else."""
@@ -55,7 +45,7 @@ class NullInstance(Instance):
         return lambda: values
 
     def writer(self, vrs: list[int]) -> Callable[[list[float]], None]:
-        return lambda values: None
+        return _nothing
 
     def stepper(self) -> Callable[[float, float], None]:
-        return lambda t, h: None
+        return _nothing

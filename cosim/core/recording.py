@@ -1,9 +1,8 @@
 """What a run records, row by row: held in memory, or streamed to a CSV file in chunks.
 
-Row k holds the time t_k and one value per column (every signal of the system at
-t_k). ``Recorder`` takes the rows as the master produces them; ``close`` hands
-back the ``Recording``. Streaming keeps memory flat however long the run: rows go
-to the CSV file in chunks, and the recording then holds none of them itself.
+Row k holds t_k and one value per column. ``Recorder`` takes the rows as the master makes
+them and ``close`` gives the ``Recording``; streamed, memory stays flat however long the run
+and the recording holds no rows itself.
 """
 from __future__ import annotations
 
@@ -44,14 +43,13 @@ class Recording:
                              "read them from there")
 
     def write_csv(self, path: str | Path) -> None:
-        """All rows, a header of column names; floats in their shortest exact form."""
         sink = CsvSink(path, self.columns)
         sink.write(self.t, self.data)
         sink.close()
 
 
 class CsvSink:
-    """Rows appended to a CSV file as they come, in the shortest exact float form."""
+    """Rows appended to a CSV file as they come, floats in their shortest exact form."""
 
     def __init__(self, path: str | Path, columns: list[str]):
         self.path, self.rows = Path(path), 0
@@ -85,7 +83,6 @@ class Recorder:
 
     @property
     def rows(self) -> int:
-        """Rows recorded so far: written and held."""
         return (self.sink.rows if self.sink else 0) + self.held
 
     def append(self, t: float, values: list[float]) -> None:
@@ -100,7 +97,6 @@ class Recorder:
         self.held = 0
 
     def close(self, error: str | None = None) -> Recording:
-        """The recording; a stream gets its last rows and is closed."""
         if self.sink is None:
             return Recording(self.columns, self.time[:self.held], self.data[:self.held],
                              self.held, error, self.interrupted, self.meta, units=self.units)

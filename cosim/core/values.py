@@ -1,50 +1,31 @@
 """Values for FMU variables, checked against what the FMU declares before any FMU call.
 
-Every value the master sets (a ``--set`` text, a .ssd parameter binding, a Python
-caller's override) passes through ``checked``, on every backend: it returns the exact
-value to set, or raises ValueError naming the component, the variable, the value and
-what the variable takes. Two stages:
-
-- ``fmi_value``: what the FMI 2.0 call of the variable's type carries exactly
-  (section 2.1.2: fmi2Real a C double, fmi2Integer a C int, fmi2Boolean, fmi2String a
-  UTF-8 C string). Nothing is rounded, truncated or wrapped: an Integer is a whole
-  number in [-2^31, 2^31 - 1] (7, 7.0, "7", "+7", "7.0" and "1e3" are whole numbers;
-  1.5 and 4294967297 are refused, not set as 1); a Boolean is a bool, 0 or 1, or the
-  text true, false, 1 or 0 in any case; a String is text as given, without NUL. A
-  number given as text is read as the type declares (ASCII digits, optional sign,
-  fraction and exponent; surrounding blanks ignored, as XML Schema does; no "0x10",
-  "1_000" or other digits); a Real's text may also be inf or nan, and a text beyond
-  the range of a double is refused rather than read as infinite.
-- ``checked``: that value against the declaration (section 2.2.7): a Real finite
-  (+inf only where the FMU declares max="INF", -inf only where min="-INF"; NaN never)
-  and within the declared min and max, an Integer within them, an Enumeration one of
-  its items (by number or by name).
-
-``setting`` also refuses a variable that does not exist (naming the closest names, as
-``parameters`` does for a component) or that a master may not set
-in initialisation mode, where ours sets them (section 4.2.4: variability other than
-constant and initial exact, or an input): outputs, calculated parameters, constants,
-locals; ``parameters`` checks every value of a run so (``Master.configure``), from
-the model descriptions alone, before any FMU is instantiated.
+Every value the master sets passes ``checked`` on every backend: the exact value to set, or
+ValueError naming the component, the variable, the value and what the variable takes.
+``fmi_value``: what the FMI 2.0 call of the type carries exactly (section 2.1.2): nothing
+rounded or wrapped (an Integer a whole number of 32 bits: "7", 7.0, "1e3", not 1.5; a
+Boolean a bool, 0, 1 or true/false in any case; a String UTF-8 without NUL; text read as
+the type declares). ``checked``: that value against the declaration (section 2.2.7): a
+Real finite (+-inf only where max="INF" / min="-INF"), within min and max; an Enumeration
+one of its items. ``setting`` also refuses a variable the FMU lacks or that a master may
+not set in initialisation mode (section 4.2.4).
 """
 from __future__ import annotations
 
-import difflib
 import math
 import numbers
 import re
 from dataclasses import dataclass
 from decimal import Decimal
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Iterable, Mapping
+from typing import Any, Iterable, Mapping
 
 from fmpy.model_description import ModelDescription
 
-if TYPE_CHECKING:
-    from .ssd import SystemDescription
+from .errors import close_matches, did_you_mean
+from .system import SystemDescription
 
-INTEGER_RANGE = (-2**31, 2**31 - 1)
-"""What fmi2Integer, a C int, holds (FMI 2.0, section 2.1.2)."""
+INTEGER_RANGE = (-2**31, 2**31 - 1)                 # fmi2Integer, a C int
 
 Value = bool | int | float | str
 
@@ -55,10 +36,8 @@ _BOOLEAN = {"true": True, "1": True, "false": False, "0": False}
 
 @dataclass(frozen=True)
 class Declaration:
-    """What an FMU declares of one variable (FMI 2.0, section 2.2.7): its type (Real,
-    Integer, Boolean, String or Enumeration), causality, variability and initial, its
-    min and max (None where undeclared) and an Enumeration's items (name, value)."""
-
+    """What an FMU declares of one variable (FMI 2.0, section 2.2.7); min and max None
+    where undeclared, an Enumeration's items as (name, value)."""
     name: str
     type: str
     causality: str = "parameter"
@@ -69,8 +48,7 @@ class Declaration:
     items: tuple[tuple[str, int], ...] = ()
 
     @property
-    def settable(self) -> bool:
-        """Whether a master may set it in initialisation mode (FMI 2.0, section 4.2.4)."""
+    def settable(self) -> bool:                     # in initialisation mode (section 4.2.4)
         return self.causality == "input" or (self.variability != "constant"
                                              and self.initial == "exact")
 
@@ -101,10 +79,8 @@ _TAKES = {"Real": "a Real (a double)", "Integer": "an Integer, a whole number fr
 
 
 def declarations(description: ModelDescription) -> dict[str, Declaration]:
-    """Every variable's declaration in an FMU's model description, as fmpy reads it
-    (``cosim.core.fmi.read_description``, which validates it against the FMI schema: a
-    bound is a number of its variable's type), min and max from the variable or else its
-    declared type."""
+    """Every variable's declaration in a model description (``cosim.core.fmi.read_description``,
+    schema-validated), min and max from the variable or else its declared type."""
     out = {}
     for v in description.modelVariables:
         declared, number = v.declaredType, float if v.type == "Real" else int
@@ -118,12 +94,12 @@ def declarations(description: ModelDescription) -> dict[str, Declaration]:
 
 
 class _Refusal(ValueError):
-    """Why a value is refused, in words that follow it: 'is not a whole number'."""
+    """Why a value is refused: 'is not a whole number'."""
 
 
 def fmi_value(target: str, type_name: str, value: Any) -> Value:
-    """``value`` as the FMI 2.0 call of ``type_name`` carries it, exactly (see the module);
-    ValueError naming ``target`` (component.variable), the value and what the type takes."""
+    """``value`` as the FMI 2.0 call of ``type_name`` carries it, exactly; ValueError naming
+    ``target`` (component.variable), the value and what the type takes."""
     carry = _carrier(target, type_name)
     try:
         return carry(value)
@@ -132,8 +108,7 @@ def fmi_value(target: str, type_name: str, value: Any) -> Value:
 
 
 def checked(component: str, declaration: Declaration, value: Any) -> Value:
-    """The exact value to set for ``component``'s variable so declared; ValueError naming
-    the component, the variable, the value and what the variable takes."""
+    """The exact value to set for ``component``'s variable so declared, or ValueError."""
     target = f"{component}.{declaration.name}"
     carry = _carrier(target, "Integer" if declaration.type == "Enumeration"
                      else declaration.type)
@@ -160,9 +135,9 @@ def _refused(target: str, value: Any, refusal: _Refusal, takes: str) -> ValueErr
 
 def setting(component: str, path: str | Path, declared: dict[str, Declaration], name: str,
             value: Any, elsewhere: Mapping[str, Iterable[str]] | None = None) -> Value:
-    """``checked`` for the variable ``name`` of ``component`` (its FMU at ``path``),
-    which must exist and be settable; ValueError naming what the FMU has otherwise (and,
-    for a name only ``elsewhere`` has, by component, which component has it)."""
+    """``checked`` for the variable ``name`` of ``component`` (its FMU at ``path``), which
+    must exist and be settable; ValueError naming what it has (and which component of
+    ``elsewhere`` has such a name)."""
     if name not in declared:
         raise no_variable(component, path, declared, name, elsewhere)
     declaration = declared[name]
@@ -180,9 +155,8 @@ def setting(component: str, path: str | Path, declared: dict[str, Declaration], 
 
 def no_variable(component: str, path: str | Path, names: Iterable[str], name: str,
                 elsewhere: Mapping[str, Iterable[str]] | None = None) -> ValueError:
-    """The error for a variable the FMU does not have: those it has, and the closest of
-    them or else a variable of that name (but for case) of another component
-    (``elsewhere``: its variables' names, by component)."""
+    """The error for a variable the FMU does not have: those it has, and the closest of them
+    or else one of that name (but for case) of another component (``elsewhere``)."""
     names = list(names)
     others = [f"{c}.{n}" for c, theirs in (elsewhere or {}).items() for n in theirs
               if n.lower() == name.lower()]
@@ -191,46 +165,10 @@ def no_variable(component: str, path: str | Path, names: Iterable[str], name: st
                       f"{did_you_mean(close_matches(name, names) or others)}")
 
 
-def no_component(components: Iterable[str], name: str) -> ValueError:
-    """The error for a component a system does not have: those it has, and the closest."""
-    components = list(components)
-    return ValueError(f"--set names the component '{name}'; the system has "
-                      f"{', '.join(components)}{did_you_mean(close_matches(name, components))}")
-
-
-CLOSE = 0.7
-"""How alike (``difflib``'s ratio, 0 to 1) a name must be to the one typed to be offered
-instead: 'ship' for 'shp' (0.86), 'delta_max' for 'delta_mx' (0.94); not 'wave_seed' for
-'wave_height' (0.6), a guess that would mislead."""
-
-
-def close_matches(name: str, names: Iterable[str]) -> list[str]:
-    """The names a user who typed ``name`` most likely meant, best first: those equal to it
-    but for case, then up to three ``CLOSE`` ones by ``difflib`` (ignoring case)."""
-    names = list(dict.fromkeys(names))
-    same = [n for n in names if n.lower() == name.lower() and n != name]
-    folded = {}
-    for n in names:
-        folded.setdefault(n.lower(), n)
-    close = [folded[n] for n in difflib.get_close_matches(name.lower(), list(folded), 3, CLOSE)]
-    return list(dict.fromkeys(n for n in [*same, *close] if n != name))
-
-
-def did_you_mean(matches: list[str]) -> str:
-    """"; did you mean 'Hs'?", the end of a message, for ``matches`` (``close_matches``);
-    '' for none."""
-    quoted = [f"'{n}'" for n in matches]
-    if not quoted:
-        return ""
-    listed = quoted[0] if len(quoted) == 1 else f"{', '.join(quoted[:-1])} or {quoted[-1]}"
-    return f"; did you mean {listed}?"
-
-
 def _article(word: str) -> str:
     return "an" if word[0] in "aeiou" else "a"
 
 
-# -- what each FMI type carries ------------------------------------------------------
 def _real(value: Any) -> float:
     if isinstance(value, str):
         text = value.strip()
@@ -308,7 +246,6 @@ def _integer_bounds(declaration: Declaration) -> tuple[int, int]:
 
 
 def _within(declaration: Declaration, value: Value) -> None:
-    """_Refusal if a value of the declared type is outside what the declaration allows."""
     if declaration.type == "Real":
         if math.isnan(value):
             raise _Refusal("is not a number (NaN)")
@@ -327,11 +264,10 @@ def parameters(system: SystemDescription, paths: dict[str, Path],
                declared: dict[str, dict[str, Declaration]],
                overrides: Mapping[str, Mapping[str, Any]] | None = None
                ) -> tuple[dict[str, dict[str, Value]], dict[str, dict[str, Value]]]:
-    """The values of a run, each as ``setting`` returns it for its component (its FMU at
-    ``paths[component]``, declaring ``declared[component]``): the system's parameter
-    bindings updated by ``overrides`` (by component, then variable); and the overrides
-    alone, as set. ValueError naming the value (and the .ssd, for a binding of its own),
-    also for an input that a connection sets."""
+    """The values of a run as ``setting`` returns them (FMUs at ``paths``, declaring
+    ``declared``): the system's bindings updated by ``overrides`` (component: variable:
+    value), and the overrides alone. ValueError naming the value (and the .ssd, for a
+    binding), also for an input that a connection sets."""
     if not isinstance(overrides or {}, Mapping):
         raise ValueError(f"set: overrides must map component names to their values, got "
                          f"{overrides!r}")
@@ -341,9 +277,6 @@ def parameters(system: SystemDescription, paths: dict[str, Path],
             raise ValueError(f"set: the values for '{component}' must map variable names to "
                              f"values, got {values!r}")
         given[component] = dict(values)
-    for component in given:
-        if component not in system.components:
-            raise no_component(system.components, component)
     connected = {(c.end_element, c.end_connector): f"{c.start_element}.{c.start_connector}"
                  for c in system.connections}
     settable = {c: [n for n, d in theirs.items() if d.settable] for c, theirs in declared.items()}

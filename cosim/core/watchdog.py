@@ -1,34 +1,18 @@
 """Time limits for a run, and signals that reach it even while an FMU never returns.
 
-The master's loop checks for Ctrl-C and SIGTERM between steps
-(``cosim.core.interrupt``), and that is all it can do from its own thread: an FMU
-that loops in fmi2DoStep never lets it run again. A ``Watchdog`` is a thread
-beside the loop that enforces
+A ``Watchdog`` is a thread beside the master's loop enforcing a step time limit
+(``Limits.step``: one communication step, or one instantiation, in wall-clock seconds), a run
+time limit (``Limits.run``) and a signal's grace (``Limits.grace``: after Ctrl-C or SIGTERM
+the step under way must end within it). In the main thread it takes SIGINT and SIGTERM from
+Python's wakeup file descriptor, which the C-level handler writes while FMU code runs; a
+second signal ends the process (``StopSignals.receive``).
 
-- a **step time limit** (``Limits.step``, wall-clock seconds): one communication
-  step, every FMU's calls at one time, or one FMU's instantiation and
-  initialisation, must end within it;
-- a **run time limit** (``Limits.run``): the whole run must end within it;
-- a **signal's grace** (``Limits.grace``): after Ctrl-C or SIGTERM the step under
-  way must end within it, so that the run can stop between steps.
-
-In the main thread it takes SIGINT and SIGTERM itself, from Python's wakeup file
-descriptor (``signal.set_wakeup_fd``: written by the C-level handler, in whatever
-thread the signal lands, while FMU code runs, Python or not), with Python-level
-handlers that do nothing meanwhile; a second signal ends the process at once
-(``StopSignals.receive``).
-
-Once the run time limit is passed, the loop stops at its next step (``beat``
-returns why). A step that does not end (past the step limit, or the grace after a
-signal or after the run limit) is hung: the watchdog raises ``TimeLimit`` in the
-loop's thread (``PyThreadState_SetAsyncExc``), where Python FMU code fails its
-call (fmukit turns it into a refusal), and the master stops, names the FMU and
-call, and writes what it kept as after any FMU failure. (Raised only while an
-FMU's call is under way, the exception cannot land in the master's own writing.) Code that
-runs no Python (a C FMU in an endless loop) cannot take an exception: after
-``Limits.grace`` more, the watchdog writes the rows kept
-(``salvage``) from its own thread, says so, and ends the process (status 1, or 130 /
-143 after a signal); ``faulthandler`` ends it regardless if even that cannot run.
+Past the run limit the loop stops at its next step (``beat`` says why). A step that does not
+end is hung: ``TimeLimit`` is raised in the loop's thread (``PyThreadState_SetAsyncExc``,
+only while an FMU call is under way), where Python FMU code fails its call and the master
+stops as after any FMU failure. Code that runs no Python cannot take it: after the grace the
+watchdog writes the rows kept (``salvage``), says so, and ends the process (status 1, or
+130/143 after a signal); ``faulthandler`` ends it if even that cannot run.
 """
 from __future__ import annotations
 
@@ -48,8 +32,7 @@ from .instance import Instance
 from .interrupt import STOP_SIGNALS, StopSignals
 
 STEP_LIMIT_S = 60.0
-"""The default step time limit: a step of our FMUs takes about 0.1 ms, their
-instantiation about 0.3 s."""
+"""The default step time limit, far above a step's or an instantiation's time."""
 
 
 class Limits(NamedTuple):
@@ -69,24 +52,22 @@ class Limits(NamedTuple):
 
 
 def no_limit(what: str | float) -> None:
-    """What ``Watchdog.beat`` does where there is no watchdog: no limit expires."""
+    """``Watchdog.beat`` where there is no watchdog."""
 
 
 class TimeLimit(BaseException):
-    """Raised in the loop's thread when a limit is passed (a BaseException, so that no
-    ``except Exception`` in the way swallows it; ``Watchdog.expired`` says which)."""
+    """Raised in the loop's thread when a limit is passed (a BaseException: no ``except
+    Exception`` swallows it; ``Watchdog.expired`` says which)."""
 
     def __init__(self, *args: object):
         super().__init__(*(args or ("a time limit of the run was passed",)))
 
 
 class Watchdog:
-    """``with Watchdog(limits, stop) as dog``: call ``dog.beat(what)`` as each step (or
-    instantiation) begins; ``dog.expired`` says which limit was passed, if one was.
-
-    ``salvage(reason)`` is what to keep if the loop's thread never returns: it writes
-    what it can and returns a sentence saying what was kept (called from this thread).
-    """
+    """``with Watchdog(limits, stop) as dog``: ``dog.beat(what)`` as each step (or
+    instantiation) begins; ``dog.expired`` says which limit was passed. ``salvage(reason)``,
+    called from the watchdog's thread if the loop never returns, writes what it can and
+    says what was kept."""
 
     def __init__(self, limits: Limits = Limits(), stop: StopSignals | None = None,
                  salvage: Callable[[str], str] | None = None):
@@ -105,16 +86,15 @@ class Watchdog:
         self._saved: tuple[int, dict] = (-1, {})
 
     def finishing(self, what: str) -> None:
-        """The run is over and ``what`` (terminating the FMUs) begins: its time limit starts
-        now, and nothing is raised into it any more (an exception in fmi2Terminate has no
-        safe way out of pythonfmu's C++); past the limit the rows are kept (``salvage``) and
-        the process ends."""
+        """The run is over and ``what`` (terminating the FMUs) begins: its limit starts now,
+        and nothing is raised into it (an exception in fmi2Terminate has no safe way out of
+        pythonfmu's C++); past the limit the rows are kept and the process ends."""
         self._raise = False
         self.beat(what)
 
     def beat(self, what: str | float) -> str | None:
-        """A new step (its time, in s) or call (``what``, a phrase) begins: its time limit
-        starts now. Returns ``expired``: the loop is to stop here if it is not None."""
+        """A step (its time, in s) or call (a phrase) begins: its limit starts now. Returns
+        ``expired``: the loop stops here if it is not None."""
         self._beat, self._what = time.monotonic(), what
         return self.expired
 
@@ -166,14 +146,12 @@ class Watchdog:
         self._wakeup = None
 
     def _received(self) -> list[signal.Signals]:
-        """The signals the wakeup socket has seen since last asked."""
         try:
             data = self._wakeup[0].recv(64)
         except BlockingIOError:
             return []
         return [signal.Signals(number) for number in data if number in STOP_SIGNALS]
     def _deadline(self) -> tuple[float, str]:
-        """When the next limit falls, and what it is."""
         candidates = [(float("inf"), "")]
         if self.limits.step is not None:
             candidates.append((self._beat + self.limits.step,
@@ -247,9 +225,8 @@ class Watchdog:
 
 
 def _calling(thread_id: int) -> str | None:
-    """The FMU and call that the thread is in, from its Python stack ("FMU 'ship' in
-    doStep"), or None if it is in none. (A backend's prepared calls are closures over
-    the instance: ``step``, ``read``, ``write``.)"""
+    """The FMU and call the thread is in ("FMU 'ship' in doStep"), from its stack, or None.
+    An ``Instance`` has its name from ``__new__`` on; prepared calls are closures over one."""
     frame = sys._current_frames().get(thread_id)
     while frame is not None:
         owner, what = frame.f_locals.get("self"), frame.f_locals.get("what")
@@ -265,15 +242,14 @@ _PREPARED = {"step": "doStep", "read": "a get call", "write": "a set call"}
 
 
 def _idle(number: int, frame: object) -> None:
-    """Python's handler of SIGINT and SIGTERM while a watchdog takes them: nothing to do."""
+    """Python's handler of SIGINT and SIGTERM while a watchdog takes them."""
 
 
 _idle.safe_in_fmu_code = True      # fmukit need not defer it (fmukit.hostsignals)
 
 
 def _raise_in(thread_id: int, exception: type[BaseException] | None) -> None:
-    """Raise ``exception`` in a thread at its next Python instruction (None: clear one
-    raised before and not yet taken)."""
+    """Raise ``exception`` in a thread at its next Python instruction (None: clear one)."""
     ctypes.pythonapi.PyThreadState_SetAsyncExc(ctypes.c_ulong(thread_id),
                                                ctypes.py_object(exception) if exception
                                                else None)

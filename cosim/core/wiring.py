@@ -1,11 +1,9 @@
 """How the components of a system connect: checks, the Gauss-Seidel order, the loop's layout.
 
-``check_connections`` refuses a connection that does not join a Real output to a
-Real input of the FMUs named. ``feedthrough_order`` derives the Gauss-Seidel
-order: a component whose output feeds through from its inputs (declared in its
-model structure) goes before the components it feeds. ``layout`` assigns every
-signal a column, in contiguous blocks per component, and prepares each
-component's calls for the loop (a ``Node``).
+``check_connections`` refuses a connection that does not join a Real output to a Real input;
+``feedthrough_order`` puts a component whose outputs feed through from its inputs (its model
+structure) before those it feeds; ``layout`` gives every signal a column, in blocks per
+component, and prepares each component's calls (a ``Node``).
 """
 from __future__ import annotations
 
@@ -15,7 +13,7 @@ from operator import itemgetter
 from typing import Callable
 
 from .instance import Instance
-from .ssd import Connection, SystemDescription
+from .system import Connection, SystemDescription
 
 
 class WiringError(ValueError):
@@ -58,10 +56,8 @@ def _empty() -> slice:
 
 @dataclass
 class Node:
-    """One component as the loop sees it: its column blocks and prepared calls.
-
-    A prepared call is None where the component has nothing of that kind.
-    """
+    """One component as the loop sees it: its column blocks and prepared calls (None where
+    it has nothing of that kind)."""
 
     name: str
     instance: Instance
@@ -84,11 +80,8 @@ class Node:
 def layout(instances: dict[str, Instance], connections: list[Connection],
            verify_inputs: bool = False) -> tuple[list[str], dict[str, Node]]:
     """(columns, nodes by name): every output, then every connected input, per component.
-
-    ``apply_inputs(values)`` sets a node's inputs from the values of their sources
-    and records them in ``values``: as sent, or as read back from the FMU with
-    ``verify_inputs``.
-    """
+    A node's ``apply_inputs(values)`` sets its inputs from their sources and records them
+    in ``values``: as sent, or as read back with ``verify_inputs``."""
     columns: list[str] = []
 
     def block(names: list[str]) -> slice:

@@ -1,10 +1,6 @@
-"""The guidance and the autopilots of ``autopilot_fmu`` for M members at once.
-
-``WaypointGuidance`` (eq 18), ``PDAutopilot`` (eq 20), ``PIDAutopilot`` and
-``SlidingModeAutopilot`` (eqs 37-44) on (M,) arrays, each built from the scalar models the
-in-process route initialised (routes, gains, designs, initial states), operation for
-operation in their order (pinned bit for bit by tests/test_ensemble.py). Each member keeps
-its own route (padded to the longest), gains and design.
+"""The guidance (eq 18) and the autopilots (eqs 20, 37-44) of ``autopilot_fmu`` on (M,)
+arrays, built from the scalar models the in-process route initialised, operation for
+operation in their order. Each member keeps its own route (padded), gains and design.
 """
 from __future__ import annotations
 
@@ -69,8 +65,8 @@ class GuidanceArrays:
         return leg, finished
 
     def outputs(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(psi_d, wp_index) at (x, y); the leg switches are committed (``update``: the
-        master commits them at the step, with the position unchanged)."""
+        """(psi_d, wp_index) at (x, y), the leg switches committed (as ``update`` would be,
+        at the same position)."""
         self.leg, self.finished = self.active_leg(x, y)
         psi_d = self.course[self.members, self.leg]
         return psi_d, np.where(self.finished, self.points, self.leg + 1)
@@ -81,9 +77,8 @@ NEAR = 1e-12
 
 
 def _within(dx: np.ndarray, dy: np.ndarray, radius: np.ndarray) -> np.ndarray:
-    """``math.hypot(dx, dy) <= radius`` of each member. ``np.hypot`` (the C library's,
-    a tenth of the cost) and ``math.hypot`` both round to within an ulp or two, so they
-    decide alike but within ``NEAR`` of the circle, where ``math.hypot`` decides."""
+    """``math.hypot(dx, dy) <= radius`` of each member: ``np.hypot`` (a tenth of the cost)
+    decides, but within ``NEAR`` of the circle, where ``math.hypot`` does."""
     distance = np.hypot(dx, dy)
     inside = distance <= radius
     near = np.abs(distance - radius) <= NEAR * radius
@@ -103,7 +98,7 @@ class PDArrays:
 
     def step(self, t: float, h: float, psi: np.ndarray, r: np.ndarray,
              psi_d: np.ndarray) -> None:
-        """Nothing to advance."""
+        pass
 
 
 class PIDArrays:
@@ -172,5 +167,4 @@ def autopilot_arrays(pilots: Sequence) -> PDArrays | PIDArrays | SMCArrays:
 
 KINDS = {"PDAutopilot": PDArrays, "PIDAutopilot": PIDArrays,
          "SlidingModeAutopilot": SMCArrays}
-"""The scalar autopilots the batch route covers, by class name, and their array forms (the
-PID's class lives in its FMU's slave script, so it is known by name)."""
+"""The array forms of the scalar autopilots, by class name (the PID's lives in its slave)."""

@@ -1,15 +1,9 @@
 """The scalar models' functions on arrays, each element to the bit of the scalar call.
 
-The scalar models call ``math.hypot`` (CPython's own algorithm, not the C library's),
-``math.tanh`` and ``math.remainder`` (through ``fmukit.numerics.wrap``); numpy's
-``np.hypot`` and ``np.tanh`` round differently on a share of inputs. Here ``hypot`` and
-``tanh`` call the math functions element by element (at a few hundred members that costs
-no more than a dozen array operations would), and ``wrap`` rebuilds CPython's
-``math.remainder`` from ``np.fmod``, which is exact, with the same case analysis.
-
-What numpy computes on arrays as the C library does (``np.sin``, ``np.cos``, ``+ - * /``,
-``np.sqrt``) is used as is; ``cosim.ensemble.selftest`` checks on each machine that it
-does.
+numpy's ``np.hypot`` and ``np.tanh`` round differently from ``math.hypot`` and ``math.tanh``
+on a share of inputs, so ``hypot`` and ``tanh`` call the math functions element by element;
+``wrap`` rebuilds CPython's ``math.remainder`` from ``np.fmod``, which is exact. What numpy
+computes as the C library does (sin, cos, sqrt, + - * /) is used as is (``selftest``).
 """
 from __future__ import annotations
 

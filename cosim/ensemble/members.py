@@ -1,15 +1,11 @@
-"""Which systems and members the batch kernel runs, and each member's initial models.
-
-A member is initialised by the in-process master exactly as a run of it would be
-(parameters checked and set, initial outputs propagated, the models built by the FMUs'
-own slave classes); the kernel then takes over the stepping from the models it built.
-"""
+"""Which systems and members the batch kernel runs, and each member's initial models: built
+by the in-process master exactly as a run of it would be, then stepped by the kernel."""
 from __future__ import annotations
 
 from dataclasses import dataclass
 from typing import Any
 
-from fmubuild.manifest import read as read_manifest
+from fmukit.manifest import read as read_manifest
 
 from ..core.inprocess import fallback_note
 from ..core.instance import FmuCallError
@@ -29,9 +25,8 @@ MODELS = {"guidance": ("guidance",), "ship": ("ship",),
 
 
 def coverage(system: SystemDescription) -> str | None:
-    """Why the batch kernel cannot run ``system`` at all, or None if it can: this
-    project's guidance, ship and PD, PID or sliding-mode autopilot, current in this
-    process, wired as the course-keeping scenarios are."""
+    """Why the batch kernel cannot run ``system``, or None: it runs this project's current
+    guidance, ship and PD, PID or sliding-mode autopilot wired as course keeping."""
     names = set(system.components)
     if names != set(COMPONENTS):
         return (f"the batch route runs course keeping (guidance, autopilot, ship), not "
@@ -63,9 +58,8 @@ class Member:
 
 def initialise(master: Master, overrides: dict[str, dict[str, Any]],
                n_steps: int) -> Member | None:
-    """The member of ``overrides`` initialised by ``master`` (an in-process master of a
-    covered system, reset here), or None if its initialisation fails (its run on the
-    in-process route then records why)."""
+    """The member of ``overrides`` initialised by ``master`` (in-process, of a covered
+    system), or None if that fails (its run alone then records why)."""
     master.reset()
     master.configure(overrides)
     try:

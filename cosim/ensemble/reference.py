@@ -1,10 +1,5 @@
-"""The scalar models stepped as the master steps them: the reference the batch kernel is
-pinned to.
-
-guidance -> autopilot -> ship at each communication point, in the Gauss-Seidel order the
-master derives from the declared feedthrough, each signal sampled at t_k = t_0 + k h
-(``fmukit.timebase``), as the master records its rows.
-"""
+"""The scalar models stepped as the master steps them (guidance -> autopilot -> ship,
+Gauss-Seidel, sampled at t_k = t_0 + k h): the reference the batch kernel is pinned to."""
 from __future__ import annotations
 
 from typing import Any
@@ -15,14 +10,13 @@ from fmukit.timebase import communication_point
 
 SIGNALS = ("guidance.psi_d", "guidance.wp_index", "autopilot.delta_c", "ship.x", "ship.y",
            "ship.psi", "ship.u", "ship.v", "ship.r", "ship.delta")
-"""Every signal of the course-keeping loop that the scalar reference and the kernel
-record (the ship's wave loads aside)."""
+"""Every signal of the loop the reference and the kernel record (wave loads aside)."""
 
 
 def step_models(guidance: Any, autopilot: Any, ship: Any, shafts: tuple[float, float, float],
                 t0: float, h: float, n_steps: int) -> dict[str, np.ndarray]:
-    """Step initialised scalar models ``n_steps`` steps of h from t0 with the shaft speeds
-    ``shafts`` (n1, n2, n3); each of ``SIGNALS`` at t_0 .. t_N."""
+    """Each of ``SIGNALS`` at t_0 .. t_N of initialised scalar models stepped ``n_steps``
+    steps of h from t0 with the shaft speeds ``shafts`` (n1, n2, n3)."""
     n1, n2, n3 = shafts
     stepping_pilot = hasattr(autopilot, "step")
     pid = type(autopilot).__name__ == "PIDAutopilot"      # steps with its inputs, as its slave

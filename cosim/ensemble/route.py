@@ -1,15 +1,23 @@
-"""``simulate_members``: the members of one system, in lockstep where the kernel covers
-them, alone on the in-process route where it does not."""
+"""``simulate_members``: the members of one system in lockstep where the kernel covers them,
+alone on the in-process route where it does not; ``selftest``, the kernel checked on this
+machine against the scalar models."""
 from __future__ import annotations
 
+import math
 import time
 from collections import defaultdict
+from functools import lru_cache
 from typing import Any, Callable, Sequence
 
 import numpy as np
 
+from autopilot_fmu.design import design_model
+from autopilot_fmu.guidance import WaypointGuidance
+from autopilot_fmu.pd import PDAutopilot
+from autopilot_fmu.smc import SlidingModeAutopilot, SlidingModeDesign
 from fmukit.autopilot import INPUTS
 from fmukit.timebase import communication_point
+from ship_fmu.vessel import N_PROPELLER, Vessel, VesselParameters
 
 from ..core.master import Master
 from ..core.recording import Recording
@@ -17,13 +25,12 @@ from ..core.ssd import SystemDescription
 from ..core.watchdog import TimeLimit, no_limit
 from .control import GuidanceArrays, autopilot_arrays
 from .members import Member, coverage, initialise
-from .reference import SIGNALS as ALL_SIGNALS
-from .selftest import selftest
+from .reference import SIGNALS as ALL_SIGNALS, step_models
 from .vessel import VesselArrays
 
 SIGNALS = ("guidance.psi_d", "guidance.wp_index", "ship.x", "ship.y", "ship.psi",
            "ship.delta")
-"""What the figures of merit of a run need (``cosim.studies.sweep_task.run_metrics``)."""
+"""What the figures of merit of a run need (``cosim.studies.merit.run_metrics``)."""
 
 R_MAX = next(var.max for var in INPUTS if var.name == "r")
 """The autopilots' declared range of their yaw-rate input, rad/s: beyond it they refuse."""
@@ -32,14 +39,11 @@ R_MAX = next(var.max for var in INPUTS if var.name == "r")
 def simulate_members(system: SystemDescription, overrides: Sequence[dict[str, dict[str, Any]]],
                      stop_time: float | None = None, signals: Sequence[str] = SIGNALS,
                      beat: Callable[[str | float], str | None] = no_limit) -> list[Recording]:
-    """One recording per member of ``system`` with ``overrides[i]`` (as
-    ``Master(system, backend="inprocess").run(stop_time)`` records it, holding the columns
-    ``signals``, any of ``reference.SIGNALS``). ValueError naming the member whose settings
-    are refused, before anything runs.
-
-    ``beat`` (``Watchdog.beat``) is called as each member's initialisation and each step
-    of the members together begins, with a phrase or the step's time; where it returns a
-    reason (a time limit passed), the batch stops there: TimeLimit with that reason."""
+    """One recording per member of ``system`` with ``overrides[i]``, as the in-process
+    ``Master.run(stop_time)`` records it, holding ``signals`` (any of ``reference.SIGNALS``).
+    ValueError naming the member whose settings are refused, before anything runs.
+    ``beat`` (``Watchdog.beat``) is called before each member's initialisation and each
+    step; where it returns a reason, the batch stops: TimeLimit with that reason."""
     unknown = [s for s in signals if s not in ALL_SIGNALS]
     if unknown:
         raise ValueError(f"signals {', '.join(unknown)}: the batch route records only "
@@ -50,7 +54,7 @@ def simulate_members(system: SystemDescription, overrides: Sequence[dict[str, di
                 master.configure(member)
             except ValueError as error:
                 raise ValueError(f"member {i}: {error}") from None
-        _, h, n_steps = master.steps(stop_time)
+        _, h, n_steps = master.system.steps(stop_time)
         reason = coverage(system) or selftest()
         recordings: dict[int, Recording] = {}
         groups: dict[tuple, list[tuple[int, Member]]] = defaultdict(list)
@@ -63,8 +67,8 @@ def simulate_members(system: SystemDescription, overrides: Sequence[dict[str, di
             else:
                 groups[_group(member)].append((i, member))
         for members in groups.values():
-            for i, recording in _lockstep(members, system.start_time, h, n_steps, signals,
-                                          master.units, beat):
+            for i, recording in lockstep(members, system.start_time, h, n_steps, signals,
+                                         master.units, beat):
                 recordings[i] = recording or _alone(
                     master, overrides[i], stop_time, signals,
                     "it failed in the batch kernel, and ran alone to say why")
@@ -72,7 +76,6 @@ def simulate_members(system: SystemDescription, overrides: Sequence[dict[str, di
 
 
 def _check(expired: str | None) -> None:
-    """TimeLimit if a ``beat`` said a limit passed."""
     if expired:
         raise TimeLimit(expired)
 
@@ -89,8 +92,7 @@ def _outside(member: Member | None, h: float) -> str | None:
 
 
 def _group(member: Member) -> tuple:
-    """What members stepped together must share: calm water or waves, and how many
-    wave components."""
+    """What members stepped together share: calm water, or the number of wave components."""
     waves = member.models["ship"].waves
     return (0,) if waves is None else (len(waves.components.omega),)
 
@@ -109,18 +111,18 @@ def _alone(master: Master, overrides: dict[str, dict[str, Any]], stop_time: floa
                      units={s: recording.units.get(s, "") for s in signals})
 
 
-def _lockstep(members: list[tuple[int, Member]], t0: float, h: float, n_steps: int,
-              signals: Sequence[str], units: dict[str, str],
-              beat: Callable[[str | float], str | None] = no_limit
-              ) -> list[tuple[int, Recording | None]]:
-    """The members stepped together; (index, recording), None for a member that failed
+def lockstep(members: list[tuple[int, Member]], t0: float, h: float, n_steps: int,
+             signals: Sequence[str], units: dict[str, str],
+             beat: Callable[[str | float], str | None] = no_limit
+             ) -> list[tuple[int, Recording | None]]:
+    """The members stepped together: (index, recording), None for a member that failed
     (a signal not finite, or a yaw rate outside the autopilot's range)."""
     started = time.perf_counter()
     models = [m.models for _, m in members]
     ship = VesselArrays([m["ship"] for m in models], h, [m.shafts for _, m in members])
     guidance = GuidanceArrays([m["guidance"] for m in models])
     pilot = autopilot_arrays([m["autopilot"] for m in models])
-    block = np.empty((n_steps + 1, len(signals), len(members)))   # a step's values together
+    block = np.empty((n_steps + 1, len(signals), len(members)))
     rows = [ALL_SIGNALS.index(s) for s in signals]
     failed = np.zeros(len(members), dtype=bool)
     with np.errstate(all="ignore"):                # a failing member's lanes only
@@ -151,3 +153,58 @@ def _lockstep(members: list[tuple[int, Member]], t0: float, h: float, n_steps: i
         out.append((i, Recording(list(signals), times, block[:, :, j], n_steps + 1,
                                  meta=meta, units={s: units[s] for s in signals})))
     return out
+
+
+# -- the self-test: numpy dispatches its loops by CPU, so each process checks once that its
+# sin, cos, sqrt, arithmetic and sums give the scalar models' bits (docs/performance.md).
+STEPS, H = 100, 0.1
+"""10 s: every autopilot's members switch legs, cross +-180 deg and, some, reach a stop."""
+ROUTE = [(0.0, 0.0), (-1.5, 0.2), (-2.5, 2.5), (0.5, 3.0)]
+"""A short route with turns beyond 90 deg, from a start heading near 180 deg."""
+
+
+def _pilot(kind: str, psi0: float, member: int):
+    if kind == "pd":
+        return PDAutopilot(Kp=2.0 + member, Kd=50.0)
+    if kind == "pid":
+        from autopilot_fmu.pid_autopilot_slave import PIDAutopilot
+        return PIDAutopilot(Ki=0.5, e_int=math.radians(90))
+    design = SlidingModeDesign.from_model(design_model("paper", 0.3))
+    return SlidingModeAutopilot(design, psi_z=psi0, equivalent_control=kind[4:])
+
+
+def _members(kind: str, Hs: float) -> list[dict]:
+    """Four members of one autopilot: seeds, headings near +-pi, gear rates."""
+    out = []
+    for member in range(4):
+        psi0 = (-1.0) ** member * (math.pi - 0.01 * member)
+        ship = Vessel(VesselParameters(psi0=psi0, Hs=Hs, wave_seed=member, T0=0.7 + 0.1 * member,
+                                       delta_rate_max=math.radians(10.0 + 5.0 * member)))
+        out.append({"guidance": WaypointGuidance(ROUTE, 0.5), "ship": ship,
+                    "autopilot": _pilot(kind, psi0, member)})
+    return out
+
+
+@lru_cache(maxsize=1)
+def selftest() -> str | None:
+    """Why the batch kernel would not give the scalar models' bits here, or None: each
+    autopilot in calm water and waves, every signal of every step compared to the bit."""
+    shafts = (N_PROPELLER, N_PROPELLER, 0.0)
+    for kind in ("pd", "pid", "smc_paper", "smc_tracking"):
+        for Hs in (0.0, 0.02):
+            batch = [Member(models, shafts, {"backends": {}}) for models in _members(kind, Hs)]
+            recordings = lockstep(list(enumerate(batch)), 0.0, H, STEPS, ALL_SIGNALS,
+                                  {s: "" for s in ALL_SIGNALS})
+            for (i, recording), models in zip(recordings, _members(kind, Hs)):
+                scalar = step_models(models["guidance"], models["autopilot"], models["ship"],
+                                     shafts, 0.0, H, STEPS)
+                for signal in ALL_SIGNALS:
+                    ours = recording[signal] if recording is not None else np.full(STEPS + 1, 0.0)
+                    if recording is None or ours.tobytes() != scalar[signal].tobytes():
+                        where = "failed" if recording is None else (
+                            f"{signal} differs from step "
+                            f"{int(np.flatnonzero(ours != scalar[signal])[0])}")
+                        return (f"on this machine the batch kernel does not compute as the "
+                                f"scalar models ({kind}, Hs = {Hs} m, member {i}: {where}); "
+                                "numpy's array functions round differently here")
+    return None

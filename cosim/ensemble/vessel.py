@@ -1,12 +1,7 @@
-"""The vessel of ``ship_fmu.vessel`` for M members at once: ``Vessel.step`` on arrays.
-
-Each state is an (M,) array, the wave components (M, N) arrays; every member keeps its own
-parameters, sea and steering gear. The hull's Coriolis and damping forces, the
-kinematics, the actuators' forces and the RK4 update are the scalar model's own functions,
-which take arrays as they take floats; what the scalar model writes with branches (the
-steering gear's kink, the step cut there) or with scalar calls (the wave loads) is written
-here on arrays, operation for operation in the scalar model's order, and pinned to it bit
-for bit by tests/test_ensemble.py.
+"""``ship_fmu.vessel.Vessel.step`` for M members at once: states (M,) arrays, wave
+components (M, N). The rates, actuator forces and RK4 update are the scalar model's own
+functions on arrays; what it writes with branches (the steering gear's kink) or scalar calls
+(the wave loads) is written here on arrays, operation for operation in its order.
 """
 from __future__ import annotations
 
@@ -15,7 +10,7 @@ from typing import Callable, Sequence
 import numpy as np
 
 from ship_fmu.thrusters import actuator_model
-from ship_fmu.vessel import Vessel, axpy, rk4_update, state_rates
+from ship_fmu.vessel import Vessel, axpy, calm_water, rk4_update, state_rates
 
 from . import exact
 
@@ -23,8 +18,7 @@ Arrays = tuple[np.ndarray, ...]
 
 
 class RudderArrays:
-    """``ship_fmu.steering_gear.RudderMotion`` of every member: the rudder angle a time s
-    into the step, with delta_c held (s an array or a float)."""
+    """``ship_fmu.steering_gear.RudderMotion`` of every member (s an array or a float)."""
 
     def __init__(self, delta0: np.ndarray, delta_c: np.ndarray, delta_max: np.ndarray,
                  delta_rate_max: np.ndarray):
@@ -46,8 +40,8 @@ class RudderArrays:
 
 
 class WaveArrays:
-    """``ship_fmu.waves.WaveLoads`` of every member: (X_w, Y_w, N_w) from (M, N) components,
-    eqs (14)-(16), each sum over a member's N components in numpy's order for N values."""
+    """``ship_fmu.waves.WaveLoads`` of every member, eqs (14)-(16), each sum over a member's
+    N components in numpy's order for N values."""
 
     FIELDS = ("omega", "k", "phase", "slope_amplitude", "psi_w", "c_force", "c_moment")
 
@@ -64,8 +58,8 @@ class WaveArrays:
         self._part = {name: np.empty_like(getattr(self, name)) for name in self.FIELDS}
 
     def take(self, lanes: np.ndarray) -> WaveArrays:
-        """The waves of the members ``lanes`` (indices) only, held in this object's spare
-        arrays (so valid until the next ``take``) and computed in its work arrays."""
+        """The waves of the members ``lanes`` only, in this object's spare arrays (valid
+        until the next ``take``)."""
         part = object.__new__(WaveArrays)
         for name in self.FIELDS:
             setattr(part, name, np.take(getattr(self, name), lanes, axis=0,
@@ -74,9 +68,8 @@ class WaveArrays:
         return part
 
     def __call__(self, t: np.ndarray | float, xi: np.ndarray, psi: np.ndarray) -> Arrays:
-        # The (M, N) intermediates are written into arrays made once: made afresh, a few
-        # hundred members' would each be a fresh mmap (128 kB and over) on every call
-        # where glibc's mmap threshold is fixed, as Dask's workers fix it.
+        # into arrays made once: made afresh, each would be an mmap where glibc's mmap
+        # threshold is fixed, as Dask's workers fix it
         m = len(xi)
         s, ks = self._work[0][:m], self._work[1][:m]
         np.multiply(self.omega, t[:, None] if isinstance(t, np.ndarray) else t, s)
@@ -91,30 +84,24 @@ class WaveArrays:
                 self.c_moment * np.sin(2.0 * beta) * sum_s2)
 
 
-def _calm(t: np.ndarray | float, xi: np.ndarray, psi: np.ndarray) -> Arrays:
-    return (0.0, 0.0, 0.0)
-
-
 def _no_travel(u: np.ndarray, v: np.ndarray) -> float:
-    """Calm water: no load depends on the travel xi along the waves, so its rate is left at
-    0 (``hypot`` element by element is the costliest call of a calm step)."""
+    """Calm water: no load depends on xi, so its rate is left at 0 (saves ``hypot``)."""
     return 0.0
 
 
 class Lanes:
-    """What each member's vessel is made of (its waves, its actuators' forces) and
-    ``Vessel.rates`` and ``Vessel._integrate`` over them, for all members or some."""
+    """The members' waves and actuator forces, and ``Vessel.rates`` and one RK4 step of
+    ``Vessel._integrate`` over them, for all members or some."""
 
     def __init__(self, hull, minv: tuple, m11_inv: float, waves: WaveArrays | None,
                  psi_w: np.ndarray, forces: list[tuple[np.ndarray | None, Callable]]):
         self.hull, self.minv, self.m11_inv, self.waves = hull, minv, m11_inv, waves
-        self.wave_loads, self.hypot = (waves, exact.hypot) if waves is not None else (_calm,
-                                                                                     _no_travel)
+        self.wave_loads, self.hypot = (waves, exact.hypot) if waves is not None else (
+            calm_water, _no_travel)
         self.psi_w = psi_w
         self._forces = forces          # (members or None for all, tau_th of delta)
 
     def take(self, lanes: np.ndarray) -> Lanes:
-        """The members ``lanes`` (indices) only."""
         return Lanes(self.hull, self.minv, self.m11_inv,
                      None if self.waves is None else self.waves.take(lanes), self.psi_w[lanes],
                      [(None if m is None else m[lanes], f) for m, f in self._forces])
@@ -130,13 +117,12 @@ class Lanes:
         return tuple(out)
 
     def rates(self, t: np.ndarray | float, state: Arrays, tau_th: Arrays) -> Arrays:
-        """``Vessel.rates`` of every member (``vessel.state_rates`` on arrays)."""
         return state_rates(self.hull, self.minv, self.m11_inv, self.wave_loads, self.psi_w, t,
                            state, tau_th, self.hypot, np.cos, np.sin)
 
     def rk4(self, t: float, start: np.ndarray | float, length: np.ndarray, y: Arrays,
             gear: RudderArrays) -> Arrays:
-        """``Vessel._integrate`` over one RK4 step of ``length`` from t + start."""
+        """One step of ``Vessel._integrate``, of ``length`` from t + start."""
         hs = length
         hh, c = 0.5 * hs, hs / 6.0
         s = start + 0.0 * hs
@@ -153,8 +139,7 @@ class Lanes:
 
 
 class VesselArrays:
-    """M vessels, stepped together with their inputs held; built from the scalar vessels
-    as the in-process route initialised them (their parameters, sea and initial state)."""
+    """M vessels stepped together, built from the scalar vessels as initialised."""
 
     STATES = ("x", "y", "psi", "u", "v", "r", "xi")
 
@@ -181,8 +166,8 @@ class VesselArrays:
         self.delta = np.array([v.delta for v in vessels])
 
     def step(self, t: float, h: float, delta_c: np.ndarray) -> None:
-        """``Vessel.step`` of every member from t to t + h: one RK4 step, or two where the
-        rudder reaches its command or its stop within the step (those members only)."""
+        """``Vessel.step``: one RK4 step, or two where the rudder reaches its command or
+        stop within the step (those members only)."""
         gear = RudderArrays(self.delta, delta_c, self.delta_max, self.delta_rate_max)
         y = tuple(getattr(self, name) for name in self.STATES)
         split = (0.0 < gear.reach) & (gear.reach < h)
@@ -202,9 +187,8 @@ class VesselArrays:
 
 
 def _actuators(actuators, shafts: np.ndarray) -> list[tuple[np.ndarray | None, Callable]]:
-    """The actuators' forces as a function of the rudder angle (``thrusters.actuator_model``,
-    which takes arrays of angles), for each distinct (n1, n2, n3) among the members, with the
-    members that have it (None: all have)."""
+    """``thrusters.actuator_model`` of each distinct (n1, n2, n3), with the members that
+    have it (None: all)."""
     distinct = np.unique(shafts, axis=0)
     return [(None if len(distinct) == 1 else np.all(shafts == row, axis=1),
              actuator_model(actuators, *map(float, row))) for row in distinct]

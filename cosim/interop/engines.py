@@ -1,36 +1,9 @@
-"""Run an exported SSP package (``cosim.export``) in another co-simulation engine.
-
-Engines: ``libcosim`` (OSP, through libcosimpy), ``ecos`` (through ecospy) and
-``fmpy`` (fmpy's own SSP runner). libcosim also runs the OSP folder that
-``cosim.export`` writes beside the package (OspSystemStructure.xml, ``cosim.interop.osp``).
-Each returns the signals it recorded with the time each value belongs to:
-
-- ecos: t_k = k h for k = 0 .. N, read after every step (its coupling is Jacobi:
-  every FMU steps on the previous step's outputs); libcosim likewise, but from t_1,
-  because it initialises the FMUs at its first step and has nothing to observe before;
-- fmpy's runner records after each step but labels the row with the time the step
-  started, so its values belong to t_1, t_2, ...; and it accumulates time as a
-  float, stepping while the sum is below the stop time. Where the sum falls short
-  it takes one step too many: 0.1 added 3000 times is 299.9999999999998, so a 300 s
-  run gets 3001 steps; added 4000 times it is 400.00000000002, so a 400 s run gets
-  exactly 4000. Compare by time, as ``tests/test_engines.py`` does.
-
-By default each run happens in a child process, because neither engine can be
-trusted with its caller: libcosimpy 0.0.6 aborts the process (std::terminate
-from a worker thread) when an FMU call fails during initialisation, and ecos
-0.7.2 ignores FMI status codes and discards FMU log messages. Our FMUs write an
-error to standard error when the host does not listen (``fmukit.hostlog`` and each adapter's ``hostlog``) and
-read NaN once they have failed; a crash, a failed step, or outputs that read NaN
-becomes an ``EngineError`` that carries the child's output, with the FMU's
-message and the time. A package is checked first (``check_package``).
-
-libcosim and fmpy's runner take FMI 2.0 FMUs only (``cosim.interop.ssp.FMI2_ONLY``):
-a package of FMI 3.0 FMUs (``cosim.export --fmi 3``) is refused before either starts,
-naming its FMI 3.0 components, where libcosim would say only 'Unable to create
-execution from path'; ecos runs it.
-
-The command line: ``python -m cosim.engines ENGINE PACKAGE.ssp --out trace.npz``
-(``libcosim`` also takes the OSP folder or its OspSystemStructure.xml).
+"""Run an exported SSP package (``cosim.export``) in another engine: ``libcosim`` (OSP,
+through libcosimpy; also the OSP folder beside the package), ``ecos`` (ecospy) or ``fmpy``
+(its SSP runner), in a child process: libcosimpy 0.0.6 aborts its host when an FMU fails,
+ecos 0.7.2 ignores FMI status codes. A crash, a failed step or outputs that read NaN become
+an ``EngineError`` carrying the child's output. Each returns the signals with the time
+each value belongs to (the engines' time conventions: docs/interop.md).
 """
 from __future__ import annotations
 
@@ -41,7 +14,6 @@ import sys
 import tempfile
 import zipfile
 from pathlib import Path
-from xml.etree import ElementTree
 
 import numpy as np
 
@@ -49,7 +21,7 @@ from fmukit.timebase import communication_point, step_count
 
 from ..core.files import write_atomically
 from ..core.interrupt import STOP_SIGNALS, Interrupted, StopSignals
-from ..core.ssd import SystemDescription, split_name
+from ..core.system import SystemDescription, split_name
 
 from .osp import read_osp
 from .ssp import FMI2_ONLY, fmi_versions, read_package, unapplied_strings
@@ -88,10 +60,6 @@ def _libcosim(ssp: Path, signals: tuple[str, ...], stop: StopSignals) -> dict[st
     observer = CosimObserver.create_last_value()
     execution.add_observer(observer)
     reads = [(slaves[c], references[c][v]) for c, v in map(split_name, signals)]
-
-    def sample() -> list[float]:
-        return [observer.last_real_values(index, [vr])[0] for index, vr in reads]
-
     rows = []
     for k in range(n_steps):
         stop.check()
@@ -99,7 +67,7 @@ def _libcosim(ssp: Path, signals: tuple[str, ...], stop: StopSignals) -> dict[st
             raise EngineError(f"libcosim failed in the step from t = "
                               f"{communication_point(system.start_time, k, system.step_size):g}"
                               " s (the FMU's message is above)")
-        rows.append(sample())
+        rows.append([observer.last_real_values(index, [vr])[0] for index, vr in reads])
     times = system.start_time + system.step_size * np.arange(1, n_steps + 1)
     return {"time": times, **dict(zip(signals, np.array(rows).T))}
 
@@ -152,7 +120,7 @@ def _fmpy(ssp: Path, signals: tuple[str, ...], stop: StopSignals) -> dict[str, n
     result = simulate_ssp(str(ssp), start_time=system.start_time, stop_time=system.stop_time,
                           step_size=system.step_size, parameter_set=parameters)
     stop.check()                        # fmpy's runner cannot be stopped before its end
-    times = np.array(result["time"]) + system.step_size   # rows hold values after each step
+    times = np.array(result["time"]) + system.step_size   # it labels a row with the step's start
     return {"time": times, **{s: np.asarray(result[s]) for s in signals}}
 
 
@@ -161,15 +129,12 @@ RUNNERS = {"libcosim": _libcosim, "ecos": _ecos, "fmpy": _fmpy}
 
 def check_package(ssp: Path, engine: str | None = None) -> None:
     """EngineError naming the file, the parameter or the components if the package cannot
-    be run as it is (by ``engine``, if given): not an SSP package (or OSP system
-    structure), a parameter value that is not finite, or FMUs of an FMI version the engine
-    does not take (which engines reject with messages of their own, such as libcosim's
-    'Unable to create execution from path')."""
+    be run (by ``engine``, if given): not an SSP package or OSP system structure, a value
+    not finite, or FMUs of an FMI version the engine does not take."""
     try:
         system = read_system(ssp)
         versions = fmi_versions(ssp)
-    except (OSError, KeyError, ValueError, zipfile.BadZipFile, ElementTree.ParseError) \
-            as error:
+    except (OSError, KeyError, ValueError, zipfile.BadZipFile) as error:
         raise EngineError(f"{ssp} is not an SSP package this project can run ({error})") \
             from None
     newer = [f"{name} (FMI {version})" for name, version in versions.items()
@@ -185,25 +150,15 @@ def check_package(ssp: Path, engine: str | None = None) -> None:
                                   "finite")
 
 
-def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = TRACED,
-        isolate: bool = True) -> dict[str, np.ndarray]:
-    """Run ``ssp`` in ``engine``; raise EngineError with the engine's output if it fails.
-
-    With ``isolate`` (the default) the engine runs in a child process, which may die
-    (libcosim aborts its host on some FMU failures) without taking this one with it;
-    a child ended by SIGINT or SIGTERM raises ``Interrupted`` here.
-    """
+def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = TRACED) -> dict[str, np.ndarray]:
+    """Run ``ssp`` in ``engine`` in a child process; EngineError with the engine's output if
+    it fails, ``Interrupted`` if SIGINT or SIGTERM ended the child."""
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
     ssp = Path(ssp).resolve()
     if is_osp(ssp) and engine != "libcosim":
         raise ValueError(f"{engine} reads SSP packages, not OSP's {ssp.name}; give the .ssp")
     check_package(ssp, engine)
-    if not isolate:
-        with StopSignals() as stop:
-            result = RUNNERS[engine](ssp, tuple(signals), stop)
-        _check_defined(engine, result, "")
-        return result
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "trace.npz"
         child = subprocess.run([sys.executable, "-c", _CHILD, engine, str(ssp), str(out),
@@ -218,7 +173,12 @@ def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = TRACED,
             raise EngineError(f"{engine} failed on {ssp.name} ({how}):\n{log}")
         with np.load(out) as data:
             result = {key: data[key] for key in data.files}
-    _check_defined(engine, result, log)
+    for name, values in result.items():
+        bad = np.flatnonzero(~np.isfinite(values))
+        if bad.size:
+            raise EngineError(f"{engine} reported success, but {name} is undefined from "
+                              f"t = {result['time'][bad[0]]:.6g} s: an FMU refused to run "
+                              f"and the engine did not stop.\n{log}")
     return result
 
 
@@ -227,10 +187,9 @@ _CHILD = ("import sys\nfrom cosim.interop.engines import record\n"
 
 
 def record(engine: str, ssp: str, out: str, signals: tuple[str, ...]) -> int:
-    """Run an engine in this process and save what it recorded to ``out`` (.npz): the
-    child's side of ``run``. 1, and the reason on standard error, if the engine fails;
-    130 or 143 if SIGINT or SIGTERM stopped it (between steps: the engines' own clean-up
-    is not safe against a KeyboardInterrupt)."""
+    """The child's side of ``run``: the engine run here, its trace saved to ``out`` (.npz).
+    1 and the reason on standard error if it fails; 130 or 143 if SIGINT or SIGTERM stopped
+    it (between steps: the engines' clean-up is not safe against a KeyboardInterrupt)."""
     try:
         with StopSignals() as stop:
             result = RUNNERS[engine](Path(ssp), signals, stop)
@@ -245,8 +204,7 @@ def record(engine: str, ssp: str, out: str, signals: tuple[str, ...]) -> int:
 
 
 def save_trace(path: Path, result: dict[str, np.ndarray]) -> None:
-    """A trace as .npz, written whole or not at all, at exactly ``path`` (np.savez would
-    add .npz to a name without it)."""
+    """A trace as .npz, written whole or not at all, at exactly ``path``."""
     def write(temporary: Path) -> None:
         with open(temporary, "wb") as f:
             np.savez(f, **result)
@@ -261,11 +219,3 @@ def log_summary(log: str, head: int = 20, tail: int = 5) -> str:
     return "\n".join(lines[:head] + [f"... ({len(lines) - head - tail} more lines) ..."]
                      + lines[-tail:])
 
-
-def _check_defined(engine: str, result: dict[str, np.ndarray], log: str) -> None:
-    for name, values in result.items():
-        bad = np.flatnonzero(~np.isfinite(values))
-        if bad.size:
-            raise EngineError(f"{engine} reported success, but {name} is undefined from "
-                              f"t = {result['time'][bad[0]]:.6g} s: an FMU refused to run "
-                              f"and the engine did not stop.\n{log}")

@@ -1,27 +1,10 @@
 """Run an exported SSP package in OpenModelica's OMSimulator, and read its result file.
 
-OMSimulator's PyPI package downloads its binaries while it builds, so it is used
-from a build folder ``home`` holding bin/OMSimulator (its command line, a C++ host)
-and lib/x86_64-linux-gnu/OMSimulator (its Python API). Each run happens in a child
-process with a time limit. What each interface takes of the package:
-
-- the command line: the system's type and fixed step only from OpenModelica's
-  annotation on ssd:System (``cosim.core.ssd.write_ssd`` writes it; without it,
-  '[NewSystem] internal error' and SIGABRT), the stop time only from ``--stopTime``
-  (default 1 s; the DefaultExperiment is not read). pythonfmu's binary needs
-  libpython preloaded (``LD_PRELOAD``) and numpy on ``PYTHONPATH``;
-- the Python API (``SSP(path).instantiate()``): the stop time from the
-  DefaultExperiment, but no annotation: the step is 1 ms unless
-  ``setFixedStepSize`` gives it;
-- neither applies an ssv:String binding (the command line logs 'Unknown
-  ParameterBinding-type'; the API's setString leaves the FMU's default), so a
-  package with a String value other than its FMU's default is refused
-  (``cosim.interop.ssp.unapplied_strings``); the guidance's route is exported as numbers.
-
-Its master steps the FMUs in order of their dependencies, as our Gauss-Seidel
-coupling does, and adds the step to a float time. The result CSV holds every
-variable to 12 significant digits, twice per communication point (after the step,
-and after the exchange of inputs); ``read_result`` keeps the last of each.
+OMSimulator is used from a build folder ``home`` holding bin/OMSimulator (its command line)
+and lib/x86_64-linux-gnu/OMSimulator (its Python API), each run in a child process with a
+time limit. What each interface takes of a package, and why a String binding is refused:
+docs/interop.md. The result CSV holds each communication point twice (after the step and
+after the exchange of inputs); ``read_result`` keeps the last.
 """
 from __future__ import annotations
 

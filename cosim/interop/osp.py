@@ -1,15 +1,7 @@
-"""OSP's own system structure, OspSystemStructure.xml, written beside an SSP package.
-
-OSP's tools (libcosim's ``cosim_osp_config_execution_create``, so libcosimpy's
-``CosimExecution.from_osp_config_file``, and cosim-cli, sim-explorer, ospx on top
-of it) read a folder holding this file and the FMUs it names. The file (schema
-OspSystemStructure.xsd, version 0.1, of libcosim) gives the start and end time, the
-base step and each simulator's step (the fixed step of the .ssd), each simulator's
-source and initial values (the .ssd's parameter bindings, of the same four types),
-and one VariableConnection per .ssd connection, output first. OSP model
-descriptions (<fmu>_OspModelDescription.xml) are optional and only add variable
-groups and units for plug-and-bond connections, which these systems do not use;
-none is written.
+"""OSP's own system structure, OspSystemStructure.xml (schema version 0.1 of libcosim),
+written beside an SSP package: the times, each simulator's FMU, step and initial values,
+and the connections, output first. Read by libcosim's ``from_osp_config_file`` and the OSP
+tools on top of it. No OSP model description is written: these systems need none.
 """
 from __future__ import annotations
 
@@ -57,9 +49,7 @@ def write_osp(system: SystemDescription, path: Path, sources: dict[str, str]) ->
 
 
 def read_osp(path: Path) -> SystemDescription:
-    """The system in an OspSystemStructure.xml written by ``write_osp`` (or the folder
-    holding one): components with their sources and initial values (typed by the
-    FMU's declaration, by ``cosim.core.values.fmi_value``), connections and times;
+    """The system in an OspSystemStructure.xml written by ``write_osp`` (or its folder);
     ValueError naming the file for what it does not hold."""
     path = path / OSP_FILE if path.is_dir() else path
     try:

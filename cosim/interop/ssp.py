@@ -1,29 +1,20 @@
 """SSP packages for other FMI tools: a scenario exported as one self-contained .ssp file.
 
-The package is a zip holding SystemStructure.ssd (components, connections, the
-scenario's parameter values, the fixed step as OSP's and OpenModelica's annotations,
-``cosim.core.ssd.write_ssd``) and resources/<fmu>.fmu for every FMU it uses. Beside
-it, a folder of the same name holds OSP's OspSystemStructure.xml and the FMUs
-(``cosim.interop.osp``). OSP libcosim, ecos, fmpy and OMSimulator load the package
-unchanged (docs/interop.md). The guidance's route is written in its numeric form
-(``autopilot_fmu.guidance.numeric_route``), because OMSimulator and fmpy's SSP runner
-apply no String binding; ``unapplied_strings`` names any String binding left that
-such a tool would silently drop. Each is written whole or not at all: a full disk or
-a kill leaves no package, or the previous one (``cosim.core.files``).
-
-``export(..., fmi=3)`` packs this project's FMI 3.0 twins (fmus/fmi3/) in place of the
-FMUs the scenario names; SSP 1.0 types their Float64 connectors as ssc:Real, as
-FMI 2.0's. ecos and OMSimulator run such a package; libcosim and fmpy's SSP runner take
-FMI 2.0 FMUs only (``fmi_versions`` says which a package holds; ``FMI2_ONLY``).
+The zip holds SystemStructure.ssd (``cosim.core.ssd.write_ssd``) and resources/<fmu>.fmu;
+beside it, a folder of the same name holds OSP's OspSystemStructure.xml and the FMUs
+(``cosim.interop.osp``). The guidance's route is written as numbers, because OMSimulator
+and fmpy's SSP runner apply no String binding (``unapplied_strings`` names any left).
+``export(..., fmi=3)`` packs the FMI 3.0 twins; libcosim and fmpy's SSP runner take FMI 2.0
+only (``FMI2_ONLY``). Files are written whole or not at all (``cosim.core.files``).
 """
 from __future__ import annotations
 
-import io
 import shutil
 import tempfile
 import zipfile
 from pathlib import Path
-from xml.etree import ElementTree
+
+from fmpy.model_description import ModelDescription
 
 from autopilot_fmu.guidance import ROUTE_PARAMETERS, numeric_route, route
 
@@ -35,14 +26,12 @@ from .osp import OSP_FILE, read_osp, write_osp
 
 SSD_NAME = "SystemStructure.ssd"
 FMI2_ONLY = {"libcosim": "OSP libcosim", "fmpy": "fmpy's SSP runner"}
-"""The engines (``cosim.interop.engines``) that run FMI 2.0 FMUs only: libcosimpy 0.0.6's
-libcosim, and fmpy's SSP runner (its FMU2Slave); ecos and OMSimulator take FMI 2.0 and
-3.0."""
+"""The engines that run FMI 2.0 FMUs only (libcosimpy 0.0.6, fmpy's FMU2Slave)."""
 
 
 def _with_numeric_route(system: SystemDescription, fmus: dict[str, Path]) -> None:
-    """Replace a String route by its numbers in each component whose FMU declares both
-    forms (our guidance); ValueError if the two forms disagree or the route is too long."""
+    """A String route replaced by its numbers where the FMU declares both forms (our
+    guidance); ValueError if the two forms disagree or the route is too long."""
     for name, component in system.components.items():
         if not isinstance(component.parameters.get("waypoints"), str):
             continue
@@ -85,9 +74,8 @@ def export(scenario: str | Path, out: Path, overrides: dict[str, dict] | None = 
            autopilot: str | Path | None = None, port_map: dict[str, str] | None = None,
            name: str | None = None, fmi: int | None = None) -> Path:
     """Write out/<label>.ssp (``scenarios.label``) and out/<label>/ with OSP's
-    OspSystemStructure.xml and the FMUs: the scenario, with this project's FMUs of FMI
-    version ``fmi`` if given (``scenarios.load``), ``autopilot`` in place of its own if
-    given, and ``overrides`` changing parameter values by component."""
+    OspSystemStructure.xml and the FMUs: the scenario as ``scenarios.load`` gives it (FMI
+    version ``fmi``, ``autopilot`` in place of its own), with ``overrides`` by component."""
     system = scenarios.load(scenario, autopilot, port_map, name, fmi)
     for component, values in system.parameters(overrides).items():
         system.components[component].parameters = values
@@ -116,29 +104,6 @@ def export(scenario: str | Path, out: Path, overrides: dict[str, dict] | None = 
     return target
 
 
-def fmi_version(fmu: zipfile.ZipFile) -> str:
-    """The fmiVersion of an FMU ("2.0", "3.0"), from its modelDescription.xml."""
-    return ElementTree.fromstring(fmu.read("modelDescription.xml")).get("fmiVersion", "")
-
-
-def fmi_versions(path: Path) -> dict[str, str]:
-    """Each component's FMI version, from its FMU in an SSP package or in an OSP folder
-    (a .ssp, else the folder or its OspSystemStructure.xml)."""
-    if path.suffix.lower() == ".ssp":
-        with zipfile.ZipFile(path) as package:
-            sources = {name: io.BytesIO(package.read(component.source))
-                       for name, component in read_package(path).components.items()}
-    else:
-        folder = path if path.is_dir() else path.parent
-        sources = {name: folder / component.source
-                   for name, component in read_osp(path).components.items()}
-    versions = {}
-    for name, source in sources.items():
-        with zipfile.ZipFile(source) as fmu:
-            versions[name] = fmi_version(fmu)
-    return versions
-
-
 def read_package(ssp: Path) -> SystemDescription:
     """The system description inside an SSP package."""
     with tempfile.TemporaryDirectory() as tmp:
@@ -147,22 +112,34 @@ def read_package(ssp: Path) -> SystemDescription:
         return read_ssd(Path(tmp) / SSD_NAME)
 
 
+def _descriptions(path: Path) -> dict[str, ModelDescription]:
+    """Each component's model description, from its FMU in an SSP package (.ssp) or an OSP
+    folder (or its OspSystemStructure.xml)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        if path.suffix.lower() == ".ssp":
+            system, folder = read_package(path), Path(tmp)
+            with zipfile.ZipFile(path) as package:
+                package.extractall(tmp)
+        else:
+            system, folder = read_osp(path), path if path.is_dir() else path.parent
+        return {name: read_description(folder / component.source, name)
+                for name, component in system.components.items()}
+
+
+def fmi_versions(path: Path) -> dict[str, str]:
+    """Each component's FMI version ("2.0", "3.0") in a package or OSP folder."""
+    return {name: d.fmiVersion for name, d in _descriptions(path).items()}
+
+
 def unapplied_strings(ssp: Path) -> dict[str, tuple[str, str]]:
     """The package's String bindings that a tool applying none (OMSimulator, fmpy's SSP
-    runner) would drop without a word, changing the run: 'component.variable':
-    (value, the FMU's default), for each whose value is not its FMU's default."""
-    system = read_package(ssp)
+    runner) would drop without a word: 'component.variable': (value, the FMU's default),
+    for each whose value is not its FMU's default."""
+    descriptions = _descriptions(ssp)
     dropped = {}
-    with tempfile.TemporaryDirectory() as tmp:
-        with zipfile.ZipFile(ssp) as package:
-            package.extractall(tmp)
-        for name, component in system.components.items():
-            strings = {v: value for v, value in component.parameters.items()
-                       if isinstance(value, str)}
-            if not strings:
-                continue
-            starts = {v.name: v.start for v in read_description(
-                Path(tmp) / component.source, name).modelVariables}
-            dropped.update({f"{name}.{v}": (value, starts[v]) for v, value in strings.items()
-                            if value != starts[v]})
+    for name, component in read_package(ssp).components.items():
+        starts = {v.name: v.start for v in descriptions[name].modelVariables}
+        dropped.update({f"{name}.{v}": (value, starts[v])
+                        for v, value in component.parameters.items()
+                        if isinstance(value, str) and value != starts[v]})
     return dropped

@@ -1,24 +1,24 @@
-"""The scenarios: one SSP system structure file (.ssd) each, and their registry.
-
-Every command that takes a scenario takes its name (a file here, e.g.
-``calm_pd``) or a path to a .ssd file. ``PAPER`` lists the paper's four runs, the
-ones behind its Tables 1-2. ``autopilot`` puts a user's autopilot FMU into a
-course-keeping scenario. A scenario runs the FMUs its .ssd names (this package's name
-fmus/, FMI 2.0); ``load(..., fmi=3)`` gives it this project's FMI 3.0 twins from
-fmus/fmi3/ in their place (``cosim.core.ssd.with_fmi``).
-"""
+"""The scenarios, one SSP system structure file (.ssd) each, by name (``calm_pd``) or path;
+``PAPER``: the four behind Tables 1-2; ``autopilot`` puts a user's FMU into one."""
 from __future__ import annotations
 
 from pathlib import Path
 
+from fmubuild import project
+
+from ..core.errors import close_matches, did_you_mean
 from ..core.files import plain_name
-from ..core.ssd import SystemDescription, read_ssd, with_fmi
-from ..core.values import close_matches, did_you_mean
+from ..core.ssd import read_ssd
+from ..core.system import FmuFolders, SystemDescription, with_fmi
 from .autopilot import with_autopilot
 
 SCENARIO_DIR = Path(__file__).resolve().parent
-PAPER = ("calm_pd", "calm_smc", "waves_pd", "waves_smc")
-"""Tomera (2010), Tables 1-2 and Figs 2-3: PD and sliding mode, calm water and waves."""
+PAPER = ("calm_pd", "calm_smc", "waves_pd", "waves_smc")    # Tomera (2010), Tables 1-2
+
+
+def fmus() -> FmuFolders:
+    """Where this project builds its FMUs (``fmubuild.project``), for the core to find them."""
+    return FmuFolders(dict(project.FMU_DIRS), frozenset({*project.FMUS, *project.C_FMUS}))
 
 
 def names() -> list[str]:
@@ -27,11 +27,8 @@ def names() -> list[str]:
 
 
 def path(scenario: str | Path) -> Path:
-    """A scenario's .ssd: a name of this package, or a path to a .ssd file.
-
-    ValueError listing the valid names for an unknown name; FileNotFoundError for
-    a .ssd path that is not a file.
-    """
+    """A scenario's .ssd, by name or path; ValueError listing the names for an unknown one,
+    FileNotFoundError for a .ssd path that is not a file."""
     if str(scenario).endswith(".ssd"):
         if not Path(scenario).is_file():
             raise FileNotFoundError(f"no system structure file {scenario}")
@@ -44,9 +41,8 @@ def path(scenario: str | Path) -> Path:
 
 def label(scenario: str | Path, autopilot: str | Path | None = None,
           name: str | None = None) -> str:
-    """What a run of the scenario is called in file names: the scenario's name, and the
-    autopilot's (``name``, or the FMU's file name) when it replaces the scenario's;
-    ValueError if ``name`` is not a plain file name (``core.files.plain_name``)."""
+    """A run's name in file names: the scenario's, and the autopilot's (``name`` or the
+    FMU's stem) in place of its own; ValueError if ``name`` is not a plain file name."""
     if name is not None:
         plain_name(name, "the autopilot's name")
     stem = Path(scenario).stem
@@ -56,11 +52,9 @@ def label(scenario: str | Path, autopilot: str | Path | None = None,
 def load(scenario: str | Path, autopilot: str | Path | None = None,
          port_map: dict[str, str] | None = None, name: str | None = None,
          fmi: int | None = None) -> SystemDescription:
-    """The system description of a scenario (a name or a .ssd path, as ``path``), this
-    project's FMUs of FMI version ``fmi`` (2 or 3) in place of those it names if given,
-    with ``autopilot``, an FMU of either version, in place of its own
-    (``cosim.scenarios.autopilot``)."""
-    system = read_ssd(path(scenario))
+    """A scenario's system description, with this project's FMUs of FMI version ``fmi`` (2
+    or 3) in place of those it names, and ``autopilot`` in place of its own."""
+    system = read_ssd(path(scenario), fmus())
     if fmi is not None:
         system = with_fmi(system, fmi)
     return system if autopilot is None else with_autopilot(system, autopilot, port_map, name)

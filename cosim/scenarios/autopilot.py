@@ -1,23 +1,8 @@
 """Your own autopilot in the paper's scenarios: the port contract, checked, and the substitution.
 
-An autopilot is any FMI 2.0 or 3.0 co-simulation FMU with these ports (SI units, radians),
-Real in FMI 2.0, Float64 in FMI 3.0:
-
-| port | causality | unit | meaning |
-|---|---|---|---|
-| ``psi`` | input | rad | ship heading |
-| ``r`` | input | rad/s | ship yaw rate |
-| ``psi_d`` | input | rad | desired heading, from the guidance |
-| ``delta_c`` | output | rad | commanded rudder angle; positive turns the ship to port |
-
-An FMU whose ports have other names maps them with ``port_map`` (contract name ->
-the FMU's name, ``--map psi=heading`` on the command line). A port's unit, where
-the FMU declares one, must be the contract's: a heading in degrees is refused,
-not converted, so that a run never rests on a guess about what a number means.
-``check_autopilot`` lists every port that breaks the contract at once, each with
-what it expects (``port_problems``).
-``with_autopilot`` puts such an FMU in place of the ``autopilot`` component of a
-course-keeping scenario; its parameters keep the FMU's defaults unless set.
+An autopilot is an FMI 2.0 or 3.0 co-simulation FMU with inputs psi (rad), r (rad/s), psi_d
+(rad) and output delta_c (rad), Real or Float64 (docs/own_autopilot.md); ``port_map`` maps
+other names. A port in another unit is refused, not converted: a run never rests on a guess.
 """
 from __future__ import annotations
 
@@ -33,14 +18,13 @@ from fmubuild.instantiate import InstantiationFailed
 from fmubuild.instantiate import instantiate_in_child
 from fmukit.units import UNITS
 
+from ..core.errors import close_matches, did_you_mean
 from ..core.ssd import Connection, SystemDescription
-from ..core.values import close_matches, did_you_mean
 
 COMPONENT = "autopilot"
 PORTS = {v.name: (v.causality, v.unit) for v in fmukit.autopilot.PORTS}
 DESCRIPTIONS = {v.name: v.description for v in fmukit.autopilot.PORTS}
-PORT_TYPES = {"2.0": "Real", "3.0": "Float64"}
-"""FMI version an autopilot may be of: the type of its ports."""
+PORT_TYPES = {"2.0": "Real", "3.0": "Float64"}      # FMI version: the type of its ports
 
 
 class AutopilotError(ValueError):
@@ -71,8 +55,7 @@ def _contract(real: str) -> str:
 
 def port_problems(description: ModelDescription, port_map: dict[str, str]) -> list[str]:
     """Every way the FMU's variables break the port contract, each with what it expects: a
-    port missing (with the names closest to it), of the wrong causality or type (Real in
-    FMI 2.0, Float64 in FMI 3.0: the description as fmpy reads it), or in another unit."""
+    port missing (with the closest names), of the wrong causality or type, or unit."""
     variables = {v.name: v for v in description.modelVariables}
     real = PORT_TYPES[description.fmiVersion]
     problems = []
@@ -96,8 +79,7 @@ def port_problems(description: ModelDescription, port_map: dict[str, str]) -> li
 
 
 def _unit_advice(name: str, declared: str, unit: str) -> str:
-    """What to do about a port in another unit than the contract's, which is not
-    converted: declare the contract's, and convert inside the FMU (by this factor)."""
+    """Advice for a port in another unit: declare the contract's, convert inside the FMU."""
     known = UNITS.get(declared)
     scale = (f" (1 {declared} = {known[1] / UNITS[unit][1]:.6g} {unit})"
              if known and known[0] == UNITS[unit][0] else "")

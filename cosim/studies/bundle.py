@@ -1,16 +1,9 @@
 """What a worker needs to run a sweep's controller, shipped from the client by content.
 
-A worker needs only a Python environment with this project installed (a wheel: no
-checkout, no build step). The client reads each controller's system (its scenario,
-with a user's autopilot in place if given) and hashes every FMU it uses; a
-``Bundle`` carries the system with each FMU named by its SHA-256, and the FMU
-files travel once per worker as Dask data, addressed by that hash. A worker writes
-each FMU once into its cache folder (``fmu_cache``: private to its user) and points
-the system at it; a cached file is checked against its hash whenever a system is
-made from it, and one that does not match is written again from the bytes sent.
-
-The same hashes make a run's identity (``Bundle.digest``): anything that changes an
-FMU or the system changes the digest, and so every run id of that controller.
+A ``Bundle`` carries a controller's system with each FMU named by its SHA-256; the FMUs
+travel once per worker, and a worker keeps them in its private cache (``fmu_cache``),
+checking a cached file against its hash each time. A worker needs the project installed,
+nothing else. The hashes make a run's identity (``Bundle.digest``).
 """
 from __future__ import annotations
 
@@ -64,15 +57,15 @@ def bundle(controller: dict[str, Any]) -> tuple[Bundle, dict[str, Path]]:
         sha = file_hash(path)
         files[sha] = path
         components[name] = dataclasses.replace(component, source=f"{sha}.fmu")
-    shipped = dataclasses.replace(system, components=components, path=None)
+    shipped = dataclasses.replace(system, components=components, path=None, fmus=None)
     content = json.dumps(dataclasses.asdict(shipped), sort_keys=True, default=str)
     return Bundle(shipped, hashlib.sha256(content.encode()).hexdigest()), files
 
 
 def fmu_cache() -> Path:
     """Where a worker keeps the FMUs it was sent: $COSIM_FMU_CACHE, else cosim-fmus in
-    $XDG_CACHE_HOME (default ~/.cache). Created with mode 0o700; UnsafeCache if it is not a
-    folder of this user's that no one else may write (not a symbolic link either)."""
+    $XDG_CACHE_HOME (default ~/.cache), made 0o700; UnsafeCache unless it is a folder of
+    this user's that no one else may write."""
     folder = Path(os.environ.get("COSIM_FMU_CACHE")
                   or Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
                   / "cosim-fmus")
@@ -91,8 +84,8 @@ def fmu_cache() -> Path:
 
 
 def materialise(shipped: Bundle, blobs: dict[str, bytes]) -> SystemDescription:
-    """The bundle's system with its FMUs in this machine's cache (written once, by hash;
-    a cached file whose content does not match its hash is written again, with a warning)."""
+    """The bundle's system with its FMUs in this machine's cache (a cached file that does not
+    match its hash is written again, with a warning)."""
     cache = fmu_cache()
     components = {}
     for name, component in shipped.system.components.items():

@@ -1,39 +1,31 @@
-"""Dask clusters for ensembles of co-simulations: a local one, or an existing scheduler.
-
-Our co-simulations hold the GIL for their whole run, so a worker runs one at a
-time: a local cluster has one single-threaded worker process per core, and the
-workers of an existing cluster should be started the same way
-(``dask worker ADDRESS --nthreads 1 --nworkers N``).
+"""Dask clusters for sweeps: a local one or an existing scheduler, its workers checked before
+any run and watched while it goes. A run holds the GIL from start to end, so a worker is
+one single-threaded process (``dask worker ADDRESS --nthreads 1 --nworkers N``).
 """
 from __future__ import annotations
 
 import json
 import logging
 import os
+import queue
 import signal
 import sys
+import time
 from pathlib import Path
+from typing import Any, Iterator
 
 from dask.distributed import Client, LocalCluster
 
 from ..core.files import read_small_text
+from ..provenance import PACKAGE, code_version
+from .bundle import UnsafeCache, fmu_cache
 
 
 def local_cluster(workers: int | None = None) -> LocalCluster:
-    """``workers`` single-threaded worker processes (default: one per core), quiet; its web
-    server on a free port (the dashboard, where bokeh is installed).
-
-    One task in flight per worker thread (worker-saturation 1.0): when a run kills
-    its worker, no queued neighbour is counted as having died with it (and failed
-    after three deaths).
-
-    The cluster is made with SIGINT blocked in this thread: the threads it starts here
-    (its event loop, which starts and restarts the workers) and the worker processes
-    they start (a blocked signal stays blocked through exec) never take it. A Ctrl-C at
-    a terminal goes to every process of its group; the client alone stops, and closes
-    the workers, instead of each worker printing its traceback. A Ctrl-C while the
-    cluster starts arrives once it has started (and closes it).
-    """
+    """``workers`` single-threaded worker processes (default: one per core), quiet, the
+    dashboard on a free port. Worker-saturation 1.0: a run that kills its worker takes no
+    queued run with it. Made with SIGINT blocked, which its threads and workers inherit: a
+    terminal's Ctrl-C stops the client alone, which closes the workers."""
     import dask
 
     _start_resource_tracker()
@@ -53,10 +45,8 @@ def local_cluster(workers: int | None = None) -> LocalCluster:
 
 
 def _start_resource_tracker() -> None:
-    """Start multiprocessing's resource tracker (if it is not running) with its standard
-    error on the null device: before SIGINT is blocked, since starting it unblocks SIGINT
-    in the thread that does; and quiet, since all it would ever tell the user is that Dask's
-    queues leaked semaphores, when a second Ctrl-C ended the process at once."""
+    """Start multiprocessing's resource tracker before SIGINT is blocked (starting it
+    unblocks SIGINT), quiet (it would only report semaphores leaked at a second Ctrl-C)."""
     from multiprocessing import resource_tracker
 
     sys.stderr.flush()
@@ -72,20 +62,18 @@ def _start_resource_tracker() -> None:
 
 class ClusterError(ValueError):
     """No cluster to run on: the scheduler cannot be reached or found, or the options that
-    say where it is or how big a local one is make no sense (a ValueError: of the options)."""
+    say where it is or how big a local one is make no sense."""
 
 
 CONNECT_TIMEOUT = 30.0
 """Seconds a client tries to reach an existing scheduler (Dask's own default)."""
 SCHEDULER_FILE_BYTES = 1 << 20
-"""The largest scheduler file read (Dask writes a few hundred bytes)."""
 
 
 def local_workers(workers: int | None) -> tuple[int | None, str | None]:
-    """The number of worker processes of a local cluster for the ``workers`` asked (None:
-    Dask's default, one per core), and a note where it was capped at the cores this
-    process may use (a run holds the GIL: more processes than cores only share them).
-    ClusterError for fewer than one."""
+    """The worker processes of a local cluster for the ``workers`` asked (None: one per
+    core), and a note where capped at the cores this process may use; ClusterError for
+    fewer than one."""
     from dask.system import CPU_COUNT
 
     if workers is None:
@@ -100,9 +88,8 @@ def local_workers(workers: int | None) -> tuple[int | None, str | None]:
 
 
 def scheduler_address(scheduler_file: str | Path) -> str:
-    """The address in a scheduler file (``dask scheduler --scheduler-file``); ClusterError
-    naming the file if it is missing, unreadable or holds no address. (Dask's own client
-    waits for a missing file to appear, for ever.)"""
+    """The address in a scheduler file; ClusterError naming the file if it is missing,
+    unreadable or holds no address (Dask's own client waits for ever for a missing one)."""
     path = Path(scheduler_file)
     if not path.exists():
         raise ClusterError(f"scheduler file {path} does not exist (has the scheduler "
@@ -120,11 +107,10 @@ def scheduler_address(scheduler_file: str | Path) -> str:
 def connect(scheduler: str | None = None, workers: int | None = None,
             scheduler_file: str | None = None, timeout: float = CONNECT_TIMEOUT
             ) -> tuple[Client, LocalCluster | None]:
-    """A client of an existing scheduler, found as Dask's own tools find it (an address,
-    a scheduler file, or DASK_SCHEDULER_ADDRESS) and reached within ``timeout`` seconds,
-    or of a new local cluster of ``workers`` processes (``local_workers``; returned too).
-    ClusterError, naming the address or file, if the scheduler cannot be reached or found,
-    or for ``workers`` with an existing scheduler, whose workers are its own."""
+    """(a client, the local cluster or None): of an existing scheduler, found as Dask's tools
+    find it (an address, a scheduler file, DASK_SCHEDULER_ADDRESS) and reached within
+    ``timeout`` s, or of a new local cluster of ``workers``. ClusterError, naming the
+    address or file, if none is reached or found, or for ``workers`` with a scheduler."""
     import dask
 
     if scheduler and scheduler_file:
@@ -155,3 +141,147 @@ def connect(scheduler: str | None = None, workers: int | None = None,
         print(f"note: {note}", file=sys.stderr)
     cluster = local_cluster(workers)
     return Client(cluster), cluster
+
+
+class SweepError(RuntimeError):
+    """The sweep cannot start: a worker runs other code, or another sweep writes its folder."""
+
+
+class NoWorkers(RuntimeError):
+    """The sweep stopped: its cluster had no worker for as long as it waits for one (the
+    runs completed stay in the journal)."""
+
+    exit_status = 3
+
+
+class WorkerWatch:
+    """``check`` raises ``NoWorkers`` once the scheduler has counted no worker for ``timeout``
+    seconds; it asks at most every ``interval`` seconds, while the client waits."""
+
+    def __init__(self, client, timeout: float):
+        self.client, self.timeout = client, timeout
+        self.interval = max(0.05, min(1.0, timeout / 4))   # Dask fails a shorter wait
+        self.seen = False                   # a worker was counted at least once
+        self.gone_since: float | None = None
+        self.gone_at = ""                   # when none was first counted, for the message
+        self.next_check = 0.0
+        self.check()
+
+    def check(self) -> None:
+        now = time.monotonic()
+        if now < self.next_check:
+            return
+        self.next_check = now + self.interval
+        try:
+            workers = len(self.client.nthreads())
+        except OSError:                     # the scheduler cannot be reached: no worker either
+            workers = 0
+        if workers:
+            self.seen, self.gone_since = True, None
+        elif self.gone_since is None:
+            self.gone_since, self.gone_at = now, time.strftime("%Y-%m-%d %H:%M:%S")
+        elif now - self.gone_since >= self.timeout:
+            since = "the last one left by" if self.seen else "none has joined since"
+            raise NoWorkers(f"no worker in the cluster for {self.timeout:g} s ({since} "
+                            f"{self.gone_at}); the sweep stopped")
+
+    def result(self, future):
+        """``future.result()``, checking the cluster while it waits (a result is fetched from
+        its worker, and computed again if that worker has just died)."""
+        from dask.distributed import TimeoutError
+
+        while True:
+            try:
+                return future.result(timeout=self.interval)
+            except TimeoutError:
+                if future.status == "error":    # the task's own TimeoutError
+                    raise
+                self.check()
+
+
+class Completions:
+    """Futures as they complete (more may be added meanwhile), the watch checked while none
+    does: Dask's ``as_completed`` has a deadline for the whole iteration instead."""
+
+    def __init__(self) -> None:
+        self.done: queue.SimpleQueue = queue.SimpleQueue()
+        self.waiting = 0
+
+    def add(self, future) -> None:
+        self.waiting += 1
+        future.add_done_callback(self.done.put)
+
+    def each(self, watch: WorkerWatch) -> Iterator:
+        """Each future added, before or while iterating, as it completes."""
+        while self.waiting:
+            try:
+                future = self.done.get(timeout=watch.interval)
+            except queue.Empty:
+                watch.check()
+                continue
+            self.waiting -= 1
+            yield future
+
+
+def say(message: str) -> None:
+    print(message, file=sys.stderr, flush=True)
+
+
+def worker_facts() -> dict[str, Any]:
+    """What the client checks of a worker before it sends work."""
+    return {"code": code_version()}
+
+
+def check_workers(client) -> None:
+    """SweepError naming each worker that runs other code than this client, or whose FMU
+    cache is not private to its user; a warning for workers of more than one thread, or a
+    scheduler that queues more than one run per thread."""
+    mine = code_version()
+    try:
+        facts = client.run(worker_facts, on_error="return")
+    except Exception as error:              # e.g. no worker can import cosim at all
+        raise SweepError(f"cannot ask the workers what they run ({error})") from None
+    wrong = []
+    for address, fact in sorted(facts.items()):
+        theirs = fact["code"] if isinstance(fact, dict) else f"none ({type(fact).__name__}: {fact})"
+        if theirs != mine:
+            wrong.append(f"  {address} runs {PACKAGE} {theirs}")
+    if wrong:
+        raise SweepError(f"workers run other code than this client ({PACKAGE} {mine}):\n"
+                         + "\n".join(wrong) + "\ninstall the client's version on every worker "
+                         "(a wheel: pip wheel --no-deps -w dist . ; pip install dist/*.whl)")
+    unsafe = {a: problem for a, problem in client.run(_cache_problem).items() if problem}
+    if unsafe:
+        raise SweepError("workers whose FMU cache is not safe to run FMUs from:\n" + "\n".join(
+            f"  {address}: {problem}" for address, problem in sorted(unsafe.items())))
+    threaded = {a: n for a, n in client.nthreads().items() if n > 1}
+    if threaded:
+        say(f"warning: {', '.join(f'{a} has {n} threads' for a, n in threaded.items())}; a "
+             "run holds the GIL from start to end, so threads of one worker take turns: start "
+             "workers with --nthreads 1 and more processes (--nworkers)")
+    saturation = client.run_on_scheduler(_worker_saturation)
+    if saturation != 1.0:
+        say(f"warning: the scheduler's worker-saturation is {saturation}: it queues more than "
+             "one run per worker thread, and a worker killed by one run takes the queued ones "
+             "with it; start the scheduler with DASK_DISTRIBUTED__SCHEDULER__WORKER_SATURATION=1.0")
+
+
+def _cache_problem() -> str:
+    """Why this worker's FMU cache is unsafe (``bundle.fmu_cache``), or ""."""
+    try:
+        fmu_cache()
+    except (UnsafeCache, OSError) as error:
+        return str(error)
+    return ""
+
+
+def has_dashboard(dask_scheduler=None) -> bool:
+    """Whether the scheduler serves its dashboard (which needs bokeh where it runs)."""
+    import importlib.util
+    return ("dashboard" in dask_scheduler.services
+            and importlib.util.find_spec("bokeh") is not None)
+
+
+def _worker_saturation(dask_scheduler=None) -> float:
+    """The running scheduler's worker-saturation."""
+    return float(dask_scheduler.WORKER_SATURATION)

@@ -1,18 +1,10 @@
 """Does a run depend on the CPU? The same run under other CPUs' numpy, OpenBLAS and libm.
 
-numpy picks its SIMD loops (SSE, AVX2, AVX-512) by CPU, OpenBLAS its kernels, and
-glibc's libm an FMA variant of sin, cos, exp, pow, atan2 and tanh; any of them may
-round a last bit differently. Each can be made to choose as on another CPU:
-
-- ``NPY_DISABLE_CPU_FEATURES`` turns numpy's dispatch off above a feature set;
-- ``OPENBLAS_CORETYPE`` forces an OpenBLAS kernel (Haswell, SkylakeX, Zen, ...);
-- ``GLIBC_TUNABLES=glibc.cpu.hwcaps=-AVX2,-FMA`` makes glibc pick its variants for a
-  CPU without FMA (x86-64 before 2013; every current server CPU has FMA).
-
-All three are read once at start-up, so each run is a child process with its own
-environment. A run's CSV holds every signal at every step, printed to 12 significant
-digits; the runs are compared on those bytes, and on the first row and column that
-differ.
+numpy picks its SIMD loops by CPU, OpenBLAS its kernels, glibc's libm an FMA variant of
+sin, cos, exp, pow, atan2 and tanh; each can be made to choose as on another CPU
+(``NPY_DISABLE_CPU_FEATURES``, ``OPENBLAS_CORETYPE``, ``GLIBC_TUNABLES=glibc.cpu.hwcaps=-AVX2,
+-FMA``), read once at start-up: so each run is a child process. Runs are compared on the
+bytes of their CSVs (every signal at every step, 12 significant digits).
 """
 from __future__ import annotations
 
@@ -53,9 +45,7 @@ simulate(sys.argv[1], stop_time=stop, backend="inprocess").write_csv(sys.argv[2]
 def run_in(variant: str, scenario: str, csv_path: Path,
            stop_time: float | None = None) -> Path:
     """Run ``scenario`` in-process in a child under ``VARIANTS[variant]``; its CSV.
-
-    RuntimeError with the child's last words if it fails; it is killed after ``TIMEOUT``.
-    """
+    RuntimeError with the child's last words if it fails; killed after ``TIMEOUT``."""
     env = {**os.environ, **VARIANTS[variant]}
     child = subprocess.run([sys.executable, "-c", _CHILD, scenario, str(csv_path),
                             "-" if stop_time is None else repr(stop_time)],

@@ -1,13 +1,7 @@
-"""The paper's block diagram wired by hand from the plain modules: no FMI, no master.
-
-guidance -> autopilot -> ship, in that order at every step, as in the paper's
-Simulink model and the master's Gauss-Seidel coupling. The models are built by
-the same ``build_model`` code the FMUs use (as this checkout has it, whatever the FMUs
-were built from), from the parameters of a course-keeping system description
-(components named guidance, autopilot and ship). This is the
-in-process limit the benchmark measures and the reference the equality tests use
-(the loop itself: ``cosim.ensemble.reference.step_models``).
-"""
+"""The paper's diagram wired by hand from the plain modules, without FMI or master: guidance ->
+autopilot -> ship at every step (``cosim.ensemble.reference.step_models``), the models built
+by the FMUs' own code from a course-keeping system's parameters. The benchmark's in-process
+limit, the tests' reference, and the monolithic model's start."""
 from __future__ import annotations
 
 import numpy as np
@@ -17,10 +11,7 @@ from ship_fmu.vessel import N_PROPELLER
 
 from ..core.inprocess import InProcessInstance
 from ..core.ssd import SystemDescription
-from ..ensemble.reference import SIGNALS, step_models
-
-COMPARED = SIGNALS
-"""The signals compared between the co-simulation and the modules wired by hand."""
+from ..ensemble.reference import step_models
 
 
 def build_models(system: SystemDescription) -> dict:
@@ -45,7 +36,7 @@ def shaft_speeds(system: SystemDescription) -> tuple[float, float, float]:
 
 
 def run_direct(system: SystemDescription, stop_time: float | None = None) -> dict[str, np.ndarray]:
-    """Simulate; each signal sampled at t_k = k h, k = 0 .. N, like the master's rows."""
+    """Each signal of ``SIGNALS`` at t_k = k h, k = 0 .. N, like the master's rows."""
     models = build_models(system)
     h, t0 = system.step_size, system.start_time
     n_steps = step_count(t0, system.stop_time if stop_time is None else stop_time, h)

@@ -1,21 +1,11 @@
-"""How large are the set-up's own numerical errors? (Issue 17.) Part 1: integration error,
-open loop.
+"""The accuracy study's part 1, the integration error open loop: the ship (``Vessel``, the
+model the FMU wraps) under a rudder program held over each 0.1 s step, integrated by its RK4
+at h_max = 0.1, 0.05 and 0.025 s, against DOP853 (rtol = atol = 1e-12) restarted at each
+communication point and at each kink of the steering gear's response, so that no step
+straddles one; the reference's own error from a solve at half the tolerances.
 
-The ship (``ship_fmu.vessel.Vessel``, the model the FMU wraps) under a rudder program
-held over each 0.1 s communication step, as a master delivers it, integrated by its
-fixed-step RK4 at h_max = 0.1, 0.05 and 0.025 s, against a reference solution of the
-same equations: scipy's ``solve_ivp`` (DOP853, rtol = atol = 1e-12) on each
-communication step. The steering gear's response is piecewise linear in time
-(``steering_gear.RudderMotion``); its kink, where the rudder reaches the command or its
-stop, is known exactly (``reach``), and both the reference and the vessel's RK4 restart
-there, so no step straddles a discontinuity of the derivative. The reference's own error
-is estimated by solving again with the tolerances halved.
-
-Programs, 400 s from straight running at 0.3 m/s, calm water: a 20 deg rudder step;
-a sine of 10 deg amplitude and 30 s period; the 20/20 zig-zag (its commands are
-taken from one run and then fixed, so that every integrator sees the same input).
-
-Parts 2 and 3, the co-simulation against a monolithic model, are ``accuracy``.
+Programs, 400 s from straight running at 0.3 m/s in calm water: a 20 deg rudder step, a sine
+of 10 deg and 30 s, the 20/20 zig-zag (its commands taken from one run, then fixed).
 """
 from __future__ import annotations
 

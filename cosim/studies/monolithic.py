@@ -1,5 +1,5 @@
-"""The monolithic reference of the accuracy study (``accuracy``, parts 2 and 3): guidance,
-autopilot and ship as one ODE, with the controller inside the solver."""
+"""The monolithic reference of the accuracy study (``coupling_error``): guidance, autopilot
+and ship as one ODE, with the controller inside the solver."""
 from __future__ import annotations
 
 import math
@@ -14,32 +14,25 @@ from ship_fmu.thrusters import actuator_model
 from .integration_error import H
 
 METHOD = "LSODA"
-"""Stiff where the servo slews, not elsewhere: LSODA switches between Adams and BDF as
-needed, 7x faster than Radau in waves; on calm_smc both give J equal to 1e-8."""
+"""Stiff where the servo slews, not elsewhere: LSODA switches between Adams and BDF."""
 MAX_STEP = 1.0
-"""s: on a straight leg the solver's steps grow long enough to pass through a circle of
-acceptance (5 m across, 16 s at 0.3 m/s) without an endpoint inside it, and the
-event would be missed."""
+"""s: longer steps could pass through a circle of acceptance and miss its event."""
 SERVO_GAIN = 1000.0
-"""1/s: the steering gear as a stiff servo in the monolithic model (see ``monolithic``)."""
+"""1/s: the steering gear as a stiff servo."""
 
 
 def monolithic(system, stop_time: float | None = None, servo_gain: float = SERVO_GAIN,
                tolerance: float = 1e-9) -> dict[str, np.ndarray]:
     """Guidance, autopilot and ship as one ODE, the controller evaluated at every stage of
-    the solver (``METHOD``), as a continuous Simulink block would be; sampled every 0.1 s
-    like the master's rows.
+    the solver as a continuous Simulink block would be; sampled every 0.1 s like the
+    master's rows.
 
     State: the ship's (x, y, psi, u, v, r, xi), the rudder angle delta and, for the SMC,
-    its reference model (psi_z, r_z). The steering gear, a rate limiter in the FMU, is
-    here delta' = clip(k (sat(delta_c) - delta), +-delta_rate_max) with k = ``servo_gain``:
-    it slews at the rate limit as the FMU's does, and otherwise follows the command with a
-    lag of 1/k (1 ms, against the 50 ms mean delay of a 0.1 s zero-order hold); the stiff
-    k is why the solver must handle stiffness. The guidance's waypoint switching is an event (the
-    circle of acceptance reached, or the leg's end passed): the solver stops there,
-    switches the leg, and restarts (steps of at most ``MAX_STEP``, so that no crossing is
-    stepped over). The SMC's switching term is eq (42)'s tanh boundary
-    layer (phi_h), continuous: no event is needed.
+    its reference model (psi_z, r_z). The steering gear is delta' = clip(k (sat(delta_c) -
+    delta), +-delta_rate_max), k = ``servo_gain``: it slews at the rate limit as the FMU's
+    does, else lags the command by 1/k. A waypoint switch (the circle of acceptance reached,
+    or the leg's end passed) is an event: the solver stops, switches the leg and restarts.
+    The SMC's eq (42) tanh boundary layer is continuous: no event.
     """
     from .direct import build_models, shaft_speeds
 

@@ -1,24 +1,17 @@
 """How many of a run's digits mean something? The run again with a last bit changed.
 
-The sliding-mode loop chatters, and in waves every loop switches legs at an instant
-that a tiny change can move by a step: a difference in the last bit of one number
-grows into percent of J. A CPU or C library that rounds one operation differently
-moves a run by as much. The ensemble here makes that size visible: the run itself,
-and the same run with one parameter moved by k units in the last place (ulp),
-k = +-1 ... +-ulps: the ship's initial surge speed u0 (a change that the run then
-carries), and the direction the waves travel to psi_w (a change to the wave loads at
-every step, as a C library's sin that rounds differently makes). The largest change
-of each figure of eq (19) over it is the precision a published figure of that run
-has; a figure that no member moves at the printed digits is exact there.
-
-Members run on the in-process backend (the same bits as through FMI, faster); a
-component that cannot runs through FMI.
+The sliding-mode loop chatters, and in waves a leg switch can move by a step: a last-bit
+difference grows into percent of J, as a CPU or C library that rounds otherwise would make.
+The ensemble: the run, and the run with one parameter moved by k ulps, k = +-1 ... +-ulps:
+the initial surge speed u0 (a change the run carries) and the wave direction psi_w (a change
+to the wave loads at every step). The largest change of each figure of eq (19) over it is
+the precision a published figure of that run has.
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any
 
 from ..analysis.cost import LAMBDA, Cost, cost
 from ..core.master import Master
@@ -40,13 +33,8 @@ def nudged(value: float, ulps: int) -> float:
 @dataclass(frozen=True)
 class Spread:
     """How far one last bit moves each figure of eq (19): the run's value and the largest
-    change from it over a perturbation ensemble.
-
-    The largest change, not the ensemble's range: a member is one more draw of a chaotic
-    run, the run itself may lie at either end of what such draws give (waves_smc's delta_E
-    does: no member exceeds it), and another CPU's run may diverge from it in either
-    direction.
-    """
+    change from it over the ensemble (not its range: the run itself may lie at either end,
+    and another CPU's run may diverge either way)."""
 
     runs: int
     ulps: int                       # each member moved one parameter by -ulps ... +ulps
@@ -67,14 +55,10 @@ class Spread:
 
 def spread(system: SystemDescription, overrides: dict[str, dict[str, Any]] | None = None,
            ulps: int = 20, lam: float = LAMBDA, coupling: str = "gauss-seidel",
-           stop_time: float | None = None,
-           progress: Callable[[int, int], None] | None = None) -> Spread:
-    """The run and 2 ulps runs for each of ``PERTURBED``, its value moved by -ulps ...
-    +ulps; how far they move each figure of eq (19) from the run's.
-
-    ValueError if ulps < 1 or the system lacks a perturbed parameter; RuntimeError
-    naming the member if a run fails.
-    """
+           stop_time: float | None = None) -> Spread:
+    """The run and 2 ulps runs for each of ``PERTURBED`` (in-process), moved by -ulps ...
+    +ulps; ValueError if ulps < 1 or the system lacks a perturbed parameter; RuntimeError
+    naming the member if a run fails."""
     if ulps < 1:
         raise ValueError(f"spread: ulps must be >= 1, got {ulps}")
     overrides = {c: dict(v) for c, v in (overrides or {}).items()}
@@ -88,7 +72,7 @@ def spread(system: SystemDescription, overrides: dict[str, dict[str, Any]] | Non
                 raise ValueError(f"spread: the system {system.name!r} has no "
                                  f"{component}.{name} to perturb")
         held: dict[str, dict[str, Any]] = {}     # the values the unperturbed run used
-        for i, (parameter, k) in enumerate(members):
+        for parameter, k in members:
             if parameter is not None:
                 component, name = parameter
                 value = nudged(float(held[component][name]), k)
@@ -102,8 +86,6 @@ def spread(system: SystemDescription, overrides: dict[str, dict[str, Any]] | Non
             if parameter is None:
                 held = master.parameter_values
             costs.append(cost(recording, lam))
-            if progress is not None:
-                progress(i + 1, len(members))
     nominal = {f: getattr(costs[0], f) for f in FIGURES}
     deviation = {f: max(abs(getattr(c, f) - nominal[f]) for c in costs) for f in FIGURES}
     return Spread(len(costs), ulps, nominal, deviation)

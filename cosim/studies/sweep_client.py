@@ -1,18 +1,10 @@
-"""A sweep's client side: its runs submitted to a Dask cluster, each row journaled as it
-completes, and the cluster watched for workers that run other code, or none at all.
-
-On the batch backend the runs of each system and stop time go in batches (``plan``,
-``batches``), one task each; a batch whose worker died on every retry has its runs
-submitted again one per task, so that only a run that kills its worker fails.
-``sweep_task`` is the other side: what a worker runs.
-"""
+"""A sweep's client side: runs submitted to a Dask cluster (on the batch backend in batches,
+``plan``), each row journaled as it completes, the workers checked and watched."""
 from __future__ import annotations
 
 import logging
 import math
-import queue
 import sys
-import time
 import uuid
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -21,177 +13,28 @@ from typing import Iterator
 from fmukit.timebase import step_count
 
 from ..core.interrupt import Interrupted, StopSignals
-from ..core.provenance import PACKAGE, code_version
 from ..core.watchdog import Limits
 from ..ensemble import SIGNALS
-from .bundle import UnsafeCache, fmu_cache
+from .cluster import (Completions, NoWorkers, WorkerWatch, check_workers, has_dashboard,
+                      say)
 from .journal import Journal
 from .sweep_spec import Spec
 from .sweep_task import (BATCH, Job, SweepTeardown, batch_refusal, blank_row, fmu_bytes, noted,
-                         run_batch, worker_facts)
-
-
-# -- the client side --------------------------------------------------------------------
-class SweepError(RuntimeError):
-    """The sweep cannot start: a worker runs other code, or another sweep holds the journal."""
-
-
-class NoWorkers(RuntimeError):
-    """The sweep stopped: its cluster had no worker for as long as it waits for one. The
-    runs completed stay in the journal, as on an interruption."""
-
-    exit_status = 3
-    """The command's exit status for it (0: every run ok, 1: some failed, 2: cannot start)."""
-
-
-class _WorkerWatch:
-    """Raises ``NoWorkers`` from ``check`` once the scheduler has counted no worker for
-    ``timeout`` seconds; it is asked at most every ``interval`` seconds (1 s, or less for a
-    short timeout), and only while the client waits."""
-
-    def __init__(self, client, timeout: float):
-        self.client, self.timeout = client, timeout
-        self.interval = max(0.05, min(1.0, timeout / 4))   # Dask fails a shorter wait
-        self.seen = False                   # a worker was counted at least once
-        self.gone_since: float | None = None
-        self.gone_at = ""                   # when none was first counted, for the message
-        self.next_check = 0.0
-        self.check()
-
-    def check(self) -> None:
-        now = time.monotonic()
-        if now < self.next_check:
-            return
-        self.next_check = now + self.interval
-        try:
-            workers = len(self.client.nthreads())
-        except OSError:                     # the scheduler cannot be reached: no worker either
-            workers = 0
-        if workers:
-            self.seen, self.gone_since = True, None
-        elif self.gone_since is None:
-            self.gone_since, self.gone_at = now, time.strftime("%Y-%m-%d %H:%M:%S")
-        elif now - self.gone_since >= self.timeout:
-            since = "the last one left by" if self.seen else "none has joined since"
-            raise NoWorkers(f"no worker in the cluster for {self.timeout:g} s ({since} "
-                            f"{self.gone_at}); the sweep stopped")
-
-    def result(self, future):
-        """``future.result()``, checking the cluster while it waits: a finished run's result
-        is fetched from its worker, and computed again if that worker has just died."""
-        from dask.distributed import TimeoutError
-
-        while True:
-            try:
-                return future.result(timeout=self.interval)
-            except TimeoutError:
-                if future.status == "error":    # the task's own TimeoutError
-                    raise
-                self.check()
-
-
-class _Completions:
-    """Futures as they complete, from their done callbacks (run by the future's own client,
-    not the newest one); more may be added while they are taken. While none completes,
-    the watch is checked. Dask's ``as_completed`` cannot do this: its timeout is a deadline
-    for the whole iteration."""
-
-    def __init__(self) -> None:
-        self.done: queue.SimpleQueue = queue.SimpleQueue()
-        self.waiting = 0
-
-    def add(self, future) -> None:
-        self.waiting += 1
-        future.add_done_callback(self.done.put)
-
-    def each(self, watch: _WorkerWatch) -> Iterator:
-        """Each future added, before or while iterating, as it completes."""
-        while self.waiting:
-            try:
-                future = self.done.get(timeout=watch.interval)
-            except queue.Empty:
-                watch.check()
-                continue
-            self.waiting -= 1
-            yield future
-
-
-def _say(message: str) -> None:
-    print(message, file=sys.stderr, flush=True)
-
-
-def check_workers(client) -> None:
-    """SweepError naming each worker that runs other code than this client (or none of
-    it), or whose FMU cache is not private to its user; a warning for workers with more than one thread, or a scheduler that queues
-    more than one run per thread."""
-    mine = code_version()
-    try:
-        facts = client.run(worker_facts, on_error="return")
-    except Exception as error:              # e.g. no worker can import cosim at all
-        raise SweepError(f"cannot ask the workers what they run ({error})") from None
-    wrong = []
-    for address, fact in sorted(facts.items()):
-        theirs = fact["code"] if isinstance(fact, dict) else f"none ({type(fact).__name__}: {fact})"
-        if theirs != mine:
-            wrong.append(f"  {address} runs {PACKAGE} {theirs}")
-    if wrong:
-        raise SweepError(f"workers run other code than this client ({PACKAGE} {mine}):\n"
-                         + "\n".join(wrong) + "\ninstall the client's version on every worker "
-                         "(a wheel: pip wheel --no-deps -w dist . ; pip install dist/*.whl)")
-    unsafe = {a: problem for a, problem in client.run(_cache_problem).items() if problem}
-    if unsafe:
-        raise SweepError("workers whose FMU cache is not safe to run FMUs from:\n" + "\n".join(
-            f"  {address}: {problem}" for address, problem in sorted(unsafe.items())))
-    threaded = {a: n for a, n in client.nthreads().items() if n > 1}
-    if threaded:
-        _say(f"warning: {', '.join(f'{a} has {n} threads' for a, n in threaded.items())}; a "
-             "run holds the GIL from start to end, so threads of one worker take turns: start "
-             "workers with --nthreads 1 and more processes (--nworkers)")
-    saturation = client.run_on_scheduler(_worker_saturation)
-    if saturation != 1.0:
-        _say(f"warning: the scheduler's worker-saturation is {saturation}: it queues more than "
-             "one run per worker thread, and a worker killed by one run takes the queued ones "
-             "with it; start the scheduler with DASK_DISTRIBUTED__SCHEDULER__WORKER_SATURATION=1.0")
-
-
-def _cache_problem() -> str:
-    """Why this worker's FMU cache is unsafe (``bundle.fmu_cache``), or ""."""
-    try:
-        fmu_cache()
-    except (UnsafeCache, OSError) as error:
-        return str(error)
-    return ""
-
-
-def _has_dashboard(dask_scheduler=None) -> bool:
-    """Whether the scheduler serves its dashboard (which needs bokeh where it runs)."""
-    import importlib.util
-    return ("dashboard" in dask_scheduler.services
-            and importlib.util.find_spec("bokeh") is not None)
-
-
-def _worker_saturation(dask_scheduler=None) -> float:
-    """The running scheduler's worker-saturation (read at its start from Dask's config)."""
-    return float(dask_scheduler.WORKER_SATURATION)
+                         run_batch)
 
 
 MAX_BATCH = 1024
-"""The most runs a batch gets unless told otherwise (``--batch-size``): in calm water a
-step's cost is mostly numpy's per call, shared by the runs (1.2 us a run-step at 256 runs,
-0.6 at 1024)."""
+"""The most runs a batch gets unless told otherwise (``--batch-size``)."""
 BATCH_MEMORY = 128 << 20
-"""Bytes a batch's recorded signals may take on its worker (the figures of merit need every
-sample): a batch of 400 s runs holds at most 698 runs."""
+"""Bytes a batch's recorded signals may take on its worker."""
 MIN_BATCH = 32
 """The fewest runs a batch is cut down to for keeping workers busy (``batch_counts``)."""
 WAVES_SHARE = 128
-"""The fewest runs a batch in waves is cut down to for giving every worker a share of its
-system (``batch_counts``): at 128 runs the shared cost of a step is about a quarter of it."""
+"""The fewest runs a batch in waves is cut down to for giving every worker a share."""
 
 
 def batch_limit(job: Job) -> int:
-    """The most runs a batch of ``job``'s system and stop time gets by default:
-    ``MAX_BATCH``, or as many as ``BATCH_MEMORY`` holds the recorded signals of."""
+    """The most runs a batch of ``job``'s system and stop time gets by default."""
     system = job.bundle.system
     stop = system.stop_time if job.stop_time is None else job.stop_time
     rows = step_count(system.start_time, stop, system.step_size) + 1
@@ -199,25 +42,16 @@ def batch_limit(job: Job) -> int:
 
 
 def batches(jobs: list[Job], workers: int, size: int | None = None) -> list[list[Job]]:
-    """``jobs`` (of one system and stop time) cut into batches as ``plan`` cuts a sweep of
-    them alone."""
+    """``jobs`` (of one system and stop time) cut as ``plan`` cuts a sweep of them alone."""
     return _cut(jobs, batch_counts([jobs], workers, size)[0])
 
 
 def batch_counts(groups: list[list[Job]], workers: int, size: int | None = None) -> list[int]:
     """How many batches each group (runs of one system and stop time) is cut into: with
-    ``size``, as many as hold at most ``size`` runs each; by default, as few as its
-    ``batch_limit`` allows, and in waves one per worker where they keep ``WAVES_SHARE``
-    runs; then, while the sweep has fewer batches than ``workers``, the group with the
-    largest batches gets one batch more, as long as its batches keep ``MIN_BATCH`` runs.
-
-    A batch's cost per step is partly shared by its runs (numpy's cost per call, about
-    0.5 ms a step) and partly each run's own. In calm water the shared part is most of it,
-    and the runs of one controller cost about what another's do: there batches are made no
-    smaller than keeping every worker busy needs. In waves each run's own part (the sines
-    of the wave loads) is most of it, and it differs between controllers (a waves_pd run
-    costs 1.4 times a waves_smc run): a system there gives every worker a share, so that
-    none waits at the end for another's costlier batch."""
+    ``size``, batches of at most ``size``; by default as few as ``batch_limit`` allows, in
+    waves one per worker where they keep ``WAVES_SHARE`` runs; then, while there are fewer
+    batches than ``workers``, the group of the largest batches gets one more, as long as
+    they keep ``MIN_BATCH`` runs (why: docs/sweeps.md, the batch backend)."""
     if size:
         return [math.ceil(len(group) / size) for group in groups]
     counts = [math.ceil(len(group) / batch_limit(group[0])) for group in groups]
@@ -245,10 +79,9 @@ def _cut(jobs: list[Job], count: int) -> list[list[Job]]:
 
 def plan(spec: Spec, jobs: list[Job], workers: int, size: int | None = None
          ) -> tuple[list[list[Job]], list[Job]]:
-    """(the batches, the runs to run alone) of a sweep on the batch backend: the runs of
-    each system (``Bundle.digest``) and stop time cut into batches of at most ``size`` runs
-    or by default as ``batch_counts`` says, those of a controller the kernel does not cover
-    (``Spec.batch_coverage``) one by one."""
+    """(the batches, the runs to run alone) of a sweep on the batch backend: each system's
+    runs of one stop time cut as ``batch_counts`` says, those the kernel does not cover
+    (``Spec.batch_coverage``) alone."""
     covered = spec.batch_coverage()
     groups: dict[tuple[str, float | None], list[Job]] = {}
     alone = []
@@ -265,11 +98,9 @@ def plan(spec: Spec, jobs: list[Job], workers: int, size: int | None = None
 def run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, progress: bool,
                    task, backend: str, no_worker_timeout: float, limits: Limits,
                    batch_task=run_batch, batch_size: int | None = None) -> None:
-    """Run ``todo`` (runs of ``spec``) as ``task`` on the cluster of ``connection`` (a
-    client and the local cluster it made, or None), journaling each row as it completes;
-    on the batch backend, in batches as ``batch_task``; the client, and a local cluster,
-    closed on every path (``execute`` documents the rest). When the sweep stops early, the
-    cluster closes quietly (``_stopping``)."""
+    """Run ``todo`` (runs of ``spec``) on the cluster of ``connection`` (a client, and the
+    local cluster it made or None), journaling each row; both closed on every path, quietly
+    when the sweep stops early (``campaign.execute`` says the rest)."""
     client, cluster = connection
     teardown = SweepTeardown(uuid.uuid4().hex[:12])
     stopped = None
@@ -297,8 +128,8 @@ def _submit_and_journal(spec: Spec, todo: list[dict], journal: Journal, client, 
                         teardown: SweepTeardown, batch_task, batch_size: int | None) -> None:
     """Check the workers, send the FMUs and ``todo``, and journal each row as it completes."""
     token = teardown.sweep
-    if client.run_on_scheduler(_has_dashboard):
-        _say(f"dashboard: {client.dashboard_link}")
+    if client.run_on_scheduler(has_dashboard):
+        say(f"dashboard: {client.dashboard_link}")
     check_workers(client)
     client.register_plugin(teardown)
     # Each FMU as a task holding its bytes, not scattered data: a task's result lost with
@@ -308,7 +139,7 @@ def _submit_and_journal(spec: Spec, todo: list[dict], journal: Journal, client, 
                                   pure=False)
                for sha, path in spec.files().items()}
     tasks: dict = {}
-    completions = _Completions()
+    completions = Completions()
 
     def submit(jobs: list[Job], batch: bool, why: str = "") -> None:
         blobs = {sha: shipped[sha] for sha in jobs[0].bundle.fmu_hashes()}
@@ -320,23 +151,20 @@ def _submit_and_journal(spec: Spec, todo: list[dict], journal: Journal, client, 
 
     route = "inprocess" if backend == BATCH else backend      # a batch's runs alone: in-process
     jobs = [spec.job(run, token, route, limits) for run in todo]
-    if backend == BATCH:
-        together, alone = plan(spec, jobs, sum(client.nthreads().values()) or 1, batch_size)
-        if together:
-            _say_batch_refusals(client)
-        for batch in together:
-            submit(batch, True)
-        for job in alone:
-            submit([job], False)
-    else:
-        for job in jobs:
-            submit([job], False)
+    together, alone = (plan(spec, jobs, sum(client.nthreads().values()) or 1, batch_size)
+                       if backend == BATCH else ([], jobs))
+    if together:
+        _say_batch_refusals(client)
+    for batch in together:
+        submit(batch, True)
+    for job in alone:
+        submit([job], False)
     bar = None
     if progress:
         from tqdm import tqdm
         bar = tqdm(total=len(todo), desc=spec.name, unit="run", file=sys.stderr,
                    disable=None)                # None: only on a terminal
-    watch = _WorkerWatch(client, no_worker_timeout)
+    watch = WorkerWatch(client, no_worker_timeout)
     try:
         for future in completions.each(watch):
             done = tasks.pop(future)
@@ -368,8 +196,7 @@ def _submit_and_journal(spec: Spec, todo: list[dict], journal: Journal, client, 
 
 
 def _say_batch_refusals(client) -> None:
-    """A note for each reason a worker gives to refuse the batch route (``batch_refusal``),
-    once, naming the workers that give it."""
+    """A note for each reason workers give to refuse the batch route, naming them."""
     try:
         refusals = client.run(batch_refusal, on_error="return")
     except Exception:                       # a worker gone: its runs' rows will say
@@ -379,9 +206,9 @@ def _say_batch_refusals(client) -> None:
         if reason is not None:
             said.setdefault(str(reason), []).append(address)
     for reason, addresses in said.items():
-        _say(f"note: the batch route is refused on {len(addresses)} worker"
-                 f"{'s' if len(addresses) > 1 else ''} ({', '.join(addresses)}): {reason}; "
-                 "their batches run one run at a time on the in-process route")
+        say(f"note: the batch route is refused on {len(addresses)} worker"
+            f"{'s' if len(addresses) > 1 else ''} ({', '.join(addresses)}): {reason}; "
+            "their batches run one run at a time on the in-process route")
 
 
 def _close(client, cluster, teardown: SweepTeardown) -> None:
@@ -399,10 +226,8 @@ def _close(client, cluster, teardown: SweepTeardown) -> None:
 
 @contextmanager
 def _stopping(stopped: BaseException | None, journal: Journal) -> Iterator[None]:
-    """Within, after the sweep stopped early (``stopped``): logging is silenced (distributed's
-    of the teardown: runs cancelled, workers lost), so the user reads only our
-    message; after Ctrl-C or SIGTERM, a second signal ends the process at once, saying
-    what the journal keeps (``StopSignals``)."""
+    """After the sweep stopped early: distributed's logging of the teardown silenced, and
+    after Ctrl-C or SIGTERM a second signal ends the process at once (``StopSignals``)."""
     if stopped is None:
         yield
         return

@@ -1,6 +1,5 @@
-"""Figures of a sweep and of the scorecard: J (or each criterion) per controller and sea
-state, the tracks, and the J_SMC / J_PD map; each file written whole or not at all
-(``cosim.analysis.figures.save``)."""
+"""Figures of a sweep and of the scorecard: each criterion per controller and sea state, the
+paired changes, the tracks and the J_SMC / J_PD map; drawn without pyplot (no backend)."""
 from __future__ import annotations
 
 import math
@@ -11,17 +10,17 @@ from typing import Sequence
 import matplotlib
 import matplotlib.ticker
 import matplotlib.transforms
+import numpy as np
+from matplotlib.figure import Figure
+from matplotlib.patches import Circle
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+from autopilot_fmu.guidance import parse_waypoints
 
-from autopilot_fmu.guidance import parse_waypoints  # noqa: E402
-
-from ..analysis.figures import save, waypoint_name  # noqa: E402
-from ..analysis.seastate import model_scale  # noqa: E402
-from .sweep_tables import distinct  # noqa: E402
-from .sweep_task import CRITERIA, Criterion  # noqa: E402
+from ..analysis.figures import save
+from ..analysis.track import waypoint_name
+from ..analysis.seastate import model_scale
+from .merit import CRITERIA, Merit
+from .sweep_tables import distinct
 
 SEA_AXES = ("sea_state", "Hs")
 
@@ -36,20 +35,18 @@ STATISTICS = ("box: median and IQR (25-75 %) of the runs, whiskers: min-max; the
 
 
 def distribution(spec, rows: list[dict], path: Path,
-                 criteria: Sequence[Criterion] = CRITERIA[:1]) -> Path:
-    """Box plots of each criterion (J alone by default) per controller, grouped by sea state
-    when that is an axis: one panel per criterion, each on a log scale where its values
-    span more than a decade (said on its axis). A run shared by several combinations
-    (calm water over the wave seeds) counts once."""
+                 criteria: Sequence[Merit] = CRITERIA[:1]) -> Path:
+    """Box plots of each criterion (J alone by default) per controller and sea state, one
+    panel each, on a log scale where it spans decades; each run counted once."""
     ok = [r for r in distinct(rows) if r["status"] == "ok"]
     sea = _sea_axis(spec)
     groups = spec.axes[sea] if sea else [None]
     boxes = len(groups) * len(spec.controllers)
     columns = min(4, len(criteria))
     width = max(6.0 if len(criteria) == 1 else 3.4, 0.75 * boxes + 1.2)
-    fig, axes = plt.subplots(math.ceil(len(criteria) / columns), columns, squeeze=False,
-                             figsize=(width * columns, 3.9 * math.ceil(len(criteria) / columns)),
-                             constrained_layout=True)
+    fig = Figure(figsize=(width * columns, 3.9 * math.ceil(len(criteria) / columns)),
+                 layout="constrained")
+    axes = fig.subplots(math.ceil(len(criteria) / columns), columns, squeeze=False)
     for ax, criterion in zip(axes.flat, criteria):
         _boxes(ax, spec, ok, criterion, sea, groups)
     for ax in axes.flat[len(criteria):]:
@@ -61,7 +58,7 @@ def distribution(spec, rows: list[dict], path: Path,
     return save(fig, path)[0]
 
 
-def _boxes(ax, spec, ok: list[dict], criterion: Criterion, sea: str | None,
+def _boxes(ax, spec, ok: list[dict], criterion: Merit, sea: str | None,
            groups: list) -> None:
     """One criterion's panel of ``distribution``."""
     positions, data, labels = [], [], []
@@ -100,15 +97,14 @@ def _boxes(ax, spec, ok: list[dict], criterion: Criterion, sea: str | None,
     ax.grid(alpha=0.3, axis="y")
 
 
-def paired_figure(title: str, changes: dict[Criterion, dict[str, np.ndarray]], baseline: str,
+def paired_figure(title: str, changes: dict[Merit, dict[str, np.ndarray]], baseline: str,
                   path: Path) -> Path:
-    """Each criterion's paired ratios (or differences) of every controller to ``baseline``,
-    one dot per seed and a bar at their median, the side that is better shaded; ratios on
-    a log scale (a ratio of 0 is left out of it)."""
+    """Each criterion's paired ratios (log scale) or differences of every controller to
+    ``baseline``: a dot per seed, a bar at their median, the better side shaded."""
     columns = min(4, len(changes))
     rows = math.ceil(len(changes) / columns)
-    fig, axes = plt.subplots(rows, columns, squeeze=False, constrained_layout=True,
-                             figsize=(3.6 * columns, 3.6 * rows))
+    fig = Figure(figsize=(3.6 * columns, 3.6 * rows), layout="constrained")
+    axes = fig.subplots(rows, columns, squeeze=False)
     for ax, (criterion, by_controller) in zip(axes.flat, changes.items()):
         _paired_panel(ax, criterion, by_controller, baseline)
     for ax in axes.flat[len(changes):]:
@@ -118,7 +114,7 @@ def paired_figure(title: str, changes: dict[Criterion, dict[str, np.ndarray]], b
     return save(fig, path)[0]
 
 
-def _paired_panel(ax, criterion: Criterion, by_controller: dict[str, np.ndarray],
+def _paired_panel(ax, criterion: Merit, by_controller: dict[str, np.ndarray],
                   baseline: str) -> None:
     """One criterion's panel of ``paired_figure``."""
     ratio = criterion.paired == "ratio"
@@ -174,7 +170,8 @@ def ratio_map(spec, rows: list[dict], path: Path, numerator: str = "smc",
                      and r[x_axis] == x and r[y_axis] == y]
                 means.append(np.mean(J) if J else np.nan)
             ratio[i, j] = means[0] / means[1]
-    fig, ax = plt.subplots(figsize=(6.5, 4.5), constrained_layout=True)
+    fig = Figure(figsize=(6.5, 4.5), layout="constrained")
+    ax = fig.subplots()
     image = ax.imshow(np.log2(ratio), cmap="RdBu_r", vmin=-3, vmax=3, origin="lower",
                       aspect="auto")
     for i in range(len(ys)):
@@ -191,13 +188,14 @@ def ratio_map(spec, rows: list[dict], path: Path, numerator: str = "smc",
 
 
 def tracks(spec, rows: list[dict], path: Path) -> Path | None:
-    """The tracks of the runs [plots] tracks selects, overlaid, one colour per controller:
-    every run a thin line, so the spread over seeds shows; the route dashed."""
+    """The tracks of the runs [plots] tracks selects, one colour per controller, the route
+    dashed."""
     chosen = [r for r in rows if r.get("track")]
     if not chosen:
         return None
-    fig, ax = plt.subplots(figsize=(6.5, 7), constrained_layout=True)
-    for controller, color in zip(spec.controllers, plt.rcParams["axes.prop_cycle"].by_key()
+    fig = Figure(figsize=(6.5, 7), layout="constrained")
+    ax = fig.subplots()
+    for controller, color in zip(spec.controllers, matplotlib.rcParams["axes.prop_cycle"].by_key()
                                  ["color"]):
         mine = [r["track"] for r in chosen if r["controller"] == controller]
         for i, track in enumerate(mine):
@@ -205,7 +203,6 @@ def tracks(spec, rows: list[dict], path: Path) -> Path | None:
                     label=f"{controller} ({len(mine)} runs)" if i == 0 else None)
     route = chosen[0]["track"].get("route")
     if route:
-        # a str: a row journaled before routes were recorded as points
         _route(ax, np.array(parse_waypoints(route) if isinstance(route, str) else route),
                chosen[0]["track"].get("R_accept"))
     ax.set(xlabel="east y (m)", ylabel="north x (m)")
@@ -221,15 +218,14 @@ def tracks(spec, rows: list[dict], path: Path) -> Path | None:
 
 
 def _route(ax, points: np.ndarray, R_accept: float | None) -> None:
-    """The route dashed, its waypoints numbered from 1 (the start), and their circles of
-    acceptance (dotted) where the row recorded the radius."""
+    """The route dashed, its waypoints named, and their circles of acceptance dotted."""
     ax.plot(points[:, 1], points[:, 0], "--o", color="0.3", linewidth=0.8, markersize=3,
             label="route" + (f", circles of acceptance {R_accept:g} m" if R_accept else ""))
     for k, (x, y) in enumerate(points):
         ax.annotate(waypoint_name(k), (y, x), xytext=(4, 4), textcoords="offset points",
                     fontsize=8, color="0.2")
         if R_accept:
-            ax.add_patch(plt.Circle((y, x), R_accept, fill=False, linestyle=":", color="0.3",
+            ax.add_patch(Circle((y, x), R_accept, fill=False, linestyle=":", color="0.3",
                                     linewidth=0.8))
 
 

@@ -1,11 +1,6 @@
 """A sweep's rows as tables: results.parquet, .csv and .json, summary.csv and the printed
-summary (each figure of merit per setting and controller), and comparison.md (every
-controller against the baseline, seed by seed).
-
-A row is a combination of the spec; combinations that share one run's result
-(``Spec.shared_runs``: the wave settings in calm water) name it in ``ran_as``, and the
-statistics count each run once. The figures of merit are those of ``sweep_task.METRICS``,
-with their units: a column added there appears here.
+summary (each figure of merit per setting and controller, each run counted once), and
+comparison.md (every controller against the baseline, seed by seed).
 """
 from __future__ import annotations
 
@@ -18,28 +13,24 @@ import numpy as np
 
 from ..core.files import write_atomically
 from .sweep_spec import Spec
-from .sweep_task import METRICS
+from .merit import METRICS
 
 TIMES = {"seconds": "s", "sim_seconds": "s"}
-"""The wall-clock times of a row (``sweep_task.run_one``): the task's, and the master's run
-alone; a batch's run (``sweep_task.run_batch``) has its share of its batch's."""
+"""A row's wall-clock times: its task's, and its run's alone (in a batch: its share)."""
 
 MONTE_CARLO = "wave_seed"
 """The axis the statistics are taken over, and that pairs runs (the same sea)."""
 
 STATISTICS = {"median": "median", "q25": "25th percentile", "q75": "75th percentile",
               "min": "least", "max": "greatest"}
-"""What summary.csv gives of each figure of merit, over the runs of a setting (percentiles
-interpolated linearly between the ordered values, numpy's default)."""
+"""What summary.csv gives of each figure of merit over the runs of a setting."""
 
 MOST_PRINTED = 48
-"""The most lines of the printed summary's table: a larger sweep prints its axes one by one
-(summary.csv has every setting)."""
+"""The most lines of the printed summary's table: a larger sweep prints its axes one by one."""
 
 
 def units(spec: Spec | None, columns: list[str]) -> dict[str, str]:
-    """The unit of each column ("" for none): the figures of merit's, the times', and the
-    axes' (the parameter's declared unit; known with ``spec``)."""
+    """The unit of each column ("" for none; an axis's known with ``spec``)."""
     known = {**(spec.units() if spec is not None else {}), **METRICS, **TIMES}
     return {name: known.get(name, "") for name in columns}
 
@@ -51,9 +42,8 @@ def headed(name: str, unit: str) -> str:
 
 def write_tables(rows: list[dict], out: Path, csv: bool, spec: Spec | None = None
                  ) -> list[Path]:
-    """results.parquet (each column's unit in its field metadata), results.csv with ``csv``
-    (each header with its unit), results.json (the unit of every column) and, with
-    ``spec``, summary.csv (``summary_table``)."""
+    """results.parquet (units in its field metadata), results.csv with ``csv`` (units in its
+    headers), results.json (every column's unit) and, with ``spec``, summary.csv."""
     import pyarrow as pa
     import pyarrow.csv as pacsv
     import pyarrow.parquet as pq
@@ -95,7 +85,7 @@ def _in(row: dict, where: dict[str, Any]) -> bool:
 
 
 def _ran_as(row: dict) -> str:
-    """The run whose result the row is (its own for a row journaled before runs were shared)."""
+    """The run whose result the row is."""
     return row.get("ran_as", row["run_id"])
 
 
@@ -114,8 +104,7 @@ def _statistics(values: np.ndarray) -> dict[str, float]:
 
 def summary_table(spec: Spec, rows: list[dict]) -> list[list]:
     """Header and lines of summary.csv: per setting (the axes but ``MONTE_CARLO``) and
-    controller, the runs ok and failed and each figure of merit's ``STATISTICS`` over the
-    ok runs, each run counted once; headers with their units ('J median [rad^2]')."""
+    controller, the runs ok and failed and each figure of merit's ``STATISTICS``."""
     axes = _settings_axes(spec)
     header = [*axes, "controller", "runs ok", "runs failed",
               *(headed(f"{metric} {name}", unit) for metric, unit in METRICS.items()
@@ -136,8 +125,7 @@ def summary_table(spec: Spec, rows: list[dict]) -> list[list]:
 
 
 def summary(spec: Spec, rows: list[dict], shown_failures: int = 10) -> str:
-    """Runs, ok and failed; J per setting and controller (median, interquartile range,
-    extremes, over the Monte Carlo axis); each failed run with its message."""
+    """Runs ok and failed; J per setting and controller; each failed run with its message."""
     runs = distinct(rows)
     ok = [r for r in runs if r["status"] == "ok"]
     shared = len(rows) - len(runs)
@@ -158,8 +146,8 @@ def summary(spec: Spec, rows: list[dict], shown_failures: int = 10) -> str:
 
 
 def _J_lines(spec: Spec, rows: list[dict]) -> list[str]:
-    """The printed table of J: per setting and controller, or, for a sweep of more than
-    ``MOST_PRINTED`` lines, per value of each axis, pooled over the other axes."""
+    """The printed table of J: per setting and controller, or past ``MOST_PRINTED`` lines
+    per value of each axis, pooled over the others."""
     axes = _settings_axes(spec)
     groups = [(" ".join(str(where[a]) for a in axes), where) for where in _settings(spec)]
     pooled = len(groups) * len(spec.controllers) > MOST_PRINTED
@@ -191,13 +179,9 @@ def _J_lines(spec: Spec, rows: list[dict]) -> list[str]:
 
 def comparison(spec: Spec, rows: list[dict], baseline: str = "pd",
                monte_carlo: str = MONTE_CARLO) -> str:
-    """Markdown table: per setting of the other axes, median J and wins against the baseline.
-
-    Runs are paired by the Monte Carlo axis (the same sea for both controllers); a
-    controller wins a pair when its J is lower. A pair of runs counts once however many
-    combinations share it (in calm water every seed is one pair). The share of wins and
-    the median J ratio are given for every controller other than the baseline.
-    """
+    """Markdown table: per setting of the other axes, each controller's median J, its wins
+    against the baseline (a lower J on the same sea, each pair of runs counted once) and
+    the median J ratio."""
     others = [c for c in spec.controllers if c != baseline]
     axes = [a for a in spec.axes if a != monte_carlo]
     ok = {(r["controller"], *(json.dumps(r[a]) for a in spec.axes)): r
@@ -227,6 +211,6 @@ def comparison(spec: Spec, rows: list[dict], baseline: str = "pd",
 
 
 def _median_J(found: list[dict | None]) -> str:
-    """The median J of the rows found (each run once), for a table cell."""
+    """The median J of the rows found (each run once), as a cell."""
     J = [r["J"] for r in distinct([r for r in found if r is not None])]
     return f"{np.median(J):.1f}" if J else "-"

@@ -1,13 +1,9 @@
 """A sweep's tasks, on a worker: one whole co-simulation from a ``Job`` and the FMUs' bytes
-(``run_one``), or a batch of runs of one system as one array program (``run_batch``).
+(``run_one``), or the runs of one system as one array program (``run_batch``).
 
-Both make a run's row from its recording with one function (``result_row``), so a run's
-row is the same, every column but ``backend``, ``seconds`` and ``sim_seconds``, whichever
-task ran it. A worker keeps one master per sweep, thread, system (``Bundle.digest``) and
-backend, and resets it (fmi2Reset) between tasks. Each sweep registers its own
-``SweepTeardown`` worker plugin, named after the sweep's token: when the sweep ends (or
-the worker closes) it frees that sweep's masters only, so two sweeps on one cluster do not
-free each other's FMUs.
+Both make a row with ``result_row``, so a row is the same whichever task ran it, but for
+``backend``, ``seconds`` and ``sim_seconds``. A worker keeps one master per sweep, thread,
+system and backend, reset between tasks, and freed by that sweep's ``SweepTeardown``.
 """
 from __future__ import annotations
 
@@ -19,66 +15,15 @@ from typing import Any
 
 from distributed import WorkerPlugin
 
-from autopilot_fmu.guidance import R_ACCEPT, route as followed_route
-
-from ..analysis.cost import cost
-from ..analysis.metrics import (cross_track_error, fraction_at_stops, heading_error,
-                                mean_abs_rate, peak, rms, route_completion,
-                                rudder_reversals_per_minute)
 from ..core.master import RUN_BACKENDS
-from ..core.provenance import code_version
+from ..provenance import code_version
 from ..core.watchdog import Limits, TimeLimit, Watchdog
 from .bundle import Bundle, materialise
+from .merit import METRICS, run_metrics, track
 
-METRICS = {"psi_E": "rad^2", "sum_delta2": "rad^2", "J": "rad^2",
-           "rms_heading_error_deg": "deg", "reversals_per_min": "1/min", "max_delta_deg": "deg",
-           "mean_rudder_rate_deg_s": "deg/s", "at_stops_pct": "%",
-           "cross_track_rms_m": "m", "cross_track_max_m": "m",
-           "waypoints_reached": "", "waypoints": "", "last_waypoint_reached": ""}
-"""The figures of merit of a run and their units, as ``cosim.run`` prints them (angles in
-degrees for display; ``run_metrics`` says what each is). Counts and the 0/1 flag have no
-unit; every value is a float, NaN in a failed run's row."""
-
-
-@dataclass(frozen=True)
-class Criterion:
-    """A column of ``METRICS`` as a criterion to compare controllers by."""
-    column: str
-    label: str
-    lower_is_better: bool = True
-    paired: str = "ratio"           # how a run is set beside another's: ratio or difference
-    digits: int = 1                 # decimals shown
-    out_of: str | None = None       # the column it is a count out of, if any
-
-    @property
-    def unit(self) -> str:
-        return METRICS[self.column]
-
-    @property
-    def better(self) -> str:
-        return "lower is better" if self.lower_is_better else "higher is better"
-
-    def format(self, value: float, sign: str = "") -> str:
-        """``value`` to this criterion's decimals (a median of counts may be a half: 2.5),
-        '-' if it is not finite; ``sign="+"`` signs it."""
-        if not math.isfinite(value):
-            return "-"
-        return f"{value:{sign}g}" if self.digits == 0 else f"{value:{sign}.{self.digits}f}"
-
-
-CRITERIA = (
-    Criterion("J", "J of eq (19)"),
-    Criterion("rms_heading_error_deg", "RMS heading error psi_d - psi", paired="difference",
-              digits=2),
-    Criterion("reversals_per_min", "rudder reversals"),
-    Criterion("mean_rudder_rate_deg_s", "mean abs rudder rate", digits=2),
-    Criterion("at_stops_pct", "time on the rudder stops", paired="difference"),
-    Criterion("cross_track_rms_m", "RMS cross-track error", paired="difference", digits=2),
-    Criterion("cross_track_max_m", "max cross-track error", paired="difference", digits=2),
-    Criterion("waypoints_reached", "waypoints reached", lower_is_better=False,
-              paired="difference", digits=0, out_of="waypoints"),
-)
-"""The criteria a scorecard compares controllers by, each with the side that is better."""
+BATCH = "batch"
+"""The sweep backend that runs the runs of one system as batches (``run_batch``)."""
+SWEEP_BACKENDS = (*RUN_BACKENDS, BATCH)
 
 
 @dataclass(frozen=True)
@@ -146,9 +91,8 @@ class SweepTeardown(WorkerPlugin):
 
 
 def ran_on(kinds: dict[str, str] | None, asked: str) -> str:
-    """How a run's components ran (``kinds``: each component's backend, as
-    ``Master.backends``): "inprocess" or "fmi" if all alike, else each named
-    ("inprocess; autopilot: fmi"); ``asked`` where no master was made."""
+    """How a run's components ran (``Master.backends``): "fmi" or "inprocess" if all alike,
+    else each other named ("inprocess; autopilot: fmi"); ``asked`` without a master."""
     if not kinds:
         return asked
     if len(set(kinds.values())) == 1:
@@ -157,13 +101,8 @@ def ran_on(kinds: dict[str, str] | None, asked: str) -> str:
     return "; ".join([asked, *others])
 
 
-def worker_facts() -> dict[str, Any]:
-    """What the client checks of a worker before it sends work: the code it runs."""
-    return {"code": code_version()}
-
-
 def fmu_bytes(data: bytes) -> bytes:
-    """An FMU's file, as a task's result: what each run of its system depends on."""
+    """An FMU's file as a task's result (a lost worker's copy is computed again)."""
     return data
 
 
@@ -174,10 +113,8 @@ def blank_row(run: dict[str, Any], error: str = "") -> dict[str, Any]:
 
 
 def run_one(job: Job, blobs: dict[str, bytes]) -> dict[str, Any]:
-    """One whole co-simulation; never raises for a failed run, records it. ``seconds`` is
-    the task's wall time, ``sim_seconds`` the master's run alone. A run past its time
-    limits fails (``core.watchdog``; one whose FMU runs no Python ends the worker, and
-    the sweep retries it, then records it failed, as any run that kills its worker)."""
+    """One whole co-simulation's row; a failed run (past its time limits too) is recorded,
+    never raised. ``seconds``: the task's wall time, ``sim_seconds``: the run's alone."""
     started = time.perf_counter()
     if job.code != code_version():          # a worker that joined after the client's check
         return _other_code(job)
@@ -212,26 +149,19 @@ def _other_code(job: Job) -> dict[str, Any]:
 
 
 def result_row(job: Job, recording) -> dict[str, Any]:
-    """The row of ``job``'s run from its recording, whichever route made it: failed with the
-    recording's error, else every figure of merit (``run_metrics``) and, if the job asks,
-    the track; the times and the backend are the caller's to fill in."""
+    """The row of ``job``'s run from its recording, whichever route made it (the times and
+    the backend are the caller's to fill in)."""
     if recording.error:
         return blank_row(job.run, recording.error)
     row = {**blank_row(job.run), **run_metrics(recording)}
     if job.track:
-        row["track"] = _track(recording)
+        row["track"] = track(recording)
     return row
 
 
-BATCH = "batch"
-"""The sweep backend that runs the runs of one system as batches (``run_batch``)."""
-SWEEP_BACKENDS = (*RUN_BACKENDS, BATCH)
-"""The backends a sweep may take: a master's (``RUN_BACKENDS``), or batches."""
-
-
 def batch_refusal() -> str | None:
-    """Why this worker would not give the in-process route's bits on the batch route
-    (``cosim.ensemble.selftest``, run once per process), None if it would."""
+    """Why this worker's numpy would not give the in-process route's bits on the batch
+    route (``cosim.ensemble.selftest``), None if it would."""
     from ..ensemble import selftest
 
     try:
@@ -247,18 +177,13 @@ def batch_limits(limits: Limits, members: int) -> Limits:
 
 
 def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
-    """The rows of ``jobs`` (runs of one system and stop time, in-process jobs) in their
-    order, computed together by the batch kernel (``cosim.ensemble.simulate_members``);
-    never raises for a failed run.
+    """The rows of ``jobs`` (in-process runs of one system and stop time), in their order,
+    computed together by ``cosim.ensemble.simulate_members``; never raises for a failed run.
 
-    Each row is the row ``run_one`` makes of the job but for ``backend`` ("batch", or
-    what the member ran on and why), ``seconds`` and ``sim_seconds`` (the member's share
-    of the batch). A member ``Master.configure`` refuses is run by ``run_one`` (which
-    refuses it the same way); every member is, saying why in its backend, where
-    ``batch_refusal`` refuses the route on this worker or the batch fails as a whole (an
-    exception, or its time limits passed, ``batch_limits``: each member's initialisation
-    and each step of the members together within N times the step limit, the batch
-    within N times the run limit; the kernel stops at the step after a limit passed)."""
+    A row is ``run_one``'s but for ``backend``, ``seconds`` and ``sim_seconds`` (the run's
+    share). A run ``Master.configure`` refuses is left to ``run_one``; so is every run,
+    saying why in its backend, where ``batch_refusal`` refuses or the batch fails as a
+    whole (an exception, or past ``batch_limits``)."""
     from ..ensemble import simulate_members
 
     started = time.perf_counter()
@@ -313,52 +238,10 @@ def noted(row: dict[str, Any], why: str) -> dict[str, Any]:
 
 
 def member_backend(meta: dict[str, Any]) -> str:
-    """A batch member's backend column, from its recording's meta: "batch", or how it ran
-    alone and why (the kernel's notes: "ran on the in-process route, not in the batch: ...")."""
+    """A batch member's backend column: "batch", or how it ran alone and why (the kernel's
+    notes)."""
     if meta.get("backend") == BATCH:
         return BATCH
     ran = ran_on(meta.get("backends"), meta.get("backend", "inprocess"))
     notes = "; ".join(meta.get("notes") or [])
     return f"{ran} ({notes})" if notes else ran
-
-
-def _track(recording, every: float = 1.0) -> dict:
-    """The run's track every ``every`` s, its route and circle of acceptance, for the
-    tracks figure."""
-    stride = max(1, round(every / recording.meta["step_size"]))
-    points, R_accept = route_of(recording)
-    return {"x": recording["ship.x"][::stride].tolist(),
-            "y": recording["ship.y"][::stride].tolist(),
-            "route": [list(point) for point in points], "R_accept": R_accept}
-
-
-def route_of(recording) -> tuple[list[tuple[float, float]], float]:
-    """The route the run's guidance followed (m) and its radius of acceptance (m), from the
-    parameter values the FMUs used."""
-    guidance = recording.meta.get("parameters", {}).get("guidance", {})
-    return followed_route(guidance), float(guidance.get("R_accept", R_ACCEPT))
-
-
-def run_metrics(recording) -> dict[str, float]:
-    """Every figure of merit of ``METRICS`` of a course-keeping run: eq (19); the RMS
-    heading error psi_d - psi; from the actual rudder ship.delta its largest angle, its
-    reversals per minute, its mean absolute rate and the time on its stops; the RMS and
-    largest cross-track error from the leg the guidance follows; and the waypoints of the
-    route reached, within the circle of acceptance, of those it has."""
-    c = cost(recording)
-    t, delta, x, y = (recording.t, recording["ship.delta"], recording["ship.x"],
-                      recording["ship.y"])
-    points, R_accept = route_of(recording)
-    stops = recording.meta.get("parameters", {}).get("ship", {}).get("delta_max", math.inf)
-    track = cross_track_error(x, y, recording["guidance.wp_index"], points)
-    completion = route_completion(x, y, points, R_accept)
-    return {"psi_E": c.psi_E, "sum_delta2": c.sum_delta2, "J": c.J,
-            "rms_heading_error_deg": math.degrees(rms(heading_error(
-                recording["guidance.psi_d"], recording["ship.psi"]))),
-            "reversals_per_min": rudder_reversals_per_minute(t, delta),
-            "max_delta_deg": math.degrees(peak(delta)),
-            "mean_rudder_rate_deg_s": math.degrees(mean_abs_rate(t, delta)),
-            "at_stops_pct": 100.0 * fraction_at_stops(delta, stops),
-            "cross_track_rms_m": rms(track), "cross_track_max_m": peak(track),
-            "waypoints_reached": float(completion.count), "waypoints": float(len(points)),
-            "last_waypoint_reached": float(completion.last_reached)}

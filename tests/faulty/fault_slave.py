@@ -7,7 +7,9 @@ NaN), 2 'range' (the propeller command n1 is 100 rev/s, outside the ship's +-50)
 5 'sigterm' (its step sends that signal to its own process, once: Ctrl-C or a
 kill arriving while FMU code runs), 6 'loop' (its step never returns, looping in
 Python), 7 'block' (its step never returns, waiting in C: a sleep that no Python
-exception interrupts), 0 'none'.
+exception interrupts), 0 'none'. Where the environment names a file in
+``FAULT_HANG_MARKER``, a step that is about to hang creates it first, so that a test can
+wait for the hang itself instead of for a time.
 """
 import os
 import signal
@@ -38,6 +40,10 @@ class Fault:
         if self.fault_kind.startswith("sig") and t >= self.fault_time and not self.signalled:
             self.signalled = True
             os.kill(os.getpid(), getattr(signal, self.fault_kind.upper()))
+        if self.fault_kind in ("loop", "block") and t >= self.fault_time:
+            marker = os.environ.get("FAULT_HANG_MARKER")
+            if marker:
+                open(marker, "w").close()
         if self.fault_kind == "loop" and t >= self.fault_time:
             while True:
                 pass

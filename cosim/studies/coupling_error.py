@@ -1,13 +1,7 @@
-"""How large are the set-up's own numerical errors? (Issue 17.) Parts 2 and 3: coupling
-error, closed loop.
-
-Part 2 runs each of the paper's runs through our master at the 0.1 s communication
-step, with Gauss-Seidel and with Jacobi coupling, against the monolithic reference
-(``monolithic``: the controller inside the solver, as a continuous Simulink block
-would be), by psi_E, sum delta^2 and J of eq (19) and the largest heading difference;
-part 3 follows J's distance from the monolithic value over communication steps from
-0.4 s to 0.0125 s. Their tables and the convergence figure are here too. Part 1, the
-open-loop integration error, is ``integration_error``.
+"""The accuracy study's parts 2 and 3, the coupling error closed loop: each of the paper's runs
+through our master at the 0.1 s communication step, Gauss-Seidel and Jacobi, against the
+monolithic reference (``monolithic``) by the figures of eq (19) and the largest heading
+difference; then J's distance from it over communication steps of 0.4 s to 0.0125 s.
 """
 from __future__ import annotations
 
@@ -26,9 +20,8 @@ STEPS = (0.4, 0.2, 0.1, 0.05, 0.025, 0.0125)   # s, communication steps of part 
 
 def cosimulation(name: str, step: float, coupling: str,
                  stop_time: float | None = None) -> dict[str, np.ndarray]:
-    """Our master (the FMUs' classes in-process: the same code, without FMI's cost) at
-    communication step ``step``, sampled on the 0.1 s grid; a coarser step is sampled at
-    its own points, each standing for step / 0.1 samples of the grid (``weight``)."""
+    """Our master in-process at communication step ``step``, sampled on the 0.1 s grid (a
+    coarser step at its own points, each standing for step / 0.1 samples: ``weight``)."""
     import dataclasses
 
     from .. import scenarios
@@ -55,8 +48,7 @@ def figures(run: dict[str, np.ndarray]) -> dict[str, float]:
 
 
 def closed_loop(name: str, stop_time: float | None = None) -> dict[str, dict]:
-    """Part 2 for one run: figures of the monolithic reference and of both couplings at
-    0.1 s, with the largest heading difference from the reference."""
+    """Part 2 for one run: the figures of the reference and of both couplings at 0.1 s."""
     from .. import scenarios
 
     reference_run = monolithic(scenarios.load(name), stop_time)
@@ -82,8 +74,8 @@ def closed_loop_table(results: dict[str, dict]) -> str:
 
 def convergence(name: str, reference_figures: dict[str, float], steps=STEPS,
                 stop_time: float | None = None) -> dict[str, list[dict]]:
-    """Part 3 for one run: J, psi_E and sum delta^2 at each communication step, each
-    coupling, and the relative distance of J from the monolithic value."""
+    """Part 3 for one run: the figures at each step and coupling, and J's relative distance
+    from the monolithic value."""
     out = {}
     for coupling in COUPLINGS:
         rows = []
@@ -111,12 +103,11 @@ def convergence_table(results: dict[str, dict], references: dict[str, dict]) -> 
 
 def convergence_figure(results: dict[str, dict], path: Path) -> Path:
     """|J - J_monolithic| / J_monolithic against the communication step, log-log."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     import matplotlib.ticker
+    from matplotlib.figure import Figure
 
-    fig, ax = plt.subplots(figsize=(7, 4.5))
+    fig = Figure(figsize=(7, 4.5))
+    ax = fig.subplots()
     for name, by_coupling in results.items():
         for coupling, rows in by_coupling.items():
             ax.loglog([r["step"] for r in rows], [max(r["J_error"], 1e-12) for r in rows],
@@ -132,5 +123,4 @@ def convergence_figure(results: dict[str, dict], path: Path) -> Path:
     ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
-    plt.close(fig)
     return path

@@ -1,53 +1,30 @@
-"""The sweep benchmark (``python -m cosim.bench sweep``): sweeps on a local cluster, every
-backend side by side, and the batch route's goals (issue 29), each printed beside its figure.
-
-- ``sweep_throughput``: runs per second of sweeps of 400 s runs (waves_pd and waves_smc over
-  wave seeds; calm_pd and calm_smc over initial headings) on the FMI, in-process and batch
-  backends with 1 and 2 workers, per core, and the batch route's against the in-process
-  route's;
-- ``campaign``: 1,000 waves_pd runs of 400 s on the batch route on 2 workers, from
-  submission to the last row, and with the cluster's start-up;
-- ``batch_memory``: the peak memory of ``simulate_members`` against its number of members,
-  and of a worker against the size of the sweep it ran (cut into batches as the sweep cuts
-  them, ``sweep_client.plan``).
-
-The machines are shared: each part prints the load average before and after it.
+"""The sweep benchmark (``python -m cosim.bench sweep``): sweeps on fresh local clusters, every
+backend side by side (``sweep_throughput``) and 1,000 waves_pd runs on the batch route
+(``campaign``; its memory: ``memory.batch_memory``), each goal printed beside its figure and
+the load average before and after each part.
 """
 from __future__ import annotations
 
 import math
 import os
 import statistics
-import subprocess
-import sys
 import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from .bench import machine, peak_rss_mb, require_in_process
 from .sweep_client import plan
 from .sweep_task import BATCH, SWEEP_BACKENDS
+from .timing import machine, peak_rss_mb, require_in_process
 
 SEAS = {"waves": ("waves_pd", "waves_smc"), "calm": ("calm_pd", "calm_smc")}
-"""The scenarios of each sea's sweeps: the paper's two autopilots."""
 GOALS = {"waves": 5.0, "calm": 10.0}
-"""The batch route's runs per second per core, at least this many times the in-process
-route's (issue 29)."""
+"""The batch route's goal: its runs per second per core over the in-process route's."""
 CAMPAIGN_RUNS, CAMPAIGN_STOP_TIME, CAMPAIGN_WORKERS, CAMPAIGN_GOAL = 1000, 400.0, 2, 30.0
-"""The issue's campaign: 1,000 waves_pd runs of 400 s in under 30 s on these two cores."""
-MEMORY_MEMBERS = (64, 256, 1024, 4096)
-"""Members of the ``simulate_members`` calls, and runs of the sweeps, whose memory is
-measured."""
-MEMORY_STOP_TIME = 40.0
-"""s, each run of the memory measurement (its results grow with it; nothing else does)."""
-FLAT = 0.10
-"""A worker's peak memory counts as flat if the largest sweep's is within this fraction of
-that of the smallest sweep whose batches are as large."""
+"""The campaign's goal: these runs of this stop time on these workers within this many s."""
 
 
 def load() -> str:
-    """The load average, as printed beside the figures."""
     one, five, fifteen = os.getloadavg()
     return f"load average {one:.2f} {five:.2f} {fifteen:.2f} (1, 5, 15 min)"
 
@@ -80,11 +57,9 @@ def sweep_throughput(runs: int = 32, batch_runs: int = 1024,
                      seas: tuple[str, ...] = tuple(SEAS), worker_counts: tuple[int, ...] = (1, 2),
                      backends: tuple[str, ...] = SWEEP_BACKENDS, rounds: int = 1,
                      stop_time: float = 400.0) -> dict[tuple[str, str, int], float]:
-    """Runs per second, (sea, backend, workers): the median of ``rounds`` sweeps of ``runs``
-    runs (``batch_runs`` on the batch backend), measured in turn, round after round; printed
-    with the per-core rates, the parallel efficiency and the batch route's goals (judged by
-    the median of the rounds' ratios, each of a batch sweep to the in-process sweep of its
-    round)."""
+    """Runs per second by (sea, backend, workers): the median of ``rounds`` sweeps of ``runs``
+    runs (``batch_runs`` on the batch backend) taken in turn; printed with the per-core
+    rates, the parallel efficiency and the goals (the median of the rounds' ratios)."""
     _check_runs(runs, "runs")
     _check_runs(batch_runs, "batch_runs")
     if rounds < 1:
@@ -100,8 +75,9 @@ def sweep_throughput(runs: int = 32, batch_runs: int = 1024,
         for workers in worker_counts:             # backends side by side, under the same load
             for sea in seas:
                 for backend in backends:
-                    measure = _sea_sweep(sea, batch_runs if backend == BATCH else runs,
-                                         workers, backend, stop_time)
+                    with tempfile.TemporaryDirectory() as tmp:
+                        measure = timed_sweep(_sea_spec(Path(tmp), sea, batch_runs if backend ==
+                                                   BATCH else runs, stop_time), workers, backend)
                     _print_measure(f"{sea:5} {backend:9}", measure)
                     measured.setdefault((sea, backend, workers), []).append(measure.rate)
     rates = {key: statistics.median(values) for key, values in measured.items()}
@@ -117,26 +93,25 @@ def sweep_throughput(runs: int = 32, batch_runs: int = 1024,
 
 def campaign(runs: int = CAMPAIGN_RUNS, workers: int = CAMPAIGN_WORKERS,
              stop_time: float = CAMPAIGN_STOP_TIME) -> Measure:
-    """``runs`` waves_pd runs of ``stop_time`` on the batch route on a local cluster of
-    ``workers``: the wall time from submission to the last row, and with the cluster's
-    start-up, against the issue's goal where it is the issue's campaign."""
+    """``runs`` waves_pd runs of ``stop_time`` on the batch route on ``workers``: the wall
+    time from submission to the last row, and with the start-up, against the goal."""
     if runs < 1:
         raise ValueError(f"the campaign's runs must be at least 1, got {runs}")
     print(f"campaign: {runs} waves_pd runs of {stop_time:g} s on the batch route, a local "
           f"cluster of {_workers(workers)}, on {machine()}; {load()}")
     with tempfile.TemporaryDirectory() as tmp:
-        spec = _bench_spec(Path(tmp), {"pd": "waves_pd"}, _seeds(runs), stop_time)
-        _require_batch(spec)
-        measure = _sweep(spec, workers, BATCH)
+        spec = bench_spec(Path(tmp), {"pd": "waves_pd"}, seeds(runs), stop_time)
+        require_batch(spec)
+        measure = timed_sweep(spec, workers, BATCH)
     total = measure.wall + measure.startup
     print(f"  {measure.runs} runs in {measure.wall:.1f} s from submission to the last row "
           f"({measure.rate:.1f} runs/s, {measure.rate / workers:.1f} per core; batches of "
-          f"{_sizes(measure.batches)}); {total:.1f} s with the cluster's start-up "
+          f"{sizes(measure.batches)}); {total:.1f} s with the cluster's start-up "
           f"({measure.startup:.1f} s)")
     if (runs, stop_time, workers) == (CAMPAIGN_RUNS, CAMPAIGN_STOP_TIME, CAMPAIGN_WORKERS):
         print(f"  goal: {CAMPAIGN_RUNS:,} waves_pd runs of {CAMPAIGN_STOP_TIME:g} s in under "
               f"{CAMPAIGN_GOAL:g} s on {CAMPAIGN_WORKERS} cores: {measure.wall:.1f} s "
-              f"({total:.1f} s with the start-up): {_verdict(measure.wall < CAMPAIGN_GOAL)}"
+              f"({total:.1f} s with the start-up): {verdict(measure.wall < CAMPAIGN_GOAL)}"
               + ("" if total < CAMPAIGN_GOAL or measure.wall >= CAMPAIGN_GOAL
                  else ", not with the start-up"))
     else:
@@ -146,53 +121,13 @@ def campaign(runs: int = CAMPAIGN_RUNS, workers: int = CAMPAIGN_WORKERS,
     return measure
 
 
-def batch_memory(members: tuple[int, ...] = MEMORY_MEMBERS,
-                 stop_time: float = MEMORY_STOP_TIME, batch_size: int | None = None) -> dict:
-    """Peak memory (MB) of waves_pd runs of ``stop_time`` on the batch route: of a
-    ``simulate_members`` call in a fresh process for each number of ``members`` (with what
-    its results take), and of the one worker of a sweep of as many runs in batches of at
-    most ``batch_size`` (default: the sweep's); whether the worker's is flat in the sweep's
-    size."""
-    print(f"batch route memory: waves_pd runs of {stop_time:g} s, on {machine()}; {load()}")
-    calls = {m: _members_call(m, stop_time) for m in members}
-    for m, (wall, before, peak, results) in calls.items():
-        rest = peak - before - results
-        print(f"  simulate_members, {m:5} members: {wall:6.1f} s, peak RSS {peak:7.1f} MB, "
-              f"{peak - before:7.1f} MB over the process before the call: results "
-              f"{results:6.1f} MB, the rest {rest:6.1f} MB ({rest / m * 1024:5.1f} kB a member)")
-    sweeps = {}
-    with tempfile.TemporaryDirectory() as tmp:
-        for m in members:
-            spec = _bench_spec(Path(tmp) / str(m), {"pd": "waves_pd"}, _seeds(m), stop_time)
-            _require_batch(spec)
-            sweeps[m] = _sweep(spec, 1, BATCH, batch_size)
-            print(f"  sweep of {m:5} runs, 1 worker, {len(sweeps[m].batches):3} batch"
-                  f"{'es' if len(sweeps[m].batches) > 1 else '  '} of "
-                  f"{_sizes(sweeps[m].batches):9}: worker peak RSS "
-                  f"{sweeps[m].peak_rss[0]:7.1f} MB ({sweeps[m].wall:6.1f} s)")
-    largest = max(max(s.batches) for s in sweeps.values())
-    full = [m for m in members if max(sweeps[m].batches) == largest]
-    if len(full) < 2:
-        print(f"  memory in the sweep's size: not judged (it takes two sweeps whose batches "
-              f"are of {largest} runs, the largest here)")
-    else:
-        low, high = sweeps[min(full)].peak_rss[0], sweeps[max(full)].peak_rss[0]
-        growth = high / low - 1.0
-        print(f"  goal: memory flat in the sweep's size (batches of at most {largest} runs): "
-              f"worker peak RSS {low:.1f} MB at {min(full)} runs, {high:.1f} MB at "
-              f"{max(full)} runs ({growth:+.1%}; flat: within {FLAT:.0%}): "
-              f"{_verdict(growth <= FLAT)}")
-    print(f"  {load()}")
-    return {"calls": calls, "sweeps": sweeps}
-
-
 def _check_runs(runs: int, name: str) -> None:
     if runs < 2 or runs % 2:
         raise ValueError(f"{name} must be an even number of runs >= 2 (half for each "
                          f"autopilot), got {runs}")
 
 
-def _verdict(met: bool) -> str:
+def verdict(met: bool) -> str:
     return "met" if met else "NOT met"
 
 
@@ -200,24 +135,23 @@ def _workers(count: int) -> str:
     return f"{count} worker{'s' if count > 1 else ''}"
 
 
-def _sizes(sizes: tuple[int, ...]) -> str:
+def sizes(sizes: tuple[int, ...]) -> str:
     """Batch sizes, as "256" or "250-256"."""
     low, high = min(sizes), max(sizes)
     return f"{low}" if low == high else f"{low}-{high}"
 
 
-def _seeds(runs: int) -> dict[str, str]:
-    """The axis of ``runs`` wave seeds from 1, in TOML."""
+def seeds(runs: int) -> dict[str, str]:
+    """The axis of ``runs`` wave seeds from 1, in TOML (in calm water: headings, 1 mrad apart,
+    since the seed changes nothing there)."""
     return {"wave_seed": f"{{ start = 1, count = {runs} }}"}
 
 
 def _headings(runs: int) -> dict[str, str]:
-    """The axis of ``runs`` initial headings 0, 1, 2, ... mrad, in TOML (in calm water the
-    wave seed changes nothing)."""
     return {'"ship.psi0"': "[" + ", ".join(repr(k / 1000) for k in range(runs)) + "]"}
 
 
-def _bench_spec(folder: Path, controllers: dict[str, str], axes: dict[str, str],
+def bench_spec(folder: Path, controllers: dict[str, str], axes: dict[str, str],
                 stop_time: float):
     """A sweep of ``controllers`` (name: scenario) over ``axes`` (name: its TOML value)."""
     from .sweep_spec import Spec
@@ -234,8 +168,8 @@ def _bench_spec(folder: Path, controllers: dict[str, str], axes: dict[str, str],
 
 def _sea_spec(folder: Path, sea: str, runs: int, stop_time: float):
     """The sweep of ``runs`` runs of a sea: half with each of its scenarios."""
-    axis = _seeds if sea == "waves" else _headings
-    return _bench_spec(folder, dict(zip(("pd", "smc"), SEAS[sea])), axis(runs // 2), stop_time)
+    axis = seeds if sea == "waves" else _headings
+    return bench_spec(folder, dict(zip(("pd", "smc"), SEAS[sea])), axis(runs // 2), stop_time)
 
 
 def _require(sea: str, backends: tuple[str, ...]) -> None:
@@ -245,13 +179,12 @@ def _require(sea: str, backends: tuple[str, ...]) -> None:
         if "inprocess" in backends:
             require_in_process(spec.backend_notes("inprocess"))
         if BATCH in backends:
-            _require_batch(spec)
+            require_batch(spec)
 
 
-def _require_batch(spec) -> None:
-    """RuntimeError if the runs of ``spec`` would not all run in batches (the kernel does not
-    cover a system, or refuses this machine): the batch route could not be measured. Prints
-    the self-test's time, which each worker process spends once."""
+def require_batch(spec) -> None:
+    """RuntimeError if the runs of ``spec`` would not all run in batches; prints the
+    self-test's time, which each worker process spends once."""
     from ..ensemble import selftest
 
     notes = spec.backend_notes(BATCH)
@@ -266,18 +199,13 @@ def _require_batch(spec) -> None:
               "per worker process (within each batch sweep's time)")
 
 
-def _sea_sweep(sea: str, runs: int, workers: int, backend: str, stop_time: float) -> Measure:
-    with tempfile.TemporaryDirectory() as tmp:
-        return _sweep(_sea_spec(Path(tmp), sea, runs, stop_time), workers, backend)
-
-
-def _sweep(spec, workers: int, backend: str, batch_size: int | None = None) -> Measure:
+def timed_sweep(spec, workers: int, backend: str, batch_size: int | None = None) -> Measure:
     """``spec`` run on a fresh local cluster of ``workers``; RuntimeError if a run failed,
     or, on the batch backend, ran other than in a batch."""
     from dask.distributed import Client
 
+    from .campaign import execute
     from .cluster import local_cluster
-    from .sweep import execute
 
     with tempfile.TemporaryDirectory() as tmp:
         started = time.perf_counter()
@@ -309,37 +237,8 @@ def _sweep(spec, workers: int, backend: str, batch_size: int | None = None) -> M
                    sizes, peaks, os.getloadavg()[0])
 
 
-def _members_call(members: int, stop_time: float) -> tuple[float, float, float, float]:
-    """(wall s, peak RSS before the call MB, peak RSS MB, results MB) of ``simulate_members``
-    of ``members`` waves_pd runs of ``stop_time`` (wave seeds 1, 2, ...) in a fresh process;
-    RuntimeError if a member did not run in the batch."""
-    code = ("import sys, time\n"
-            "from cosim import scenarios\n"
-            "from cosim.ensemble import selftest, simulate_members\n"
-            "from cosim.studies.bench import peak_rss_mb\n"
-            "system = scenarios.load('waves_pd')\n"
-            "selftest()\n"
-            "before = peak_rss_mb()\n"
-            "started = time.perf_counter()\n"
-            f"recordings = simulate_members(system, [{{'ship': {{'wave_seed': seed}}}} "
-            f"for seed in range(1, {members + 1})], {stop_time!r})\n"
-            "wall = time.perf_counter() - started\n"
-            "alone = [r.meta['notes'] for r in recordings if r.meta['backend'] != 'batch']\n"
-            "if alone:\n"
-            "    sys.exit(f'{len(alone)} members ran alone: {alone[0]}')\n"
-            "print(wall, before, peak_rss_mb(),\n"
-            "      sum(r.data.nbytes for r in recordings) + recordings[0].t.nbytes)\n")
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                          check=False)
-    if done.returncode:
-        raise RuntimeError(f"simulate_members of {members} members failed: "
-                           f"{done.stderr.strip().splitlines()[-1:]}")
-    wall, before, peak, results = map(float, done.stdout.split())
-    return wall, before, peak, results / 2**20
-
-
 def _print_measure(label: str, m: Measure) -> None:
-    batched = f"; batches of {_sizes(m.batches)}" if m.batches else ""
+    batched = f"; batches of {sizes(m.batches)}" if m.batches else ""
     print(f"  {label} {m.workers} worker{'s' if m.workers > 1 else ' '}: {m.rate:6.2f} runs/s "
           f"({m.runs} runs in {m.wall:5.1f} s; cluster start-up {m.startup:4.1f} s{batched}); "
           f"per run: simulation {m.simulated:5.3f} s, overhead in the task {m.in_task:5.3f} s "
@@ -347,16 +246,9 @@ def _print_measure(label: str, m: Measure) -> None:
           f"({m.outside / m.simulated:4.1%}); load {m.load:.2f}")
 
 
-def _efficiency(rates: dict[tuple[str, str, int], float], sea: str, backend: str, base: int,
-                workers: int) -> float:
-    """The parallel efficiency from ``base`` workers to ``workers``: 1.0 if each worker runs
-    as fast as one of ``base`` alone."""
-    return rates[sea, backend, workers] / rates[sea, backend, base] / (workers / base)
-
-
 def _print_rates(rates: dict[tuple[str, str, int], float], seas: tuple[str, ...],
                  worker_counts: tuple[int, ...], backends: tuple[str, ...], rounds: int) -> None:
-    """Per-core rates and parallel efficiency, the ratios between backends and the goals."""
+    """Per-core rates and parallel efficiency, and the ratios between backends."""
     base = min(worker_counts)
     others = [w for w in worker_counts if w != base]
     print("  runs/s per core (runs/s / workers" + (f", median of {rounds} rounds" if rounds > 1
@@ -365,10 +257,9 @@ def _print_rates(rates: dict[tuple[str, str, int], float], seas: tuple[str, ...]
           + "".join(f"{f'efficiency {base}->{w}':>17}" for w in others))
     for sea in seas:
         for backend in backends:
-            print(f"    {sea:5} {backend:9}"
-                  + "".join(f"{rates[sea, backend, w] / w:11.2f}" for w in worker_counts)
-                  + "".join(f"{_efficiency(rates, sea, backend, base, w):17.2f}"
-                            for w in others))
+            rate = {w: rates[sea, backend, w] for w in worker_counts}
+            print(f"    {sea:5} {backend:9}" + "".join(f"{rate[w] / w:11.2f}" for w in rate)
+                  + "".join(f"{rate[w] / rate[base] * base / w:17.2f}" for w in others))
     print("    (efficiency 1.00: each worker as fast as one alone)")
     for sea in seas:
         for backend in backends:
@@ -379,12 +270,11 @@ def _print_rates(rates: dict[tuple[str, str, int], float], seas: tuple[str, ...]
 
 
 def _print_goal(sea: str, ratios: dict[int, list[float]]) -> None:
-    """The batch route's goal in ``sea``: for each number of workers, the batch sweep's
-    rate over the in-process sweep's of the same round (the same per core), the median of
-    the rounds, each round's beside it."""
+    """The batch route's goal in ``sea``: its rate over the in-process sweep's of the same
+    round, the median of the rounds, each round's beside it."""
     medians = {w: statistics.median(r) for w, r in ratios.items()}
     print(f"  goal, {sea}: batch runs/s per core at least {GOALS[sea]:g}x in-process: "
           + ", ".join(f"{medians[w]:.2f}x with {_workers(w)}"
                       + (f" (rounds: {', '.join(f'{x:.2f}' for x in r)})" if len(r) > 1 else "")
                       for w, r in ratios.items())
-          + f": {_verdict(all(m >= GOALS[sea] for m in medians.values()))}")
+          + f": {verdict(all(m >= GOALS[sea] for m in medians.values()))}")

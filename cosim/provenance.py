@@ -1,12 +1,10 @@
 """What it takes to reproduce a run, written as JSON next to its CSV.
 
-The unit of every column, every parameter value the FMUs held (defaults and what
-was set) with its unit, the values the scenario sets (inputs such as propeller
-speeds included) and those given on top of it, the scenario file and its SHA-256,
-each FMU's file, GUID and SHA-256 (and, for one built with fmukit, its sources' digest
-and whether they are this process's: ``current``), the backend, coupling, step and times, the wall
-time, the command, and the versions of this package (with its git commit), Python,
-numpy, fmpy and pythonfmu. Strict JSON: a non-finite number is written as a string.
+Besides what the master records (``Master.run_meta``: units, parameters as held and as set,
+backends, step, times), each FMU's SHA-256 (and, for one built with fmukit, its sources'
+digest and whether they are this process's: ``current``), the scenario's SHA-256, the
+command, and the versions of this package (with its git commit), Python, numpy, fmpy and
+pythonfmu. Strict JSON: a non-finite number is written as a string.
 """
 from __future__ import annotations
 
@@ -24,9 +22,9 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any
 
-from fmubuild.manifest import read, staleness
+from fmukit.manifest import read, staleness
 
-from .recording import Recording
+from .core.recording import Recording
 
 PACKAGE = "ship-autopilot-cosim"
 CODE_PACKAGES = ("cosim", "fmukit", "ship_fmu", "autopilot_fmu")
@@ -47,9 +45,8 @@ def _sha256(path: str) -> str | None:
 
 
 def _manifest(path: str) -> dict[str, Any]:
-    """What an FMU built with fmukit says of its sources (``fmubuild.manifest``): their
-    digest, and whether they are the ones this process imports (``current``: the one
-    notion of a stale FMU; the reason where not). Nothing for any other FMU."""
+    """An FMU built with fmukit: its sources' digest, and whether they are this process's
+    (``fmukit.manifest.staleness``); nothing for any other FMU."""
     try:
         manifest = read(path)
     except (OSError, ValueError, zipfile.BadZipFile):
@@ -63,7 +60,7 @@ def _manifest(path: str) -> dict[str, Any]:
 
 def _commit() -> str | None:
     """The git commit of this checkout, with '+changes' if it has uncommitted ones."""
-    root = Path(__file__).resolve().parents[2]
+    root = Path(__file__).resolve().parents[1]
     try:
         head = subprocess.run(["git", "-C", str(root), "rev-parse", "HEAD"], capture_output=True,
                               text=True, timeout=10)

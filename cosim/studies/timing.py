@@ -1,14 +1,6 @@
-"""Benchmarks that print figures (never timed assertions); ``python -m cosim.bench`` runs them.
-
-- ``engines``: calm_pd and waves_pd, 400 s, (a) the plain Python modules wired by
-  hand (``cosim.studies.direct``), our master (b) on its in-process backend and (c)
-  through the FMUs, (d) OSP libcosim and (e) ecos on the exported SSP package of the
-  same scenario, timed in turn round after round (median of each), and (f) the floor
-  of any FMI route: (a) plus the FMI calls a step makes times the measured cost of one;
-- ``overhead``: what the routes do besides the models (the ship's step doing nothing);
-- ``memory``: a long calm_pd run streamed to CSV, peak memory against a 1 h run;
-- ``sweep_throughput`` (in ``bench_sweep``): runs per second of a seed sweep on a local
-  cluster, for each backend with 1 and 2 workers.
+"""The engine benchmarks behind ``python -m cosim.bench`` (figures printed, never asserted):
+``engines`` side by side on calm_pd and waves_pd, and ``overhead``, what the routes do
+besides the models; the helpers the other benchmarks share.
 """
 from __future__ import annotations
 
@@ -16,22 +8,17 @@ import os
 import platform
 import resource
 import statistics
-import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
 from typing import Callable
 
-from ..core.master import RUN_BACKENDS
-
 STEPS = 4000
 
 
 def peak_rss_mb() -> float:
-    """This process's peak resident memory, MB (run on each worker): Linux's VmHWM, which
-    starts afresh with the process's program. (``ru_maxrss`` does not: a child started by
-    fork and exec keeps its parent's peak at the fork.)"""
+    """This process's peak resident memory, MB: Linux's VmHWM, which starts afresh with the
+    process's program (``ru_maxrss`` keeps a forked parent's peak)."""
     try:
         for line in Path("/proc/self/status").read_text().splitlines():
             if line.startswith("VmHWM:"):
@@ -56,8 +43,8 @@ def machine() -> str:
 
 
 def side_by_side(runners: dict[str, Callable[[], object]], repeats: int) -> dict[str, float]:
-    """Median wall time of each runner, timed in turn, round after round (after one warm-up
-    round): on a shared machine, the alternatives see the same load."""
+    """Median wall time of each runner, timed in turn round after round after a warm-up
+    round, so that on a shared machine they see the same load."""
     times: dict[str, list[float]] = {key: [] for key in runners}
     for round_ in range(repeats + 1):
         for key, run in runners.items():
@@ -104,8 +91,10 @@ ROWS = {"direct": "(a) cosim.direct: the modules wired by hand",
 
 
 def engines(repeats: int) -> dict[str, dict[str, float]]:
-    """calm_pd and waves_pd, 400 s, every way at once; prints one table per scenario and the
-    ratios, returns the times by scenario and row."""
+    """calm_pd and waves_pd, 400 s, by (a) the modules wired by hand (``direct``), our master
+    (b) in-process and (c) through the FMUs, (d) libcosim and (e) ecos on the exported SSP
+    package, and (f) the FMI floor, (a) plus the calls per step times one's cost; one table
+    per scenario with the ratios, and the times by scenario and row."""
     from .. import scenarios
     from ..core.master import Master
     from ..interop.ssp import export
@@ -174,15 +163,15 @@ def _print_engines(name: str, times: dict[str, float], calls: int, per_call: flo
 
 
 def fmi_calls_per_step(master) -> int:
-    """FMI calls one Gauss-Seidel step of ``master`` makes (its prepared calls)."""
+    """FMI calls one Gauss-Seidel step of ``master`` makes."""
     return sum(bool(call) for node in master.nodes
                for call in (node.read_state, node.apply_inputs, node.read_feedthrough,
                             node.read_integers, node.step))
 
 
 def fmi_call_cost(master, calls: int = 20_000) -> float:
-    """Seconds per FMI call of the cheapest kind a step makes, setReal and getReal of one
-    value on the autopilot FMU, as the master's loop makes them."""
+    """Seconds per FMI call of the cheapest kind, setReal and getReal of one value on the
+    autopilot FMU, as the master's loop makes them."""
     master.reset()
     master.initialize()
     instance = master.instances["autopilot"]
@@ -197,8 +186,7 @@ def fmi_call_cost(master, calls: int = 20_000) -> float:
 
 def overhead(repeats: int) -> dict[str, float]:
     """What the routes do besides the models: calm_pd with the ship's step doing nothing,
-    by hand (``cosim.direct``), the master with no FMU behind it (null backend) and the
-    in-process master; microseconds per step, timed in turn."""
+    by hand, on the null backend and in-process; microseconds per step."""
     from unittest import mock
 
     from ship_fmu.vessel import Vessel
@@ -225,27 +213,3 @@ def overhead(repeats: int) -> dict[str, float]:
           f"{per_step['inprocess'] - per_step['direct']:.1f} us/step (its calls into the slaves, "
           "and its bookkeeping beyond direct's)")
     return per_step
-
-
-def memory(hours: float, backends: tuple[str, ...] = RUN_BACKENDS) -> None:
-    """A long calm_pd run with rows streamed to disk; peak RSS against a short run, for each
-    backend."""
-    print(f"Memory: calm_pd streamed to CSV in chunks of 10,000 rows, on {machine()}")
-    for backend, duration in ((b, d) for b in backends for d in (3600.0, hours * 3600.0)):
-        code = ("import time, tempfile, os\n"
-                "from cosim import scenarios\nfrom cosim.core.master import Master\n"
-                "from cosim.studies.bench import peak_rss_mb\n"
-                f"m = Master(scenarios.load('calm_pd'), backend={backend!r})\n"
-                "out = os.path.join(tempfile.mkdtemp(), 'run.csv')\n"
-                "t = time.perf_counter()\n"
-                f"rec = m.run({duration!r}, csv_path=out)\n"
-                "wall = time.perf_counter() - t\n"
-                "m.free()\n"
-                "assert rec.error is None, rec.error\n"
-                "print(rec.rows, wall, os.path.getsize(out), peak_rss_mb())\n"
-                "os.remove(out)\n")
-        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                             check=True).stdout.split()
-        rows, wall, size, peak = int(out[0]), float(out[1]), int(out[2]), float(out[3])
-        print(f"  {backend:9} {duration / 3600:5.1f} h simulated: {rows:>8} rows, "
-              f"{wall:6.1f} s wall, CSV {size / 1e6:7.1f} MB, peak RSS {peak:6.1f} MB")

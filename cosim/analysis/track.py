@@ -1,0 +1,195 @@
+"""The track panel every figure of a run shares: north up, east right at equal scale, the
+route with its circles of acceptance and named waypoints, where each leg switched, the
+ship's outline at regular times (enlarged where it could not be seen) and the wave direction.
+"""
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from matplotlib.lines import Line2D
+from matplotlib.patches import Circle, Polygon
+from matplotlib.path import Path as Shape
+
+from autopilot_fmu.guidance import route as followed_route
+from ship_fmu.data import Hull
+
+from ..core.recording import Recording
+
+OUTLINES = 12                                   # ship outlines along a track, about
+TRACK = "track"                                 # a track panel's label, for legend_if_any
+_DIRECTIONS = [(math.cos(a), math.sin(a)) for a in np.radians(np.arange(0, 360, 45))]
+
+
+def waypoint_name(i: int) -> str:
+    """Route point ``i`` (0-based, as ``wp_index``) by name: numbered from 1 as in Fossen
+    (2011, ch. 10), so the start is 'WP1' and the first leg steers for WP2."""
+    return f"WP{i + 1}"
+
+
+def hull_outline(x: float, y: float, psi: float, scale: float = 1.0) -> np.ndarray:
+    """The ship's waterline as (east, north) corners at (x, y, psi), ``scale`` times enlarged."""
+    L, B = scale * Hull.L, scale * Hull.B
+    body = np.array([(L / 2, 0.0), (L / 4, B / 2), (-L / 2, B / 2), (-L / 2, -B / 2),
+                     (L / 4, -B / 2)])                  # x forward, y starboard
+    c, s = math.cos(psi), math.sin(psi)
+    north = x + body[:, 0] * c - body[:, 1] * s
+    east = y + body[:, 0] * s + body[:, 1] * c
+    return np.column_stack([east, north])
+
+
+def outline_scale(spacing: float, extent: float) -> int:
+    """The largest one-digit factor (1 ... 9, 10, 20, ...) that keeps an enlarged outline
+    within 0.8 of ``spacing`` and 1/12 of ``extent`` (m); 1 if to scale is large enough."""
+    limit = min(0.8 * spacing, extent / 12.0) / Hull.L
+    if limit < 1.0:
+        return 1
+    decade = 10 ** math.floor(math.log10(limit))
+    return int(limit // decade * decade)
+
+
+@dataclass(frozen=True)
+class Outlines:
+    """Where a track shows the ship's outline: the rows, every how many s, how enlarged."""
+
+    rows: list[int]
+    every: float
+    scale: int
+
+    @property
+    def size(self) -> str:
+        return "to scale" if self.scale == 1 else f"x{self.scale}, true heading"
+
+
+def outlines(run: Recording) -> Outlines:
+    """About ``OUTLINES`` outlines at round times, none on top of an earlier one."""
+    x, y, t = run["ship.x"], run["ship.y"], run.t
+    every = max(1.0, round((t[-1] - t[0]) / OUTLINES / 10.0) * 10.0)
+    stride = max(1, round(every / run.meta.get("step_size", t[1] - t[0])))
+    rows = list(range(0, len(t), stride))
+    steps = np.hypot(np.diff(x[rows]), np.diff(y[rows]))
+    extent = max(np.ptp(x), np.ptp(y))
+    scale = outline_scale(float(np.median(steps)) if len(steps) else extent, extent)
+    drawn: list[int] = []
+    for k in rows:
+        if all(math.hypot(x[k] - x[j], y[k] - y[j]) > scale * Hull.L for j in drawn):
+            drawn.append(k)
+    return Outlines(drawn, every, scale)
+
+
+def _arrow(direction: float) -> Shape:
+    """An arrow pointing to ``direction`` (rad, clockwise from north) on a north-up panel."""
+    shape = np.array([(0, 1), (0.5, 0.15), (0.17, 0.15), (0.17, -1), (-0.17, -1),
+                      (-0.17, 0.15), (-0.5, 0.15), (0, 1)])           # east, north
+    c, s = math.cos(direction), math.sin(direction)
+    return Shape(np.column_stack([shape[:, 0] * c + shape[:, 1] * s,
+                                  -shape[:, 0] * s + shape[:, 1] * c]), closed=True)
+
+
+def _in_view(tracks: list[np.ndarray], points: np.ndarray) -> np.ndarray:
+    """The route points within half the tracks' size of the box around them."""
+    seen = np.concatenate(tracks)
+    low, high = seen.min(axis=0), seen.max(axis=0)
+    size = max(*(high - low), 4 * Hull.L)
+    gap = np.linalg.norm(np.maximum(0.0, np.maximum(low - points, points - high)), axis=1)
+    return gap <= size / 2
+
+
+def _dense(points: np.ndarray, pieces: int = 40) -> np.ndarray:
+    """The polyline through ``points`` as many points along each of its segments."""
+    steps = np.linspace(0.0, 1.0, pieces, endpoint=False)[:, None]
+    legs = [a + steps * (b - a) for a, b in itertools.pairwise(points)]
+    return np.concatenate([*legs, points[-1:]])
+
+
+def _label_waypoints(ax: Any, points: np.ndarray, avoid: np.ndarray, reach: float,
+                     size: float) -> None:
+    """Name each route point beside its circle, on the side farthest from ``avoid``."""
+    def clearance(where: np.ndarray) -> float:
+        return float(np.min(np.hypot(*(avoid - where).T))) if len(avoid) else math.inf
+    for i, point in enumerate(points):
+        away = np.array(max(_DIRECTIONS, key=lambda d: clearance(
+            point + np.array(d) * (reach + 0.04 * size))))
+        ax.annotate(waypoint_name(i), tuple(point), xytext=tuple(point + away * reach * 1.1),
+                    textcoords="data", fontsize=8, fontweight="bold", color="tab:blue",
+                    ha="left" if away[0] > 0.3 else "right" if away[0] < -0.3 else "center",
+                    va="bottom" if away[1] > 0.3 else "top" if away[1] < -0.3 else "center",
+                    zorder=5)
+
+
+def _route(ax: Any, guidance: dict[str, Any], tracks: list[np.ndarray]) -> None:
+    """The route, its circles and named waypoints; framed on the tracks and the points near
+    them, a route going on out of view says where to."""
+    points = np.array(followed_route(guidance))[:, ::-1]              # (east, north)
+    reach = guidance["R_accept"]
+    near = _in_view(tracks, points)
+    label = "route"
+    if not near.all():
+        last = int(np.flatnonzero(~near)[-1])
+        label += (f", continuing out of view to {waypoint_name(last)} "
+                  f"({points[last][1]:g}, {points[last][0]:g}) m")
+    # add_artist leaves the data limits (the frame) alone: the points in view set them.
+    ax.add_artist(Line2D(points[:, 0], points[:, 1], linestyle="--", marker="o",
+                         color="tab:blue", linewidth=0.8, markersize=4, label=label,
+                         zorder=2))
+    for east, north in points[1:]:
+        ax.add_artist(Circle((east, north), reach, fill=False, linestyle=":",
+                             color="tab:blue", zorder=2))
+    framed = np.concatenate([*tracks, points[near] - reach, points[near] + reach])
+    ax.update_datalim(framed)
+    _label_waypoints(ax, points, np.concatenate([*(t[::10] for t in tracks), _dense(points)]),
+                     reach, float(np.ptp(framed, axis=0).max()))
+
+
+def track_panel(ax: Any, run: Recording, ship: bool = True,
+                others: Iterable[Recording] = ()) -> None:
+    """The route, the wave direction and, with ``ship``, the track, leg switches and outlines;
+    framed on the tracks of ``run`` and ``others`` (which the caller draws)."""
+    p = run.meta.get("parameters", {})
+    x, y, psi = run["ship.x"], run["ship.y"], run["ship.psi"]
+    tracks = [np.column_stack([r["ship.y"], r["ship.x"]]) for r in (run, *others)]
+    ax.set_label(TRACK)
+    if ship:
+        ax.plot(y, x, color="k", linewidth=1.0, label="track", zorder=3)
+    if "guidance" in p:
+        _route(ax, p["guidance"], tracks)
+        if ship:
+            switched = np.flatnonzero(np.diff(run["guidance.wp_index"])) + 1
+            ax.plot(y[switched], x[switched], "x", color="tab:red", markersize=8, mew=2,
+                    label="leg switched", zorder=4)
+    if ship:
+        shown = outlines(run)
+        for k in shown.rows:
+            ax.add_patch(Polygon(hull_outline(x[k], y[k], psi[k], shown.scale), closed=True,
+                                 facecolor="0.8", edgecolor="0.3", linewidth=0.6, zorder=2.5))
+        ax.plot([], [], "s", color="0.8", markeredgecolor="0.3",
+                label=f"ship outline {shown.size}, every {shown.every:g} s")
+    sea = p.get("ship", {})
+    if sea.get("Hs", 0.0) > 0.0:
+        ax.plot([], [], linestyle="none", marker=_arrow(sea["psi_w"]), markersize=11,
+                color="tab:cyan", label=f"waves travel to "
+                f"{math.degrees(sea['psi_w']) % 360:.0f} deg")
+    ax.set(xlabel="east y (m)", ylabel="north x (m)")
+    ax.set_aspect("equal", adjustable="datalim")
+    legend_if_any(ax)
+
+
+def legend_if_any(ax: Any, **kwargs: Any) -> None:
+    """A legend of what has a label, over no data: a track panel's below the panels, any
+    other's in a row above its axes."""
+    handles, labels = ax.get_legend_handles_labels()
+    if not handles:
+        return
+    if ax.get_label() == TRACK:
+        for old in list(ax.figure.legends):
+            old.remove()
+        ax.figure.legend(handles, labels, **{"loc": "outside lower left", "fontsize": 7,
+                                             "ncol": min(3, len(handles)),
+                                             "handleheight": 1.8, **kwargs})
+        return
+    ax.legend(**{"loc": "lower right", "bbox_to_anchor": (1.0, 1.0), "fontsize": 7,
+                 "ncol": len(handles), "frameon": False, "borderaxespad": 0.1, **kwargs})

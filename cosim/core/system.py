@@ -1,0 +1,154 @@
+"""A system: its components, their connections and experiment, and where its FMUs are.
+
+The core's data model of a flat co-simulation (``cosim.core.ssd`` reads and writes it as
+SSP 1.0). Where FMUs are built is the caller's to say (``FmuFolders``).
+"""
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from fmukit.timebase import MAX_TIME, nanoseconds, on_time_base, seconds, step_count
+
+from .errors import FmuNotFound, close_matches, did_you_mean
+
+
+def split_name(name: str) -> tuple[str, str]:
+    """'ship.psi' -> ('ship', 'psi'); ValueError naming ``name`` if it is not so."""
+    component, dot, variable = name.partition(".") if isinstance(name, str) else ("", "", "")
+    if not (dot and component and variable):
+        raise ValueError(f"{name!r} is not 'component.variable'")
+    return component, variable
+
+
+@dataclass(frozen=True)
+class FmuFolders:
+    """Where the caller builds its FMUs, a folder per FMI version, and their names (file
+    stems). An FMU a .ssd names is also looked for in the first folder, by its path after
+    the last folder of that name (``fmi3/ship.fmu`` for ``../../fmus/fmi3/ship.fmu``), so
+    that a .ssd copied anywhere still finds them."""
+    by_fmi: dict[int, Path]
+    names: frozenset[str]
+
+    def fmi_of(self, path: Path) -> int | None:
+        """The FMI version of the folder ``path`` is in, if it is one of these FMUs."""
+        if path.stem not in self.names:
+            return None
+        return next((fmi for fmi, folder in self.by_fmi.items() if path.parent == folder), None)
+
+
+@dataclass
+class Component:
+    name: str
+    source: str                                  # FMU path, relative to the .ssd
+    connectors: dict[str, tuple[str, str]] = field(default_factory=dict)   # name: (kind, type)
+    parameters: dict[str, float | int | bool | str] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Connection:
+    start_element: str
+    start_connector: str
+    end_element: str
+    end_connector: str
+
+    def __str__(self) -> str:
+        return (f"{self.start_element}.{self.start_connector} -> "
+                f"{self.end_element}.{self.end_connector}")
+
+
+@dataclass
+class SystemDescription:
+    name: str
+    components: dict[str, Component]
+    connections: list[Connection]
+    start_time: float = 0.0
+    stop_time: float = 400.0
+    step_size: float = 0.1
+    report: str = "none"
+    description: str = ""
+    path: Path | None = None                     # the .ssd this was read from
+    fmus: FmuFolders | None = field(default=None, compare=False, repr=False)
+
+    def parameters(self, overrides: dict[str, dict[str, Any]] | None = None
+                   ) -> dict[str, dict[str, Any]]:
+        """Each component's parameter values, updated by ``overrides`` (by component);
+        ValueError naming a component the system does not have, and the closest."""
+        parameters = {name: dict(c.parameters) for name, c in self.components.items()}
+        for component, values in (overrides or {}).items():
+            if component not in parameters:
+                raise ValueError(f"--set names the component '{component}'; the system has "
+                                 f"{', '.join(parameters)}"
+                                 f"{did_you_mean(close_matches(component, parameters))}")
+            parameters[component].update(values)
+        return parameters
+
+    def steps(self, stop_time: float | None = None) -> tuple[float, float, int]:
+        """(t0, h, number of steps) of a run to ``stop_time`` (default: the system's), h on
+        the FMUs' time base; ValueError unless the stop time is a whole number of steps."""
+        h = seconds(nanoseconds(self.step_size))
+        return self.start_time, h, step_count(
+            self.start_time, self.stop_time if stop_time is None else stop_time, h)
+
+    def check_times(self) -> None:
+        """ValueError unless start, stop and step are times an FMU takes, on the time base
+        (``fmukit.timebase``), with a whole number of steps from start to stop."""
+        for name, t in (("startTime", self.start_time), ("stopTime", self.stop_time),
+                        ("baseStepSize", self.step_size)):
+            if abs(t) > MAX_TIME:
+                raise ValueError(f"{name} {t!r} s is beyond +-{MAX_TIME:g} s, the times an FMU "
+                                 "takes (fmukit.timebase)")
+            if on_time_base(t) != t:
+                raise ValueError(f"{name} {t!r} s is not a whole number of nanoseconds, the "
+                                 "time base (fmukit.timebase)")
+        step_count(self.start_time, self.stop_time, self.step_size)
+
+    def ours(self, path: str | Path) -> bool:
+        """Whether ``path`` is named as one of the FMUs of ``fmus``."""
+        return self.fmus is not None and Path(path).stem in self.fmus.names
+
+    def fmu_candidates(self, component: str) -> list[Path]:
+        """Where a component's FMU may be: its source relative to the .ssd (or the current
+        folder), then in ``fmus`` (not for an absolute source: another file of its name
+        would run in its place unseen)."""
+        source = Path(self.components[component].source)
+        base = self.path.parent if self.path else Path.cwd()
+        candidates = [(base / source).resolve()]
+        if self.fmus is not None and not source.is_absolute():
+            root = next(iter(self.fmus.by_fmi.values()))
+            parts = source.parts
+            tail = Path(*parts[len(parts) - parts[::-1].index(root.name):]) \
+                if root.name in parts[:-1] else Path(source.name)
+            candidates.append(root / tail)
+        return list(dict.fromkeys(candidates))
+
+    def fmu_path(self, component: str) -> Path:
+        """The first of ``fmu_candidates`` that exists; FmuNotFound naming all tried."""
+        candidates = self.fmu_candidates(component)
+        for path in candidates:
+            if path.is_file():
+                return path
+        ours = self.ours(self.components[component].source)
+        twin = ours and 3 in map(self.fmus.fmi_of, candidates)
+        hint = (f"one of this project's {'FMI 3.0 ' if twin else ''}FMUs, not built" if ours
+                else f"check the source of component '{component}' in {self.path or 'the system'}")
+        raise FmuNotFound(f"FMU for '{component}' not found; tried "
+                          f"{', '.join(map(str, candidates))}; {hint}", ours)
+
+
+def with_fmi(system: SystemDescription, fmi: int) -> SystemDescription:
+    """A copy of ``system`` whose components that run FMUs of ``system.fmus`` (found in, or
+    missing from, one of its folders) take those of FMI version ``fmi``."""
+    folders = system.fmus.by_fmi if system.fmus else {}
+    if fmi not in folders:
+        raise ValueError(f"FMI {fmi}: this project's FMUs are built for FMI "
+                         f"{' and '.join(f'{v}.0' for v in folders) or 'no version'}")
+    new = copy.deepcopy(system)
+    for name, component in new.components.items():
+        candidates = system.fmu_candidates(name)
+        found = next((p for p in candidates if p.is_file()), None)
+        if any(system.fmus.fmi_of(p) for p in ([found] if found else candidates)):
+            component.source = str(folders[fmi] / Path(component.source).name)
+    return new

@@ -1,0 +1,100 @@
+"""A sweep run end to end: its runs not yet done on a Dask cluster, each row journaled, and
+the rows of every combination (docs/sweeps.md)."""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Any
+
+from ..core.files import FolderBusy, FolderLock
+from ..core.watchdog import Limits
+from .cluster import CONNECT_TIMEOUT, connect
+from .journal import Journal, read_rows
+from .cluster import SweepError
+from .sweep_client import run_on_cluster
+from .sweep_spec import Spec
+from .sweep_task import BATCH, SWEEP_BACKENDS, run_batch, run_one
+
+NO_WORKER_TIMEOUT = 60.0
+"""Seconds a sweep waits while its cluster has no worker, then stops (``NoWorkers``)."""
+
+
+def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | None = None,
+            progress: bool = True, task=None, scheduler_file: str | None = None,
+            backend: str = "fmi", no_worker_timeout: float = NO_WORKER_TIMEOUT,
+            connect_timeout: float = CONNECT_TIMEOUT, limits: Limits = Limits(),
+            batch_size: int | None = None, batch_task=None) -> list[dict]:
+    """Run every run of ``spec`` without an ok row in ``out``'s journal; every row of the sweep.
+
+    ``backend``: "fmi" or "inprocess" (the master's), or "batch" (runs of a system the batch
+    kernel covers in batches of at most ``batch_size``, one ``batch_task(jobs, blobs)`` each;
+    the others alone). ``task(job, blobs) -> row`` runs one run (default ``run_one``). On
+    ``Interrupted``, or ``NoWorkers`` after ``no_worker_timeout`` s, the rows done stay in
+    the journal and the same call resumes. SweepError if a worker runs other code or another
+    sweep writes ``out``; ``cluster.ClusterError`` (a ValueError) if no cluster is reached.
+    """
+    if backend not in SWEEP_BACKENDS:
+        raise ValueError(f"backend must be {', '.join(SWEEP_BACKENDS[:-1])} or "
+                         f"{SWEEP_BACKENDS[-1]}, got {backend!r}")
+    if batch_size is not None and backend != BATCH:
+        raise ValueError(f"batch_size is the batch backend's, not the {backend} backend's")
+    if batch_size is not None and (isinstance(batch_size, bool)
+                                   or not isinstance(batch_size, int) or batch_size < 1):
+        raise ValueError(f"batch_size must be a whole number >= 1, got {batch_size!r}")
+    if not 0 < no_worker_timeout < float("inf"):
+        raise ValueError(f"no_worker_timeout must be a number of seconds > 0, got "
+                         f"{no_worker_timeout!r}")
+    try:
+        with FolderLock(out):
+            journal = Journal(out / "runs.jsonl")
+            groups = spec.shared_runs()
+            todo = [group[0] for group in groups
+                    if (_result(group, journal.rows) or {}).get("status") != "ok"]
+            if len(todo) < len(groups):
+                print(f"{len(groups) - len(todo)} of {len(groups)} runs already done in "
+                      f"{journal.path}; {len(todo)} to run", file=sys.stderr, flush=True)
+            if todo:
+                run_on_cluster(spec, todo, journal,
+                               connect(scheduler, workers, scheduler_file, connect_timeout),
+                               progress, task or run_one, backend, no_worker_timeout,
+                               limits.check(), batch_task or run_batch, batch_size)
+    except FolderBusy as busy:
+        raise SweepError(str(busy)) from None
+    return completed(spec, out)
+
+
+def completed(spec: Spec, out: Path) -> list[dict]:
+    """A row for each combination of ``spec`` whose result is in its journal, in the order of
+    ``spec.runs()``: its group's result (``Spec.shared_runs``) with its own axis values and
+    run id, ``ran_as`` the run whose result it is, and ``command`` (``Spec.replay``)."""
+    rows = read_rows(out / "runs.jsonl", quiet=True)
+    found = {}
+    for group in spec.shared_runs():
+        result = _result(group, rows)
+        if result is not None:
+            for run in group:
+                found[run["run_id"]] = _as_row_of(spec, run, result)
+    return [found[r["run_id"]] for r in spec.runs() if r["run_id"] in found]
+
+
+def _result(group: list[dict], rows: dict[str, dict]) -> dict | None:
+    """A group's row in the journal: a member's ok row, else a member's failed row, else None."""
+    mine = [rows[r["run_id"]] for r in group if r["run_id"] in rows]
+    return next((r for r in mine if r["status"] == "ok"), mine[0] if mine else None)
+
+
+def _as_row_of(spec: Spec, run: dict, result: dict) -> dict:
+    """``result`` (a journal row) as the row of ``run``, an equivalent run."""
+    row = {**result, **run, "ran_as": result["run_id"], "command": spec.replay(run)}
+    if result["run_id"] != run["run_id"]:
+        row.pop("track", None)          # drawn once, by the run it is
+    return row
+
+
+def run_locally(spec: Spec, run: dict[str, Any], backend: str = "fmi",
+                limits: Limits = Limits()) -> dict[str, Any]:
+    """One run of ``spec`` in this process, as a worker would do it (on "batch", as a batch
+    of one)."""
+    job = spec.job(run, "local", "inprocess" if backend == BATCH else backend, limits)
+    blobs = {sha: spec.files()[sha].read_bytes() for sha in job.bundle.fmu_hashes()}
+    return run_batch([job], blobs)[0] if backend == BATCH else run_one(job, blobs)

@@ -1,0 +1,299 @@
+"""What a scorecard says: each controller against the PD seed by seed, and scorecard.md."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..analysis.cost import Cost, cost
+from ..analysis.metrics import RUDDER_DEADBAND, RouteCompletion, route_completion
+from ..core.recording import Recording
+from .sweep_figures import STATISTICS
+from .merit import CRITERIA, route_of, run_metrics
+
+if TYPE_CHECKING:
+    from .merit import Merit
+
+BASELINE = "PD"                 # every other controller is paired with it, seed by seed
+TIE = 0.01                      # values closer than this share of the baseline's tie
+
+
+@dataclass(frozen=True)
+class Sea:
+    """The sea of a wave ensemble: the scenarios' own (the paper's) or a WMO code's."""
+
+    key: str                             # in file names: ensemble_<key>, criteria_<key>.png
+    name: str
+    detail: str                          # its Hs and T0
+    sea_state: int | None = None
+
+    @property
+    def title(self) -> str:
+        return f"{self.name} ({self.detail})"
+
+
+@dataclass(frozen=True)
+class CourseChange:
+    settling_time: float          # s, inf if it never settles within the run
+    overshoot: float              # rad
+    metrics: dict[str, float]     # merit.run_metrics of the run
+
+
+@dataclass(frozen=True)
+class Paired:
+    """One criterion of a controller against the baseline over the seeds both ran."""
+
+    wins: int
+    losses: int
+    ties: int
+    median: float                 # of the paired ratios or differences; nan if none
+
+    @property
+    def seeds(self) -> int:
+        return self.wins + self.losses + self.ties
+
+    @property
+    def verdict(self) -> str:
+        """better / worse on more than half the seeds; else even (mostly ties) or mixed."""
+        if 2 * self.wins > self.seeds:
+            return "better"
+        if 2 * self.losses > self.seeds:
+            return "worse"
+        return "even" if 2 * self.ties > self.seeds else "mixed"
+
+
+def pairs(criterion: Merit, rows: list[dict], controller: str,
+          baseline: str = BASELINE) -> tuple[np.ndarray, np.ndarray]:
+    """(controller's, baseline's) values of ``criterion`` (of ``merit.CRITERIA``) on
+    the seeds both ran ok, paired by wave_seed."""
+    values = {name: {r["wave_seed"]: r[criterion.column] for r in rows
+                     if r["status"] == "ok" and r["controller"] == name}
+              for name in (controller, baseline)}
+    seeds = sorted(set(values[controller]) & set(values[baseline]))
+    return (np.array([values[controller][s] for s in seeds], dtype=float),
+            np.array([values[baseline][s] for s in seeds], dtype=float))
+
+
+def change(criterion: Merit, mine: np.ndarray, base: np.ndarray) -> np.ndarray:
+    """The paired ratios mine / base (where base is not 0) or differences mine - base."""
+    if criterion.paired == "ratio":
+        return mine[base != 0] / base[base != 0]
+    return mine - base
+
+
+def paired(criterion: Merit, rows: list[dict], controller: str,
+           baseline: str = BASELINE) -> Paired:
+    """A win is the better value on the same sea by more than ``TIE`` of the baseline's."""
+    mine, base = pairs(criterion, rows, controller, baseline)
+    margin = (1.0 if criterion.lower_is_better else -1.0) * (base - mine)   # > 0: mine better
+    tied = np.abs(margin) <= TIE * np.abs(base)
+    changes = change(criterion, mine, base)
+    return Paired(int(np.sum((margin > 0) & ~tied)), int(np.sum((margin < 0) & ~tied)),
+                  int(np.sum(tied)), float(np.median(changes)) if changes.size else math.nan)
+
+
+def completion(run: Recording) -> RouteCompletion:
+    """Which waypoints of its route a run reached."""
+    points, R_accept = route_of(run)
+    return route_completion(run["ship.x"], run["ship.y"], points, R_accept)
+
+
+def markdown(fmu: Path, name: str, seeds: int, paper: dict[str, str],
+             route: dict[str, dict[str, Recording]], changes: dict[str, CourseChange],
+             course: tuple[float, float], failures: dict[tuple[str, str], str],
+             ensembles: dict[Sea, list[dict]]) -> str:
+    """scorecard.md: ``paper`` gives each controller's J calm / waves in the paper ('-');
+    ``course`` the course change's duration (s) and leg (m)."""
+    names = list(paper)
+    lines = [f"# Scorecard: {name}", "",
+             f"Autopilot `{fmu}` beside the paper's PD and sliding-mode (SMC) autopilots and "
+             "the project's PID, on CyberShip II (docs/own_autopilot.md says how each is run).",
+             "Each criterion is scored on its own, with its unit and the side that is better; "
+             "there is no overall rank. Angles in degrees, distances in m; a waypoint is "
+             "reached when the ship comes within the guidance's circle of acceptance of it "
+             "(waypoints are numbered from 1, the start); a rudder reversal is a crossing "
+             "from one side to the other, counted once the rudder is "
+             f"{math.degrees(RUDDER_DEADBAND):g} deg past amidships on the new side.", ""]
+    lines += _at_a_glance(names, route, ensembles, seeds)
+    lines += _paper_route(paper, route)
+    lines += _course_change(names, changes, *course)
+    for sea, rows in ensembles.items():
+        lines += _ensemble_section(sea, names, seeds, rows)
+    if failures:
+        lines += ["## Runs that failed", "", *(f"- {who}, {test}: `{message[:200]}`"
+                                               for (who, test), message in failures.items()),
+                  ""]
+    return "\n".join(lines)
+
+
+def _cell(criterion: Merit, row: dict) -> str:
+    total = f" of {row[criterion.out_of]:.0f}" if criterion.out_of else ""
+    return criterion.format(row[criterion.column]) + total
+
+
+def _heading(criterion: Merit) -> str:
+    unit = f" ({criterion.unit})" if criterion.unit else ""
+    return f"{criterion.label}{unit}, {criterion.better}"
+
+
+def _reached(done: RouteCompletion) -> str:
+    last = "the last included" if done.last_reached else "**not** the last"
+    return f"reached {done.count} of {len(done.points)} waypoints, {last}"
+
+
+def _ok(rows: list[dict], name: str) -> list[dict]:
+    return [r for r in rows if r["status"] == "ok" and r["controller"] == name]
+
+
+def _at_a_glance(names: list[str], route: dict[str, dict[str, Recording]],
+                 ensembles: dict[Sea, list[dict]], seeds: int) -> list[str]:
+    """Each controller's verdicts against the PD per ensemble, and route completion."""
+    lines = [f"## At a glance: each controller against the {BASELINE}", "",
+             f"Seed-paired over {seeds} wave seeds: **better** (**worse**) means better "
+             f"(worse) than the {BASELINE} on the same sea in more than half of the seeds, "
+             f"*even* that most are ties (within {100 * TIE:g} % of the {BASELINE}'s value), "
+             "*mixed* neither; then the seeds won, lost and tied of those both ran, and the "
+             f"median paired ratio to the {BASELINE} or difference from it.", ""]
+    for sea, rows in ensembles.items():
+        lines += [f"The route in {sea.title}:", "",
+                  "| criterion | better | " + " | ".join(names[1:]) + " |",
+                  "|---|---|" + "---|" * len(names[1:])]
+        for c in CRITERIA:
+            unit = f" ({c.unit})" if c.unit else ""
+            lines.append(f"| {c.label}{unit} | {c.better.split()[0]} | " + " | ".join(
+                _verdict(c, paired(c, rows, name)) for name in names[1:]) + " |")
+        lines.append("")
+    lines += ["Route completion (higher is better):", "",
+              "| controller | calm water | waves | "
+              + " | ".join(f"ensemble, {sea.name}" for sea in ensembles) + " |",
+              "|---|---|---|" + "---|" * len(ensembles)]
+    for name in names:
+        cells = [_reached(completion(route[sea][name])) if name in route[sea] else "failed"
+                 for sea in ("calm", "waves")]
+        for rows in ensembles.values():
+            ok = _ok(rows, name)
+            last = sum(r["last_waypoint_reached"] == 1.0 for r in ok)
+            cells.append(f"{_waypoints_reached(ok)}; the last in {last} of {len(ok)} seeds"
+                         if ok else "no run ok")
+        lines.append(f"| {name} | {' | '.join(cells)} |")
+    lines.append("")
+    for sea, rows in ensembles.items():
+        for name in names:                  # a plain sentence for a route never finished
+            ok = _ok(rows, name)
+            if ok and not any(r["last_waypoint_reached"] == 1.0 for r in ok):
+                stops = np.median([r["at_stops_pct"] for r in ok])
+                held = (f", the rudder on its stops a median {stops:.0f} % of the run"
+                        if stops else "")
+                lines.append(f"- In {sea.name}, **{name} never reached the last waypoint** "
+                             f"in any of {len(ok)} seeds: it {_waypoints_reached(ok)}{held}.")
+    return lines + [""]
+
+
+def _verdict(criterion: Merit, p: Paired) -> str:
+    """'**better**: won 18, lost 2, tied 0 of 20; median ratio 0.13'."""
+    if not p.seeds:
+        return "no seed ran for both"
+    word = f"**{p.verdict}**" if p.verdict in ("better", "worse") else f"*{p.verdict}*"
+    if criterion.paired == "ratio":
+        median = f"median ratio {p.median:.2f}" if math.isfinite(p.median) else "no ratio"
+    else:
+        unit = {"": "", "%": " percentage points"}.get(criterion.unit, f" {criterion.unit}")
+        median = f"median difference {criterion.format(p.median, '+')}{unit}"
+    return f"{word}: won {p.wins}, lost {p.losses}, tied {p.ties} of {p.seeds}; {median}"
+
+
+def _waypoints_reached(ok: list[dict]) -> str:
+    """'reached 3 of 4 waypoints' over runs that ran ok: the count, or its median and range."""
+    reached = np.array([r["waypoints_reached"] for r in ok])
+    spread = (f"{reached.min():.0f}" if reached.min() == reached.max() else
+              f"a median {np.median(reached):g} (from {reached.min():.0f} to "
+              f"{reached.max():.0f})")
+    return f"reached {spread} of {ok[0]['waypoints']:.0f} waypoints"
+
+
+def _paper_route(paper: dict[str, str], route: dict[str, dict[str, Recording]]) -> list[str]:
+    lines = ["## The paper's route (Tables 1-2, eq 19; lower is better)", "",
+             "| controller | calm psi_E | calm delta_E | calm J | waves psi_E | waves delta_E "
+             "| waves J | paper J calm / waves |", "|---|---|---|---|---|---|---|---|"]
+    costs = {(n, sea): cost(r) for sea, runs in route.items() for n, r in runs.items()}
+    for name, theirs in paper.items():
+        cells = []
+        for sea in ("calm", "waves"):
+            r: Cost | None = costs.get((name, sea))
+            cells += ([f"{r.psi_E:.1f}", f"{r.delta_E:.1f}", f"{r.J:.1f}"] if r
+                      else ["failed"] * 3)
+        lines.append(f"| {name} | {' | '.join(cells)} | {theirs} |")
+    lines += ["", "Every criterion, one run each (the scenarios' wave seed):", "",
+              "| controller | sea | " + " | ".join(_heading(c) for c in CRITERIA) + " |",
+              "|---|---|" + "---|" * len(CRITERIA)]
+    misses = []
+    for sea, runs in route.items():
+        for name, run in runs.items():
+            row = run_metrics(run)
+            lines.append(f"| {name} | {sea} | "
+                         + " | ".join(_cell(c, row) for c in CRITERIA) + " |")
+            done = completion(run)
+            if done.count < len(done.points):
+                missed = ", ".join(f"waypoint {k} ({x:g}, {y:g}) by {d:.1f} m"
+                                   for k, ((x, y), d, hit) in enumerate(
+                                       zip(done.points, done.closest, done.reached), start=1)
+                                   if not hit)
+                misses.append(f"- {name}, {sea}: {_reached(done)}; missed {missed} "
+                              f"(circle of acceptance {done.R_accept:g} m)")
+    return lines + ["", *misses, "", "![route in calm water](route_calm.png)",
+                    "![route in waves](route_waves.png)", ""]
+
+
+def _course_change(names: list[str], changes: dict[str, CourseChange], time: float,
+                   leg: float) -> list[str]:
+    lines = [f"## A 40 deg course change, calm water, {time:.0f} s (lower is better)", "",
+             "| controller | settling time to 2 % (s) | overshoot (deg) | rudder reversals "
+             "(1/min) | mean abs rudder rate (deg/s) | max rudder (deg) | max cross-track (m) |",
+             "|---|---|---|---|---|---|---|"]
+    for name in names:
+        r = changes.get(name)
+        if r is None:
+            lines.append(f"| {name} |" + " failed |" * 6)
+            continue
+        settled = f"{r.settling_time:.1f}" if math.isfinite(r.settling_time) else f"> {time:.0f}"
+        m = r.metrics
+        lines.append(f"| {name} | {settled} | {math.degrees(r.overshoot):.2f} | "
+                     f"{m['reversals_per_min']:.1f} | {m['mean_rudder_rate_deg_s']:.2f} | "
+                     f"{m['max_delta_deg']:.1f} | {m['cross_track_max_m']:.2f} |")
+    return lines + ["", f"The course change follows one leg of {leg:.0f} m, longer than the "
+                        f"ship sails in {time:.0f} s: route completion does not apply to it.",
+                    "", "![course change](course_change.png)", ""]
+
+
+def _ensemble_section(sea: Sea, names: list[str], seeds: int, rows: list[dict]) -> list[str]:
+    """Each criterion's median and IQR per controller."""
+    lines = [f"## Wave ensemble: the route in {sea.title}, {seeds} wave seeds", "",
+             "Each criterion: median [IQR, 25-75 %] over the seeds that ran; waypoints "
+             "reached out of the route's.", "",
+             "| controller | runs ok | " + " | ".join(_heading(c) for c in CRITERIA) + " |",
+             "|---|---|" + "---|" * len(CRITERIA)]
+    for name in names:
+        mine = _ok(rows, name)
+        lines.append(f"| {name} | {len(mine)}/{seeds} | "
+                     f"{' | '.join(_spread(c, mine) for c in CRITERIA)} |")
+    failed = [r for r in rows if r["status"] != "ok"]
+    if failed:
+        lines += ["", f"{len(failed)} runs of the ensemble failed; the first: "
+                      f"`{failed[0]['error'].splitlines()[0][:200]}`"]
+    return lines + ["", f"![each criterion](criteria_{sea.key}.png) ({STATISTICS})",
+                    f"![each criterion against the {BASELINE}, seed by seed]"
+                    f"(paired_{sea.key}.png)",
+                    f"![tracks of every seed](tracks_{sea.key}.png)", ""]
+
+
+def _spread(criterion: Merit, rows: list[dict]) -> str:
+    """'median [25 % - 75 %]' of the rows' values (' of N' for a count), '-' if none."""
+    if not rows:
+        return "-"
+    q1, median, q3 = np.percentile([r[criterion.column] for r in rows], [25, 50, 75])
+    total = f" of {rows[0][criterion.out_of]:.0f}" if criterion.out_of else ""
+    return (f"{criterion.format(median)} [{criterion.format(q1)} - "
+            f"{criterion.format(q3)}]{total}")

@@ -1,0 +1,105 @@
+"""What an FMU built with fmukit carries about itself, ``resources/fmukit_manifest.json``, and
+whether it is current here.
+
+The manifest names the model, its slave class (module, class), each Python module the FMU
+carries (file in the FMU, SHA-256 of its source) and their digest, the FMI version, the
+entry module the build wrote, the pythonfmu and options that built it and fmukit's
+version. No time, path or machine is in it: the same sources give the same manifest.
+Format 1 (before FMI 3.0) has no entry module; it is read so that ``staleness`` can say
+to rebuild. This module only reads; ``fmubuild`` writes manifests.
+"""
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import json
+import zipfile
+from dataclasses import dataclass
+from importlib import metadata
+from pathlib import Path
+from typing import Callable
+
+MANIFEST = "resources/fmukit_manifest.json"
+FORMAT = 2
+DISTRIBUTION = "ship-autopilot-cosim"
+"""The distribution fmukit is part of: its version is fmukit's."""
+
+
+@dataclass(frozen=True)
+class Manifest:
+    model_name: str
+    slave_module: str                       # as the host imports it
+    slave_class: str
+    modules: dict[str, dict[str, str]]      # module: {"file": in the FMU, "sha256": ...}
+    digest: str                             # of every module's name and SHA-256
+    pythonfmu: str                          # the version of the pythonfmu that built it
+    options: dict[str, bool]
+    version: str | None                     # fmukit's that built it; None before it was kept
+    fmi: int = 2
+    entry: dict[str, str] | None = None     # {"module", "file", "sha256"}; None in format 1
+
+    def to_json(self) -> str:
+        return json.dumps({"format": FORMAT, "model_name": self.model_name,
+                           "slave": {"module": self.slave_module, "class": self.slave_class},
+                           "modules": self.modules, "digest": self.digest,
+                           "pythonfmu": self.pythonfmu, "options": self.options,
+                           "version": self.version, "fmi": self.fmi, "entry": self.entry},
+                          indent=1, sort_keys=True) + "\n"
+
+
+def version() -> str:
+    """fmukit's version: its installed distribution's."""
+    return metadata.version(DISTRIBUTION)
+
+
+def sha256(path: Path) -> str:
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def digest_of(modules: dict[str, str]) -> str:
+    """SHA-256 over each module's name and source SHA-256."""
+    return hashlib.sha256("".join(f"{name} {modules[name]}\n" for name in sorted(modules))
+                          .encode()).hexdigest()
+
+
+def read(fmu: str | Path) -> Manifest | None:
+    """The manifest of an FMU, None if it has none (not built with fmukit); ValueError
+    naming the file if it cannot be read."""
+    with zipfile.ZipFile(fmu) as package:
+        if MANIFEST not in package.namelist():
+            return None
+        try:
+            data = json.loads(package.read(MANIFEST))
+            if data["format"] not in (1, FORMAT):
+                raise ValueError(f"format {data['format']}, not {FORMAT}")
+            extra = {"fmi": data["fmi"], "entry": data["entry"]} if data["format"] > 1 else {}
+            return Manifest(data["model_name"], data["slave"]["module"],
+                            data["slave"]["class"], data["modules"], data["digest"],
+                            data["pythonfmu"], data["options"], data.get("version"), **extra)
+        except (KeyError, TypeError, ValueError) as error:
+            raise ValueError(f"{fmu}: its {MANIFEST} cannot be read ({error})") from error
+
+
+def staleness(manifest: Manifest,
+              entry_source: Callable[[Manifest], str] | None = None) -> str | None:
+    """Why the FMU is not current in this process, or None: built by another fmukit, or a
+    module it carries is not importable here or has another source; with ``entry_source``
+    (the build's, ``fmubuild.manifest.entry_source``), also its entry module is not the
+    one the build writes."""
+    if manifest.version != version():
+        return (f"it was built by fmukit {manifest.version or 'of an older version'}, this "
+                f"is fmukit {version()} (rebuild it)")
+    for module, carried in manifest.modules.items():
+        try:
+            spec = importlib.util.find_spec(module)
+        except (ImportError, ValueError):
+            spec = None
+        if spec is None or not spec.origin or not Path(spec.origin).is_file():
+            return f"its module {module} is not importable here"
+        if sha256(Path(spec.origin)) != carried["sha256"]:
+            return f"its {module} differs from {spec.origin} (built before a change: rebuild it)"
+    if entry_source is not None and manifest.entry and hashlib.sha256(
+            entry_source(manifest).encode()).hexdigest() != manifest.entry["sha256"]:
+        return (f"its entry module {manifest.entry['module']} is not the one this build writes "
+                "(built before a change of fmubuild.routes: rebuild it)")
+    return None
