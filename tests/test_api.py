@@ -63,7 +63,9 @@ def test_simulate_refuses_bad_input_by_name(fmu_paths, kwargs, error, fragment):
         simulate("calm_pd", **kwargs)
 
 
-@pytest.mark.parametrize("name", ["pd_autopilot", "pid_autopilot", "pd_autopilot_c"])
+@pytest.mark.parametrize("name", [      # the quick suite: the PD; --long: the PID and C ones too
+    "pd_autopilot", pytest.param("pid_autopilot", marks=pytest.mark.long),
+    pytest.param("pd_autopilot_c", marks=pytest.mark.long)])
 def test_the_example_test_file_passes_for_the_pd_the_pid_and_the_c_autopilot(
         fmu_paths, pytester, name):
     if name not in fmu_paths:

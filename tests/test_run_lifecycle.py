@@ -3,7 +3,8 @@ leaves the earlier results as they were (issue 25: nothing lost, nothing hangs).
 
 The hung FMUs are the fault FMU of the fault matrix (``tests/faulty/fault_slave.py``)
 looping in Python ('loop') or waiting in C ('block') from t = 5 s; every child process
-here has a time limit of its own.
+here has a time limit of its own. The quick suite sends each hang one of the two signals
+(SIGINT to the loop, SIGTERM to the block); ``pytest --long`` sends both to both.
 """
 from __future__ import annotations
 
@@ -187,8 +188,10 @@ def test_a_hung_fmu_ends_at_the_step_time_limit_with_its_rows(hung, kind, backen
     assert took < 1 + 5 * reference, f"took {took:.1f} s, a plain run {reference:.1f} s"
 
 
-@pytest.mark.parametrize("number", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
-@pytest.mark.parametrize("kind", ["loop", "block"])
+@pytest.mark.parametrize("kind, number", [
+    pytest.param(kind, number, id=f"{kind}-{number.name}",
+                 marks=() if (kind == "loop") == (number == signal.SIGINT) else pytest.mark.long)
+    for kind in ("loop", "block") for number in (signal.SIGINT, signal.SIGTERM)])
 def test_a_signal_stops_a_hung_fmu_within_its_grace(hung, kind, number, tmp_path, reference):
     with subprocess.Popen([PY, "-m", "cosim.run", str(hung[kind]), "--out", str(tmp_path)],
                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
