@@ -77,3 +77,18 @@ def reference_seconds(folder: Path) -> float:
                     "--no-plot", "--backend", "inprocess", "--out", str(folder)],
                    check=True, capture_output=True, timeout=600)
     return time.monotonic() - started
+
+
+def command(main, *args: str) -> subprocess.CompletedProcess:
+    """A command's ``main(args)`` run in this process, as a child's result: its exit status
+    and what it printed (for tests of what a command says, not of processes)."""
+    import contextlib
+    import io
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            status = main(list(args))
+        except SystemExit as exit_:           # argparse's refusals
+            status = exit_.code if isinstance(exit_.code, int) else 1
+    return subprocess.CompletedProcess(["main", *args], status, out.getvalue(), err.getvalue())

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from cosim import run as run_command
 from cosim import scenarios
 from cosim.core.fmi import FmuInstance
 from cosim.core.master import Master
@@ -26,6 +27,7 @@ from cosim.interop.engines import run as run_engine
 from cosim.interop.ssp import export
 from fmubuild.packaging import build_script
 from fmubuild.project import ROOT
+from helpers import command
 from fmukit.timebase import communication_point
 
 # Inputs that drive each FMU through something worth restoring, by step k.
@@ -87,10 +89,9 @@ def test_same_scenario_same_bits_across_runs_and_processes(fmu_paths, tmp_path):
     subprocess.run([sys.executable, "-m", "cosim.run", "waves_smc", "--out", str(tmp_path),
                     "--no-plot"], check=True, capture_output=True, cwd=ROOT, timeout=300)
     assert (tmp_path / "waves_smc.csv").read_text() == first
-    other = subprocess.run([sys.executable, "-m", "cosim.run", "waves_smc", "--out",
-                            str(tmp_path / "seed"), "--no-plot", "--set", "ship.wave_seed=1"],
-                           check=True, capture_output=True, cwd=ROOT, timeout=300)
-    assert other.returncode == 0
+    other = command(run_command.main, "waves_smc", "--out", str(tmp_path / "seed"), "--no-plot",
+                    "--set", "ship.wave_seed=1")                   # another sea, here
+    assert other.returncode == 0, other.stderr
     assert (tmp_path / "seed" / "waves_smc.csv").read_text() != first
 
 

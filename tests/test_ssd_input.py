@@ -2,13 +2,13 @@
 attribute (issue 25), never a traceback."""
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
+from cosim import run as run_command
 from cosim.core.ssd import read_ssd, write_ssd
+from helpers import command
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -244,9 +244,7 @@ def test_what_write_ssd_writes_read_ssd_reads_back(tmp_path):
 def test_the_command_line_refuses_a_malformed_ssd_in_one_line(tmp_path, case):
     _, old, new, fragment = next(c for c in MALFORMED if c[0] == case)
     path = _write(tmp_path, GOOD.replace(old, new, 1))
-    child = subprocess.run([sys.executable, "-m", "cosim.run", str(path), "--out",
-                            str(tmp_path / "out"), "--no-plot"], cwd=ROOT, capture_output=True,
-                           text=True, timeout=120)
+    child = command(run_command.main, str(path), "--out", str(tmp_path / "out"), "--no-plot")
     assert child.returncode == 2, child.stderr
     assert "Traceback" not in child.stderr
     assert child.stderr.startswith(f"error: {path}: ") and fragment in child.stderr

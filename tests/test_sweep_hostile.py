@@ -29,7 +29,8 @@ from cosim.studies.sweep_spec import Spec
 from cosim.studies.bundle import UnsafeCache, file_hash, fmu_cache
 from cosim.studies.cluster import ClusterError, SweepError, connect, local_cluster, local_workers
 from fmubuild.instantiate import InstantiationFailed, instantiate_in_child
-from helpers import reference_seconds
+from cosim import sweep as sweep_command
+from helpers import command, reference_seconds
 
 
 @pytest.mark.timeout(60, method="thread")
@@ -160,10 +161,8 @@ def test_the_command_refuses_a_bad_spec_with_one_line_and_writes_nothing(tmp_pat
                        ("[axes]\nwave_seed = [1, 1]\n", "axis 'wave_seed' has 1 twice"),
                        ("[axes]\nwave_seed = { start = 1, count = 60 }\n",
                         "2 controllers x 60 wave_seed = 120 runs, more than the 100")]:
-        child = subprocess.run([sys.executable, "-m", "cosim.sweep",
-                                str(spec_file(tmp_path, text)), "--out", str(out),
-                                "--max-runs", "100"],
-                               capture_output=True, text=True, timeout=120)
+        child = command(sweep_command.main, str(spec_file(tmp_path, text)), "--out", str(out),
+                        "--max-runs", "100")
         assert child.returncode == 2 and child.stdout == "", child
         assert child.stderr.startswith(f"error: {tmp_path / 'spec.toml'}: {said}"), child.stderr
         assert len(child.stderr.splitlines()) == 1 and "Traceback" not in child.stderr

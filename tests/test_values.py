@@ -5,7 +5,6 @@ from __future__ import annotations
 import json
 import math
 import subprocess
-import sys
 from fractions import Fraction
 from pathlib import Path
 
@@ -19,7 +18,8 @@ from cosim.core.fmi import FmuInstance, read_description
 from cosim.core.instance import FmuCallError
 from cosim.core.master import RUN_BACKENDS, Master
 from cosim.core.values import Declaration, checked, declarations, fmi_value, setting
-from helpers import fmu_variant
+from cosim import run as run_command
+from helpers import command, fmu_variant
 
 ROOT = Path(__file__).resolve().parent.parent
 SEED = Declaration("wave_seed", "Integer", min=0, max=2**31 - 1)
@@ -274,9 +274,8 @@ def test_a_variable_set_twice_is_refused():
 
 
 def _cli(tmp_path: Path, *args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "cosim.run", *args, "--out",
-                           str(tmp_path / "out"), "--no-plot", "--stop-time", "1"],
-                          cwd=ROOT, capture_output=True, text=True, timeout=180)
+    return command(run_command.main, *args, "--out", str(tmp_path / "out"), "--no-plot",
+                   "--stop-time", "1")
 
 
 @pytest.mark.parametrize("value, fragment", [
