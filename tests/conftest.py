@@ -13,13 +13,13 @@ import gc
 import shutil
 import tempfile
 from pathlib import Path
-from typing import Iterator
+from typing import Callable, Iterator
 
 import pytest
 
 from fmubuild.cbuild import build_c, c_compiler, sources
 from fmubuild.manifest import entry_source
-from fmubuild.packaging import build
+from fmubuild.packaging import build, build_script
 from fmubuild.project import C_FMUS, FMU_DIRS, FMUS, ROOT
 from fmukit.manifest import read, staleness
 
@@ -169,6 +169,21 @@ def fmu_paths() -> dict[str, Path]:
 def fmi3_paths() -> dict[str, Path]:
     """Every FMI 3.0 twin in fmus/fmi3/, current (``_current``)."""
     return _current(3)
+
+
+@pytest.fixture(scope="session")
+def faulty_fmu(tmp_path_factory) -> Callable[..., Path]:
+    """``faulty_fmu(name, fmi=2)``: the test FMU of tests/faulty/<name>_slave.py, built once
+    a session."""
+    built: dict[tuple[str, int], Path] = {}
+
+    def get(name: str, fmi: int = 2) -> Path:
+        if (name, fmi) not in built:
+            folder = tmp_path_factory.mktemp(f"{name}{fmi}")
+            built[name, fmi] = build_script(ROOT / "tests" / "faulty" / f"{name}_slave.py",
+                                            ("fmukit",), folder / f"{name}.fmu", fmi=fmi)
+        return built[name, fmi]
+    return get
 
 
 @pytest.fixture

@@ -11,7 +11,6 @@ import numpy as np
 import pytest
 
 from cosim import SimulationError, simulate
-from fmubuild.packaging import build_script
 from fmubuild.project import ROOT
 
 EXAMPLE = ROOT / "docs" / "own_autopilot" / "test_my_autopilot.py"
@@ -97,9 +96,8 @@ def test_the_example_test_file_tells_what_the_smc_as_printed_does(fmu_paths, pyt
 
 
 def test_the_example_test_file_fails_an_autopilot_that_does_not_steer(fmu_paths, pytester,
-                                                                       tmp_path):
-    idle = build_script(ROOT / "tests" / "faulty" / "idle_pilot_slave.py", ("fmukit",),
-                        tmp_path / "idle_pilot.fmu")
+                                                                       faulty_fmu):
+    idle = faulty_fmu("idle_pilot")
     result = pytester.runpytest_subprocess(str(EXAMPLE), "--autopilot", str(idle),
                                            "-p", "no:cacheprovider")
     result.assert_outcomes(passed=6, failed=2)          # every check but the heading's

@@ -55,7 +55,6 @@ import pytest
 
 from cosim.core.ssd import Component, Connection, SystemDescription, write_ssd
 from cosim.interop.ssp import export
-from fmubuild.packaging import build_script
 from fmubuild.project import ROOT
 
 FAULTS = ("nan", "range", "parameter", "exception", "sigint", "sigterm", "corrupt", "loop",
@@ -212,10 +211,9 @@ def _truncated(source: Path, target: Path) -> Path:
     return target
 
 
-def _files(ship: Path, root: Path, fmi: int) -> Files:
+def _files(ship: Path, root: Path, fmi: int, faulty_fmu) -> Files:
     """The systems of FMI version ``fmi``: this ship, and the fault FMU built as that version."""
-    fault_fmu = build_script(FAULTY / "fault_slave.py", ("fmukit",), root / "fault.fmu",
-                             fmi=fmi)
+    fault_fmu = faulty_fmu("fault", fmi)
     (root / "packages").mkdir()
     for fault in KIND:
         write_ssd(_system(ship, fault_fmu, fault), root / f"{fault}.ssd")
@@ -238,15 +236,16 @@ def _files(ship: Path, root: Path, fmi: int) -> Files:
 
 
 @pytest.fixture(scope="session")
-def files(fmu_paths, tmp_path_factory) -> Files:
+def files(fmu_paths, tmp_path_factory, faulty_fmu) -> Files:
     """The FMI 2.0 systems."""
-    return _files(fmu_paths["ship"], tmp_path_factory.mktemp("fault_matrix"), 2)
+    return _files(fmu_paths["ship"], tmp_path_factory.mktemp("fault_matrix"), 2, faulty_fmu)
 
 
 @pytest.fixture(scope="session")
-def files3(fmi3_paths, tmp_path_factory) -> Files:
+def files3(fmi3_paths, tmp_path_factory, faulty_fmu) -> Files:
     """The FMI 3.0 systems: the twins."""
-    return _files(fmi3_paths["ship"], tmp_path_factory.mktemp("fault_matrix_fmi3"), 3)
+    return _files(fmi3_paths["ship"], tmp_path_factory.mktemp("fault_matrix_fmi3"), 3,
+                  faulty_fmu)
 
 
 def _libpython() -> str:

@@ -25,7 +25,6 @@ from cosim.core.master import Master
 from cosim.core.ssd import Component, Connection, SystemDescription, write_ssd
 from cosim.interop.engines import run as run_engine
 from cosim.interop.ssp import export
-from fmubuild.packaging import build_script
 from fmubuild.project import ROOT
 from helpers import command
 from fmukit.timebase import communication_point
@@ -108,9 +107,8 @@ def test_same_bits_in_our_master_and_in_libcosim(fmu_paths, tmp_path):
 
 
 @pytest.fixture(scope="module")
-def fault_fmu(tmp_path_factory) -> Path:
-    return build_script(Path(__file__).parent / "faulty" / "fault_slave.py", ("fmukit",),
-                        tmp_path_factory.mktemp("fault") / "fault.fmu")
+def fault_fmu(faulty_fmu) -> Path:
+    return faulty_fmu("fault")
 
 
 def _zombies() -> list[int]:

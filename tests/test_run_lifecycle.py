@@ -24,7 +24,6 @@ from cosim.core.files import FolderLock, Outputs, OutputError, whole_file
 from cosim.core.interrupt import StopSignals
 from cosim.core.ssd import Component, Connection, SystemDescription, write_ssd
 from cosim.core.watchdog import Limits, Watchdog
-from fmubuild.packaging import build_script
 from fmubuild.project import ROOT
 from helpers import reference_seconds
 
@@ -40,11 +39,10 @@ def reference(tmp_path_factory, fmu_paths) -> float:
 
 
 @pytest.fixture(scope="module")
-def hung(fmu_paths, tmp_path_factory) -> dict[str, Path]:
+def hung(fmu_paths, tmp_path_factory, faulty_fmu) -> dict[str, Path]:
     """A system per kind: the ship steered by the fault FMU, which hangs from t = 5 s."""
     root = tmp_path_factory.mktemp("hung")
-    fault = build_script(ROOT / "tests" / "faulty" / "fault_slave.py", ("fmukit",),
-                         root / "fault.fmu")
+    fault = faulty_fmu("fault")
     systems = {}
     for kind, number in KINDS.items():
         system = SystemDescription(
@@ -286,14 +284,14 @@ def test_a_watchdog_without_signals_leaves_the_handlers_alone():
         assert signal.getsignal(signal.SIGINT) is before
 
 
-def test_a_sweep_records_a_hung_run_as_failed_and_goes_on(fmu_paths, tmp_path, reference):
+def test_a_sweep_records_a_hung_run_as_failed_and_goes_on(fmu_paths, tmp_path, reference,
+                                                          faulty_fmu):
     """A run whose autopilot loops in its step fails at the step time limit, saying so;
     the worker (here, this process) is free for the next run."""
     from cosim.studies import campaign, sweep_task
     from cosim.studies.sweep_spec import Spec
 
-    pilot = build_script(ROOT / "tests" / "faulty" / "idle_pilot_slave.py", ("fmukit",),
-                         tmp_path / "idle_pilot.fmu")
+    pilot = faulty_fmu("idle_pilot")
     spec_path = tmp_path / "spec.toml"
     spec_path.write_text(f'stop_time = 10\n[controllers]\nidle = {{ autopilot = "{pilot}" }}\n'
                          '[axes]\n"autopilot.hang_time" = [5.0, 1e9]\n')
@@ -427,12 +425,12 @@ def test_an_absolute_fmu_source_that_is_missing_is_not_replaced_by_one_of_its_na
 
 
 @pytest.mark.parametrize("backend", ["fmi", "inprocess"])
-def test_an_fmu_that_hangs_in_terminate_keeps_the_finished_run(fmu_paths, tmp_path, backend):
+def test_an_fmu_that_hangs_in_terminate_keeps_the_finished_run(fmu_paths, tmp_path, backend,
+                                                               faulty_fmu):
     """Nothing is raised into fmi2Terminate (an exception there has no safe way out of
     pythonfmu); past the step limit the finished run's files are written and the process
     ends, saying so."""
-    pilot = build_script(ROOT / "tests" / "faulty" / "idle_pilot_slave.py", ("fmukit",),
-                         tmp_path / "idle_pilot.fmu")
+    pilot = faulty_fmu("idle_pilot")
     result = _run(["calm_pd", "--autopilot", str(pilot), "--set", "autopilot.hang_terminate=1",
                    "--stop-time", "10", "--step-timeout", "1", "--backend", backend,
                    "--out", str(tmp_path / "out"), "--no-plot"], tmp_path,

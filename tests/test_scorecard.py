@@ -175,12 +175,9 @@ def test_the_scorecard_refuses_a_name_that_is_a_baseline_s(fmu_paths, tmp_path, 
     assert not (tmp_path / "s").exists()
 
 
-def test_an_autopilot_that_fails_is_scored_as_failed_and_the_rest_goes_on(tmp_path, capsys):
-    from fmubuild.packaging import build_script
-    from fmubuild.project import ROOT
-
-    failing = build_script(ROOT / "tests" / "faulty" / "idle_pilot_slave.py", ("fmukit",),
-                           tmp_path / "idle_pilot.fmu")
+def test_an_autopilot_that_fails_is_scored_as_failed_and_the_rest_goes_on(tmp_path, capsys,
+                                                                         faulty_fmu):
+    failing = faulty_fmu("idle_pilot")
     out = tmp_path / "score"
     assert cli.main([str(failing), "--set", "autopilot.fail_time=150", "--seeds", "1",
                      "--workers", "1", "--out", str(out), "--backend", "inprocess"]) == 0
