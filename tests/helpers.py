@@ -92,3 +92,24 @@ def command(main, *args: str) -> subprocess.CompletedProcess:
         except SystemExit as exit_:           # argparse's refusals
             status = exit_.code if isinstance(exit_.code, int) else 1
     return subprocess.CompletedProcess(["main", *args], status, out.getvalue(), err.getvalue())
+
+
+_recordings: dict = {}
+
+
+def recorded(name: str, fmi: int = 2, coupling: str = "gauss-seidel", backend: str = "fmi",
+             **master: object):
+    """A scenario's run on this project's FMUs of FMI version ``fmi``, by the master with
+    these settings, recorded once a test process (several test files look at the same runs;
+    treat it as read-only)."""
+    from cosim import scenarios
+    from cosim.core.master import Master
+
+    key = (name, fmi, coupling, backend, tuple(sorted(master.items())))
+    if key not in _recordings:
+        with Master(scenarios.load(name, fmi=fmi), coupling=coupling, backend=backend,
+                    **master) as runner:
+            recording = runner.run()
+        assert recording.error is None, recording.error
+        _recordings[key] = recording
+    return _recordings[key]

@@ -24,11 +24,10 @@ from cosim.ensemble.reference import SIGNALS
 from cosim.studies.direct import run_direct
 from fmubuild import project
 from fmubuild.project import ROOT
-from helpers import fmu_variant
+from helpers import fmu_variant, recorded
 
 SCENARIOS = scenarios.SCENARIO_DIR
 PAPER = ["calm_pd", "calm_smc", "waves_pd", "waves_smc"]
-_cache: dict = {}
 
 
 def system(name: str):
@@ -36,16 +35,8 @@ def system(name: str):
 
 
 def run(name: str, coupling: str = "gauss-seidel", backend: str = "fmi", **kwargs):
-    """A recorded run, cached: several tests look at the same runs."""
-    key = (name, coupling, backend, tuple(sorted(kwargs.items())))
-    if key not in _cache:
-        master = Master(system(name), coupling=coupling, backend=backend, **kwargs)
-        try:
-            _cache[key] = master.run()
-        finally:
-            master.free()
-        assert _cache[key].error is None
-    return _cache[key]
+    """A recorded run, cached for the session (``helpers.recorded``)."""
+    return recorded(name, coupling=coupling, backend=backend, **kwargs)
 
 
 @pytest.fixture(scope="module", autouse=True)

@@ -12,12 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cosim import scenarios
-from cosim.core.master import Master
 from cosim.interop.engines import TRACED, EngineError, run
 from cosim.interop.ssp import export
 from fmukit.timebase import nanoseconds
-from helpers import ecos_missing
+from helpers import ecos_missing, recorded
 
 PAPER = ["calm_pd", "calm_smc", "waves_pd", "waves_smc"]
 NEEDS_ECOS = pytest.mark.skipif(ecos_missing() is not None, reason=str(ecos_missing()))
@@ -34,17 +32,10 @@ def packages(fmu_paths, tmp_path_factory) -> dict[str, Path]:
     return {name: export(name, out) for name in PAPER + ["turning_circle"]}
 
 
-_ours: dict = {}
 
 
 def ours(name: str):
-    if name not in _ours:
-        master = Master(scenarios.load(name), coupling="jacobi")
-        try:
-            _ours[name] = master.run()
-        finally:
-            master.free()
-    return _ours[name]
+    return recorded(name, coupling="jacobi")
 
 
 def _compare(engine_trace: dict, name: str) -> tuple[float, int]:

@@ -28,9 +28,8 @@ from cosim.core.system import with_fmi
 from cosim.scenarios.autopilot import AutopilotError, check_autopilot
 from fmubuild import project
 from fmubuild.project import FMU_DIRS, FMUS
-from helpers import fmu_variant
+from helpers import fmu_variant, recorded
 
-_runs: dict = {}
 ROUTES = [(c, b) for c in ("gauss-seidel", "jacobi") for b in ("fmi", "inprocess")]
 """Each coupling on each backend."""
 
@@ -42,14 +41,9 @@ def twins(fmu_paths, fmi3_paths) -> dict[str, Path]:
 
 
 def run(name: str, fmi: int, coupling: str = "gauss-seidel", backend: str = "fmi"):
-    """A recorded run of a scenario on this project's FMUs of one FMI version, cached."""
-    key = (name, fmi, coupling, backend)
-    if key not in _runs:
-        with Master(scenarios.load(name, fmi=fmi), coupling=coupling,
-                    backend=backend) as master:
-            _runs[key] = master.run()
-        assert _runs[key].error is None, _runs[key].error
-    return _runs[key]
+    """A recorded run of a scenario on this project's FMUs of one FMI version, cached for
+    the session (``helpers.recorded``)."""
+    return recorded(name, fmi, coupling, backend)
 
 
 def assert_same_bits(a, b) -> None:
