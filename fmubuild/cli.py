@@ -35,7 +35,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("names", nargs="*", metavar="NAME|SCRIPT.py",
                         help=f"FMUs of the project (default: all of {', '.join(project)}), or "
                              "paths of your own scripts")
-    parser.add_argument("--out", type=Path,
+    parser.add_argument("--out", "--dest", dest="out", type=Path,
                         help=f"output folder (default: {FMU_DIRS[2]} for the project's FMUs, "
                              f"{FMU_DIRS[3]} for their FMI 3.0 twins, the script's folder for "
                              "a script, its folder fmi3 for its FMI 3.0 FMU)")
