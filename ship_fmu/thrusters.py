@@ -25,9 +25,8 @@ def thrust(n: float, k_p: float, k_n: float) -> float:
 
 def actuator_model(act: Actuators, n1: float, n2: float,
                    n3: float) -> Callable[[float], tuple[float, float, float]]:
-    """tau_th as a function of the rudder angle at fixed shaft speeds, eqs (8)-(13): the
-    thrusts and slipstream factors T_i (1 + k_Ln n_i), T_i (1 + k_Dn n_i) computed once. A
-    propeller turning astern (n_i < 0) gives its rudder no lift or drag."""
+    """tau_th of the rudder angle at fixed shaft speeds, eqs (8)-(13); a propeller turning
+    astern (n_i < 0) gives its rudder no lift or drag."""
     T1 = thrust(n1, act.k_Tp, act.k_Tn)
     T2 = thrust(n2, act.k_Tp, act.k_Tn)
     T3 = thrust(n3, act.k_T3p, act.k_T3n)
