@@ -1,6 +1,5 @@
-"""Titles and printed headers of a run, made from the parameter values the FMUs held
-(``Recording.meta``), never typed in per scenario: a label cannot describe a run that was
-not made. Angles in degrees."""
+"""Titles and headers of a run from the parameter values the FMUs held (``Recording.meta``),
+never typed per scenario: a label cannot describe a run that was not made."""
 from __future__ import annotations
 
 import math
@@ -17,7 +16,7 @@ _DISPLAY = {"rad": (math.degrees(1.0), "deg"), "rad/s": (math.degrees(1.0), "deg
 
 
 def value(x: Any, unit: str = "", degrees: bool = True) -> str:
-    """A parameter value for people: 4 significant digits; angles in degrees if ``degrees``."""
+    """A parameter value, 4 significant digits; angles in degrees if ``degrees``."""
     if isinstance(x, str) or isinstance(x, bool) or x is None:
         return str(x)
     factor, shown = _DISPLAY.get(unit, (1.0, unit)) if degrees else (1.0, unit)
@@ -27,7 +26,7 @@ def value(x: Any, unit: str = "", degrees: bool = True) -> str:
 
 
 def sea(ship: dict[str, Any]) -> str:
-    """'calm water', or the sea state: Hs, T0, the direction the waves travel to, the seed."""
+    """'calm water', or Hs, T0, the direction the waves travel to and the seed."""
     if ship.get("Hs", 0.0) == 0.0:
         return "calm water"
     return (f"waves Hs {ship['Hs'] * 1000:.3g} mm, T0 {ship['T0']:.3g} s, travelling to "
@@ -48,19 +47,18 @@ def gear(ship: dict[str, Any]) -> str:
 
 
 def settings(parameters: dict[str, Any], units: dict[str, str], degrees: bool = True) -> str:
-    """'name = value unit, ...' of one component's parameters."""
     return ", ".join(f"{name} = {value(x, units.get(name, ''), degrees)}"
                      for name, x in parameters.items())
 
 
 def overrides(meta: dict[str, Any]) -> str:
-    """The settings given on top of the scenario, as the --set options that give them."""
+    """The settings on top of the scenario, as --set options."""
     return " ".join(f"--set {c}.{n}={x}" for c, values in meta.get("overrides", {}).items()
                     for n, x in values.items())
 
 
 def conditions(meta: dict[str, Any]) -> list[str]:
-    """What a run was, line by line: route, sea, gear, controller or program, settings."""
+    """What a run was, line by line."""
     p, units = meta.get("parameters", {}), meta.get("parameter_units", {})
     lines = []
     if "stop_time" in meta:
@@ -84,7 +82,7 @@ def conditions(meta: dict[str, Any]) -> list[str]:
 
 
 def changes(meta: dict[str, Any]) -> str:
-    """How the run differs from its scenario, as the --set and --stop-time options ('')."""
+    """How the run differs from its scenario, as --set and --stop-time options."""
     changed = [overrides(meta)] if meta.get("overrides") else []
     stop = meta.get("scenario_stop_time")
     if stop is not None and meta.get("stop_time", stop) != stop:
@@ -93,7 +91,7 @@ def changes(meta: dict[str, Any]) -> str:
 
 
 def paper_row(meta: dict[str, Any]) -> tuple[str, tuple[float, float, float]] | None:
-    """The paper's table and (psi_E, delta_E, J) for one of its own runs, unchanged; else None."""
+    """The paper's table and (psi_E, delta_E, J) for one of its own runs, unchanged."""
     system = meta.get("system", "")
     if system not in PAPER_TABLES or changes(meta) or not meta.get("scenario_file"):
         return None
@@ -104,7 +102,6 @@ def paper_row(meta: dict[str, Any]) -> tuple[str, tuple[float, float, float]] | 
 
 
 def headline(label: str, meta: dict[str, Any]) -> str:
-    """The label and the scenario's description, or what changed the scenario."""
     changed = changes(meta)
     if not changed:
         return f"{label}: {meta.get('description', '')}"
@@ -114,5 +111,4 @@ def headline(label: str, meta: dict[str, Any]) -> str:
 
 
 def title(label: str, meta: dict[str, Any]) -> str:
-    """A figure title: the headline, then what the run was, line by line."""
     return "\n".join([headline(label, meta), *conditions(meta)])
