@@ -17,7 +17,6 @@ def rudder_target(delta_c: float, delta_max: float = DELTA_MAX) -> float:
 class RudderMotion:
     """The rudder angle s >= 0 after delta0, delta_c held: at the rate limit until
     ``reach`` (the kink, where the integrator cuts its step), then at the target."""
-
     __slots__ = ("delta0", "target", "velocity", "reach")
 
     def __init__(self, delta0: float, delta_c: float, delta_max: float = DELTA_MAX,

@@ -66,7 +66,6 @@ class VesselParameters:
 
 class Vessel:
     """CyberShip II in calm water or waves, stepped with inputs held."""
-
     STATE = ("x", "y", "psi", "u", "v", "r", "delta", "xi", "t")
 
     def __init__(self, params: VesselParameters = VesselParameters(),

@@ -25,30 +25,12 @@ def value(x: Any, unit: str = "", degrees: bool = True) -> str:
     return f"{text} {shown}".strip()
 
 
-def sea(ship: dict[str, Any]) -> str:
-    """'calm water', or Hs, T0, the direction the waves travel to and the seed."""
-    if ship.get("Hs", 0.0) == 0.0:
-        return "calm water"
-    return (f"waves Hs {ship['Hs'] * 1000:.3g} mm, T0 {ship['T0']:.3g} s, travelling to "
-            f"{math.degrees(ship['psi_w']) % 360:.0f} deg, seed {ship['wave_seed']}")
-
-
 def route(guidance: dict[str, Any]) -> str:
     try:
         points = " ".join(f"({x:g},{y:g})" for x, y in followed_route(guidance))
     except ValueError:                  # the guidance refuses it: shown as given
         points = repr(guidance.get("waypoints"))
     return f"route {points} m, acceptance radius {guidance['R_accept']:.3g} m"
-
-
-def gear(ship: dict[str, Any]) -> str:
-    return (f"rudder within +-{math.degrees(ship['delta_max']):.3g} deg at up to "
-            f"{math.degrees(ship['delta_rate_max']):.3g} deg/s")
-
-
-def settings(parameters: dict[str, Any], units: dict[str, str], degrees: bool = True) -> str:
-    return ", ".join(f"{name} = {value(x, units.get(name, ''), degrees)}"
-                     for name, x in parameters.items())
 
 
 def overrides(meta: dict[str, Any]) -> str:
@@ -68,14 +50,21 @@ def conditions(meta: dict[str, Any]) -> list[str]:
     if "guidance" in p:
         lines.append(route(p["guidance"]))
     if "ship" in p:
-        lines.append(f"{sea(p['ship'])}; {gear(p['ship'])}; starting at "
-                     f"{p['ship']['u0']:.3g} m/s")
+        ship = p["ship"]
+        sea = "calm water" if ship.get("Hs", 0.0) == 0.0 else (
+            f"waves Hs {ship['Hs'] * 1000:.3g} mm, T0 {ship['T0']:.3g} s, travelling to "
+            f"{math.degrees(ship['psi_w']) % 360:.0f} deg, seed {ship['wave_seed']}")
+        lines.append(f"{sea}; rudder within +-{math.degrees(ship['delta_max']):.3g} deg at up "
+                     f"to {math.degrees(ship['delta_rate_max']):.3g} deg/s; starting at "
+                     f"{ship['u0']:.3g} m/s")
     # An autopilot's gains stay in their units (eta_h = 10 rad); a program's angles in deg.
     for component, degrees in (("autopilot", False), ("program", True)):
         if component in p:
             fmu = meta.get("fmus", {}).get(component, {}).get("file", "")
-            lines.append(f"{component} {fmu.rsplit('/', 1)[-1]}: "
-                         f"{settings(p[component], units.get(component, {}), degrees)}")
+            given = units.get(component, {})
+            lines.append(f"{component} {fmu.rsplit('/', 1)[-1]}: " + ", ".join(
+                f"{name} = {value(x, given.get(name, ''), degrees)}"
+                for name, x in p[component].items()))
     if meta.get("overrides"):
         lines.append(f"set: {overrides(meta)}")
     return lines
@@ -93,12 +82,10 @@ def changes(meta: dict[str, Any]) -> str:
 def paper_row(meta: dict[str, Any]) -> tuple[str, tuple[float, float, float]] | None:
     """The paper's table and (psi_E, delta_E, J) for one of its own runs, unchanged."""
     system = meta.get("system", "")
-    if system not in PAPER_TABLES or changes(meta) or not meta.get("scenario_file"):
+    if system not in PAPER_TABLES or changes(meta) or not meta.get("scenario_file") or \
+            Path(meta["scenario_file"]).resolve() != (SCENARIO_DIR / f"{system}.ssd").resolve():
         return None
-    if Path(meta["scenario_file"]).resolve() != (SCENARIO_DIR / f"{system}.ssd").resolve():
-        return None
-    table = 1 if system.startswith("calm") else 2
-    return f"Tomera (2010) Table {table}", PAPER_TABLES[system]
+    return f"Tomera (2010) Table {1 if system.startswith('calm') else 2}", PAPER_TABLES[system]
 
 
 def headline(label: str, meta: dict[str, Any]) -> str:
@@ -106,8 +93,7 @@ def headline(label: str, meta: dict[str, Any]) -> str:
     if not changed:
         return f"{label}: {meta.get('description', '')}"
     whose = "the paper's" if meta.get("system") in PAPER_TABLES else "the scenario's"
-    return (f"{label}: {meta.get('system', label)} changed by {changed} "
-            f"(not {whose} run)")
+    return f"{label}: {meta.get('system', label)} changed by {changed} (not {whose} run)"
 
 
 def title(label: str, meta: dict[str, Any]) -> str:

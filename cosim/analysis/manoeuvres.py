@@ -58,10 +58,6 @@ class ZigZagResult:
     def checked(self) -> bool:
         return len(self.overshoots) >= 2
 
-    def overshoot(self, n: int) -> float:
-        """The n-th overshoot angle (1, 2, ...), rad; NaN if that turn was never checked."""
-        return self.overshoots[n - 1].angle if len(self.overshoots) >= n else math.nan
-
     def overshoot_bound(self, n: int) -> tuple[float, bool]:
         """(angle, at_least): measured, a lower bound if the run ended in that turn, or NaN."""
         if len(self.overshoots) >= n:
@@ -72,11 +68,11 @@ class ZigZagResult:
 
     @property
     def first_overshoot(self) -> float:
-        return self.overshoot(1)
+        return self.overshoots[0].angle if self.overshoots else math.nan
 
     @property
     def second_overshoot(self) -> float:
-        return self.overshoot(2)
+        return self.overshoots[1].angle if self.checked else math.nan
 
     @property
     def initial_turning_time(self) -> float:
@@ -96,8 +92,8 @@ class ZigZagResult:
         return self._between(1, 3)
 
     def _between(self, first: int, last: int) -> float:
-        return self.executes[last] - self.executes[first] if len(self.executes) > last \
-            else math.nan
+        return self.executes[last] - self.executes[first] if len(self.executes) > last else \
+            math.nan
 
 
 def _first_reaching(level: np.ndarray, target: float, *series: np.ndarray) -> list[float]:

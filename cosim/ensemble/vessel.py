@@ -38,7 +38,6 @@ class RudderArrays:
 
 class WaveArrays:
     """``ship_fmu.waves.WaveLoads`` of every member, eqs (14)-(16)."""
-
     FIELDS = ("omega", "k", "phase", "slope_amplitude", "psi_w", "c_force", "c_moment")
 
     def __init__(self, vessels: Sequence[Vessel]):
@@ -132,7 +131,6 @@ class Lanes:
 
 class VesselArrays:
     """M vessels stepped together, built from the scalar vessels as initialised."""
-
     STATES = ("x", "y", "psi", "u", "v", "r", "xi")
 
     def __init__(self, vessels: Sequence[Vessel], h: float,

@@ -39,14 +39,12 @@ def read_system(path: Path) -> SystemDescription:
     return read_osp(path) if is_osp(path) else read_package(path)
 
 
-def _libcosim(ssp: Path, signals: tuple[str, ...], stop: StopSignals) -> dict[str, np.ndarray]:
+def _libcosim(ssp: Path, system: SystemDescription, n_steps: int, signals: tuple[str, ...],
+              stop: StopSignals) -> dict[str, np.ndarray]:
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimObserver import CosimObserver
-
     log_output_level(CosimLogLevel.ERROR)
-    system = read_system(ssp)
-    n_steps = step_count(system.start_time, system.stop_time, system.step_size)
     execution = (CosimExecution.from_osp_config_file if is_osp(ssp)
                  else CosimExecution.from_ssp_file)(str(ssp))
     slaves = {s.name.decode(): s.index for s in execution.slave_infos()}
@@ -67,12 +65,10 @@ def _libcosim(ssp: Path, signals: tuple[str, ...], stop: StopSignals) -> dict[st
     return {"time": times, **dict(zip(signals, np.array(rows).T))}
 
 
-def _ecos(ssp: Path, signals: tuple[str, ...], stop: StopSignals) -> dict[str, np.ndarray]:
+def _ecos(ssp: Path, system: SystemDescription, n_steps: int, signals: tuple[str, ...],
+          stop: StopSignals) -> dict[str, np.ndarray]:
     from ecospy import EcosLib, EcosSimulation
-
     EcosLib.set_log_level("err")
-    system = read_package(ssp)
-    n_steps = step_count(system.start_time, system.stop_time, system.step_size)
     simulation = EcosSimulation(step_size=system.step_size, ssp_path=str(ssp))
     identifiers = [f"{c}::{v}" for c, v in map(split_name, signals)]
     try:
@@ -95,11 +91,10 @@ def _ecos(ssp: Path, signals: tuple[str, ...], stop: StopSignals) -> dict[str, n
     return {"time": times, **dict(zip(signals, np.array(rows).T))}
 
 
-def _fmpy(ssp: Path, signals: tuple[str, ...], stop: StopSignals) -> dict[str, np.ndarray]:
+def _fmpy(ssp: Path, system: SystemDescription, n_steps: int, signals: tuple[str, ...],
+          stop: StopSignals) -> dict[str, np.ndarray]:
     from fmpy.ssp.simulation import simulate_ssp
     from fmpy.ssp.ssd import Parameter, ParameterSet
-
-    system = read_package(ssp)
     # fmpy's runner applies no parameter bindings itself and cannot set Strings:
     # pass the package's own values, fully qualified; a String must equal the FMU's
     # default, or the run would not be the scenario.
@@ -185,7 +180,9 @@ def record(engine: str, ssp: str, out: str, signals: tuple[str, ...]) -> int:
     stderr if it fails; 130 or 143 if SIGINT or SIGTERM stopped it (between steps)."""
     try:
         with StopSignals() as stop:
-            result = RUNNERS[engine](Path(ssp), signals, stop)
+            system = read_system(Path(ssp))
+            n_steps = step_count(system.start_time, system.stop_time, system.step_size)
+            result = RUNNERS[engine](Path(ssp), system, n_steps, signals, stop)
     except Interrupted as interrupted:
         print(interrupted, file=sys.stderr)
         return interrupted.exit_status
