@@ -1,19 +1,8 @@
-"""Sliding-mode autopilot, eqs (35)-(44).
-
-Design (computed, never typed in): sway-yaw model -> Nomoto model (33) -> pole placement of
-A_c = A_h - B_h K^T at lambda_1, lambda_2 (38) -> h, the eigenvector of A_c^T for the
-eigenvalue of smaller magnitude -> N from (40)-(41). Control law, x = [psi, r]:
-
-    delta_c = u_eq + u_sw                                    (43)
-    u_eq  = N psi_z - K^T x                                  (39), stabilising reading
-    u_sw  = h^T [r_z, r_z_dot] - eta_h tanh(sigma_h / phi_h)  (42)
-    sigma_h = h_1 (psi_z - psi) + h_2 (r_z - r)              (37)
-
-Eq (39) as printed (-N psi_z + K x) feeds the heading back with the wrong sign;
-``equivalent_control='tracking'`` is u_eq = -K^T (x - x_z), not the paper's law
-(docs/reproduction.md). Heading differences are wrapped to (-pi, pi]; the reference
-model (44) is integrated by RK4 with psi_d held over the step.
-"""
+"""Sliding-mode autopilot, eqs (35)-(44), designed from the Nomoto model (33) by pole placement
+(38), h the eigenvector of A_c^T of the smaller eigenvalue, N from (40)-(41). delta_c = u_eq +
+u_sw (43), u_eq = N psi_z - K^T x (39, read to stabilise: as printed it feeds the heading back
+with the wrong sign; 'tracking': -K^T (x - x_z), docs/reproduction.md), u_sw = h^T [r_z,
+r_z_dot] - eta_h tanh(sigma_h / phi_h) (42), sigma_h = h_1 (psi_z - psi) + h_2 (r_z - r) (37)."""
 from __future__ import annotations
 
 import math
