@@ -48,11 +48,10 @@ def time_axes(fig: Figure, cells: list[Any]) -> list[Any]:
     """Panels over time, one per grid cell, sharing the time axis."""
     axes = [fig.add_subplot(cells[0])]
     axes += [fig.add_subplot(c, sharex=axes[0]) for c in cells[1:]]
-    for a in axes[:-1]:
-        a.tick_params(labelbottom=False)
-    axes[-1].set_xlabel("time (s)")
     for a in axes:
         a.grid(alpha=0.3)
+        a.tick_params(labelbottom=a is axes[-1])
+    axes[-1].set_xlabel("time (s)")
     return axes
 
 

@@ -144,10 +144,8 @@ def turning_circle_figures(x, y, psi, u, v, r) -> TurningCircle:
     _, tactical, u180, v180 = at_heading_change(psi, math.pi, along, across, u, v)
     turn = math.copysign(math.pi, psi[-1] - psi[0])
     course = turn + math.atan2(v180, u180) - math.atan2(v[0], u[0])
-    return TurningCircle(advance=advance, transfer=abs(transfer),
-                         tactical_diameter=abs(tactical),
-                         steady_yaw_rate=float(r[-1]),
-                         steady_speed=float(math.hypot(u[-1], v[-1])),
+    return TurningCircle(advance=advance, transfer=abs(transfer), tactical_diameter=abs(tactical),
+                         steady_yaw_rate=float(r[-1]), steady_speed=float(math.hypot(u[-1], v[-1])),
                          steady_diameter=steady_circle(x, y, psi)[2],
                          approach_speed=float(math.hypot(u[0], v[0])),
                          drift_angle=float(math.atan2(v[-1], u[-1])),
@@ -189,8 +187,7 @@ def turning_circle(delta: float = TURNING_RUDDER, t_end: float = 300.0,
 
 
 def zigzag(delta: float = math.radians(20.0), psi_switch: float = math.radians(20.0),
-           t_end: float = 300.0,
-           params: VesselParameters = VesselParameters()) -> ZigZagResult:
+           t_end: float = 300.0, params: VesselParameters = VesselParameters()) -> ZigZagResult:
     track = trial(RudderProgram(delta, psi_switch), t_end, params)
     t = DT * np.arange(len(track["psi"]))
     return zigzag_figures(track["psi"], track["reversals"], psi_switch, t, track["x"],

@@ -21,6 +21,7 @@ from .track import hull_outline, legend_if_any, outlines, track_panel
 RUDDER = "rudder -delta (deg, + turns to starboard)"
 _ORDINALS = ("1st", "2nd", "3rd", "4th")
 _BOX = dict(boxstyle="round,pad=0.15", facecolor="white", alpha=0.85, edgecolor="none")
+_ROUND = {**_BOX, "boxstyle": "round"}
 
 
 def _rudder(ax: Any, run: Recording) -> None:
@@ -160,8 +161,7 @@ def _dimension(ax: Any, run: Recording, start: tuple[float, float], end: tuple[f
     middle = (0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1]))
     where = middle if label_at is None else _earth(run, *label_at)
     ax.annotate(label, xy=middle, xytext=where, fontsize=8, color=colour, ha="center",
-                va="center", zorder=7,
-                bbox=dict(boxstyle="round", facecolor="white", alpha=0.85, edgecolor="none"),
+                va="center", zorder=7, bbox=_ROUND,
                 arrowprops=None if label_at is None else dict(arrowstyle="-", color=colour,
                                                               linewidth=0.7))
 
@@ -226,8 +226,7 @@ def _steady(ax: Any, run: Recording, tc: TurningCircle, L: float) -> None:
     ax.text(centre_y, centre_x, f"steady turning diameter {diameter:.2f} m = "
             f"{diameter / L:.2f} L\n(circle fitted to the last lap; 2U/|r| = "
             f"{tc.diameter_from_rates:.2f} m)", ha="center", va="bottom", fontsize=7,
-            color="tab:orange", zorder=7,
-            bbox=dict(boxstyle="round", facecolor="white", alpha=0.85, edgecolor="none"))
+            color="tab:orange", zorder=7, bbox=_ROUND)
 
 
 def _wrapped_heading(ax: Any, run: Recording) -> None:
