@@ -67,14 +67,9 @@ class WaveComponents:
         return cls(omega=omega, k=omega * omega / G,
                    amplitude=np.sqrt(2.0 * m0_bins), phase=phase)
 
-    def phases(self, t: float, xi: float, out: np.ndarray | None = None,
-               omega_t: np.ndarray | None = None) -> np.ndarray:
-        """theta_i(t) = omega_i t - k_i xi + phi_i (into ``out``; ``omega_t``: omega_i t)."""
-        if omega_t is None:
-            omega_t = self.omega * t
-        out = np.multiply(self.k, xi, out)
-        np.subtract(omega_t, out, out)
-        return np.add(out, self.phase, out)
+    def phases(self, t: float, xi: float) -> np.ndarray:
+        """theta_i(t) = omega_i t - k_i xi + phi_i."""
+        return self.omega * t - self.k * xi + self.phase
 
 
 class WaveLoads:
@@ -101,7 +96,9 @@ class WaveLoads:
         if t != self._t:
             np.multiply(self.components.omega, t, self._omega_t)
             self._t = t
-        s = self.components.phases(t, xi, self._s, self._omega_t)
+        s = np.multiply(self.components.k, xi, self._s)    # theta_i, in place
+        np.subtract(self._omega_t, s, s)
+        np.add(s, self.components.phase, s)
         np.sin(s, s)
         np.multiply(self._slope_amplitude, s, s)          # s_i = A_i k_i sin(theta_i)
         beta = self.psi_w - psi

@@ -106,14 +106,6 @@ def _zoom(ax: Any, run: Recording, zz: ZigZagResult) -> None:
             color="0.4", bbox=_BOX)
 
 
-def _switching_angles(ax: Any, switch: float) -> None:
-    ax.axhline(0.0, color="0.6", linewidth=0.6)
-    for level in (-switch, switch):
-        ax.axhline(level, linestyle=":", color="0.4", linewidth=0.9)
-        ax.text(1.0, level, f" {level:+g}", transform=ax.get_yaxis_transform(), va="center",
-                fontsize=7, color="0.4")
-
-
 def zigzag_plate(run: Recording, **_: Any) -> Figure:
     """Heading and rudder with executes, overshoots and times; yaw rate; track; criteria."""
     a = zigzag_of(run)
@@ -125,7 +117,11 @@ def zigzag_plate(run: Recording, **_: Any) -> Figure:
     heading.plot(run.t, np.degrees(run["ship.psi"]), color="k", linewidth=1.4,
                  label="heading psi")
     _rudder(heading, run)
-    _switching_angles(heading, math.degrees(zz.psi_switch))
+    heading.axhline(0.0, color="0.6", linewidth=0.6)
+    for level in (-math.degrees(zz.psi_switch), math.degrees(zz.psi_switch)):
+        heading.axhline(level, linestyle=":", color="0.4", linewidth=0.9)     # rudder reverses
+        heading.text(1.0, level, f" {level:+g}", transform=heading.get_yaxis_transform(),
+                     va="center", fontsize=7, color="0.4")
     _executes(heading, run, zz)
     _overshoots(heading, zz)
     if zz.running is not None:
@@ -229,13 +225,6 @@ def _steady(ax: Any, run: Recording, tc: TurningCircle, L: float) -> None:
             color="tab:orange", zorder=7, bbox=_ROUND)
 
 
-def _wrapped_heading(ax: Any, run: Recording) -> None:
-    heading = np.degrees(run["ship.psi"]) % 360.0
-    heading[1:][np.abs(np.diff(heading)) > 180.0] = np.nan
-    ax.plot(run.t, heading, color="k")
-    ax.set(ylim=(0, 360), yticks=(0, 90, 180, 270, 360), ylabel="heading psi\n(deg, 0-360)")
-
-
 def turning_circle_plate(run: Recording, **_: Any) -> Figure:
     """Track with the diameters; heading, speed, drift, yaw rate and rudder; criteria."""
     a = turning_circle_of(run)
@@ -245,7 +234,10 @@ def turning_circle_plate(run: Recording, **_: Any) -> Figure:
     _turning_track(fig.add_subplot(grid[0:5, 0]), run, a)
     heading, speed, drift, r, rudder = time_axes(fig, [grid[i, 1] for i in range(5)])
     t, u, v = run.t, run["ship.u"], run["ship.v"]
-    _wrapped_heading(heading, run)
+    compass = np.degrees(run["ship.psi"]) % 360.0          # broken where it wraps
+    compass[1:][np.abs(np.diff(compass)) > 180.0] = np.nan
+    heading.plot(t, compass, color="k")
+    heading.set(ylim=(0, 360), yticks=(0, 90, 180, 270, 360), ylabel="heading psi\n(deg, 0-360)")
     for target in (math.pi / 2, math.pi):
         when, = at_heading_change(run["ship.psi"], target, t)
         if math.isnan(when):
