@@ -54,7 +54,6 @@ def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> P
     """Write the animation, whole or not at all, at ``path`` with ``fmt``'s suffix."""
     require_track(run.columns)
     fmt = fmt or video_format()
-    rows = frame_times(run.t)
     x, y, psi, delta, t = (run["ship.x"], run["ship.y"], run["ship.psi"], run["ship.delta"],
                            run.t)
     fig = new_figure(figsize=(10, 5.6), dpi=90, layout="constrained")
@@ -65,8 +64,7 @@ def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> P
     track.plot(y, x, color="0.8", linewidth=0.8, zorder=1)            # the whole track, faint
     wake, = track.plot([], [], color="k", linewidth=1.2, zorder=3)
     shown = outlines(run)
-    scale = shown.scale
-    hull = track.add_patch(Polygon(hull_outline(x[0], y[0], psi[0], scale), closed=True,
+    hull = track.add_patch(Polygon(hull_outline(x[0], y[0], psi[0], shown.scale), closed=True,
                                    color="tab:red", zorder=5))
     track.plot([], [], "s", color="tab:red", label=f"ship outline {shown.size}")
     legs = run.meta.get("parameters", {}).get("guidance")
@@ -90,7 +88,7 @@ def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> P
 
     def draw(k: int) -> str:
         wake.set_data(y[:k + 1], x[:k + 1])
-        hull.set_xy(hull_outline(x[k], y[k], psi[k], scale))
+        hull.set_xy(hull_outline(x[k], y[k], psi[k], shown.scale))
         for cursor in cursors:
             cursor.set_xdata([t[k], t[k]])
         text = (f"t = {t[k]:.0f} s   heading {math.degrees(psi[k]):.1f} deg   "
@@ -111,7 +109,7 @@ def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> P
     width, height = fig.canvas.get_width_height()
     target = path.with_suffix(f".{fmt}")
     frames = []
-    for k in rows:
+    for k in frame_times(t):
         readout.set_text(draw(k))
         fig.canvas.restore_region(background)
         for artist in dynamic:
@@ -125,7 +123,6 @@ def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> P
 def _write(frames: list[np.ndarray], path: Path, fmt: str, width: int, height: int) -> None:
     if fmt == "gif":
         from PIL import Image
-
         images = [Image.fromarray(frame).quantize(colors=64, method=Image.Quantize.FASTOCTREE)
                   for frame in frames]
         images[0].save(path, save_all=True, append_images=images[1:],
