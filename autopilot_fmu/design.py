@@ -1,10 +1,7 @@
-"""Linear design models of the sliding-mode autopilot, eqs (22)-(32) and (45)-(46), of the
-sway-yaw model M nu_dot + N(u0) nu = b delta, nu = [v, r]:
-
-- ``PAPER_EQ45``: eq (45) as printed, to reproduce the paper (its n_22 and b_1 do not
-  follow from the hull data: ../shared/cybership2.md, erratum 4);
-- ``linearised_ship(u0)``: the Jacobian of our own ship model at nu = [u0, 0, 0], taken
-  numerically from the functions the vessel integrates.
+"""Linear design models of the sliding-mode autopilot, eqs (22)-(32), (45)-(46), of the
+sway-yaw model M nu_dot + N(u0) nu = b delta, nu = [v, r]: ``PAPER_EQ45`` as printed (its
+n_22 and b_1 do not follow from the hull data: ../shared/cybership2.md, erratum 4), or
+``linearised_ship(u0)``, the numerical Jacobian of our ship model at nu = [u0, 0, 0].
 """
 from __future__ import annotations
 
@@ -22,7 +19,6 @@ from ship_fmu.vessel import N_PROPELLER
 @dataclass(frozen=True)
 class SwayYawModel:
     """M nu_dot + N nu = b delta with nu = [v, r], eq (23)."""
-
     M: np.ndarray
     N: np.ndarray
     b: np.ndarray
@@ -36,8 +32,7 @@ PAPER_EQ45 = SwayYawModel(
 
 
 def _derivative(f: Callable[[float], np.ndarray], x: float, step: float = 1e-3) -> np.ndarray:
-    """df/dx by central differences with one Richardson step, which removes exactly the
-    error, proportional to the step, of the |a| b terms at a = 0."""
+    """Central differences with one Richardson step (exact for the |a| b terms at a = 0)."""
     def central(h: float) -> np.ndarray:
         return (f(x + h) - f(x - h)) / (2.0 * h)
     return 2.0 * central(step / 2.0) - central(step)
@@ -49,7 +44,6 @@ def linearised_ship(u0: float, n: float = N_PROPELLER, hull: Hull = Hull(),
     def hydrodynamic(v: float, r: float) -> np.ndarray:
         forces = np.add(coriolis_forces(hull, u0, v, r), damping_forces(hull, u0, v, r))
         return forces[1:]
-
     N = np.column_stack([_derivative(lambda v: hydrodynamic(v, 0.0), 0.0),
                          _derivative(lambda r: hydrodynamic(0.0, r), 0.0)])
     b = _derivative(lambda d: np.array(actuator_forces(actuators, n, n, 0.0, d)[1:]), 0.0)
@@ -59,7 +53,6 @@ def linearised_ship(u0: float, n: float = N_PROPELLER, hull: Hull = Hull(),
 @dataclass(frozen=True)
 class NomotoModel:
     """psi/delta = K / (s (1 + T s)), eqs (26)-(34), as the state model (33)."""
-
     K_R: float      # eq (29)
     T3: float       # eq (30)
     T: float        # T1 + T2 - T3, s
@@ -87,7 +80,6 @@ class NomotoModel:
 
     @property
     def b2(self) -> float:
-        """K / T."""
         return self.K / self.T
 
     def state_model(self) -> tuple[list[list[float]], list[float], list[float], float]:

@@ -1,14 +1,8 @@
-"""Waypoint guidance, eq (18): the desired course is the bearing of the active leg,
-
-    psi_d = atan2(y_{k+1} - y_k, x_{k+1} - x_k)         (x north, y east)
-
-The ship moves on to the next leg inside the circle of acceptance around the waypoint it
-heads for, *or* once past that waypoint along the track (a circle-only rule strands a
-ship whose turn leaves it wide of the circle); after the last it holds the last course.
-``active_leg`` evaluates the rule without committing it. The route is the String
-``waypoints`` 'x0,y0;x1,y1;...' or, for hosts that set no String parameter (OMSimulator),
-the numbers ``n_waypoints``, ``wp<i>_x``, ``wp<i>_y`` (``route``; docs/interop.md).
-"""
+"""Waypoint guidance, eq (18): psi_d = atan2(y_{k+1} - y_k, x_{k+1} - x_k), x north. The
+next leg starts inside the circle of acceptance *or* once past the waypoint along the track
+(a circle-only rule strands a ship turning wide); past the last, the last course holds. The
+route: the String ``waypoints`` 'x0,y0;x1,y1;...' or, for hosts without String parameters
+(OMSimulator), ``n_waypoints``, ``wp<i>_x``, ``wp<i>_y`` (``route``; docs/interop.md)."""
 from __future__ import annotations
 
 import math
@@ -18,28 +12,21 @@ from typing import Any
 from fmukit.numerics import require_finite
 from ship_fmu.data import Hull
 
-PAPER_ROUTE = "0,0;30,0;60,25;90,25"
-"""The reproduction route, m: the paper gives no waypoints (see docs/reproduction.md)."""
-
-R_ACCEPT = 2.0 * Hull.L
-"""Radius of the circle of acceptance, m: two ship lengths."""
-MAX_WAYPOINTS = 16
-"""Points the numeric form of the route holds: wp0_x, wp0_y ... wp15_x, wp15_y."""
+PAPER_ROUTE = "0,0;30,0;60,25;90,25"    # m; the paper gives none (docs/reproduction.md)
+R_ACCEPT = 2.0 * Hull.L                  # m, radius of the circle of acceptance
+MAX_WAYPOINTS = 16                       # points of the numeric route: wp0_x ... wp15_y
 
 
 def coordinate_names(i: int) -> tuple[str, str]:
-    """The numeric form's parameters of point ``i``: ('wp<i>_x', 'wp<i>_y')."""
     return f"wp{i}_x", f"wp{i}_y"
 
 
 COORDINATES = tuple(name for i in range(MAX_WAYPOINTS) for name in coordinate_names(i))
-ROUTE_PARAMETERS = ("waypoints", "n_waypoints", *COORDINATES)
-"""Every parameter the route is read from (``route``)."""
+ROUTE_PARAMETERS = ("waypoints", "n_waypoints", *COORDINATES)   # what ``route`` reads
 
 
 def _checked(points: list[tuple[float, float]], what: str) -> list[tuple[float, float]]:
-    """``points`` if finite, no two consecutive alike; ValueError naming ``what`` (the
-    parameters giving them)."""
+    """``points`` if finite, no two consecutive alike; ValueError naming ``what``."""
     for i, (x, y) in enumerate(points):
         if not (math.isfinite(x) and math.isfinite(y)):
             raise ValueError(f"parameter {what}: point {i} ({x}, {y}) is not finite")
@@ -68,8 +55,7 @@ def parse_waypoints(text: str) -> list[tuple[float, float]]:
 
 
 def numeric_route(text: str) -> dict[str, int | float]:
-    """The route 'x0,y0;...' as n_waypoints and wp<i>_x, wp<i>_y (the others at their
-    default, 0); ValueError beyond ``MAX_WAYPOINTS`` points."""
+    """The route 'x0,y0;...' as n_waypoints and wp<i>_x, wp<i>_y (others unset)."""
     points = parse_waypoints(text)
     if len(points) > MAX_WAYPOINTS:
         raise ValueError(f"the route {text!r} has {len(points)} points; its numeric form "
@@ -81,11 +67,9 @@ def numeric_route(text: str) -> dict[str, int | float]:
 
 
 def route(parameters: Mapping[str, Any]) -> list[tuple[float, float]]:
-    """The route the guidance follows, from its parameters by name (absent: at their
-    defaults); ValueError naming the parameters if it is not well defined.
-    ``n_waypoints`` = 0: the String ``waypoints``, every wp<i> unset (0). n >= 2: wp0 ..
-    wp<n-1>, the others unset, and ``waypoints`` at its default or the same points.
-    """
+    """The route of the guidance's parameters by name (absent: defaults); ValueError naming
+    them unless n_waypoints = 0 with every wp<i> unset (the String), or n >= 2 with wp0 ..
+    wp<n-1> and ``waypoints`` at its default or the same points."""
     text = parameters.get("waypoints", PAPER_ROUTE)
     count = parameters.get("n_waypoints", 0)
     coordinates = [float(parameters.get(name, 0.0)) for name in COORDINATES]
@@ -113,7 +97,6 @@ class WaypointGuidance:
 
     def __init__(self, waypoints: str | Sequence[tuple[float, float]] = PAPER_ROUTE,
                  R_accept: float = R_ACCEPT):
-        """``waypoints``: 'x0,y0;x1,y1;...' or the points, as ``route`` gives them."""
         if not (math.isfinite(R_accept) and R_accept > 0.0):
             raise ValueError(f"parameter R_accept must be finite and > 0, got {R_accept}")
         self.points = (parse_waypoints(waypoints) if isinstance(waypoints, str)
@@ -124,7 +107,6 @@ class WaypointGuidance:
         self._last: tuple = (None, None)  # the last evaluation (an FMU asks 3 times)
 
     def _reached(self, leg: int, x: float, y: float) -> bool:
-        """Whether the ship is done with ``leg``: inside the circle or past its end."""
         (x0, y0), (x1, y1) = self.points[leg], self.points[leg + 1]
         dx, dy = x1 - x0, y1 - y0
         length = math.hypot(dx, dy)
@@ -152,7 +134,6 @@ class WaypointGuidance:
         return math.atan2(y1 - y0, x1 - x0)
 
     def psi_d(self, x: float, y: float) -> float:
-        """Desired course at (x, y), rad."""
         return self.course(self.active_leg(x, y)[0])
 
     def wp_index(self, x: float, y: float) -> int:
@@ -161,7 +142,6 @@ class WaypointGuidance:
         return len(self.points) if finished else leg + 1
 
     def update(self, x: float, y: float) -> None:
-        """Commit leg switches at (x, y)."""
         self.leg, self.finished = self.active_leg(x, y)
 
     def snapshot(self) -> dict[str, int | bool]:

@@ -1,16 +1,7 @@
 """Waypoint guidance as an FMI 2.0 co-simulation FMU (fmus/guidance.fmu), eq (18): psi_d and
-wp_index are direct feedthrough from the position, the leg switch committed at each step's
-end. The route: the String ``waypoints`` or its numeric form (``guidance.route``).
-"""
-from autopilot_fmu.guidance import (
-    MAX_WAYPOINTS,
-    PAPER_ROUTE,
-    R_ACCEPT,
-    ROUTE_PARAMETERS,
-    WaypointGuidance,
-    coordinate_names,
-    route,
-)
+wp_index direct feedthrough from the position, the leg switch committed at each step's end."""
+from autopilot_fmu.guidance import (MAX_WAYPOINTS, PAPER_ROUTE, R_ACCEPT, ROUTE_PARAMETERS,
+                                    WaypointGuidance, coordinate_names, route)
 from fmukit.slave import ModelSlave, Var
 
 _ROUTE = ROUTE_PARAMETERS + ("R_accept",)

@@ -1,8 +1,5 @@
-"""PD autopilot, eq (20): delta_c = K_P (psi - psi_d) + K_D r.
-
-A positive rudder turns this ship to port (r < 0), so eq (20) as printed is a stabilising
-feedback. The heading error is wrapped to (-pi, pi]: the ship turns the short way.
-"""
+"""PD autopilot, eq (20): delta_c = K_P (psi - psi_d) + K_D r, stabilising as printed (a
+positive rudder turns this ship to port); the error wrapped to (-pi, pi]: the short way."""
 from __future__ import annotations
 
 import math
@@ -22,7 +19,6 @@ class PDAutopilot:
                 raise ValueError(f"parameter {name} = {getattr(self, name)} is not finite")
 
     def command(self, psi: float, r: float, psi_d: float) -> float:
-        """Commanded rudder angle delta_c, rad."""
         return self.Kp * wrap(psi - psi_d) + self.Kd * r
 
     def snapshot(self) -> dict:

@@ -1,19 +1,8 @@
-"""Sliding-mode autopilot, eqs (35)-(44).
-
-Design (computed, never typed in): sway-yaw model -> Nomoto model (33) -> pole placement of
-A_c = A_h - B_h K^T at lambda_1, lambda_2 (38) -> h, the eigenvector of A_c^T for the
-eigenvalue of smaller magnitude -> N from (40)-(41). Control law, x = [psi, r]:
-
-    delta_c = u_eq + u_sw                                    (43)
-    u_eq  = N psi_z - K^T x                                  (39), stabilising reading
-    u_sw  = h^T [r_z, r_z_dot] - eta_h tanh(sigma_h / phi_h)  (42)
-    sigma_h = h_1 (psi_z - psi) + h_2 (r_z - r)              (37)
-
-Eq (39) as printed (-N psi_z + K x) feeds the heading back with the wrong sign;
-``equivalent_control='tracking'`` is u_eq = -K^T (x - x_z), not the paper's law
-(docs/reproduction.md). Heading differences are wrapped to (-pi, pi]; the reference
-model (44) is integrated by RK4 with psi_d held over the step.
-"""
+"""Sliding-mode autopilot, eqs (35)-(44), designed from the Nomoto model (33) by pole placement
+(38), h the eigenvector of A_c^T of the smaller eigenvalue, N from (40)-(41). delta_c = u_eq +
+u_sw (43), u_eq = N psi_z - K^T x (39, read to stabilise: as printed it feeds the heading back
+with the wrong sign; 'tracking': -K^T (x - x_z), docs/reproduction.md), u_sw = h^T [r_z,
+r_z_dot] - eta_h tanh(sigma_h / phi_h) (42), sigma_h = h_1 (psi_z - psi) + h_2 (r_z - r) (37)."""
 from __future__ import annotations
 
 import math
@@ -24,23 +13,19 @@ from fmukit.numerics import require_finite, substeps, wrap
 
 from .design import NomotoModel, SwayYawModel
 
-H_MAX = 0.1
-"""Largest RK4 step of the reference model, s."""
-
+H_MAX = 0.1                     # s, the largest RK4 step of the reference model
 EQUIVALENT_CONTROLS = ("paper", "tracking")
 
 
 def reference_step_bound(omega_n: float, zeta: float) -> float:
-    """The largest RK4 step of the reference model (44), s: |lambda| h <= 1 on its fastest
-    eigenvalue, and at most H_MAX."""
+    """The largest RK4 step of model (44), s: |lambda| h <= 1 on its fastest eigenvalue."""
     fastest = omega_n * (zeta + math.sqrt(max(zeta * zeta - 1.0, 0.0)))
     return H_MAX if fastest * H_MAX <= 1.0 else 1.0 / fastest
 
 
 def reference_acceleration(psi_d: float, psi_z: float, r_z: float, omega_n: float,
                            zeta: float, wrap: Callable = wrap) -> float:
-    """r_z_dot of the reference model, eq (44): omega_n^2 (psi_d - psi_z, wrapped) -
-    2 zeta omega_n r_z. Floats, or arrays with an array ``wrap`` (``cosim.ensemble``)."""
+    """r_z_dot of eq (44); floats, or arrays with an array ``wrap`` (``cosim.ensemble``)."""
     return omega_n * omega_n * wrap(psi_d - psi_z) - 2.0 * zeta * omega_n * r_z
 
 
@@ -61,7 +46,6 @@ def reference_rk4(psi_d: float, psi_z: float, r_z: float, hs: float, omega_n: fl
 @dataclass(frozen=True)
 class SlidingModeDesign:
     """Gains of the sliding-mode autopilot for a Nomoto model, eqs (38)-(41)."""
-
     nomoto: NomotoModel
     lambda1: float
     lambda2: float
@@ -99,7 +83,6 @@ class SlidingModeDesign:
 # The design's linear algebra written out in exactly rounded operations, not by LAPACK,
 # whose last bits vary by CPU: the chattering loop turns a last bit into another run.
 def _eigenvalues(M: list[list[float]]) -> tuple[float, float]:
-    """The real eigenvalues of a 2 x 2 matrix, from its characteristic polynomial."""
     trace, det = M[0][0] + M[1][1], M[0][0] * M[1][1] - M[0][1] * M[1][0]
     discriminant = trace * trace - 4.0 * det
     if discriminant < 0.0:
@@ -110,14 +93,13 @@ def _eigenvalues(M: list[list[float]]) -> tuple[float, float]:
 
 
 def _null_vector(M: list[list[float]], eigenvalue: float) -> tuple[float, float]:
-    """A vector h with (M - eigenvalue I) h = 0, from the row of larger norm."""
+    """h with (M - eigenvalue I) h = 0, from the row of larger norm."""
     rows = [(M[0][0] - eigenvalue, M[0][1]), (M[1][0], M[1][1] - eigenvalue)]
     a, b = max(rows, key=lambda row: math.hypot(*row))
     return -b, a
 
 
 def _solve(M: list[list[float]], b: list[float]) -> list[float]:
-    """x with M x = b for a 3 x 3 M, by Cramer's rule."""
     def det(m: list[list[float]]) -> float:
         return (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
                 - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
@@ -153,7 +135,6 @@ class SlidingModeAutopilot:
 
     def r_z_dot(self, psi_d: float, psi_z: float | None = None,
                 r_z: float | None = None) -> float:
-        """r_z_dot of the reference model, eq (44)."""
         return reference_acceleration(psi_d, self.psi_z if psi_z is None else psi_z,
                                       self.r_z if r_z is None else r_z, self.omega_n, self.zeta)
 
@@ -163,7 +144,7 @@ class SlidingModeAutopilot:
         return h1 * wrap(self.psi_z - psi) + h2 * (self.r_z - r)
 
     def command(self, psi: float, r: float, psi_d: float) -> float:
-        """Commanded rudder angle delta_c = u_eq + u_sw, eq (43), rad."""
+        """delta_c = u_eq + u_sw, eq (43), rad."""
         (k1, k2), (h1, h2) = self.design.K, self.design.h
         u_eq = k1 * wrap(self.psi_z - psi) + k2 * ((self.r_z if self.tracking else 0.0) - r)
         u_sw = (h1 * self.r_z + h2 * self.r_z_dot(psi_d)
@@ -171,7 +152,6 @@ class SlidingModeAutopilot:
         return u_eq + u_sw
 
     def step(self, t: float, h: float, psi_d: float) -> None:
-        """Advance the reference model from t to t + h with psi_d held (RK4)."""
         require_finite(psi_d=psi_d)
         n = substeps(h, self._h_max, "of the reference model")
         hs = h / n

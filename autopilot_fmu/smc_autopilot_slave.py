@@ -1,8 +1,5 @@
-"""The sliding-mode autopilot as an FMI 2.0 co-simulation FMU (fmus/smc_autopilot.fmu).
-
-The reference model (44) is the FMU's state, started at the heading and yaw rate seen at
-initialisation; delta_c and sigma are direct feedthrough from the inputs.
-"""
+"""The sliding-mode autopilot as an FMI 2.0 co-simulation FMU (fmus/smc_autopilot.fmu): the
+reference model (44), its state, starts at the heading and yaw rate seen at initialisation."""
 from autopilot_fmu.design import design_model
 from autopilot_fmu.smc import SlidingModeAutopilot, SlidingModeDesign
 from fmukit.autopilot import INPUTS, rudder_command

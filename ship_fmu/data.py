@@ -1,22 +1,18 @@
-"""CyberShip II model data: the numbers the paper cites but does not print.
-
-Hull: Skjetne, Smogeli and Fossen (2004), "Modeling, identification and adaptive
-maneuvering of CyberShip II". Propellers and rudders: Sveen (2003), as carried by
-MSS ``initCS2.m``. Lever arms: Skjetne (2004). Sign conventions follow Fossen:
-hydrodynamic derivatives are forces per unit motion (X_u < 0 is damping).
+"""CyberShip II model data, which the paper cites but does not print: hull from Skjetne,
+Smogeli and Fossen (2004); propellers and rudders from Sveen (2003), as MSS ``initCS2.m``;
+lever arms from Skjetne (2004). Fossen's signs: X_u < 0 is damping.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-G = 9.81
-"""Acceleration of gravity, m/s^2."""
+G = 9.81                        # m/s^2
+RHO_WATER = 1000.0              # kg/m^3, the fresh water of the model basin (MCLab)
 
 
 @dataclass(frozen=True)
 class Hull:
     """Rigid-body, added-mass and damping coefficients of eqs (4)-(6)."""
-
     m: float = 23.8          # kg
     I_z: float = 1.76        # kg m^2
     x_g: float = 0.046       # m
@@ -52,7 +48,6 @@ class Hull:
 @dataclass(frozen=True)
 class Actuators:
     """Propeller, bow-thruster and rudder constants of eqs (8)-(13), n in rev/s."""
-
     k_Tp: float = 3.74e-3     # main propellers 1, 2, n >= 0
     k_Tn: float = 5.05e-3     # main propellers 1, 2, n < 0
     k_T3p: float = 1.84e-4    # bow thruster, n >= 0
@@ -66,7 +61,3 @@ class Actuators:
     l_yT: float = 0.078       # |l_yT1| = |l_yT2|, m
     l_xT3: float = 0.466      # |l_xT3|, m
     l_xR: float = 0.549       # |l_xR1| = |l_xR2|, m
-
-
-RHO_WATER = 1000.0
-"""Density of the fresh water in the model basin (MCLab), kg/m^3."""

@@ -1,10 +1,6 @@
-"""Rigid-body and hydrodynamic terms of the 3-DOF manoeuvring model, eqs (1)-(6):
-
-    eta_dot = R(psi) nu                              (1), (2)
-    M nu_dot + C(nu) nu + D(nu) nu = tau             (3)
-
-with eta = [x, y, psi] (north, east, heading) and nu = [u, v, r]. C(nu) nu and D(nu) nu are
-returned as force vectors, which is what the integrator needs.
+"""The 3-DOF manoeuvring model, eqs (1)-(6): eta_dot = R(psi) nu (1)-(2) and
+M nu_dot + C(nu) nu + D(nu) nu = tau (3), eta = [x, y, psi] (north, east, heading),
+nu = [u, v, r]; C(nu) nu and D(nu) nu as force vectors.
 """
 from __future__ import annotations
 
@@ -20,8 +16,7 @@ Vector3 = tuple[float, float, float]
 
 def kinematics(psi: float, u: float, v: float, r: float,
                cos: Callable = math.cos, sin: Callable = math.sin) -> Vector3:
-    """Earth-fixed velocity eta_dot = R(psi) nu, eqs (1)-(2); numpy's ``cos`` and ``sin``
-    for arrays of states (``cosim.ensemble``)."""
+    """eta_dot = R(psi) nu, eqs (1)-(2); numpy's cos and sin for arrays of states."""
     c, s = cos(psi), sin(psi)
     return u * c - v * s, u * s + v * c, r
 
@@ -51,10 +46,8 @@ def coriolis_forces(hull: Hull, u: float, v: float, r: float) -> Vector3:
 
 
 def damping_forces(hull: Hull, u: float, v: float, r: float) -> Vector3:
-    """D(nu) nu with D = D_L + D_NL(nu), eq (6).
-
-    d_32 uses N_|r|v, as in Skjetne et al. (2004); the paper prints Y_|r|v there.
-    """
+    """D(nu) nu with D = D_L + D_NL(nu), eq (6); d_32 uses N_|r|v, as Skjetne et al.
+    (2004); the paper prints Y_|r|v there."""
     h = hull
     au, av, ar = abs(u), abs(v), abs(r)
     d11 = -(h.X_u + h.X_uu * au + h.X_uuu * u * u)

@@ -1,16 +1,13 @@
-"""The rudder program of a turning circle or a zig-zag test (IMO MSC.137(76)).
-
-A positive rudder turns the ship to port, so headings go negative first. The figures of a
-run are post-processing (``cosim.analysis.manoeuvres``)."""
+"""The rudder program of a turning circle or a zig-zag test (IMO MSC.137(76)); a positive
+rudder turns the ship to port, so headings go negative first."""
 from __future__ import annotations
 
 import math
 
 
 class RudderProgram:
-    """Executes ``delta`` at t = 0; with psi_switch > 0 reverses it each time the heading
-    deviation passes -+psi_switch (a zig-zag), with psi_switch = 0 holds it (a turning
-    circle). ``command`` evaluates the rule at a heading, ``update`` commits it."""
+    """Executes ``delta`` at t = 0 and reverses it each time the heading deviation passes
+    -+psi_switch (a zig-zag); psi_switch = 0 holds it (a turning circle)."""
 
     def __init__(self, delta: float = math.radians(20.0),
                  psi_switch: float = math.radians(20.0)):
@@ -21,17 +18,14 @@ class RudderProgram:
         self.sign, self.reversals = 1, 0
 
     def _next(self, psi: float) -> tuple[int, int]:
-        """(sign, reversals) after the rule is applied at heading deviation psi."""
         if self.psi_switch > 0.0 and self.sign * psi <= -self.psi_switch:
             return -self.sign, self.reversals + 1
         return self.sign, self.reversals
 
     def command(self, psi: float) -> float:
-        """Rudder command at heading deviation psi, rad."""
         return self._next(psi)[0] * self.delta
 
     def reversals_at(self, psi: float) -> int:
-        """Rudder reversals so far, counting one due at heading deviation psi."""
         return self._next(psi)[1]
 
     def update(self, psi: float) -> None:

@@ -1,8 +1,5 @@
-"""The vessel as an FMI 2.0 co-simulation FMU (fmus/ship.fmu): wraps ship_fmu.vessel.
-
-Inputs are held over each step; no output depends on an input at the same instant (the
-rudder acts through the steering gear and the hull's inertia): no direct feedthrough.
-"""
+"""The vessel as an FMI 2.0 co-simulation FMU (fmus/ship.fmu); no direct feedthrough (the
+rudder acts through the steering gear and the hull's inertia)."""
 import math
 from dataclasses import fields
 
@@ -10,11 +7,8 @@ from fmukit.slave import ModelSlave, Var
 from ship_fmu.vessel import N_PROPELLER, Vessel, VesselParameters
 
 _P = VesselParameters()
-N_MAX = 50.0
-"""Largest shaft speed an input may ask for, rev/s (8.13 gives 0.3 m/s)."""
-ANGLE_MAX = 1e6
-"""Largest |psi0| and |psi_w|, rad (160,000 turns): beyond about 1e307 the wave moment's
-sin(2 beta) has no finite argument."""
+N_MAX = 50.0                    # rev/s, the largest shaft speed (8.13 gives 0.3 m/s)
+ANGLE_MAX = 1e6                 # rad, |psi0|, |psi_w|: past 1e307 sin(2 beta) is not finite
 _SEA = ("Hs", "T0", "psi_w", "wave_seed", "wave_components", "psi0")
 
 

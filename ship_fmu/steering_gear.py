@@ -1,8 +1,6 @@
-"""Steering gear: the rudder follows the command, clipped to +-delta_max, at a limited rate.
-
-With the command held over a step the rudder angle is piecewise linear in time and known
-exactly at any instant, so a run does not depend on how the step is cut. Defaults: 35 deg
-stops, and 20 deg/s, the IMO full-scale rate (about 2.3 deg/s) Froude-scaled to 1:70.
+"""Steering gear: the rudder follows the command, within +-delta_max, at a limited rate;
+piecewise linear in time, exact at any instant (a run does not depend on how a step is cut).
+20 deg/s is the IMO full-scale rate (about 2.3 deg/s) Froude-scaled to 1:70.
 """
 from __future__ import annotations
 
@@ -13,15 +11,12 @@ DELTA_RATE_MAX = math.radians(20.0)
 
 
 def rudder_target(delta_c: float, delta_max: float = DELTA_MAX) -> float:
-    """Where the rudder heads for: the command, within the stops."""
     return min(max(delta_c, -delta_max), delta_max)
 
 
 class RudderMotion:
-    """The rudder angle a time s >= 0 after it was delta0, with delta_c held: at the rate
-    limit toward the target until ``reach`` (the kink, where the integrator cuts its
-    step; 0 if the rudder is there already), then at the target."""
-
+    """The rudder angle s >= 0 after delta0, delta_c held: at the rate limit until
+    ``reach`` (the kink, where the integrator cuts its step), then at the target."""
     __slots__ = ("delta0", "target", "velocity", "reach")
 
     def __init__(self, delta0: float, delta_c: float, delta_max: float = DELTA_MAX,

@@ -1,15 +1,7 @@
-"""Propellers, bow thruster and rudders: tau_th = T u, eqs (8)-(13); n in rev/s, delta in rad.
-
-The paper prints the first two rows of T, eq (13), as zeros; the real matrix (Sveen 2003;
-Skjetne 2004) puts T_i - D_i of the main propellers into surge, the bow thruster and both
-rudder lifts into sway::
-
-        [ 1      1     0      0      0    ]
-    T = [ 0      0     1      1      1    ]
-        [ l_yT  -l_yT  l_xT3 -l_xR  -l_xR ]
-
-With n > 0 a positive rudder gives a positive lift (eq 9) and a negative yaw moment:
-**positive rudder -> r < 0, psi decreasing**, as eqs (20) and (45) agree.
+"""Propellers, bow thruster and rudders: tau_th = T u, eqs (8)-(13), n in rev/s, delta in rad.
+The paper prints T's first two rows as zeros; the real one (Sveen 2003; Skjetne 2004) puts
+T_i - D_i into surge, the bow thruster and both lifts into sway, yaw [l_yT, -l_yT, l_xT3,
+-l_xR, -l_xR]. A positive rudder (n > 0) gives r < 0, psi decreasing, as eqs (20), (45) agree.
 """
 from __future__ import annotations
 
@@ -25,9 +17,8 @@ def thrust(n: float, k_p: float, k_n: float) -> float:
 
 def actuator_model(act: Actuators, n1: float, n2: float,
                    n3: float) -> Callable[[float], tuple[float, float, float]]:
-    """tau_th as a function of the rudder angle at fixed shaft speeds, eqs (8)-(13): the
-    thrusts and slipstream factors T_i (1 + k_Ln n_i), T_i (1 + k_Dn n_i) computed once. A
-    propeller turning astern (n_i < 0) gives its rudder no lift or drag."""
+    """tau_th of the rudder angle at fixed shaft speeds, eqs (8)-(13); a propeller turning
+    astern (n_i < 0) gives its rudder no lift or drag."""
     T1 = thrust(n1, act.k_Tp, act.k_Tn)
     T2 = thrust(n2, act.k_Tp, act.k_Tn)
     T3 = thrust(n3, act.k_T3p, act.k_T3n)

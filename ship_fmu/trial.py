@@ -8,14 +8,12 @@ from fmukit.timebase import step_count
 from .manoeuvres import RudderProgram
 from .vessel import Vessel, VesselParameters
 
-DT = 0.1
-"""s, the step of a trial, as of the co-simulated manoeuvres."""
+DT = 0.1                        # s, as the co-simulated manoeuvres
 
 
 def trial(program: RudderProgram, t_end: float, params: VesselParameters) -> dict[str, list]:
-    """The ship alone under ``program`` for ``t_end`` s in steps of ``DT``, from steady
-    straight running at the origin along x: its x, y, psi, u, v and r at the start of
-    each step, and the program's reversals so far."""
+    """x, y, psi, u, v, r and the program's reversals at each step's start, from straight
+    running at the origin along x."""
     vessel = Vessel(replace(params, x0=0.0, y0=0.0, psi0=0.0))
     track = {name: [] for name in ("x", "y", "psi", "u", "v", "r", "reversals")}
     for k in range(step_count(0.0, t_end, DT)):

@@ -1,10 +1,7 @@
-"""The vessel: CyberShip II hull, actuators, steering gear and waves, integrated by RK4.
-
-Fixed-step RK4 over (x, y, psi, u, v, r, xi) with the inputs held over the communication
-step, cut into ceil(h / h_max) equal sub-steps, and cut where the rudder reaches its
-command or stop (its angle has a kink there, and RK4 keeps its order only on smooth
-pieces: ``cosim.accuracy``). The rudder angle is the steering gear's exact response, the
-wave loads are evaluated at every stage, psi is not wrapped. Parameters carry the FMU's names.
+"""The vessel: CyberShip II hull, actuators, steering gear and waves, integrated by RK4
+with the inputs held, each step cut into ceil(h / h_max) equal sub-steps and where the rudder
+reaches its command or stop (a kink: RK4 keeps its order only on smooth pieces,
+``cosim.accuracy``). psi is not wrapped. Parameters carry the FMU's names.
 """
 from __future__ import annotations
 
@@ -20,20 +17,14 @@ from .steering_gear import DELTA_MAX, DELTA_RATE_MAX, RudderMotion
 from .thrusters import actuator_model
 from .waves import WaveComponents, WaveLoads
 
-State = tuple[float, float, float, float, float, float, float]
-"""(x, y, psi, u, v, r, xi): what RK4 integrates."""
-
-MAX_STEEPNESS = 7.0
-"""Waves break beyond Hs / lambda_p = 1/7."""
-
-N_PROPELLER = 8.13
-"""Main propeller speed of the paper's runs, rev/s: 0.3 m/s in calm water."""
+State = tuple[float, float, float, float, float, float, float]   # (x, y, psi, u, v, r, xi)
+MAX_STEEPNESS = 7.0             # waves break beyond Hs / lambda_p = 1/7
+N_PROPELLER = 8.13              # rev/s, the paper's main propellers: 0.3 m/s in calm water
 
 
 @dataclass(frozen=True)
 class VesselParameters:
     """Initial state, steering gear and sea state; names as in the FMU."""
-
     x0: float = 0.0
     y0: float = 0.0
     psi0: float = 0.0
@@ -75,21 +66,17 @@ class VesselParameters:
 
 class Vessel:
     """CyberShip II in calm water or waves, stepped with inputs held."""
-
     STATE = ("x", "y", "psi", "u", "v", "r", "delta", "xi", "t")
 
     def __init__(self, params: VesselParameters = VesselParameters(),
                  hull: Hull = Hull(), actuators: Actuators = Actuators()):
         params.validate()
-        self.params = params
-        self.hull = hull
-        self.actuators = actuators
+        self.params, self.hull, self.actuators = params, hull, actuators
         M = mass_matrix(hull).tolist()
         det = M[1][1] * M[2][2] - M[1][2] * M[2][1]
         self._m11_inv = 1.0 / M[0][0]
         self._minv = (M[2][2] / det, -M[1][2] / det, -M[2][1] / det, M[1][1] / det)
-        self.waves = None
-        self._wave_loads = calm_water
+        self.waves, self._wave_loads = None, calm_water
         if params.Hs > 0.0:
             components = WaveComponents.from_spectrum(
                 params.Hs, params.T0, params.wave_components, params.wave_seed)
@@ -102,14 +89,12 @@ class Vessel:
         self.X_w, self.Y_w, self.N_w = self._wave_loads(self.t, self.xi, self.psi)
 
     def rates(self, t: float, state: State, tau_th: tuple[float, float, float]) -> State:
-        """Time derivative of (x, y, psi, u, v, r, xi), eqs (1)-(17), under the actuator
-        forces tau_th (``thrusters.actuator_model``)."""
+        """d/dt of the state, eqs (1)-(17), under actuator forces tau_th."""
         return state_rates(self.hull, self._minv, self._m11_inv, self._wave_loads,
                            self.params.psi_w, t, state, tau_th)
 
     def step(self, t: float, h: float, delta_c: float,
              n1: float = N_PROPELLER, n2: float = N_PROPELLER, n3: float = 0.0) -> None:
-        """Advance from communication point t to t + h with the inputs held."""
         if not (math.isfinite(delta_c) and math.isfinite(n1) and math.isfinite(n2)
                 and math.isfinite(n3)):
             require_finite(delta_c=delta_c, n1=n1, n2=n2, n3=n3)
@@ -169,9 +154,8 @@ def state_rates(hull: Hull, minv: tuple[float, float, float, float], m11_inv: fl
                 wave_loads: Callable, psi_w: float, t: float, state: State,
                 tau_th: tuple[float, float, float], hypot: Callable = math.hypot,
                 cos: Callable = math.cos, sin: Callable = math.sin) -> State:
-    """Time derivative of (x, y, psi, u, v, r, xi), eqs (1)-(17), given the inverse inertia
-    (sway-yaw ``minv``, surge ``m11_inv``), the ``wave_loads`` (X_w, Y_w, N_w) of (t, xi,
-    psi) and psi_w. Floats, or arrays with numpy's cos, sin and an exact hypot."""
+    """d/dt of the state, eqs (1)-(17); floats, or arrays with numpy's cos, sin and an
+    exact hypot (``cosim.ensemble``)."""
     _, _, psi, u, v, r, xi = state
     cX, cY, cN = coriolis_forces(hull, u, v, r)
     dX, dY, dN = damping_forces(hull, u, v, r)
@@ -188,7 +172,6 @@ def state_rates(hull: Hull, minv: tuple[float, float, float, float], m11_inv: fl
 
 
 def calm_water(t: float, xi: float, psi: float) -> tuple[float, float, float]:
-    """The wave loads (X_w, Y_w, N_w) without waves."""
     return (0.0, 0.0, 0.0)
 
 

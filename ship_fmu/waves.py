@@ -1,13 +1,8 @@
-"""Wave loads from the modified Pierson-Moskowitz spectrum, eqs (14)-(17).
-
-The sea is N regular components: omega_i drawn uniformly in N bins of equal variance of the
-band holding ``band_fraction`` (98 %) of the spectrum (equal spacing would repeat the sea),
-k_i = omega_i^2 / g, A_i = sqrt(2 m0_i) with m0_i the exact variance of bin i, a random
-phase phi_i. theta_i(t) = omega_i t - k_i xi(t) + phi_i, with xi the ship's travel along
-the wave direction (d xi/dt = U cos(beta), a state of the vessel), solves the encounter
-phase d theta_i/dt = omega_i - k_i U cos(beta) exactly. A seed names one realisation, with
-the same bits on every CPU: only exactly rounded operations and decimal logarithms, never a
-vectorised transcendental function or BLAS.
+"""Wave loads from the modified Pierson-Moskowitz spectrum, eqs (14)-(17): N components,
+omega_i uniform in N equal-variance bins of 98 % of the spectrum (equal spacing repeats the
+sea), theta_i = omega_i t - k_i xi + phi_i with xi the travel along the waves (a vessel state:
+the encounter phase, exactly). A seed gives the same bits on every CPU: exactly rounded
+operations and decimal logarithms only, never a vectorised transcendental or BLAS.
 """
 from __future__ import annotations
 
@@ -22,14 +17,13 @@ from .data import G, RHO_WATER, Hull
 
 
 def spectrum(omega: np.ndarray | float, Hs: float, T0: float) -> np.ndarray | float:
-    """Modified Pierson-Moskowitz spectral density S(omega), m^2 s, eq (17):
-    S = A omega^-5 exp(-B omega^-4) with B = 16 pi^3 / (0.710 T0)^4 and A = Hs^2 B / 4."""
+    """S(omega) = A omega^-5 exp(-B omega^-4), m^2 s, eq (17), A = Hs^2 B / 4."""
     B = _spectrum_b(T0)
     return Hs * Hs / 4.0 * B / omega ** 5 * np.exp(-B / omega ** 4)
 
 
 def _spectrum_b(T0: float) -> float:
-    """B of eq (17), by products: ``**`` is the C library's pow, whose last bit varies."""
+    """B = 16 pi^3 / (0.710 T0)^4 by products: ``**`` is libm's pow, whose last bit varies."""
     Tz = 0.710 * T0
     return 16.0 * math.pi * math.pi * math.pi / (Tz * Tz * Tz * Tz)
 
@@ -40,8 +34,7 @@ def variance_fraction_below(omega: np.ndarray | float, T0: float) -> np.ndarray 
 
 
 def frequency_at_fraction(fraction: float, T0: float) -> float:
-    """Inverse of ``variance_fraction_below``: omega = (B / -ln F)^(1/4), rad/s, in decimal
-    arithmetic (correctly rounded) and rounded once: the same on every CPU."""
+    """omega = (B / -ln F)^(1/4), rad/s, in decimal arithmetic: the same on every CPU."""
     with localcontext() as context:
         context.prec = 34
         quotient = Decimal(_spectrum_b(T0)) / -Decimal(fraction).ln()
@@ -50,7 +43,6 @@ def frequency_at_fraction(fraction: float, T0: float) -> float:
 
 @lru_cache(maxsize=64)
 def _bins(T0: float, n: int, band_fraction: float) -> tuple[tuple[float, ...], tuple[float, ...]]:
-    """The n + 1 bin edges of the band, as variance fractions and frequencies (rad/s)."""
     tail = 0.5 * (1.0 - band_fraction)
     fractions = np.linspace(tail, 1.0 - tail, n + 1).tolist()
     return tuple(fractions), tuple(frequency_at_fraction(f, T0) for f in fractions)
@@ -59,7 +51,6 @@ def _bins(T0: float, n: int, band_fraction: float) -> tuple[tuple[float, ...], t
 @dataclass(frozen=True)
 class WaveComponents:
     """N regular components of one sea-state realisation."""
-
     omega: np.ndarray       # rad/s
     k: np.ndarray           # rad/m
     amplitude: np.ndarray   # m
@@ -68,7 +59,6 @@ class WaveComponents:
     @classmethod
     def from_spectrum(cls, Hs: float, T0: float, n: int, seed: int,
                       band_fraction: float = 0.98) -> WaveComponents:
-        """Equal-variance discretisation of eq (17); see the module docstring."""
         edges_fraction, edges = map(np.array, _bins(T0, n, band_fraction))
         rng = np.random.default_rng(seed)
         omega = rng.uniform(edges[:-1], edges[1:])
@@ -77,26 +67,15 @@ class WaveComponents:
         return cls(omega=omega, k=omega * omega / G,
                    amplitude=np.sqrt(2.0 * m0_bins), phase=phase)
 
-    def phases(self, t: float, xi: float, out: np.ndarray | None = None,
-               omega_t: np.ndarray | None = None) -> np.ndarray:
-        """theta_i(t) = omega_i t - k_i xi + phi_i (into ``out``; ``omega_t``: omega_i t)."""
-        if omega_t is None:
-            omega_t = self.omega * t
-        out = np.multiply(self.k, xi, out)
-        np.subtract(omega_t, out, out)
-        return np.add(out, self.phase, out)
+    def phases(self, t: float, xi: float) -> np.ndarray:
+        """theta_i(t) = omega_i t - k_i xi + phi_i."""
+        return self.omega * t - self.k * xi + self.phase
 
 
 class WaveLoads:
-    """First-order wave forces on a block-shaped hull, eqs (14)-(16): with
-    s_i = A_i k_i sin(theta_i) and beta = psi_w - psi,
-    X_w = rho g B L T cos(beta) sum s_i, Y_w = rho g B L T sin(beta) sum s_i and
-    N_w = rho g B L (L^2 - B^2) / 24 sin(2 beta) sum s_i^2.
-
-    omega_i t is computed once per time and the last evaluation kept, into arrays made
-    once; every value is added in the equations' order (not by a matrix product), so the
-    results are a plain evaluation's to the bit.
-    """
+    """Eqs (14)-(16) on a block hull, s_i = A_i k_i sin(theta_i), beta = psi_w - psi:
+    X_w, Y_w = rho g B L T (cos, sin)(beta) sum s_i, N_w = rho g B L (L^2 - B^2) / 24
+    sin(2 beta) sum s_i^2; summed in order (no matrix product), into arrays made once."""
 
     def __init__(self, components: WaveComponents, hull: Hull, psi_w: float,
                  rho: float = RHO_WATER):
@@ -112,13 +91,14 @@ class WaveLoads:
         self._loads = (0.0, 0.0, 0.0)                 # and its loads
 
     def __call__(self, t: float, xi: float, psi: float) -> tuple[float, float, float]:
-        """(X_w, Y_w, N_w) at time t, travel xi and heading psi."""
         if self._key == (t, xi, psi):
             return self._loads
         if t != self._t:
             np.multiply(self.components.omega, t, self._omega_t)
             self._t = t
-        s = self.components.phases(t, xi, self._s, self._omega_t)
+        s = np.multiply(self.components.k, xi, self._s)    # theta_i, in place
+        np.subtract(self._omega_t, s, s)
+        np.add(s, self.components.phase, s)
         np.sin(s, s)
         np.multiply(self._slope_amplitude, s, s)          # s_i = A_i k_i sin(theta_i)
         beta = self.psi_w - psi

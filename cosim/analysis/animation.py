@@ -1,9 +1,5 @@
-"""An animation of a run: the ship moving along its track, its heading, rudder and leg.
-
-A GIF (Pillow), or an MP4 where ffmpeg is installed, about 25 s at 10 frames per second.
-The track panel is the figure's (``track.track_panel``), drawn once as a background;
-each frame redraws only what moves (outline, wake, active leg, readout, time cursors).
-"""
+"""An animation of a run, a GIF (Pillow) or an MP4 (ffmpeg) of about 25 s at 10 frames per
+second: the track panel drawn once as a background, each frame only what moves."""
 from __future__ import annotations
 
 import math
@@ -33,7 +29,6 @@ def video_format() -> str:
 
 
 def require_track(columns: list[str]) -> None:
-    """ValueError naming what is missing if these columns hold no track to animate."""
     missing = [c for c in NEEDS if c not in columns]
     if missing:
         raise ValueError(f"--animate needs the ship's track; this system records no "
@@ -41,14 +36,13 @@ def require_track(columns: list[str]) -> None:
 
 
 def frame_times(t: np.ndarray, fps: int = FPS, seconds: float = VIDEO_SECONDS) -> np.ndarray:
-    """Indices of the rows shown, one per frame, evenly spaced over the run."""
+    """Indices of the rows shown, one per frame."""
     frames = max(2, min(len(t), round(seconds * fps)))
     return np.unique(np.round(np.linspace(0, len(t) - 1, frames)).astype(int))
 
 
 def leg_text(wp_index: int, points: np.ndarray) -> str:
-    """'leg WP1 -> WP2 (30, 0) m' while steering for point ``wp_index`` of ``points``, or,
-    past the last, that the guidance holds the last leg's course."""
+    """'leg WP1 -> WP2 (30, 0) m' toward point ``wp_index``; past the last, held course."""
     if wp_index >= len(points):
         return f"past {waypoint_name(len(points) - 1)}, the last: holding its course"
     north, east = points[wp_index]
@@ -57,11 +51,9 @@ def leg_text(wp_index: int, points: np.ndarray) -> str:
 
 
 def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> Path:
-    """Write the animation of a run, whole or not at all, to ``path`` with the suffix of
-    ``fmt``; its path. ValueError naming what is missing if the run has no track."""
+    """Write the animation, whole or not at all, at ``path`` with ``fmt``'s suffix."""
     require_track(run.columns)
     fmt = fmt or video_format()
-    rows = frame_times(run.t)
     x, y, psi, delta, t = (run["ship.x"], run["ship.y"], run["ship.psi"], run["ship.delta"],
                            run.t)
     fig = new_figure(figsize=(10, 5.6), dpi=90, layout="constrained")
@@ -72,8 +64,7 @@ def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> P
     track.plot(y, x, color="0.8", linewidth=0.8, zorder=1)            # the whole track, faint
     wake, = track.plot([], [], color="k", linewidth=1.2, zorder=3)
     shown = outlines(run)
-    scale = shown.scale
-    hull = track.add_patch(Polygon(hull_outline(x[0], y[0], psi[0], scale), closed=True,
+    hull = track.add_patch(Polygon(hull_outline(x[0], y[0], psi[0], shown.scale), closed=True,
                                    color="tab:red", zorder=5))
     track.plot([], [], "s", color="tab:red", label=f"ship outline {shown.size}")
     legs = run.meta.get("parameters", {}).get("guidance")
@@ -96,9 +87,8 @@ def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> P
     leg = run["guidance.wp_index"].astype(int) if "guidance.wp_index" in run.columns else None
 
     def draw(k: int) -> str:
-        """Move everything that moves to row ``k``; the readout's text there."""
         wake.set_data(y[:k + 1], x[:k + 1])
-        hull.set_xy(hull_outline(x[k], y[k], psi[k], scale))
+        hull.set_xy(hull_outline(x[k], y[k], psi[k], shown.scale))
         for cursor in cursors:
             cursor.set_xdata([t[k], t[k]])
         text = (f"t = {t[k]:.0f} s   heading {math.degrees(psi[k]):.1f} deg   "
@@ -119,7 +109,7 @@ def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> P
     width, height = fig.canvas.get_width_height()
     target = path.with_suffix(f".{fmt}")
     frames = []
-    for k in rows:
+    for k in frame_times(t):
         readout.set_text(draw(k))
         fig.canvas.restore_region(background)
         for artist in dynamic:
@@ -131,10 +121,8 @@ def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> P
 
 
 def _write(frames: list[np.ndarray], path: Path, fmt: str, width: int, height: int) -> None:
-    """RGB frames to a GIF (Pillow) or to an MP4 (ffmpeg, fed raw frames on a pipe)."""
     if fmt == "gif":
         from PIL import Image
-
         images = [Image.fromarray(frame).quantize(colors=64, method=Image.Quantize.FASTOCTREE)
                   for frame in frames]
         images[0].save(path, save_all=True, append_images=images[1:],

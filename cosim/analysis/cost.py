@@ -1,9 +1,5 @@
-"""The cost of eq (19) over a recorded run: J = psi_E + lambda sum(delta^2).
-
-The paper's lambda only brings both terms to the same level; it is calibrated once, on
-calm_pd (psi_E = lambda sum(delta^2) there), and held fixed; ``tests/test_cosim.py`` fails
-if the model no longer gives it.
-"""
+"""Eq (19) over a recorded run: J = psi_E + lambda sum(delta^2), lambda bringing both terms
+to one level, calibrated once on calm_pd and held (``tests/test_cosim.py`` checks it)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -16,8 +12,7 @@ LAMBDA = 1.8649470947066942     # psi_E / sum(delta^2) of calm_pd: 100.175 / 53.
 
 @dataclass(frozen=True)
 class Cost:
-    """Eq (19) over the recorded samples: J = psi_E + lambda sum(delta^2)."""
-
+    """Eq (19) over the recorded samples."""
     psi_E: float
     sum_delta2: float
     lam: float

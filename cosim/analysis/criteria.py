@@ -1,7 +1,5 @@
-"""The MSC.137(76) criteria a standard manoeuvre is judged by (5.3; terms in 4.2, notes in
-MSC/Circ.1053). The standard is for ships of 100 m and over; for this 1:70 model they apply
-through Froude scaling: lengths in ship lengths are the same, L/V scales with sqrt(70).
-"""
+"""The MSC.137(76) 5.3 criteria of a standard manoeuvre, for ships of 100 m and over: on
+this 1:70 model through Froude scaling (ship lengths the same, L/V times sqrt(70))."""
 from __future__ import annotations
 
 import math
@@ -25,7 +23,6 @@ _SAME_ANGLE = 1e-6                    # rad: a test's angles match the standard'
 @dataclass(frozen=True)
 class Criterion:
     """One MSC.137(76) criterion: a figure of the run, its limit and the clause setting it."""
-
     figure: str      # what is judged, in the standard's words
     value: float     # in ``unit``; NaN if the run never produced it (a turn never checked)
     limit: float     # the largest value that passes, in ``unit``
@@ -53,8 +50,7 @@ def length_over_speed(length: float, speed: float, scale: float = SCALE) -> floa
 
 
 def overshoot_limits(lv: float) -> tuple[float, float]:
-    """(first, second) overshoot limits of the 10/10 zig-zag, rad, for L/V in s at full
-    scale (MSC.137(76) 5.3.3.1-2)."""
+    """(first, second) 10/10 overshoot limits, rad, for L/V in s at full scale (5.3.3.1-2)."""
     if lv < 10.0:
         first, second = 10.0, 25.0
     elif lv >= 30.0:
@@ -108,7 +104,6 @@ def _overshoot_criterion(zz: ZigZagResult, n: int, limit: float, clause: str,
 @dataclass(frozen=True)
 class Assessment:
     """A recorded manoeuvre: its figures and the criteria that apply to it."""
-
     figures: TurningCircle | ZigZagResult
     criteria: tuple[Criterion, ...]
     delta: float                # rad, the test's rudder angle
@@ -116,7 +111,6 @@ class Assessment:
 
 
 def turning_circle_of(run: Recording) -> Assessment:
-    """The turning circle of a recorded run, and its criteria."""
     tc = turning_circle_figures(*(run[f"ship.{n}"] for n in ("x", "y", "psi", "u", "v", "r")))
     p = run.meta["parameters"]
     delta = p["program"]["delta"]
@@ -124,7 +118,6 @@ def turning_circle_of(run: Recording) -> Assessment:
 
 
 def zigzag_of(run: Recording) -> Assessment:
-    """The zig-zag of a recorded run, and its criteria."""
     program = run.meta["parameters"]["program"]
     zz = zigzag_figures(run["ship.psi"], run["program.reversals"], program["psi_switch"],
                         run.t, run["ship.x"], run["ship.y"])

@@ -1,6 +1,5 @@
-"""Titles and printed headers of a run, made from the parameter values the FMUs held
-(``Recording.meta``), never typed in per scenario: a label cannot describe a run that was
-not made. Angles in degrees."""
+"""Titles and headers of a run from the parameter values the FMUs held (``Recording.meta``),
+never typed per scenario: a label cannot describe a run that was not made."""
 from __future__ import annotations
 
 import math
@@ -17,21 +16,13 @@ _DISPLAY = {"rad": (math.degrees(1.0), "deg"), "rad/s": (math.degrees(1.0), "deg
 
 
 def value(x: Any, unit: str = "", degrees: bool = True) -> str:
-    """A parameter value for people: 4 significant digits; angles in degrees if ``degrees``."""
+    """A parameter value, 4 significant digits; angles in degrees if ``degrees``."""
     if isinstance(x, str) or isinstance(x, bool) or x is None:
         return str(x)
     factor, shown = _DISPLAY.get(unit, (1.0, unit)) if degrees else (1.0, unit)
     shown = "" if shown in ("", "1") else shown
     text = f"{x * factor:.4g}" if isinstance(x, float) else str(x)
     return f"{text} {shown}".strip()
-
-
-def sea(ship: dict[str, Any]) -> str:
-    """'calm water', or the sea state: Hs, T0, the direction the waves travel to, the seed."""
-    if ship.get("Hs", 0.0) == 0.0:
-        return "calm water"
-    return (f"waves Hs {ship['Hs'] * 1000:.3g} mm, T0 {ship['T0']:.3g} s, travelling to "
-            f"{math.degrees(ship['psi_w']) % 360:.0f} deg, seed {ship['wave_seed']}")
 
 
 def route(guidance: dict[str, Any]) -> str:
@@ -42,25 +33,14 @@ def route(guidance: dict[str, Any]) -> str:
     return f"route {points} m, acceptance radius {guidance['R_accept']:.3g} m"
 
 
-def gear(ship: dict[str, Any]) -> str:
-    return (f"rudder within +-{math.degrees(ship['delta_max']):.3g} deg at up to "
-            f"{math.degrees(ship['delta_rate_max']):.3g} deg/s")
-
-
-def settings(parameters: dict[str, Any], units: dict[str, str], degrees: bool = True) -> str:
-    """'name = value unit, ...' of one component's parameters."""
-    return ", ".join(f"{name} = {value(x, units.get(name, ''), degrees)}"
-                     for name, x in parameters.items())
-
-
 def overrides(meta: dict[str, Any]) -> str:
-    """The settings given on top of the scenario, as the --set options that give them."""
+    """The settings on top of the scenario, as --set options."""
     return " ".join(f"--set {c}.{n}={x}" for c, values in meta.get("overrides", {}).items()
                     for n, x in values.items())
 
 
 def conditions(meta: dict[str, Any]) -> list[str]:
-    """What a run was, line by line: route, sea, gear, controller or program, settings."""
+    """What a run was, line by line."""
     p, units = meta.get("parameters", {}), meta.get("parameter_units", {})
     lines = []
     if "stop_time" in meta:
@@ -70,21 +50,28 @@ def conditions(meta: dict[str, Any]) -> list[str]:
     if "guidance" in p:
         lines.append(route(p["guidance"]))
     if "ship" in p:
-        lines.append(f"{sea(p['ship'])}; {gear(p['ship'])}; starting at "
-                     f"{p['ship']['u0']:.3g} m/s")
+        ship = p["ship"]
+        sea = "calm water" if ship.get("Hs", 0.0) == 0.0 else (
+            f"waves Hs {ship['Hs'] * 1000:.3g} mm, T0 {ship['T0']:.3g} s, travelling to "
+            f"{math.degrees(ship['psi_w']) % 360:.0f} deg, seed {ship['wave_seed']}")
+        lines.append(f"{sea}; rudder within +-{math.degrees(ship['delta_max']):.3g} deg at up "
+                     f"to {math.degrees(ship['delta_rate_max']):.3g} deg/s; starting at "
+                     f"{ship['u0']:.3g} m/s")
     # An autopilot's gains stay in their units (eta_h = 10 rad); a program's angles in deg.
     for component, degrees in (("autopilot", False), ("program", True)):
         if component in p:
             fmu = meta.get("fmus", {}).get(component, {}).get("file", "")
-            lines.append(f"{component} {fmu.rsplit('/', 1)[-1]}: "
-                         f"{settings(p[component], units.get(component, {}), degrees)}")
+            given = units.get(component, {})
+            lines.append(f"{component} {fmu.rsplit('/', 1)[-1]}: " + ", ".join(
+                f"{name} = {value(x, given.get(name, ''), degrees)}"
+                for name, x in p[component].items()))
     if meta.get("overrides"):
         lines.append(f"set: {overrides(meta)}")
     return lines
 
 
 def changes(meta: dict[str, Any]) -> str:
-    """How the run differs from its scenario, as the --set and --stop-time options ('')."""
+    """How the run differs from its scenario, as --set and --stop-time options."""
     changed = [overrides(meta)] if meta.get("overrides") else []
     stop = meta.get("scenario_stop_time")
     if stop is not None and meta.get("stop_time", stop) != stop:
@@ -93,26 +80,21 @@ def changes(meta: dict[str, Any]) -> str:
 
 
 def paper_row(meta: dict[str, Any]) -> tuple[str, tuple[float, float, float]] | None:
-    """The paper's table and (psi_E, delta_E, J) for one of its own runs, unchanged; else None."""
+    """The paper's table and (psi_E, delta_E, J) for one of its own runs, unchanged."""
     system = meta.get("system", "")
-    if system not in PAPER_TABLES or changes(meta) or not meta.get("scenario_file"):
+    if system not in PAPER_TABLES or changes(meta) or not meta.get("scenario_file") or \
+            Path(meta["scenario_file"]).resolve() != (SCENARIO_DIR / f"{system}.ssd").resolve():
         return None
-    if Path(meta["scenario_file"]).resolve() != (SCENARIO_DIR / f"{system}.ssd").resolve():
-        return None
-    table = 1 if system.startswith("calm") else 2
-    return f"Tomera (2010) Table {table}", PAPER_TABLES[system]
+    return f"Tomera (2010) Table {1 if system.startswith('calm') else 2}", PAPER_TABLES[system]
 
 
 def headline(label: str, meta: dict[str, Any]) -> str:
-    """The label and the scenario's description, or what changed the scenario."""
     changed = changes(meta)
     if not changed:
         return f"{label}: {meta.get('description', '')}"
     whose = "the paper's" if meta.get("system") in PAPER_TABLES else "the scenario's"
-    return (f"{label}: {meta.get('system', label)} changed by {changed} "
-            f"(not {whose} run)")
+    return f"{label}: {meta.get('system', label)} changed by {changed} (not {whose} run)"
 
 
 def title(label: str, meta: dict[str, Any]) -> str:
-    """A figure title: the headline, then what the run was, line by line."""
     return "\n".join([headline(label, meta), *conditions(meta)])

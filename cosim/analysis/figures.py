@@ -1,7 +1,5 @@
-"""Figures of a run, in degrees: the track panel (``track``) beside the signals over time;
-a course-keeping figure carries eq (19), and the paper's values for its own runs. Drawn on
-Agg canvases without pyplot, so importing this picks no backend.
-"""
+"""Figures of a run, in degrees: the track panel beside the signals over time, eq (19) and
+the paper's values for its own runs; on Agg canvases without pyplot (no backend picked)."""
 from __future__ import annotations
 
 import math
@@ -36,7 +34,6 @@ def new_figure(**options: Any) -> Figure:
 
 def _layout(panels: int, heights: tuple[float, ...] | None = None
             ) -> tuple[Figure, Any, list[Any]]:
-    """A track panel on the left, ``panels`` time panels sharing the time axis on the right."""
     fig = new_figure(figsize=(13, 8), layout="constrained")
     grid = fig.add_gridspec(panels, 2, width_ratios=(1.0, 1.25), height_ratios=heights)
     track = fig.add_subplot(grid[:, 0])
@@ -48,14 +45,13 @@ def _layout(panels: int, heights: tuple[float, ...] | None = None
 
 
 def time_axes(fig: Figure, cells: list[Any]) -> list[Any]:
-    """Panels over time, one per grid cell, sharing the time axis, labelled at the bottom."""
+    """Panels over time, one per grid cell, sharing the time axis."""
     axes = [fig.add_subplot(cells[0])]
     axes += [fig.add_subplot(c, sharex=axes[0]) for c in cells[1:]]
-    for a in axes[:-1]:
-        a.tick_params(labelbottom=False)
-    axes[-1].set_xlabel("time (s)")
     for a in axes:
         a.grid(alpha=0.3)
+        a.tick_params(labelbottom=a is axes[-1])
+    axes[-1].set_xlabel("time (s)")
     return axes
 
 
@@ -76,7 +72,7 @@ def _wrapped(lines: list[str]) -> list[str]:
 
 
 def text_panel(ax: Any, lines: list[str]) -> None:
-    """The report's lines, wrapped, one under the other; a verdict in its colour."""
+    """The report's lines, wrapped; a verdict in its colour."""
     ax.set_axis_off()
     shown = _wrapped(lines)
     rows = sum(line.count("\n") + 1 for line in shown)
@@ -89,7 +85,6 @@ def text_panel(ax: Any, lines: list[str]) -> None:
 
 
 def _rudder(ax: Any, run: Recording, commanded: str) -> None:
-    """Actual rudder over the command; a command far beyond the stops is clipped, and said."""
     command = np.degrees(run[commanded])
     ax.plot(run.t, command, color="tab:orange", linewidth=0.5, alpha=0.55, zorder=1,
             label="commanded delta_c")
@@ -108,7 +103,7 @@ def _rudder(ax: Any, run: Recording, commanded: str) -> None:
 
 
 def merit_table(run: Recording, lam: float = LAMBDA) -> str:
-    """Eq (19) of the run as a table, the paper's values beside for one of its own runs."""
+    """Eq (19) of the run as a table, with the paper's values for one of its own runs."""
     c = cost(run, lam)
     rows = [("eq (19), rad^2", "psi_E", "delta_E", "J"),
             ("this run", f"{c.psi_E:.2f}", f"{c.delta_E:.2f}", f"{c.J:.2f}")]
@@ -163,7 +158,6 @@ def save(fig: Figure, path: Path, formats: tuple[str, ...] = ("png",)) -> list[P
 
 def save_figure(run: Recording, draw: Callable[..., Figure], path: Path, label: str,
                 formats: tuple[str, ...] = ("png",), **draw_options: Any) -> list[Path]:
-    """Draw a run's figure, title it from what the run used, write it in each format."""
     fig = draw(run, **draw_options)
     fig.suptitle(title(label, run.meta), fontsize=8)
     return save(fig, path, formats)
@@ -190,5 +184,4 @@ def comparison(runs: dict[str, Recording], caption: str) -> Figure:
 
 
 def comparison_figure(runs: dict[str, Recording], path: Path, title: str) -> Path:
-    """Write ``comparison`` of the runs as a PNG at ``path``, whole or not at all."""
     return save(comparison(runs, title), path)[0]

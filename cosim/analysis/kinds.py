@@ -16,7 +16,6 @@ from .reports import course_keeping_report, turning_circle_report, zigzag_report
 @dataclass(frozen=True)
 class Analysis:
     """What ``cosim.run`` prints (``report``) and draws (``figure``) for a kind of scenario."""
-
     report: Callable[..., list[str]]
     figure: Callable[[Recording], Figure] | None = None
 

@@ -1,8 +1,6 @@
-"""The figures of a standard manoeuvre from its recorded trajectory: a turning circle's
-advance, transfer, tactical and steady diameters; a zig-zag's executes, overshoots, initial
-turning, time to check yaw and period (MSC.137(76) 4.2, MSC/Circ.1053; judged in
-``criteria``). A positive rudder turns the ship to port. SI units and radians.
-"""
+"""The figures of a standard manoeuvre from its trajectory (MSC.137(76) 4.2, MSC/Circ.1053):
+a turning circle's advance, transfer, tactical and steady diameters; a zig-zag's executes,
+overshoots and times. A positive rudder turns the ship to port. SI units and radians."""
 from __future__ import annotations
 
 import math
@@ -20,7 +18,6 @@ TURNING_RUDDER = math.radians(35.0)   # 4.2.2: 35 deg, or the largest permissibl
 @dataclass(frozen=True)
 class TurningCircle:
     """A turning circle's figures; NaN where the run's heading never changed enough."""
-
     advance: float               # m, along the approach course at 90 deg heading change
     transfer: float              # m, across the approach course at 90 deg
     tactical_diameter: float     # m, across the approach course at 180 deg
@@ -41,7 +38,6 @@ class TurningCircle:
 @dataclass(frozen=True)
 class Overshoot:
     """A checked turn: how far the heading went beyond the switching angle, and when."""
-
     angle: float     # rad, beyond the switching angle
     time: float      # s, when the heading deviation peaked (NaN without times)
     heading: float   # rad, the heading deviation at the peak, signed
@@ -50,7 +46,6 @@ class Overshoot:
 @dataclass(frozen=True)
 class ZigZagResult:
     """A delta/psi_switch zig-zag's figures, as MSC/Circ.1053 draws them."""
-
     reversals: int                         # rudder reversals the test reached
     psi_switch: float = math.nan           # rad, heading deviation that reverses the rudder
     overshoots: tuple[Overshoot, ...] = ()  # one per checked turn, in order
@@ -61,16 +56,10 @@ class ZigZagResult:
 
     @property
     def checked(self) -> bool:
-        """Whether the ship checked its first two turns: both overshoots measured."""
         return len(self.overshoots) >= 2
 
-    def overshoot(self, n: int) -> float:
-        """The n-th overshoot angle (1, 2, ...), rad; NaN if that turn was never checked."""
-        return self.overshoots[n - 1].angle if len(self.overshoots) >= n else math.nan
-
     def overshoot_bound(self, n: int) -> tuple[float, bool]:
-        """(angle, at_least) of the n-th overshoot: measured, or a lower bound if the run
-        ended in that turn; NaN if the turn never began."""
+        """(angle, at_least): measured, a lower bound if the run ended in that turn, or NaN."""
         if len(self.overshoots) >= n:
             return self.overshoots[n - 1].angle, False
         if self.running is not None and len(self.overshoots) == n - 1:
@@ -79,11 +68,11 @@ class ZigZagResult:
 
     @property
     def first_overshoot(self) -> float:
-        return self.overshoot(1)
+        return self.overshoots[0].angle if self.overshoots else math.nan
 
     @property
     def second_overshoot(self) -> float:
-        return self.overshoot(2)
+        return self.overshoots[1].angle if self.checked else math.nan
 
     @property
     def initial_turning_time(self) -> float:
@@ -103,13 +92,11 @@ class ZigZagResult:
         return self._between(1, 3)
 
     def _between(self, first: int, last: int) -> float:
-        """Time from execute ``first`` to ``last`` (0-based), s; NaN if not reached."""
-        return self.executes[last] - self.executes[first] if len(self.executes) > last \
-            else math.nan
+        return self.executes[last] - self.executes[first] if len(self.executes) > last else \
+            math.nan
 
 
 def _first_reaching(level: np.ndarray, target: float, *series: np.ndarray) -> list[float]:
-    """Each series, interpolated where ``level`` first reaches ``target``; NaNs if never."""
     i = int(np.argmax(level >= target))
     if level[i] < target:
         return [math.nan] * len(series)
@@ -141,7 +128,7 @@ def fitted_circle(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
 
 
 def steady_circle(x: np.ndarray, y: np.ndarray, psi: np.ndarray) -> tuple[float, float, float]:
-    """``fitted_circle`` over the last 360 deg of heading; NaNs unless it turned 540 deg."""
+    """``fitted_circle`` of the last lap; NaNs unless it turned 540 deg."""
     x, y, psi = map(np.asarray, (x, y, psi))
     if abs(psi[-1] - psi[0]) < 3.0 * math.pi:
         return math.nan, math.nan, math.nan
@@ -157,10 +144,8 @@ def turning_circle_figures(x, y, psi, u, v, r) -> TurningCircle:
     _, tactical, u180, v180 = at_heading_change(psi, math.pi, along, across, u, v)
     turn = math.copysign(math.pi, psi[-1] - psi[0])
     course = turn + math.atan2(v180, u180) - math.atan2(v[0], u[0])
-    return TurningCircle(advance=advance, transfer=abs(transfer),
-                         tactical_diameter=abs(tactical),
-                         steady_yaw_rate=float(r[-1]),
-                         steady_speed=float(math.hypot(u[-1], v[-1])),
+    return TurningCircle(advance=advance, transfer=abs(transfer), tactical_diameter=abs(tactical),
+                         steady_yaw_rate=float(r[-1]), steady_speed=float(math.hypot(u[-1], v[-1])),
                          steady_diameter=steady_circle(x, y, psi)[2],
                          approach_speed=float(math.hypot(u[0], v[0])),
                          drift_angle=float(math.atan2(v[-1], u[-1])),
@@ -170,17 +155,13 @@ def turning_circle_figures(x, y, psi, u, v, r) -> TurningCircle:
 
 def zigzag_figures(psi, reversals, psi_switch: float, t=None, x=None,
                    y=None) -> ZigZagResult:
-    """A zig-zag's figures from its heading deviation psi and the program's reversal count.
-
-    An overshoot counts once the heading turned back; a first or second turn the run ended
-    in is ``running``, a lower bound. The times need ``t``, the distance ``x`` and ``y``.
-    """
+    """A zig-zag's figures from heading deviation psi and the program's reversal count; an
+    overshoot counts once the heading turned back, else it is ``running`` (a lower bound)."""
     psi, reversals = np.asarray(psi), np.asarray(reversals)
     times = np.asarray(t) if t is not None else np.full(len(psi), math.nan)
     reached = int(reversals.max())
 
     def peak(n: int) -> tuple[Overshoot, bool]:
-        """The n-th turn's largest heading deviation, and whether the heading turned back."""
         turn = np.flatnonzero(reversals == n)
         k = turn[np.argmax(np.abs(psi[turn]))]
         return Overshoot(float(abs(psi[k]) - psi_switch), float(times[k]), float(psi[k])), \
@@ -201,15 +182,12 @@ def zigzag_figures(psi, reversals, psi_switch: float, t=None, x=None,
 
 def turning_circle(delta: float = TURNING_RUDDER, t_end: float = 300.0,
                    params: VesselParameters = VesselParameters()) -> TurningCircle:
-    """Turning circle from steady straight running with rudder delta."""
     track = trial(RudderProgram(delta, 0.0), t_end, params)
     return turning_circle_figures(*(track[n] for n in ("x", "y", "psi", "u", "v", "r")))
 
 
 def zigzag(delta: float = math.radians(20.0), psi_switch: float = math.radians(20.0),
-           t_end: float = 300.0,
-           params: VesselParameters = VesselParameters()) -> ZigZagResult:
-    """The figures of a delta/psi_switch zig-zag test from steady straight running."""
+           t_end: float = 300.0, params: VesselParameters = VesselParameters()) -> ZigZagResult:
     track = trial(RudderProgram(delta, psi_switch), t_end, params)
     t = DT * np.arange(len(track["psi"]))
     return zigzag_figures(track["psi"], track["reversals"], psi_switch, t, track["x"],

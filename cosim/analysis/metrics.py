@@ -1,5 +1,4 @@
-"""Figures of merit of a heading response and of a route: eq (19) cost, settling, overshoot,
-rudder activity, cross-track error and route completion. SI units and radians throughout."""
+"""Figures of merit of a heading response and of a route, SI units and radians."""
 from __future__ import annotations
 
 import math
@@ -13,7 +12,7 @@ from ..ensemble.exact import wrap
 
 
 def heading_error(psi_d: np.ndarray, psi: np.ndarray) -> np.ndarray:
-    """Delta psi_i = psi_d - psi wrapped to (-pi, pi], rad, to the bit as the FMUs wrap it."""
+    """psi_d - psi wrapped to (-pi, pi], rad, to the bit as the FMUs wrap it."""
     return wrap(np.asarray(psi_d, dtype=float) - np.asarray(psi, dtype=float))
 
 
@@ -23,17 +22,15 @@ def cost_terms(psi_d: np.ndarray, psi: np.ndarray, delta: np.ndarray) -> tuple[f
 
 
 def rms(values: np.ndarray) -> float:
-    """Root mean square over the samples, in the values' unit."""
     return math.sqrt(float(np.mean(np.square(values))))
 
 
 def peak(values: np.ndarray) -> float:
-    """Largest magnitude over the samples, in the values' unit."""
     return float(np.max(np.abs(values)))
 
 
 def settling_time(t: np.ndarray, error: np.ndarray, band: float) -> float:
-    """First time after which |error| stays within band; inf if it never does."""
+    """First time after which |error| stays within band; inf if never."""
     outside = np.flatnonzero(np.abs(error) > band)
     if outside.size == 0:
         return float(t[0])
@@ -53,8 +50,7 @@ RUDDER_DEADBAND = math.radians(0.5)   # past amidships for a crossing to count: 
 
 def rudder_reversals_per_minute(t: np.ndarray, delta: np.ndarray,
                                 deadband: float = RUDDER_DEADBAND) -> float:
-    """Rudder crossings from one side to the other per minute, each counted once the rudder
-    is beyond ``deadband`` on the new side."""
+    """Rudder crossings per minute, each counted once beyond ``deadband`` on the new side."""
     delta = np.asarray(delta)
     sides = np.sign(delta)[np.abs(delta) > deadband]
     reversals = int(np.count_nonzero(sides[1:] != sides[:-1]))
@@ -62,25 +58,22 @@ def rudder_reversals_per_minute(t: np.ndarray, delta: np.ndarray,
 
 
 def mean_abs_rate(t: np.ndarray, delta: np.ndarray) -> float:
-    """Mean |d delta / dt| over the run, rad/s: the rudder's total travel over the time."""
+    """Mean |d delta / dt|, rad/s: the rudder's total travel over the time."""
     return float(np.sum(np.abs(np.diff(delta)))) / float(t[-1] - t[0])
 
 
 def at_stops(delta: np.ndarray, delta_max: float) -> np.ndarray:
-    """Whether the rudder is on its stops, |delta| >= delta_max, each sample."""
     return np.abs(np.asarray(delta)) >= delta_max * (1 - 1e-9)
 
 
 def fraction_at_stops(delta: np.ndarray, delta_max: float) -> float:
-    """Share of the samples (0 to 1) with the rudder on its stops (``at_stops``)."""
     return float(np.mean(at_stops(delta, delta_max)))
 
 
 def cross_track_error(x: np.ndarray, y: np.ndarray, wp_index: np.ndarray,
                       points: Sequence[tuple[float, float]]) -> np.ndarray:
-    """Signed distance of (x, y) from the line of the leg followed, m, positive to starboard
-    (Fossen 2011, ch 10: e = -(x - x_k) sin alpha_k + (y - y_k) cos alpha_k). The leg runs
-    to waypoint ``wp_index``; past the last, the last leg's line."""
+    """e = -(x - x_k) sin alpha_k + (y - y_k) cos alpha_k of the leg to ``wp_index`` (past
+    the last: the last leg), m, positive to starboard (Fossen 2011, ch 10)."""
     guidance = WaypointGuidance(points)
     leg = np.clip(np.asarray(wp_index, dtype=int) - 1, 0, len(points) - 2)
     alpha = np.array([guidance.course(k) for k in range(len(points) - 1)])[leg]
@@ -90,9 +83,8 @@ def cross_track_error(x: np.ndarray, y: np.ndarray, wp_index: np.ndarray,
 
 @dataclass(frozen=True)
 class RouteCompletion:
-    """How close the track came to each waypoint: reached if within R_accept of it (the
-    guidance also moves on past a waypoint it never reached)."""
-
+    """How close the track came to each waypoint: reached within R_accept (the guidance
+    also moves on past a waypoint it never reached)."""
     points: tuple[tuple[float, float], ...]     # the route, m
     closest: tuple[float, ...]                  # the track's closest approach to each, m
     R_accept: float                             # radius of the circle of acceptance, m
@@ -103,7 +95,7 @@ class RouteCompletion:
 
     @property
     def count(self) -> int:
-        """Waypoints reached, the start (the route's first point) included."""
+        """Waypoints reached, the start included."""
         return sum(self.reached)
 
     @property
@@ -113,6 +105,5 @@ class RouteCompletion:
 
 def route_completion(x: np.ndarray, y: np.ndarray, points: Sequence[tuple[float, float]],
                      R_accept: float) -> RouteCompletion:
-    """Which waypoints of ``points`` the track (x, y) reached, within ``R_accept`` (m)."""
     closest = tuple(float(np.min(np.hypot(x - px, y - py))) for px, py in points)
     return RouteCompletion(tuple(map(tuple, points)), closest, R_accept)

@@ -1,8 +1,6 @@
-"""IMO-style plates of a zig-zag and a turning circle, as MSC/Circ.1053 draws them, with the
-standard's figures and the MSC.137(76) criteria; the figures from ``manoeuvres``, the words
-from ``reports``, so plate and report cannot disagree. On a zig-zag plate the rudder is drawn
-as -delta, with the heading's sign sense (a positive delta turns this ship to port).
-"""
+"""IMO-style plates of a zig-zag and a turning circle (MSC/Circ.1053) with the MSC.137(76)
+criteria, their words from ``reports``: plate and report cannot disagree. The rudder is drawn
+as -delta, the heading's sign sense (a positive delta turns this ship to port)."""
 from __future__ import annotations
 
 import math
@@ -23,10 +21,10 @@ from .track import hull_outline, legend_if_any, outlines, track_panel
 RUDDER = "rudder -delta (deg, + turns to starboard)"
 _ORDINALS = ("1st", "2nd", "3rd", "4th")
 _BOX = dict(boxstyle="round,pad=0.15", facecolor="white", alpha=0.85, edgecolor="none")
+_ROUND = {**_BOX, "boxstyle": "round"}
 
 
 def _rudder(ax: Any, run: Recording) -> None:
-    """Ordered and actual rudder, -delta in degrees (the heading's sign sense)."""
     ax.plot(run.t, -np.degrees(run["ship.delta_c"]), "--", color="tab:blue", linewidth=0.7,
             label="rudder ordered")
     ax.plot(run.t, -np.degrees(run["ship.delta"]), color="tab:blue", linewidth=1.2,
@@ -34,7 +32,6 @@ def _rudder(ax: Any, run: Recording) -> None:
 
 
 def _span(ax: Any, start: float, end: float, height: float, label: str, colour: str) -> None:
-    """A time span drawn as a dimension line at ``height`` (axes fraction), labelled."""
     where = ax.get_xaxis_transform()
     ax.annotate("", xy=(end, height), xytext=(start, height), xycoords=where,
                 arrowprops=dict(arrowstyle="<->", color=colour, shrinkA=0, shrinkB=0))
@@ -43,7 +40,6 @@ def _span(ax: Any, start: float, end: float, height: float, label: str, colour: 
 
 
 def _executes(ax: Any, run: Recording, zz: ZigZagResult) -> None:
-    """The executes on the heading, the first four named."""
     rows = np.searchsorted(run.t, zz.executes)
     psi = np.degrees(run["ship.psi"][rows])
     ax.plot(zz.executes, psi, "o", color="tab:red", markersize=4, zorder=5,
@@ -54,7 +50,6 @@ def _executes(ax: Any, run: Recording, zz: ZigZagResult) -> None:
 
 
 def _overshoots(ax: Any, zz: ZigZagResult) -> None:
-    """Each overshoot as an arrow from the switching angle to the peak, the first two named."""
     switch = math.degrees(zz.psi_switch)
     for n, o in enumerate(zz.overshoots):
         peak = math.degrees(o.heading)
@@ -69,7 +64,6 @@ def _overshoots(ax: Any, zz: ZigZagResult) -> None:
 
 
 def _spans(ax: Any, zz: ZigZagResult) -> None:
-    """Initial turning time, time to check yaw and period, as dimension lines below the curves."""
     low, high = ax.get_ylim()
     ticks = [tick for tick in ax.get_yticks() if low <= tick <= high]
     ax.set_ylim(low - 0.4 * (high - low), high)
@@ -85,7 +79,6 @@ def _spans(ax: Any, zz: ZigZagResult) -> None:
 
 
 def _runaway(ax: Any, run: Recording, zz: ZigZagResult, a: Assessment) -> None:
-    """A turn never checked: keep the rudder in sight, show where the heading went."""
     limit = 6.0 * max(math.degrees(zz.psi_switch), math.degrees(a.delta))
     ax.set_ylim(-limit, limit)
     psi = np.degrees(run["ship.psi"])
@@ -99,7 +92,6 @@ def _runaway(ax: Any, run: Recording, zz: ZigZagResult, a: Assessment) -> None:
 
 
 def _zoom(ax: Any, run: Recording, zz: ZigZagResult) -> None:
-    """Time up to a little past the fifth execute, where the standard's figures are."""
     if len(zz.executes) < 6:
         return
     end = zz.executes[5] + 0.25 * (zz.executes[5] - zz.executes[4])
@@ -114,15 +106,6 @@ def _zoom(ax: Any, run: Recording, zz: ZigZagResult) -> None:
             color="0.4", bbox=_BOX)
 
 
-def _switching_angles(ax: Any, switch: float) -> None:
-    """The heading deviations (deg) that reverse the rudder, and zero."""
-    ax.axhline(0.0, color="0.6", linewidth=0.6)
-    for level in (-switch, switch):
-        ax.axhline(level, linestyle=":", color="0.4", linewidth=0.9)
-        ax.text(1.0, level, f" {level:+g}", transform=ax.get_yaxis_transform(), va="center",
-                fontsize=7, color="0.4")
-
-
 def zigzag_plate(run: Recording, **_: Any) -> Figure:
     """Heading and rudder with executes, overshoots and times; yaw rate; track; criteria."""
     a = zigzag_of(run)
@@ -134,7 +117,11 @@ def zigzag_plate(run: Recording, **_: Any) -> Figure:
     heading.plot(run.t, np.degrees(run["ship.psi"]), color="k", linewidth=1.4,
                  label="heading psi")
     _rudder(heading, run)
-    _switching_angles(heading, math.degrees(zz.psi_switch))
+    heading.axhline(0.0, color="0.6", linewidth=0.6)
+    for level in (-math.degrees(zz.psi_switch), math.degrees(zz.psi_switch)):
+        heading.axhline(level, linestyle=":", color="0.4", linewidth=0.9)     # rudder reverses
+        heading.text(1.0, level, f" {level:+g}", transform=heading.get_yaxis_transform(),
+                     va="center", fontsize=7, color="0.4")
     _executes(heading, run, zz)
     _overshoots(heading, zz)
     if zz.running is not None:
@@ -152,7 +139,7 @@ def zigzag_plate(run: Recording, **_: Any) -> Figure:
 
 
 def _earth(run: Recording, along: float, across: float) -> tuple[float, float]:
-    """(east, north) of a point given along and across (to starboard of) the approach course."""
+    """(east, north) of a point along and across (to starboard of) the approach course."""
     x0, y0, psi0 = run["ship.x"][0], run["ship.y"][0], run["ship.psi"][0]
     c, s = math.cos(psi0), math.sin(psi0)
     return y0 + along * s + across * c, x0 + along * c - across * s
@@ -160,8 +147,7 @@ def _earth(run: Recording, along: float, across: float) -> tuple[float, float]:
 
 def _dimension(ax: Any, run: Recording, start: tuple[float, float], end: tuple[float, float],
                label: str, colour: str, label_at: tuple[float, float] | None = None) -> None:
-    """A dimension line between two (along, across) points, labelled at its middle or at
-    ``label_at``; its gid is the label's first word."""
+    """A dimension line between two (along, across) points; its gid the label's first word."""
     p, q = _earth(run, *start), _earth(run, *end)
     ax.plot([p[0], q[0]], [p[1], q[1]], color=colour, linewidth=1.6, zorder=6,
             gid=label.split()[0])
@@ -171,22 +157,19 @@ def _dimension(ax: Any, run: Recording, start: tuple[float, float], end: tuple[f
     middle = (0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1]))
     where = middle if label_at is None else _earth(run, *label_at)
     ax.annotate(label, xy=middle, xytext=where, fontsize=8, color=colour, ha="center",
-                va="center", zorder=7,
-                bbox=dict(boxstyle="round", facecolor="white", alpha=0.85, edgecolor="none"),
+                va="center", zorder=7, bbox=_ROUND,
                 arrowprops=None if label_at is None else dict(arrowstyle="-", color=colour,
                                                               linewidth=0.7))
 
 
 def _extension(ax: Any, run: Recording, start: tuple[float, float],
                end: tuple[float, float]) -> None:
-    """A thin extension line between two (along, across) points."""
     p, q = _earth(run, *start), _earth(run, *end)
     ax.plot([p[0], q[0]], [p[1], q[1]], color="0.5", linewidth=0.6, linestyle="--", zorder=5)
 
 
 def _turning_track(ax: Any, run: Recording, a: Assessment) -> None:
-    """The track with the approach course, the advance (outside the turn), transfer and
-    tactical diameter the run reached, the steady circle, the ship at 90 and 180 deg."""
+    """The track dimensioned: advance, transfer, tactical and steady diameters."""
     track_panel(ax, run)
     tc, L = a.figures, a.length
     x, y, psi = run["ship.x"], run["ship.y"], run["ship.psi"]
@@ -227,7 +210,6 @@ def _turning_track(ax: Any, run: Recording, a: Assessment) -> None:
 
 
 def _steady(ax: Any, run: Recording, tc: TurningCircle, L: float) -> None:
-    """The steady turning circle fitted to the last lap, with its diameter."""
     centre_x, centre_y, diameter = steady_circle(run["ship.x"], run["ship.y"], run["ship.psi"])
     if math.isnan(diameter):
         return
@@ -240,16 +222,7 @@ def _steady(ax: Any, run: Recording, tc: TurningCircle, L: float) -> None:
     ax.text(centre_y, centre_x, f"steady turning diameter {diameter:.2f} m = "
             f"{diameter / L:.2f} L\n(circle fitted to the last lap; 2U/|r| = "
             f"{tc.diameter_from_rates:.2f} m)", ha="center", va="bottom", fontsize=7,
-            color="tab:orange", zorder=7,
-            bbox=dict(boxstyle="round", facecolor="white", alpha=0.85, edgecolor="none"))
-
-
-def _wrapped_heading(ax: Any, run: Recording) -> None:
-    """The compass heading 0-360 deg, the line broken where it wraps."""
-    heading = np.degrees(run["ship.psi"]) % 360.0
-    heading[1:][np.abs(np.diff(heading)) > 180.0] = np.nan
-    ax.plot(run.t, heading, color="k")
-    ax.set(ylim=(0, 360), yticks=(0, 90, 180, 270, 360), ylabel="heading psi\n(deg, 0-360)")
+            color="tab:orange", zorder=7, bbox=_ROUND)
 
 
 def turning_circle_plate(run: Recording, **_: Any) -> Figure:
@@ -261,7 +234,10 @@ def turning_circle_plate(run: Recording, **_: Any) -> Figure:
     _turning_track(fig.add_subplot(grid[0:5, 0]), run, a)
     heading, speed, drift, r, rudder = time_axes(fig, [grid[i, 1] for i in range(5)])
     t, u, v = run.t, run["ship.u"], run["ship.v"]
-    _wrapped_heading(heading, run)
+    compass = np.degrees(run["ship.psi"]) % 360.0          # broken where it wraps
+    compass[1:][np.abs(np.diff(compass)) > 180.0] = np.nan
+    heading.plot(t, compass, color="k")
+    heading.set(ylim=(0, 360), yticks=(0, 90, 180, 270, 360), ylabel="heading psi\n(deg, 0-360)")
     for target in (math.pi / 2, math.pi):
         when, = at_heading_change(run["ship.psi"], target, t)
         if math.isnan(when):

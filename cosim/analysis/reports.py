@@ -35,7 +35,6 @@ def course_keeping_report(recording: Recording, lam: float = LAMBDA, **_) -> lis
 
 
 def criterion_text(c: Criterion) -> str:
-    """One criterion for people: PASS, FAIL or OPEN, the figure, its limit, the clause."""
     if math.isnan(c.value):
         value = c.missing
     elif c.at_least:
@@ -48,7 +47,6 @@ def criterion_text(c: Criterion) -> str:
 
 
 def _amount(x: float, unit: str) -> str:
-    """A criterion's value in its unit: degrees for angles, ship lengths for distances."""
     return f"{math.degrees(x):.1f} deg" if unit == "rad" else f"{x:.2f} L"
 
 
@@ -63,7 +61,6 @@ def scope(a: Assessment) -> str:
 
 
 def _turning_figures(tc: TurningCircle, L: float) -> str:
-    """Advance, transfer and tactical diameter in m and ship lengths, as far as the run got."""
     short = f"the heading changed by only {math.degrees(tc.heading_change):.0f} deg in the run"
     if math.isnan(tc.advance):
         return f"{short}: no advance, transfer or tactical diameter (at 90 and 180 deg)"
@@ -76,7 +73,6 @@ def _turning_figures(tc: TurningCircle, L: float) -> str:
 
 
 def _steady_diameter(tc: TurningCircle, L: float) -> str:
-    """The steady turning diameter, measured and from the rates, for people."""
     rates = f"2U/|r| = {tc.diameter_from_rates:.3f} m"
     if math.isnan(tc.steady_diameter):
         return f"diameter {rates} (the run turned less than 540 deg: no lap to fit)"
@@ -85,7 +81,6 @@ def _steady_diameter(tc: TurningCircle, L: float) -> str:
 
 
 def turning_circle_lines(a: Assessment) -> list[str]:
-    """The turning circle's figures, why its two diameters differ, and its criteria."""
     tc, L = a.figures, a.length
     lines = [_turning_figures(tc, L),
              f"steady turn: {_steady_diameter(tc, L)}, yaw rate "
@@ -101,7 +96,6 @@ def turning_circle_lines(a: Assessment) -> list[str]:
 
 
 def _zigzag_times(zz: ZigZagResult, L: float) -> str:
-    """Initial turning time and distance, time to check yaw and period, as far as reached."""
     if len(zz.executes) < 2:
         return "the heading never reached the switching angle"
     times = [f"initial turning time {zz.initial_turning_time:.1f} s (first to second execute, "
@@ -115,8 +109,6 @@ def _zigzag_times(zz: ZigZagResult, L: float) -> str:
 
 
 def zigzag_lines(a: Assessment, run: Recording) -> list[str]:
-    """The zig-zag's overshoots (or that the turn was not checked, and where the heading
-    went), its times and its criteria."""
     zz = a.figures
     measured = [f"{name} overshoot {math.degrees(o.angle):.2f} deg"
                 for name, o in zip(("first", "second"), zz.overshoots)]
@@ -143,15 +135,13 @@ def zigzag_report(recording: Recording, **_) -> list[str]:
 
 
 def _label(sea: str, controller: str) -> str:
-    """The paper's controllers in capitals (PD, SMC), a user's as named."""
     return controller.upper() if f"{sea}_{controller}" in PAPER_TABLES else controller
 
 
 def tables(costs: dict[tuple[str, str], Cost],
            spreads: dict[tuple[str, str], str] | None = None, spreads_title: str = "") -> str:
-    """Tables 1 and 2 of the paper beside ours; ``costs`` by (sea, controller), "pd" and
-    "smc" with the paper's values, any other a row of its own; ``spreads`` (what a
-    perturbation ensemble says of each row) below, under ``spreads_title``."""
+    """Tables 1 and 2 of the paper beside ours, ``costs`` by (sea, controller); ``spreads``
+    (a perturbation ensemble's word on each row) below, under ``spreads_title``."""
     lines = []
     for title, sea in (("Table 1, calm water", "calm"), ("Table 2, waves", "waves")):
         lines += [f"{title}:", f"  {'':16}{'psi_E':>9}{'delta_E':>9}{'J':>9}   |"

@@ -1,11 +1,7 @@
-"""WMO sea state codes at the model's scale (CyberShip II is 1:70, Froude scaling: heights
-scale with 70, periods with sqrt(70)).
-
-Full-scale Hs: the middle of the code's range; modal period: the most probable of the open
-North Atlantic for that code (Lee and Bales 1980, as in STANAG 4194); code 1 takes code 2's,
-since shorter waves would break the block model of eqs (14)-(16), which holds only for waves
-longer than the hull. The paper's waves (Hs 5 mm, T0 0.8 s) are code 2.
-"""
+"""WMO sea state codes at the 1:70 model's scale (Froude: heights / 70, periods / sqrt(70)):
+Hs the middle of the code's range, the modal period the open North Atlantic's most probable
+(Lee and Bales 1980, STANAG 4194); code 1 takes code 2's, since shorter waves break the block
+model of eqs (14)-(16). The paper's waves (Hs 5 mm, T0 0.8 s) are code 2."""
 from __future__ import annotations
 
 import math

@@ -1,7 +1,6 @@
-"""The track panel every figure of a run shares: north up, east right at equal scale, the
-route with its circles of acceptance and named waypoints, where each leg switched, the
-ship's outline at regular times (enlarged where it could not be seen) and the wave direction.
-"""
+"""The track panel every figure of a run shares: north up at equal scale, the route with its
+circles and named waypoints, the leg switches, the ship's outline at regular times (enlarged
+where it could not be seen) and the wave direction."""
 from __future__ import annotations
 
 import itertools
@@ -20,14 +19,13 @@ from ship_fmu.data import Hull
 
 from ..core.recording import Recording
 
-OUTLINES = 12                                   # ship outlines along a track, about
-TRACK = "track"                                 # a track panel's label, for legend_if_any
+OUTLINES = 12                   # ship outlines along a track, about
+TRACK = "track"                 # a track panel's label, for legend_if_any
 _DIRECTIONS = [(math.cos(a), math.sin(a)) for a in np.radians(np.arange(0, 360, 45))]
 
 
 def waypoint_name(i: int) -> str:
-    """Route point ``i`` (0-based, as ``wp_index``) by name: numbered from 1 as in Fossen
-    (2011, ch. 10), so the start is 'WP1' and the first leg steers for WP2."""
+    """Route point ``i`` (0-based) by name, from 'WP1' as Fossen (2011, ch. 10)."""
     return f"WP{i + 1}"
 
 
@@ -43,8 +41,8 @@ def hull_outline(x: float, y: float, psi: float, scale: float = 1.0) -> np.ndarr
 
 
 def outline_scale(spacing: float, extent: float) -> int:
-    """The largest one-digit factor (1 ... 9, 10, 20, ...) that keeps an enlarged outline
-    within 0.8 of ``spacing`` and 1/12 of ``extent`` (m); 1 if to scale is large enough."""
+    """The largest factor 1 ... 9, 10, 20, ... keeping an outline within 0.8 ``spacing`` and
+    ``extent`` / 12 (m)."""
     limit = min(0.8 * spacing, extent / 12.0) / Hull.L
     if limit < 1.0:
         return 1
@@ -55,7 +53,6 @@ def outline_scale(spacing: float, extent: float) -> int:
 @dataclass(frozen=True)
 class Outlines:
     """Where a track shows the ship's outline: the rows, every how many s, how enlarged."""
-
     rows: list[int]
     every: float
     scale: int
@@ -82,7 +79,6 @@ def outlines(run: Recording) -> Outlines:
 
 
 def _arrow(direction: float) -> Shape:
-    """An arrow pointing to ``direction`` (rad, clockwise from north) on a north-up panel."""
     shape = np.array([(0, 1), (0.5, 0.15), (0.17, 0.15), (0.17, -1), (-0.17, -1),
                       (-0.17, 0.15), (-0.5, 0.15), (0, 1)])           # east, north
     c, s = math.cos(direction), math.sin(direction)
@@ -91,7 +87,6 @@ def _arrow(direction: float) -> Shape:
 
 
 def _in_view(tracks: list[np.ndarray], points: np.ndarray) -> np.ndarray:
-    """The route points within half the tracks' size of the box around them."""
     seen = np.concatenate(tracks)
     low, high = seen.min(axis=0), seen.max(axis=0)
     size = max(*(high - low), 4 * Hull.L)
@@ -100,7 +95,6 @@ def _in_view(tracks: list[np.ndarray], points: np.ndarray) -> np.ndarray:
 
 
 def _dense(points: np.ndarray, pieces: int = 40) -> np.ndarray:
-    """The polyline through ``points`` as many points along each of its segments."""
     steps = np.linspace(0.0, 1.0, pieces, endpoint=False)[:, None]
     legs = [a + steps * (b - a) for a, b in itertools.pairwise(points)]
     return np.concatenate([*legs, points[-1:]])
@@ -108,7 +102,6 @@ def _dense(points: np.ndarray, pieces: int = 40) -> np.ndarray:
 
 def _label_waypoints(ax: Any, points: np.ndarray, avoid: np.ndarray, reach: float,
                      size: float) -> None:
-    """Name each route point beside its circle, on the side farthest from ``avoid``."""
     def clearance(where: np.ndarray) -> float:
         return float(np.min(np.hypot(*(avoid - where).T))) if len(avoid) else math.inf
     for i, point in enumerate(points):
@@ -122,8 +115,6 @@ def _label_waypoints(ax: Any, points: np.ndarray, avoid: np.ndarray, reach: floa
 
 
 def _route(ax: Any, guidance: dict[str, Any], tracks: list[np.ndarray]) -> None:
-    """The route, its circles and named waypoints; framed on the tracks and the points near
-    them, a route going on out of view says where to."""
     points = np.array(followed_route(guidance))[:, ::-1]              # (east, north)
     reach = guidance["R_accept"]
     near = _in_view(tracks, points)
@@ -147,8 +138,8 @@ def _route(ax: Any, guidance: dict[str, Any], tracks: list[np.ndarray]) -> None:
 
 def track_panel(ax: Any, run: Recording, ship: bool = True,
                 others: Iterable[Recording] = ()) -> None:
-    """The route, the wave direction and, with ``ship``, the track, leg switches and outlines;
-    framed on the tracks of ``run`` and ``others`` (which the caller draws)."""
+    """The route, waves and, with ``ship``, the track, leg switches and outlines; framed on
+    the tracks of ``run`` and ``others`` (which the caller draws)."""
     p = run.meta.get("parameters", {})
     x, y, psi = run["ship.x"], run["ship.y"], run["ship.psi"]
     tracks = [np.column_stack([r["ship.y"], r["ship.x"]]) for r in (run, *others)]
@@ -179,8 +170,7 @@ def track_panel(ax: Any, run: Recording, ship: bool = True,
 
 
 def legend_if_any(ax: Any, **kwargs: Any) -> None:
-    """A legend of what has a label, over no data: a track panel's below the panels, any
-    other's in a row above its axes."""
+    """A legend over no data: a track panel's below the panels, others' above their axes."""
     handles, labels = ax.get_legend_handles_labels()
     if not handles:
         return

@@ -1,11 +1,7 @@
-"""Many runs of one course-keeping system at once: the batch route of sweeps and scorecards.
-
-The kernel steps M members in lockstep, each state an (M,) array, writing the vessel,
-guidance and autopilot equations again on arrays, operation for operation in the scalar
-models' order; the tests pin every signal of every member to the in-process route bit for
-bit. Each member is initialised by the in-process master (``members``). A member the kernel
-does not cover (``members.coverage``), or one that fails, runs alone on the in-process route;
-``selftest`` checks once per process that this machine's numpy computes as the scalar models.
+"""The batch route of sweeps and scorecards: M members of one course-keeping system stepped
+in lockstep on (M,) arrays, operation for operation in the scalar models' order (the tests pin
+every signal to the in-process route bit for bit). A member not covered (``members.coverage``)
+or failing runs alone in-process; ``selftest`` checks this machine's numpy once per process.
 """
 from .route import SIGNALS, selftest, simulate_members
 

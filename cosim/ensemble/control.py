@@ -1,7 +1,5 @@
-"""The guidance (eq 18) and the autopilots (eqs 20, 37-44) of ``autopilot_fmu`` on (M,)
-arrays, built from the scalar models the in-process route initialised, operation for
-operation in their order. Each member keeps its own route (padded), gains and design.
-"""
+"""The guidance (eq 18) and autopilots (eqs 20, 37-44) of ``autopilot_fmu`` on (M,) arrays,
+built from the initialised scalar models; each member keeps its route (padded) and gains."""
 from __future__ import annotations
 
 import math
@@ -44,7 +42,6 @@ class GuidanceArrays:
         self.members = np.arange(len(guidances))
 
     def _reached(self, leg: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-        """``WaypointGuidance._reached``: inside the circle, or past the leg's end."""
         i = self.members
         (x0, y0), (x1, y1) = self.start[i, leg].T, self.end[i, leg].T
         dx, dy = self.delta[i, leg].T
@@ -65,20 +62,17 @@ class GuidanceArrays:
         return leg, finished
 
     def outputs(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(psi_d, wp_index) at (x, y), the leg switches committed (as ``update`` would be,
-        at the same position)."""
+        """(psi_d, wp_index) at (x, y), the leg switches committed."""
         self.leg, self.finished = self.active_leg(x, y)
         psi_d = self.course[self.members, self.leg]
         return psi_d, np.where(self.finished, self.points, self.leg + 1)
 
 
-NEAR = 1e-12
-"""Relative distance from the circle within which ``_within`` asks ``math.hypot``."""
+NEAR = 1e-12           # relative distance from the circle within which math.hypot decides
 
 
 def _within(dx: np.ndarray, dy: np.ndarray, radius: np.ndarray) -> np.ndarray:
-    """``math.hypot(dx, dy) <= radius`` of each member: ``np.hypot`` (a tenth of the cost)
-    decides, but within ``NEAR`` of the circle, where ``math.hypot`` does."""
+    """``math.hypot(dx, dy) <= radius``, by the cheaper ``np.hypot`` away from the circle."""
     distance = np.hypot(dx, dy)
     inside = distance <= radius
     near = np.abs(distance - radius) <= NEAR * radius
@@ -129,20 +123,17 @@ class SMCArrays:
             setattr(self, name.lstrip("_"), _column(pilots, name))
         self._cuts: tuple[float, np.ndarray] | None = None
 
-    def r_z_dot(self, psi_d: np.ndarray, psi_z: np.ndarray, r_z: np.ndarray) -> np.ndarray:
-        return reference_acceleration(psi_d, psi_z, r_z, self.omega_n, self.zeta, wrap)
-
     def command(self, psi: np.ndarray, r: np.ndarray, psi_d: np.ndarray) -> np.ndarray:
         error = wrap(self.psi_z - psi)
         u_eq = self.k1 * error + self.k2 * (np.where(self.tracking, self.r_z, 0.0) - r)
         sigma = self.h1 * error + self.h2 * (self.r_z - r)
-        u_sw = (self.h1 * self.r_z + self.h2 * self.r_z_dot(psi_d, self.psi_z, self.r_z)
-                - self.eta_h * tanh(sigma / self.phi_h))
+        r_z_dot = reference_acceleration(psi_d, self.psi_z, self.r_z, self.omega_n,
+                                         self.zeta, wrap)
+        u_sw = self.h1 * self.r_z + self.h2 * r_z_dot - self.eta_h * tanh(sigma / self.phi_h)
         return u_eq + u_sw
 
     def step(self, t: float, h: float, psi: np.ndarray, r: np.ndarray,
              psi_d: np.ndarray) -> None:
-        """RK4 over h with psi_d held, in each member's number of sub-steps."""
         if self._cuts is None or self._cuts[0] != h:
             self._cuts = h, np.array([substeps(h, bound, "of the reference model")
                                       for bound in self.h_max])
@@ -165,6 +156,5 @@ def autopilot_arrays(pilots: Sequence) -> PDArrays | PIDArrays | SMCArrays:
     return KINDS[kinds.pop()](pilots)
 
 
-KINDS = {"PDAutopilot": PDArrays, "PIDAutopilot": PIDArrays,
-         "SlidingModeAutopilot": SMCArrays}
-"""The array forms of the scalar autopilots, by class name (the PID's lives in its slave)."""
+KINDS = {"PDAutopilot": PDArrays, "PIDAutopilot": PIDArrays,   # by class name: the PID's
+         "SlidingModeAutopilot": SMCArrays}                    # lives in its slave

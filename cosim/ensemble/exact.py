@@ -1,10 +1,7 @@
-"""The scalar models' functions on arrays, each element to the bit of the scalar call.
-
-numpy's ``np.hypot`` and ``np.tanh`` round differently from ``math.hypot`` and ``math.tanh``
-on a share of inputs, so ``hypot`` and ``tanh`` call the math functions element by element;
-``wrap`` rebuilds CPython's ``math.remainder`` from ``np.fmod``, which is exact. What numpy
-computes as the C library does (sin, cos, sqrt, + - * /) is used as is (``selftest``).
-"""
+"""The scalar models' functions on arrays, to the bit: ``np.hypot`` and ``np.tanh`` round
+unlike ``math``'s on some inputs, so these call ``math`` per element; ``wrap`` rebuilds
+CPython's ``math.remainder`` from the exact ``np.fmod``. sin, cos, sqrt, + - * / are numpy's
+(``selftest`` checks them)."""
 from __future__ import annotations
 
 import math
@@ -18,18 +15,15 @@ _tanh = np.frompyfunc(math.tanh, 1, 1)
 
 
 def hypot(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """``math.hypot`` of each pair of elements."""
     return _hypot(x, y).astype(float)
 
 
 def tanh(x: np.ndarray) -> np.ndarray:
-    """``math.tanh`` of each element."""
     return _tanh(x).astype(float)
 
 
 def remainder(x: np.ndarray, y: float) -> np.ndarray:
-    """``math.remainder(x, y)`` of each element, for a finite y > 0: x - n y with n the
-    integer nearest x / y (ties to even), as CPython computes it (``m_remainder``)."""
+    """``math.remainder(x, y)`` for a finite y > 0, as CPython's ``m_remainder``."""
     absx = np.abs(x)
     with np.errstate(invalid="ignore"):          # an infinite x: NaN, as math.remainder
         m = np.fmod(absx, y)

@@ -1,5 +1,5 @@
-"""Which systems and members the batch kernel runs, and each member's initial models: built
-by the in-process master exactly as a run of it would be, then stepped by the kernel."""
+"""Which systems and members the batch kernel runs, each member's models initialised by the
+in-process master exactly as a run of it would be."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -18,15 +18,12 @@ WIRING = frozenset({("guidance", "psi_d", "autopilot", "psi_d"),
                     ("ship", "psi", "autopilot", "psi"), ("ship", "r", "autopilot", "r"),
                     ("autopilot", "delta_c", "ship", "delta_c"),
                     ("ship", "x", "guidance", "x"), ("ship", "y", "guidance", "y")})
-"""The course-keeping loop of cosim/scenarios: the only wiring the kernel steps."""
-MODELS = {"guidance": ("guidance",), "ship": ("ship",),
+MODELS = {"guidance": ("guidance",), "ship": ("ship",),     # the models with array forms
           "autopilot": ("pd_autopilot", "pid_autopilot", "smc_autopilot")}
-"""The FMUs, by model name, whose models the kernel has array forms of."""
 
 
 def coverage(system: SystemDescription) -> str | None:
-    """Why the batch kernel cannot run ``system``, or None: it runs this project's current
-    guidance, ship and PD, PID or sliding-mode autopilot wired as course keeping."""
+    """Why the batch kernel cannot run ``system`` (course keeping of this project's FMUs)."""
     names = set(system.components)
     if names != set(COMPONENTS):
         return (f"the batch route runs course keeping (guidance, autopilot, ship), not "
@@ -50,7 +47,6 @@ def coverage(system: SystemDescription) -> str | None:
 @dataclass
 class Member:
     """One member as the in-process master initialised it."""
-
     models: dict[str, Any]              # component: its model (Vessel, WaypointGuidance, ...)
     shafts: tuple[float, float, float]  # the ship's n1, n2, n3
     meta: dict[str, Any]                # what Master.run records about the run
@@ -58,8 +54,7 @@ class Member:
 
 def initialise(master: Master, overrides: dict[str, dict[str, Any]],
                n_steps: int) -> Member | None:
-    """The member of ``overrides`` initialised by ``master`` (in-process, of a covered
-    system), or None if that fails (its run alone then records why)."""
+    """The member of ``overrides`` initialised by ``master``; None if that fails."""
     master.reset()
     master.configure(overrides)
     try:

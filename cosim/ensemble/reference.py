@@ -9,14 +9,12 @@ import numpy as np
 from fmukit.timebase import communication_point
 
 SIGNALS = ("guidance.psi_d", "guidance.wp_index", "autopilot.delta_c", "ship.x", "ship.y",
-           "ship.psi", "ship.u", "ship.v", "ship.r", "ship.delta")
-"""Every signal of the loop the reference and the kernel record (wave loads aside)."""
+           "ship.psi", "ship.u", "ship.v", "ship.r", "ship.delta")   # wave loads aside
 
 
 def step_models(guidance: Any, autopilot: Any, ship: Any, shafts: tuple[float, float, float],
                 t0: float, h: float, n_steps: int) -> dict[str, np.ndarray]:
-    """Each of ``SIGNALS`` at t_0 .. t_N of initialised scalar models stepped ``n_steps``
-    steps of h from t0 with the shaft speeds ``shafts`` (n1, n2, n3)."""
+    """Each of ``SIGNALS`` at t_0 .. t_N of initialised models, shafts (n1, n2, n3) held."""
     n1, n2, n3 = shafts
     stepping_pilot = hasattr(autopilot, "step")
     pid = type(autopilot).__name__ == "PIDAutopilot"      # steps with its inputs, as its slave

@@ -1,6 +1,5 @@
-"""``simulate_members``: the members of one system in lockstep where the kernel covers them,
-alone on the in-process route where it does not; ``selftest``, the kernel checked on this
-machine against the scalar models."""
+"""``simulate_members``: in lockstep where the kernel covers them, alone in-process where
+not; ``selftest``, the kernel checked on this machine against the scalar models."""
 from __future__ import annotations
 
 import math
@@ -29,21 +28,16 @@ from .reference import SIGNALS as ALL_SIGNALS, step_models
 from .vessel import VesselArrays
 
 SIGNALS = ("guidance.psi_d", "guidance.wp_index", "ship.x", "ship.y", "ship.psi",
-           "ship.delta")
-"""What the figures of merit of a run need (``cosim.studies.merit.run_metrics``)."""
-
-R_MAX = next(var.max for var in INPUTS if var.name == "r")
-"""The autopilots' declared range of their yaw-rate input, rad/s: beyond it they refuse."""
+           "ship.delta")                           # what ``studies.merit.run_metrics`` needs
+R_MAX = next(var.max for var in INPUTS if var.name == "r")   # rad/s: beyond, autopilots refuse
 
 
 def simulate_members(system: SystemDescription, overrides: Sequence[dict[str, dict[str, Any]]],
                      stop_time: float | None = None, signals: Sequence[str] = SIGNALS,
                      beat: Callable[[str | float], str | None] = no_limit) -> list[Recording]:
-    """One recording per member of ``system`` with ``overrides[i]``, as the in-process
-    ``Master.run(stop_time)`` records it, holding ``signals`` (any of ``reference.SIGNALS``).
-    ValueError naming the member whose settings are refused, before anything runs.
-    ``beat`` (``Watchdog.beat``) is called before each member's initialisation and each
-    step; where it returns a reason, the batch stops: TimeLimit with that reason."""
+    """One recording per member with ``overrides[i]``, as in-process ``Master.run`` records
+    it, of ``signals``; ValueError naming a refused member before anything runs; TimeLimit
+    where ``beat`` (``Watchdog.beat``, before each initialisation and step) gives a reason."""
     unknown = [s for s in signals if s not in ALL_SIGNALS]
     if unknown:
         raise ValueError(f"signals {', '.join(unknown)}: the batch route records only "
@@ -81,7 +75,6 @@ def _check(expired: str | None) -> None:
 
 
 def _outside(member: Member | None, h: float) -> str | None:
-    """Why the kernel does not step this member (None: it does)."""
     if member is None:
         return "its initialisation failed"
     ship = member.models["ship"]
@@ -92,14 +85,13 @@ def _outside(member: Member | None, h: float) -> str | None:
 
 
 def _group(member: Member) -> tuple:
-    """What members stepped together share: calm water, or the number of wave components."""
+    """Calm water, or the number of wave components: what members stepped together share."""
     waves = member.models["ship"].waves
     return (0,) if waves is None else (len(waves.components.omega),)
 
 
 def _alone(master: Master, overrides: dict[str, dict[str, Any]], stop_time: float | None,
            signals: Sequence[str], why: str) -> Recording:
-    """The member run on the in-process route, its recording cut to ``signals``."""
     master.reset()
     master.configure(overrides)
     recording = master.run(stop_time)
@@ -115,8 +107,8 @@ def lockstep(members: list[tuple[int, Member]], t0: float, h: float, n_steps: in
              signals: Sequence[str], units: dict[str, str],
              beat: Callable[[str | float], str | None] = no_limit
              ) -> list[tuple[int, Recording | None]]:
-    """The members stepped together: (index, recording), None for a member that failed
-    (a signal not finite, or a yaw rate outside the autopilot's range)."""
+    """(index, recording) of the members stepped together; None where a signal went
+    non-finite or the yaw rate left the autopilot's range."""
     started = time.perf_counter()
     models = [m.models for _, m in members]
     ship = VesselArrays([m["ship"] for m in models], h, [m.shafts for _, m in members])
@@ -142,25 +134,17 @@ def lockstep(members: list[tuple[int, Member]], t0: float, h: float, n_steps: in
             ship.step(t, h, delta_c)
     times = np.array([communication_point(t0, k, h) for k in range(n_steps + 1)])
     share = (time.perf_counter() - started) / len(members)
-    out = []
-    for j, (i, member) in enumerate(members):
-        if failed[j]:
-            out.append((i, None))
-            continue
-        meta = {**member.meta, "backend": "batch",
-                "backends": {name: "batch" for name in member.meta["backends"]},
-                "wall_time_s": share}
-        out.append((i, Recording(list(signals), times, block[:, :, j], n_steps + 1,
-                                 meta=meta, units={s: units[s] for s in signals})))
-    return out
+    return [(i, None if failed[j] else Recording(
+        list(signals), times, block[:, :, j], n_steps + 1, units={s: units[s] for s in signals},
+        meta={**member.meta, "backend": "batch", "backends": dict.fromkeys(
+            member.meta["backends"], "batch"), "wall_time_s": share}))
+        for j, (i, member) in enumerate(members)]
 
 
 # -- the self-test: numpy dispatches its loops by CPU, so each process checks once that its
 # sin, cos, sqrt, arithmetic and sums give the scalar models' bits (docs/performance.md).
-STEPS, H = 100, 0.1
-"""10 s: every autopilot's members switch legs, cross +-180 deg and, some, reach a stop."""
-ROUTE = [(0.0, 0.0), (-1.5, 0.2), (-2.5, 2.5), (0.5, 3.0)]
-"""A short route with turns beyond 90 deg, from a start heading near 180 deg."""
+STEPS, H = 100, 0.1     # 10 s: members switch legs, cross +-180 deg, some reach a stop
+ROUTE = [(0.0, 0.0), (-1.5, 0.2), (-2.5, 2.5), (0.5, 3.0)]   # turns beyond 90 deg
 
 
 def _pilot(kind: str, psi0: float, member: int):
@@ -174,7 +158,6 @@ def _pilot(kind: str, psi0: float, member: int):
 
 
 def _members(kind: str, Hs: float) -> list[dict]:
-    """Four members of one autopilot: seeds, headings near +-pi, gear rates."""
     out = []
     for member in range(4):
         psi0 = (-1.0) ** member * (math.pi - 0.01 * member)
@@ -187,8 +170,7 @@ def _members(kind: str, Hs: float) -> list[dict]:
 
 @lru_cache(maxsize=1)
 def selftest() -> str | None:
-    """Why the batch kernel would not give the scalar models' bits here, or None: each
-    autopilot in calm water and waves, every signal of every step compared to the bit."""
+    """Why the batch kernel would not give the scalar models' bits here, or None."""
     shafts = (N_PROPELLER, N_PROPELLER, 0.0)
     for kind in ("pd", "pid", "smc_paper", "smc_tracking"):
         for Hs in (0.0, 0.02):
@@ -199,11 +181,10 @@ def selftest() -> str | None:
                 scalar = step_models(models["guidance"], models["autopilot"], models["ship"],
                                      shafts, 0.0, H, STEPS)
                 for signal in ALL_SIGNALS:
-                    ours = recording[signal] if recording is not None else np.full(STEPS + 1, 0.0)
-                    if recording is None or ours.tobytes() != scalar[signal].tobytes():
+                    if recording is None or recording[signal].tobytes() != scalar[signal].tobytes():
                         where = "failed" if recording is None else (
                             f"{signal} differs from step "
-                            f"{int(np.flatnonzero(ours != scalar[signal])[0])}")
+                            f"{int(np.flatnonzero(recording[signal] != scalar[signal])[0])}")
                         return (f"on this machine the batch kernel does not compute as the "
                                 f"scalar models ({kind}, Hs = {Hs} m, member {i}: {where}); "
                                 "numpy's array functions round differently here")

@@ -1,8 +1,6 @@
-"""``ship_fmu.vessel.Vessel.step`` for M members at once: states (M,) arrays, wave
-components (M, N). The rates, actuator forces and RK4 update are the scalar model's own
-functions on arrays; what it writes with branches (the steering gear's kink) or scalar calls
-(the wave loads) is written here on arrays, operation for operation in its order.
-"""
+"""``Vessel.step`` for M members: states (M,), wave components (M, N); the scalar model's
+own rates, forces and RK4 update on arrays, its branches (the gear's kink) and scalar calls
+(wave loads) rewritten on arrays operation for operation."""
 from __future__ import annotations
 
 from typing import Callable, Sequence
@@ -32,7 +30,6 @@ class RudderArrays:
         return np.where(s >= self.reach, self.target, self.delta0 + self.velocity * s)
 
     def take(self, lanes: np.ndarray) -> RudderArrays:
-        """The gear of the members ``lanes`` (indices) only."""
         part = object.__new__(RudderArrays)
         for name in ("delta0", "target", "velocity", "reach"):
             setattr(part, name, getattr(self, name)[lanes])
@@ -40,9 +37,7 @@ class RudderArrays:
 
 
 class WaveArrays:
-    """``ship_fmu.waves.WaveLoads`` of every member, eqs (14)-(16), each sum over a member's
-    N components in numpy's order for N values."""
-
+    """``ship_fmu.waves.WaveLoads`` of every member, eqs (14)-(16)."""
     FIELDS = ("omega", "k", "phase", "slope_amplitude", "psi_w", "c_force", "c_moment")
 
     def __init__(self, vessels: Sequence[Vessel]):
@@ -58,8 +53,7 @@ class WaveArrays:
         self._part = {name: np.empty_like(getattr(self, name)) for name in self.FIELDS}
 
     def take(self, lanes: np.ndarray) -> WaveArrays:
-        """The waves of the members ``lanes`` only, in this object's spare arrays (valid
-        until the next ``take``)."""
+        """The members ``lanes`` only, in spare arrays valid until the next ``take``."""
         part = object.__new__(WaveArrays)
         for name in self.FIELDS:
             setattr(part, name, np.take(getattr(self, name), lanes, axis=0,
@@ -85,13 +79,12 @@ class WaveArrays:
 
 
 def _no_travel(u: np.ndarray, v: np.ndarray) -> float:
-    """Calm water: no load depends on xi, so its rate is left at 0 (saves ``hypot``)."""
+    """Calm water: no load depends on xi, its rate stays 0 (saves ``hypot``)."""
     return 0.0
 
 
 class Lanes:
-    """The members' waves and actuator forces, and ``Vessel.rates`` and one RK4 step of
-    ``Vessel._integrate`` over them, for all members or some."""
+    """``Vessel.rates`` and an RK4 step of ``Vessel._integrate``, for all members or some."""
 
     def __init__(self, hull, minv: tuple, m11_inv: float, waves: WaveArrays | None,
                  psi_w: np.ndarray, forces: list[tuple[np.ndarray | None, Callable]]):
@@ -107,7 +100,6 @@ class Lanes:
                      [(None if m is None else m[lanes], f) for m, f in self._forces])
 
     def forces(self, delta: np.ndarray) -> Arrays:
-        """tau_th of every member at rudder angles ``delta``."""
         if len(self._forces) == 1:
             return self._forces[0][1](delta)
         out = [np.empty_like(delta) for _ in range(3)]
@@ -122,7 +114,6 @@ class Lanes:
 
     def rk4(self, t: float, start: np.ndarray | float, length: np.ndarray, y: Arrays,
             gear: RudderArrays) -> Arrays:
-        """One step of ``Vessel._integrate``, of ``length`` from t + start."""
         hs = length
         hh, c = 0.5 * hs, hs / 6.0
         s = start + 0.0 * hs
@@ -140,7 +131,6 @@ class Lanes:
 
 class VesselArrays:
     """M vessels stepped together, built from the scalar vessels as initialised."""
-
     STATES = ("x", "y", "psi", "u", "v", "r", "xi")
 
     def __init__(self, vessels: Sequence[Vessel], h: float,
@@ -166,8 +156,7 @@ class VesselArrays:
         self.delta = np.array([v.delta for v in vessels])
 
     def step(self, t: float, h: float, delta_c: np.ndarray) -> None:
-        """``Vessel.step``: one RK4 step, or two where the rudder reaches its command or
-        stop within the step (those members only)."""
+        """``Vessel.step``: two RK4 steps for the members whose rudder kinks in the step."""
         gear = RudderArrays(self.delta, delta_c, self.delta_max, self.delta_rate_max)
         y = tuple(getattr(self, name) for name in self.STATES)
         split = (0.0 < gear.reach) & (gear.reach < h)
@@ -187,8 +176,7 @@ class VesselArrays:
 
 
 def _actuators(actuators, shafts: np.ndarray) -> list[tuple[np.ndarray | None, Callable]]:
-    """``thrusters.actuator_model`` of each distinct (n1, n2, n3), with the members that
-    have it (None: all)."""
+    """``actuator_model`` of each distinct (n1, n2, n3), with its members (None: all)."""
     distinct = np.unique(shafts, axis=0)
     return [(None if len(distinct) == 1 else np.all(shafts == row, axis=1),
              actuator_model(actuators, *map(float, row))) for row in distinct]

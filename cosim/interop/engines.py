@@ -1,10 +1,8 @@
-"""Run an exported SSP package (``cosim.export``) in another engine: ``libcosim`` (OSP,
-through libcosimpy; also the OSP folder beside the package), ``ecos`` (ecospy) or ``fmpy``
-(its SSP runner), in a child process: libcosimpy 0.0.6 aborts its host when an FMU fails,
-ecos 0.7.2 ignores FMI status codes. A crash, a failed step or outputs that read NaN become
-an ``EngineError`` carrying the child's output. Each returns the signals with the time
-each value belongs to (the engines' time conventions: docs/interop.md).
-"""
+"""Run an exported SSP package in ``libcosim`` (libcosimpy; also the OSP folder beside it),
+``ecos`` (ecospy) or ``fmpy`` (its SSP runner), in a child process: libcosimpy 0.0.6 aborts
+its host when an FMU fails, ecos 0.7.2 ignores FMI status codes. A crash, a failed step or
+NaN outputs become an ``EngineError`` with the child's output (time conventions:
+docs/interop.md)."""
 from __future__ import annotations
 
 import math
@@ -33,25 +31,20 @@ TRACED = ("ship.psi", "ship.r", "ship.delta")
 class EngineError(RuntimeError):
     """An engine failed or produced undefined values; the message holds its output."""
 
-
 def is_osp(path: Path) -> bool:
-    """Whether ``path`` is an OSP system structure (its folder, or the .xml itself)."""
     return path.is_dir() or path.suffix.lower() == ".xml"
 
 
 def read_system(path: Path) -> SystemDescription:
-    """The system of an SSP package or of an OSP system structure."""
     return read_osp(path) if is_osp(path) else read_package(path)
 
 
-def _libcosim(ssp: Path, signals: tuple[str, ...], stop: StopSignals) -> dict[str, np.ndarray]:
+def _libcosim(ssp: Path, system: SystemDescription, n_steps: int, signals: tuple[str, ...],
+              stop: StopSignals) -> dict[str, np.ndarray]:
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimObserver import CosimObserver
-
     log_output_level(CosimLogLevel.ERROR)
-    system = read_system(ssp)
-    n_steps = step_count(system.start_time, system.stop_time, system.step_size)
     execution = (CosimExecution.from_osp_config_file if is_osp(ssp)
                  else CosimExecution.from_ssp_file)(str(ssp))
     slaves = {s.name.decode(): s.index for s in execution.slave_infos()}
@@ -72,12 +65,10 @@ def _libcosim(ssp: Path, signals: tuple[str, ...], stop: StopSignals) -> dict[st
     return {"time": times, **dict(zip(signals, np.array(rows).T))}
 
 
-def _ecos(ssp: Path, signals: tuple[str, ...], stop: StopSignals) -> dict[str, np.ndarray]:
+def _ecos(ssp: Path, system: SystemDescription, n_steps: int, signals: tuple[str, ...],
+          stop: StopSignals) -> dict[str, np.ndarray]:
     from ecospy import EcosLib, EcosSimulation
-
     EcosLib.set_log_level("err")
-    system = read_package(ssp)
-    n_steps = step_count(system.start_time, system.stop_time, system.step_size)
     simulation = EcosSimulation(step_size=system.step_size, ssp_path=str(ssp))
     identifiers = [f"{c}::{v}" for c, v in map(split_name, signals)]
     try:
@@ -100,11 +91,10 @@ def _ecos(ssp: Path, signals: tuple[str, ...], stop: StopSignals) -> dict[str, n
     return {"time": times, **dict(zip(signals, np.array(rows).T))}
 
 
-def _fmpy(ssp: Path, signals: tuple[str, ...], stop: StopSignals) -> dict[str, np.ndarray]:
+def _fmpy(ssp: Path, system: SystemDescription, n_steps: int, signals: tuple[str, ...],
+          stop: StopSignals) -> dict[str, np.ndarray]:
     from fmpy.ssp.simulation import simulate_ssp
     from fmpy.ssp.ssd import Parameter, ParameterSet
-
-    system = read_package(ssp)
     # fmpy's runner applies no parameter bindings itself and cannot set Strings:
     # pass the package's own values, fully qualified; a String must equal the FMU's
     # default, or the run would not be the scenario.
@@ -128,9 +118,8 @@ RUNNERS = {"libcosim": _libcosim, "ecos": _ecos, "fmpy": _fmpy}
 
 
 def check_package(ssp: Path, engine: str | None = None) -> None:
-    """EngineError naming the file, the parameter or the components if the package cannot
-    be run (by ``engine``, if given): not an SSP package or OSP system structure, a value
-    not finite, or FMUs of an FMI version the engine does not take."""
+    """EngineError naming the file, parameter or components if ``engine`` cannot run the
+    package: not SSP or OSP, a value not finite, or FMUs of an FMI version it does not take."""
     try:
         system = read_system(ssp)
         versions = fmi_versions(ssp)
@@ -151,8 +140,8 @@ def check_package(ssp: Path, engine: str | None = None) -> None:
 
 
 def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = TRACED) -> dict[str, np.ndarray]:
-    """Run ``ssp`` in ``engine`` in a child process; EngineError with the engine's output if
-    it fails, ``Interrupted`` if SIGINT or SIGTERM ended the child."""
+    """Run ``ssp`` in ``engine`` in a child process; EngineError with its output if it
+    fails, ``Interrupted`` if SIGINT or SIGTERM ended the child."""
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
     ssp = Path(ssp).resolve()
@@ -187,12 +176,13 @@ _CHILD = ("import sys\nfrom cosim.interop.engines import record\n"
 
 
 def record(engine: str, ssp: str, out: str, signals: tuple[str, ...]) -> int:
-    """The child's side of ``run``: the engine run here, its trace saved to ``out`` (.npz).
-    1 and the reason on standard error if it fails; 130 or 143 if SIGINT or SIGTERM stopped
-    it (between steps: the engines' clean-up is not safe against a KeyboardInterrupt)."""
+    """The child's side of ``run``: the trace saved to ``out`` (.npz); 1 and the reason on
+    stderr if it fails; 130 or 143 if SIGINT or SIGTERM stopped it (between steps)."""
     try:
         with StopSignals() as stop:
-            result = RUNNERS[engine](Path(ssp), signals, stop)
+            system = read_system(Path(ssp))
+            n_steps = step_count(system.start_time, system.stop_time, system.step_size)
+            result = RUNNERS[engine](Path(ssp), system, n_steps, signals, stop)
     except Interrupted as interrupted:
         print(interrupted, file=sys.stderr)
         return interrupted.exit_status
@@ -204,7 +194,6 @@ def record(engine: str, ssp: str, out: str, signals: tuple[str, ...]) -> int:
 
 
 def save_trace(path: Path, result: dict[str, np.ndarray]) -> None:
-    """A trace as .npz, written whole or not at all, at exactly ``path``."""
     def write(temporary: Path) -> None:
         with open(temporary, "wb") as f:
             np.savez(f, **result)

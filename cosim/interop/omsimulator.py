@@ -1,11 +1,6 @@
-"""Run an exported SSP package in OpenModelica's OMSimulator, and read its result file.
-
-OMSimulator is used from a build folder ``home`` holding bin/OMSimulator (its command line)
-and lib/x86_64-linux-gnu/OMSimulator (its Python API), each run in a child process with a
-time limit. What each interface takes of a package, and why a String binding is refused:
-docs/interop.md. The result CSV holds each communication point twice (after the step and
-after the exchange of inputs); ``read_result`` keeps the last.
-"""
+"""Run an exported SSP package in OMSimulator from a build folder ``home`` (bin/OMSimulator,
+its command line; lib/x86_64-linux-gnu/OMSimulator, its Python API) in a child process with a
+time limit (docs/interop.md), and read its result file."""
 from __future__ import annotations
 
 import csv
@@ -37,13 +32,11 @@ model.delete()
 
 
 def libpython() -> str:
-    """The path of this interpreter's libpython, for a C++ host's LD_PRELOAD."""
     return os.path.join(sysconfig.get_config_var("LIBDIR"), sysconfig.get_config_var("LDLIBRARY"))
 
 
 def command(home: Path, interface: str, ssp: Path, result: Path, temp: Path
             ) -> tuple[list[str], dict[str, str]]:
-    """The child's command line and environment of a run of ``ssp`` writing ``result``."""
     system = read_package(ssp)
     site = sysconfig.get_paths()["purelib"]
     if interface == "cli":
@@ -57,8 +50,8 @@ def command(home: Path, interface: str, ssp: Path, result: Path, temp: Path
 
 
 def read_result(path: Path) -> dict[str, np.ndarray]:
-    """An OMSimulator result CSV: 'time' and each variable as 'component.variable', one row
-    per communication point (the last of the rows written at that time)."""
+    """'time' and each 'component.variable' of a result CSV, one row per communication
+    point: the last of the two written (after the step, after the exchange)."""
     with open(path, newline="") as f:
         rows = list(csv.reader(f))
     names = ["time"] + [".".join(h.split(".")[-2:]) for h in rows[0][1:]]
@@ -69,9 +62,8 @@ def read_result(path: Path) -> dict[str, np.ndarray]:
 
 def run(ssp: str | Path, home: str | Path, interface: str = "cli",
         timeout: float = 600.0) -> dict[str, np.ndarray]:
-    """Run the package ``ssp`` in OMSimulator at ``home`` through ``interface`` ('cli' or
-    'api'); EngineError with its output if it fails, runs out of ``timeout`` seconds,
-    or would drop a String binding; ValueError for an unknown interface."""
+    """Run ``ssp`` in OMSimulator at ``home`` through ``interface``; EngineError with its
+    output if it fails, times out or would drop a String binding."""
     if interface not in INTERFACES:
         raise ValueError(f"interface must be one of {', '.join(INTERFACES)}, got {interface!r}")
     ssp, home = Path(ssp).resolve(), Path(home).resolve()

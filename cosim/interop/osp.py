@@ -1,8 +1,6 @@
-"""OSP's own system structure, OspSystemStructure.xml (schema version 0.1 of libcosim),
-written beside an SSP package: the times, each simulator's FMU, step and initial values,
-and the connections, output first. Read by libcosim's ``from_osp_config_file`` and the OSP
-tools on top of it. No OSP model description is written: these systems need none.
-"""
+"""OSP's OspSystemStructure.xml (libcosim's schema 0.1), written beside an SSP package: the
+times, each simulator's FMU, step and initial values, and the connections, output first.
+No OSP model description: these systems need none."""
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
@@ -20,8 +18,7 @@ def _q(tag: str) -> str:
 
 
 def write_osp(system: SystemDescription, path: Path, sources: dict[str, str]) -> None:
-    """Write ``system`` as OspSystemStructure.xml at ``path``; ``sources`` gives each
-    component's FMU relative to the file's folder."""
+    """Write ``system`` at ``path``, ``sources`` each FMU relative to the file's folder."""
     ET.register_namespace("", NS)
     root = ET.Element(_q("OspSystemStructure"), version="0.1")
     for tag, value in (("StartTime", system.start_time), ("EndTime", system.stop_time),
@@ -49,8 +46,7 @@ def write_osp(system: SystemDescription, path: Path, sources: dict[str, str]) ->
 
 
 def read_osp(path: Path) -> SystemDescription:
-    """The system in an OspSystemStructure.xml written by ``write_osp`` (or its folder);
-    ValueError naming the file for what it does not hold."""
+    """The system in an OspSystemStructure.xml (or its folder); ValueError naming it."""
     path = path / OSP_FILE if path.is_dir() else path
     try:
         root = ET.parse(path).getroot()

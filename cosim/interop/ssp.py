@@ -1,12 +1,6 @@
-"""SSP packages for other FMI tools: a scenario exported as one self-contained .ssp file.
-
-The zip holds SystemStructure.ssd (``cosim.core.ssd.write_ssd``) and resources/<fmu>.fmu;
-beside it, a folder of the same name holds OSP's OspSystemStructure.xml and the FMUs
-(``cosim.interop.osp``). The guidance's route is written as numbers, because OMSimulator
-and fmpy's SSP runner apply no String binding (``unapplied_strings`` names any left).
-``export(..., fmi=3)`` packs the FMI 3.0 twins; libcosim and fmpy's SSP runner take FMI 2.0
-only (``FMI2_ONLY``). Files are written whole or not at all (``cosim.core.files``).
-"""
+"""A scenario as one .ssp (SystemStructure.ssd and resources/<fmu>.fmu) and beside it a
+folder with OSP's OspSystemStructure.xml and the FMUs, written whole or not at all. The route
+goes as numbers: OMSimulator and fmpy's SSP runner apply no String binding."""
 from __future__ import annotations
 
 import shutil
@@ -25,13 +19,11 @@ from ..core.ssd import SystemDescription, Units, read_ssd, write_ssd
 from .osp import OSP_FILE, read_osp, write_osp
 
 SSD_NAME = "SystemStructure.ssd"
-FMI2_ONLY = {"libcosim": "OSP libcosim", "fmpy": "fmpy's SSP runner"}
-"""The engines that run FMI 2.0 FMUs only (libcosimpy 0.0.6, fmpy's FMU2Slave)."""
+FMI2_ONLY = {"libcosim": "OSP libcosim", "fmpy": "fmpy's SSP runner"}   # FMI 2.0 FMUs only
 
 
 def _with_numeric_route(system: SystemDescription, fmus: dict[str, Path]) -> None:
-    """A String route replaced by its numbers where the FMU declares both forms (our
-    guidance); ValueError if the two forms disagree or the route is too long."""
+    """A String route replaced by its numbers where the FMU declares both (our guidance)."""
     for name, component in system.components.items():
         if not isinstance(component.parameters.get("waypoints"), str):
             continue
@@ -47,8 +39,7 @@ _EXPONENTS = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
 
 
 def connector_units(system: SystemDescription, fmus: dict[str, Path]) -> Units:
-    """Each connector's unit and each unit's definition, from the FMUs' model descriptions
-    (a connector whose variable declares no unit gets none)."""
+    """Each connector's unit and each unit's definition, from the FMUs' descriptions."""
     connectors: dict[str, dict[str, str]] = {}
     definitions: dict[str, dict[str, float]] = {}
     for name, component in system.components.items():
@@ -73,9 +64,8 @@ def connector_units(system: SystemDescription, fmus: dict[str, Path]) -> Units:
 def export(scenario: str | Path, out: Path, overrides: dict[str, dict] | None = None,
            autopilot: str | Path | None = None, port_map: dict[str, str] | None = None,
            name: str | None = None, fmi: int | None = None) -> Path:
-    """Write out/<label>.ssp (``scenarios.label``) and out/<label>/ with OSP's
-    OspSystemStructure.xml and the FMUs: the scenario as ``scenarios.load`` gives it (FMI
-    version ``fmi``, ``autopilot`` in place of its own), with ``overrides`` by component."""
+    """Write out/<label>.ssp and out/<label>/ (OSP) of the scenario as ``scenarios.load``
+    gives it, with ``overrides`` by component."""
     system = scenarios.load(scenario, autopilot, port_map, name, fmi)
     for component, values in system.parameters(overrides).items():
         system.components[component].parameters = values
@@ -105,7 +95,6 @@ def export(scenario: str | Path, out: Path, overrides: dict[str, dict] | None = 
 
 
 def read_package(ssp: Path) -> SystemDescription:
-    """The system description inside an SSP package."""
     with tempfile.TemporaryDirectory() as tmp:
         with zipfile.ZipFile(ssp) as package:
             package.extract(SSD_NAME, tmp)
@@ -113,8 +102,6 @@ def read_package(ssp: Path) -> SystemDescription:
 
 
 def _descriptions(path: Path) -> dict[str, ModelDescription]:
-    """Each component's model description, from its FMU in an SSP package (.ssp) or an OSP
-    folder (or its OspSystemStructure.xml)."""
     with tempfile.TemporaryDirectory() as tmp:
         if path.suffix.lower() == ".ssp":
             system, folder = read_package(path), Path(tmp)
@@ -132,9 +119,8 @@ def fmi_versions(path: Path) -> dict[str, str]:
 
 
 def unapplied_strings(ssp: Path) -> dict[str, tuple[str, str]]:
-    """The package's String bindings that a tool applying none (OMSimulator, fmpy's SSP
-    runner) would drop without a word: 'component.variable': (value, the FMU's default),
-    for each whose value is not its FMU's default."""
+    """String bindings a tool applying none would drop without a word, not at their FMU's
+    default: 'component.variable': (value, default)."""
     descriptions = _descriptions(ssp)
     dropped = {}
     for name, component in read_package(ssp).components.items():

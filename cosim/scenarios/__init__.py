@@ -17,18 +17,16 @@ PAPER = ("calm_pd", "calm_smc", "waves_pd", "waves_smc")    # Tomera (2010), Tab
 
 
 def fmus() -> FmuFolders:
-    """Where this project builds its FMUs (``fmubuild.project``), for the core to find them."""
+    """Where this project builds its FMUs (``fmubuild.project``)."""
     return FmuFolders(dict(project.FMU_DIRS), frozenset({*project.FMUS, *project.C_FMUS}))
 
 
 def names() -> list[str]:
-    """The scenarios of this package, sorted."""
     return sorted(p.stem for p in SCENARIO_DIR.glob("*.ssd"))
 
 
 def path(scenario: str | Path) -> Path:
-    """A scenario's .ssd, by name or path; ValueError listing the names for an unknown one,
-    FileNotFoundError for a .ssd path that is not a file."""
+    """A scenario's .ssd by name or path; ValueError listing the names, FileNotFoundError."""
     if str(scenario).endswith(".ssd"):
         if not Path(scenario).is_file():
             raise FileNotFoundError(f"no system structure file {scenario}")
@@ -41,8 +39,7 @@ def path(scenario: str | Path) -> Path:
 
 def label(scenario: str | Path, autopilot: str | Path | None = None,
           name: str | None = None) -> str:
-    """A run's name in file names: the scenario's, and the autopilot's (``name`` or the
-    FMU's stem) in place of its own; ValueError if ``name`` is not a plain file name."""
+    """A run's name in file names: the scenario's, then the autopilot's if not its own."""
     if name is not None:
         plain_name(name, "the autopilot's name")
     stem = Path(scenario).stem
@@ -52,8 +49,7 @@ def label(scenario: str | Path, autopilot: str | Path | None = None,
 def load(scenario: str | Path, autopilot: str | Path | None = None,
          port_map: dict[str, str] | None = None, name: str | None = None,
          fmi: int | None = None) -> SystemDescription:
-    """A scenario's system description, with this project's FMUs of FMI version ``fmi`` (2
-    or 3) in place of those it names, and ``autopilot`` in place of its own."""
+    """A scenario's system, this project's FMUs of FMI version ``fmi`` and ``autopilot`` in."""
     system = read_ssd(path(scenario), fmus())
     if fmi is not None:
         system = with_fmi(system, fmi)

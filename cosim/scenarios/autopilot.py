@@ -1,9 +1,6 @@
-"""Your own autopilot in the paper's scenarios: the port contract, checked, and the substitution.
-
-An autopilot is an FMI 2.0 or 3.0 co-simulation FMU with inputs psi (rad), r (rad/s), psi_d
-(rad) and output delta_c (rad), Real or Float64 (docs/own_autopilot.md); ``port_map`` maps
-other names. A port in another unit is refused, not converted: a run never rests on a guess.
-"""
+"""Your own autopilot in the paper's scenarios: an FMI 2.0 or 3.0 co-simulation FMU with inputs
+psi (rad), r (rad/s), psi_d (rad), output delta_c (rad) (docs/own_autopilot.md). A port in
+another unit is refused, not converted: a run never rests on a guess."""
 from __future__ import annotations
 
 import copy
@@ -46,16 +43,13 @@ def _mapped(port: str, port_map: dict[str, str]) -> str:
 
 
 def _contract(real: str) -> str:
-    """'Real inputs psi (rad), r (rad/s), psi_d (rad) and a Real output delta_c (rad)', with
-    ``real`` the version's type name."""
     def ports(causality: str) -> str:
         return ", ".join(f"{n} ({unit})" for n, (c, unit) in PORTS.items() if c == causality)
     return f"{real} inputs {ports('input')} and a {real} output {ports('output')}"
 
 
 def port_problems(description: ModelDescription, port_map: dict[str, str]) -> list[str]:
-    """Every way the FMU's variables break the port contract, each with what it expects: a
-    port missing (with the closest names), of the wrong causality or type, or unit."""
+    """Every way the FMU's variables break the port contract, each with what it expects."""
     variables = {v.name: v for v in description.modelVariables}
     real = PORT_TYPES[description.fmiVersion]
     problems = []
@@ -79,7 +73,6 @@ def port_problems(description: ModelDescription, port_map: dict[str, str]) -> li
 
 
 def _unit_advice(name: str, declared: str, unit: str) -> str:
-    """Advice for a port in another unit: declare the contract's, convert inside the FMU."""
     known = UNITS.get(declared)
     scale = (f" (1 {declared} = {known[1] / UNITS[unit][1]:.6g} {unit})"
              if known and known[0] == UNITS[unit][0] else "")
@@ -89,10 +82,8 @@ def _unit_advice(name: str, declared: str, unit: str) -> str:
 
 def check_autopilot(fmu: str | Path, port_map: dict[str, str] | None = None,
                     trial: bool = False) -> ModelDescription:
-    """The FMU's model description if it keeps the port contract; AutopilotError if not.
-
-    ``trial`` also instantiates it once in a child process (``fmubuild.instantiate``).
-    """
+    """The FMU's model description if it keeps the port contract, else AutopilotError;
+    ``trial`` also instantiates it once in a child process."""
     fmu, port_map = Path(fmu), port_map or {}
     if not fmu.is_file():
         raise AutopilotError(f"autopilot FMU {fmu} not found")
@@ -137,8 +128,7 @@ def check_autopilot(fmu: str | Path, port_map: dict[str, str] | None = None,
 def with_autopilot(system: SystemDescription, fmu: str | Path,
                    port_map: dict[str, str] | None = None,
                    name: str | None = None) -> SystemDescription:
-    """A copy of a course-keeping system with ``fmu`` as its autopilot; AutopilotError if the
-    FMU breaks the contract or the system has no autopilot to replace."""
+    """A copy of a course-keeping system with ``fmu`` as its autopilot, or AutopilotError."""
     fmu, port_map = Path(fmu).resolve(), port_map or {}
     if COMPONENT not in system.components or system.report != "course_keeping":
         raise AutopilotError(f"scenario {system.name!r} has no autopilot to replace; "
