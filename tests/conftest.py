@@ -28,6 +28,12 @@ pytest_plugins = ["pytester"]       # to run the example test file for each auto
 HARD_LIMIT = 1200
 """Seconds any test may take, its fixtures' setup included, unless it has a limit of its own:
 more than the whole suite takes, so only a hang reaches it."""
+_FIRST = {name: k for k, name in enumerate((
+    "test_fault_matrix.py", "test_run_lifecycle.py", "test_sweep_hostile.py",
+    "test_scorecard.py", "test_fuzz.py", "test_sweep.py", "test_api.py", "test_fmi3_tools.py"))}
+"""The files that take longest, collected first: pytest-xdist hands out whole files in
+collection order (``--dist loadfile``), so the workers end together instead of one
+finishing a long file alone."""
 LONG = "pytest --long"
 """The command that runs the whole suite."""
 _LEFT_OUT = pytest.StashKey[int]()
@@ -45,13 +51,14 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     """Without --long or -m, the tests marked ``long`` are deselected. Every test without
     ``@pytest.mark.timeout`` gets HARD_LIMIT (pytest-timeout's thread method: it prints every
     thread's stack and ends the session, wherever the test is stuck, instead of waiting for
-    ever)."""
+    ever). The longest files come first (``_FIRST``)."""
     if not config.getoption("long_run") and not config.option.markexpr:
         left_out = [item for item in items if item.get_closest_marker("long") is not None]
         if left_out:
             config.hook.pytest_deselected(items=left_out)
             items[:] = [item for item in items if item.get_closest_marker("long") is None]
         config.stash[_LEFT_OUT] = len(left_out)
+    items.sort(key=lambda item: _FIRST.get(item.path.name, len(_FIRST)))     # stable
     for item in items:
         if item.get_closest_marker("timeout") is None:
             item.add_marker(pytest.mark.timeout(HARD_LIMIT, method="thread"))
