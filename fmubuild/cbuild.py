@@ -16,8 +16,8 @@ from pathlib import Path
 from fmukit.manifest import version
 
 from . import documentation, reproducible
-from .manifest import project_identity
-from .project import C_FMUS, FMU_DIRS, ROOT
+from .project import C_FMUS, FMU_DIRS, ROOT, project_identity
+from .routes import ROUTES
 
 FILES = {2: ("{name}.c", "modelDescription.xml"),
          3: ("{name}_fmi3.c", "modelDescription_fmi3.xml")}
@@ -26,11 +26,11 @@ FILES = {2: ("{name}.c", "modelDescription.xml"),
 WINDOWS = {2: "win64", 3: "x86_64-windows"}
 """FMI version: the name of its folder for 64-bit Windows binaries."""
 
-C_HOSTS = {fmi: {linux: f"any FMI {fmi}.0 co-simulation host; the library needs only libc "
-                        "and libm.",
-                 WINDOWS[fmi]: f"any FMI {fmi}.0 co-simulation host; the DLL needs only "
-                               "KERNEL32 and msvcrt."}
-           for fmi, linux in ((2, "linux64"), (3, "x86_64-linux"))}
+C_HOSTS = {fmi: {ROUTES[fmi].linux: f"any FMI {fmi}.0 co-simulation host; the library needs "
+                                    "only libc and libm.",
+                 windows: f"any FMI {fmi}.0 co-simulation host; the DLL needs only KERNEL32 "
+                          "and msvcrt."}
+           for fmi, windows in WINDOWS.items()}
 """FMI version: what a host needs for the C FMU, by platform (tests/test_windows.py reads
 the DLL's imports)."""
 
@@ -43,6 +43,18 @@ WIN64_COMPILER = "x86_64-w64-mingw32-gcc"
 _WIN64_FLAGS = ["-static-libgcc",        # no libgcc_s DLL for the host to find
                 "-s",                    # strip: mingw-w64's start-up code brings debug sections
                 "-Wl,--no-insert-timestamp,--disable-auto-image-base"]   # reproducible
+
+_BUILD_DESCRIPTION = """<?xml version="1.0" encoding="UTF-8"?>
+<fmiBuildDescription fmiVersion="3.0">
+  <BuildConfiguration modelIdentifier="{name}">
+    <SourceFileSet language="C99">
+      <SourceFile name="{source}"/>
+    </SourceFileSet>
+    <Library name="m" external="true" description="the C math library"/>
+  </BuildConfiguration>
+</fmiBuildDescription>
+"""
+"""sources/buildDescription.xml of an FMI 3.0 FMU compiled from one source and libm."""
 
 
 class NoCompiler(RuntimeError):
@@ -69,8 +81,6 @@ def build_c(name: str, dest: Path | None = None, fmi: int = 2) -> Path:
     import fmpy
     from fmpy.validation import validate_fmu
 
-    if fmi not in FILES:
-        raise ValueError(f"FMI {fmi}: the C FMUs are built as FMI 2 or 3")
     compiler = c_compiler()
     if compiler is None:
         raise NoCompiler(f"no C compiler found (set CC, or install gcc): {name}.fmu, an "
@@ -79,9 +89,8 @@ def build_c(name: str, dest: Path | None = None, fmi: int = 2) -> Path:
         raise NoCompiler(f"{name}.fmu is built for Linux and macOS only, not {fmpy.platform}")
     here = fmpy.platform if fmi == 2 else fmpy.platform_tuple
     targets = {here: ([compiler, "-fPIC"], _LIBRARY[fmpy.platform])}
-    win64 = shutil.which(WIN64_COMPILER)
-    if win64 is not None:
-        targets[WINDOWS[fmi]] = ([win64, *_WIN64_FLAGS], ".dll")
+    if shutil.which(WIN64_COMPILER):
+        targets[WINDOWS[fmi]] = ([shutil.which(WIN64_COMPILER), *_WIN64_FLAGS], ".dll")
     else:
         print(f"note: {WIN64_COMPILER} not found (apt-get install gcc-mingw-w64-x86-64): "
               f"{name}.fmu (FMI {fmi}.0) is built without its Windows binary "
@@ -90,36 +99,25 @@ def build_c(name: str, dest: Path | None = None, fmi: int = 2) -> Path:
     entries = {"modelDescription.xml": description.read_bytes(),
                **{f"sources/{p.name}": p.read_bytes() for p in (source, *headers)}}
     if fmi == 3:
-        entries["sources/buildDescription.xml"] = build_description(name, source.name)
-    fmi_headers = Path(fmpy.__file__).parent / "c-code"
+        entries["sources/buildDescription.xml"] = _BUILD_DESCRIPTION.format(
+            name=name, source=source.name).encode()
     with tempfile.TemporaryDirectory(prefix=f"build_{name}_") as tmp:
         for platform, (command, suffix) in targets.items():
             library = Path(tmp) / f"{name}{suffix}"
-            compiled = subprocess.run([*command, "-std=c99", "-O2", "-Wall", "-shared",
-                                       "-I", str(fmi_headers), str(source), "-o", str(library),
-                                       "-lm"], capture_output=True, text=True, timeout=120)
+            compiled = subprocess.run([*command, "-std=c99", "-O2", "-Wall", "-shared", "-I",
+                                       str(Path(fmpy.__file__).parent / "c-code"), str(source),
+                                       "-o", str(library), "-lm"],
+                                      capture_output=True, text=True, timeout=120)
             if compiled.returncode != 0:
                 raise RuntimeError(f"{command[0]} could not compile {source} for {platform}:\n"
                                    f"{compiled.stderr}")
             entries[f"binaries/{platform}/{library.name}"] = library.read_bytes()
-    entries = documentation.describe(entries, f"fmukit {version()} (fmubuild.cbuild)",
-                                     project_identity(), "", {}, C_HOSTS[fmi])
-    dest = FMU_DIRS[fmi] if dest is None else dest
-    dest.mkdir(parents=True, exist_ok=True)
-    fmu = dest / f"{name}.fmu"
-    reproducible.write(fmu, entries)
+    fmu = (dest or FMU_DIRS[fmi]) / f"{name}.fmu"
+    fmu.parent.mkdir(parents=True, exist_ok=True)
+    reproducible.write(fmu, documentation.describe(
+        entries, f"fmukit {version()} (fmubuild.cbuild)", project_identity(), "", {},
+        C_HOSTS[fmi]))
     problems = validate_fmu(str(fmu))
     if problems:
         raise RuntimeError(f"{fmu} does not validate:\n" + "\n".join(problems))
     return fmu
-
-
-def build_description(model_identifier: str, source: str) -> bytes:
-    """sources/buildDescription.xml of an FMI 3.0 FMU compiled from ``source`` and libm."""
-    return ('<?xml version="1.0" encoding="UTF-8"?>\n<fmiBuildDescription fmiVersion="3.0">\n'
-            f'  <BuildConfiguration modelIdentifier="{model_identifier}">\n'
-            '    <SourceFileSet language="C99">\n'
-            f'      <SourceFile name="{source}"/>\n'
-            '    </SourceFileSet>\n'
-            '    <Library name="m" external="true" description="the C math library"/>\n'
-            '  </BuildConfiguration>\n</fmiBuildDescription>\n').encode()

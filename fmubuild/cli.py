@@ -20,7 +20,7 @@ import traceback
 from pathlib import Path
 
 from .cbuild import NoCompiler, build_c
-from .imports import Uncarried, uncarried
+from .imports import uncarried
 from .packaging import build, build_script
 from .project import C_FMUS, FMU_DIRS, FMUS
 from .routes import ROUTES
@@ -68,35 +68,45 @@ def main(argv: list[str] | None = None) -> int:
 
 def _build_script(script: Path, includes: list[Path], out: Path | None, fmi: int) -> Path:
     """A user's script built as FMI ``fmi`` into ``out`` (default: its folder, for FMI 3.0
-    its folder fmi3); ValueError naming what its FMU would not carry, or its sys.exit."""
-    if script.is_file() and script.suffix == ".py" and all(p.exists() for p in includes):
-        missing = uncarried(script, includes, ("fmukit",))
-        if missing:
-            raise ValueError(_carry_them(script, includes, missing))
-    folder = script.resolve().parent / ("fmi3" if fmi == 3 else "")
+    its folder fmi3); ValueError naming what is missing, what its FMU would not carry, or
+    its sys.exit."""
+    if not script.is_file():
+        raise ValueError(f"{script} does not exist")
+    for include in includes:
+        if not include.exists():
+            raise ValueError(f"{include}, to be carried by {script.name}'s FMU, does not exist")
+    missing = uncarried(script, includes, ("fmukit",))
+    if missing:
+        raise ValueError(_carry_them(script, includes, missing))
     try:
-        return build_script(script, ("fmukit", *includes), out or folder, fmi=fmi)
+        return build_script(script, ("fmukit", *includes),
+                            out or script.resolve().parent / ("fmi3" if fmi == 3 else ""), fmi=fmi)
     except SystemExit as exit_:
-        raise ValueError(f"cannot build an FMU from {script}: {_exit_site(script, exit_)} "
-                         f"called sys.exit({exit_.code!r}) when imported; a slave script "
-                         "must only define its classes (move a test run under "
+        frames = [f for f in traceback.extract_tb(exit_.__traceback__)
+                  if Path(f.filename).name == script.name]      # the innermost in the script
+        site = f"{script}:{frames[-1].lineno}" if frames else f"{script}, or a module it imports,"
+        raise ValueError(f"cannot build an FMU from {script}: {site} called "
+                         f"sys.exit({exit_.code!r}) when imported; a slave script must only "
+                         "define its classes (move a test run under "
                          "'if __name__ == \"__main__\":')") from None
 
 
-def _carry_them(script: Path, includes: list[Path], missing: list[Uncarried]) -> str:
+def _carry_them(script: Path, includes: list[Path],
+                missing: list[tuple[str, Path, Path | None]]) -> str:
     """What to do about modules a script's FMU would not carry: the command with an
     --include for each, where this build finds it."""
     one = len(missing) == 1
     lines = [(f"cannot build an FMU from {script}: {'a module' if one else 'modules'} it "
               "imports would not be in the FMU, and a host has only the FMU:")]
-    for m in missing:
-        where = (f"found at {_shown(m.found)}" if m.found else
+    for module, importer, found in missing:
+        where = (f"found at {_shown(found)}" if found else
                  "found neither here nor among the packages installed in this Python: "
                  "pip install it, if it is a package")
-        lines.append(f"  {_shown(m.importer)} imports {m.module} ({where})")
-    paths = [_shown(m.found) if m.found else f"PATH/TO/{m.module}.py" for m in missing]
+        lines.append(f"  {_shown(importer)} imports {module} ({where})")
     command = ["python -m fmukit.build", _shown(script),
-               *(f"--include {_shown(p)}" for p in includes), *(f"--include {p}" for p in paths)]
+               *(f"--include {_shown(p)}" for p in includes),
+               *(f"--include {_shown(found) if found else f'PATH/TO/{module}.py'}"
+                 for module, _, found in missing)]
     lines.append(f"carry {'it' if one else 'them'} with --include "
                  f"(a module's file or a package's folder):\n  {' '.join(command)}")
     return "\n".join(lines)
@@ -106,16 +116,7 @@ def _shown(path: Path) -> str:
     """A path as a command typed in the working directory takes it: relative to it where
     it lies inside it."""
     absolute = Path(path).resolve()
-    inside = Path.cwd().resolve() in absolute.parents
-    return os.path.relpath(absolute) if inside else str(absolute)
-
-
-def _exit_site(script: Path, exit_: SystemExit) -> str:
-    """'script:line' of the sys.exit in ``script`` (the innermost call in a file of its
-    name), else 'script, or a module it imports,'."""
-    frames = [f for f in traceback.extract_tb(exit_.__traceback__)
-              if Path(f.filename).name == script.name]
-    return f"{script}:{frames[-1].lineno}" if frames else f"{script}, or a module it imports,"
+    return os.path.relpath(absolute) if Path.cwd().resolve() in absolute.parents else str(absolute)
 
 
 if __name__ == "__main__":

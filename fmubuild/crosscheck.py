@@ -24,10 +24,9 @@ from .project import FMU_DIR, FMU_DIRS
 from .routes import ROUTES
 
 TOOL, VERSION = "ship_autopilot_cosim", "0.1.0"
-PLATFORMS = {2: "linux64", 3: "x86_64-linux"}
-"""FMI version: the cross-check platform folder of the references (made on 64-bit Linux)."""
-CROSSCHECK_DIRS = {fmi: FMU_DIR / "crosscheck" / f"{fmi}.0" / "cs" / platform / TOOL / VERSION
-                   for fmi, platform in PLATFORMS.items()}
+CROSSCHECK_DIRS = {fmi: FMU_DIR / "crosscheck" / f"{fmi}.0" / "cs" / route.linux / TOOL / VERSION
+                   for fmi, route in ROUTES.items()}
+"""FMI version: the folder of its references (made on 64-bit Linux)."""
 
 SIMULATE = """
 import sys
@@ -39,8 +38,6 @@ write_csv(reference, simulate_fmu(fmu, start_time=0.0, stop_time=float(stop),
                                   input=read_csv(inputs)))
 """
 """A child process's script: simulate FMU with the inputs, write the reference CSV."""
-SIMULATE_LIMIT = 300
-"""Seconds the simulation of one reference may take."""
 
 
 @dataclass(frozen=True)
@@ -52,18 +49,18 @@ class Case:
     rel_tol: float = 1e-9
 
 
+_HEADING = Case(30.0, ("psi", "r", "psi_d"),
+                ((0, 0.0, 0.0, 0.0), (10, 0.2, 0.01, 0.7), (20, 0.6, 0.004, 0.7),
+                 (20, 0.6, 0.004, -3.0), (30, 3.1, -0.01, -3.0)))
+"""The PD's and the PID's case: a heading step, then a turn across +-180 deg."""
 CASES = {
     "ship": Case(60.0, ("delta_c", "n1", "n2", "n3"),
                  ((0, 0.0, 8.13, 8.13, 0.0), (5, 0.0, 8.13, 8.13, 0.0),
                   (5, 0.35, 8.13, 8.13, 0.0), (25, 0.35, 8.13, 8.13, 0.0),
                   (25, -0.2, 6.0, 7.0, 2.0), (45, -0.2, 6.0, 7.0, 2.0),
                   (60, 0.1, 8.13, 8.13, -2.0))),
-    "pd_autopilot": Case(30.0, ("psi", "r", "psi_d"),
-                         ((0, 0.0, 0.0, 0.0), (10, 0.2, 0.01, 0.7), (20, 0.6, 0.004, 0.7),
-                          (20, 0.6, 0.004, -3.0), (30, 3.1, -0.01, -3.0))),
-    "pid_autopilot": Case(30.0, ("psi", "r", "psi_d"),
-                          ((0, 0.0, 0.0, 0.0), (10, 0.2, 0.01, 0.7), (20, 0.6, 0.004, 0.7),
-                           (20, 0.6, 0.004, -3.0), (30, 3.1, -0.01, -3.0))),
+    "pd_autopilot": _HEADING,
+    "pid_autopilot": _HEADING,
     "smc_autopilot": Case(60.0, ("psi", "r", "psi_d"),
                           ((0, 0.0, 0.0, 0.0), (10, 0.0, 0.0, 0.7), (40, 0.5, 0.005, 0.7),
                            (40, 0.5, 0.005, 0.0), (60, 0.3, -0.005, 0.0))),
@@ -103,7 +100,7 @@ def generate(name: str, fmi: int = 2) -> Path:
         simulated = subprocess.run(
             [sys.executable, "-I", "-c", SIMULATE, str(staged["fmu"]), str(staged["in"]),
              str(staged["ref"]), repr(case.stop), repr(case.step)],
-            capture_output=True, text=True, timeout=SIMULATE_LIMIT)
+            capture_output=True, text=True, timeout=300)
         if simulated.returncode != 0:
             raise RuntimeError(f"fmpy could not simulate {FMU_DIRS[fmi] / name}.fmu "
                                f"(exit status {simulated.returncode}):\n{simulated.stderr}")
@@ -120,15 +117,12 @@ def generate(name: str, fmi: int = 2) -> Path:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m fmubuild.crosscheck",
                                      description=__doc__.split("\n\n")[0].replace("\n", " "))
-    parser.add_argument("names", nargs="*", metavar="NAME", help=f"FMUs (default: all of "
-                                                                  f"{', '.join(CASES)})")
+    parser.add_argument("names", nargs="*", metavar="NAME", choices=list(CASES),
+                        help=f"FMUs (default: all of {', '.join(CASES)})")
     parser.add_argument("--fmi", type=int, choices=sorted(CROSSCHECK_DIRS),
                         help="only the FMUs of this FMI version (default: both, FMI 2.0's "
                              f"from {FMU_DIRS[2]}, FMI 3.0's from {FMU_DIRS[3]})")
     args = parser.parse_args(argv)
-    for name in args.names:
-        if name not in CASES:
-            parser.error(f"unknown FMU {name!r}; known: {', '.join(CASES)}")
     for fmi in [args.fmi] if args.fmi else sorted(CROSSCHECK_DIRS):
         for name in args.names or CASES:
             print(f"wrote {generate(name, fmi)}")

@@ -1,27 +1,30 @@
-"""What an FMU says of itself (``describe``): its model description's generation tool and the
-identity the model does not declare, documentation/index.html (its sources' docstrings,
-every variable, the default experiment, what a host needs, a worked example with fmpy) and
-model.png (``icon``). Derived from the entries alone, so the same sources give the same bytes.
+"""What an FMU says of itself (``describe``), derived from its entries alone so that the same
+sources give the same bytes: the generation tool and the identity the model does not
+declare, documentation/index.html (its sources' docstrings, every variable, the default
+experiment, what a host needs, a worked example with fmpy) and the icon model.png.
 """
 from __future__ import annotations
 
 import html
+import io
 import re
 import textwrap
 from collections.abc import Mapping
+from importlib import metadata
 from xml.dom.minidom import parseString
 from xml.etree.ElementTree import Element, fromstring, tostring
 
-from . import icon
+import matplotlib.style
+from matplotlib.figure import Figure
+from matplotlib.patches import FancyBboxPatch, Polygon
 
-PAGE = "documentation/index.html"
+from fmukit.manifest import DISTRIBUTION
+from ship_fmu.data import Hull
+
 IDENTITY = ("author", "version", "copyright", "license")
 """modelDescription.xml attributes set where the model does not declare them."""
-
 PAPER = ("Tomera, M. (2010). <i>Nonlinear controller design of a ship autopilot</i>. "
          "Int. J. Appl. Math. Comput. Sci. 20(2), 271-280.")
-"""The paper whose equation numbers the project's docstrings cite as Tomera 2010."""
-
 _PRELOAD = ("a C or C++ program) must load libpython before the FMU: <code>LD_PRELOAD="
             "/path/to/libpython3.X.so</code>, with <code>PYTHONPATH</code> naming a "
             "site-packages that has numpy if that Python's own has none.")
@@ -48,10 +51,17 @@ PYTHON_HOSTS = {
              "not on a Windows host.)",
 }
 """What a host needs to run a Python FMU, by platform; {python}: the Python versions."""
-
 _STYLE = ("body{font-family:sans-serif;max-width:60em;margin:1em auto;padding:0 1em}"
           "table{border-collapse:collapse}th,td{border:1px solid #bbb;padding:2px 6px;"
           "text-align:left;vertical-align:top}pre{background:#f4f4f4;padding:4px}")
+_ICON_INCHES, _DPI, _FONT = 2.56, 100, "DejaVu Sans"      # 256 x 256, matplotlib's own font
+
+
+def python_hosts() -> dict[str, str]:
+    """``PYTHON_HOSTS`` with the Python versions this project runs on (its Requires-Python)."""
+    needed = metadata.metadata(DISTRIBUTION)["Requires-Python"]
+    python = f"{needed[2:]} or later" if needed.startswith(">=") else needed
+    return {platform: needs.format(python=python) for platform, needs in PYTHON_HOSTS.items()}
 
 
 def describe(entries: Mapping[str, bytes], generation_tool: str, identity: Mapping[str, str],
@@ -59,39 +69,29 @@ def describe(entries: Mapping[str, bytes], generation_tool: str, identity: Mappi
              hosts: Mapping[str, str]) -> dict[str, bytes]:
     """``entries`` with the model description's ``generation_tool`` and ``identity``, the
     page (``overview``: the model's docstring; ``sources``: module: docstring; ``hosts``:
-    platform: HTML) and the icon."""
-    xml = identified(entries["modelDescription.xml"], generation_tool, identity)
-    platforms = sorted({name.split("/")[1] for name in entries
-                        if name.startswith("binaries/") and name.count("/") == 2})
-    return {**entries, "modelDescription.xml": xml,
-            PAGE: index_html(xml, overview, sources,
-                             {p: hosts[p] for p in platforms if p in hosts}),
-            "model.png": icon.model_png(xml)}
-
-
-def identified(xml: bytes, generation_tool: str, identity: Mapping[str, str]) -> bytes:
-    """The model description ``xml`` naming ``generation_tool``, with each attribute of
-    ``identity`` it lacks; written as pythonfmu writes it (minidom, tab-indented)."""
-    root = fromstring(xml)
+    platform: HTML, for the platforms it has binaries for) and the icon."""
+    root = fromstring(entries["modelDescription.xml"])
     for element in root.iter():             # the layout is written again below
-        if element.text is not None and not element.text.strip():
-            element.text = None
-        if element.tail is not None and not element.tail.strip():
-            element.tail = None
+        element.text = element.text if (element.text or "").strip() else None
+        element.tail = element.tail if (element.tail or "").strip() else None
     root.set("generationTool", generation_tool)
     for name in IDENTITY:
         if name in identity and not root.get(name):
             root.set(name, identity[name])
-    return parseString(tostring(root, "UTF-8")).toprettyxml(indent="\t", encoding="UTF-8")
+    platforms = {name.split("/")[1] for name in entries
+                 if name.startswith("binaries/") and name.count("/") == 2}
+    return {**entries, "documentation/index.html": index_html(
+                root, overview, sources, {p: hosts[p] for p in sorted(platforms) if p in hosts}),
+            "model.png": model_png(root),   # as pythonfmu writes it: minidom, tab-indented
+            "modelDescription.xml": parseString(tostring(root, "UTF-8")).toprettyxml(
+                indent="\t", encoding="UTF-8")}
 
 
-def index_html(xml: bytes, overview: str, sources: Mapping[str, str],
+def index_html(root: Element, overview: str, sources: Mapping[str, str],
                hosts: Mapping[str, str]) -> bytes:
-    """documentation/index.html of the FMU with model description ``xml``; see ``describe``."""
-    root = fromstring(xml)
-    name = root.get("modelName", "")
-    variables = root.find("ModelVariables")
-    if root.get("fmiVersion", "").startswith("3"):       # by value reference
+    """documentation/index.html of the FMU whose model description is ``root``."""
+    name, variables = root.get("modelName", ""), root.find("ModelVariables")
+    if root.get("fmiVersion", "").startswith("3"):       # outputs by value reference
         by_key = {v.get("valueReference"): v.get("name") for v in variables}
         unknowns, key = root.iterfind("ModelStructure/Output"), "valueReference"
     else:                                                # by 1-based index
@@ -103,38 +103,38 @@ def index_html(xml: bytes, overview: str, sources: Mapping[str, str],
                                    for c in ("input", "output", "parameter"))
     about = [("FMI", f"{root.get('fmiVersion')}, co-simulation"),
              *((a, root.get(a)) for a in (*IDENTITY, "generationTool") if root.get(a))]
-    body = [f"<h1>{html.escape(name)}</h1>",
-            f"<p>{html.escape(root.get('description', ''))}</p>",
-            "<table>\n" + "\n".join(f"<tr><th>{a}</th><td>{html.escape(value)}</td></tr>"
-                                    for a, value in about) + "\n</table>",
+    body = [f"<h1>{html.escape(name)}</h1>", f"<p>{html.escape(root.get('description', ''))}</p>",
+            _table([f"<tr><th>{a}</th><td>{html.escape(value)}</td></tr>" for a, value in about]),
             "<h2>Model</h2>", _prose(overview)]
     if "Tomera" in overview + root.get("description", "") + "".join(sources.values()):
         body.append(f"<p>Equation numbers are those of {PAPER}</p>")
-    if sources:
-        body.append("<h2>Equations and sources</h2>")
-        for module, doc in sources.items():
-            summary, _, rest = doc.strip().partition("\n\n")
-            body.append(f"<details><summary><code>{html.escape(module)}</code>: "
-                        f"{_inline(summary)}</summary>{_prose(rest)}</details>")
-    body += ["<h2>Inputs</h2>", _table(inputs, ("start", "min", "max")),
-             "<h2>Outputs</h2>", _table(outputs, (), feedthrough),
-             "<h2>Parameters</h2>", _table(parameters, ("start", "min", "max"))]
+    body += ["<h2>Equations and sources</h2>"] if sources else []
+    for module, doc in sources.items():
+        summary, _, rest = doc.strip().partition("\n\n")
+        body.append(f"<details><summary><code>{html.escape(module)}</code>: "
+                    f"{_inline(summary)}</summary>{_prose(rest)}</details>")
+    body += ["<h2>Inputs</h2>", _variables(inputs, ("start", "min", "max")),
+             "<h2>Outputs</h2>", _variables(outputs, (), feedthrough),
+             "<h2>Parameters</h2>", _variables(parameters, ("start", "min", "max"))]
     experiment = root.find("DefaultExperiment")
     if experiment is not None:
         body.append("<h2>Default experiment</h2><p>" + ", ".join(
             f"{a} {experiment.get(a)} s" for a in ("startTime", "stopTime", "stepSize")
             if experiment.get(a)) + "</p>")
     body += ["<h2>Host requirements</h2>", "<ul>" + "".join(
-        f"<li><b>{p}</b>: {needs}</li>" for p, needs in hosts.items()) + "</ul>"]
-    body += ["<h2>Example</h2>", _example(name, inputs, experiment)]
-    page = ('<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8"/>\n'
+        f"<li><b>{p}</b>: {needs}</li>" for p, needs in hosts.items()) + "</ul>",
+             "<h2>Example</h2>", _example(name, inputs, experiment)]
+    return ('<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8"/>\n'
             f"<title>{html.escape(name)}</title>\n<style>{_STYLE}</style>\n</head>\n<body>\n"
-            + "\n".join(part for part in body if part) + "\n</body>\n</html>\n")
-    return page.encode()
+            + "\n".join(part for part in body if part) + "\n</body>\n</html>\n").encode()
 
 
-def _table(variables: list[Element], columns: tuple[str, ...],
-           feedthrough: Mapping[str, list[str]] | None = None) -> str:
+def _table(rows: list[str]) -> str:
+    return "<table>\n" + "\n".join(rows) + "\n</table>"
+
+
+def _variables(variables: list[Element], columns: tuple[str, ...],
+               feedthrough: Mapping[str, list[str]] | None = None) -> str:
     """A table of ``variables``: name, type, unit, the typed element's ``columns`` and
     meaning; for outputs (``feedthrough``), the inputs each depends on at once."""
     if not variables:
@@ -144,17 +144,16 @@ def _table(variables: list[Element], columns: tuple[str, ...],
     rows = ["<tr>" + "".join(f"<th>{h}</th>" for h in heads) + "</tr>"]
     for v in variables:
         typed = _typed(v)
-        unit = typed.get("unit", "")
-        if typed.get("displayUnit"):
-            unit += f" (shown in {typed.get('displayUnit')})"
-        cells = [f"<code>{html.escape(v.get('name'))}</code>", typed.tag, unit,
-                 *(_attribute(typed, c) for c in columns)]
+        unit = typed.get("unit", "") + (f" (shown in {typed.get('displayUnit')})"
+                                        if typed.get("displayUnit") else "")
+        start = typed.find("Start")         # FMI 3.0: a String's start is a child's value
+        cells = [typed.tag, unit, *(start.get("value", "") if c == "start" and start is not None
+                                    else typed.get(c, "") for c in columns)]
         if feedthrough is not None:
             cells.append(", ".join(feedthrough.get(v.get("name"), [])) or "none")
-        cells.append(v.get("description", ""))
-        rows.append("<tr>" + "".join(f"<td>{c if i == 0 else html.escape(c)}</td>"
-                                     for i, c in enumerate(cells)) + "</tr>")
-    return "<table>\n" + "\n".join(rows) + "\n</table>"
+        rows.append(f"<tr><td><code>{html.escape(v.get('name'))}</code></td>" + "".join(
+            f"<td>{html.escape(c)}</td>" for c in (*cells, v.get("description", ""))) + "</tr>")
+    return _table(rows)
 
 
 def _example(name: str, inputs: list[Element], experiment: Element | None) -> str:
@@ -163,23 +162,19 @@ def _example(name: str, inputs: list[Element], experiment: Element | None) -> st
     held = next((v for v in inputs if _typed(v).tag in ("Real", "Float64")
                  and float(_typed(v).get("start", 1)) == 0), None)
     stop = experiment.get("stopTime") if experiment is not None else None
-    stop_option = f" --stop-time {stop}" if stop else ""
+    command = f"fmpy simulate {name}.fmu" + (f" --stop-time {stop}" if stop else "")
     if held is None:
-        return (f"<pre>fmpy simulate {name}.fmu{stop_option} --output-file {name}.csv</pre>")
-    typed = _typed(held)
+        return f"<pre>{command} --output-file {name}.csv</pre>"
+    typed, variable = _typed(held), held.get("name")
     value = repr(min(max(0.1, float(typed.get("min", "-inf"))), float(typed.get("max", "inf"))))
-    variable = held.get("name")
-    arguments = f"start_values={{{variable!r}: {value}}}" + (f", stop_time={stop}" if stop
-                                                              else "")
     unit = "" if typed.get("unit", "1") == "1" else " " + html.escape(typed.get("unit"))
     return (f"<p>The FMU alone{f' for {stop} s' if stop else ''}, with input "
-            f"<code>{variable}</code> held at {value}{unit} "
-            "and every other variable at its start value; its outputs at every step go to "
-            f"{name}.csv:</p>\n"
-            f"<pre>fmpy simulate {name}.fmu{stop_option} --start-values {variable} {value} "
-            f"--output-file {name}.csv</pre>\n<p>or in Python:</p>\n"
-            f"<pre>from fmpy import simulate_fmu\n"
-            f"result = simulate_fmu({name + '.fmu'!r}, {arguments})</pre>")
+            f"<code>{variable}</code> held at {value}{unit} and every other variable at its "
+            f"start value; its outputs at every step go to {name}.csv:</p>\n"
+            f"<pre>{command} --start-values {variable} {value} --output-file {name}.csv</pre>\n"
+            f"<p>or in Python:</p>\n<pre>from fmpy import simulate_fmu\nresult = simulate_fmu("
+            f"{name + '.fmu'!r}, start_values={{{variable!r}: {value}}}"
+            + (f", stop_time={stop}" if stop else "") + ")</pre>")
 
 
 def _typed(variable: Element) -> Element:
@@ -187,29 +182,56 @@ def _typed(variable: Element) -> Element:
     return variable[0] if variable.tag == "ScalarVariable" else variable
 
 
-def _attribute(typed: Element, name: str) -> str:
-    """An attribute of a variable's type ('' if it has none); FMI 3.0 gives a String's
-    start as the value of a <Start> child."""
-    start = typed.find("Start") if name == "start" else None
-    return typed.get(name, "") if start is None else start.get("value", "")
-
-
 def _prose(doc: str) -> str:
-    """A docstring as HTML: paragraphs, indented blocks as preformatted text, '- ' lists."""
-    parts = []
-    for block in re.split(r"\n\s*\n", textwrap.dedent(doc).strip("\n")):
-        lines = block.splitlines()
-        if all(line.startswith(" ") for line in lines):
-            parts.append(f"<pre>{html.escape(textwrap.dedent(block))}</pre>")
-        elif block.startswith("- "):
-            items = re.split(r"\n- ", block[2:])
-            parts.append("<ul>" + "".join(f"<li>{_inline(i)}</li>" for i in items) + "</ul>")
-        elif block:
-            parts.append(f"<p>{_inline(block)}</p>")
-    return "\n".join(parts)
+    """A docstring as HTML paragraphs, its indented blocks as preformatted text."""
+    blocks = re.split(r"\n\s*\n", textwrap.dedent(doc).strip("\n"))
+    return "\n".join(f"<pre>{html.escape(textwrap.dedent(block))}</pre>"
+                     if all(line.startswith(" ") for line in block.splitlines())
+                     else f"<p>{_inline(block)}</p>" for block in blocks if block)
 
 
 def _inline(text: str) -> str:
     """Escaped text, its ``literals`` as code, joined onto one line."""
-    text = html.escape(" ".join(text.split()))
-    return re.sub(r"``(.+?)``", r"<code>\1</code>", text)
+    return re.sub(r"``(.+?)``", r"<code>\1</code>", html.escape(" ".join(text.split())))
+
+
+def model_png(root: Element) -> bytes:
+    """model.png of the model whose description is ``root``: a vessel (outputs x, y, psi) as
+    CyberShip II's waterline to scale, any other model as a block with its ports; matplotlib's
+    default style, no software or time in the file."""
+    name = root.get("modelName", "")
+    inputs, outputs = ([v.get("name") for v in root.find("ModelVariables")
+                        if v.get("causality") == c] for c in ("input", "output"))
+    with matplotlib.style.context("default"):
+        figure = Figure(figsize=(_ICON_INCHES, _ICON_INCHES), dpi=_DPI)
+        ax = figure.add_axes((0, 0, 1, 1), xlim=(0, 1), ylim=(0, 1))
+        ax.set_axis_off()
+        if {"x", "y", "psi"} <= set(outputs):       # the waterline, bow up, and two rudders
+            length, half_beam, stern = 0.78, 0.39 * Hull.B / Hull.L, 0.16
+            ax.add_patch(Polygon([(0.5, stern + length), (0.5 + half_beam, stern + 0.75 * length),
+                                  (0.5 + half_beam, stern), (0.5 - half_beam, stern),
+                                  (0.5 - half_beam, stern + 0.75 * length)], closed=True,
+                                 facecolor="0.75", edgecolor="black", linewidth=2))
+            for side in (-1, 1):
+                ax.plot([0.5 + side * half_beam / 2] * 2, [stern, stern - 0.05],
+                        color="black", linewidth=3, solid_capstyle="butt")
+            title, size, arrows = 0.05, 14, ()
+        else:                                       # a block with an arrow for each port
+            ax.add_patch(FancyBboxPatch((0.1, 0.06), 0.8, 0.88, facecolor="#dde8f4",
+                                        boxstyle="round,pad=0,rounding_size=0.06",
+                                        edgecolor="black", linewidth=2))
+            title, size = 0.85, 13
+            arrows = ((inputs, 0.01, 0.1, 0.13, "left"), (outputs, 0.9, 0.99, 0.87, "right"))
+        ax.text(0.5, title, name, ha="center", va="center", family=_FONT, weight="bold",
+                fontsize=min(size, size * 11 / max(len(name), 1)))     # fits across
+        for ports, start, end, label, side in arrows:
+            step = 0.62 / max(len(ports), 1)
+            for k, port in enumerate(ports):
+                y = 0.7 - step * (k + 0.5)
+                ax.annotate("", xy=(end, y), xytext=(start, y),
+                            arrowprops=dict(arrowstyle="-|>", color="black", linewidth=1.5))
+                ax.text(label, y, port, ha=side, va="center", family=_FONT,
+                        fontsize=min(9.0, 0.9 * 72 * step * _ICON_INCHES))
+        png = io.BytesIO()
+        figure.savefig(png, format="png", transparent=True, metadata={"Software": None})
+    return png.getvalue()

@@ -20,20 +20,16 @@ def patch(binary: bytes, where: str, fmi: int = 2) -> bytes:
     """The binary with ``onLibraryUnload`` made a no-op; RuntimeError naming ``where`` if
     it is not the binary of FMI ``fmi``'s pythonfmu that fmukit knows."""
     route = ROUTES[fmi]
-    known_binaries = importlib.import_module(f"{route.adapter}.binary").KNOWN_BINARIES
     digest = hashlib.sha256(binary).hexdigest()
-    fix = known_binaries.get(digest)
+    fix = importlib.import_module(f"{route.adapter}.binary").KNOWN_BINARIES.get(digest)
     if fix is None:
-        platform = route.linux_binaries.split("/")[1]
-        raise RuntimeError(f"{where} is not the {route.pythonfmu} {route.known} {platform} "
+        raise RuntimeError(f"{where} is not the {route.pythonfmu} {route.known} {route.linux} "
                            f"binary whose exit-time heap corruption fmubuild.exit_fix knows how "
                            f"to fix (SHA-256 {digest}); check the new binary and extend "
                            f"{route.adapter}.binary")
-    offset, code = fix.offset, fix.code
-    if binary[offset:offset + len(code)] != code:
-        raise RuntimeError(f"{where}: unexpected code at onLibraryUnload")
-    fixed = binary[:offset] + fix.patched + binary[offset + len(code):]
-    if hashlib.sha256(fixed).hexdigest() != fix.fixed_sha256:
+    end = fix.offset + len(fix.code)
+    fixed = binary[:fix.offset] + fix.patched + binary[end:]
+    if binary[fix.offset:end] != fix.code or hashlib.sha256(fixed).hexdigest() != fix.fixed_sha256:
         raise RuntimeError(f"{where}: the patched binary is not the one fmukit expects")
     return fixed
 
@@ -41,6 +37,6 @@ def patch(binary: bytes, where: str, fmi: int = 2) -> bytes:
 def patch_binaries(entries: dict[str, bytes], fmu: Path, fmi: int = 2) -> dict[str, bytes]:
     """An FMU's entries (name: bytes) with ``patch`` applied to every Linux binary of FMI
     ``fmi``'s layout."""
-    folder = ROUTES[fmi].linux_binaries
+    folder = f"binaries/{ROUTES[fmi].linux}/"
     return {name: patch(data, f"{fmu}:{name}", fmi) if name.startswith(folder) else data
             for name, data in entries.items()}

@@ -33,17 +33,18 @@ slave.freeInstance()
 
 class InstantiationFailed(RuntimeError):
     """The FMU did not instantiate: ``crashed`` names the signal, ``timed_out`` the limit
-    (s), ``last_words`` are the child's last lines."""
+    (s), ``last_words`` are the child's last lines (the FMU's, else Python's)."""
 
-    def __init__(self, fmu: Path, returncode: int | None, last_words: list[str],
-                 timed_out: float | None = None):
-        self.fmu, self.last_words, self.timed_out = fmu, last_words, timed_out
+    def __init__(self, fmu: Path, returncode: int | None, out: str | bytes | None,
+                 err: str | bytes | None, timed_out: float | None = None):
+        self.last_words = _last_lines(out) or _last_lines(err)
+        self.timed_out = timed_out
         self.crashed = signal.Signals(-returncode).name if returncode and returncode < 0 \
             else None
         how = (f"did not end within {timed_out:g} s (the child was killed)" if timed_out
                else f"crashed its host ({self.crashed})" if self.crashed else "failed")
         super().__init__(f"{fmu}: instantiating the FMU {how}"
-                         + "".join(f"\n  {line}" for line in last_words))
+                         + "".join(f"\n  {line}" for line in self.last_words))
 
 
 def _last_lines(text: str | bytes | None) -> list[str]:
@@ -63,8 +64,7 @@ def instantiate_in_child(fmu: str | Path, isolated: bool = False, timeout: float
                                    cwd=elsewhere, capture_output=True, text=True,
                                    timeout=timeout)
         except subprocess.TimeoutExpired as expired:
-            raise InstantiationFailed(fmu, None, _last_lines(expired.stdout) or _last_lines(
-                expired.stderr), timed_out=timeout) from None
+            raise InstantiationFailed(fmu, None, expired.stdout, expired.stderr,
+                                      timeout) from None
     if child.returncode != 0:
-        raise InstantiationFailed(fmu, child.returncode,    # the FMU's words, else Python's
-                          _last_lines(child.stdout) or _last_lines(child.stderr))
+        raise InstantiationFailed(fmu, child.returncode, child.stdout, child.stderr)

@@ -1,7 +1,10 @@
-"""This project's FMUs: where their sources are, and where they are built to."""
+"""This project's FMUs: where their sources are, where they are built to, and who made them."""
 from __future__ import annotations
 
+from importlib import metadata
 from pathlib import Path
+
+from fmukit.manifest import DISTRIBUTION
 
 ROOT = Path(__file__).resolve().parent.parent
 FMU_DIR = ROOT / "fmus"
@@ -26,3 +29,13 @@ C_FMUS = {"pd_autopilot_c": "autopilot_fmu/pd_autopilot_c"}
 """FMU name: the folder of its C source and model description."""
 
 BUILD_HINT = "build the FMUs with: python -m fmukit.build"
+
+
+def project_identity() -> dict[str, str]:
+    """Who made this project's FMUs, as their model descriptions say: the author, version,
+    copyright and license of its distribution (pyproject.toml; with no author there, the
+    project's authors by its name)."""
+    meta = metadata.metadata(DISTRIBUTION)
+    author = meta.get("Author") or meta.get("Author-email") or f"the {DISTRIBUTION} authors"
+    return {"author": author, "version": meta["Version"], "copyright": f"Copyright (c) {author}",
+            "license": meta.get("License-Expression") or meta["License"]}

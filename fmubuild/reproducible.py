@@ -1,6 +1,6 @@
 """The same sources give the same FMU, byte for byte: entries in name order with one fixed time
-and mode, no generation time, and a GUID (FMI 3.0: instantiation token) derived from the
-contents.
+and mode, no generation time, and (``derive_guid``) a GUID (FMI 3.0: instantiation token)
+derived from the contents.
 """
 from __future__ import annotations
 
@@ -9,7 +9,6 @@ import re
 import uuid
 import zipfile
 from pathlib import Path
-from typing import Callable
 
 EPOCH = (1980, 1, 1, 0, 0, 0)
 """The time of every entry: the earliest a zip file can hold."""
@@ -18,29 +17,19 @@ _GUID = re.compile(rb'\s(guid|instantiationToken)="[^"]*"')
 _GENERATED = re.compile(rb'\sgenerationDateAndTime="[^"]*"')
 
 
-def rewrite(fmu: Path, transform: Callable[[dict[str, bytes]], dict[str, bytes]],
-            to: Path) -> None:
-    """Write ``fmu`` again reproducibly ``to`` another path (whole or not at all), its
-    entries (name: bytes) passed through ``transform`` first."""
-    with zipfile.ZipFile(fmu) as package:
-        entries = transform({info.filename: package.read(info)
-                             for info in package.infolist() if not info.is_dir()})
-    description = _GENERATED.sub(b"", entries["modelDescription.xml"])
-    found = _GUID.search(description)
-    attribute = found.group(1) if found else b"guid"
-    entries["modelDescription.xml"] = _GUID.sub(b' ' + attribute + b'=""', description, count=1)
-    contents = hashlib.sha256()
-    for name in sorted(entries):
-        contents.update(name.encode() + b"\0" + hashlib.sha256(entries[name]).digest())
-    guid = str(uuid.uuid5(uuid.NAMESPACE_OID, contents.hexdigest()))
-    entries["modelDescription.xml"] = entries["modelDescription.xml"].replace(
-        b' ' + attribute + b'=""', b' ' + attribute + f'="{{{guid}}}"'.encode(), 1)
-    write(to, entries)
-
-
-def write(fmu: Path, entries: dict[str, bytes]) -> None:
+def write(fmu: Path, entries: dict[str, bytes], derive_guid: bool = False) -> None:
     """An archive of ``entries`` (name: bytes) at ``fmu``, in name order, fixed times and
-    modes, compressed; written beside it, then renamed."""
+    modes, compressed; written beside it, then renamed. ``derive_guid``: the model
+    description without its generation time, and its GUID derived from the contents."""
+    if derive_guid:
+        blank = _GUID.sub(rb' \1=""', _GENERATED.sub(b"", entries["modelDescription.xml"]), 1)
+        contents = hashlib.sha256()
+        for name in sorted(entries):
+            data = blank if name == "modelDescription.xml" else entries[name]
+            contents.update(name.encode() + b"\0" + hashlib.sha256(data).digest())
+        guid = uuid.uuid5(uuid.NAMESPACE_OID, contents.hexdigest())
+        entries = {**entries, "modelDescription.xml": _GUID.sub(
+            rb' \1="{%s}"' % str(guid).encode(), blank, 1)}
     temporary = fmu.with_name(f".{fmu.name}.tmp")
     try:
         with zipfile.ZipFile(temporary, "w", zipfile.ZIP_DEFLATED) as package:

@@ -1,23 +1,26 @@
 """The FMI versions fmubuild builds: for each, the pythonfmu that builds it (the one version
-its fmukit adapter knows), its builder's options, its Linux binary's folder, and the entry
-module written into each FMU (``<model_name>_fmi<N>.py``, named in ``slavemodule.txt``),
-which composes the slave class with the adapter's mixin and pythonfmu's slave class, as
+its fmukit adapter knows), its builder's options, its Linux platform, and the entry module
+written into each FMU (``<model_name>_fmi<N>.py``, named in ``slavemodule.txt``), which
+composes the slave class with the adapter's mixin and pythonfmu's slave class, as
 ``fmukit.compose.fmu_class`` does in code.
 """
 from __future__ import annotations
 
 import importlib
 from dataclasses import dataclass
+from pathlib import Path
+
+from fmukit.manifest import Manifest
 
 _ENTRY = '''"""The FMI {fmi}.0 entry of the FMU {model_name}, written by fmubuild.routes: {cls}
 of {module} as an FMI {fmi}.0 co-simulation FMU of {pythonfmu} {known}."""
-from {pythonfmu} import {base}
+from {pythonfmu} import Fmi{fmi}Slave
 
 from {adapter}.slave import {imported}
 from {module} import {cls} as _Model
 {calls}
 
-class {cls}({mixin}, _Model, {base}):
+class {cls}(Fmi{fmi}Entry, _Model, Fmi{fmi}Slave):
     """{cls} of {module}, on FMI {fmi}.0."""
 '''
 
@@ -31,7 +34,7 @@ class Route:
     known: str                      # the one version of it that the adapter knows
     adapter: str                    # fmukit's adapter package
     options: dict[str, bool]        # the builder's options (FMI 2.0 and 3.0 spell them apart)
-    linux_binaries: str             # the folder of the FMU's Linux binary
+    linux: str                      # the platform folder of the FMU's Linux binary
     namespace_calls: tuple[str, ...] = ()   # functions of the adapter's slave module that
                                             # the entry module calls on its globals()
 
@@ -39,26 +42,19 @@ class Route:
         """The installed version of this route's pythonfmu; RuntimeError unless the adapter
         knows it."""
         adapter = importlib.import_module(self.adapter)
-        installed = adapter.PYTHONFMU_VERSION
         if not adapter.ACTIVE:
-            raise RuntimeError(f"{self.pythonfmu} {installed} is installed; fmukit builds FMI "
-                               f"{self.fmi}.0 FMUs with {self.pythonfmu} {self.known} only, "
-                               f"whose defects {self.adapter} compensates (pip install "
-                               f"{self.pythonfmu}=={self.known}, or check the new version and "
-                               f"extend {self.adapter})")
-        return installed
-
-    def entry_module(self, model_name: str) -> str:
-        """The name of the FMU's entry module."""
-        return f"{model_name}_fmi{self.fmi}"
+            raise RuntimeError(f"{self.pythonfmu} {adapter.PYTHONFMU_VERSION} is installed; "
+                               f"fmukit builds FMI {self.fmi}.0 FMUs with {self.pythonfmu} "
+                               f"{self.known} only, whose defects {self.adapter} compensates "
+                               f"(pip install {self.pythonfmu}=={self.known}, or check the new "
+                               f"version and extend {self.adapter})")
+        return adapter.PYTHONFMU_VERSION
 
     def entry_source(self, model_name: str, module: str, cls: str) -> str:
         """The entry module's source: ``cls`` of ``module`` composed for this version."""
-        mixin = f"Fmi{self.fmi}Entry"
         return _ENTRY.format(fmi=self.fmi, model_name=model_name, module=module, cls=cls,
                              pythonfmu=self.pythonfmu, known=self.known, adapter=self.adapter,
-                             base=f"Fmi{self.fmi}Slave", mixin=mixin,
-                             imported=", ".join([mixin, *self.namespace_calls]),
+                             imported=", ".join([f"Fmi{self.fmi}Entry", *self.namespace_calls]),
                              calls="".join(f"{call}(globals())\n"
                                            for call in self.namespace_calls))
 
@@ -67,12 +63,20 @@ ROUTES = {
     # hold_namespace: pythonfmu 0.7 releases the entry module's namespace once per
     # instantiation (fmukit.pythonfmu07.slave.hold_namespace).
     2: Route(2, "pythonfmu", "0.7.0", "fmukit.pythonfmu07",
-             {"canGetAndSetFMUstate": True, "canSerializeFMUstate": True}, "binaries/linux64/",
+             {"canGetAndSetFMUstate": True, "canSerializeFMUstate": True}, "linux64",
              ("hold_namespace",)),
     # canHandleVariableCommunicationStepSize: pythonfmu3 0.3.4 writes the value of another
     # option for it (a loop variable left over); given, its builder writes it.
     3: Route(3, "pythonfmu3", "0.3.4", "fmukit.pythonfmu3_03",
              {"canGetAndSetFMUState": True, "canSerializeFMUState": True,
-              "canHandleVariableCommunicationStepSize": True}, "binaries/x86_64-linux/"),
+              "canHandleVariableCommunicationStepSize": True}, "x86_64-linux"),
 }
 """FMI version: its route."""
+
+
+def entry_source(manifest: Manifest) -> str:
+    """The entry module this build writes for the FMU of ``manifest``; pass it to
+    ``fmukit.manifest.staleness`` to check an FMU's against it."""
+    return ROUTES[manifest.fmi].entry_source(
+        manifest.model_name, Path(manifest.modules[manifest.slave_module]["file"]).stem,
+        manifest.slave_class)

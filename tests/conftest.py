@@ -18,7 +18,7 @@ from typing import Callable, Iterator
 import pytest
 
 from fmubuild.cbuild import build_c, c_compiler, sources
-from fmubuild.manifest import entry_source
+from fmubuild.routes import entry_source
 from fmubuild.packaging import build, build_script
 from fmubuild.project import C_FMUS, FMU_DIRS, FMUS, ROOT
 from fmukit.manifest import read, staleness

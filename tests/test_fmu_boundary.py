@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from fmubuild.cbuild import build_c
-from fmubuild.manifest import entry_source
+from fmubuild.routes import entry_source
 from fmubuild.packaging import build
 from fmubuild.project import FMUS, ROOT
 from fmukit.manifest import digest_of, read, staleness
