@@ -1,8 +1,6 @@
-"""FMUs written in C: compiled against fmpy's FMI headers with the system compiler (``$CC``,
-else cc or gcc) and, where mingw-w64 is installed, cross-compiled for 64-bit Windows (no
-time stamp, a fixed image base: the same bytes each build); zipped with their sources
-(FMI 3.0: and ``sources/buildDescription.xml``) and validated. Without a compiler:
-``NoCompiler``, and the Python FMUs are unaffected.
+"""FMUs written in C, compiled with the system compiler (``$CC``, else cc or gcc) and, where
+mingw-w64 is installed, for 64-bit Windows, reproducibly; zipped with their sources and
+validated. Without a compiler: ``NoCompiler``, and the Python FMUs are unaffected.
 """
 from __future__ import annotations
 
@@ -22,28 +20,19 @@ from .routes import ROUTES
 FILES = {2: ("{name}.c", "modelDescription.xml"),
          3: ("{name}_fmi3.c", "modelDescription_fmi3.xml")}
 """FMI version: the C FMU folder's entry-point source and model description for it."""
-
 WINDOWS = {2: "win64", 3: "x86_64-windows"}
-"""FMI version: the name of its folder for 64-bit Windows binaries."""
-
+"""FMI version: its platform folder for 64-bit Windows."""
 C_HOSTS = {fmi: {ROUTES[fmi].linux: f"any FMI {fmi}.0 co-simulation host; the library needs "
                                     "only libc and libm.",
                  windows: f"any FMI {fmi}.0 co-simulation host; the DLL needs only KERNEL32 "
-                          "and msvcrt."}
+                          "and msvcrt."}      # tests/test_windows.py reads the DLL's imports
            for fmi, windows in WINDOWS.items()}
-"""FMI version: what a host needs for the C FMU, by platform (tests/test_windows.py reads
-the DLL's imports)."""
-
-_LIBRARY = {"linux64": ".so", "darwin64": ".dylib"}
-"""fmpy's platform: the suffix of a shared library there."""
-
 WIN64_COMPILER = "x86_64-w64-mingw32-gcc"
 """mingw-w64's C compiler for 64-bit Windows (Debian: gcc-mingw-w64-x86-64)."""
-
 _WIN64_FLAGS = ["-static-libgcc",        # no libgcc_s DLL for the host to find
                 "-s",                    # strip: mingw-w64's start-up code brings debug sections
                 "-Wl,--no-insert-timestamp,--disable-auto-image-base"]   # reproducible
-
+_LIBRARY = {"linux64": ".so", "darwin64": ".dylib"}     # fmpy's platform: a library's suffix
 _BUILD_DESCRIPTION = """<?xml version="1.0" encoding="UTF-8"?>
 <fmiBuildDescription fmiVersion="3.0">
   <BuildConfiguration modelIdentifier="{name}">
@@ -54,7 +43,6 @@ _BUILD_DESCRIPTION = """<?xml version="1.0" encoding="UTF-8"?>
   </BuildConfiguration>
 </fmiBuildDescription>
 """
-"""sources/buildDescription.xml of an FMI 3.0 FMU compiled from one source and libm."""
 
 
 class NoCompiler(RuntimeError):

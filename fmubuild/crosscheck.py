@@ -1,11 +1,9 @@
-"""FMI cross-check reference files for every Python FMU and its FMI 3.0 twin (docs/interop.md).
+"""FMI cross-check reference files of every Python FMU and its FMI 3.0 twin (docs/interop.md),
+simulated by fmpy isolated from this checkout and committed; tests/test_crosscheck.py
+replays them. Regenerate them, saying why in the commit, only when results change.
 
     python -m fmubuild.crosscheck            # both versions: fmus/crosscheck/2.0/..., 3.0/...
     python -m fmubuild.crosscheck --fmi 3    # only the FMI 3.0 twins (fmus/fmi3/)
-
-The references are simulated with fmpy in a child process isolated from this checkout, and
-committed: tests/test_crosscheck.py replays them. Regenerate them, saying why in the
-commit, only when a change of results is intended.
 """
 from __future__ import annotations
 
@@ -27,17 +25,6 @@ TOOL, VERSION = "ship_autopilot_cosim", "0.1.0"
 CROSSCHECK_DIRS = {fmi: FMU_DIR / "crosscheck" / f"{fmi}.0" / "cs" / route.linux / TOOL / VERSION
                    for fmi, route in ROUTES.items()}
 """FMI version: the folder of its references (made on 64-bit Linux)."""
-
-SIMULATE = """
-import sys
-from fmpy import simulate_fmu
-from fmpy.util import read_csv, write_csv
-fmu, inputs, reference, stop, step = sys.argv[1:]
-write_csv(reference, simulate_fmu(fmu, start_time=0.0, stop_time=float(stop),
-                                  step_size=float(step), output_interval=float(step),
-                                  input=read_csv(inputs)))
-"""
-"""A child process's script: simulate FMU with the inputs, write the reference CSV."""
 
 
 @dataclass(frozen=True)
@@ -89,17 +76,18 @@ def generate(name: str, fmi: int = 2) -> Path:
     case, paths = CASES[name], files(name, fmi)
     paths["dir"].parent.mkdir(parents=True, exist_ok=True)
     with fresh_folder(paths["dir"]) as folder:
-        staged = {key: folder / path.name for key, path in paths.items() if key != "dir"}
-        shutil.copy2(FMU_DIRS[fmi] / f"{name}.fmu", staged["fmu"])
-        with open(staged["in"], "w", newline="") as f:
+        fmu, inputs, ref, opt = (folder / paths[key].name for key in ("fmu", "in", "ref", "opt"))
+        shutil.copy2(FMU_DIRS[fmi] / f"{name}.fmu", fmu)
+        with open(inputs, "w", newline="") as f:
             writer = csv.writer(f, quoting=csv.QUOTE_NONNUMERIC)
             writer.writerow(["time", *case.inputs])
             writer.writerows([float(v) for v in row] for row in case.table)
-        staged["opt"].write_text(f"StartTime, 0.0\nStopTime, {case.stop!r}\n"
-                                 f"StepSize, {case.step!r}\nRelTol, {case.rel_tol!r}\n")
+        opt.write_text(f"StartTime, 0.0\nStopTime, {case.stop!r}\nStepSize, {case.step!r}\n"
+                       f"RelTol, {case.rel_tol!r}\n")
         simulated = subprocess.run(
-            [sys.executable, "-I", "-c", SIMULATE, str(staged["fmu"]), str(staged["in"]),
-             str(staged["ref"]), repr(case.stop), repr(case.step)],
+            [sys.executable, "-I", "-m", "fmpy.cli", "simulate", str(fmu), "--start-time", "0.0",
+             "--stop-time", repr(case.stop), "--step-size", repr(case.step), "--output-interval",
+             repr(case.step), "--input-file", str(inputs), "--output-file", str(ref)],
             capture_output=True, text=True, timeout=300)
         if simulated.returncode != 0:
             raise RuntimeError(f"fmpy could not simulate {FMU_DIRS[fmi] / name}.fmu "
@@ -117,12 +105,15 @@ def generate(name: str, fmi: int = 2) -> Path:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m fmubuild.crosscheck",
                                      description=__doc__.split("\n\n")[0].replace("\n", " "))
-    parser.add_argument("names", nargs="*", metavar="NAME", choices=list(CASES),
+    parser.add_argument("names", nargs="*", metavar="NAME",
                         help=f"FMUs (default: all of {', '.join(CASES)})")
     parser.add_argument("--fmi", type=int, choices=sorted(CROSSCHECK_DIRS),
                         help="only the FMUs of this FMI version (default: both, FMI 2.0's "
                              f"from {FMU_DIRS[2]}, FMI 3.0's from {FMU_DIRS[3]})")
     args = parser.parse_args(argv)
+    for name in args.names:
+        if name not in CASES:
+            parser.error(f"unknown FMU {name!r}; known: {', '.join(CASES)}")
     for fmi in [args.fmi] if args.fmi else sorted(CROSSCHECK_DIRS):
         for name in args.names or CASES:
             print(f"wrote {generate(name, fmi)}")

@@ -1,6 +1,6 @@
-"""An FMU instantiated once in a child process (pythonfmu's C++ takes its host down when the
-script fails to import), with fmpy; ``isolated`` leaves this checkout off the child's path,
-as on a host that has only the FMU.
+"""An FMU instantiated once with fmpy in a child process, since pythonfmu's C++ takes its
+host down when the script fails to import; ``isolated`` leaves this checkout off the child's
+path, as on a host that has only the FMU.
 """
 from __future__ import annotations
 
@@ -18,16 +18,10 @@ import sys
 if sys.argv[2] == "isolated":
     sys.path = [p for p in sys.path if p not in ("", {root!r})]
     sys.meta_path = [f for f in sys.meta_path if "editable" not in repr(f).lower()]
-from fmpy import extract, read_model_description
-from fmpy.fmi2 import FMU2Slave
-from fmpy.fmi3 import FMU3Slave
-description = read_model_description(sys.argv[1])
+from fmpy import extract, instantiate_fmu, read_model_description
 unzipped = extract(sys.argv[1], os.path.abspath("unzipped"))  # in the child's folder: removed
-slave = (FMU3Slave if description.fmiVersion.startswith("3") else FMU2Slave)(
-    guid=description.guid, unzipDirectory=unzipped,
-    modelIdentifier=description.coSimulation.modelIdentifier, instanceName="trial")
-slave.instantiate(loggingOn=True)     # pythonfmu 0.7 logs only then
-slave.freeInstance()
+instantiate_fmu(unzipped, read_model_description(sys.argv[1]), "CoSimulation",
+                debug_logging=True).freeInstance()            # pythonfmu 0.7 logs only then
 """
 
 
@@ -39,8 +33,7 @@ class InstantiationFailed(RuntimeError):
                  err: str | bytes | None, timed_out: float | None = None):
         self.last_words = _last_lines(out) or _last_lines(err)
         self.timed_out = timed_out
-        self.crashed = signal.Signals(-returncode).name if returncode and returncode < 0 \
-            else None
+        self.crashed = signal.Signals(-returncode).name if (returncode or 0) < 0 else None
         how = (f"did not end within {timed_out:g} s (the child was killed)" if timed_out
                else f"crashed its host ({self.crashed})" if self.crashed else "failed")
         super().__init__(f"{fmu}: instantiating the FMU {how}"
@@ -48,7 +41,7 @@ class InstantiationFailed(RuntimeError):
 
 
 def _last_lines(text: str | bytes | None) -> list[str]:
-    if isinstance(text, bytes):
+    if isinstance(text, bytes):         # what a killed child had written
         text = text.decode(errors="replace")
     return [line for line in (text or "").splitlines() if line.strip()][-3:]
 
