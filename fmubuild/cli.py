@@ -14,16 +14,20 @@ exits when imported is refused with one message. See docs/own_autopilot.md.
 from __future__ import annotations
 
 import argparse
+import ast
 import os
 import sys
 import traceback
+from importlib.machinery import PathFinder
 from pathlib import Path
 
 from .cbuild import NoCompiler, build_c
-from .imports import uncarried
-from .packaging import build, build_script
-from .project import C_FMUS, FMU_DIRS, FMUS
+from .packaging import build, build_script, parsed
+from .project import C_FMUS, FMU_DIRS, FMUS, ROOT
 from .routes import ROUTES
+
+_IMPORT_ERRORS = {"ImportError", "ModuleNotFoundError", "Exception", "BaseException"}
+"""What an ``except`` that makes an import optional catches."""
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -75,9 +79,9 @@ def _build_script(script: Path, includes: list[Path], out: Path | None, fmi: int
     for include in includes:
         if not include.exists():
             raise ValueError(f"{include}, to be carried by {script.name}'s FMU, does not exist")
-    missing = uncarried(script, includes, ("fmukit",))
-    if missing:
-        raise ValueError(_carry_them(script, includes, missing))
+    uncarried = _uncarried(script, includes)
+    if uncarried:
+        raise ValueError(uncarried)
     try:
         return build_script(script, ("fmukit", *includes),
                             out or script.resolve().parent / ("fmi3" if fmi == 3 else ""), fmi=fmi)
@@ -91,14 +95,31 @@ def _build_script(script: Path, includes: list[Path], out: Path | None, fmi: int
                          "'if __name__ == \"__main__\":')") from None
 
 
-def _carry_them(script: Path, includes: list[Path],
-                missing: list[tuple[str, Path, Path | None]]) -> str:
-    """What to do about modules a script's FMU would not carry: the command with an
-    --include for each, where this build finds it."""
+def _uncarried(script: Path, includes: list[Path]) -> str | None:
+    """What to do about the top-level modules ``script`` or ``includes`` import (outside a
+    try that catches ImportError) that a host would not have: not fmukit, not included, not
+    standard, not installed in this Python (this checkout and the local folders do not
+    count). The command with an --include for each, where this build finds it; or None."""
+    provided = {"fmukit", *(p.stem if p.is_file() else p.name for p in includes)}
+    local = [script.resolve().parent, Path.cwd().resolve(), ROOT,
+             *(p.resolve().parent for p in includes)]
+    host = [p for p in sys.path if p and Path(p).exists() and Path(p).resolve() not in local]
+    files = [f for p in includes for f in ([p] if p.is_file() else sorted(p.rglob("*.py")))]
+    missing: dict[str, tuple[Path, Path | None]] = {}       # module: its importer, where
+    for file in [script, *(f for f in files if f.suffix == ".py")]:
+        for module in _top_level_imports(parsed(file)):
+            if module in provided or module in sys.stdlib_module_names or module in missing \
+                    or module in sys.builtin_module_names or PathFinder.find_spec(module, host):
+                continue
+            spec = PathFinder.find_spec(module, [str(folder) for folder in local])
+            where = spec and (spec.submodule_search_locations or [spec.origin])  # a package's
+            missing[module] = (file, Path(next(iter(where))) if where else None)
+    if not missing:
+        return None
     one = len(missing) == 1
     lines = [(f"cannot build an FMU from {script}: {'a module' if one else 'modules'} it "
               "imports would not be in the FMU, and a host has only the FMU:")]
-    for module, importer, found in missing:
+    for module, (importer, found) in missing.items():
         where = (f"found at {_shown(found)}" if found else
                  "found neither here nor among the packages installed in this Python: "
                  "pip install it, if it is a package")
@@ -106,7 +127,7 @@ def _carry_them(script: Path, includes: list[Path],
     command = ["python -m fmukit.build", _shown(script),
                *(f"--include {_shown(p)}" for p in includes),
                *(f"--include {_shown(found) if found else f'PATH/TO/{module}.py'}"
-                 for module, _, found in missing)]
+                 for module, (_, found) in missing.items())]
     lines.append(f"carry {'it' if one else 'them'} with --include "
                  f"(a module's file or a package's folder):\n  {' '.join(command)}")
     return "\n".join(lines)
@@ -117,6 +138,25 @@ def _shown(path: Path) -> str:
     it lies inside it."""
     absolute = Path(path).resolve()
     return os.path.relpath(absolute) if Path.cwd().resolve() in absolute.parents else str(absolute)
+
+
+def _top_level_imports(tree: ast.Module) -> list[str]:
+    """The first name of every absolute import in ``tree`` outside a try that catches
+    ImportError."""
+    optional = {id(node) for block in ast.walk(tree) if isinstance(block, ast.Try)
+                and any(handler.type is None or _IMPORT_ERRORS & {
+                    n.id for n in ast.walk(handler.type) if isinstance(n, ast.Name)}
+                        for handler in block.handlers)
+                for statement in block.body for node in ast.walk(statement)}
+    names = []
+    for node in ast.walk(tree):
+        if id(node) in optional:
+            continue
+        if isinstance(node, ast.Import):
+            names += [alias.name.split(".")[0] for alias in node.names]
+        elif isinstance(node, ast.ImportFrom) and not node.level and node.module:
+            names.append(node.module.split(".")[0])
+    return list(dict.fromkeys(names))
 
 
 if __name__ == "__main__":

@@ -1,35 +1,40 @@
 """A slave script written with fmukit built into an FMU that carries exactly its model: the
-script, what it imports of fmukit and this project (``imports``), the ``--include``s, a
-requirements.txt (numpy), its manifest and entry module (``routes``); its Linux binary fixed
-(``exit_fix``), its documentation (``documentation``), written reproducibly
-(``reproducible``), validated with fmpy and instantiated without this checkout
-(``instantiate``). A package whose __init__.py holds only a docstring is carried as a
-namespace package: a non-Python host runs all its Python FMUs in one interpreter, where the
-first FMU to import a package would otherwise own it (the guidance carries ship_fmu.data).
+script, what it imports of fmukit and this project (read from the sources, followed
+through), the ``--include``s, a requirements.txt (numpy), its manifest and entry module
+(``routes``); its Linux binary fixed (``exit_fix``), its documentation (``documentation``);
+validated with fmpy, instantiated without this checkout (``instantiate``) and written
+reproducibly: the same sources give the same bytes. A package whose __init__.py holds only
+a docstring is carried as a namespace package: a non-Python host runs all its Python FMUs in
+one interpreter, where the first FMU to import a package would otherwise own it.
 """
 from __future__ import annotations
 
 import ast
 import contextlib
-import importlib
+import hashlib
+import importlib.util
 import inspect
 import os
+import re
 import shutil
 import sys
 import tempfile
+import traceback
+import uuid
 import zipfile
-from collections.abc import Mapping
+from collections.abc import Iterable, Iterator, Mapping
 from pathlib import Path
 
 from fmukit.manifest import Manifest, digest_of, sha256, version
 
-from . import documentation, exit_fix, reproducible
-from .imports import needed_modules
+from . import documentation, exit_fix
 from .instantiate import InstantiationFailed, instantiate_in_child
 from .project import FMU_DIRS, FMUS, ROOT, project_identity
 from .routes import ROUTES
 
 PROJECT_PACKAGES = ("fmukit", "ship_fmu", "autopilot_fmu")
+_GUID = re.compile(rb'\s(guid|instantiationToken)="[^"]*"')
+_GENERATED = re.compile(rb'\sgenerationDateAndTime="[^"]*"')
 
 
 def build(name: str, dest: Path | None = None, fmi: int = 2) -> Path:
@@ -43,8 +48,6 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
     """The slave in ``script`` built as FMI ``fmi`` into ``dest`` (a .fmu, or a folder);
     ``packages``: project package names (carried as imported) and paths (carried whole).
     ValueError naming the script if it cannot be built; RuntimeError if invalid."""
-    from fmpy.validation import validate_fmu
-
     route, script, dest = ROUTES[fmi], Path(script), Path(dest)
     pythonfmu_version = route.gate()
     (dest.parent if dest.suffix == ".fmu" else dest).mkdir(parents=True, exist_ok=True)
@@ -76,7 +79,7 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
             for module, found in needed_modules([script, entry], project).items():
                 if found.name != "__init__.py" or not all(
                         isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant)
-                        for node in ast.parse(found.read_bytes()).body):   # not a docstring
+                        for node in parsed(found).body):        # not only a docstring
                     staged[module] = _copy(found, stage / found.relative_to(ROOT))
             modules = {m: _carried(path, stage) for m, path in sorted(staged.items())}
             manifest = Manifest(model_name, _module_name(script), slave.__name__, modules,
@@ -85,8 +88,8 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
                                 {"module": entry.stem, **_carried(entry, stage)})
             (stage / "fmukit_manifest.json").write_text(manifest.to_json())
             (stage / "requirements.txt").write_text("numpy\n")
-            sources = {m: doc for m, path in sorted(staged.items()) if m.split(".")[0] != "fmukit"
-                       and m != manifest.slave_module and (doc := _docstring(path))}
+            sources = {m: doc for m, path in sorted(staged.items()) if m != manifest.slave_module
+                       and m.split(".")[0] != "fmukit" and (doc := _docstring(path))}
             built = importlib.import_module(route.pythonfmu).FmuBuilder.build_FMU(
                 entry, dest=Path(tmp) / "built",
                 project_files=[p for p in stage.iterdir() if p != entry], **route.options)
@@ -101,13 +104,10 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
         with zipfile.ZipFile(built) as package:
             entries = {info.filename: package.read(info) for info in package.infolist()
                        if not info.is_dir()}
-    tool = f"fmukit {version()} ({route.pythonfmu} {pythonfmu_version})"
-    reproducible.write(fmu, documentation.describe(
-        exit_fix.patch_binaries(entries, fmu, fmi), tool, identity or {}, _docstring(script),
-        sources, documentation.python_hosts()), derive_guid=True)
-    problems = validate_fmu(str(fmu))
-    if problems:
-        raise RuntimeError(f"{fmu} does not validate:\n" + "\n".join(problems))
+    write_fmu(fmu, _with_guid(documentation.describe(
+        exit_fix.patch_binaries(entries, fmu, fmi),
+        f"fmukit {version()} ({route.pythonfmu} {pythonfmu_version})", identity or {},
+        _docstring(script), sources, documentation.python_hosts())))
     try:
         instantiate_in_child(fmu, isolated=True)
     except InstantiationFailed as failed:
@@ -119,6 +119,92 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
                            f"checkout, so it was removed; {why}:\n  "
                            + "\n  ".join(failed.last_words)) from None
     return fmu
+
+
+def write_fmu(fmu: Path, entries: Mapping[str, bytes]) -> None:
+    """The FMU of ``entries`` (name: bytes) written at ``fmu`` reproducibly (in name order,
+    fixed times and modes; beside it, then renamed) and validated by fmpy (RuntimeError)."""
+    from fmpy.validation import validate_fmu
+
+    temporary = fmu.with_name(f".{fmu.name}.tmp")
+    try:
+        with zipfile.ZipFile(temporary, "w", zipfile.ZIP_DEFLATED) as package:
+            for name in sorted(entries):
+                info = zipfile.ZipInfo(name, (1980, 1, 1, 0, 0, 0))     # the earliest
+                info.compress_type = zipfile.ZIP_DEFLATED
+                info.external_attr = (0o755 if name.startswith("binaries/") else 0o644) << 16
+                package.writestr(info, entries[name])
+        temporary.replace(fmu)
+    finally:
+        temporary.unlink(missing_ok=True)
+    problems = validate_fmu(str(fmu))
+    if problems:
+        raise RuntimeError(f"{fmu} does not validate:\n" + "\n".join(problems))
+
+
+def _with_guid(entries: dict[str, bytes]) -> dict[str, bytes]:
+    """``entries`` without the generation time, with a GUID (FMI 3.0: instantiation token)
+    derived from their contents."""
+    blank = _GUID.sub(rb' \1=""', _GENERATED.sub(b"", entries["modelDescription.xml"]), 1)
+    contents = hashlib.sha256()
+    for name in sorted(entries):
+        data = blank if name == "modelDescription.xml" else entries[name]
+        contents.update(name.encode() + b"\0" + hashlib.sha256(data).digest())
+    guid = uuid.uuid5(uuid.NAMESPACE_OID, contents.hexdigest())
+    return {**entries, "modelDescription.xml": _GUID.sub(rb' \1="{%s}"' % str(guid).encode(),
+                                                          blank, 1)}
+
+
+def needed_modules(scripts: Iterable[Path], packages: Iterable[str]) -> dict[str, Path]:
+    """Module: file, for every module of ``packages`` (of this checkout) that ``scripts``
+    import, directly or not, read from their sources; ValueError if one has no file."""
+    found: dict[str, Path] = {}
+    todo = [(None, script) for script in scripts]
+    while todo:
+        name, path = todo.pop()
+        for module, required in _imports(path, name):
+            parts = module.split(".")
+            if parts[0] not in packages:
+                continue
+            for i in range(1, len(parts) + 1):      # a.b.c: a, a.b and a.b.c
+                parent, base = ".".join(parts[:i]), ROOT.joinpath(*parts[:i])
+                file = next((f for f in (base / "__init__.py", base.with_suffix(".py"))
+                             if f.is_file()), None)
+                if file is None and required:
+                    raise ValueError(f"{path} imports {module}, which has no file in {ROOT}")
+                if file is None:
+                    break                           # a name imported from a module
+                if parent not in found:
+                    found[parent] = file
+                    todo.append((parent, file))
+    return dict(sorted(found.items()))
+
+
+def _imports(path: Path, module: str | None) -> Iterator[tuple[str, bool]]:
+    """(module, must exist) for what ``path`` (module ``module``, None for a script)
+    imports; for ``from a import b``, a and, as may-exist, a.b (b may be a module)."""
+    package = module if path.name == "__init__.py" else (module or "").rpartition(".")[0]
+    for node in ast.walk(parsed(path)):
+        if isinstance(node, ast.Import):
+            yield from ((alias.name, True) for alias in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level and package:
+                base = importlib.util.resolve_name("." * node.level + base, package)
+            yield from [(base, True)] if base else []
+            yield from ((f"{base}.{alias.name}".lstrip("."), False) for alias in node.names
+                        if alias.name != "*")
+
+
+def parsed(path: Path) -> ast.Module:
+    """The syntax tree of ``path``; ValueError naming the file and line, with the line and a
+    caret under the error."""
+    try:
+        return ast.parse(path.read_bytes(), str(path))
+    except SyntaxError as error:
+        quoted = "".join(traceback.format_exception_only(error)[1:-1]).rstrip()
+        raise ValueError(f"{path}:{error.lineno}: {type(error).__name__}: {error.msg}"
+                         + (f"\n{quoted}" if quoted else "")) from None
 
 
 def _slave_class(module_name: str) -> type:
@@ -150,7 +236,7 @@ def _carried(file: Path, stage: Path) -> dict[str, str]:
 
 
 def _docstring(file: Path) -> str:
-    return ast.get_docstring(ast.parse(file.read_bytes())) or ""
+    return ast.get_docstring(parsed(file)) or ""
 
 
 def _module_name(script: Path) -> str:
@@ -162,7 +248,7 @@ def _module_name(script: Path) -> str:
 
 
 @contextlib.contextmanager
-def _imports_undone(stage: str):
+def _imports_undone(stage: str) -> Iterator[None]:
     """Forget what building imported from ``stage`` or pythonfmu's temporary folders (and
     its sys.path), so the next build or in-process run finds no stale module."""
     path, modules = list(sys.path), set(sys.modules)
