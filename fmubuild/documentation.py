@@ -1,7 +1,6 @@
-"""What an FMU says of itself (``describe``), derived from its entries alone so that the same
-sources give the same bytes: the generation tool and the identity the model does not
-declare, documentation/index.html (its sources' docstrings, every variable, the default
-experiment, what a host needs, a worked example with fmpy) and the icon model.png.
+"""What an FMU says of itself, derived from its entries alone (the same sources give the same
+bytes): the generation tool and the identity the model does not declare, its page (its
+sources' docstrings, every variable, what a host needs, an example with fmpy) and its icon.
 """
 from __future__ import annotations
 
@@ -9,12 +8,15 @@ import html
 import io
 import re
 import textwrap
+import zipfile
 from collections.abc import Mapping
 from importlib import metadata
 from xml.dom.minidom import parseString
-from xml.etree.ElementTree import Element, fromstring, tostring
+from xml.etree.ElementTree import fromstring, tostring
 
 import matplotlib.style
+from fmpy import read_model_description
+from fmpy.model_description import ModelDescription, ModelVariable
 from matplotlib.figure import Figure
 from matplotlib.patches import FancyBboxPatch, Polygon
 
@@ -25,18 +27,15 @@ IDENTITY = ("author", "version", "copyright", "license")
 """modelDescription.xml attributes set where the model does not declare them."""
 PAPER = ("Tomera, M. (2010). <i>Nonlinear controller design of a ship autopilot</i>. "
          "Int. J. Appl. Math. Comput. Sci. 20(2), 271-280.")
-_PRELOAD = ("a C or C++ program) must load libpython before the FMU: <code>LD_PRELOAD="
-            "/path/to/libpython3.X.so</code>, with <code>PYTHONPATH</code> naming a "
-            "site-packages that has numpy if that Python's own has none.")
+_LINUX = ("CPython {{python}} (64-bit) with numpy. A Python host {} needs nothing else. A host "
+          "that is not Python ({}, a C or C++ program) must load libpython before the FMU: "
+          "<code>LD_PRELOAD=/path/to/libpython3.X.so</code>, with <code>PYTHONPATH</code> "
+          "naming a site-packages that has numpy if that Python's own has none.")
 _HOME = ("Set <code>PYTHONHOME</code> to that folder if Python cannot find its standard "
          "library, <code>PYTHONPATH</code> to a site-packages with numpy if its own has none.")
 PYTHON_HOSTS = {
-    "linux64": "CPython {python} (64-bit) with numpy. A Python host (fmpy, libcosimpy, "
-               "ecospy) needs nothing else. A host that is not Python (ecos, cosim-cli, "
-               "OMSimulator, " + _PRELOAD,
-    "x86_64-linux": "CPython {python} (64-bit) with numpy. A Python host that runs FMI 3.0 "
-                    "(fmpy, ecospy) needs nothing else. A host that is not Python (ecos, "
-                    "OMSimulator, " + _PRELOAD,
+    "linux64": _LINUX.format("(fmpy, libcosimpy, ecospy)", "ecos, cosim-cli, OMSimulator"),
+    "x86_64-linux": _LINUX.format("that runs FMI 3.0 (fmpy, ecospy)", "ecos, OMSimulator"),
     "x86_64-windows": "A 64-bit CPython {python} with numpy, whose installation folder (the "
                       "one with <code>python3.dll</code>) is on <code>PATH</code> of every "
                       "host: the binary imports python3.dll and KERNEL32 only. " + _HOME
@@ -69,7 +68,7 @@ def describe(entries: Mapping[str, bytes], generation_tool: str, identity: Mappi
              hosts: Mapping[str, str]) -> dict[str, bytes]:
     """``entries`` with the model description's ``generation_tool`` and ``identity``, the
     page (``overview``: the model's docstring; ``sources``: module: docstring; ``hosts``:
-    platform: HTML, for the platforms it has binaries for) and the icon."""
+    platform: what a host needs there, in HTML) and the icon."""
     root = fromstring(entries["modelDescription.xml"])
     for element in root.iter():             # the layout is written again below
         element.text = element.text if (element.text or "").strip() else None
@@ -78,35 +77,32 @@ def describe(entries: Mapping[str, bytes], generation_tool: str, identity: Mappi
     for name in IDENTITY:
         if name in identity and not root.get(name):
             root.set(name, identity[name])
+    # as pythonfmu writes it: minidom, tab-indented
+    xml = parseString(tostring(root, "UTF-8")).toprettyxml(indent="\t", encoding="UTF-8")
+    with zipfile.ZipFile(buffer := io.BytesIO(), "w") as package:
+        package.writestr("modelDescription.xml", xml)           # as fmpy reads it
+    model = read_model_description(buffer, validate=False)
     platforms = {name.split("/")[1] for name in entries
                  if name.startswith("binaries/") and name.count("/") == 2}
-    return {**entries, "documentation/index.html": index_html(
-                root, overview, sources, {p: hosts[p] for p in sorted(platforms) if p in hosts}),
-            "model.png": model_png(root),   # as pythonfmu writes it: minidom, tab-indented
-            "modelDescription.xml": parseString(tostring(root, "UTF-8")).toprettyxml(
-                indent="\t", encoding="UTF-8")}
+    return {**entries, "modelDescription.xml": xml, "model.png": model_png(model),
+            "documentation/index.html": index_html(
+                model, overview, sources, {p: hosts[p] for p in sorted(platforms) if p in hosts})}
 
 
-def index_html(root: Element, overview: str, sources: Mapping[str, str],
+def index_html(model: ModelDescription, overview: str, sources: Mapping[str, str],
                hosts: Mapping[str, str]) -> bytes:
-    """documentation/index.html of the FMU whose model description is ``root``."""
-    name, variables = root.get("modelName", ""), root.find("ModelVariables")
-    if root.get("fmiVersion", "").startswith("3"):       # outputs by value reference
-        by_key = {v.get("valueReference"): v.get("name") for v in variables}
-        unknowns, key = root.iterfind("ModelStructure/Output"), "valueReference"
-    else:                                                # by 1-based index
-        by_key = {str(i): v.get("name") for i, v in enumerate(variables, 1)}
-        unknowns, key = root.iterfind("ModelStructure/Outputs/Unknown"), "index"
-    feedthrough = {by_key[u.get(key)]: [by_key[d] for d in (u.get("dependencies") or "").split()]
-                   for u in unknowns}
-    inputs, outputs, parameters = ([v for v in variables if v.get("causality") == c]
+    """documentation/index.html of ``model``; see ``describe``."""
+    inputs, outputs, parameters = ([v for v in model.modelVariables if v.causality == c]
                                    for c in ("input", "output", "parameter"))
-    about = [("FMI", f"{root.get('fmiVersion')}, co-simulation"),
-             *((a, root.get(a)) for a in (*IDENTITY, "generationTool") if root.get(a))]
-    body = [f"<h1>{html.escape(name)}</h1>", f"<p>{html.escape(root.get('description', ''))}</p>",
+    feedthrough = {u.variable.name: [d.name for d in u.dependencies or []]
+                   for u in model.outputs}
+    about = [("FMI", f"{model.fmiVersion}, co-simulation"),
+             *((a, getattr(model, a)) for a in (*IDENTITY, "generationTool") if getattr(model, a))]
+    body = [f"<h1>{html.escape(model.modelName)}</h1>",
+            f"<p>{html.escape(model.description or '')}</p>",
             _table([f"<tr><th>{a}</th><td>{html.escape(value)}</td></tr>" for a, value in about]),
             "<h2>Model</h2>", _prose(overview)]
-    if "Tomera" in overview + root.get("description", "") + "".join(sources.values()):
+    if "Tomera" in overview + (model.description or "") + "".join(sources.values()):
         body.append(f"<p>Equation numbers are those of {PAPER}</p>")
     body += ["<h2>Equations and sources</h2>"] if sources else []
     for module, doc in sources.items():
@@ -116,70 +112,61 @@ def index_html(root: Element, overview: str, sources: Mapping[str, str],
     body += ["<h2>Inputs</h2>", _variables(inputs, ("start", "min", "max")),
              "<h2>Outputs</h2>", _variables(outputs, (), feedthrough),
              "<h2>Parameters</h2>", _variables(parameters, ("start", "min", "max"))]
-    experiment = root.find("DefaultExperiment")
+    experiment = model.defaultExperiment
     if experiment is not None:
         body.append("<h2>Default experiment</h2><p>" + ", ".join(
-            f"{a} {experiment.get(a)} s" for a in ("startTime", "stopTime", "stepSize")
-            if experiment.get(a)) + "</p>")
+            f"{a} {getattr(experiment, a)} s" for a in ("startTime", "stopTime", "stepSize")
+            if getattr(experiment, a)) + "</p>")
     body += ["<h2>Host requirements</h2>", "<ul>" + "".join(
         f"<li><b>{p}</b>: {needs}</li>" for p, needs in hosts.items()) + "</ul>",
-             "<h2>Example</h2>", _example(name, inputs, experiment)]
+             "<h2>Example</h2>", _example(model, inputs)]
     return ('<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8"/>\n'
-            f"<title>{html.escape(name)}</title>\n<style>{_STYLE}</style>\n</head>\n<body>\n"
-            + "\n".join(part for part in body if part) + "\n</body>\n</html>\n").encode()
+            f"<title>{html.escape(model.modelName)}</title>\n<style>{_STYLE}</style>\n</head>\n"
+            "<body>\n" + "\n".join(part for part in body if part) + "\n</body>\n</html>\n").encode()
 
 
 def _table(rows: list[str]) -> str:
     return "<table>\n" + "\n".join(rows) + "\n</table>"
 
 
-def _variables(variables: list[Element], columns: tuple[str, ...],
+def _variables(variables: list[ModelVariable], columns: tuple[str, ...],
                feedthrough: Mapping[str, list[str]] | None = None) -> str:
-    """A table of ``variables``: name, type, unit, the typed element's ``columns`` and
-    meaning; for outputs (``feedthrough``), the inputs each depends on at once."""
+    """A table of ``variables``: name, type, unit, ``columns`` and meaning; for outputs
+    (``feedthrough``), the inputs each depends on at once."""
     if not variables:
         return "<p>None.</p>"
     heads = ["name", "type", "unit", *("default" if c == "start" else c for c in columns),
              *(("direct feedthrough from",) if feedthrough is not None else ()), "meaning"]
     rows = ["<tr>" + "".join(f"<th>{h}</th>" for h in heads) + "</tr>"]
     for v in variables:
-        typed = _typed(v)
-        unit = typed.get("unit", "") + (f" (shown in {typed.get('displayUnit')})"
-                                        if typed.get("displayUnit") else "")
-        start = typed.find("Start")         # FMI 3.0: a String's start is a child's value
-        cells = [typed.tag, unit, *(start.get("value", "") if c == "start" and start is not None
-                                    else typed.get(c, "") for c in columns)]
+        shown = f" (shown in {v.displayUnit})" if v.displayUnit else ""
+        cells = [v.type, (v.unit or "") + shown, *(getattr(v, c) or "" for c in columns)]
         if feedthrough is not None:
-            cells.append(", ".join(feedthrough.get(v.get("name"), [])) or "none")
-        rows.append(f"<tr><td><code>{html.escape(v.get('name'))}</code></td>" + "".join(
-            f"<td>{html.escape(c)}</td>" for c in (*cells, v.get("description", ""))) + "</tr>")
+            cells.append(", ".join(feedthrough.get(v.name, [])) or "none")
+        rows.append(f"<tr><td><code>{html.escape(v.name)}</code></td>" + "".join(
+            f"<td>{html.escape(c)}</td>" for c in (*cells, v.description or "")) + "</tr>")
     return _table(rows)
 
 
-def _example(name: str, inputs: list[Element], experiment: Element | None) -> str:
+def _example(model: ModelDescription, inputs: list[ModelVariable]) -> str:
     """fmpy's command line and Python running the FMU alone, its first input that starts
     at 0 held at 0.1 instead (clipped to its range)."""
-    held = next((v for v in inputs if _typed(v).tag in ("Real", "Float64")
-                 and float(_typed(v).get("start", 1)) == 0), None)
-    stop = experiment.get("stopTime") if experiment is not None else None
+    name = model.modelName
+    held = next((v for v in inputs if v.type in ("Real", "Float64")
+                 and float(v.start or 1) == 0), None)
+    stop = model.defaultExperiment.stopTime if model.defaultExperiment else None
     command = f"fmpy simulate {name}.fmu" + (f" --stop-time {stop}" if stop else "")
     if held is None:
         return f"<pre>{command} --output-file {name}.csv</pre>"
-    typed, variable = _typed(held), held.get("name")
-    value = repr(min(max(0.1, float(typed.get("min", "-inf"))), float(typed.get("max", "inf"))))
-    unit = "" if typed.get("unit", "1") == "1" else " " + html.escape(typed.get("unit"))
+    value = repr(min(max(0.1, float(held.min or "-inf")), float(held.max or "inf")))
+    unit = "" if (held.unit or "1") == "1" else " " + html.escape(held.unit)
     return (f"<p>The FMU alone{f' for {stop} s' if stop else ''}, with input "
-            f"<code>{variable}</code> held at {value}{unit} and every other variable at its "
+            f"<code>{held.name}</code> held at {value}{unit} and every other variable at its "
             f"start value; its outputs at every step go to {name}.csv:</p>\n"
-            f"<pre>{command} --start-values {variable} {value} --output-file {name}.csv</pre>\n"
+            f"<pre>{command} --start-values {held.name} {value} --output-file {name}.csv</pre>\n"
             f"<p>or in Python:</p>\n<pre>from fmpy import simulate_fmu\nresult = simulate_fmu("
-            f"{name + '.fmu'!r}, start_values={{{variable!r}: {value}}}"
+            f"{name + '.fmu'!r}, start_values={{{held.name!r}: {value}}}"
             + (f", stop_time={stop}" if stop else "") + ")</pre>")
-
-
-def _typed(variable: Element) -> Element:
-    """The element of a variable's type (FMI 2.0: its child; FMI 3.0: itself)."""
-    return variable[0] if variable.tag == "ScalarVariable" else variable
 
 
 def _prose(doc: str) -> str:
@@ -195,13 +182,13 @@ def _inline(text: str) -> str:
     return re.sub(r"``(.+?)``", r"<code>\1</code>", html.escape(" ".join(text.split())))
 
 
-def model_png(root: Element) -> bytes:
-    """model.png of the model whose description is ``root``: a vessel (outputs x, y, psi) as
-    CyberShip II's waterline to scale, any other model as a block with its ports; matplotlib's
-    default style, no software or time in the file."""
-    name = root.get("modelName", "")
-    inputs, outputs = ([v.get("name") for v in root.find("ModelVariables")
-                        if v.get("causality") == c] for c in ("input", "output"))
+def model_png(model: ModelDescription) -> bytes:
+    """model.png of ``model``: a vessel (outputs x, y, psi) as CyberShip II's waterline to
+    scale, any other model as a block with its ports; matplotlib's default style, no
+    software or time in the file."""
+    inputs, outputs = ([v.name for v in model.modelVariables if v.causality == c]
+                       for c in ("input", "output"))
+    name = model.modelName
     with matplotlib.style.context("default"):
         figure = Figure(figsize=(_ICON_INCHES, _ICON_INCHES), dpi=_DPI)
         ax = figure.add_axes((0, 0, 1, 1), xlim=(0, 1), ylim=(0, 1))

@@ -2,10 +2,10 @@
 
 pythonfmu 0.7.0's and pythonfmu3 0.3.4's binaries keep their Python state in a global
 ``std::shared_ptr<PyState>``; at exit its static destructor frees it, and only afterwards
-``onLibraryUnload`` (``.fini_array``) assigns to the dead pointer, corrupting malloc's
-free lists (an intermittent SIGABRT of every host that loaded an FMU). The destructor
-already shuts Python down, so ``onLibraryUnload`` becomes a plain return, in a binary the
-adapter knows by SHA-256 only (``KNOWN_BINARIES`` of its ``binary``); any other fails the build.
+``onLibraryUnload`` (``.fini_array``) assigns to the dead pointer, corrupting malloc's free
+lists (an intermittent SIGABRT of every host that loaded an FMU). The destructor already
+shuts Python down, so ``onLibraryUnload`` becomes a plain return, in a binary the adapter
+knows by SHA-256 (``KNOWN_BINARIES`` of its ``binary``); any other fails the build.
 """
 from __future__ import annotations
 
@@ -19,8 +19,7 @@ from .routes import ROUTES
 def patch(binary: bytes, where: str, fmi: int = 2) -> bytes:
     """The binary with ``onLibraryUnload`` made a no-op; RuntimeError naming ``where`` if
     it is not the binary of FMI ``fmi``'s pythonfmu that fmukit knows."""
-    route = ROUTES[fmi]
-    digest = hashlib.sha256(binary).hexdigest()
+    route, digest = ROUTES[fmi], hashlib.sha256(binary).hexdigest()
     fix = importlib.import_module(f"{route.adapter}.binary").KNOWN_BINARIES.get(digest)
     if fix is None:
         raise RuntimeError(f"{where} is not the {route.pythonfmu} {route.known} {route.linux} "
@@ -35,8 +34,7 @@ def patch(binary: bytes, where: str, fmi: int = 2) -> bytes:
 
 
 def patch_binaries(entries: dict[str, bytes], fmu: Path, fmi: int = 2) -> dict[str, bytes]:
-    """An FMU's entries (name: bytes) with ``patch`` applied to every Linux binary of FMI
-    ``fmi``'s layout."""
+    """An FMU's entries with ``patch`` applied to every Linux binary of FMI ``fmi``."""
     folder = f"binaries/{ROUTES[fmi].linux}/"
     return {name: patch(data, f"{fmu}:{name}", fmi) if name.startswith(folder) else data
             for name, data in entries.items()}

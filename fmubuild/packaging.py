@@ -123,7 +123,7 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
 
 def write_fmu(fmu: Path, entries: Mapping[str, bytes]) -> None:
     """The FMU of ``entries`` (name: bytes) written at ``fmu`` reproducibly (in name order,
-    fixed times and modes; beside it, then renamed) and validated by fmpy (RuntimeError)."""
+    fixed times and modes; whole: beside it, then renamed) and validated by fmpy."""
     from fmpy.validation import validate_fmu
 
     temporary = fmu.with_name(f".{fmu.name}.tmp")

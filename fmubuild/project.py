@@ -9,8 +9,7 @@ from fmukit.manifest import DISTRIBUTION
 ROOT = Path(__file__).resolve().parent.parent
 FMU_DIR = ROOT / "fmus"
 FMU_DIRS = {2: FMU_DIR, 3: FMU_DIR / "fmi3"}
-"""Where the FMUs of each FMI version are built: FMI 2.0's in fmus/, their FMI 3.0 twins in
-fmus/fmi3/ (the same names: fmus/fmi3/ship.fmu)."""
+"""Where the FMUs of each FMI version are built (the same names: fmus/fmi3/ship.fmu)."""
 
 FMUS: dict[str, str] = {
     "ship": "ship_fmu/ship_slave.py",
@@ -32,9 +31,8 @@ BUILD_HINT = "build the FMUs with: python -m fmukit.build"
 
 
 def project_identity() -> dict[str, str]:
-    """Who made this project's FMUs, as their model descriptions say: the author, version,
-    copyright and license of its distribution (pyproject.toml; with no author there, the
-    project's authors by its name)."""
+    """The author, version, copyright and license of this project's distribution
+    (pyproject.toml; with no author there, its authors by its name) for its FMUs."""
     meta = metadata.metadata(DISTRIBUTION)
     author = meta.get("Author") or meta.get("Author-email") or f"the {DISTRIBUTION} authors"
     return {"author": author, "version": meta["Version"], "copyright": f"Copyright (c) {author}",

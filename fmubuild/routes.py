@@ -1,8 +1,7 @@
-"""The FMI versions fmubuild builds: for each, the pythonfmu that builds it (the one version
-its fmukit adapter knows), its builder's options, its Linux platform, and the entry module
-written into each FMU (``<model_name>_fmi<N>.py``, named in ``slavemodule.txt``), which
-composes the slave class with the adapter's mixin and pythonfmu's slave class, as
-``fmukit.compose.fmu_class`` does in code.
+"""The FMI versions fmubuild builds, each by the one pythonfmu version its fmukit adapter
+knows, and the entry module written into each FMU (``<model_name>_fmi<N>.py``, named in
+``slavemodule.txt``): the slave class composed with the adapter's mixin and pythonfmu's
+slave class, as ``fmukit.compose.fmu_class`` does in code.
 """
 from __future__ import annotations
 
@@ -35,12 +34,10 @@ class Route:
     adapter: str                    # fmukit's adapter package
     options: dict[str, bool]        # the builder's options (FMI 2.0 and 3.0 spell them apart)
     linux: str                      # the platform folder of the FMU's Linux binary
-    namespace_calls: tuple[str, ...] = ()   # functions of the adapter's slave module that
-                                            # the entry module calls on its globals()
+    namespace_calls: tuple[str, ...] = ()   # the entry module calls them on its globals()
 
     def gate(self) -> str:
-        """The installed version of this route's pythonfmu; RuntimeError unless the adapter
-        knows it."""
+        """The installed version of its pythonfmu; RuntimeError unless the adapter knows it."""
         adapter = importlib.import_module(self.adapter)
         if not adapter.ACTIVE:
             raise RuntimeError(f"{self.pythonfmu} {adapter.PYTHONFMU_VERSION} is installed; "
@@ -60,8 +57,7 @@ class Route:
 
 
 ROUTES = {
-    # hold_namespace: pythonfmu 0.7 releases the entry module's namespace once per
-    # instantiation (fmukit.pythonfmu07.slave.hold_namespace).
+    # pythonfmu 0.7 releases the entry module's namespace once per instantiation.
     2: Route(2, "pythonfmu", "0.7.0", "fmukit.pythonfmu07",
              {"canGetAndSetFMUstate": True, "canSerializeFMUstate": True}, "linux64",
              ("hold_namespace",)),
@@ -75,8 +71,8 @@ ROUTES = {
 
 
 def entry_source(manifest: Manifest) -> str:
-    """The entry module this build writes for the FMU of ``manifest``; pass it to
-    ``fmukit.manifest.staleness`` to check an FMU's against it."""
+    """The entry module this build writes for the FMU of ``manifest`` (for
+    ``fmukit.manifest.staleness``)."""
     return ROUTES[manifest.fmi].entry_source(
         manifest.model_name, Path(manifest.modules[manifest.slave_module]["file"]).stem,
         manifest.slave_class)
