@@ -14,7 +14,6 @@ exits when imported is refused with one message. See docs/own_autopilot.md.
 from __future__ import annotations
 
 import argparse
-import ast
 import os
 import sys
 import traceback
@@ -22,12 +21,9 @@ from importlib.machinery import PathFinder
 from pathlib import Path
 
 from .cbuild import NoCompiler, build_c
-from .packaging import build, build_script, parsed
+from .packaging import build, build_script, imports
 from .project import C_FMUS, FMU_DIRS, FMUS, ROOT
 from .routes import ROUTES
-
-_IMPORT_ERRORS = {"ImportError", "ModuleNotFoundError", "Exception", "BaseException"}
-"""What an ``except`` that makes an import optional catches."""
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -72,8 +68,7 @@ def main(argv: list[str] | None = None) -> int:
 
 def _build_script(script: Path, includes: list[Path], out: Path | None, fmi: int) -> Path:
     """A user's script built as FMI ``fmi`` into ``out`` (default: its folder, for FMI 3.0
-    its folder fmi3); ValueError naming what is missing, what its FMU would not carry, or
-    its sys.exit."""
+    its folder fmi3); ValueError naming what is missing, what it would not carry, its exit."""
     if not script.is_file():
         raise ValueError(f"{script} does not exist")
     for include in includes:
@@ -96,10 +91,9 @@ def _build_script(script: Path, includes: list[Path], out: Path | None, fmi: int
 
 
 def _uncarried(script: Path, includes: list[Path]) -> str | None:
-    """What to do about the top-level modules ``script`` or ``includes`` import (outside a
-    try that catches ImportError) that a host would not have: not fmukit, not included, not
-    standard, not installed in this Python (this checkout and the local folders do not
-    count). The command with an --include for each, where this build finds it; or None."""
+    """What to do about the modules ``script`` or ``includes`` import (outside a try that
+    catches ImportError) that a host would not have: not fmukit, not included, not standard,
+    not installed in this Python (this checkout and the local folders do not count); or None."""
     provided = {"fmukit", *(p.stem if p.is_file() else p.name for p in includes)}
     local = [script.resolve().parent, Path.cwd().resolve(), ROOT,
              *(p.resolve().parent for p in includes)]
@@ -107,9 +101,10 @@ def _uncarried(script: Path, includes: list[Path]) -> str | None:
     files = [f for p in includes for f in ([p] if p.is_file() else sorted(p.rglob("*.py")))]
     missing: dict[str, tuple[Path, Path | None]] = {}       # module: its importer, where
     for file in [script, *(f for f in files if f.suffix == ".py")]:
-        for module in _top_level_imports(parsed(file)):
-            if module in provided or module in sys.stdlib_module_names or module in missing \
-                    or module in sys.builtin_module_names or PathFinder.find_spec(module, host):
+        needed = [m for m, required, optional in imports(file) if required and not optional]
+        for module in dict.fromkeys(m.split(".")[0] for m in needed):
+            if module in {*provided, *missing, *sys.stdlib_module_names} \
+                    or PathFinder.find_spec(module, host):
                 continue
             spec = PathFinder.find_spec(module, [str(folder) for folder in local])
             where = spec and (spec.submodule_search_locations or [spec.origin])  # a package's
@@ -134,29 +129,9 @@ def _uncarried(script: Path, includes: list[Path]) -> str | None:
 
 
 def _shown(path: Path) -> str:
-    """A path as a command typed in the working directory takes it: relative to it where
-    it lies inside it."""
+    """A path as a command typed here takes it: relative where it lies inside this folder."""
     absolute = Path(path).resolve()
     return os.path.relpath(absolute) if Path.cwd().resolve() in absolute.parents else str(absolute)
-
-
-def _top_level_imports(tree: ast.Module) -> list[str]:
-    """The first name of every absolute import in ``tree`` outside a try that catches
-    ImportError."""
-    optional = {id(node) for block in ast.walk(tree) if isinstance(block, ast.Try)
-                and any(handler.type is None or _IMPORT_ERRORS & {
-                    n.id for n in ast.walk(handler.type) if isinstance(n, ast.Name)}
-                        for handler in block.handlers)
-                for statement in block.body for node in ast.walk(statement)}
-    names = []
-    for node in ast.walk(tree):
-        if id(node) in optional:
-            continue
-        if isinstance(node, ast.Import):
-            names += [alias.name.split(".")[0] for alias in node.names]
-        elif isinstance(node, ast.ImportFrom) and not node.level and node.module:
-            names.append(node.module.split(".")[0])
-    return list(dict.fromkeys(names))
 
 
 if __name__ == "__main__":

@@ -33,6 +33,7 @@ from .project import FMU_DIRS, FMUS, ROOT, project_identity
 from .routes import ROUTES
 
 PROJECT_PACKAGES = ("fmukit", "ship_fmu", "autopilot_fmu")
+_IMPORT_ERRORS = {"ImportError", "ModuleNotFoundError", "Exception", "BaseException"}
 _GUID = re.compile(rb'\s(guid|instantiationToken)="[^"]*"')
 _GENERATED = re.compile(rb'\sgenerationDateAndTime="[^"]*"')
 
@@ -157,12 +158,13 @@ def _with_guid(entries: dict[str, bytes]) -> dict[str, bytes]:
 
 def needed_modules(scripts: Iterable[Path], packages: Iterable[str]) -> dict[str, Path]:
     """Module: file, for every module of ``packages`` (of this checkout) that ``scripts``
-    import, directly or not, read from their sources; ValueError if one has no file."""
+    import, directly or not; ValueError if one has no file."""
     found: dict[str, Path] = {}
     todo = [(None, script) for script in scripts]
     while todo:
         name, path = todo.pop()
-        for module, required in _imports(path, name):
+        package = name if path.name == "__init__.py" else (name or "").rpartition(".")[0]
+        for module, required, _ in imports(path, package):
             parts = module.split(".")
             if parts[0] not in packages:
                 continue
@@ -180,20 +182,25 @@ def needed_modules(scripts: Iterable[Path], packages: Iterable[str]) -> dict[str
     return dict(sorted(found.items()))
 
 
-def _imports(path: Path, module: str | None) -> Iterator[tuple[str, bool]]:
-    """(module, must exist) for what ``path`` (module ``module``, None for a script)
-    imports; for ``from a import b``, a and, as may-exist, a.b (b may be a module)."""
-    package = module if path.name == "__init__.py" else (module or "").rpartition(".")[0]
-    for node in ast.walk(parsed(path)):
+def imports(path: Path, package: str = "") -> Iterator[tuple[str, bool, bool]]:
+    """(module, must exist, optional) for each import in ``path``, a module of ``package``
+    (a script's relative imports are left out): for ``from a import b``, a and, as may-exist,
+    a.b; optional if inside a try that catches ImportError."""
+    tree = parsed(path)
+    optional = {id(node) for block in ast.walk(tree) if isinstance(block, ast.Try)
+                and any(handler.type is None or _IMPORT_ERRORS & {
+                    n.id for n in ast.walk(handler.type) if isinstance(n, ast.Name)}
+                        for handler in block.handlers)
+                for statement in block.body for node in ast.walk(statement)}
+    for node in ast.walk(tree):
         if isinstance(node, ast.Import):
-            yield from ((alias.name, True) for alias in node.names)
-        elif isinstance(node, ast.ImportFrom):
-            base = node.module or ""
-            if node.level and package:
-                base = importlib.util.resolve_name("." * node.level + base, package)
-            yield from [(base, True)] if base else []
-            yield from ((f"{base}.{alias.name}".lstrip("."), False) for alias in node.names
-                        if alias.name != "*")
+            yield from ((alias.name, True, id(node) in optional) for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and (package or not node.level):
+            base = importlib.util.resolve_name("." * node.level + (node.module or ""), package) \
+                if node.level else node.module
+            yield base, True, id(node) in optional
+            yield from ((f"{base}.{alias.name}", False, id(node) in optional)
+                        for alias in node.names if alias.name != "*")
 
 
 def parsed(path: Path) -> ast.Module:
