@@ -101,8 +101,8 @@ def _uncarried(script: Path, includes: list[Path]) -> str | None:
     files = [f for p in includes for f in ([p] if p.is_file() else sorted(p.rglob("*.py")))]
     missing: dict[str, tuple[Path, Path | None]] = {}       # module: its importer, where
     for file in [script, *(f for f in files if f.suffix == ".py")]:
-        needed = [m for m, required, optional in imports(file) if required and not optional]
-        for module in dict.fromkeys(m.split(".")[0] for m in needed):
+        for module in dict.fromkeys(m.split(".")[0] for m, optional in imports(file)
+                                    if not optional):
             if module in {*provided, *missing, *sys.stdlib_module_names} \
                     or PathFinder.find_spec(module, host):
                 continue

@@ -49,18 +49,11 @@ PYTHON_HOSTS = {
              + _HOME + " (Tested on Linux with the platform faked and the DLL's imports read, "
              "not on a Windows host.)",
 }
-"""What a host needs to run a Python FMU, by platform; {python}: the Python versions."""
+"""What a host needs to run a Python FMU, by platform."""
 _STYLE = ("body{font-family:sans-serif;max-width:60em;margin:1em auto;padding:0 1em}"
           "table{border-collapse:collapse}th,td{border:1px solid #bbb;padding:2px 6px;"
           "text-align:left;vertical-align:top}pre{background:#f4f4f4;padding:4px}")
 _ICON_INCHES, _DPI, _FONT = 2.56, 100, "DejaVu Sans"      # 256 x 256, matplotlib's own font
-
-
-def python_hosts() -> dict[str, str]:
-    """``PYTHON_HOSTS`` with the Python versions this project runs on (its Requires-Python)."""
-    needed = metadata.metadata(DISTRIBUTION)["Requires-Python"]
-    python = f"{needed[2:]} or later" if needed.startswith(">=") else needed
-    return {platform: needs.format(python=python) for platform, needs in PYTHON_HOSTS.items()}
 
 
 def describe(entries: Mapping[str, bytes], generation_tool: str, identity: Mapping[str, str],
@@ -68,12 +61,14 @@ def describe(entries: Mapping[str, bytes], generation_tool: str, identity: Mappi
              hosts: Mapping[str, str]) -> dict[str, bytes]:
     """``entries`` with the model description's ``generation_tool`` and ``identity``, the
     page (``overview``: the model's docstring; ``sources``: module: docstring; ``hosts``:
-    platform: what a host needs there, in HTML) and the icon."""
+    platform: what a host needs there, in HTML, {python} the Python versions this project
+    runs on) and the icon."""
     root = fromstring(entries["modelDescription.xml"])
     for element in root.iter():             # the layout is written again below
         element.text = element.text if (element.text or "").strip() else None
         element.tail = element.tail if (element.tail or "").strip() else None
     root.set("generationTool", generation_tool)
+    root.attrib.pop("generationDateAndTime", None)       # the same sources, the same bytes
     for name in IDENTITY:
         if name in identity and not root.get(name):
             root.set(name, identity[name])
@@ -84,9 +79,12 @@ def describe(entries: Mapping[str, bytes], generation_tool: str, identity: Mappi
     model = read_model_description(buffer, validate=False)
     platforms = {name.split("/")[1] for name in entries
                  if name.startswith("binaries/") and name.count("/") == 2}
+    needed = metadata.metadata(DISTRIBUTION)["Requires-Python"]
+    python = f"{needed[2:]} or later" if needed.startswith(">=") else needed
     return {**entries, "modelDescription.xml": xml, "model.png": model_png(model),
             "documentation/index.html": index_html(
-                model, overview, sources, {p: hosts[p] for p in sorted(platforms) if p in hosts})}
+                model, overview, sources,
+                {p: hosts[p].format(python=python) for p in sorted(platforms) if p in hosts})}
 
 
 def index_html(model: ModelDescription, overview: str, sources: Mapping[str, str],

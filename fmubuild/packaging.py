@@ -35,7 +35,6 @@ from .routes import ROUTES
 PROJECT_PACKAGES = ("fmukit", "ship_fmu", "autopilot_fmu")
 _IMPORT_ERRORS = {"ImportError", "ModuleNotFoundError", "Exception", "BaseException"}
 _GUID = re.compile(rb'\s(guid|instantiationToken)="[^"]*"')
-_GENERATED = re.compile(rb'\sgenerationDateAndTime="[^"]*"')
 
 
 def build(name: str, dest: Path | None = None, fmi: int = 2) -> Path:
@@ -51,11 +50,14 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
     ValueError naming the script if it cannot be built; RuntimeError if invalid."""
     route, script, dest = ROUTES[fmi], Path(script), Path(dest)
     pythonfmu_version = route.gate()
+    folder = script.resolve().parent        # as imported: ship_fmu.ship_slave, a user's by name
+    slave_module = (f"{folder.name}.{script.stem}" if folder.parent == ROOT
+                    and folder.name in PROJECT_PACKAGES else script.stem)
     (dest.parent if dest.suffix == ".fmu" else dest).mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix=f"build_{script.stem}_") as tmp, \
             _imports_undone(tmp):
         stage = Path(tmp) / "resources"             # module: its copy in the FMU
-        staged = {_module_name(script): _copy(script, stage / script.name)}
+        staged = {slave_module: _copy(script, stage / script.name)}
         for include in (Path(p) for p in packages if not isinstance(p, str)):
             for file in [include] if include.is_file() else sorted(
                     f for f in include.rglob("*") if f.is_file()
@@ -83,13 +85,13 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
                         for node in parsed(found).body):        # not only a docstring
                     staged[module] = _copy(found, stage / found.relative_to(ROOT))
             modules = {m: _carried(path, stage) for m, path in sorted(staged.items())}
-            manifest = Manifest(model_name, _module_name(script), slave.__name__, modules,
+            manifest = Manifest(model_name, slave_module, slave.__name__, modules,
                                 digest_of({m: c["sha256"] for m, c in modules.items()}),
                                 pythonfmu_version, route.options, version(), fmi,
                                 {"module": entry.stem, **_carried(entry, stage)})
             (stage / "fmukit_manifest.json").write_text(manifest.to_json())
             (stage / "requirements.txt").write_text("numpy\n")
-            sources = {m: doc for m, path in sorted(staged.items()) if m != manifest.slave_module
+            sources = {m: doc for m, path in sorted(staged.items()) if m != slave_module
                        and m.split(".")[0] != "fmukit" and (doc := _docstring(path))}
             built = importlib.import_module(route.pythonfmu).FmuBuilder.build_FMU(
                 entry, dest=Path(tmp) / "built",
@@ -108,7 +110,7 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
     write_fmu(fmu, _with_guid(documentation.describe(
         exit_fix.patch_binaries(entries, fmu, fmi),
         f"fmukit {version()} ({route.pythonfmu} {pythonfmu_version})", identity or {},
-        _docstring(script), sources, documentation.python_hosts())))
+        _docstring(script), sources, documentation.PYTHON_HOSTS)))
     try:
         instantiate_in_child(fmu, isolated=True)
     except InstantiationFailed as failed:
@@ -144,9 +146,8 @@ def write_fmu(fmu: Path, entries: Mapping[str, bytes]) -> None:
 
 
 def _with_guid(entries: dict[str, bytes]) -> dict[str, bytes]:
-    """``entries`` without the generation time, with a GUID (FMI 3.0: instantiation token)
-    derived from their contents."""
-    blank = _GUID.sub(rb' \1=""', _GENERATED.sub(b"", entries["modelDescription.xml"]), 1)
+    """``entries`` with a GUID (FMI 3.0: instantiation token) derived from their contents."""
+    blank = _GUID.sub(rb' \1=""', entries["modelDescription.xml"], 1)
     contents = hashlib.sha256()
     for name in sorted(entries):
         data = blank if name == "modelDescription.xml" else entries[name]
@@ -158,13 +159,13 @@ def _with_guid(entries: dict[str, bytes]) -> dict[str, bytes]:
 
 def needed_modules(scripts: Iterable[Path], packages: Iterable[str]) -> dict[str, Path]:
     """Module: file, for every module of ``packages`` (of this checkout) that ``scripts``
-    import, directly or not; ValueError if one has no file."""
+    import, directly or not."""
     found: dict[str, Path] = {}
     todo = [(None, script) for script in scripts]
     while todo:
         name, path = todo.pop()
         package = name if path.name == "__init__.py" else (name or "").rpartition(".")[0]
-        for module, required, _ in imports(path, package):
+        for module, _ in imports(path, package):
             parts = module.split(".")
             if parts[0] not in packages:
                 continue
@@ -172,8 +173,6 @@ def needed_modules(scripts: Iterable[Path], packages: Iterable[str]) -> dict[str
                 parent, base = ".".join(parts[:i]), ROOT.joinpath(*parts[:i])
                 file = next((f for f in (base / "__init__.py", base.with_suffix(".py"))
                              if f.is_file()), None)
-                if file is None and required:
-                    raise ValueError(f"{path} imports {module}, which has no file in {ROOT}")
                 if file is None:
                     break                           # a name imported from a module
                 if parent not in found:
@@ -182,10 +181,10 @@ def needed_modules(scripts: Iterable[Path], packages: Iterable[str]) -> dict[str
     return dict(sorted(found.items()))
 
 
-def imports(path: Path, package: str = "") -> Iterator[tuple[str, bool, bool]]:
-    """(module, must exist, optional) for each import in ``path``, a module of ``package``
-    (a script's relative imports are left out): for ``from a import b``, a and, as may-exist,
-    a.b; optional if inside a try that catches ImportError."""
+def imports(path: Path, package: str = "") -> Iterator[tuple[str, bool]]:
+    """(module, optional) for each import in ``path``, a module of ``package`` (a script's
+    relative imports are left out): for ``from a import b``, a and a.b (b may be a module);
+    optional if inside a try that catches ImportError."""
     tree = parsed(path)
     optional = {id(node) for block in ast.walk(tree) if isinstance(block, ast.Try)
                 and any(handler.type is None or _IMPORT_ERRORS & {
@@ -194,13 +193,12 @@ def imports(path: Path, package: str = "") -> Iterator[tuple[str, bool, bool]]:
                 for statement in block.body for node in ast.walk(statement)}
     for node in ast.walk(tree):
         if isinstance(node, ast.Import):
-            yield from ((alias.name, True, id(node) in optional) for alias in node.names)
+            yield from ((alias.name, id(node) in optional) for alias in node.names)
         elif isinstance(node, ast.ImportFrom) and (package or not node.level):
             base = importlib.util.resolve_name("." * node.level + (node.module or ""), package) \
                 if node.level else node.module
-            yield base, True, id(node) in optional
-            yield from ((f"{base}.{alias.name}", False, id(node) in optional)
-                        for alias in node.names if alias.name != "*")
+            yield from ((name, id(node) in optional) for name in
+                        [base, *(f"{base}.{alias.name}" for alias in node.names)])
 
 
 def parsed(path: Path) -> ast.Module:
@@ -237,21 +235,12 @@ def _copy(file: Path, to: Path) -> Path:
     return Path(shutil.copy2(file, to))
 
 
-def _carried(file: Path, stage: Path) -> dict[str, str]:
-    """A module's entry in the manifest: its file in the FMU and its SHA-256."""
+def _carried(file: Path, stage: Path) -> dict[str, str]:      # its entry in the manifest
     return {"file": file.relative_to(stage.parent).as_posix(), "sha256": sha256(file)}
 
 
 def _docstring(file: Path) -> str:
     return ast.get_docstring(parsed(file)) or ""
-
-
-def _module_name(script: Path) -> str:
-    """How this project imports a slave script: ship_fmu.ship_slave, or a user's by name."""
-    folder = script.resolve().parent
-    if folder.parent == ROOT and folder.name in PROJECT_PACKAGES:
-        return f"{folder.name}.{script.stem}"
-    return script.stem
 
 
 @contextlib.contextmanager
