@@ -18,9 +18,6 @@ from .packaging import write_fmu
 from .project import C_FMUS, FMU_DIRS, ROOT, project_identity
 from .routes import ROUTES
 
-FILES = {2: ("{name}.c", "modelDescription.xml"),
-         3: ("{name}_fmi3.c", "modelDescription_fmi3.xml")}
-"""FMI version: the C FMU folder's entry-point source and model description for it."""
 WINDOWS = {2: "win64", 3: "x86_64-windows"}
 """FMI version: its platform folder for 64-bit Windows."""
 C_HOSTS = {fmi: {ROUTES[fmi].linux: f"any FMI {fmi}.0 co-simulation host; the library needs "
@@ -59,9 +56,9 @@ def c_compiler() -> str | None:
 
 def sources(name: str, fmi: int = 2) -> list[Path]:
     """The C FMU ``name``'s FMI ``fmi`` source, headers and model description."""
-    folder = ROOT / C_FMUS[name]
-    source, description = (folder / f.format(name=name) for f in FILES[fmi])
-    return [source, *sorted(folder.glob("*.h")), description]
+    folder, version_suffix = ROOT / C_FMUS[name], "" if fmi == 2 else "_fmi3"
+    return [folder / f"{name}{version_suffix}.c", *sorted(folder.glob("*.h")),
+            folder / f"modelDescription{version_suffix}.xml"]
 
 
 def build_c(name: str, dest: Path | None = None, fmi: int = 2) -> Path:
@@ -101,7 +98,6 @@ def build_c(name: str, dest: Path | None = None, fmi: int = 2) -> Path:
                                    f"{compiled.stderr}")
             entries[f"binaries/{platform}/{library.name}"] = library.read_bytes()
     fmu = (dest or FMU_DIRS[fmi]) / f"{name}.fmu"
-    fmu.parent.mkdir(parents=True, exist_ok=True)
     write_fmu(fmu, documentation.describe(entries, f"fmukit {version()} (fmubuild.cbuild)",
                                           project_identity(), "", {}, C_HOSTS[fmi]))
     return fmu

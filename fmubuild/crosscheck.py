@@ -1,6 +1,6 @@
 """FMI cross-check reference files of every Python FMU and its FMI 3.0 twin (docs/interop.md),
-simulated by fmpy isolated from this checkout and committed; tests/test_crosscheck.py
-replays them. Regenerate them, saying why in the commit, only when results change.
+simulated by fmpy apart from this checkout; committed, replayed by tests/test_crosscheck.py.
+Regenerate them, saying why in the commit, only when results change.
 
     python -m fmubuild.crosscheck            # both versions: fmus/crosscheck/2.0/..., 3.0/...
     python -m fmubuild.crosscheck --fmi 3    # only the FMI 3.0 twins (fmus/fmi3/)
@@ -23,13 +23,12 @@ from .routes import ROUTES
 
 TOOL, VERSION = "ship_autopilot_cosim", "0.1.0"
 CROSSCHECK_DIRS = {fmi: FMU_DIR / "crosscheck" / f"{fmi}.0" / "cs" / route.linux / TOOL / VERSION
-                   for fmi, route in ROUTES.items()}
-"""FMI version: the folder of its references (made on 64-bit Linux)."""
+                   for fmi, route in ROUTES.items()}     # the references are made on Linux
 
 
 @dataclass(frozen=True)
 class Case:
-    stop: float
+    stop: float                              # s
     inputs: tuple[str, ...]
     table: tuple[tuple[float, ...], ...]     # rows of (time, *inputs), linearly interpolated
     step: float = 0.1
@@ -71,8 +70,7 @@ def read_opt(path: Path) -> dict[str, float]:
 
 
 def generate(name: str, fmi: int = 2) -> Path:
-    """Write the cross-check files of FMU ``name``'s FMI ``fmi`` twin from the built
-    ``FMU_DIRS[fmi]/<name>.fmu``, replacing its folder whole; the folder."""
+    """The cross-check folder of ``FMU_DIRS[fmi]/<name>.fmu``, written again whole."""
     case, paths = CASES[name], files(name, fmi)
     paths["dir"].parent.mkdir(parents=True, exist_ok=True)
     with fresh_folder(paths["dir"]) as folder:

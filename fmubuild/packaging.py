@@ -53,7 +53,6 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
     folder = script.resolve().parent        # as imported: ship_fmu.ship_slave, a user's by name
     slave_module = (f"{folder.name}.{script.stem}" if folder.parent == ROOT
                     and folder.name in PROJECT_PACKAGES else script.stem)
-    (dest.parent if dest.suffix == ".fmu" else dest).mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix=f"build_{script.stem}_") as tmp, \
             _imports_undone(tmp):
         stage = Path(tmp) / "resources"             # module: its copy in the FMU
@@ -129,6 +128,7 @@ def write_fmu(fmu: Path, entries: Mapping[str, bytes]) -> None:
     fixed times and modes; whole: beside it, then renamed) and validated by fmpy."""
     from fmpy.validation import validate_fmu
 
+    fmu.parent.mkdir(parents=True, exist_ok=True)
     temporary = fmu.with_name(f".{fmu.name}.tmp")
     try:
         with zipfile.ZipFile(temporary, "w", zipfile.ZIP_DEFLATED) as package:

@@ -10,7 +10,6 @@ ROOT = Path(__file__).resolve().parent.parent
 FMU_DIR = ROOT / "fmus"
 FMU_DIRS = {2: FMU_DIR, 3: FMU_DIR / "fmi3"}
 """Where the FMUs of each FMI version are built (the same names: fmus/fmi3/ship.fmu)."""
-
 FMUS: dict[str, str] = {
     "ship": "ship_fmu/ship_slave.py",
     "manoeuvre": "ship_fmu/manoeuvre_slave.py",
@@ -23,10 +22,8 @@ FMUS: dict[str, str] = {
 """FMU name: its slave script. An FMU carries the project modules its script imports."""
 SLAVE_MODULES = frozenset(".".join(Path(script).with_suffix("").parts) for script in FMUS.values())
 """The modules of those scripts, as a manifest names them."""
-
 C_FMUS = {"pd_autopilot_c": "autopilot_fmu/pd_autopilot_c"}
 """FMU name: the folder of its C source and model description."""
-
 BUILD_HINT = "build the FMUs with: python -m fmukit.build"
 
 

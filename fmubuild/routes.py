@@ -6,7 +6,7 @@ slave class, as ``fmukit.compose.fmu_class`` does in code.
 from __future__ import annotations
 
 import importlib
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from fmukit.manifest import Manifest
@@ -49,11 +49,9 @@ class Route:
 
     def entry_source(self, model_name: str, module: str, cls: str) -> str:
         """The entry module's source: ``cls`` of ``module`` composed for this version."""
-        return _ENTRY.format(fmi=self.fmi, model_name=model_name, module=module, cls=cls,
-                             pythonfmu=self.pythonfmu, known=self.known, adapter=self.adapter,
+        return _ENTRY.format(**asdict(self), model_name=model_name, module=module, cls=cls,
                              imported=", ".join([f"Fmi{self.fmi}Entry", *self.namespace_calls]),
-                             calls="".join(f"{call}(globals())\n"
-                                           for call in self.namespace_calls))
+                             calls="".join(f"{f}(globals())\n" for f in self.namespace_calls))
 
 
 ROUTES = {
@@ -67,7 +65,6 @@ ROUTES = {
              {"canGetAndSetFMUState": True, "canSerializeFMUState": True,
               "canHandleVariableCommunicationStepSize": True}, "x86_64-linux"),
 }
-"""FMI version: its route."""
 
 
 def entry_source(manifest: Manifest) -> str:
