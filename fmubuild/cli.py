@@ -50,12 +50,9 @@ def main(argv: list[str] | None = None) -> int:
                          "nor a Python script (.py)")
     for name in args.names or project:
         try:
-            if name in FMUS:
-                fmu = build(name, args.out, args.fmi)
-            elif name in C_FMUS:
-                fmu = build_c(name, args.out, args.fmi)
-            else:
-                fmu = _build_script(Path(name), args.include, args.out, args.fmi)
+            builder = {**dict.fromkeys(FMUS, build), **dict.fromkeys(C_FMUS, build_c)}.get(name)
+            fmu = (builder(name, args.out, args.fmi) if builder else
+                   _build_script(Path(name), args.include, args.out, args.fmi))
         except NoCompiler as missing:
             print(f"note: {missing}", file=sys.stderr)
             continue

@@ -11,8 +11,7 @@ import textwrap
 import zipfile
 from collections.abc import Mapping
 from importlib import metadata
-from xml.dom.minidom import parseString
-from xml.etree.ElementTree import fromstring, tostring
+from xml.etree.ElementTree import fromstring, indent, tostring
 
 import matplotlib.style
 from fmpy import read_model_description
@@ -64,16 +63,13 @@ def describe(entries: Mapping[str, bytes], generation_tool: str, identity: Mappi
     platform: what a host needs there, in HTML, {python} the Python versions this project
     runs on) and the icon."""
     root = fromstring(entries["modelDescription.xml"])
-    for element in root.iter():             # the layout is written again below
-        element.text = element.text if (element.text or "").strip() else None
-        element.tail = element.tail if (element.tail or "").strip() else None
     root.set("generationTool", generation_tool)
     root.attrib.pop("generationDateAndTime", None)       # the same sources, the same bytes
     for name in IDENTITY:
         if name in identity and not root.get(name):
             root.set(name, identity[name])
-    # as pythonfmu writes it: minidom, tab-indented
-    xml = parseString(tostring(root, "UTF-8")).toprettyxml(indent="\t", encoding="UTF-8")
+    indent(root, "\t")
+    xml = tostring(root, "UTF-8", xml_declaration=True)
     with zipfile.ZipFile(buffer := io.BytesIO(), "w") as package:
         package.writestr("modelDescription.xml", xml)           # as fmpy reads it
     model = read_model_description(buffer, validate=False)
@@ -98,7 +94,8 @@ def index_html(model: ModelDescription, overview: str, sources: Mapping[str, str
              *((a, getattr(model, a)) for a in (*IDENTITY, "generationTool") if getattr(model, a))]
     body = [f"<h1>{html.escape(model.modelName)}</h1>",
             f"<p>{html.escape(model.description or '')}</p>",
-            _table([f"<tr><th>{a}</th><td>{html.escape(value)}</td></tr>" for a, value in about]),
+            "<table>\n" + "\n".join(f"<tr><th>{a}</th><td>{html.escape(value)}</td></tr>"
+                                    for a, value in about) + "\n</table>",
             "<h2>Model</h2>", _prose(overview)]
     if "Tomera" in overview + (model.description or "") + "".join(sources.values()):
         body.append(f"<p>Equation numbers are those of {PAPER}</p>")
@@ -123,10 +120,6 @@ def index_html(model: ModelDescription, overview: str, sources: Mapping[str, str
             "<body>\n" + "\n".join(part for part in body if part) + "\n</body>\n</html>\n").encode()
 
 
-def _table(rows: list[str]) -> str:
-    return "<table>\n" + "\n".join(rows) + "\n</table>"
-
-
 def _variables(variables: list[ModelVariable], columns: tuple[str, ...],
                feedthrough: Mapping[str, list[str]] | None = None) -> str:
     """A table of ``variables``: name, type, unit, ``columns`` and meaning; for outputs
@@ -143,7 +136,7 @@ def _variables(variables: list[ModelVariable], columns: tuple[str, ...],
             cells.append(", ".join(feedthrough.get(v.name, [])) or "none")
         rows.append(f"<tr><td><code>{html.escape(v.name)}</code></td>" + "".join(
             f"<td>{html.escape(c)}</td>" for c in (*cells, v.description or "")) + "</tr>")
-    return _table(rows)
+    return "<table>\n" + "\n".join(rows) + "\n</table>"
 
 
 def _example(model: ModelDescription, inputs: list[ModelVariable]) -> str:

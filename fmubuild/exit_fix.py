@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import hashlib
 import importlib
-from pathlib import Path
 
 from .routes import ROUTES
 
@@ -32,9 +31,3 @@ def patch(binary: bytes, where: str, fmi: int = 2) -> bytes:
         raise RuntimeError(f"{where}: the patched binary is not the one fmukit expects")
     return fixed
 
-
-def patch_binaries(entries: dict[str, bytes], fmu: Path, fmi: int = 2) -> dict[str, bytes]:
-    """An FMU's entries with ``patch`` applied to every Linux binary of FMI ``fmi``."""
-    folder = f"binaries/{ROUTES[fmi].linux}/"
-    return {name: patch(data, f"{fmu}:{name}", fmi) if name.startswith(folder) else data
-            for name, data in entries.items()}

@@ -49,12 +49,17 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
     ``packages``: project package names (carried as imported) and paths (carried whole).
     ValueError naming the script if it cannot be built; RuntimeError if invalid."""
     route, script, dest = ROUTES[fmi], Path(script), Path(dest)
-    pythonfmu_version = route.gate()
+    adapter = importlib.import_module(route.adapter)
+    if not adapter.ACTIVE:
+        raise RuntimeError(f"{route.pythonfmu} {adapter.PYTHONFMU_VERSION} is installed; fmukit "
+                           f"builds FMI {fmi}.0 FMUs with {route.pythonfmu} {route.known} only, "
+                           f"whose defects {route.adapter} compensates (pip install "
+                           f"{route.pythonfmu}=={route.known}, or check the new version and "
+                           f"extend {route.adapter})")
     folder = script.resolve().parent        # as imported: ship_fmu.ship_slave, a user's by name
     slave_module = (f"{folder.name}.{script.stem}" if folder.parent == ROOT
                     and folder.name in PROJECT_PACKAGES else script.stem)
-    with tempfile.TemporaryDirectory(prefix=f"build_{script.stem}_") as tmp, \
-            _imports_undone(tmp):
+    with _imports_undone(), tempfile.TemporaryDirectory(prefix=f"build_{script.stem}_") as tmp:
         stage = Path(tmp) / "resources"             # module: its copy in the FMU
         staged = {slave_module: _copy(script, stage / script.name)}
         for include in (Path(p) for p in packages if not isinstance(p, str)):
@@ -86,7 +91,7 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
             modules = {m: _carried(path, stage) for m, path in sorted(staged.items())}
             manifest = Manifest(model_name, slave_module, slave.__name__, modules,
                                 digest_of({m: c["sha256"] for m, c in modules.items()}),
-                                pythonfmu_version, route.options, version(), fmi,
+                                adapter.PYTHONFMU_VERSION, route.options, version(), fmi,
                                 {"module": entry.stem, **_carried(entry, stage)})
             (stage / "fmukit_manifest.json").write_text(manifest.to_json())
             (stage / "requirements.txt").write_text("numpy\n")
@@ -103,13 +108,13 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
             if shadowed is not None:
                 sys.modules[script.stem] = shadowed
         fmu = dest if dest.suffix == ".fmu" else dest / Path(built).name
-        with zipfile.ZipFile(built) as package:
-            entries = {info.filename: package.read(info) for info in package.infolist()
-                       if not info.is_dir()}
-    write_fmu(fmu, _with_guid(documentation.describe(
-        exit_fix.patch_binaries(entries, fmu, fmi),
-        f"fmukit {version()} ({route.pythonfmu} {pythonfmu_version})", identity or {},
-        _docstring(script), sources, documentation.PYTHON_HOSTS)))
+        with zipfile.ZipFile(built) as package:     # the Linux binary with its exit fixed
+            entries = {name: exit_fix.patch(package.read(name), f"{fmu}:{name}", fmi)
+                       if name.startswith(f"binaries/{route.linux}/") else package.read(name)
+                       for name in package.namelist() if not name.endswith("/")}
+    tool = f"fmukit {version()} ({route.pythonfmu} {adapter.PYTHONFMU_VERSION})"
+    write_fmu(fmu, documentation.describe(entries, tool, identity or {}, _docstring(script),
+                                          sources, documentation.PYTHON_HOSTS), derive_guid=True)
     try:
         instantiate_in_child(fmu, isolated=True)
     except InstantiationFailed as failed:
@@ -123,11 +128,20 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
     return fmu
 
 
-def write_fmu(fmu: Path, entries: Mapping[str, bytes]) -> None:
+def write_fmu(fmu: Path, entries: Mapping[str, bytes], derive_guid: bool = False) -> None:
     """The FMU of ``entries`` (name: bytes) written at ``fmu`` reproducibly (in name order,
-    fixed times and modes; whole: beside it, then renamed) and validated by fmpy."""
+    fixed times and modes; whole: beside it, then renamed) and validated by fmpy; with
+    ``derive_guid``, its GUID (FMI 3.0: instantiation token) derived from its contents."""
     from fmpy.validation import validate_fmu
 
+    if derive_guid:
+        blank = _GUID.sub(rb' \1=""', entries["modelDescription.xml"], 1)
+        contents = hashlib.sha256()
+        for name in sorted(entries):
+            data = blank if name == "modelDescription.xml" else entries[name]
+            contents.update(name.encode() + b"\0" + hashlib.sha256(data).digest())
+        guid = str(uuid.uuid5(uuid.NAMESPACE_OID, contents.hexdigest())).encode()
+        entries = {**entries, "modelDescription.xml": _GUID.sub(rb' \1="{%s}"' % guid, blank, 1)}
     fmu.parent.mkdir(parents=True, exist_ok=True)
     temporary = fmu.with_name(f".{fmu.name}.tmp")
     try:
@@ -143,18 +157,6 @@ def write_fmu(fmu: Path, entries: Mapping[str, bytes]) -> None:
     problems = validate_fmu(str(fmu))
     if problems:
         raise RuntimeError(f"{fmu} does not validate:\n" + "\n".join(problems))
-
-
-def _with_guid(entries: dict[str, bytes]) -> dict[str, bytes]:
-    """``entries`` with a GUID (FMI 3.0: instantiation token) derived from their contents."""
-    blank = _GUID.sub(rb' \1=""', entries["modelDescription.xml"], 1)
-    contents = hashlib.sha256()
-    for name in sorted(entries):
-        data = blank if name == "modelDescription.xml" else entries[name]
-        contents.update(name.encode() + b"\0" + hashlib.sha256(data).digest())
-    guid = uuid.uuid5(uuid.NAMESPACE_OID, contents.hexdigest())
-    return {**entries, "modelDescription.xml": _GUID.sub(rb' \1="{%s}"' % str(guid).encode(),
-                                                          blank, 1)}
 
 
 def needed_modules(scripts: Iterable[Path], packages: Iterable[str]) -> dict[str, Path]:
@@ -244,15 +246,15 @@ def _docstring(file: Path) -> str:
 
 
 @contextlib.contextmanager
-def _imports_undone(stage: str) -> Iterator[None]:
-    """Forget what building imported from ``stage`` or pythonfmu's temporary folders (and
-    its sys.path), so the next build or in-process run finds no stale module."""
+def _imports_undone() -> Iterator[None]:
+    """sys.path restored, and the modules building imported from temporary folders, gone
+    since, forgotten: the next build or in-process run finds no stale module."""
     path, modules = list(sys.path), set(sys.modules)
     try:
         yield
     finally:
         sys.path[:] = path
         for name in set(sys.modules) - modules:
-            file = str(getattr(sys.modules[name], "__file__", None) or "")
-            if file.startswith(stage) or (file and not os.path.exists(file)):
+            file = getattr(sys.modules[name], "__file__", None)
+            if file and not os.path.exists(file):
                 del sys.modules[name]

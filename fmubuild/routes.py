@@ -5,7 +5,6 @@ slave class, as ``fmukit.compose.fmu_class`` does in code.
 """
 from __future__ import annotations
 
-import importlib
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -35,17 +34,6 @@ class Route:
     options: dict[str, bool]        # the builder's options (FMI 2.0 and 3.0 spell them apart)
     linux: str                      # the platform folder of the FMU's Linux binary
     namespace_calls: tuple[str, ...] = ()   # the entry module calls them on its globals()
-
-    def gate(self) -> str:
-        """The installed version of its pythonfmu; RuntimeError unless the adapter knows it."""
-        adapter = importlib.import_module(self.adapter)
-        if not adapter.ACTIVE:
-            raise RuntimeError(f"{self.pythonfmu} {adapter.PYTHONFMU_VERSION} is installed; "
-                               f"fmukit builds FMI {self.fmi}.0 FMUs with {self.pythonfmu} "
-                               f"{self.known} only, whose defects {self.adapter} compensates "
-                               f"(pip install {self.pythonfmu}=={self.known}, or check the new "
-                               f"version and extend {self.adapter})")
-        return adapter.PYTHONFMU_VERSION
 
     def entry_source(self, model_name: str, module: str, cls: str) -> str:
         """The entry module's source: ``cls`` of ``module`` composed for this version."""
