@@ -18,15 +18,13 @@ from .packaging import write_fmu
 from .project import C_FMUS, FMU_DIRS, ROOT, project_identity
 from .routes import ROUTES
 
-WINDOWS = {2: "win64", 3: "x86_64-windows"}
-"""FMI version: its platform folder for 64-bit Windows."""
+WINDOWS = {2: "win64", 3: "x86_64-windows"}                # FMI version: the platform folder
 C_HOSTS = {fmi: {ROUTES[fmi].linux: f"any FMI {fmi}.0 co-simulation host; the library needs "
                                     "only libc and libm.",
                  windows: f"any FMI {fmi}.0 co-simulation host; the DLL needs only KERNEL32 "
                           "and msvcrt."}      # tests/test_windows.py reads the DLL's imports
            for fmi, windows in WINDOWS.items()}
-WIN64_COMPILER = "x86_64-w64-mingw32-gcc"
-"""mingw-w64's C compiler for 64-bit Windows (Debian: gcc-mingw-w64-x86-64)."""
+WIN64_COMPILER = "x86_64-w64-mingw32-gcc"          # mingw-w64's (Debian: gcc-mingw-w64-x86-64)
 _WIN64_FLAGS = ["-static-libgcc",        # no libgcc_s DLL for the host to find
                 "-s",                    # strip: mingw-w64's start-up code brings debug sections
                 "-Wl,--no-insert-timestamp,--disable-auto-image-base"]   # reproducible

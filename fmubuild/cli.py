@@ -31,7 +31,7 @@ def main(argv: list[str] | None = None) -> int:
                                      description=__doc__.split("\n\n")[0],
                                      epilog="\n\n".join(__doc__.split("\n\n")[1:]),
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    project = [*FMUS, *C_FMUS]
+    project = {**dict.fromkeys(FMUS, build), **dict.fromkeys(C_FMUS, build_c)}   # name: builder
     parser.add_argument("names", nargs="*", metavar="NAME|SCRIPT.py",
                         help=f"FMUs of the project (default: all of {', '.join(project)}), or "
                              "paths of your own scripts")
@@ -50,8 +50,7 @@ def main(argv: list[str] | None = None) -> int:
                          "nor a Python script (.py)")
     for name in args.names or project:
         try:
-            builder = {**dict.fromkeys(FMUS, build), **dict.fromkeys(C_FMUS, build_c)}.get(name)
-            fmu = (builder(name, args.out, args.fmi) if builder else
+            fmu = (project[name](name, args.out, args.fmi) if name in project else
                    _build_script(Path(name), args.include, args.out, args.fmi))
         except NoCompiler as missing:
             print(f"note: {missing}", file=sys.stderr)
@@ -88,9 +87,9 @@ def _build_script(script: Path, includes: list[Path], out: Path | None, fmi: int
 
 
 def _uncarried(script: Path, includes: list[Path]) -> str | None:
-    """What to do about the modules ``script`` or ``includes`` import (outside a try that
-    catches ImportError) that a host would not have: not fmukit, not included, not standard,
-    not installed in this Python (this checkout and the local folders do not count); or None."""
+    """What to do about the modules ``script`` or ``includes`` import (outside a try catching
+    ImportError) that a host would not have: not fmukit, included, standard, or installed here
+    (this checkout and the local folders do not count); None if there is none."""
     provided = {"fmukit", *(p.stem if p.is_file() else p.name for p in includes)}
     local = [script.resolve().parent, Path.cwd().resolve(), ROOT,
              *(p.resolve().parent for p in includes)]

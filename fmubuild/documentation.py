@@ -22,8 +22,7 @@ from matplotlib.patches import FancyBboxPatch, Polygon
 from fmukit.manifest import DISTRIBUTION
 from ship_fmu.data import Hull
 
-IDENTITY = ("author", "version", "copyright", "license")
-"""modelDescription.xml attributes set where the model does not declare them."""
+IDENTITY = ("author", "version", "copyright", "license")      # set where the model has none
 PAPER = ("Tomera, M. (2010). <i>Nonlinear controller design of a ship autopilot</i>. "
          "Int. J. Appl. Math. Comput. Sci. 20(2), 271-280.")
 _LINUX = ("CPython {{python}} (64-bit) with numpy. A Python host {} needs nothing else. A host "
@@ -32,23 +31,21 @@ _LINUX = ("CPython {{python}} (64-bit) with numpy. A Python host {} needs nothin
           "naming a site-packages that has numpy if that Python's own has none.")
 _HOME = ("Set <code>PYTHONHOME</code> to that folder if Python cannot find its standard "
          "library, <code>PYTHONPATH</code> to a site-packages with numpy if its own has none.")
-PYTHON_HOSTS = {
+PYTHON_HOSTS = {                        # what a host needs to run a Python FMU, by platform
     "linux64": _LINUX.format("(fmpy, libcosimpy, ecospy)", "ecos, cosim-cli, OMSimulator"),
     "x86_64-linux": _LINUX.format("that runs FMI 3.0 (fmpy, ecospy)", "ecos, OMSimulator"),
-    "x86_64-windows": "A 64-bit CPython {python} with numpy, whose installation folder (the "
-                      "one with <code>python3.dll</code>) is on <code>PATH</code> of every "
-                      "host: the binary imports python3.dll and KERNEL32 only. " + _HOME
-                      + " (Not tested on a Windows host.)",
-    "win64": "A 64-bit CPython {python} with numpy, whose installation folder (the one "
-             "with <code>python3.dll</code>, not a venv's <code>Scripts</code>) is on "
-             "<code>PATH</code> of every host, Python or not (Simulink, Dymola, "
-             "OMSimulator, cosim-cli), and the Microsoft Visual C++ 2015-2022 "
-             "Redistributable (x64) for <code>MSVCP140.dll</code>: the binary imports "
+    "x86_64-windows": "A 64-bit CPython {python} with numpy, its installation folder (with "
+                      "<code>python3.dll</code>) on <code>PATH</code> of every host: the binary "
+                      "imports python3.dll and KERNEL32 only. " + _HOME + " (Not tested on a "
+                      "Windows host.)",
+    "win64": "A 64-bit CPython {python} with numpy, its installation folder (with "
+             "<code>python3.dll</code>, not a venv's <code>Scripts</code>) on <code>PATH</code> "
+             "of every host, Python or not (Simulink, Dymola, OMSimulator, cosim-cli), and the "
+             "Microsoft Visual C++ 2015-2022 Redistributable (x64): the binary imports "
              "python3.dll, MSVCP140, VCRUNTIME140(_1), the Universal C runtime and KERNEL32. "
-             + _HOME + " (Tested on Linux with the platform faked and the DLL's imports read, "
-             "not on a Windows host.)",
+             + _HOME + " (Tested with the platform faked and the DLL's imports read, not on "
+             "a Windows host.)",
 }
-"""What a host needs to run a Python FMU, by platform."""
 _STYLE = ("body{font-family:sans-serif;max-width:60em;margin:1em auto;padding:0 1em}"
           "table{border-collapse:collapse}th,td{border:1px solid #bbb;padding:2px 6px;"
           "text-align:left;vertical-align:top}pre{background:#f4f4f4;padding:4px}")
@@ -60,8 +57,7 @@ def describe(entries: Mapping[str, bytes], generation_tool: str, identity: Mappi
              hosts: Mapping[str, str]) -> dict[str, bytes]:
     """``entries`` with the model description's ``generation_tool`` and ``identity``, the
     page (``overview``: the model's docstring; ``sources``: module: docstring; ``hosts``:
-    platform: what a host needs there, in HTML, {python} the Python versions this project
-    runs on) and the icon."""
+    platform: what a host needs, in HTML, {python} this project's Pythons) and the icon."""
     root = fromstring(entries["modelDescription.xml"])
     root.set("generationTool", generation_tool)
     root.attrib.pop("generationDateAndTime", None)       # the same sources, the same bytes
@@ -175,8 +171,7 @@ def _inline(text: str) -> str:
 
 def model_png(model: ModelDescription) -> bytes:
     """model.png of ``model``: a vessel (outputs x, y, psi) as CyberShip II's waterline to
-    scale, any other model as a block with its ports; matplotlib's default style, no
-    software or time in the file."""
+    scale, any other model as a block with its ports; no software or time in the file."""
     inputs, outputs = ([v.name for v in model.modelVariables if v.causality == c]
                        for c in ("input", "output"))
     name = model.modelName

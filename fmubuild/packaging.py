@@ -1,11 +1,8 @@
-"""A slave script written with fmukit built into an FMU that carries exactly its model: the
-script, what it imports of fmukit and this project (read from the sources, followed
-through), the ``--include``s, a requirements.txt (numpy), its manifest and entry module
-(``routes``); its Linux binary fixed (``exit_fix``), its documentation (``documentation``);
-validated with fmpy, instantiated without this checkout (``instantiate``) and written
-reproducibly: the same sources give the same bytes. A package whose __init__.py holds only
-a docstring is carried as a namespace package: a non-Python host runs all its Python FMUs in
-one interpreter, where the first FMU to import a package would otherwise own it.
+"""A slave script written with fmukit built into an FMU that carries exactly its model (the
+script, what it imports of fmukit and this project, the ``--include``s), reproducibly. A
+package whose __init__.py holds only a docstring is carried as a namespace package: a
+non-Python host runs all its Python FMUs in one interpreter, where the first FMU to import a
+package would otherwise own it.
 """
 from __future__ import annotations
 
@@ -135,13 +132,13 @@ def write_fmu(fmu: Path, entries: Mapping[str, bytes], derive_guid: bool = False
     from fmpy.validation import validate_fmu
 
     if derive_guid:
-        blank = _GUID.sub(rb' \1=""', entries["modelDescription.xml"], 1)
-        contents = hashlib.sha256()
-        for name in sorted(entries):
-            data = blank if name == "modelDescription.xml" else entries[name]
-            contents.update(name.encode() + b"\0" + hashlib.sha256(data).digest())
-        guid = str(uuid.uuid5(uuid.NAMESPACE_OID, contents.hexdigest())).encode()
-        entries = {**entries, "modelDescription.xml": _GUID.sub(rb' \1="{%s}"' % guid, blank, 1)}
+        blank = {**entries, "modelDescription.xml": _GUID.sub(
+            rb' \1=""', entries["modelDescription.xml"], 1)}
+        contents = b"".join(name.encode() + b"\0" + hashlib.sha256(blank[name]).digest()
+                            for name in sorted(blank))
+        guid = uuid.uuid5(uuid.NAMESPACE_OID, hashlib.sha256(contents).hexdigest())
+        entries = {**blank, "modelDescription.xml": _GUID.sub(
+            rb' \1="{%s}"' % str(guid).encode(), blank["modelDescription.xml"], 1)}
     fmu.parent.mkdir(parents=True, exist_ok=True)
     temporary = fmu.with_name(f".{fmu.name}.tmp")
     try:

@@ -21,15 +21,12 @@ FMUS: dict[str, str] = {
 }
 """FMU name: its slave script. An FMU carries the project modules its script imports."""
 SLAVE_MODULES = frozenset(".".join(Path(script).with_suffix("").parts) for script in FMUS.values())
-"""The modules of those scripts, as a manifest names them."""
-C_FMUS = {"pd_autopilot_c": "autopilot_fmu/pd_autopilot_c"}
-"""FMU name: the folder of its C source and model description."""
+C_FMUS = {"pd_autopilot_c": "autopilot_fmu/pd_autopilot_c"}       # name: its sources' folder
 BUILD_HINT = "build the FMUs with: python -m fmukit.build"
 
 
 def project_identity() -> dict[str, str]:
-    """The author, version, copyright and license of this project's distribution
-    (pyproject.toml; with no author there, its authors by its name) for its FMUs."""
+    """Its FMUs' author (with none in pyproject.toml, its authors), version, copyright, license."""
     meta = metadata.metadata(DISTRIBUTION)
     author = meta.get("Author") or meta.get("Author-email") or f"the {DISTRIBUTION} authors"
     return {"author": author, "version": meta["Version"], "copyright": f"Copyright (c) {author}",

@@ -56,8 +56,6 @@ ROUTES = {
 
 
 def entry_source(manifest: Manifest) -> str:
-    """The entry module this build writes for the FMU of ``manifest`` (for
-    ``fmukit.manifest.staleness``)."""
-    return ROUTES[manifest.fmi].entry_source(
-        manifest.model_name, Path(manifest.modules[manifest.slave_module]["file"]).stem,
-        manifest.slave_class)
+    """The entry module this build writes for ``manifest``'s FMU (``fmukit.manifest.staleness``)."""
+    module = Path(manifest.modules[manifest.slave_module]["file"]).stem
+    return ROUTES[manifest.fmi].entry_source(manifest.model_name, module, manifest.slave_class)
