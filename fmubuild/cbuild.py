@@ -63,9 +63,7 @@ def build_c(name: str, dest: Path | None = None, fmi: int = 2) -> Path:
     """Compile the C FMU ``name`` as FMI ``fmi`` into dest/name.fmu (default: ``FMU_DIRS``)
     for this platform and, with mingw-w64, 64-bit Windows; validated; its path."""
     import fmpy
-
-    compiler = c_compiler()
-    if compiler is None:
+    if (compiler := c_compiler()) is None:
         raise NoCompiler(f"no C compiler found (set CC, or install gcc): {name}.fmu, an "
                          "autopilot in C, is not built; everything else is")
     if fmpy.platform not in _LIBRARY:
@@ -95,7 +93,5 @@ def build_c(name: str, dest: Path | None = None, fmi: int = 2) -> Path:
                 raise RuntimeError(f"{command[0]} could not compile {source} for {platform}:\n"
                                    f"{compiled.stderr}")
             entries[f"binaries/{platform}/{library.name}"] = library.read_bytes()
-    fmu = (dest or FMU_DIRS[fmi]) / f"{name}.fmu"
-    write_fmu(fmu, documentation.describe(entries, f"fmukit {version()} (fmubuild.cbuild)",
-                                          project_identity(), "", {}, C_HOSTS[fmi]))
-    return fmu
+    return write_fmu((dest or FMU_DIRS[fmi]) / f"{name}.fmu", documentation.describe(
+        entries, f"fmukit {version()} (fmubuild.cbuild)", project_identity(), "", {}, C_HOSTS[fmi]))

@@ -70,8 +70,7 @@ def _build_script(script: Path, includes: list[Path], out: Path | None, fmi: int
     for include in includes:
         if not include.exists():
             raise ValueError(f"{include}, to be carried by {script.name}'s FMU, does not exist")
-    uncarried = _uncarried(script, includes)
-    if uncarried:
+    if uncarried := _uncarried(script, includes):
         raise ValueError(uncarried)
     try:
         return build_script(script, ("fmukit", *includes),

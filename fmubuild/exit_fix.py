@@ -1,7 +1,6 @@
-"""A fix for pythonfmu's Linux binaries, which corrupt their host's heap at process exit.
-
-pythonfmu 0.7.0's and pythonfmu3 0.3.4's binaries keep their Python state in a global
-``std::shared_ptr<PyState>``; at exit its static destructor frees it, and only afterwards
+"""A fix for pythonfmu's Linux binaries, which corrupt their host's heap at process exit:
+pythonfmu 0.7.0's and pythonfmu3 0.3.4's keep their Python state in a global
+``std::shared_ptr<PyState>``, which its static destructor frees at exit, after which
 ``onLibraryUnload`` (``.fini_array``) assigns to the dead pointer, corrupting malloc's free
 lists (an intermittent SIGABRT of every host that loaded an FMU). The destructor already
 shuts Python down, so ``onLibraryUnload`` becomes a plain return, in a binary the adapter

@@ -31,8 +31,7 @@ class InstantiationFailed(RuntimeError):
 
     def __init__(self, fmu: Path, returncode: int | None, out: str | bytes | None,
                  err: str | bytes | None, timed_out: float | None = None):
-        self.last_words = _last_lines(out) or _last_lines(err)
-        self.timed_out = timed_out
+        self.last_words, self.timed_out = _last_lines(out) or _last_lines(err), timed_out
         self.crashed = signal.Signals(-returncode).name if (returncode or 0) < 0 else None
         how = (f"did not end within {timed_out:g} s (the child was killed)" if timed_out
                else f"crashed its host ({self.crashed})" if self.crashed else "failed")

@@ -93,7 +93,7 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
             (stage / "fmukit_manifest.json").write_text(manifest.to_json())
             (stage / "requirements.txt").write_text("numpy\n")
             sources = {m: doc for m, path in sorted(staged.items()) if m != slave_module
-                       and m.split(".")[0] != "fmukit" and (doc := _docstring(path))}
+                       and m.split(".")[0] != "fmukit" and (doc := ast.get_docstring(parsed(path)))}
             built = importlib.import_module(route.pythonfmu).FmuBuilder.build_FMU(
                 entry, dest=Path(tmp) / "built",
                 project_files=[p for p in stage.iterdir() if p != entry], **route.options)
@@ -110,8 +110,9 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
                        if name.startswith(f"binaries/{route.linux}/") else package.read(name)
                        for name in package.namelist() if not name.endswith("/")}
     tool = f"fmukit {version()} ({route.pythonfmu} {adapter.PYTHONFMU_VERSION})"
-    write_fmu(fmu, documentation.describe(entries, tool, identity or {}, _docstring(script),
-                                          sources, documentation.PYTHON_HOSTS), derive_guid=True)
+    overview = ast.get_docstring(parsed(script)) or ""
+    write_fmu(fmu, documentation.describe(entries, tool, identity or {}, overview, sources,
+                                          documentation.PYTHON_HOSTS), derive_guid=True)
     try:
         instantiate_in_child(fmu, isolated=True)
     except InstantiationFailed as failed:
@@ -125,12 +126,11 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
     return fmu
 
 
-def write_fmu(fmu: Path, entries: Mapping[str, bytes], derive_guid: bool = False) -> None:
-    """The FMU of ``entries`` (name: bytes) written at ``fmu`` reproducibly (in name order,
-    fixed times and modes; whole: beside it, then renamed) and validated by fmpy; with
-    ``derive_guid``, its GUID (FMI 3.0: instantiation token) derived from its contents."""
+def write_fmu(fmu: Path, entries: Mapping[str, bytes], derive_guid: bool = False) -> Path:
+    """``fmu`` written whole and reproducibly (in name order, fixed times and modes) from
+    ``entries`` (name: bytes), and validated by fmpy; with ``derive_guid``, its GUID (FMI 3.0:
+    instantiation token) derived from its contents."""
     from fmpy.validation import validate_fmu
-
     if derive_guid:
         blank = {**entries, "modelDescription.xml": _GUID.sub(
             rb' \1=""', entries["modelDescription.xml"], 1)}
@@ -154,11 +154,11 @@ def write_fmu(fmu: Path, entries: Mapping[str, bytes], derive_guid: bool = False
     problems = validate_fmu(str(fmu))
     if problems:
         raise RuntimeError(f"{fmu} does not validate:\n" + "\n".join(problems))
+    return fmu
 
 
 def needed_modules(scripts: Iterable[Path], packages: Iterable[str]) -> dict[str, Path]:
-    """Module: file, for every module of ``packages`` (of this checkout) that ``scripts``
-    import, directly or not."""
+    """Module: file, for the modules of ``packages`` that ``scripts`` import, directly or not."""
     found: dict[str, Path] = {}
     todo = [(None, script) for script in scripts]
     while todo:
@@ -236,10 +236,6 @@ def _copy(file: Path, to: Path) -> Path:
 
 def _carried(file: Path, stage: Path) -> dict[str, str]:      # its entry in the manifest
     return {"file": file.relative_to(stage.parent).as_posix(), "sha256": sha256(file)}
-
-
-def _docstring(file: Path) -> str:
-    return ast.get_docstring(parsed(file)) or ""
 
 
 @contextlib.contextmanager

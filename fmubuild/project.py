@@ -8,9 +8,8 @@ from fmukit.manifest import DISTRIBUTION
 
 ROOT = Path(__file__).resolve().parent.parent
 FMU_DIR = ROOT / "fmus"
-FMU_DIRS = {2: FMU_DIR, 3: FMU_DIR / "fmi3"}
-"""Where the FMUs of each FMI version are built (the same names: fmus/fmi3/ship.fmu)."""
-FMUS: dict[str, str] = {
+FMU_DIRS = {2: FMU_DIR, 3: FMU_DIR / "fmi3"}       # by FMI version, the same names in each
+FMUS: dict[str, str] = {                          # name: its slave script, whose imports it carries
     "ship": "ship_fmu/ship_slave.py",
     "manoeuvre": "ship_fmu/manoeuvre_slave.py",
     "pd_autopilot": "autopilot_fmu/pd_autopilot_slave.py",
@@ -19,7 +18,6 @@ FMUS: dict[str, str] = {
     # Written as a user's own autopilot is (docs/own_autopilot.md): one file and fmukit.
     "pid_autopilot": "autopilot_fmu/pid_autopilot_slave.py",
 }
-"""FMU name: its slave script. An FMU carries the project modules its script imports."""
 SLAVE_MODULES = frozenset(".".join(Path(script).with_suffix("").parts) for script in FMUS.values())
 C_FMUS = {"pd_autopilot_c": "autopilot_fmu/pd_autopilot_c"}       # name: its sources' folder
 BUILD_HINT = "build the FMUs with: python -m fmukit.build"

@@ -26,7 +26,6 @@ class {cls}(Fmi{fmi}Entry, _Model, Fmi{fmi}Slave):
 @dataclass(frozen=True)
 class Route:
     """How an FMU of one FMI version is built."""
-
     fmi: int
     pythonfmu: str                  # the package that builds it (its import name)
     known: str                      # the one version of it that the adapter knows
@@ -47,8 +46,7 @@ ROUTES = {
     2: Route(2, "pythonfmu", "0.7.0", "fmukit.pythonfmu07",
              {"canGetAndSetFMUstate": True, "canSerializeFMUstate": True}, "linux64",
              ("hold_namespace",)),
-    # canHandleVariableCommunicationStepSize: pythonfmu3 0.3.4 writes the value of another
-    # option for it (a loop variable left over); given, its builder writes it.
+    # canHandleVariableCommunicationStepSize given, else pythonfmu3 0.3.4 writes a stale value.
     3: Route(3, "pythonfmu3", "0.3.4", "fmukit.pythonfmu3_03",
              {"canGetAndSetFMUState": True, "canSerializeFMUState": True,
               "canHandleVariableCommunicationStepSize": True}, "x86_64-linux"),
