@@ -23,7 +23,7 @@ from fmubuild.project import FMUS, ROOT
 
 PROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
 BLOCK = (0xdd, 0xe8, 0xf4)
-"""The fill of a block icon (fmubuild.icon)."""
+"""The fill of a block icon (fmubuild.documentation)."""
 BUILT_WITH = {2: "pythonfmu 0.7.0", 3: "pythonfmu3 0.3.4"}
 PLATFORMS = {2: ("linux64", "win64"), 3: ("x86_64-linux", "x86_64-windows")}
 """What builds each FMI version, and the platforms of its binaries."""
