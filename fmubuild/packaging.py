@@ -57,8 +57,8 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
     slave_module = (f"{folder.name}.{script.stem}" if folder.parent == ROOT
                     and folder.name in PROJECT_PACKAGES else script.stem)
     with _imports_undone(), tempfile.TemporaryDirectory(prefix=f"build_{script.stem}_") as tmp:
-        stage = Path(tmp) / "resources"             # module: its copy in the FMU
-        staged = {slave_module: _copy(script, stage / script.name)}
+        stage = Path(tmp) / "resources"
+        staged = {slave_module: _copy(script, stage / script.name)}     # module: its copy
         for include in (Path(p) for p in packages if not isinstance(p, str)):
             for file in [include] if include.is_file() else sorted(
                     f for f in include.rglob("*") if f.is_file()
