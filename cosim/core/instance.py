@@ -70,6 +70,7 @@ class Instance:
 
     name: str
     path: Path
+    guid: str | None
     variables: dict[str, Any]          # name: object with valueReference, type, causality
     feedthrough: dict[str, frozenset[str]]   # output name: the inputs it depends on
 
@@ -82,19 +83,6 @@ class Instance:
              strict: bool = False) -> Any:
         """Run ``function``; FmuCallError if it fails, or, ``strict``, if it returns OK but
         logs an error."""
-        raise NotImplementedError
-
-    def fmi(self, name: str) -> Callable:
-        raise NotImplementedError
-
-    def enter_initialization(self, start_time: float = 0.0) -> None:
-        raise NotImplementedError
-
-    def reset(self) -> None:
-        """Back to the state after instantiation (fmi2Reset, fmi3Reset)."""
-        raise NotImplementedError
-
-    def free(self) -> None:
         raise NotImplementedError
 
     def variable(self, name: str):
