@@ -35,7 +35,6 @@ _FMI_TYPE = {float: "Real", int: "Integer", str: "String"}
 _FAILED = frozenset({"discard", "error", "fatal"})
 _PYTHONFMU = ("resources/pythonfmu/", "resources/pythonfmu3/")
 """What pythonfmu 0.7 and pythonfmu3 carry of their own."""
-_DECLARATIONS = ("ModelVariables", "UnitDefinitions", "ModelStructure")
 
 
 @dataclass(frozen=True)
@@ -51,7 +50,10 @@ class Reason(str):
     """Why an FMU runs through FMI; ``stale_module``: the slave module of an FMU built with
     fmukit before a change of its sources (a rebuild mends it), else None."""
 
-    stale_module: str | None = None
+    def __new__(cls, text: str, stale_module: str | None = None) -> Reason:
+        reason = super().__new__(cls, text)
+        reason.stale_module = stale_module
+        return reason
 
 
 def slave_class(manifest: Manifest) -> type[ModelSlave]:
@@ -61,17 +63,12 @@ def slave_class(manifest: Manifest) -> type[ModelSlave]:
     return fmu_class(getattr(module, manifest.slave_class), manifest.fmi)
 
 
-@cache
-def _cached_refusal(path: Path, size: int, mtime_ns: int) -> str | None:
-    return _refusal(path)
-
-
-def in_process_refusal(path: str | Path) -> str | None:
+def in_process_refusal(path: str | Path) -> Reason | None:
     """Why the FMU at ``path`` cannot run in-process, or None: it must be built with fmukit,
     hold what its manifest lists, declare what its class declares and be current here
     (``fmukit.manifest.staleness``), so that both routes compute the same."""
     stat = Path(path).stat()
-    return _cached_refusal(Path(path).resolve(), stat.st_size, stat.st_mtime_ns)
+    return _refusal(Path(path).resolve(), stat.st_size, stat.st_mtime_ns)
 
 
 def fallback_note(name: str, path: str | Path) -> Reason | None:
@@ -80,42 +77,39 @@ def fallback_note(name: str, path: str | Path) -> Reason | None:
     refusal = in_process_refusal(path)
     if refusal is None:
         return None
-    note = Reason(f"{name} ({Path(path).name}) runs through FMI, not in-process: {refusal}")
-    note.stale_module = getattr(refusal, "stale_module", None)
-    return note
+    return Reason(f"{name} ({Path(path).name}) runs through FMI, not in-process: {refusal}",
+                  refusal.stale_module)
 
 
-def _refusal(path: Path) -> str | None:
+@cache
+def _refusal(path: Path, size: int, mtime_ns: int) -> Reason | None:     # cached by version
     try:
         manifest = read(path)
         if manifest is None:
-            return "it was not built with fmukit (it has no manifest)"
+            return Reason("it was not built with fmukit (it has no manifest)")
         described = read_description(path)
         if described.modelName != manifest.model_name:
-            return (f"its model description names the model '{described.modelName}', "
-                    f"its manifest '{manifest.model_name}'")
+            return Reason(f"its model description names the model '{described.modelName}', "
+                          f"its manifest '{manifest.model_name}'")
         with zipfile.ZipFile(path) as fmu:
             refusal = _contents_refusal(fmu, manifest)
             declared = ElementTree.fromstring(fmu.read("modelDescription.xml"))
         if refusal:
-            return refusal
+            return Reason(refusal)
         stale = staleness(manifest)
         if stale is not None:
-            refusal = Reason(stale)
-            refusal.stale_module = manifest.slave_module
-            return refusal
-        if manifest.fmi != int(described.fmiVersion.partition(".")[0]):
-            return (f"its model description is of FMI {described.fmiVersion}, its "
-                    f"manifest says FMI {manifest.fmi}")
+            return Reason(stale, manifest.slave_module)
+        # an FMI version other than the manifest's declares other ModelVariables, too
         ours = slave_class(manifest)(instance_name=manifest.model_name).to_xml()
-        for section in _DECLARATIONS:
+        for section in ("ModelVariables", "UnitDefinitions", "ModelStructure"):
             if _canonical(declared.find(section)) != _canonical(ours.find(section)):
-                return (f"its {section} differ from those its class "
-                        f"{manifest.slave_module}.{manifest.slave_class} declares")
+                return Reason(f"its {section} differ from those its class "
+                              f"{manifest.slave_module}.{manifest.slave_class} declares")
         return None
     except (OSError, KeyError, UnicodeDecodeError, ValueError, ImportError, AttributeError,
             zipfile.BadZipFile, ElementTree.ParseError) as error:
-        return f"it cannot be read as an FMU built with fmukit ({type(error).__name__}: {error})"
+        return Reason("it cannot be read as an FMU built with fmukit "
+                      f"({type(error).__name__}: {error})")
 
 
 def _contents_refusal(fmu: zipfile.ZipFile, manifest: Manifest) -> str | None:
@@ -151,8 +145,7 @@ class InProcessInstance(Instance):
     def __init__(self, path: str | Path, name: str, same_sources: bool = True):
         """ValueError if the FMU cannot run in-process (``in_process_refusal``); without
         ``same_sources``, only if it was not built with fmukit (``cosim.studies.direct``)."""
-        description = read_description(self.path, name)
-        self.model_name, self.guid = description.modelName, description.guid
+        self.guid = read_description(self.path, name).guid
         refusal = in_process_refusal(self.path)
         manifest = read(self.path)
         if refusal and (same_sources or manifest is None):
