@@ -1,11 +1,10 @@
 """The co-simulation master: FMUs wired by a system description, stepped at a fixed step.
 
 Time is counted in integer steps, t_k = t_0 + k h in whole nanoseconds (``fmukit.timebase``),
-so a 400 s run at 0.1 s has exactly 4000 steps and 4001 rows. The master wires and
-delegates: ``wiring`` checks the connections, orders and lays out the columns, ``coupling``
-does one communication step, ``recording`` keeps the rows. A failed call, a time limit
-passed (``watchdog``) or a signal (``interrupt``) stops the run between steps with an error
-naming the FMU, the call and the time; the rows recorded up to then are kept.
+so a 400 s run at 0.1 s has exactly 4000 steps and 4001 rows. ``wiring`` checks, orders and
+lays out, ``coupling`` does one communication step, ``recording`` keeps the rows. A failed
+call, a time limit passed (``watchdog``) or a signal (``interrupt``) stops the run between
+steps with an error naming the FMU, the call and the time; the rows up to then are kept.
 """
 from __future__ import annotations
 
@@ -42,8 +41,8 @@ class Master:
     def __init__(self, system: SystemDescription, coupling: str = "gauss-seidel",
                  backend: str = "fmi", overrides: dict[str, dict[str, Any]] | None = None,
                  verify_inputs: bool = False):
-        for what, value, known in (("coupling", coupling, COUPLINGS), ("backend", backend,
-                                                                         BACKENDS)):
+        for what, value, known in (("coupling", coupling, COUPLINGS),
+                                   ("backend", backend, BACKENDS)):
             if value not in known:
                 raise ValueError(f"{what} must be one of {', '.join(known)}, got {value!r}")
         self.system, self.coupling, self.backend = system, coupling, backend
@@ -55,6 +54,7 @@ class Master:
         self.instances: dict[str, Instance] = {}
         self.notes: list[str] = []            # what the user should know about how this runs
         self.backends: dict[str, str] = {}    # how each component runs
+        self._recorder: Recorder | None = None
         try:
             for name, path in self.paths.items():
                 note = fallback_note(name, path) if backend == "inprocess" else None
@@ -126,8 +126,7 @@ class Master:
             self.initialize()
             for k in range(n_steps + 1):
                 t = communication_point(t0, k, h)
-                expired = beat(t)
-                signal = stop.received if stop is not None else None
+                expired, signal = beat(t), stop and stop.received
                 if signal or expired:
                     t = communication_point(t0, k - 1, h) if k else t0
                     recorder.interrupted = signal.name if signal else None
@@ -164,7 +163,7 @@ class Master:
                 "stop_time": communication_point(t0, n_steps, h),
                 "scenario_stop_time": system.stop_time,
                 "settings": self.parameters, "overrides": self.overrides,
-                "fmus": {name: {"file": str(i.path), "guid": getattr(i, "guid", None)}
+                "fmus": {name: {"file": str(i.path), "guid": i.guid}
                          for name, i in self.instances.items()},
                 "parameter_units": {name: {n: i.unit(n) for n, v in i.variables.items()
                                            if v.causality == "parameter"}
@@ -172,7 +171,7 @@ class Master:
 
     def abandon(self, reason: str) -> Recording | None:
         """The run under way's rows closed with ``reason``, for a watchdog (None if none)."""
-        recorder, self._recorder = getattr(self, "_recorder", None), None
+        recorder, self._recorder = self._recorder, None
         return recorder and recorder.close(f"{reason} ({recorder.rows} rows recorded)")
 
     def __enter__(self) -> Master:
