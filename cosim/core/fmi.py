@@ -1,11 +1,7 @@
-"""The master's FMI backend: one FMU instance of FMI 2.0 or 3.0 driven through fmpy, its log kept.
+"""The master's FMI backend: an FMU of FMI 2.0 or 3.0 driven through fmpy, its log kept.
 
 The master speaks FMI 2.0's names: ``read_description`` gives FMI 3.0's Float64 and Int32 as
-Real and Integer, and an FMI 3.0 instance maps the master's calls ("setReal") to its
-version's (``CALLS``). FMI 3.0 differs besides: no setupExperiment (the start time goes to
-enterInitializationMode), get/set take a value count too, a step that asks to end the
-simulation (terminateSimulation) fails the run, and ``time`` (value reference 0) is no
-variable of the master's.
+Real and Integer, and an FMI 3.0 instance maps the master's calls to its own (``CALLS``).
 """
 from __future__ import annotations
 
@@ -92,12 +88,9 @@ def feedthrough(description: ModelDescription) -> dict[str, frozenset[str]]:
 
 
 class FmuInstance(Instance):
-    """An instantiated co-simulation FMU of FMI 2.0 or 3.0 (``fmi_version``) through fmpy's
-    FMU2Slave or FMU3Slave. FmuNotFound, FmuUnreadable or ValueError when the FMU is missing
-    or unreadable; FmuCallError when it cannot be instantiated (its extracted files are
-    removed)."""
-
-    slave: Any
+    """An instantiated co-simulation FMU through fmpy's FMU2Slave or FMU3Slave. FMI 3.0 has
+    no setupExperiment, and a step that asks to end the simulation fails. FmuCallError when
+    it cannot be instantiated (its extracted files are removed)."""
 
     def __init__(self, path: str | Path, name: str, unzip_dir: str | Path | None = None):
         self.description = read_description(self.path, name)
@@ -202,8 +195,7 @@ class FmuInstance(Instance):
     # Prepared calls: the raw FMI functions (fmpy's ``dll``) on preallocated ctypes arrays,
     # without fmpy's per-call wrapping, which costs more than the call itself.
     def _raw(self, verb: str, kind: str, vrs: list[int]) -> tuple[Any, Callable[[], None]]:
-        """The values array for ``vrs`` and the call fmi<N><Verb><Type> on it ("get", "Real":
-        fmi2GetReal, fmi3GetFloat64)."""
+        """The values array for ``vrs`` and fmi2GetReal, fmi3SetFloat64 ... on it."""
         reference, types = RAW_TYPES[self.fmi_version]
         name, ctype = types[kind]
         function = getattr(self.slave.dll, f"fmi{self.fmi_version}{verb.title()}{name}")

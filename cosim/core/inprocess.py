@@ -1,13 +1,10 @@
 """The master's in-process backend: the FMUs' Python classes, called without FMI.
 
-An ``InProcessInstance`` has the interface of ``cosim.core.fmi.FmuInstance`` but instantiates
-in this process the class an FMU built with fmukit was made from (its manifest,
-``fmukit.manifest``), composed for the FMU's FMI version as its entry module composes it
-(``fmukit.compose.fmu_class``), and calls its methods directly. The FMU must be current
-here, so that a run differs from one through FMI only by the FMI layer: every column of every
-row is the same, bit for bit. The loop gets the slave's own plans for its value references
-(``fmukit.fastpath``); steps and parameters pass the slave's checks, so an invalid value is
-refused with the same message as through FMI.
+An ``InProcessInstance`` instantiates in this process the class an FMU built with fmukit was
+made from (its manifest), composed for its FMI version as its entry module composes it
+(``fmukit.compose.fmu_class``), and calls its methods directly. The FMU must be current here,
+so that a run differs from one through FMI only by the FMI layer, bit for bit; invalid
+values are refused with the same message as through FMI.
 """
 from __future__ import annotations
 
@@ -15,10 +12,9 @@ import hashlib
 import importlib
 import re
 import zipfile
-from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 from xml.etree import ElementTree
 
 from fmukit.compose import fmu_class
@@ -32,13 +28,11 @@ from .instance import FmuCallError, Instance, LogRecord, logged_error
 
 _FMI_TYPE = {float: "Real", int: "Integer", str: "String"}
 """The master's type names (FMI 2.0's), whichever version the class is of."""
-_FAILED = frozenset({"discard", "error", "fatal"})
 _PYTHONFMU = ("resources/pythonfmu/", "resources/pythonfmu3/")
 """What pythonfmu 0.7 and pythonfmu3 carry of their own."""
 
 
-@dataclass(frozen=True)
-class VariableInfo:
+class VariableInfo(NamedTuple):
     name: str
     valueReference: int
     type: str
@@ -57,8 +51,7 @@ class Reason(str):
 
 
 def slave_class(manifest: Manifest) -> type[ModelSlave]:
-    """The FMU's class in this process: the model class its manifest names, composed for
-    its FMI version."""
+    """The model class an FMU's manifest names, composed for its FMI version."""
     module = importlib.import_module(manifest.slave_module)
     return fmu_class(getattr(module, manifest.slave_class), manifest.fmi)
 
@@ -72,8 +65,7 @@ def in_process_refusal(path: str | Path) -> Reason | None:
 
 
 def fallback_note(name: str, path: str | Path) -> Reason | None:
-    """The note for component ``name`` when its FMU must run through FMI instead of
-    in-process (``in_process_refusal``), or None."""
+    """The note for component ``name`` whose FMU must run through FMI, not in-process."""
     refusal = in_process_refusal(path)
     if refusal is None:
         return None
@@ -146,8 +138,7 @@ class InProcessInstance(Instance):
         """ValueError if the FMU cannot run in-process (``in_process_refusal``); without
         ``same_sources``, only if it was not built with fmukit (``cosim.studies.direct``)."""
         self.guid = read_description(self.path, name).guid
-        refusal = in_process_refusal(self.path)
-        manifest = read(self.path)
+        refusal, manifest = in_process_refusal(self.path), read(self.path)
         if refusal and (same_sources or manifest is None):
             raise ValueError(f"FMU '{name}' ({self.path.name}) cannot run in-process: "
                              f"{refusal}")
@@ -183,14 +174,13 @@ class InProcessInstance(Instance):
     def _judge(self, what: str, time: float | None, result: Any, strict: bool) -> None:
         """FmuCallError if a call refused (returned False or a failed FMI 3.0 step result)
         or, ``strict``, logged an error; the log is drained either way."""
-        messages = self._drain()
-        if result is False:
-            raise FmuCallError(self.name, what, time, "discard", messages)
-        status = getattr(result, "status", None)
-        if status is not None and status.name in _FAILED:
-            raise FmuCallError(self.name, what, time, status.name, messages)
-        if strict and logged_error(messages):
-            raise FmuCallError(self.name, what, time, "OK but logged an error", messages)
+        records = self._drain()
+        status = getattr(result, "status", None)                # an FMI 3.0 step's
+        failed = "discard" if result is False else getattr(status, "name", None)
+        if failed in ("discard", "error", "fatal"):
+            raise FmuCallError(self.name, what, time, failed, records)
+        if strict and logged_error(records):
+            raise FmuCallError(self.name, what, time, "OK but logged an error", records)
 
     def _drain(self) -> list[LogRecord]:
         records = [LogRecord(m.status.name, m.category or None, m.msg)    # pythonfmu3's: ""
@@ -200,33 +190,19 @@ class InProcessInstance(Instance):
 
     def fmi(self, name: str):
         """The slave method behind a call name: setReal -> set_real (set_float64 on FMI 3.0)."""
-        if self.fmi_version == 3:
-            name = CALLS.get(name, name)
-        return getattr(self.slave, _method_name(name))
+        return getattr(self.slave, _method_name(CALLS.get(name, name) if self.fmi_version == 3
+                                                else name))
 
     # Prepared calls: the slave's own plans, valid until ``reset`` makes a new slave; through
     # the FMI entry where it has none or where the plan raises (to report it as FMI would).
     def reader(self, vrs: list[int]):
-        return self._prepared(self.slave.plans.real_reader(vrs), super().reader(vrs))
+        return _prepared(self.slave.plans.real_reader(vrs), super().reader(vrs))
 
     def integer_reader(self, vrs: list[int]):
-        return self._prepared(self.slave.plans.integer_reader(vrs), super().integer_reader(vrs))
-
-    @staticmethod
-    def _prepared(plan, through_fmi):
-        if plan is None:
-            return through_fmi
-
-        def read() -> list:
-            try:
-                return plan()
-            except Exception:
-                return through_fmi()
-        return read
+        return _prepared(self.slave.plans.integer_reader(vrs), super().integer_reader(vrs))
 
     def writer(self, vrs: list[int]):
-        write = self.slave.plans.input_writer(vrs)
-        return super().writer(vrs) if write is None else write
+        return self.slave.plans.input_writer(vrs) or super().writer(vrs)
 
     def stepper(self):
         do_step, queue = unguarded(self.slave.do_step), self.slave.log_queue
@@ -256,6 +232,19 @@ class InProcessInstance(Instance):
         """Terminate, if the slave was initialised."""
         if self.slave.sequence.phase == "step":
             self.slave.terminate()
+
+
+def _prepared(plan, through_fmi):
+    """``plan``, or ``through_fmi`` where there is none or where the plan raises."""
+    if plan is None:
+        return through_fmi
+
+    def read() -> list:
+        try:
+            return plan()
+        except Exception:
+            return through_fmi()
+    return read
 
 
 @cache

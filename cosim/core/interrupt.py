@@ -1,10 +1,8 @@
 """Ctrl-C and SIGTERM: a request to stop between steps, or an exception where no FMU runs.
 
-Our FMUs' Python runs in the master's interpreter, so a KeyboardInterrupt would land inside
-an FMU's call and fail it. Within ``StopSignals`` a signal only records itself; the master
-stops between steps and keeps every row (a second signal ends the process at once; while
-an FMU never returns, ``cosim.core.watchdog`` takes the signals). Within
-``raise_on_signals`` either signal raises ``Interrupted``, for code that runs no FMU.
+Our FMUs' Python runs in the master's interpreter, where a KeyboardInterrupt would fail an
+FMU's call: within ``StopSignals`` a signal only records itself and the master stops between
+steps (a second signal ends the process at once). ``raise_on_signals`` raises instead.
 """
 from __future__ import annotations
 
@@ -19,8 +17,7 @@ STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 
 def take_signals(handler: Callable) -> dict:
-    """``handler`` for SIGINT and SIGTERM (in the main thread; elsewhere nothing): the
-    handlers it replaced, for ``give_back``."""
+    """``handler`` for SIGINT and SIGTERM (main thread only): the handlers it replaced."""
     if threading.current_thread() is not threading.main_thread():
         return {}
     return {number: signal.signal(number, handler) for number in STOP_SIGNALS}

@@ -1,13 +1,9 @@
 """Time limits for a run, and signals that reach it even while an FMU never returns.
 
-A ``Watchdog`` is a thread beside the master's loop: a step (or instantiation) must end
-within ``Limits.step``, the run within ``Limits.run`` (past it the loop stops at its next
-step), and after Ctrl-C or SIGTERM the step under way within ``Limits.grace`` (wall-clock
-seconds). In the main thread it reads the signals from Python's wakeup file descriptor,
-which the C-level handler writes even while FMU code runs. A hung step gets ``TimeLimit``
-raised in the loop's thread (only inside an FMU call), where Python FMU code fails its call;
-code that runs no Python cannot take it, so after the grace the watchdog writes the rows
-kept (``salvage``), says so and ends the process (status 1, or 130/143 after a signal).
+A ``Watchdog`` thread beside the master's loop reads SIGINT and SIGTERM from Python's wakeup
+file descriptor (written even while FMU code runs) and raises ``TimeLimit`` into an FMU call
+that passes a limit; code that runs no Python cannot take it, so after the grace the
+watchdog writes the rows kept (``salvage``), says so and ends the process.
 """
 from __future__ import annotations
 
@@ -31,14 +27,14 @@ STEP_LIMIT_S = 60.0
 
 
 class Limits(NamedTuple):
-    """Wall-clock limits in seconds (None: no limit)."""
+    """Wall-clock limits in seconds (None: none): of a step (or instantiation), of the run
+    (the loop stops at its next step), of the step under way after a signal or the run's."""
 
     step: float | None = STEP_LIMIT_S
     run: float | None = None
     grace: float = 3.0
 
     def check(self) -> Limits:
-        """These limits, or ValueError naming the one that is not a positive number."""
         for name, value in self._asdict().items():
             if value is not None and not 0 < value < math.inf:
                 raise ValueError(f"the {name} time limit must be a positive number of "
@@ -59,10 +55,9 @@ class TimeLimit(BaseException):
 
 
 class Watchdog:
-    """``with Watchdog(limits, stop) as dog``: ``dog.beat(what)`` as each step (or
-    instantiation) begins; ``dog.expired`` says which limit was passed. ``salvage(reason)``,
-    called from the watchdog's thread if the loop never returns, writes what it can and
-    says what was kept."""
+    """``with Watchdog(limits, stop, salvage) as dog``: ``dog.beat(what)`` as each step or
+    call begins; ``dog.expired`` says which limit was passed; ``salvage(reason)`` writes
+    what it can if the loop never returns and says what was kept."""
 
     def __init__(self, limits: Limits = Limits(), stop: StopSignals | None = None,
                  salvage: Callable[[str], str] | None = None):
@@ -74,19 +69,17 @@ class Watchdog:
         self._raise = True                             # TimeLimit may be raised into the loop
         self._target = threading.get_ident()
         self._done = threading.Event()
-        self._thread: threading.Thread | None = None
+        self._thread = threading.Thread(target=self._watch, name="cosim-watchdog", daemon=True)
         self._signals = stop is not None and threading.current_thread() is threading.main_thread()
 
     def beat(self, what: str | float) -> str | None:
-        """A step (its time, in s) or call (a phrase) begins: its limit starts now. Returns
-        ``expired``: the loop stops here if it is not None."""
+        """A step (its time, in s) or call (a phrase) begins; ``expired``: not None stops it."""
         self._beat, self._what = time.monotonic(), what
         return self.expired
 
     def finishing(self, what: str) -> None:
-        """The run is over and ``what`` (terminating the FMUs) begins: its limit starts now,
-        and nothing is raised into it (an exception in fmi2Terminate has no safe way out of
-        pythonfmu's C++); past the limit the rows are kept and the process ends."""
+        """The run is over and ``what`` (terminating the FMUs) begins: nothing is raised into
+        it (an exception has no safe way out of pythonfmu's fmi2Terminate)."""
         self._raise = False
         self.beat(what)
 
@@ -98,15 +91,10 @@ class Watchdog:
                 end.setblocking(False)
             self._saved = (signal.set_wakeup_fd(self._wakeup[1].fileno(),
                                                 warn_on_full_buffer=False), take_signals(_idle))
-        if self._signals or self.limits.step is not None or self.limits.run is not None:
-            self._thread = threading.Thread(target=self._watch, name="cosim-watchdog",
-                                            daemon=True)
-            self._thread.start()
+        self._thread.start()
         return self
 
     def __exit__(self, *exc) -> None:
-        if self._thread is None:
-            return
         self._done.set()
         self._thread.join()
         if self.expired:              # one raised too late to land is cleared, not left armed
@@ -165,8 +153,8 @@ class Watchdog:
             self._grace = self._grace or (time.monotonic(), "the run time limit")
 
     def _expire(self, reason: str) -> None:
-        """The step under way is hung: raise TimeLimit in the loop's thread; if it has not
-        returned after the grace, keep what can be kept and end the process."""
+        """Raise TimeLimit in the loop's thread; if it has not returned after the grace, keep
+        what can be kept and end the process (status 1, or 130/143 after a signal)."""
         where = _calling(self._target)
         self.expired = reason = f"{reason} ({where})" if where else reason
         deadline = time.monotonic() + self.limits.grace
