@@ -21,7 +21,7 @@ from fmpy.fmi3 import FMU3Slave, fmi3Boolean, fmi3Float64, fmi3Int32, fmi3ValueR
 from fmpy.model_description import ModelDescription
 
 from .errors import FmuNotFound, FmuUnreadable
-from .instance import FmuCallError, Instance, LogRecord, logged_error, one_account
+from .instance import FmuCallError, Instance, LogRecord, logged_error
 
 STATUS = ("ok", "warning", "discard", "error", "fatal", "pending")
 VERSIONS = (2, 3)
@@ -147,9 +147,14 @@ class FmuInstance(Instance):
         return result
 
     def _since(self, before: int) -> list[LogRecord]:
-        """The log of the call that began when ``before`` had been logged (of the last 50)."""
+        """The log of the call that began when ``before`` had been logged (of the last 50),
+        each failure told once: pythonfmu's fatal message (no category) for a refusal that
+        an FMU built with fmukit logged (a cause) is left out."""
         new = self.logged - before
-        return one_account(list(self.log)[-new:] if new else [])
+        records = list(self.log)[-new:] if new else []
+        if any(r.cause for r in records):
+            records = [r for r in records if r.category is not None or r.status != "fatal"]
+        return records
 
     def _status(self, what: str, status: int, before: int, time: float | None = None) -> None:
         if status > 1:                      # discard, error, fatal

@@ -54,13 +54,6 @@ def logged_error(records: Iterable[LogRecord]) -> bool:
     return any(r.status in ("error", "fatal") for r in records)
 
 
-def one_account(records: list[LogRecord]) -> list[LogRecord]:
-    """A call's records, each failure told once: where an FMU built with fmukit logged its
-    refusal (a cause), pythonfmu's own fatal message for it (no category) is left out."""
-    if not any(r.cause for r in records):
-        return records
-    return [r for r in records if r.category is not None or r.status != "fatal"]
-
 
 class Instance:
     """One instantiated component: its variables, its feedthrough, and FMI calls.

@@ -8,7 +8,7 @@ steps with an error naming the FMU, the call and the time; the rows up to then a
 """
 from __future__ import annotations
 
-import time
+import contextlib
 from pathlib import Path
 from typing import Any, Callable
 
@@ -34,7 +34,7 @@ RUN_BACKENDS = ("fmi", "inprocess")
 """The backends a run of a scenario may take."""
 
 
-class Master:
+class Master(contextlib.AbstractContextManager):
     """Instantiate, initialise and step the components of a system description; a context
     manager: ``with Master(system) as master: recording = master.run()`` frees the FMUs."""
 
@@ -114,12 +114,10 @@ class Master:
         ``stop`` or a limit of ``watchdog`` ends it early (``Recording.error``). With
         ``csv_path`` the rows are streamed there in chunks (else TooManyRows if too many)."""
         t0, h, n_steps = self.system.steps(stop_time)
-        meta = self.run_meta(n_steps)
-        recorder = Recorder(self.columns, n_steps + 1, csv_path, chunk_rows, meta=meta,
-                            units=self.units)
-        exchange, nodes, values = COUPLINGS[self.coupling], self.nodes, [0.0] * len(self.columns)
-        k, t, error, started = 0, t0, None, time.perf_counter()
-        self.parameter_values, self._recorder = {}, recorder
+        recorder = self._recorder = Recorder(self.columns, n_steps + 1, csv_path, chunk_rows,
+                                             self.run_meta(n_steps), self.units)
+        exchange, values = COUPLINGS[self.coupling], [0.0] * len(self.columns)
+        k, t, error, self.parameter_values = 0, t0, None, {}
         beat = watchdog.beat if watchdog is not None else no_limit
         try:
             beat("the initialisation")
@@ -133,7 +131,7 @@ class Master:
                     error = (f"{'interrupted' if signal else f'{expired}: stopped'} at t = "
                              f"{t:.6g} s, {recorder.rows} rows kept")
                     break
-                exchange(nodes, values, t, h, k < n_steps)
+                exchange(self.nodes, values, t, h, k < n_steps)
                 recorder.append(t, values)
                 if progress is not None and k % 100 == 0:
                     progress(k, n_steps)
@@ -147,14 +145,13 @@ class Master:
         finally:
             self._recorder = None
             if self.parameter_values:
-                meta["parameters"] = self.parameter_values
-            meta["wall_time_s"] = time.perf_counter() - started
+                recorder.meta["parameters"] = self.parameter_values
             recording = recorder.close(error)
         return recording
 
     def run_meta(self, n_steps: int) -> dict[str, Any]:
-        """What a run of ``n_steps`` records of itself as it starts (``parameters`` and
-        ``wall_time_s`` are added as it ends)."""
+        """What a run of ``n_steps`` records of itself as it starts (it adds ``parameters``
+        and ``wall_time_s`` as it ends)."""
         system, (t0, h, _) = self.system, self.system.steps()
         return {"system": system.name, "description": system.description,
                 "scenario_file": str(system.path) if system.path else None,
@@ -173,9 +170,6 @@ class Master:
         """The run under way's rows closed with ``reason``, for a watchdog (None if none)."""
         recorder, self._recorder = self._recorder, None
         return recorder and recorder.close(f"{reason} ({recorder.rows} rows recorded)")
-
-    def __enter__(self) -> Master:
-        return self
 
     def __exit__(self, *exc_info) -> None:
         self.free()

@@ -6,6 +6,7 @@ and the ``Recording`` holds no rows itself.
 from __future__ import annotations
 
 import os
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any
@@ -74,6 +75,7 @@ class Recorder:
         self.time, self.data = np.empty(size), np.full((size, len(columns)), np.nan)
         self.held = self.written = 0         # rows in the buffer, and rows written
         self.interrupted: str | None = None
+        self.started = time.perf_counter()
 
     @property
     def rows(self) -> int:
@@ -92,6 +94,8 @@ class Recorder:
         self.written, self.held = self.written + self.held, 0
 
     def close(self, error: str | None = None) -> Recording:
+        """The recording, its meta with ``wall_time_s`` since this recorder began."""
+        self.meta["wall_time_s"] = time.perf_counter() - self.started
         if self.path is None:
             return Recording(self.columns, self.time[:self.held], self.data[:self.held],
                              self.held, error, self.interrupted, self.meta, units=self.units)

@@ -1,13 +1,9 @@
 """Values for FMU variables, checked against what the FMU declares before any FMU call.
 
-``fmi_value``: what the FMI 2.0 call of the type carries exactly (section 2.1.2): nothing
-rounded or wrapped (an Integer a whole number of 32 bits: "7", 7.0, "1e3", not 1.5; a
-Boolean a bool, 0, 1 or true/false in any case; a String UTF-8 without NUL; text read as
-the type declares). ``checked``: that value against the declaration (section 2.2.7): a
-Real finite (+-inf only where max="INF" / min="-INF"), within min and max; an Enumeration
-one of its items. ``setting`` also refuses a variable the FMU lacks or that a master may
-not set in initialisation mode (section 4.2.4). Each refusal is a ValueError naming the
-component, the variable, the value and what the variable takes.
+``fmi_value``: exactly what the FMI 2.0 call of the type carries (section 2.1.2), nothing
+rounded or wrapped; ``checked``: that value against the declaration (section 2.2.7);
+``setting``: also that a master may set the variable in initialisation mode (section
+4.2.4). A refusal names the component, the variable, the value and what the variable takes.
 """
 from __future__ import annotations
 
@@ -124,6 +120,21 @@ def _carried(target: str, type_name: str, value: Any, takes: str,
     return exact
 
 
+def _within(declaration: Declaration, value: Value) -> None:
+    """A Real finite (+-inf only where max="INF" / min="-INF"), within min and max; an
+    Enumeration one of its items."""
+    if declaration.type == "Real" and math.isnan(value):
+        raise _Refusal("is not a number (NaN)")
+    if declaration.type == "Real" and math.isinf(value) and \
+            value != (declaration.max if value > 0 else declaration.min):
+        raise _Refusal("is not finite")
+    low, high = declaration.min, declaration.max
+    if (low is not None and value < low) or (high is not None and value > high):
+        raise _Refusal("is outside its declared range")
+    if declaration.items and value not in dict(declaration.items).values():
+        raise _Refusal("is not one of its items")
+
+
 def setting(component: str, path: str | Path, declared: dict[str, Declaration], name: str,
             value: Any, elsewhere: Mapping[str, Iterable[str]] | None = None) -> Value:
     """``checked`` for the variable ``name`` of ``component`` (its FMU at ``path``), which
@@ -218,21 +229,6 @@ def _string(value: Any) -> str:
 
 
 _CARRIED = {"Real": _real, "Integer": _integer, "Boolean": _boolean, "String": _string}
-
-
-def _within(declaration: Declaration, value: Value) -> None:
-    if declaration.type == "Real":
-        if math.isnan(value):
-            raise _Refusal("is not a number (NaN)")
-        if math.isinf(value) and value != (declaration.max if value > 0 else declaration.min):
-            raise _Refusal("is not finite")
-    if declaration.type in ("Real", "Integer", "Enumeration"):
-        low, high = declaration.min, declaration.max
-        if (low is not None and value < low) or (high is not None and value > high):
-            raise _Refusal("is outside its declared range")
-    if declaration.type == "Enumeration" and declaration.items and \
-            value not in dict(declaration.items).values():
-        raise _Refusal("is not one of its items")
 
 
 def parameters(system: SystemDescription, paths: dict[str, Path],
