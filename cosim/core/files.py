@@ -1,10 +1,8 @@
 """Output files written whole or not at all, and output folders written by one process at a time.
 
-``whole_file`` writes to a temporary name beside the target and renames it into place only
-once complete: a reader finds the old file or the new one, and a failed write leaves the old
-one. ``Outputs`` does the same for a group of files, ``fresh_folder`` for a folder;
-``FolderLock`` holds an output folder for one process. A failed write raises
-``OutputError``, naming the file and what was kept.
+A file is written under a temporary name beside its target and renamed into place once
+complete (a reader finds the old file or the new one); a failed write raises ``OutputError``,
+naming the file and what was kept.
 """
 from __future__ import annotations
 
@@ -80,9 +78,8 @@ def read_small_text(path: Path, limit: int) -> str:
 
 @contextlib.contextmanager
 def whole_file(target: Path) -> Iterator[Path]:
-    """``with whole_file(target) as tmp``: ``tmp`` (a new name beside ``target``, of its
-    suffix, which tells the format) becomes ``target`` if the block succeeds, and is removed
-    if it fails (OutputError for an OSError of writing it), the old kept."""
+    """``with whole_file(target) as tmp``: ``tmp`` (a new name of the same suffix, which tells
+    the format) becomes ``target`` if the block succeeds, and is removed if it fails."""
     target = Path(target)
     if target.exists() and not target.is_file():
         raise OutputError(target, OSError(errno.EEXIST, "it exists and is not a regular file "
@@ -128,7 +125,7 @@ def fresh_folder(target: Path) -> Iterator[Path]:
         shutil.rmtree(folder, ignore_errors=True)
 
 
-class Outputs:
+class Outputs(contextlib.AbstractContextManager):
     """``with Outputs(folder, stale) as outputs``: files written to ``outputs.path(name)``
     (a hidden stage in ``folder``) are renamed into ``folder`` together if the block
     succeeds, then every ``stale`` path not rewritten is removed; if it fails (or on
@@ -156,9 +153,6 @@ class Outputs:
         path = Path(path)
         return self.folder / path.relative_to(self.stage) if path.is_relative_to(self.stage) \
             else path
-
-    def __enter__(self) -> Outputs:
-        return self
 
     def __exit__(self, kind, error, trace) -> None:
         try:

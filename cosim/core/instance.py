@@ -1,9 +1,8 @@
 """What the master needs of a component, whichever backend runs it.
 
-A backend supplies ``call`` (run a function, failure as FmuCallError), ``fmi(name)`` (the
-function behind the master's FMI 2.0 call name, "setReal"), ``enter_initialization``,
-``reset`` and ``free``, and may replace the prepared calls of the master's loop
-(``reader``, ``integer_reader``, ``writer``, ``stepper``) with faster ones.
+A backend supplies ``call``, ``fmi(name)`` (the function behind the master's FMI 2.0 call
+name, "setReal"), ``enter_initialization``, ``reset`` and ``free``, and may replace the
+prepared calls of the loop (``reader``, ``integer_reader``, ``writer``, ``stepper``).
 """
 from __future__ import annotations
 
@@ -29,8 +28,8 @@ class LogRecord(NamedTuple):
     @property
     def cause(self) -> str | None:
         """What an FMU built with fmukit refused (category fmukit.<cause>); None otherwise."""
-        prefix = "fmukit."
-        return self.category[len(prefix):] if (self.category or "").startswith(prefix) else None
+        fmukit = (self.category or "").startswith("fmukit.")
+        return self.category.removeprefix("fmukit.") if fmukit else None
 
 
 class FmuCallError(RuntimeError):
@@ -52,7 +51,6 @@ class FmuCallError(RuntimeError):
 
 def logged_error(records: Iterable[LogRecord]) -> bool:
     return any(r.status in ("error", "fatal") for r in records)
-
 
 
 class Instance:
