@@ -41,12 +41,8 @@ RAW_TYPES = {2: (fmi2ValueReference, {"Real": ("Real", fmi2Real),
 
 
 def fmi_version(description: ModelDescription) -> int:
-    """The major FMI version of a model description: 2 or 3; ValueError for another."""
-    version = int(description.fmiVersion.partition(".")[0])
-    if version not in VERSIONS:
-        raise ValueError(f"an FMI {description.fmiVersion} FMU; the master runs FMI 2.0 and "
-                         "3.0 co-simulation FMUs")
-    return version
+    """The major FMI version of a model description: 2 or 3 where ``read_description`` read it."""
+    return int(description.fmiVersion.partition(".")[0])
 
 
 def read_description(path: str | Path, name: str = "", ours: bool = False) -> ModelDescription:
@@ -67,13 +63,12 @@ def _description(path: Path, size: int, mtime_ns: int, ours: bool) -> ModelDescr
         description = read_model_description(str(path))
     except Exception as error:
         raise FmuUnreadable(f"{path} is not a readable FMU ({error})", ours) from error
-    try:
-        version = fmi_version(description)
-    except ValueError as error:
-        raise ValueError(f"{path} is {error}") from None
+    if fmi_version(description) not in VERSIONS:
+        raise ValueError(f"{path} is an FMI {description.fmiVersion} FMU; the master runs FMI "
+                         "2.0 and 3.0 co-simulation FMUs")
     if description.coSimulation is None:
         raise ValueError(f"{path} is not a co-simulation FMU (model exchange only)")
-    if version == 3:
+    if fmi_version(description) == 3:
         for variable in description.modelVariables:
             variable.type = FMI3_TYPES.get(variable.type, variable.type)
     return description
