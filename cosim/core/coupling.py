@@ -1,14 +1,6 @@
-"""Coupling algorithms: how one communication step exchanges signals and steps the FMUs.
-
-Each takes the nodes (``wiring``), the current values (one per column), t_k and h; on
-return ``values`` holds every signal at t_k and, if ``step``, every FMU is at t_k + h.
-
-- ``gauss_seidel``: outputs without feedthrough (the ship's states) read at t_k, then each
-  FMU in signal-flow order gets its inputs, gives its feedthrough outputs and steps (the
-  paper's guidance -> autopilot -> ship, as in its Simulink model);
-- ``jacobi``: every output as it stands, then every input, then every FMU steps (OSP
-  libcosim's and ecos's): a feedthrough signal arrives one step later per feedthrough FMU.
-"""
+"""Coupling algorithms: one communication step from the nodes (``wiring``), the values (one
+per column), t_k and h; after it ``values`` holds every signal at t_k and, if ``step``,
+every FMU is at t_k + h."""
 from __future__ import annotations
 
 from typing import Callable
@@ -20,7 +12,9 @@ Coupling = Callable[[list[Node], list[float], float, float, bool], None]
 
 def gauss_seidel(nodes: list[Node], values: list[float], t: float, h: float,
                  step: bool) -> None:
-    """Each FMU in turn: inputs at t_k, feedthrough outputs at t_k, step."""
+    """Outputs without feedthrough (the ship's states) at t_k, then each FMU in signal-flow
+    order gets its inputs, gives its feedthrough outputs and steps (the paper's guidance ->
+    autopilot -> ship, as in its Simulink model)."""
     for node in nodes:
         if node.read_state:
             values[node.state] = node.read_state()
@@ -36,7 +30,8 @@ def gauss_seidel(nodes: list[Node], values: list[float], t: float, h: float,
 
 
 def jacobi(nodes: list[Node], values: list[float], t: float, h: float, step: bool) -> None:
-    """All outputs as they stand, then all inputs, then all FMUs step."""
+    """All outputs as they stand, then all inputs, then all FMUs step (OSP libcosim's and
+    ecos's): a feedthrough signal arrives one step later per feedthrough FMU."""
     for node in nodes:
         if node.read_outputs:
             values[node.outputs] = node.read_outputs()

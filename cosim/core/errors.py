@@ -30,11 +30,11 @@ def close_matches(name: str, names: Iterable[str]) -> list[str]:
     """The names a user who typed ``name`` likely meant, best first: equal but for case,
     then up to three ``CLOSE`` ones (ignoring case)."""
     names = list(dict.fromkeys(names))
-    same = [n for n in names if n.lower() == name.lower() and n != name]
-    folded = {}
+    folded: dict[str, str] = {}
     for n in names:
         folded.setdefault(n.lower(), n)
     close = [folded[n] for n in difflib.get_close_matches(name.lower(), list(folded), 3, CLOSE)]
+    same = [n for n in names if n.lower() == name.lower()]
     return list(dict.fromkeys(n for n in [*same, *close] if n != name))
 
 

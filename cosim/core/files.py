@@ -1,10 +1,8 @@
 """Output files written whole or not at all, and output folders written by one process at a time.
 
-``whole_file`` writes to a temporary name beside the target and renames it into place only
-once complete: a reader finds the old file or the new one, and a failed write leaves the old
-one. ``Outputs`` does the same for a group of files, ``fresh_folder`` for a folder;
-``FolderLock`` holds an output folder for one process. A failed write raises
-``OutputError``, naming the file and what was kept.
+A file is written under a temporary name beside its target and renamed into place once
+complete (a reader finds the old file or the new one); a failed write raises ``OutputError``,
+naming the file and what was kept.
 """
 from __future__ import annotations
 
@@ -12,6 +10,7 @@ import contextlib
 import errno
 import os
 import re
+import secrets
 import shutil
 import tempfile
 from pathlib import Path
@@ -25,8 +24,6 @@ except ImportError:                     # Windows: msvcrt's byte-range lock inst
 
 TEMPORARY_PREFIX = ".partial-"
 """Temporary files beside their targets start with this (hidden, never a final name)."""
-
-
 FILE_NAME = re.compile(r"\w(?:[\w .+-]{0,98}[\w+-])?")
 """A name given for files in an output folder (``--name``): one plain file name."""
 
@@ -47,8 +44,8 @@ class OutputError(OSError):
         reason = error.strerror or str(error)
         if error.errno == errno.EFBIG:
             reason += " (a limit on file size)"
-        message = f"cannot write {target}: {reason}"
-        super().__init__(error.errno, message + (f"; {kept}" if kept else ""))
+        super().__init__(error.errno, f"cannot write {target}: {reason}"
+                                      + (f"; {kept}" if kept else ""))
         self.target = target
 
     def __str__(self) -> str:
@@ -58,9 +55,7 @@ class OutputError(OSError):
 def _writing(error: OSError, place: Path) -> bool:
     """Whether ``error`` is of writing ``place`` or into it (ENOSPC, EFBIG name no file), not
     of reading another file."""
-    if not error.filename:
-        return True
-    return Path(error.filename).resolve().is_relative_to(place.resolve())
+    return not error.filename or Path(error.filename).resolve().is_relative_to(place.resolve())
 
 
 class FolderBusy(RuntimeError):
@@ -81,38 +76,25 @@ def read_small_text(path: Path, limit: int) -> str:
         raise ValueError(str(error)) from None
 
 
-def _temporary(target: Path) -> Path:
-    handle, name = tempfile.mkstemp(dir=target.parent, prefix=f"{TEMPORARY_PREFIX}{target.stem}.",
-                                    suffix=target.suffix)     # the suffix tells the format
-    os.close(handle)
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(name, 0o666 & ~umask)       # as a file opened for writing would be
-    return Path(name)
-
-
 @contextlib.contextmanager
 def whole_file(target: Path) -> Iterator[Path]:
-    """``with whole_file(target) as tmp``: ``tmp`` becomes ``target`` if the block succeeds,
-    and is removed if it fails (OutputError for an OSError of writing it), the old kept."""
+    """``with whole_file(target) as tmp``: ``tmp`` (a new name of the same suffix, which tells
+    the format) becomes ``target`` if the block succeeds, and is removed if it fails."""
     target = Path(target)
     if target.exists() and not target.is_file():
         raise OutputError(target, OSError(errno.EEXIST, "it exists and is not a regular file "
                                           "(a folder or a device): give a file's name"))
+    tmp = target.with_name(f"{TEMPORARY_PREFIX}{target.stem}.{secrets.token_hex(4)}"
+                           f"{target.suffix}")
     try:
-        tmp = _temporary(target)
+        yield tmp
+        os.replace(tmp, target)
     except OSError as error:
-        raise OutputError(target, error, f"no {target.name} was written") from error
-    try:
-        try:
-            yield tmp
-            os.replace(tmp, target)
-        except OSError as error:
-            if not _writing(error, tmp):
-                raise                   # reading another file failed: its own error
-            kept = (f"{target.name} is as it was before" if target.exists()
-                    else f"no {target.name} was written")
-            raise OutputError(target, error, kept) from error
+        if not _writing(error, tmp):
+            raise                   # reading another file failed: its own error
+        kept = (f"{target.name} is as it was before" if target.exists()
+                else f"no {target.name} was written")
+        raise OutputError(target, error, kept) from error
     finally:
         tmp.unlink(missing_ok=True)
 
@@ -132,18 +114,16 @@ def fresh_folder(target: Path) -> Iterator[Path]:
     folder = Path(tempfile.mkdtemp(dir=target.parent, prefix=f"{TEMPORARY_PREFIX}{target.name}-"))
     try:
         yield folder
+        old = Path(tempfile.mkdtemp(dir=target.parent, prefix=f"{TEMPORARY_PREFIX}old-"))
         if target.exists():
-            old = Path(tempfile.mkdtemp(dir=target.parent, prefix=f"{TEMPORARY_PREFIX}old-"))
             os.replace(target, old / target.name)
-            os.replace(folder, target)
-            shutil.rmtree(old, ignore_errors=True)
-        else:
-            os.replace(folder, target)
+        os.replace(folder, target)
+        shutil.rmtree(old, ignore_errors=True)
     finally:
         shutil.rmtree(folder, ignore_errors=True)
 
 
-class Outputs:
+class Outputs(contextlib.AbstractContextManager):
     """``with Outputs(folder, stale) as outputs``: files written to ``outputs.path(name)``
     (a hidden stage in ``folder``) are renamed into ``folder`` together if the block
     succeeds, then every ``stale`` path not rewritten is removed; if it fails (or on
@@ -172,9 +152,6 @@ class Outputs:
         return self.folder / path.relative_to(self.stage) if path.is_relative_to(self.stage) \
             else path
 
-    def __enter__(self) -> Outputs:
-        return self
-
     def __exit__(self, kind, error, trace) -> None:
         try:
             if kind is None and self.stage.exists():     # not discarded
@@ -187,10 +164,8 @@ class Outputs:
         """``with outputs.writing("x.csv") as path``: an OSError names ``folder/x.csv``."""
         try:
             yield self.path(name)
-        except OutputError:
-            raise
         except OSError as error:
-            if not _writing(error, self.stage):
+            if isinstance(error, OutputError) or not _writing(error, self.stage):
                 raise
             raise OutputError(self.folder / name, error,
                               f"the earlier files in {self.folder} are kept") from error
@@ -205,9 +180,8 @@ class Outputs:
             except OSError as error:
                 raise OutputError(target, error) from error
             placed.append(target)
-        for old in self.stale:
-            if old not in placed:
-                old.unlink(missing_ok=True)
+        for old in set(self.stale) - set(placed):
+            old.unlink(missing_ok=True)
         self.discard()
         return placed
 
@@ -222,31 +196,24 @@ class FolderLock:
 
     def __init__(self, folder: Path):
         self.folder = Path(folder)
-        self._handle: int | None = None
 
     def __enter__(self) -> FolderLock:
-        if fcntl is not None:
-            handle = os.open(self.folder, os.O_RDONLY)
-            try:
-                fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except BlockingIOError:
-                os.close(handle)
-                raise FolderBusy(self._busy()) from None
-        else:
-            handle = os.open(self.folder / ".cosim-lock", os.O_RDWR | os.O_CREAT)
-            try:
-                msvcrt.locking(handle, msvcrt.LK_NBLCK, 1)
-            except OSError:
-                os.close(handle)
-                raise FolderBusy(self._busy()) from None
-        self._handle = handle
+        windows = fcntl is None
+        self._handle = os.open(self.folder / ".cosim-lock" if windows else self.folder,
+                               os.O_RDWR | os.O_CREAT if windows else os.O_RDONLY)
+        try:
+            if windows:
+                msvcrt.locking(self._handle, msvcrt.LK_NBLCK, 1)
+            else:
+                fcntl.flock(self._handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError as error:
+            os.close(self._handle)
+            if not (windows or isinstance(error, BlockingIOError)):
+                raise
+            raise FolderBusy(f"output folder {self.folder} is being written by another "
+                             "command; wait for it to end, or give this one another --out"
+                             ) from None
         return self
 
-    def _busy(self) -> str:
-        return (f"output folder {self.folder} is being written by another command; wait "
-                "for it to end, or give this one another --out")
-
     def __exit__(self, *exc) -> None:
-        if self._handle is not None:
-            os.close(self._handle)          # closing releases the lock
-            self._handle = None
+        os.close(self._handle)          # closing releases the lock

@@ -1,12 +1,7 @@
-"""The master's FMI backend: one FMU instance of FMI 2.0 or 3.0 driven through fmpy, its log kept.
+"""The master's FMI backend: an FMU of FMI 2.0 or 3.0 driven through fmpy, its log kept.
 
-``FmuInstance(path, name)`` is an ``Fmu2Instance`` or an ``Fmu3Instance`` by the FMU's
-fmiVersion. The master speaks FMI 2.0's names: ``read_description`` gives FMI 3.0's Float64
-and Int32 as Real and Integer, and each instance maps the master's calls ("setReal") to its
-version's (``CALLS``). FMI 3.0 differs besides: no setupExperiment (the start time goes to
-enterInitializationMode), get/set take a value count too, a step that asks to end the
-simulation (terminateSimulation) fails the run, and ``time`` (value reference 0) is no
-variable of the master's.
+The master speaks FMI 2.0's names: ``read_description`` gives FMI 3.0's Float64 and Int32 as
+Real and Integer, and an FMI 3.0 instance maps the master's calls to its own (``CALLS``).
 """
 from __future__ import annotations
 
@@ -21,12 +16,12 @@ from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException, calloc, free
 from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
                        fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, fmi2Integer, fmi2Real,
-                       fmi2True, fmi2ValueReference)
+                       fmi2ValueReference)
 from fmpy.fmi3 import FMU3Slave, fmi3Boolean, fmi3Float64, fmi3Int32, fmi3ValueReference
 from fmpy.model_description import ModelDescription
 
 from .errors import FmuNotFound, FmuUnreadable
-from .instance import FmuCallError, Instance, LogRecord, logged_error, one_account
+from .instance import FmuCallError, Instance, LogRecord, logged_error
 
 STATUS = ("ok", "warning", "discard", "error", "fatal", "pending")
 VERSIONS = (2, 3)
@@ -38,15 +33,16 @@ CALLS = {"setReal": "setFloat64", "getReal": "getFloat64",
          "freeFMUstate": "freeFMUState", "serializeFMUstate": "serializeFMUState",
          "deSerializeFMUstate": "deserializeFMUState"}
 """The master's (FMI 2.0) call names that FMI 3.0 names otherwise."""
+RAW_TYPES = {2: (fmi2ValueReference, {"Real": ("Real", fmi2Real),
+                                     "Integer": ("Integer", fmi2Integer)}),
+             3: (fmi3ValueReference, {"Real": ("Float64", fmi3Float64),
+                                     "Integer": ("Int32", fmi3Int32)})}
+"""By FMI version: the ctype of value references, and each master's type's name and ctype."""
 
 
 def fmi_version(description: ModelDescription) -> int:
-    """The major FMI version of a model description: 2 or 3; ValueError for another."""
-    version = int(description.fmiVersion.partition(".")[0])
-    if version not in VERSIONS:
-        raise ValueError(f"an FMI {description.fmiVersion} FMU; the master runs FMI 2.0 and "
-                         "3.0 co-simulation FMUs")
-    return version
+    """The major FMI version of a model description: 2 or 3 where ``read_description`` read it."""
+    return int(description.fmiVersion.partition(".")[0])
 
 
 def read_description(path: str | Path, name: str = "", ours: bool = False) -> ModelDescription:
@@ -67,13 +63,12 @@ def _description(path: Path, size: int, mtime_ns: int, ours: bool) -> ModelDescr
         description = read_model_description(str(path))
     except Exception as error:
         raise FmuUnreadable(f"{path} is not a readable FMU ({error})", ours) from error
-    try:
-        version = fmi_version(description)
-    except ValueError as error:
-        raise ValueError(f"{path} is {error}") from None
+    if fmi_version(description) not in VERSIONS:
+        raise ValueError(f"{path} is an FMI {description.fmiVersion} FMU; the master runs FMI "
+                         "2.0 and 3.0 co-simulation FMUs")
     if description.coSimulation is None:
         raise ValueError(f"{path} is not a co-simulation FMU (model exchange only)")
-    if version == 3:
+    if fmi_version(description) == 3:
         for variable in description.modelVariables:
             variable.type = FMI3_TYPES.get(variable.type, variable.type)
     return description
@@ -88,23 +83,13 @@ def feedthrough(description: ModelDescription) -> dict[str, frozenset[str]]:
 
 
 class FmuInstance(Instance):
-    """An instantiated co-simulation FMU, of the class its fmiVersion chooses. FmuNotFound,
-    FmuUnreadable or ValueError when the FMU is missing or unreadable; FmuCallError when it
-    cannot be instantiated (its extracted files are removed)."""
-
-    slave: Any                         # fmpy's FMU2Slave or FMU3Slave
-    VERSION, PREFIX, REAL, INTEGER = 0, "", "", ""    # FMI 2.0's names or FMI 3.0's
-    TYPES: tuple = ()                  # ctypes of the value references, Reals, Integers
-
-    def __new__(cls, path: str | Path, name: str, unzip_dir: str | Path | None = None):
-        chosen = cls
-        if cls is FmuInstance:
-            version = fmi_version(read_description(path, name))
-            chosen = Fmu3Instance if version == 3 else Fmu2Instance
-        return super().__new__(chosen, path, name)
+    """An instantiated co-simulation FMU through fmpy's FMU2Slave or FMU3Slave. FMI 3.0 has
+    no setupExperiment, and a step that asks to end the simulation fails. FmuCallError when
+    it cannot be instantiated (its extracted files are removed)."""
 
     def __init__(self, path: str | Path, name: str, unzip_dir: str | Path | None = None):
         self.description = read_description(self.path, name)
+        self.fmi_version, self.guid = fmi_version(self.description), self.description.guid
         self._owns_unzip_dir = unzip_dir is None
         self.unzip_dir = str(unzip_dir) if unzip_dir else extract(str(self.path))
         self.variables = {v.name: v for v in self.description.modelVariables
@@ -112,9 +97,23 @@ class FmuInstance(Instance):
         self.feedthrough = feedthrough(self.description)
         self.log: deque[LogRecord] = deque(maxlen=50)     # the last messages
         self.logged = 0                              # how many there have been
-        try:
-            self._instantiate()
-        except Exception as error:        # fmpy raises a plain Exception when it gets NULL
+
+        def log(*args) -> None:      # FMI 2.0's logger, FMI 3.0's logMessage: the last three
+            self._log(*args[-3:])    # are status, category, message
+        try:                  # fmpy raises a plain Exception when it gets NULL
+            self.slave = (FMU2Slave if self.fmi_version == 2 else FMU3Slave)(
+                guid=self.guid, unzipDirectory=self.unzip_dir, instanceName=name,
+                modelIdentifier=self.description.coSimulation.modelIdentifier)
+            if self.fmi_version == 2:
+                self._callbacks = fmi2CallbackFunctions(
+                    logger=fmi2CallbackLoggerTYPE(log),
+                    allocateMemory=fmi2CallbackAllocateMemoryTYPE(calloc),
+                    freeMemory=fmi2CallbackFreeMemoryTYPE(free))
+                self.call("instantiate", self.slave.instantiate, callbacks=self._callbacks,
+                          loggingOn=True)
+            else:
+                self.call("instantiate", self.slave.instantiate, loggingOn=True, logMessage=log)
+        except Exception as error:
             self._remove_unzip_dir()
             if isinstance(error, FmuCallError):
                 raise
@@ -122,14 +121,6 @@ class FmuInstance(Instance):
                                [*self.log, LogRecord("fatal", None,
                                                      f"{type(error).__name__}: {error}")]
                                ) from error
-
-    def _instantiate(self) -> None:
-        raise NotImplementedError
-
-    @property
-    def guid(self) -> str:
-        """The FMI 2.0 guid, or the FMI 3.0 instantiationToken."""
-        return self.description.guid
 
     def _log(self, status: int, category: bytes | None, message: bytes) -> None:
         self.logged += 1
@@ -151,9 +142,14 @@ class FmuInstance(Instance):
         return result
 
     def _since(self, before: int) -> list[LogRecord]:
-        """The log of the call that began when ``before`` had been logged (of the last 50)."""
+        """The log of the call that began when ``before`` had been logged (of the last 50),
+        each failure told once: pythonfmu's fatal message (no category) for a refusal that
+        an FMU built with fmukit logged (a cause) is left out."""
         new = self.logged - before
-        return one_account(list(self.log)[-new:] if new else [])
+        records = list(self.log)[-new:] if new else []
+        if any(r.cause for r in records):
+            records = [r for r in records if r.category is not None or r.status != "fatal"]
+        return records
 
     def _status(self, what: str, status: int, before: int, time: float | None = None) -> None:
         if status > 1:                      # discard, error, fatal
@@ -162,6 +158,23 @@ class FmuInstance(Instance):
     def _terminated(self, t: float, before: int) -> FmuCallError:
         return FmuCallError(self.name, "doStep", t, "OK but asked to end the simulation "
                             "(terminateSimulation)", self._since(before))
+
+    def fmi(self, name: str):
+        return getattr(self.slave, CALLS.get(name, name) if self.fmi_version == 3 else name)
+
+    def enter_initialization(self, start_time: float = 0.0) -> None:
+        if self.fmi_version == 2:
+            self.call("setupExperiment", self.slave.setupExperiment, startTime=start_time)
+            self.call("enterInitializationMode", self.slave.enterInitializationMode)
+        else:
+            self.call("enterInitializationMode", self.slave.enterInitializationMode,
+                      startTime=start_time)
+
+    def do_step(self, t: float, h: float) -> None:
+        before = self.logged
+        result = self.call("doStep", self.slave.doStep, t, h, time=t)
+        if self.fmi_version == 3 and result[1]:          # terminateSimulation
+            raise self._terminated(t, before)
 
     def reset(self) -> None:
         self.call("reset", self.slave.reset)
@@ -181,117 +194,57 @@ class FmuInstance(Instance):
 
     # Prepared calls: the raw FMI functions (fmpy's ``dll``) on preallocated ctypes arrays,
     # without fmpy's per-call wrapping, which costs more than the call itself.
-    def _counts(self, n: int) -> tuple:
-        return (n,) if self.VERSION == 2 else (n, n)    # FMI 3.0 also takes the value count
+    def _raw(self, verb: str, kind: str, vrs: list[int]) -> tuple[Any, Callable[[], None]]:
+        """The values array for ``vrs`` and fmi2GetReal, fmi3SetFloat64 ... on it."""
+        reference, types = RAW_TYPES[self.fmi_version]
+        name, ctype = types[kind]
+        function = getattr(self.slave.dll, f"fmi{self.fmi_version}{verb.title()}{name}")
+        component, n = self.slave.component, len(vrs)
+        refs, values = (reference * n)(*vrs), (ctype * n)()
+        counts = (n,) if self.fmi_version == 2 else (n, n)   # FMI 3.0: the value count too
+        what = f"{verb}{name}"                               # a watchdog reads it here
 
-    def _getter(self, kind: str, ctype, vrs: list[int]):
-        get, component = getattr(self.slave.dll, f"{self.PREFIX}Get{kind}"), self.slave.component
-        refs, values = (self.TYPES[0] * len(vrs))(*vrs), (ctype * len(vrs))()
-        counts = self._counts(len(vrs))
+        def run() -> None:
+            before = self.logged
+            status = function(component, refs, counts[0], values, *counts[1:])
+            if status:
+                self._status(what, status, before)
+        return values, run
+
+    def _reader(self, kind: str, vrs: list[int]) -> Callable[[], list]:
+        values, run = self._raw("get", kind, vrs)
 
         def read() -> list:
-            before = self.logged
-            status = get(component, refs, counts[0], values, *counts[1:])
-            if status:
-                self._status(f"Get{kind}", status, before)
+            run()
             return values[:]
         return read
 
     def reader(self, vrs: list[int]):
-        return self._getter(self.REAL, self.TYPES[1], vrs)
+        return self._reader("Real", vrs)
 
     def integer_reader(self, vrs: list[int]):
-        return self._getter(self.INTEGER, self.TYPES[2], vrs)
+        return self._reader("Integer", vrs)
 
     def writer(self, vrs: list[int]):
-        kind = self.REAL
-        set_, component = getattr(self.slave.dll, f"{self.PREFIX}Set{kind}"), self.slave.component
-        refs, values = (self.TYPES[0] * len(vrs))(*vrs), (self.TYPES[1] * len(vrs))()
-        counts = self._counts(len(vrs))
+        values, run = self._raw("set", "Real", vrs)
 
         def write(new: list[float]) -> None:
             values[:] = new
-            before = self.logged
-            status = set_(component, refs, counts[0], values, *counts[1:])
-            if status:
-                self._status(f"set{kind}", status, before)
+            run()
         return write
 
-
-class Fmu2Instance(FmuInstance):
-    """An FMI 2.0 co-simulation FMU through fmpy's FMU2Slave."""
-
-    VERSION, PREFIX, REAL, INTEGER = 2, "fmi2", "Real", "Integer"
-    TYPES = (fmi2ValueReference, fmi2Real, fmi2Integer)
-
-    def _instantiate(self) -> None:
-        self._callbacks = fmi2CallbackFunctions()
-        self._callbacks.logger = fmi2CallbackLoggerTYPE(
-            lambda env, instance, status, category, message: self._log(status, category,
-                                                                       message))
-        self._callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
-        self._callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-        self.slave = FMU2Slave(guid=self.description.guid, unzipDirectory=self.unzip_dir,
-                               modelIdentifier=self.description.coSimulation.modelIdentifier,
-                               instanceName=self.name)
-        self.call("instantiate", self.slave.instantiate, callbacks=self._callbacks,
-                  loggingOn=True)
-
-    def fmi(self, name: str):
-        return getattr(self.slave, name)
-
-    def enter_initialization(self, start_time: float = 0.0) -> None:
-        self.call("setupExperiment", self.slave.setupExperiment, startTime=start_time)
-        self.call("enterInitializationMode", self.slave.enterInitializationMode)
-
     def stepper(self):
-        do_step, component = self.slave.dll.fmi2DoStep, self.slave.component
+        component, terminate = self.slave.component, fmi3Boolean()    # set by FMI 3.0 only
+        if self.fmi_version == 2:
+            do_step, rest = self.slave.dll.fmi2DoStep, ()
+        else:            # noEarlierState, then eventHandlingNeeded, terminate, early, lastTime
+            do_step = self.slave.dll.fmi3DoStep
+            rest = byref(fmi3Boolean()), byref(terminate), byref(fmi3Boolean()), \
+                byref(fmi3Float64())
 
         def step(t: float, h: float) -> None:
             before = self.logged
-            status = do_step(component, t, h, fmi2True)
-            if status:
-                self._status("doStep", status, before, t)
-        return step
-
-
-class Fmu3Instance(FmuInstance):
-    """An FMI 3.0 co-simulation FMU through fmpy's FMU3Slave."""
-
-    VERSION, PREFIX, REAL, INTEGER = 3, "fmi3", "Float64", "Int32"
-    TYPES = (fmi3ValueReference, fmi3Float64, fmi3Int32)
-
-    def _instantiate(self) -> None:
-        self.slave = FMU3Slave(guid=self.description.guid, unzipDirectory=self.unzip_dir,
-                               modelIdentifier=self.description.coSimulation.modelIdentifier,
-                               instanceName=self.name)
-        self.call("instantiate", self.slave.instantiate, loggingOn=True,   # pythonfmu3: b""
-                  logMessage=lambda env, status, category, message: self._log(
-                      status, category or None, message))
-
-    def fmi(self, name: str):
-        return getattr(self.slave, CALLS.get(name, name))
-
-    def do_step(self, t: float, h: float) -> None:
-        before = self.logged
-        _, terminate, _, _ = self.call("doStep", self.slave.doStep, t, h, time=t)
-        if terminate:
-            raise self._terminated(t, before)
-
-    def enter_initialization(self, start_time: float = 0.0) -> None:
-        self.call("enterInitializationMode", self.slave.enterInitializationMode,
-                  startTime=start_time)
-
-    def stepper(self):
-        do_step, instance = self.slave.dll.fmi3DoStep, self.slave.component
-        terminate = fmi3Boolean()
-        event, early, last = fmi3Boolean(), fmi3Boolean(), fmi3Float64()
-        pointers = byref(event), byref(terminate), byref(early), byref(last)
-        no_earlier_state = fmi3Boolean(True)
-
-        def step(t: float, h: float) -> None:
-            before = self.logged
-            status = do_step(instance, t, h, no_earlier_state, *pointers)
+            status = do_step(component, t, h, True, *rest)
             if status:
                 self._status("doStep", status, before, t)
             if terminate.value:

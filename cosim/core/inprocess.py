@@ -1,13 +1,10 @@
 """The master's in-process backend: the FMUs' Python classes, called without FMI.
 
-An ``InProcessInstance`` has the interface of ``cosim.core.fmi.FmuInstance`` but instantiates
-in this process the class an FMU built with fmukit was made from (its manifest,
-``fmukit.manifest``), composed for the FMU's FMI version as its entry module composes it
-(``fmukit.compose.fmu_class``), and calls its methods directly. The FMU must be current
-here, so that a run differs from one through FMI only by the FMI layer: every column of every
-row is the same, bit for bit. The loop gets the slave's own plans for its value references
-(``fmukit.fastpath``); steps and parameters pass the slave's checks, so an invalid value is
-refused with the same message as through FMI.
+An ``InProcessInstance`` instantiates in this process the class an FMU built with fmukit was
+made from (its manifest), composed for its FMI version as its entry module composes it
+(``fmukit.compose.fmu_class``), and calls its methods directly. The FMU must be current here,
+so that a run differs from one through FMI only by the FMI layer, bit for bit; invalid
+values are refused with the same message as through FMI.
 """
 from __future__ import annotations
 
@@ -15,10 +12,9 @@ import hashlib
 import importlib
 import re
 import zipfile
-from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 from xml.etree import ElementTree
 
 from fmukit.compose import fmu_class
@@ -32,14 +28,11 @@ from .instance import FmuCallError, Instance, LogRecord, logged_error
 
 _FMI_TYPE = {float: "Real", int: "Integer", str: "String"}
 """The master's type names (FMI 2.0's), whichever version the class is of."""
-_FAILED = frozenset({"discard", "error", "fatal"})
 _PYTHONFMU = ("resources/pythonfmu/", "resources/pythonfmu3/")
 """What pythonfmu 0.7 and pythonfmu3 carry of their own."""
-_DECLARATIONS = ("ModelVariables", "UnitDefinitions", "ModelStructure")
 
 
-@dataclass(frozen=True)
-class VariableInfo:
+class VariableInfo(NamedTuple):
     name: str
     valueReference: int
     type: str
@@ -51,71 +44,64 @@ class Reason(str):
     """Why an FMU runs through FMI; ``stale_module``: the slave module of an FMU built with
     fmukit before a change of its sources (a rebuild mends it), else None."""
 
-    stale_module: str | None = None
+    def __new__(cls, text: str, stale_module: str | None = None) -> Reason:
+        reason = super().__new__(cls, text)
+        reason.stale_module = stale_module
+        return reason
 
 
 def slave_class(manifest: Manifest) -> type[ModelSlave]:
-    """The FMU's class in this process: the model class its manifest names, composed for
-    its FMI version."""
+    """The model class an FMU's manifest names, composed for its FMI version."""
     module = importlib.import_module(manifest.slave_module)
     return fmu_class(getattr(module, manifest.slave_class), manifest.fmi)
 
 
-@cache
-def _cached_refusal(path: Path, size: int, mtime_ns: int) -> str | None:
-    return _refusal(path)
-
-
-def in_process_refusal(path: str | Path) -> str | None:
+def in_process_refusal(path: str | Path) -> Reason | None:
     """Why the FMU at ``path`` cannot run in-process, or None: it must be built with fmukit,
     hold what its manifest lists, declare what its class declares and be current here
     (``fmukit.manifest.staleness``), so that both routes compute the same."""
     stat = Path(path).stat()
-    return _cached_refusal(Path(path).resolve(), stat.st_size, stat.st_mtime_ns)
+    return _refusal(Path(path).resolve(), stat.st_size, stat.st_mtime_ns)
 
 
 def fallback_note(name: str, path: str | Path) -> Reason | None:
-    """The note for component ``name`` when its FMU must run through FMI instead of
-    in-process (``in_process_refusal``), or None."""
+    """The note for component ``name`` whose FMU must run through FMI, not in-process."""
     refusal = in_process_refusal(path)
     if refusal is None:
         return None
-    note = Reason(f"{name} ({Path(path).name}) runs through FMI, not in-process: {refusal}")
-    note.stale_module = getattr(refusal, "stale_module", None)
-    return note
+    return Reason(f"{name} ({Path(path).name}) runs through FMI, not in-process: {refusal}",
+                  refusal.stale_module)
 
 
-def _refusal(path: Path) -> str | None:
+@cache
+def _refusal(path: Path, size: int, mtime_ns: int) -> Reason | None:     # cached by version
     try:
         manifest = read(path)
         if manifest is None:
-            return "it was not built with fmukit (it has no manifest)"
+            return Reason("it was not built with fmukit (it has no manifest)")
         described = read_description(path)
         if described.modelName != manifest.model_name:
-            return (f"its model description names the model '{described.modelName}', "
-                    f"its manifest '{manifest.model_name}'")
+            return Reason(f"its model description names the model '{described.modelName}', "
+                          f"its manifest '{manifest.model_name}'")
         with zipfile.ZipFile(path) as fmu:
             refusal = _contents_refusal(fmu, manifest)
             declared = ElementTree.fromstring(fmu.read("modelDescription.xml"))
         if refusal:
-            return refusal
+            return Reason(refusal)
         stale = staleness(manifest)
         if stale is not None:
-            refusal = Reason(stale)
-            refusal.stale_module = manifest.slave_module
-            return refusal
-        if manifest.fmi != int(described.fmiVersion.partition(".")[0]):
-            return (f"its model description is of FMI {described.fmiVersion}, its "
-                    f"manifest says FMI {manifest.fmi}")
+            return Reason(stale, manifest.slave_module)
+        # an FMI version other than the manifest's declares other ModelVariables, too
         ours = slave_class(manifest)(instance_name=manifest.model_name).to_xml()
-        for section in _DECLARATIONS:
+        for section in ("ModelVariables", "UnitDefinitions", "ModelStructure"):
             if _canonical(declared.find(section)) != _canonical(ours.find(section)):
-                return (f"its {section} differ from those its class "
-                        f"{manifest.slave_module}.{manifest.slave_class} declares")
+                return Reason(f"its {section} differ from those its class "
+                              f"{manifest.slave_module}.{manifest.slave_class} declares")
         return None
     except (OSError, KeyError, UnicodeDecodeError, ValueError, ImportError, AttributeError,
             zipfile.BadZipFile, ElementTree.ParseError) as error:
-        return f"it cannot be read as an FMU built with fmukit ({type(error).__name__}: {error})"
+        return Reason("it cannot be read as an FMU built with fmukit "
+                      f"({type(error).__name__}: {error})")
 
 
 def _contents_refusal(fmu: zipfile.ZipFile, manifest: Manifest) -> str | None:
@@ -151,10 +137,8 @@ class InProcessInstance(Instance):
     def __init__(self, path: str | Path, name: str, same_sources: bool = True):
         """ValueError if the FMU cannot run in-process (``in_process_refusal``); without
         ``same_sources``, only if it was not built with fmukit (``cosim.studies.direct``)."""
-        description = read_description(self.path, name)
-        self.model_name, self.guid = description.modelName, description.guid
-        refusal = in_process_refusal(self.path)
-        manifest = read(self.path)
+        self.guid = read_description(self.path, name).guid
+        refusal, manifest = in_process_refusal(self.path), read(self.path)
         if refusal and (same_sources or manifest is None):
             raise ValueError(f"FMU '{name}' ({self.path.name}) cannot run in-process: "
                              f"{refusal}")
@@ -190,14 +174,13 @@ class InProcessInstance(Instance):
     def _judge(self, what: str, time: float | None, result: Any, strict: bool) -> None:
         """FmuCallError if a call refused (returned False or a failed FMI 3.0 step result)
         or, ``strict``, logged an error; the log is drained either way."""
-        messages = self._drain()
-        if result is False:
-            raise FmuCallError(self.name, what, time, "discard", messages)
-        status = getattr(result, "status", None)
-        if status is not None and status.name in _FAILED:
-            raise FmuCallError(self.name, what, time, status.name, messages)
-        if strict and logged_error(messages):
-            raise FmuCallError(self.name, what, time, "OK but logged an error", messages)
+        records = self._drain()
+        status = getattr(result, "status", None)                # an FMI 3.0 step's
+        failed = "discard" if result is False else getattr(status, "name", None)
+        if failed in ("discard", "error", "fatal"):
+            raise FmuCallError(self.name, what, time, failed, records)
+        if strict and logged_error(records):
+            raise FmuCallError(self.name, what, time, "OK but logged an error", records)
 
     def _drain(self) -> list[LogRecord]:
         records = [LogRecord(m.status.name, m.category or None, m.msg)    # pythonfmu3's: ""
@@ -207,33 +190,19 @@ class InProcessInstance(Instance):
 
     def fmi(self, name: str):
         """The slave method behind a call name: setReal -> set_real (set_float64 on FMI 3.0)."""
-        if self.fmi_version == 3:
-            name = CALLS.get(name, name)
-        return getattr(self.slave, _method_name(name))
+        return getattr(self.slave, _method_name(CALLS.get(name, name) if self.fmi_version == 3
+                                                else name))
 
     # Prepared calls: the slave's own plans, valid until ``reset`` makes a new slave; through
     # the FMI entry where it has none or where the plan raises (to report it as FMI would).
     def reader(self, vrs: list[int]):
-        return self._prepared(self.slave.plans.real_reader(vrs), super().reader(vrs))
+        return _prepared(self.slave.plans.real_reader(vrs), super().reader(vrs))
 
     def integer_reader(self, vrs: list[int]):
-        return self._prepared(self.slave.plans.integer_reader(vrs), super().integer_reader(vrs))
-
-    @staticmethod
-    def _prepared(plan, through_fmi):
-        if plan is None:
-            return through_fmi
-
-        def read() -> list:
-            try:
-                return plan()
-            except Exception:
-                return through_fmi()
-        return read
+        return _prepared(self.slave.plans.integer_reader(vrs), super().integer_reader(vrs))
 
     def writer(self, vrs: list[int]):
-        write = self.slave.plans.input_writer(vrs)
-        return super().writer(vrs) if write is None else write
+        return self.slave.plans.input_writer(vrs) or super().writer(vrs)
 
     def stepper(self):
         do_step, queue = unguarded(self.slave.do_step), self.slave.log_queue
@@ -263,6 +232,19 @@ class InProcessInstance(Instance):
         """Terminate, if the slave was initialised."""
         if self.slave.sequence.phase == "step":
             self.slave.terminate()
+
+
+def _prepared(plan, through_fmi):
+    """``plan``, or ``through_fmi`` where there is none or where the plan raises."""
+    if plan is None:
+        return through_fmi
+
+    def read() -> list:
+        try:
+            return plan()
+        except Exception:
+            return through_fmi()
+    return read
 
 
 @cache

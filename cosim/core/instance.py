@@ -1,9 +1,8 @@
 """What the master needs of a component, whichever backend runs it.
 
-A backend supplies ``call`` (run a function, failure as FmuCallError), ``fmi(name)`` (the
-function behind the master's FMI 2.0 call name, "setReal"), ``enter_initialization``,
-``reset`` and ``free``, and may replace the prepared calls of the master's loop
-(``reader``, ``integer_reader``, ``writer``, ``stepper``) with faster ones.
+A backend supplies ``call``, ``fmi(name)`` (the function behind the master's FMI 2.0 call
+name, "setReal"), ``enter_initialization``, ``reset`` and ``free``, and may replace the
+prepared calls of the loop (``reader``, ``integer_reader``, ``writer``, ``stepper``).
 """
 from __future__ import annotations
 
@@ -29,8 +28,8 @@ class LogRecord(NamedTuple):
     @property
     def cause(self) -> str | None:
         """What an FMU built with fmukit refused (category fmukit.<cause>); None otherwise."""
-        prefix = "fmukit."
-        return self.category[len(prefix):] if (self.category or "").startswith(prefix) else None
+        fmukit = (self.category or "").startswith("fmukit.")
+        return self.category.removeprefix("fmukit.") if fmukit else None
 
 
 class FmuCallError(RuntimeError):
@@ -54,14 +53,6 @@ def logged_error(records: Iterable[LogRecord]) -> bool:
     return any(r.status in ("error", "fatal") for r in records)
 
 
-def one_account(records: list[LogRecord]) -> list[LogRecord]:
-    """A call's records, each failure told once: where an FMU built with fmukit logged its
-    refusal (a cause), pythonfmu's own fatal message for it (no category) is left out."""
-    if not any(r.cause for r in records):
-        return records
-    return [r for r in records if r.category is not None or r.status != "fatal"]
-
-
 class Instance:
     """One instantiated component: its variables, its feedthrough, and FMI calls.
 
@@ -70,6 +61,7 @@ class Instance:
 
     name: str
     path: Path
+    guid: str | None
     variables: dict[str, Any]          # name: object with valueReference, type, causality
     feedthrough: dict[str, frozenset[str]]   # output name: the inputs it depends on
 
@@ -82,19 +74,6 @@ class Instance:
              strict: bool = False) -> Any:
         """Run ``function``; FmuCallError if it fails, or, ``strict``, if it returns OK but
         logs an error."""
-        raise NotImplementedError
-
-    def fmi(self, name: str) -> Callable:
-        raise NotImplementedError
-
-    def enter_initialization(self, start_time: float = 0.0) -> None:
-        raise NotImplementedError
-
-    def reset(self) -> None:
-        """Back to the state after instantiation (fmi2Reset, fmi3Reset)."""
-        raise NotImplementedError
-
-    def free(self) -> None:
         raise NotImplementedError
 
     def variable(self, name: str):

@@ -1,10 +1,8 @@
 """Ctrl-C and SIGTERM: a request to stop between steps, or an exception where no FMU runs.
 
-Our FMUs' Python runs in the master's interpreter, so a KeyboardInterrupt would land inside
-an FMU's call and fail it. Within ``StopSignals`` a signal only records itself; the master
-stops between steps and keeps every row (a second signal ends the process at once; while
-an FMU never returns, ``cosim.core.watchdog`` takes the signals). Within
-``raise_on_signals`` either signal raises ``Interrupted``, for code that runs no FMU.
+Our FMUs' Python runs in the master's interpreter, where a KeyboardInterrupt would fail an
+FMU's call: within ``StopSignals`` a signal only records itself and the master stops between
+steps (a second signal ends the process at once). ``raise_on_signals`` raises instead.
 """
 from __future__ import annotations
 
@@ -18,24 +16,35 @@ from typing import Callable, Iterator
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 
+def take_signals(handler: Callable) -> dict:
+    """``handler`` for SIGINT and SIGTERM (main thread only): the handlers it replaced."""
+    if threading.current_thread() is not threading.main_thread():
+        return {}
+    return {number: signal.signal(number, handler) for number in STOP_SIGNALS}
+
+
+def give_back(handlers: dict) -> None:
+    for number, handler in handlers.items():
+        signal.signal(number, handler)
+
+
 class StopSignals:
     """``with StopSignals() as stop``: ``stop.received`` is the first SIGINT or SIGTERM that
     arrived, or None (main thread only; elsewhere this does nothing)."""
 
     def __init__(self) -> None:
         self.received: signal.Signals | None = None
-        self._previous: dict[signal.Signals, object] = {}
+        self._previous: dict = {}
         self._keepers: list[Callable[[], str]] = []
         self._ending = threading.Lock()
 
     def __enter__(self) -> StopSignals:
-        if threading.current_thread() is threading.main_thread():
-            for number in STOP_SIGNALS:
-                self._previous[number] = signal.signal(number, self._handle)
+        self._previous = take_signals(lambda number, frame: self.receive(signal.Signals(number)))
         return self
 
-    def _handle(self, number: int, frame) -> None:
-        self.receive(signal.Signals(number))
+    def __exit__(self, *exc) -> None:
+        give_back(self._previous)
+        self._previous = {}
 
     def receive(self, number: signal.Signals) -> None:
         """The first signal asks the run to stop between steps; a second ends the process at
@@ -61,11 +70,6 @@ class StopSignals:
         self._keepers.append(keeper)
         return lambda: self._keepers.remove(keeper) if keeper in self._keepers else None
 
-    def __exit__(self, *exc) -> None:
-        for number, handler in self._previous.items():
-            signal.signal(number, handler)
-        self._previous = {}
-
     @property
     def exit_status(self) -> int:
         """The shell's status for a command ended by the signal received: 130, 143."""
@@ -82,11 +86,8 @@ class Interrupted(BaseException):
 
     def __init__(self, number: int):
         self.signal = signal.Signals(number)
+        self.exit_status = 128 + self.signal
         super().__init__(f"interrupted by {self.signal.name}")
-
-    @property
-    def exit_status(self) -> int:
-        return 128 + self.signal
 
 
 def _raise(number: int, frame) -> None:
@@ -96,12 +97,8 @@ def _raise(number: int, frame) -> None:
 @contextmanager
 def raise_on_signals() -> Iterator[None]:
     """Within: SIGINT and SIGTERM raise ``Interrupted`` (main thread only)."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = {number: signal.signal(number, _raise) for number in STOP_SIGNALS}
+    previous = take_signals(_raise)
     try:
         yield
     finally:
-        for number, handler in previous.items():
-            signal.signal(number, handler)
+        give_back(previous)

@@ -1,15 +1,14 @@
 """The co-simulation master: FMUs wired by a system description, stepped at a fixed step.
 
 Time is counted in integer steps, t_k = t_0 + k h in whole nanoseconds (``fmukit.timebase``),
-so a 400 s run at 0.1 s has exactly 4000 steps and 4001 rows. The master wires and
-delegates: ``wiring`` checks the connections, orders and lays out the columns, ``coupling``
-does one communication step, ``recording`` keeps the rows. A failed call, a time limit
-passed (``watchdog``) or a signal (``interrupt``) stops the run between steps with an error
-naming the FMU, the call and the time; the rows recorded up to then are kept.
+so a 400 s run at 0.1 s has exactly 4000 steps and 4001 rows. ``wiring`` checks, orders and
+lays out, ``coupling`` does one communication step, ``recording`` keeps the rows. A failed
+call, a time limit passed (``watchdog``) or a signal (``interrupt``) stops the run between
+steps with an error naming the FMU, the call and the time; the rows up to then are kept.
 """
 from __future__ import annotations
 
-import time
+import contextlib
 from pathlib import Path
 from typing import Any, Callable
 
@@ -35,15 +34,15 @@ RUN_BACKENDS = ("fmi", "inprocess")
 """The backends a run of a scenario may take."""
 
 
-class Master:
+class Master(contextlib.AbstractContextManager):
     """Instantiate, initialise and step the components of a system description; a context
     manager: ``with Master(system) as master: recording = master.run()`` frees the FMUs."""
 
     def __init__(self, system: SystemDescription, coupling: str = "gauss-seidel",
                  backend: str = "fmi", overrides: dict[str, dict[str, Any]] | None = None,
                  verify_inputs: bool = False):
-        for what, value, known in (("coupling", coupling, COUPLINGS), ("backend", backend,
-                                                                         BACKENDS)):
+        for what, value, known in (("coupling", coupling, COUPLINGS),
+                                   ("backend", backend, BACKENDS)):
             if value not in known:
                 raise ValueError(f"{what} must be one of {', '.join(known)}, got {value!r}")
         self.system, self.coupling, self.backend = system, coupling, backend
@@ -55,6 +54,7 @@ class Master:
         self.instances: dict[str, Instance] = {}
         self.notes: list[str] = []            # what the user should know about how this runs
         self.backends: dict[str, str] = {}    # how each component runs
+        self._recorder: Recorder | None = None
         try:
             for name, path in self.paths.items():
                 note = fallback_note(name, path) if backend == "inprocess" else None
@@ -114,27 +114,24 @@ class Master:
         ``stop`` or a limit of ``watchdog`` ends it early (``Recording.error``). With
         ``csv_path`` the rows are streamed there in chunks (else TooManyRows if too many)."""
         t0, h, n_steps = self.system.steps(stop_time)
-        meta = self.run_meta(n_steps)
-        recorder = Recorder(self.columns, n_steps + 1, csv_path, chunk_rows, meta=meta,
-                            units=self.units)
-        exchange, nodes, values = COUPLINGS[self.coupling], self.nodes, [0.0] * len(self.columns)
-        k, t, error, started = 0, t0, None, time.perf_counter()
-        self.parameter_values, self._recorder = {}, recorder
+        recorder = self._recorder = Recorder(self.columns, n_steps + 1, csv_path, chunk_rows,
+                                             self.run_meta(n_steps), self.units)
+        exchange, values = COUPLINGS[self.coupling], [0.0] * len(self.columns)
+        k, t, error, self.parameter_values = 0, t0, None, {}
         beat = watchdog.beat if watchdog is not None else no_limit
         try:
             beat("the initialisation")
             self.initialize()
             for k in range(n_steps + 1):
                 t = communication_point(t0, k, h)
-                expired = beat(t)
-                signal = stop.received if stop is not None else None
+                expired, signal = beat(t), stop and stop.received
                 if signal or expired:
                     t = communication_point(t0, k - 1, h) if k else t0
                     recorder.interrupted = signal.name if signal else None
                     error = (f"{'interrupted' if signal else f'{expired}: stopped'} at t = "
                              f"{t:.6g} s, {recorder.rows} rows kept")
                     break
-                exchange(nodes, values, t, h, k < n_steps)
+                exchange(self.nodes, values, t, h, k < n_steps)
                 recorder.append(t, values)
                 if progress is not None and k % 100 == 0:
                     progress(k, n_steps)
@@ -148,14 +145,13 @@ class Master:
         finally:
             self._recorder = None
             if self.parameter_values:
-                meta["parameters"] = self.parameter_values
-            meta["wall_time_s"] = time.perf_counter() - started
+                recorder.meta["parameters"] = self.parameter_values
             recording = recorder.close(error)
         return recording
 
     def run_meta(self, n_steps: int) -> dict[str, Any]:
-        """What a run of ``n_steps`` records of itself as it starts (``parameters`` and
-        ``wall_time_s`` are added as it ends)."""
+        """What a run of ``n_steps`` records of itself as it starts (it adds ``parameters``
+        and ``wall_time_s`` as it ends)."""
         system, (t0, h, _) = self.system, self.system.steps()
         return {"system": system.name, "description": system.description,
                 "scenario_file": str(system.path) if system.path else None,
@@ -164,7 +160,7 @@ class Master:
                 "stop_time": communication_point(t0, n_steps, h),
                 "scenario_stop_time": system.stop_time,
                 "settings": self.parameters, "overrides": self.overrides,
-                "fmus": {name: {"file": str(i.path), "guid": getattr(i, "guid", None)}
+                "fmus": {name: {"file": str(i.path), "guid": i.guid}
                          for name, i in self.instances.items()},
                 "parameter_units": {name: {n: i.unit(n) for n, v in i.variables.items()
                                            if v.causality == "parameter"}
@@ -172,11 +168,8 @@ class Master:
 
     def abandon(self, reason: str) -> Recording | None:
         """The run under way's rows closed with ``reason``, for a watchdog (None if none)."""
-        recorder, self._recorder = getattr(self, "_recorder", None), None
+        recorder, self._recorder = self._recorder, None
         return recorder and recorder.close(f"{reason} ({recorder.rows} rows recorded)")
-
-    def __enter__(self) -> Master:
-        return self
 
     def __exit__(self, *exc_info) -> None:
         self.free()

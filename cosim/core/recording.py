@@ -1,15 +1,15 @@
 """What a run records, row by row: held in memory, or streamed to a CSV file in chunks.
 
-Row k holds t_k and one value per column. ``Recorder`` takes the rows as the master makes
-them and ``close`` gives the ``Recording``; streamed, memory stays flat however long the run
-and the recording holds no rows itself.
+Row k holds t_k and one value per column; streamed, memory stays flat however long the run
+and the ``Recording`` holds no rows itself.
 """
 from __future__ import annotations
 
 import os
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 import numpy as np
 
@@ -43,27 +43,20 @@ class Recording:
                              "read them from there")
 
     def write_csv(self, path: str | Path) -> None:
-        sink = CsvSink(path, self.columns)
-        sink.write(self.t, self.data)
-        sink.close()
+        with _open_csv(path, self.columns) as file:
+            _write_rows(file, self.t, self.data)
 
 
-class CsvSink:
-    """Rows appended to a CSV file as they come, floats in their shortest exact form."""
+def _open_csv(path: str | Path, columns: list[str]) -> IO[str]:
+    file = open(path, "w")
+    file.write(",".join(["time", *columns]) + "\n")
+    return file
 
-    def __init__(self, path: str | Path, columns: list[str]):
-        self.path, self.rows = Path(path), 0
-        self.file = open(self.path, "w")
-        self.file.write(",".join(["time", *columns]) + "\n")
 
-    def write(self, times: np.ndarray, data: np.ndarray) -> None:
-        table = np.column_stack([times, data]).tolist()
-        self.file.writelines(",".join(map(repr, row)) + "\n" for row in table)
-        self.file.flush()
-        self.rows += len(table)
-
-    def close(self) -> None:
-        self.file.close()
+def _write_rows(file: IO[str], times: np.ndarray, data: np.ndarray) -> None:
+    """Rows of a CSV file, floats in their shortest exact form."""
+    file.writelines(",".join(map(repr, row)) + "\n"
+                    for row in np.column_stack([times, data]).tolist())
 
 
 class Recorder:
@@ -73,50 +66,44 @@ class Recorder:
                  chunk_rows: int = 10_000, meta: dict[str, Any] | None = None,
                  units: dict[str, str] | None = None):
         self.columns, self.meta, self.units = columns, meta or {}, units or {}
+        self.path = None if csv_path is None else Path(csv_path)
         size = rows if csv_path is None else min(chunk_rows, rows)
         if csv_path is None:
             require_memory(size, len(columns) + 1)
-        self.sink = CsvSink(csv_path, columns) if csv_path is not None else None
+        else:
+            self.file = _open_csv(self.path, columns)
         self.time, self.data = np.empty(size), np.full((size, len(columns)), np.nan)
-        self.held = 0                   # rows in the buffer, not yet written
+        self.held = self.written = 0         # rows in the buffer, and rows written
         self.interrupted: str | None = None
+        self.started = time.perf_counter()
 
     @property
     def rows(self) -> int:
-        return (self.sink.rows if self.sink else 0) + self.held
+        return self.written + self.held
 
     def append(self, t: float, values: list[float]) -> None:
         row = self.held
         self.time[row], self.data[row] = t, values
         self.held = row + 1
-        if self.sink is not None and self.held == len(self.time):
+        if self.path is not None and self.held == len(self.time):
             self._flush()
 
     def _flush(self) -> None:
-        self.sink.write(self.time[:self.held], self.data[:self.held])
-        self.held = 0
+        _write_rows(self.file, self.time[:self.held], self.data[:self.held])
+        self.file.flush()
+        self.written, self.held = self.written + self.held, 0
 
     def close(self, error: str | None = None) -> Recording:
-        if self.sink is None:
+        """The recording, its meta with ``wall_time_s`` since this recorder began."""
+        self.meta["wall_time_s"] = time.perf_counter() - self.started
+        if self.path is None:
             return Recording(self.columns, self.time[:self.held], self.data[:self.held],
                              self.held, error, self.interrupted, self.meta, units=self.units)
         self._flush()
-        self.sink.close()
+        self.file.close()
         return Recording(self.columns, np.empty(0), np.empty((0, len(self.columns))),
-                         self.sink.rows, error, self.interrupted, self.meta, self.sink.path,
+                         self.written, error, self.interrupted, self.meta, self.path,
                          self.units)
-
-
-def available_memory() -> int:
-    """Bytes of memory available to a new allocation (Linux's MemAvailable; else all RAM)."""
-    try:
-        with open("/proc/meminfo") as meminfo:
-            for line in meminfo:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
 
 
 class TooManyRows(ValueError):
@@ -124,8 +111,16 @@ class TooManyRows(ValueError):
 
 
 def require_memory(rows: int, columns: int) -> None:
-    """TooManyRows if ``rows`` x ``columns`` floats would not fit in the memory available."""
-    needed, available = rows * columns * 8, available_memory()
+    """TooManyRows if ``rows`` x ``columns`` floats would not fit in 80 % of the memory
+    available to a new allocation (Linux's MemAvailable; else all RAM)."""
+    available = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    try:
+        with open("/proc/meminfo") as meminfo:
+            available = next(int(line.split()[1]) * 1024 for line in meminfo
+                             if line.startswith("MemAvailable:"))
+    except (OSError, StopIteration):
+        pass
+    needed = rows * columns * 8
     if needed > 0.8 * available:
         raise TooManyRows(f"the run would hold {rows} rows of {columns} values in memory, "
                           f"{needed / 2**30:,.1f} GiB, more than the {available / 2**30:,.1f} "

@@ -2,9 +2,8 @@
 
 The subset OSP libcosim, ecos and fmpy all read: FMU components with connectors, inline
 parameter values, connections, and a DefaultExperiment whose OSP annotation gives the step
-(``write_ssd`` gives it OpenModelica's annotation too, and ours, ``REPORT_ANNOTATION``, the
-kind of analysis a run gets). ``read_ssd`` refuses anything else, naming the file, the
-element and the attribute."""
+(``write_ssd`` gives it OpenModelica's annotation too, and ours, the kind of analysis a run
+gets). ``read_ssd`` refuses anything else, naming the file, the element and the attribute."""
 from __future__ import annotations
 
 import math
@@ -23,10 +22,6 @@ NS = {
     "sap": "https://github.com/ship-autopilot-cosim/annotations",
     "oms": "https://raw.githubusercontent.com/OpenModelica/OMSimulator/master/schema/oms.xsd",
 }
-OSP_ANNOTATION = "com.opensimulationplatform"
-OMS_ANNOTATION = "org.openmodelica"
-REPORT_ANNOTATION = "org.ship-autopilot-cosim"
-PARAMETER_SET = "scenario"
 _TYPES = ("Real", "Integer", "Boolean", "String")
 FMU_TYPE = "application/x-fmu-sharedlibrary"
 CONNECTOR_KINDS = ("input", "output", "inout", "parameter", "calculatedParameter")
@@ -35,7 +30,9 @@ for _prefix, _uri in NS.items():
     ET.register_namespace(_prefix, _uri)
 
 
-def _q(prefix: str, tag: str) -> str:
+def _q(prefixed: str) -> str:
+    """'ssd:System' as ElementTree names it."""
+    prefix, _, tag = prefixed.partition(":")
     return f"{{{NS[prefix]}}}{tag}"
 
 
@@ -49,8 +46,8 @@ def _local(element: ET.Element) -> str:
 class _Reader:
     """Reads one .ssd; every error names the file, the element and the attribute."""
 
-    def __init__(self, path: Path, fmus: FmuFolders | None):
-        self.path, self.fmus = path, fmus
+    def __init__(self, path: Path):
+        self.path = path
 
     def error(self, where: str, problem: str) -> ValueError:
         return ValueError(f"{self.path}: {where}: {problem}")
@@ -65,12 +62,11 @@ class _Reader:
     def typed(self, element: ET.Element, prefix: str, where: str) -> tuple[str, ET.Element]:
         """The one Real, Integer, Boolean or String child of a Connector or a Parameter."""
         children = [c for c in element if c.tag.startswith(f"{{{NS[prefix]}}}")]
-        known = [c for c in children if c.tag.rpartition("}")[2] in _TYPES]
-        if len(children) != 1 or len(known) != 1:
+        if len(children) != 1 or _local(children[0]) not in (f"{prefix}:{t}" for t in _TYPES):
             found = ", ".join(_local(c) for c in children) or "none"
             raise self.error(where, f"needs one of {', '.join(f'{prefix}:{t}' for t in _TYPES)}"
                                     f" (found: {found})")
-        return known[0].tag.rpartition("}")[2], known[0]
+        return children[0].tag.rpartition("}")[2], children[0]
 
     def number(self, element: ET.Element, attribute: str, where: str, default: float) -> float:
         text = element.get(attribute)
@@ -84,12 +80,12 @@ class _Reader:
             raise self.error(where, f"{attribute}={text!r} is not a finite number")
         return value
 
-    def system(self) -> SystemDescription:
+    def system(self, fmus: FmuFolders | None) -> SystemDescription:
         try:
             root = ET.parse(self.path).getroot()
         except (ET.ParseError, OSError) as error:
             raise ValueError(f"cannot read system structure {self.path}: {error}") from error
-        if root.tag != _q("ssd", "SystemStructureDescription"):
+        if root.tag != _q("ssd:SystemStructureDescription"):
             raise ValueError(f"{self.path} is not an SSP system structure description "
                              f"(its root element is {_local(root)})")
         name = self.required(root, "name", "SystemStructureDescription")
@@ -97,10 +93,9 @@ class _Reader:
         if len(systems) != 1:
             raise self.error("SystemStructureDescription",
                              f"needs one System element, has {len(systems)}")
-        system = systems[0]
         components: dict[str, Component] = {}
-        for i, element in enumerate(system.findall("ssd:Elements/*", NS), 1):
-            if element.tag != _q("ssd", "Component"):
+        for i, element in enumerate(systems[0].findall("ssd:Elements/*", NS), 1):
+            if element.tag != _q("ssd:Component"):
                 raise self.error(f"System, element {i} of Elements",
                                  f"{_local(element)} is not read: only Components (FMUs)")
             component = self.component(element, i)
@@ -110,11 +105,10 @@ class _Reader:
             components[component.name] = component
         if not components:
             raise self.error("System", "no Component in its Elements")
-        connections = self.connections(system, components)
-        description = SystemDescription(name=name, components=components,
-                                        connections=connections,
-                                        description=system.get("description", ""),
-                                        path=self.path, fmus=self.fmus)
+        description = SystemDescription(name, components, self.connections(systems[0],
+                                                                            components),
+                                        description=systems[0].get("description", ""),
+                                        path=self.path, fmus=fmus)
         experiment = root.find("ssd:DefaultExperiment", NS)
         if experiment is not None:
             self.experiment(experiment, description)
@@ -162,21 +156,22 @@ class _Reader:
             if name in component.parameters:
                 raise self.error(at, "given twice")
             type_name, value = self.typed(p, "ssv", at)
-            text = self.required(value, "value", f"{at}, ssv:{type_name}")
+            at = f"{at}, ssv:{type_name}"
+            text = self.required(value, "value", at)
             if value.get("unit") is not None:
-                raise self.error(f"{at}, ssv:{type_name}", f"unit={value.get('unit')!r} is "
-                                 "not read; give the value in the FMU's unit, without unit=")
+                raise self.error(at, f"unit={value.get('unit')!r} is not read; give the value "
+                                     "in the FMU's unit, without unit=")
             try:
                 component.parameters[name] = fmi_value(f"{component.name}.{name}", type_name, text)
             except ValueError as error:
-                raise self.error(f"{at}, ssv:{type_name}", str(error)) from None
+                raise self.error(at, str(error)) from None
 
     def connections(self, system: ET.Element, components: dict[str, Component]) -> list[Connection]:
         connections, fed = [], {}
         hint = " (connectors of the system itself are not read)"
         for i, c in enumerate(system.findall("ssd:Connections/ssd:Connection", NS), 1):
-            where = f"Connection {i}"
-            connection = Connection(*(self.required(c, a, where, hint if "Element" in a else "")
+            connection = Connection(*(self.required(c, a, f"Connection {i}",
+                                                    hint if "Element" in a else "")
                                       for a in ("startElement", "startConnector",
                                                 "endElement", "endConnector")))
             where = f"Connection {i} ({connection})"
@@ -219,7 +214,7 @@ class _Reader:
 def read_ssd(path: str | Path, fmus: FmuFolders | None = None) -> SystemDescription:
     """The system of a .ssd file (its FMUs looked for also in ``fmus``); ValueError naming the
     file, the element and the attribute for anything this module does not read."""
-    return _Reader(Path(path), fmus).system()
+    return _Reader(Path(path)).system(fmus)
 
 
 def ssv_value(value: float | int | bool | str) -> tuple[str, str]:
@@ -244,8 +239,8 @@ def _el(parent: ET.Element, path: str, **attributes: str) -> ET.Element:
     """New elements under ``parent``, one in the other ("ssd:A/ssc:B"), attributes on the last."""
     *chain, last = path.split("/")
     for tag in chain:
-        parent = ET.SubElement(parent, _q(*tag.split(":")))
-    return ET.SubElement(parent, _q(*last.split(":")), **attributes)
+        parent = ET.SubElement(parent, _q(tag))
+    return ET.SubElement(parent, _q(last), **attributes)
 
 
 def write_ssd(system: SystemDescription, path: str | Path,
@@ -253,7 +248,8 @@ def write_ssd(system: SystemDescription, path: str | Path,
     """Write ``system`` as a .ssd; ``sources`` replaces component sources by name; with
     ``units``, each connector carries its unit, defined in the file's ssd:Units. The step
     goes into OSP's FixedStepAlgorithm and OpenModelica's FixedStepMaster ('oms-ma')."""
-    root = ET.Element(_q("ssd", "SystemStructureDescription"), version="1.0", name=system.name)
+    unit_of = units.connectors if units else {}
+    root = ET.Element(_q("ssd:SystemStructureDescription"), version="1.0", name=system.name)
     sys_el = _el(root, "ssd:System", name=system.name, description=system.description)
     elements = _el(sys_el, "ssd:Elements")
     for c in system.components.values():
@@ -261,13 +257,13 @@ def write_ssd(system: SystemDescription, path: str | Path,
                    source=(sources or {}).get(c.name, c.source), type=FMU_TYPE)
         connectors = _el(comp, "ssd:Connectors")
         for name, (kind, type_name) in c.connectors.items():
-            unit = units.connectors.get(c.name, {}).get(name) if units else None
+            unit = unit_of.get(c.name, {}).get(name)
             _el(_el(connectors, "ssd:Connector", name=name, kind=kind), f"ssc:{type_name}",
                 **({"unit": unit} if unit else {}))
         if c.parameters:
-            pset = _el(comp, "ssd:ParameterBindings/ssd:ParameterBinding/ssd:ParameterValues/"
-                             "ssv:ParameterSet", version="1.0", name=PARAMETER_SET)
-            params = _el(pset, "ssv:Parameters")
+            params = _el(comp, "ssd:ParameterBindings/ssd:ParameterBinding/ssd:ParameterValues/"
+                               "ssv:ParameterSet", version="1.0", name="scenario")
+            params = _el(params, "ssv:Parameters")
             for name, value in c.parameters.items():
                 type_name, text = ssv_value(value)
                 _el(_el(params, "ssv:Parameter", name=name), f"ssv:{type_name}", value=text)
@@ -276,11 +272,10 @@ def write_ssd(system: SystemDescription, path: str | Path,
         _el(connections, "ssd:Connection", startElement=k.start_element,
             startConnector=k.start_connector, endElement=k.end_element,
             endConnector=k.end_connector)
-    oms = _el(sys_el, "ssd:Annotations/ssc:Annotation", type=OMS_ANNOTATION)
-    _el(oms, "oms:Annotations/oms:SimulationInformation/oms:FixedStepMaster",
-        description="oms-ma", stepSize=repr(system.step_size))
-    used = sorted({u for by_name in (units.connectors if units else {}).values()
-                   for u in by_name.values()})
+    _el(_el(sys_el, "ssd:Annotations/ssc:Annotation", type="org.openmodelica"),
+        "oms:Annotations/oms:SimulationInformation/oms:FixedStepMaster", description="oms-ma",
+        stepSize=repr(system.step_size))
+    used = sorted({u for by_name in unit_of.values() for u in by_name.values()})
     if used:                              # SSP 1.0: Units after System, before the experiment
         definitions = _el(root, "ssd:Units")
         for unit in used:
@@ -290,9 +285,9 @@ def write_ssd(system: SystemDescription, path: str | Path,
     experiment = _el(root, "ssd:DefaultExperiment", startTime=repr(system.start_time),
                      stopTime=repr(system.stop_time))
     annotations = _el(experiment, "ssd:Annotations")
-    _el(_el(annotations, "ssc:Annotation", type=OSP_ANNOTATION),
+    _el(_el(annotations, "ssc:Annotation", type="com.opensimulationplatform"),
         "osp:Algorithm/osp:FixedStepAlgorithm", baseStepSize=repr(system.step_size))
-    _el(_el(annotations, "ssc:Annotation", type=REPORT_ANNOTATION), "sap:Report",
+    _el(_el(annotations, "ssc:Annotation", type="org.ship-autopilot-cosim"), "sap:Report",
         kind=system.report)
     ET.indent(root)
     ET.ElementTree(root).write(path, encoding="UTF-8", xml_declaration=True)

@@ -1,7 +1,7 @@
 """A system: its components, their connections and experiment, and where its FMUs are.
 
-The core's data model of a flat co-simulation (``cosim.core.ssd`` reads and writes it as
-SSP 1.0). Where FMUs are built is the caller's to say (``FmuFolders``).
+The core's data model of a flat co-simulation (``ssd`` reads and writes it as SSP 1.0);
+where FMUs are built is the caller's to say (``FmuFolders``).
 """
 from __future__ import annotations
 
@@ -114,14 +114,11 @@ class SystemDescription:
         folder), then in ``fmus`` (not for an absolute source: another file of its name
         would run in its place unseen)."""
         source = Path(self.components[component].source)
-        base = self.path.parent if self.path else Path.cwd()
-        candidates = [(base / source).resolve()]
+        candidates = [((self.path.parent if self.path else Path.cwd()) / source).resolve()]
         if self.fmus is not None and not source.is_absolute():
-            root = next(iter(self.fmus.by_fmi.values()))
-            parts = source.parts
-            tail = Path(*parts[len(parts) - parts[::-1].index(root.name):]) \
-                if root.name in parts[:-1] else Path(source.name)
-            candidates.append(root / tail)
+            root, parts = next(iter(self.fmus.by_fmi.values())), source.parts[:-1]
+            after = len(parts) - parts[::-1].index(root.name) if root.name in parts else -1
+            candidates.append(root.joinpath(*source.parts[after:]))
         return list(dict.fromkeys(candidates))
 
     def fmu_path(self, component: str) -> Path:

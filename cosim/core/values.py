@@ -1,14 +1,9 @@
 """Values for FMU variables, checked against what the FMU declares before any FMU call.
 
-Every value the master sets passes ``checked`` on every backend: the exact value to set, or
-ValueError naming the component, the variable, the value and what the variable takes.
-``fmi_value``: what the FMI 2.0 call of the type carries exactly (section 2.1.2): nothing
-rounded or wrapped (an Integer a whole number of 32 bits: "7", 7.0, "1e3", not 1.5; a
-Boolean a bool, 0, 1 or true/false in any case; a String UTF-8 without NUL; text read as
-the type declares). ``checked``: that value against the declaration (section 2.2.7): a
-Real finite (+-inf only where max="INF" / min="-INF"), within min and max; an Enumeration
-one of its items. ``setting`` also refuses a variable the FMU lacks or that a master may
-not set in initialisation mode (section 4.2.4).
+``fmi_value``: exactly what the FMI 2.0 call of the type carries (section 2.1.2), nothing
+rounded or wrapped; ``checked``: that value against the declaration (section 2.2.7);
+``setting``: also that a master may set the variable in initialisation mode (section
+4.2.4). A refusal names the component, the variable, the value and what the variable takes.
 """
 from __future__ import annotations
 
@@ -32,6 +27,10 @@ Value = bool | int | float | str
 _DECIMAL = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 _SPECIAL = re.compile(r"[+-]?(?:inf|infinity|nan)", re.IGNORECASE)
 _BOOLEAN = {"true": True, "1": True, "false": False, "0": False}
+_TAKES = {"Real": "a Real (a double)", "Integer": "an Integer, a whole number from "
+          f"{INTEGER_RANGE[0]} to {INTEGER_RANGE[1]}",
+          "Boolean": "a Boolean: true, false, 1 or 0",
+          "String": "a String: UTF-8 text without NUL"}
 
 
 @dataclass(frozen=True)
@@ -55,27 +54,21 @@ class Declaration:
     def takes(self) -> str:
         """What it takes, in words: 'a finite Real, from 0.0 to 0.1'."""
         if self.type == "Enumeration":
-            return "an Enumeration item" + "".join(
-                f"{', ' if i else ': '}{v} ({n})" for i, (n, v) in enumerate(self.items))
+            return "an Enumeration item: " + ", ".join(f"{v} ({n})" for n, v in self.items)
         if self.type == "Integer":
-            low, high = _integer_bounds(self)
+            low = INTEGER_RANGE[0] if self.min is None else max(INTEGER_RANGE[0], self.min)
+            high = INTEGER_RANGE[1] if self.max is None else min(INTEGER_RANGE[1], self.max)
             return f"an Integer, a whole number from {low} to {high}"
         if self.type != "Real":
             return _TAKES[self.type]
         infinite = self.max == math.inf or self.min == -math.inf
-        low, high = (None if b is None or math.isinf(b) else b for b in (self.min, self.max))
         kind = "a Real, not NaN" if infinite else "a finite Real"
+        low, high = (None if b is None or math.isinf(b) else b for b in (self.min, self.max))
         if low is not None and high is not None:
             return f"{kind}, from {low!r} to {high!r}"
         if low is not None or high is not None:
             return f"{kind}, {'>=' if high is None else '<='} {low if high is None else high!r}"
         return kind
-
-
-_TAKES = {"Real": "a Real (a double)", "Integer": "an Integer, a whole number from "
-          f"{INTEGER_RANGE[0]} to {INTEGER_RANGE[1]}",
-          "Boolean": "a Boolean: true, false, 1 or 0",
-          "String": "a String: UTF-8 text without NUL"}
 
 
 def declarations(description: ModelDescription) -> dict[str, Declaration]:
@@ -100,37 +93,46 @@ class _Refusal(ValueError):
 def fmi_value(target: str, type_name: str, value: Any) -> Value:
     """``value`` as the FMI 2.0 call of ``type_name`` carries it, exactly; ValueError naming
     ``target`` (component.variable), the value and what the type takes."""
-    carry = _carrier(target, type_name)
-    try:
-        return carry(value)
-    except _Refusal as refusal:
-        raise _refused(target, value, refusal, _TAKES[type_name]) from None
+    return _carried(target, type_name, value, _TAKES.get(type_name, ""))
 
 
 def checked(component: str, declaration: Declaration, value: Any) -> Value:
     """The exact value to set for ``component``'s variable so declared, or ValueError."""
-    target = f"{component}.{declaration.name}"
-    carry = _carrier(target, "Integer" if declaration.type == "Enumeration"
-                     else declaration.type)
     items = dict(declaration.items)
     if isinstance(value, str) and value.strip() in items:
         return items[value.strip()]
+    kind = "Integer" if declaration.type == "Enumeration" else declaration.type
+    return _carried(f"{component}.{declaration.name}", kind, value, declaration.takes(),
+                    declaration)
+
+
+def _carried(target: str, type_name: str, value: Any, takes: str,
+             declaration: Declaration | None = None) -> Value:
+    carry = _CARRIED.get(type_name)
+    if carry is None:
+        raise ValueError(f"{target} is of type {type_name!r}, which FMI 2.0 does not have")
     try:
         exact = carry(value)
-        _within(declaration, exact)
+        if declaration is not None:
+            _within(declaration, exact)
     except _Refusal as refusal:
-        raise _refused(target, value, refusal, declaration.takes()) from None
+        raise ValueError(f"{target} = {value!r} {refusal}; {target} is {takes}") from None
     return exact
 
 
-def _carrier(target: str, type_name: str):
-    if type_name not in _CARRIED:
-        raise ValueError(f"{target} is of type {type_name!r}, which FMI 2.0 does not have")
-    return _CARRIED[type_name]
-
-
-def _refused(target: str, value: Any, refusal: _Refusal, takes: str) -> ValueError:
-    return ValueError(f"{target} = {value!r} {refusal}; {target} is {takes}")
+def _within(declaration: Declaration, value: Value) -> None:
+    """A Real finite (+-inf only where max="INF" / min="-INF"), within min and max; an
+    Enumeration one of its items."""
+    if declaration.type == "Real" and math.isnan(value):
+        raise _Refusal("is not a number (NaN)")
+    if declaration.type == "Real" and math.isinf(value) and \
+            value != (declaration.max if value > 0 else declaration.min):
+        raise _Refusal("is not finite")
+    low, high = declaration.min, declaration.max
+    if (low is not None and value < low) or (high is not None and value > high):
+        raise _Refusal("is outside its declared range")
+    if declaration.items and value not in dict(declaration.items).values():
+        raise _Refusal("is not one of its items")
 
 
 def setting(component: str, path: str | Path, declared: dict[str, Declaration], name: str,
@@ -142,10 +144,11 @@ def setting(component: str, path: str | Path, declared: dict[str, Declaration], 
         raise no_variable(component, path, declared, name, elsewhere)
     declaration = declared[name]
     if not declaration.settable:
-        kind = (f"a {declaration.variability} {declaration.causality}"
+        causality, initial = declaration.causality, declaration.initial
+        kind = (f"a {declaration.variability} {causality}"
                 if declaration.variability == "constant" else
-                f"{_article(declaration.causality)} {declaration.causality}"
-                f"{f' (initial {declaration.initial})' if declaration.initial else ''}")
+                f"{'an' if causality[0] in 'aeiou' else 'a'} {causality}"
+                f"{f' (initial {initial})' if initial else ''}")
         names = [n for n, d in declared.items() if d.settable]
         raise ValueError(f"{component}.{name} cannot be set: it is {kind}; FMU "
                          f"'{component}' ({Path(path).name}) takes values for "
@@ -163,10 +166,6 @@ def no_variable(component: str, path: str | Path, names: Iterable[str], name: st
     return ValueError(f"FMU '{component}' ({Path(path).name}) has no variable '{name}'; "
                       f"it has: {', '.join(names)}"
                       f"{did_you_mean(close_matches(name, names) or others)}")
-
-
-def _article(word: str) -> str:
-    return "an" if word[0] in "aeiou" else "a"
 
 
 def _real(value: Any) -> float:
@@ -194,20 +193,13 @@ def _real(value: Any) -> float:
 
 
 def _integer(value: Any) -> int:
-    if isinstance(value, str):
-        text = value.strip()
-        if not _DECIMAL.fullmatch(text):
-            raise _Refusal("is not a whole number")
-        exact: Decimal | float | int = Decimal(text)
-    elif isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise _Refusal("is not a whole number")
-    elif isinstance(value, numbers.Integral):
-        exact = int(value)
+    if isinstance(value, str) and _DECIMAL.fullmatch(value.strip()):
+        exact = Decimal(value.strip())
+    elif isinstance(value, numbers.Real) and not isinstance(value, bool):
+        exact = Decimal(int(value) if isinstance(value, numbers.Integral) else float(value))
     else:
-        exact = float(value)
-        if not math.isfinite(exact):
-            raise _Refusal("is not a whole number")
-    if exact != (exact.to_integral_value() if isinstance(exact, Decimal) else int(exact)):
+        raise _Refusal("is not a whole number")
+    if not exact.is_finite() or exact != exact.to_integral_value():
         raise _Refusal("is not a whole number")
     if not INTEGER_RANGE[0] <= exact <= INTEGER_RANGE[1]:
         raise _Refusal("is outside the range of an FMI Integer (32 bits)")
@@ -239,27 +231,6 @@ def _string(value: Any) -> str:
 _CARRIED = {"Real": _real, "Integer": _integer, "Boolean": _boolean, "String": _string}
 
 
-def _integer_bounds(declaration: Declaration) -> tuple[int, int]:
-    low, high = INTEGER_RANGE
-    return (low if declaration.min is None else max(low, declaration.min),
-            high if declaration.max is None else min(high, declaration.max))
-
-
-def _within(declaration: Declaration, value: Value) -> None:
-    if declaration.type == "Real":
-        if math.isnan(value):
-            raise _Refusal("is not a number (NaN)")
-        if math.isinf(value) and value != (declaration.max if value > 0 else declaration.min):
-            raise _Refusal("is not finite")
-    if declaration.type in ("Real", "Integer", "Enumeration"):
-        low, high = declaration.min, declaration.max
-        if (low is not None and value < low) or (high is not None and value > high):
-            raise _Refusal("is outside its declared range")
-    if declaration.type == "Enumeration" and declaration.items and \
-            value not in dict(declaration.items).values():
-        raise _Refusal("is not one of its items")
-
-
 def parameters(system: SystemDescription, paths: dict[str, Path],
                declared: dict[str, dict[str, Declaration]],
                overrides: Mapping[str, Mapping[str, Any]] | None = None
@@ -271,12 +242,11 @@ def parameters(system: SystemDescription, paths: dict[str, Path],
     if not isinstance(overrides or {}, Mapping):
         raise ValueError(f"set: overrides must map component names to their values, got "
                          f"{overrides!r}")
-    given: dict[str, dict[str, Any]] = {}
     for component, values in (overrides or {}).items():
         if not isinstance(values, Mapping):
             raise ValueError(f"set: the values for '{component}' must map variable names to "
                              f"values, got {values!r}")
-        given[component] = dict(values)
+    given = {component: dict(values) for component, values in (overrides or {}).items()}
     connected = {(c.end_element, c.end_connector): f"{c.start_element}.{c.start_connector}"
                  for c in system.connections}
     settable = {c: [n for n, d in theirs.items() if d.settable] for c, theirs in declared.items()}

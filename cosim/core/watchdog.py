@@ -1,23 +1,15 @@
 """Time limits for a run, and signals that reach it even while an FMU never returns.
 
-A ``Watchdog`` is a thread beside the master's loop enforcing a step time limit
-(``Limits.step``: one communication step, or one instantiation, in wall-clock seconds), a run
-time limit (``Limits.run``) and a signal's grace (``Limits.grace``: after Ctrl-C or SIGTERM
-the step under way must end within it). In the main thread it takes SIGINT and SIGTERM from
-Python's wakeup file descriptor, which the C-level handler writes while FMU code runs; a
-second signal ends the process (``StopSignals.receive``).
-
-Past the run limit the loop stops at its next step (``beat`` says why). A step that does not
-end is hung: ``TimeLimit`` is raised in the loop's thread (``PyThreadState_SetAsyncExc``,
-only while an FMU call is under way), where Python FMU code fails its call and the master
-stops as after any FMU failure. Code that runs no Python cannot take it: after the grace the
-watchdog writes the rows kept (``salvage``), says so, and ends the process (status 1, or
-130/143 after a signal); ``faulthandler`` ends it if even that cannot run.
+A ``Watchdog`` thread beside the master's loop reads SIGINT and SIGTERM from Python's wakeup
+file descriptor (written even while FMU code runs) and raises ``TimeLimit`` into an FMU call
+that passes a limit; code that runs no Python cannot take it, so after the grace the
+watchdog writes the rows kept (``salvage``), says so and ends the process.
 """
 from __future__ import annotations
 
 import ctypes
 import faulthandler
+import math
 import os
 import select
 import signal
@@ -25,27 +17,26 @@ import socket
 import sys
 import threading
 import time
-from types import TracebackType
 from typing import Callable, NamedTuple
 
 from .instance import Instance
-from .interrupt import STOP_SIGNALS, StopSignals
+from .interrupt import STOP_SIGNALS, StopSignals, give_back, take_signals
 
 STEP_LIMIT_S = 60.0
 """The default step time limit, far above a step's or an instantiation's time."""
 
 
 class Limits(NamedTuple):
-    """Wall-clock limits in seconds (None: no limit)."""
+    """Wall-clock limits in seconds (None: none): of a step (or instantiation), of the run
+    (the loop stops at its next step), of the step under way after a signal or the run's."""
 
     step: float | None = STEP_LIMIT_S
     run: float | None = None
     grace: float = 3.0
 
     def check(self) -> Limits:
-        """These limits, or ValueError naming the one that is not a positive number."""
-        for name, value in (("step", self.step), ("run", self.run), ("grace", self.grace)):
-            if value is not None and not (value > 0 and value < float("inf")):
+        for name, value in self._asdict().items():
+            if value is not None and not 0 < value < math.inf:
                 raise ValueError(f"the {name} time limit must be a positive number of "
                                  f"seconds, got {value!r}")
         return self
@@ -64,10 +55,9 @@ class TimeLimit(BaseException):
 
 
 class Watchdog:
-    """``with Watchdog(limits, stop) as dog``: ``dog.beat(what)`` as each step (or
-    instantiation) begins; ``dog.expired`` says which limit was passed. ``salvage(reason)``,
-    called from the watchdog's thread if the loop never returns, writes what it can and
-    says what was kept."""
+    """``with Watchdog(limits, stop, salvage) as dog``: ``dog.beat(what)`` as each step or
+    call begins; ``dog.expired`` says which limit was passed; ``salvage(reason)`` writes
+    what it can if the loop never returns and says what was kept."""
 
     def __init__(self, limits: Limits = Limits(), stop: StopSignals | None = None,
                  salvage: Callable[[str], str] | None = None):
@@ -75,75 +65,47 @@ class Watchdog:
         self.expired: str | None = None
         self._what: str | float = "the start of the run"
         self._beat = self._start = time.monotonic()
-        self._signal_at: float | None = None      # when a signal came
-        self._halt_at: float | None = None        # when the run time limit was passed
-        self._raise = True                        # TimeLimit may be raised into the loop
+        self._grace: tuple[float, str] | None = None   # since when, after what
+        self._raise = True                             # TimeLimit may be raised into the loop
         self._target = threading.get_ident()
         self._done = threading.Event()
-        self._thread: threading.Thread | None = None
+        self._thread = threading.Thread(target=self._watch, name="cosim-watchdog", daemon=True)
         self._signals = stop is not None and threading.current_thread() is threading.main_thread()
-        self._wakeup: tuple[socket.socket, socket.socket] | None = None
-        self._saved: tuple[int, dict] = (-1, {})
-
-    def finishing(self, what: str) -> None:
-        """The run is over and ``what`` (terminating the FMUs) begins: its limit starts now,
-        and nothing is raised into it (an exception in fmi2Terminate has no safe way out of
-        pythonfmu's C++); past the limit the rows are kept and the process ends."""
-        self._raise = False
-        self.beat(what)
 
     def beat(self, what: str | float) -> str | None:
-        """A step (its time, in s) or call (a phrase) begins: its limit starts now. Returns
-        ``expired``: the loop stops here if it is not None."""
+        """A step (its time, in s) or call (a phrase) begins; ``expired``: not None stops it."""
         self._beat, self._what = time.monotonic(), what
         return self.expired
 
-    @property
-    def what(self) -> str:
-        what = self._what
-        return f"the step at t = {what:.6g} s" if isinstance(what, float) else what
+    def finishing(self, what: str) -> None:
+        """The run is over and ``what`` (terminating the FMUs) begins: nothing is raised into
+        it (an exception has no safe way out of pythonfmu's fmi2Terminate)."""
+        self._raise = False
+        self.beat(what)
 
     def __enter__(self) -> Watchdog:
         self._beat = self._start = time.monotonic()
-        if self.limits.step is None and self.limits.run is None and not self._signals:
-            return self
-        if self._signals:
-            self._take_signals()
-        self._thread = threading.Thread(target=self._watch, name="cosim-watchdog", daemon=True)
+        if self._signals:                # signals to this socket; Python's handlers idle
+            self._wakeup = socket.socketpair()
+            for end in self._wakeup:
+                end.setblocking(False)
+            self._saved = (signal.set_wakeup_fd(self._wakeup[1].fileno(),
+                                                warn_on_full_buffer=False), take_signals(_idle))
         self._thread.start()
         return self
 
-    def __exit__(self, kind: type | None, error: BaseException | None,
-                 trace: TracebackType | None) -> None:
-        if self._thread is None:
-            return
+    def __exit__(self, *exc) -> None:
         self._done.set()
         self._thread.join()
-        self._thread = None
         if self.expired:              # one raised too late to land is cleared, not left armed
             _raise_in(self._target, None)
         if self._signals:
-            self._give_back_signals()
-
-    def _take_signals(self) -> None:
-        """Signals to this thread's socket; Python's handlers idle meanwhile."""
-        self._wakeup = socket.socketpair()
-        for end in self._wakeup:
-            end.setblocking(False)
-        handlers = {number: signal.signal(number, _idle) for number in STOP_SIGNALS}
-        self._saved = (signal.set_wakeup_fd(self._wakeup[1].fileno(),
-                                            warn_on_full_buffer=False), handlers)
-
-    def _give_back_signals(self) -> None:
-        fd, handlers = self._saved
-        signal.set_wakeup_fd(fd)
-        for number, handler in handlers.items():
-            signal.signal(number, handler)
-        for received in self._received():       # one that came as the run ended
-            self.stop.receive(received)
-        for end in self._wakeup:
-            end.close()
-        self._wakeup = None
+            signal.set_wakeup_fd(self._saved[0])
+            give_back(self._saved[1])
+            for number in self._received():         # one that came as the run ended
+                self.stop.receive(number)
+            for end in self._wakeup:
+                end.close()
 
     def _received(self) -> list[signal.Signals]:
         try:
@@ -151,51 +113,48 @@ class Watchdog:
         except BlockingIOError:
             return []
         return [signal.Signals(number) for number in data if number in STOP_SIGNALS]
+
     def _deadline(self) -> tuple[float, str]:
-        candidates = [(float("inf"), "")]
-        if self.limits.step is not None:
-            candidates.append((self._beat + self.limits.step,
-                               f"{self.what} did not end within the step time limit of "
-                               f"{self.limits.step:g} s"))
-        if self.limits.run is not None and self.expired is None:
-            candidates.append((self._start + self.limits.run, ""))
-        if self._halt_at is not None:
-            candidates.append((self._halt_at + self.limits.grace,
-                               f"{self.what} did not end within {self.limits.grace:g} s of "
-                               "the run time limit"))
-        if self._signal_at is not None:
-            candidates.append((self._signal_at + self.limits.grace,
-                               f"{self.what} did not end within {self.limits.grace:g} s of "
-                               f"{self.stop.received.name}"))
+        """The next deadline and what passing it means ('': the run limit)."""
+        what = self._what if isinstance(self._what, str) else \
+            f"the step at t = {self._what:.6g} s"
+        limits, candidates = self.limits, [(math.inf, "")]
+        if limits.step is not None:
+            candidates.append((self._beat + limits.step, f"{what} did not end within the "
+                                                         f"step time limit of {limits.step:g} s"))
+        if limits.run is not None and self.expired is None:
+            candidates.append((self._start + limits.run, ""))
+        if self._grace is not None:
+            candidates.append((self._grace[0] + limits.grace, f"{what} did not end within "
+                                                              f"{limits.grace:g} s of "
+                                                              f"{self._grace[1]}"))
         return min(candidates)
 
     def _watch(self) -> None:
         while not self._done.is_set():
-            deadline, reason = self._deadline()
-            wait = min(max(deadline - time.monotonic(), 0.0), 0.5)
+            wait = min(max(self._deadline()[0] - time.monotonic(), 0.0), 0.5)
             if self._signals:
                 select.select([self._wakeup[0]], [], [], wait)
                 received = self._received()
                 for number in received:
-                    self._signal_at = self._signal_at or time.monotonic()
+                    self._grace = self._grace or (time.monotonic(), number.name)
                     self.stop.receive(number)        # a second one ends the process
                 if received:
                     continue
             elif self._done.wait(wait):
                 return
             deadline, reason = self._deadline()    # a beat while it waited moves the limit
-            if time.monotonic() >= deadline and not self._done.is_set():
-                if not reason:          # the run limit: the loop stops at its next beat
-                    self.expired = (f"the run did not end within its time limit of "
-                                    f"{self.limits.run:g} s")
-                    self._halt_at = time.monotonic()
-                    continue
-                self._expire(reason)
-                return
+            if time.monotonic() < deadline or self._done.is_set():
+                continue
+            if reason:
+                return self._expire(reason)
+            self.expired = (f"the run did not end within its time limit of "
+                            f"{self.limits.run:g} s")     # the loop stops at its next beat
+            self._grace = self._grace or (time.monotonic(), "the run time limit")
 
     def _expire(self, reason: str) -> None:
-        """The step under way is hung: raise TimeLimit in the loop's thread; if it has not
-        returned after the grace, keep what can be kept and end the process."""
+        """Raise TimeLimit in the loop's thread; if it has not returned after the grace, keep
+        what can be kept and end the process (status 1, or 130/143 after a signal)."""
         where = _calling(self._target)
         self.expired = reason = f"{reason} ({where})" if where else reason
         deadline = time.monotonic() + self.limits.grace
@@ -220,8 +179,7 @@ class Watchdog:
                "the run is over (nothing is raised into an FMU's clean-up)")
         print(f"error: {reason}, and {why}; {kept}; ending the process", file=sys.stderr,
               flush=True)
-        status = self.stop.exit_status if self.stop is not None and self.stop.received else 1
-        os._exit(status)
+        os._exit(self.stop.exit_status if self.stop is not None and self.stop.received else 1)
 
 
 def _calling(thread_id: int) -> str | None:
@@ -231,14 +189,10 @@ def _calling(thread_id: int) -> str | None:
     while frame is not None:
         owner, what = frame.f_locals.get("self"), frame.f_locals.get("what")
         if isinstance(owner, Instance):
-            call = what if isinstance(what, str) else _PREPARED.get(frame.f_code.co_name,
-                                                                     frame.f_code.co_name)
-            return f"FMU '{owner.name}' in {call}"
+            call = what if isinstance(what, str) else frame.f_code.co_name
+            return f"FMU '{owner.name}' in {'doStep' if call == 'step' else call}"
         frame = frame.f_back
     return None
-
-
-_PREPARED = {"step": "doStep", "read": "a get call", "write": "a set call"}
 
 
 def _idle(number: int, frame: object) -> None:

@@ -50,10 +50,6 @@ def feedthrough_order(system: SystemDescription, instances: dict[str, Instance])
                           f"{' -> '.join(error.args[1])}") from None
 
 
-def _empty() -> slice:
-    return slice(0, 0)
-
-
 @dataclass
 class Node:
     """One component as the loop sees it: its column blocks and prepared calls (None where
@@ -61,16 +57,16 @@ class Node:
 
     name: str
     instance: Instance
-    state: slice = field(default_factory=_empty)        # Real outputs, no feedthrough
-    feedthrough: slice = field(default_factory=_empty)  # Real outputs, with feedthrough
-    integers: slice = field(default_factory=_empty)     # Integer outputs
-    inputs: slice = field(default_factory=_empty)       # connected inputs
+    step: Callable[[float, float], None]
+    state: slice                        # Real outputs, no feedthrough
+    feedthrough: slice                  # Real outputs, with feedthrough
+    integers: slice                     # Integer outputs
+    inputs: slice = field(default_factory=lambda: slice(0, 0))     # connected inputs
     read_state: Callable[[], list[float]] | None = None
     read_feedthrough: Callable[[], list[float]] | None = None
     read_outputs: Callable[[], list[float]] | None = None   # state and feedthrough at once
     read_integers: Callable[[], list[int]] | None = None
     apply_inputs: Callable[[list[float]], None] | None = None  # values -> this node's inputs
-    step: Callable[[float, float], None] | None = None
 
     @property
     def outputs(self) -> slice:
@@ -84,31 +80,28 @@ def layout(instances: dict[str, Instance], connections: list[Connection],
     in ``values``: as sent, or as read back with ``verify_inputs``."""
     columns: list[str] = []
 
-    def block(names: list[str]) -> slice:
-        start = len(columns)
-        columns.extend(names)
-        return slice(start, len(columns))
+    def block(name: str, variables: list) -> slice:
+        columns.extend(f"{name}.{v}" for v in variables)
+        return slice(len(columns) - len(variables), len(columns))
 
     nodes = {}
     for name, instance in instances.items():
         outputs = [v for v in instance.variables.values() if v.causality == "output"]
-        state = [v for v in outputs if v.type == "Real" and not instance.feedthrough.get(v.name)]
-        ft = [v for v in outputs if v.type == "Real" and instance.feedthrough.get(v.name)]
-        ints = [v for v in outputs if v.type == "Integer"]
-        node = Node(name, instance, step=instance.stepper())
-        node.state = block([f"{name}.{v.name}" for v in state])
-        node.feedthrough = block([f"{name}.{v.name}" for v in ft])
-        node.integers = block([f"{name}.{v.name}" for v in ints])
-        vrs = [v.valueReference for v in state + ft]
+        reals = [v for v in outputs if v.type == "Real"]
+        state = [v.name for v in reals if not instance.feedthrough.get(v.name)]
+        ft = [v.name for v in reals if instance.feedthrough.get(v.name)]
+        ints = [v.name for v in outputs if v.type == "Integer"]
+        node = nodes[name] = Node(name, instance, instance.stepper(), block(name, state),
+                                  block(name, ft), block(name, ints))
+        vrs = [instance.vr(v) for v in state + ft]
         node.read_state = instance.reader(vrs[:len(state)]) if state else None
         node.read_feedthrough = instance.reader(vrs[len(state):]) if ft else None
         node.read_outputs = instance.reader(vrs) if vrs else None
-        node.read_integers = (instance.integer_reader([v.valueReference for v in ints])
-                              if ints else None)
-        nodes[name] = node
+        node.read_integers = instance.integer_reader([instance.vr(v) for v in ints]) \
+            if ints else None
     for name, node in nodes.items():
         incoming = [c for c in connections if c.end_element == name]
-        node.inputs = block([f"{name}.{c.end_connector}" for c in incoming])
+        node.inputs = block(name, [c.end_connector for c in incoming])
         if incoming:
             sources = [columns.index(f"{c.start_element}.{c.start_connector}")
                        for c in incoming]
