@@ -54,12 +54,9 @@ def main(argv: list[str] | None = None) -> int:
                 print(f"warning: {package.name} sets the String {variable} = {value!r}; "
                       f"OMSimulator and fmpy's SSP runner apply no String binding and "
                       f"would run with its default {default!r}", file=sys.stderr)
-        except (ValueError, FileNotFoundError) as error:
+        except (ValueError, FileNotFoundError, OutputError) as error:
             say_error(error)
-            return 2
-        except OutputError as error:
-            say_error(error)
-            return 1
+            return 1 if isinstance(error, OutputError) else 2
     return 0
 
 

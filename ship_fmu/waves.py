@@ -28,11 +28,6 @@ def _spectrum_b(T0: float) -> float:
     return 16.0 * math.pi * math.pi * math.pi / (Tz * Tz * Tz * Tz)
 
 
-def variance_fraction_below(omega: np.ndarray | float, T0: float) -> np.ndarray | float:
-    """Share of the spectrum's variance m0 = Hs^2/16 at frequencies below omega."""
-    return np.exp(-_spectrum_b(T0) / np.asarray(omega, dtype=float) ** 4)
-
-
 def frequency_at_fraction(fraction: float, T0: float) -> float:
     """omega = (B / -ln F)^(1/4), rad/s, in decimal arithmetic: the same on every CPU."""
     with localcontext() as context:
