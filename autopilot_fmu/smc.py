@@ -117,10 +117,9 @@ class SlidingModeAutopilot:
         self.psi_z, self.r_z = psi_z, r_z
         self._h_max = reference_step_bound(omega_n, zeta)
 
-    def r_z_dot(self, psi_d: float, psi_z: float | None = None,
-                r_z: float | None = None) -> float:
-        return reference_acceleration(psi_d, self.psi_z if psi_z is None else psi_z,
-                                      self.r_z if r_z is None else r_z, self.omega_n, self.zeta)
+    def r_z_dot(self, psi_d: float, psi_z: float, r_z: float) -> float:
+        """Eq (44) at the reference state (psi_z, r_z)."""
+        return reference_acceleration(psi_d, psi_z, r_z, self.omega_n, self.zeta)
 
     def sigma(self, psi: float, r: float) -> float:
         """Sliding surface sigma_h, eq (37)."""
@@ -131,7 +130,7 @@ class SlidingModeAutopilot:
         """delta_c = u_eq + u_sw, eq (43), rad."""
         (k1, k2), (h1, h2) = self.design.K, self.design.h
         u_eq = k1 * wrap(self.psi_z - psi) + k2 * ((self.r_z if self.tracking else 0.0) - r)
-        u_sw = (h1 * self.r_z + h2 * self.r_z_dot(psi_d)
+        u_sw = (h1 * self.r_z + h2 * self.r_z_dot(psi_d, self.psi_z, self.r_z)
                 - self.eta_h * math.tanh(self.sigma(psi, r) / self.phi_h))
         return u_eq + u_sw
 
