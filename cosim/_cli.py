@@ -70,17 +70,14 @@ def positive_seconds(text: str) -> float:
     return value
 
 
-def add_fmi_option(parser: argparse.ArgumentParser) -> None:
-    """--fmi 2|3: which version of this project's FMUs a scenario runs."""
+def add_fmu_options(parser: argparse.ArgumentParser, also: str) -> None:
+    """The FMUs a scenario runs: --fmi 2|3 (which version of this project's), --autopilot
+    FMU, --map and --name; ``also`` says what --all does with the autopilot."""
     parser.add_argument("--fmi", type=int, choices=sorted(FMU_DIRS),
                         help="run this project's FMI 2.0 FMUs (fmus/) or their FMI 3.0 twins "
                              "(fmus/fmi3/, built by python -m fmukit.build --fmi 3) in place "
                              "of those the scenario names (default: as it names them; the "
                              "scenarios here name the FMI 2.0 ones)")
-
-
-def add_autopilot_options(parser: argparse.ArgumentParser, also: str) -> None:
-    """--autopilot FMU, --map and --name; ``also`` says what --all does with it."""
     parser.add_argument("--autopilot", type=Path, metavar="FMU",
                         help="your own autopilot, an FMI 2.0 or 3.0 co-simulation FMU with "
                              "inputs psi (rad), r (rad/s), psi_d (rad) and output delta_c "

@@ -23,9 +23,9 @@ from contextlib import closing
 from pathlib import Path
 
 from . import scenarios
-from ._cli import (Progress, add_autopilot_options, add_fmi_option, checked_autopilot,
-                   chosen_scenarios, entry, number_option, positive_seconds, say_error, say_note,
-                   setting_option, writable_folder)
+from ._cli import (Progress, add_fmu_options, checked_autopilot, chosen_scenarios, entry,
+                   number_option, positive_seconds, say_error, say_note, setting_option,
+                   writable_folder)
 from .analysis.animation import video_format
 from .analysis.cost import LAMBDA, Cost
 from .analysis.describe import conditions, headline
@@ -104,9 +104,8 @@ def main(argv: list[str] | None = None) -> int:
                              "FMUs' Python classes, without FMI, with the same results bit for "
                              "bit (an FMU not built from this checkout's sources runs through "
                              "FMI, with a note)")
-    add_fmi_option(parser)
-    add_autopilot_options(parser, "with --all it also runs in calm_pd's and waves_pd's "
-                                  "place, as an extra row of Tables 1-2")
+    add_fmu_options(parser, "with --all it also runs in calm_pd's and waves_pd's place, as an "
+                            "extra row of Tables 1-2")
     parser.add_argument("--no-plot", action="store_true", help="skip the figure")
     parser.add_argument("--figure-format", action="append", default=[], choices=("svg", "pdf"),
                         help="also write the figure as SVG or PDF (for papers); repeatable")
