@@ -12,7 +12,7 @@ import numpy as np
 
 from ship_fmu.data import Actuators, Hull
 from ship_fmu.hull import coriolis_forces, damping_forces, mass_matrix
-from ship_fmu.thrusters import actuator_forces
+from ship_fmu.thrusters import actuator_model
 from ship_fmu.vessel import N_PROPELLER
 
 
@@ -46,7 +46,8 @@ def linearised_ship(u0: float, n: float = N_PROPELLER, hull: Hull = Hull(),
         return forces[1:]
     N = np.column_stack([_derivative(lambda v: hydrodynamic(v, 0.0), 0.0),
                          _derivative(lambda r: hydrodynamic(0.0, r), 0.0)])
-    b = _derivative(lambda d: np.array(actuator_forces(actuators, n, n, 0.0, d)[1:]), 0.0)
+    forces = actuator_model(actuators, n, n, 0.0)
+    b = _derivative(lambda d: np.array(forces(d)[1:]), 0.0)
     return SwayYawModel(M=mass_matrix(hull)[1:, 1:], N=N, b=b)
 
 
@@ -81,10 +82,6 @@ class NomotoModel:
     @property
     def b2(self) -> float:
         return self.K / self.T
-
-    def state_model(self) -> tuple[list[list[float]], list[float], list[float], float]:
-        """(A_h, B_h, C_h, D_h) of eqs (33)-(36), state [psi, r]."""
-        return [[0.0, 1.0], [0.0, self.a22]], [0.0, self.b2], [1.0, 0.0], 0.0
 
 
 def design_model(name: str, u0: float) -> SwayYawModel:

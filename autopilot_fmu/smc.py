@@ -61,23 +61,19 @@ class SlidingModeDesign:
                 raise ValueError(f"parameter {name} must be a finite closed-loop eigenvalue "
                                  f"< 0, got {value}")
         nomoto = NomotoModel.from_sway_yaw(model)
-        A, B, C, D = nomoto.state_model()
         b2, a22 = nomoto.b2, nomoto.a22
-        # Pole placement, eq (38): det(sI - A_c) = s^2 - (a22 - b2 k2) s + b2 k1.
+        # Pole placement, eq (38), on the state model (33), A = [[0, 1], [0, a22]], B = [0, b2]:
+        # det(sI - A_c) = s^2 - (a22 - b2 k2) s + b2 k1, A_c = A - B K^T.
         k1 = lambda1 * lambda2 / b2
         k2 = (a22 - lambda1 - lambda2) / b2
-        A_c = [[A[0][0] - B[0] * k1, A[0][1] - B[0] * k2],
-               [A[1][0] - B[1] * k1, A[1][1] - B[1] * k2]]
-        A_c_T = [[A_c[0][0], A_c[1][0]], [A_c[0][1], A_c[1][1]]]
+        A_c_T = [[0.0, 0.0 - b2 * k1], [1.0, a22 - b2 * k2]]
         slow = min(_eigenvalues(A_c_T), key=abs)
         h1, h2 = _null_vector(A_c_T, slow)
         scale = math.copysign(1.0, h1) / math.hypot(h1, h2)
-        # Eqs (40)-(41): [N_x; N_u] = [[A, B], [C, D]]^-1 [0; 1].
-        N_x1, N_x2, N_u = _solve([[A[0][0], A[0][1], B[0]], [A[1][0], A[1][1], B[1]],
-                                  [C[0], C[1], D]], [0.0, 0.0, 1.0])
-        N = N_u + k1 * N_x1 + k2 * N_x2
+        # Eqs (40)-(41): [N_x; N_u] = [[A, B], [C, D]]^-1 [0; 1] = [1, 0; 0] with C = [1, 0]
+        # and D = 0, so N = N_u + K^T N_x = k1.
         return cls(nomoto=nomoto, lambda1=lambda1, lambda2=lambda2,
-                   K=(k1, k2), h=(h1 * scale, h2 * scale), N=N)
+                   K=(k1, k2), h=(h1 * scale, h2 * scale), N=k1)
 
 
 # The design's linear algebra written out in exactly rounded operations, not by LAPACK,
@@ -97,18 +93,6 @@ def _null_vector(M: list[list[float]], eigenvalue: float) -> tuple[float, float]
     rows = [(M[0][0] - eigenvalue, M[0][1]), (M[1][0], M[1][1] - eigenvalue)]
     a, b = max(rows, key=lambda row: math.hypot(*row))
     return -b, a
-
-
-def _solve(M: list[list[float]], b: list[float]) -> list[float]:
-    def det(m: list[list[float]]) -> float:
-        return (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-                - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-                + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]))
-    d = det(M)
-    if d == 0.0:
-        raise ValueError("the design system of eqs (40)-(41) is singular")
-    return [det([row[:j] + [b[i]] + row[j + 1:] for i, row in enumerate(M)]) / d
-            for j in range(3)]
 
 
 class SlidingModeAutopilot:
@@ -133,10 +117,9 @@ class SlidingModeAutopilot:
         self.psi_z, self.r_z = psi_z, r_z
         self._h_max = reference_step_bound(omega_n, zeta)
 
-    def r_z_dot(self, psi_d: float, psi_z: float | None = None,
-                r_z: float | None = None) -> float:
-        return reference_acceleration(psi_d, self.psi_z if psi_z is None else psi_z,
-                                      self.r_z if r_z is None else r_z, self.omega_n, self.zeta)
+    def r_z_dot(self, psi_d: float, psi_z: float, r_z: float) -> float:
+        """Eq (44) at the reference state (psi_z, r_z)."""
+        return reference_acceleration(psi_d, psi_z, r_z, self.omega_n, self.zeta)
 
     def sigma(self, psi: float, r: float) -> float:
         """Sliding surface sigma_h, eq (37)."""
@@ -147,7 +130,7 @@ class SlidingModeAutopilot:
         """delta_c = u_eq + u_sw, eq (43), rad."""
         (k1, k2), (h1, h2) = self.design.K, self.design.h
         u_eq = k1 * wrap(self.psi_z - psi) + k2 * ((self.r_z if self.tracking else 0.0) - r)
-        u_sw = (h1 * self.r_z + h2 * self.r_z_dot(psi_d)
+        u_sw = (h1 * self.r_z + h2 * self.r_z_dot(psi_d, self.psi_z, self.r_z)
                 - self.eta_h * math.tanh(self.sigma(psi, r) / self.phi_h))
         return u_eq + u_sw
 

@@ -3,21 +3,22 @@ progress bar. Only the commands import this."""
 from __future__ import annotations
 
 import argparse
+import functools
 import math
 import signal
 import sys
 import tempfile
 from pathlib import Path
-from typing import Callable
+from typing import Any, Callable
 
 from fmubuild.project import BUILD_HINT, FMU_DIRS, SLAVE_MODULES
 
 from . import scenarios
-from .api import parse_setting
+from .api import parse_port_map, parse_setting
 from .core.files import plain_name
 from .core.interrupt import Interrupted, raise_on_signals
-from .core.values import fmi_value
 from .core.recording import TooManyRows
+from .core.values import fmi_value
 from .scenarios.autopilot import AutopilotError, check_autopilot
 
 
@@ -35,77 +36,64 @@ def chosen_scenarios(parser: argparse.ArgumentParser, scenario: str | None,
     return names
 
 
-def setting_option(text: str) -> tuple[str, str]:
-    """--set COMPONENT.VARIABLE=VALUE, for argparse."""
-    try:
-        return parse_setting(text)
-    except ValueError as error:
-        raise argparse.ArgumentTypeError(str(error)) from None
+def option(parse: Callable[[str], Any]) -> Callable[[str], Any]:
+    """``parse`` as an argparse type: its ValueError is the option's message."""
+    def parsed(text: str) -> Any:
+        try:
+            return parse(text)
+        except ValueError as error:
+            raise argparse.ArgumentTypeError(str(error)) from None
+    return parsed
 
 
+setting_option = option(parse_setting)      # --set COMPONENT.VARIABLE=VALUE
+
+
+@option
 def number_option(text: str) -> float:
-    """A finite number, for argparse, read as a Real parameter is (no '5_0', no 'inf')."""
+    """A finite number, read as a Real parameter is (no '5_0', no 'inf')."""
     try:
         value = fmi_value("the option", "Real", text)
     except ValueError:
         value = math.nan
     if not math.isfinite(value):
-        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
+        raise ValueError(f"expected a finite number, got {text!r}")
     return value
 
 
+@option
 def positive_seconds(text: str) -> float:
-    """A time limit in seconds, for argparse: a finite number > 0."""
+    """A time limit in seconds: a finite number > 0."""
     value = number_option(text)
     if not value > 0:
-        raise argparse.ArgumentTypeError(f"expected a positive number of seconds, got {text!r}")
+        raise ValueError(f"expected a positive number of seconds, got {text!r}")
     return value
 
 
-def parse_port_map(text: str) -> tuple[str, str]:
-    """'psi=heading' -> ('psi', 'heading')."""
-    port, sep, name = text.partition("=")
-    if not (sep and port and name):
-        raise argparse.ArgumentTypeError(f"--map expects PORT=NAME, e.g. psi=heading; "
-                                         f"got {text!r}")
-    return port, name
-
-
-def add_fmi_option(parser: argparse.ArgumentParser) -> None:
-    """--fmi 2|3: which version of this project's FMUs a scenario runs."""
+def add_fmu_options(parser: argparse.ArgumentParser, also: str) -> None:
+    """The FMUs a scenario runs: --fmi 2|3 (which version of this project's), --autopilot
+    FMU, --map and --name; ``also`` says what --all does with the autopilot."""
     parser.add_argument("--fmi", type=int, choices=sorted(FMU_DIRS),
                         help="run this project's FMI 2.0 FMUs (fmus/) or their FMI 3.0 twins "
                              "(fmus/fmi3/, built by python -m fmukit.build --fmi 3) in place "
                              "of those the scenario names (default: as it names them; the "
                              "scenarios here name the FMI 2.0 ones)")
-
-
-def add_autopilot_options(parser: argparse.ArgumentParser, also: str) -> None:
-    """--autopilot FMU, --map and --name; ``also`` says what --all does with it."""
     parser.add_argument("--autopilot", type=Path, metavar="FMU",
                         help="your own autopilot, an FMI 2.0 or 3.0 co-simulation FMU with "
-                             "inputs psi "
-                             "(rad), r (rad/s), psi_d (rad) and output delta_c (rad), in place "
-                             f"of the scenario's; {also} (see docs/own_autopilot.md)")
+                             "inputs psi (rad), r (rad/s), psi_d (rad) and output delta_c "
+                             f"(rad), in place of the scenario's; {also} (see "
+                             "docs/own_autopilot.md)")
     add_port_options(parser)
 
 
 def add_port_options(parser: argparse.ArgumentParser) -> None:
     """--map PORT=NAME and --name NAME, which describe an autopilot FMU."""
-    parser.add_argument("--map", action="append", default=[], type=parse_port_map,
+    parser.add_argument("--map", action="append", default=[], type=option(parse_port_map),
                         metavar="PORT=NAME",
                         help="the FMU's name of an autopilot port, e.g. psi=heading; repeatable")
-    parser.add_argument("--name", type=file_name_option,
+    parser.add_argument("--name", type=option(functools.partial(plain_name, what="--name")),
                         help="the autopilot's name in file names and tables "
                              "(default: the FMU's file name)")
-
-
-def file_name_option(text: str) -> str:
-    """--name NAME, for argparse: a plain file name (``core.files.plain_name``)."""
-    try:
-        return plain_name(text, "--name")
-    except ValueError as error:
-        raise argparse.ArgumentTypeError(str(error)) from None
 
 
 def say_error(error: BaseException) -> None:
@@ -135,7 +123,7 @@ def checked_autopilot(parser: argparse.ArgumentParser, args: argparse.Namespace)
     try:
         check_autopilot(args.autopilot, dict(args.map), trial=True)
     except AutopilotError as error:
-        print(f"error: {error}", file=sys.stderr)
+        say_error(error)
         return False
     return True
 
@@ -169,15 +157,11 @@ class Progress:
     """A progress bar on standard error, for runs longer than a second, on a terminal only."""
 
     def __init__(self, label: str):
-        self.label, self.bar = label, None
+        from tqdm import tqdm
+        self.bar = tqdm(desc=label, unit="step", delay=1.0, leave=False, file=sys.stderr,
+                        disable=None)                   # None: only on a terminal
+        self.close = self.bar.close
 
     def __call__(self, k: int, n: int) -> None:
-        if self.bar is None:
-            from tqdm import tqdm
-            self.bar = tqdm(total=n, desc=self.label, unit="step", delay=1.0, leave=False,
-                            file=sys.stderr, disable=None)      # None: only on a terminal
+        self.bar.total = n
         self.bar.update(k - self.bar.n)
-
-    def close(self) -> None:
-        if self.bar is not None:
-            self.bar.close()

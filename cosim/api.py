@@ -4,9 +4,7 @@
     run = simulate("waves_pd", autopilot="my.fmu", set={"ship.Hs": 0.01}, stop_time=200)
     run["ship.psi"], run.t, run.units["ship.psi"]        # heading (rad) at every 0.1 s
 
-The recording holds every exchanged signal by ``component.variable`` at every
-communication point, with its unit. Many runs of one scenario, stepped together as arrays
-where the batch kernel covers it (``cosim.ensemble``):
+Many runs of one scenario, stepped together as arrays where the batch kernel covers it:
 
     from cosim import simulate_many
     runs = simulate_many("waves_pd", [{"ship.wave_seed": s} for s in range(100)])
@@ -37,12 +35,18 @@ def parse_setting(text: str) -> tuple[str, str]:
     for the master to read as the variable's type. ValueError naming the text."""
     target, sep, raw = text.partition("=")
     try:
-        if not sep:
-            raise ValueError("no '='")
-        split_name(target)
+        split_name(target if sep else "")
     except ValueError:
         raise ValueError(f"--set expects COMPONENT.VARIABLE=VALUE, got {text!r}") from None
     return target, raw
+
+
+def parse_port_map(text: str) -> tuple[str, str]:
+    """'psi=heading' -> ('psi', 'heading'): an autopilot port and the FMU's name for it."""
+    port, sep, name = text.partition("=")
+    if not (sep and port and name):
+        raise ValueError(f"--map expects PORT=NAME, e.g. psi=heading; got {text!r}")
+    return port, name
 
 
 def overrides_of(settings: Mapping[str, Any] | Iterable[tuple[str, Any]]

@@ -28,12 +28,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         result = run(args.engine, args.ssp, tuple(args.signals))
-    except EngineError as error:        # the engine's failure, with the FMU's message
-        print(f"error: {error}", file=sys.stderr)
-        return 1
-    try:
         save_trace(args.out, result)
-    except OutputError as error:
+    except (EngineError, OutputError) as error:     # EngineError: with the FMU's message
         print(f"error: {error}", file=sys.stderr)
         return 1
     print(f"wrote {args.out}: {', '.join(args.signals)} at {len(result['time'])} times")

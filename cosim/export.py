@@ -16,8 +16,8 @@ import sys
 from pathlib import Path
 
 from . import scenarios
-from ._cli import (add_autopilot_options, add_fmi_option, checked_autopilot, chosen_scenarios,
-                   entry, say_error, writable_folder)
+from ._cli import (add_fmu_options, checked_autopilot, chosen_scenarios, entry, say_error,
+                   writable_folder)
 from .core.files import OutputError
 from .interop.ssp import FMI2_ONLY, export, fmi_versions, unapplied_strings
 
@@ -31,9 +31,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", type=Path,
                         help="output folder (default: results/ssp, or results/ssp/fmi3 with "
                              "--fmi 3)")
-    add_fmi_option(parser)
-    add_autopilot_options(parser, "the package carries the FMU; with --all, in each of the "
-                                  "four scenarios")
+    add_fmu_options(parser, "the package carries the FMU; with --all, in each of the four "
+                            "scenarios")
     args = parser.parse_args(argv)
     names = chosen_scenarios(parser, args.scenario, args.all)
     if not checked_autopilot(parser, args):
@@ -54,12 +53,9 @@ def main(argv: list[str] | None = None) -> int:
                 print(f"warning: {package.name} sets the String {variable} = {value!r}; "
                       f"OMSimulator and fmpy's SSP runner apply no String binding and "
                       f"would run with its default {default!r}", file=sys.stderr)
-        except (ValueError, FileNotFoundError) as error:
+        except (ValueError, FileNotFoundError, OutputError) as error:
             say_error(error)
-            return 2
-        except OutputError as error:
-            say_error(error)
-            return 1
+            return 1 if isinstance(error, OutputError) else 2
     return 0
 
 

@@ -66,7 +66,7 @@ def run_and_write(system: SystemDescription, label: str, out: Path,
                   options: Options = Options(),
                   progress: Callable[[int, int], None] | None = None,
                   stop: StopSignals | None = None,
-                  notes: Callable[[str], None] | None = None) -> Outcome:
+                  notes: Callable[[str], None] = lambda note: None) -> Outcome:
     """Run ``system`` and write its outputs as ``label`` in ``out``.
 
     ``notes`` hears how it runs (a component through FMI, say) once the FMUs are up;
@@ -75,11 +75,9 @@ def run_and_write(system: SystemDescription, label: str, out: Path,
     it was.
     """
     kind = analysis(system.report)
-    stale = [out / f"{label}{suffix}" for suffix in SUFFIXES]
     with FolderLock(out):
         Outputs.remove_abandoned(out, label)          # a killed run's, if any
-        with Outputs(out, stale, label) as outputs:
-            csv_path = outputs.path(f"{label}.csv")
+        with Outputs(out, [out / f"{label}{suffix}" for suffix in SUFFIXES], label) as outputs:
             forget = stop.keep(lambda: _discard(outputs, label)) if stop is not None else None
             master: Master | None = None
             finished: list[Recording] = []    # the run, once it has returned
@@ -107,11 +105,10 @@ def run_and_write(system: SystemDescription, label: str, out: Path,
                         raise
                     with master:
                         for note in master.notes:
-                            if notes is not None:
-                                notes(note)
+                            notes(note)
                         if options.animate:
                             require_track(master.columns)
-                        with outputs.writing(f"{label}.csv"):
+                        with outputs.writing(f"{label}.csv") as csv_path:
                             recording = master.run(options.stop_time, progress=progress,
                                                    csv_path=csv_path if options.stream else None,
                                                    stop=stop, watchdog=watchdog)
@@ -119,12 +116,16 @@ def run_and_write(system: SystemDescription, label: str, out: Path,
                         parameters = master.parameters
                         watchdog.finishing("terminating and freeing the FMUs")
                 outcome = Outcome(recording, out / f"{label}.csv")
-                if recording.error and not recording.rows and not recording.interrupted:
-                    outputs.discard()       # nothing was computed: the earlier outputs stay
+                if recording.interrupted:
+                    outcome.status = 128 + int(signal.Signals[recording.interrupted])
+                elif recording.error:
                     outcome.status = 1
-                    return outcome
+                    if not recording.rows:
+                        outputs.discard()   # nothing was computed: the earlier outputs stay
+                        return outcome
                 outcome.written = _write_rows(recording, outputs, label, options.stream)
-                _analyse(outcome, system, kind, label, outputs, options, parameters)
+                if not (recording.error or options.stream):
+                    _analyse(outcome, system, kind, label, outputs, options, parameters)
                 outcome.written = [outputs.final(path) for path in outcome.written]
             finally:
                 if forget is not None:
@@ -155,16 +156,8 @@ def _write_rows(recording: Recording, outputs: Outputs, label: str, streamed: bo
 
 def _analyse(outcome: Outcome, system: SystemDescription, kind: Analysis, label: str,
              outputs: Outputs, options: Options, parameters: dict) -> None:
-    """Status, report, figure, animation and cost of a run whose rows are written."""
+    """Report, figure, animation and cost of a finished run whose rows are written."""
     recording = outcome.recording
-    if recording.interrupted:
-        outcome.status = 128 + int(signal.Signals[recording.interrupted])
-        return
-    if recording.error:
-        outcome.status = 1
-        return
-    if options.stream:
-        return
     outcome.report = kind.report(recording, lam=options.lam, parameters=parameters)
     if options.plot and kind.figure is not None:
         with outputs.writing(f"{label}.{options.formats[0]}") as path:
@@ -176,4 +169,3 @@ def _analyse(outcome: Outcome, system: SystemDescription, kind: Analysis, label:
                                            options.animate))
     if system.report == "course_keeping":
         outcome.cost = cost(recording, options.lam)
-

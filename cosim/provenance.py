@@ -12,7 +12,6 @@ import functools
 import hashlib
 import importlib.util
 import json
-import math
 import platform
 import subprocess
 import sys
@@ -28,6 +27,7 @@ from .core.recording import Recording
 
 PACKAGE = "ship-autopilot-cosim"
 CODE_PACKAGES = ("cosim", "fmukit", "ship_fmu", "autopilot_fmu")
+NON_FINITE = {"NaN": "nan", "Infinity": "inf", "-Infinity": "-inf"}   # JSON's token: repr
 
 
 def _version(distribution: str) -> str | None:
@@ -44,29 +44,29 @@ def _sha256(path: str) -> str | None:
         return None
 
 
-def _manifest(path: str) -> dict[str, Any]:
-    """An FMU built with fmukit: its sources' digest, and whether they are this process's
-    (``fmukit.manifest.staleness``); nothing for any other FMU."""
+def _fmu(fmu: dict[str, Any]) -> dict[str, Any]:
+    """An FMU's entry with its SHA-256; for one built with fmukit, its sources' digest and
+    whether they are this process's (``fmukit.manifest.staleness``)."""
+    entry = {**fmu, "sha256": _sha256(fmu["file"])}
     try:
-        manifest = read(path)
+        manifest = read(fmu["file"])
     except (OSError, ValueError, zipfile.BadZipFile):
-        return {}
-    if manifest is None:
-        return {}
-    stale = staleness(manifest)
-    return {"sources_digest": manifest.digest, "current": stale is None,
-            **({"stale": stale} if stale else {})}
+        manifest = None
+    if manifest is not None:
+        stale = staleness(manifest)
+        entry.update(sources_digest=manifest.digest, current=stale is None)
+        if stale:
+            entry["stale"] = stale
+    return entry
 
 
 def _commit() -> str | None:
     """The git commit of this checkout, with '+changes' if it has uncommitted ones."""
-    root = Path(__file__).resolve().parents[1]
+    git = ["git", "-C", str(Path(__file__).resolve().parents[1])]
     try:
-        head = subprocess.run(["git", "-C", str(root), "rev-parse", "HEAD"], capture_output=True,
-                              text=True, timeout=10)
-        dirty = subprocess.run(["git", "-C", str(root), "status", "--porcelain",
-                                "--untracked-files=no"], capture_output=True, text=True,
-                               timeout=10)
+        head, dirty = (subprocess.run(git + command, capture_output=True, text=True, timeout=10)
+                       for command in (["rev-parse", "HEAD"],
+                                       ["status", "--porcelain", "--untracked-files=no"]))
     except (OSError, subprocess.SubprocessError):
         return None
     if head.returncode != 0:
@@ -87,42 +87,22 @@ def code_version() -> str:
     return f"{_version(PACKAGE)} (code {digest.hexdigest()[:12]})"
 
 
-def _strict(value: Any) -> Any:
-    """JSON without NaN or Infinity tokens: a non-finite number becomes its name, a string."""
-    if isinstance(value, float) and not math.isfinite(value):
-        return repr(value)
-    if isinstance(value, dict):
-        return {k: _strict(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_strict(v) for v in value]
-    return value
-
-
-def run_metadata(recording: Recording, command: list[str] | None = None) -> dict[str, Any]:
-    """The metadata of a run, as plain JSON values (non-finite numbers as strings)."""
+def write_metadata(recording: Recording, path: str | Path) -> Path:
+    """Write the run's metadata to ``path`` as strict JSON; returns the path."""
     meta = dict(recording.meta)
-    meta["fmus"] = {name: {**fmu, "sha256": _sha256(fmu["file"]), **_manifest(fmu["file"])}
-                    for name, fmu in meta.get("fmus", {}).items()}
+    meta["fmus"] = {name: _fmu(fmu) for name, fmu in meta.get("fmus", {}).items()}
     if meta.get("scenario_file"):
         meta["scenario_sha256"] = _sha256(meta["scenario_file"])
-    return _strict({
-        **meta,
-        "rows": recording.rows,
-        "error": recording.error,
-        "columns": {"time": "s", **{column: recording.units.get(column, "")
-                                    for column in recording.columns}},
-        "command": command if command is not None else getattr(sys, "orig_argv", sys.argv),
-        "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
-        "versions": {PACKAGE: _version(PACKAGE), "commit": _commit(),
-                     "python": platform.python_version(), "numpy": _version("numpy"),
-                     "fmpy": _version("fmpy"), "pythonfmu": _version("pythonfmu")},
-    })
-
-
-def write_metadata(recording: Recording, path: str | Path,
-                   command: list[str] | None = None) -> Path:
-    """Write ``run_metadata`` to ``path`` as strict JSON; returns the path."""
+    meta.update(
+        rows=recording.rows, error=recording.error,
+        columns={"time": "s", **{c: recording.units.get(c, "") for c in recording.columns}},
+        command=getattr(sys, "orig_argv", sys.argv),
+        created=datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        versions={PACKAGE: _version(PACKAGE), "commit": _commit(),
+                  "python": platform.python_version(), "numpy": _version("numpy"),
+                  "fmpy": _version("fmpy"), "pythonfmu": _version("pythonfmu")})
+    # through JSON once with its NaN and Infinity tokens, read back as strings
+    strict = json.loads(json.dumps(meta), parse_constant=NON_FINITE.get)
     path = Path(path)
-    path.write_text(json.dumps(run_metadata(recording, command), indent=1, allow_nan=False)
-                    + "\n")
+    path.write_text(json.dumps(strict, indent=1, allow_nan=False) + "\n")
     return path

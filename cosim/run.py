@@ -19,13 +19,13 @@ from __future__ import annotations
 
 import argparse
 import sys
+from contextlib import closing
 from pathlib import Path
-from typing import NamedTuple
 
 from . import scenarios
-from ._cli import (Progress, add_autopilot_options, add_fmi_option, checked_autopilot,
-                   chosen_scenarios, entry, number_option, positive_seconds, say_error, say_note,
-                   setting_option, writable_folder)
+from ._cli import (Progress, add_fmu_options, checked_autopilot, chosen_scenarios, entry,
+                   number_option, positive_seconds, say_error, say_note, setting_option,
+                   writable_folder)
 from .analysis.animation import video_format
 from .analysis.cost import LAMBDA, Cost
 from .analysis.describe import conditions, headline
@@ -47,17 +47,12 @@ def run_scenario(system: SystemDescription, label: str, out: Path, overrides: di
                  options: Options) -> tuple[int, Cost | None]:
     """Simulate one system, write its outputs as ``label`` and print its report; the status
     0, 1 if an FMU failed, 130 / 143 if Ctrl-C or SIGTERM stopped it (its rows written)."""
-    with StopSignals() as stop:           # from here on, a signal stops between steps
-        progress = Progress(label)
-        try:
-            outcome = run_and_write(system, label, out, overrides, options, progress, stop,
-                                    notes=say_note)
-        finally:
-            progress.close()
+    # from here on, a signal stops the run between steps
+    with StopSignals() as stop, closing(Progress(label)) as progress:
+        outcome = run_and_write(system, label, out, overrides, options, progress, stop,
+                                notes=say_note)
     recording, csv_path = outcome.recording, outcome.csv
-    print(headline(label, recording.meta))
-    for line in conditions(recording.meta):
-        print(f"  {line}")
+    print("\n  ".join([headline(label, recording.meta), *conditions(recording.meta)]))
     if recording.interrupted:
         print(f"{recording.error}; written to {csv_path}, with its metadata", file=sys.stderr)
     elif recording.error:
@@ -81,32 +76,11 @@ def run_scenario(system: SystemDescription, label: str, out: Path, overrides: di
     return outcome.status, outcome.cost
 
 
-class Run(NamedTuple):
-    scenario: str                       # a name or a .ssd path
-    label: str                          # names the output files
-    autopilot: Path | None              # a user's autopilot in place of the scenario's
-    table_row: tuple[str, str] | None   # (sea, controller) in Tables 1-2
-
-
-def runs_asked(names: list[str], paper: bool, autopilot: Path | None,
-               name: str | None) -> list[Run]:
-    """Every run of the command line; with --all and --autopilot, the user's autopilot also
-    in calm_pd's and waves_pd's place."""
-    if not paper:
-        return [Run(names[0], scenarios.label(names[0], autopilot, name), autopilot, None)]
-    runs = [Run(scenario, scenario, None, tuple(scenario.split("_"))) for scenario in names]
-    if autopilot is not None:
-        runs += [Run(scenario, scenarios.label(scenario, autopilot, name), autopilot,
-                     (scenario.split("_")[0], name or autopilot.stem))
-                 for scenario in ("calm_pd", "waves_pd")]
-    return runs
-
-
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(
-        prog="python -m cosim.run", description=__doc__.split("\n\n")[0],
-        epilog="\n\n".join(__doc__.split("\n\n")[1:]),
-        formatter_class=argparse.RawDescriptionHelpFormatter)
+    description, _, epilog = __doc__.partition("\n\n")
+    parser = argparse.ArgumentParser(prog="python -m cosim.run", description=description,
+                                     epilog=epilog,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("scenario", nargs="?",
                         help=f"one of: {', '.join(scenarios.names())}; or a path to a .ssd file")
     parser.add_argument("--all", action="store_true",
@@ -130,9 +104,8 @@ def main(argv: list[str] | None = None) -> int:
                              "FMUs' Python classes, without FMI, with the same results bit for "
                              "bit (an FMU not built from this checkout's sources runs through "
                              "FMI, with a note)")
-    add_fmi_option(parser)
-    add_autopilot_options(parser, "with --all it also runs in calm_pd's and waves_pd's "
-                                  "place, as an extra row of Tables 1-2")
+    add_fmu_options(parser, "with --all it also runs in calm_pd's and waves_pd's place, as an "
+                            "extra row of Tables 1-2")
     parser.add_argument("--no-plot", action="store_true", help="skip the figure")
     parser.add_argument("--figure-format", action="append", default=[], choices=("svg", "pdf"),
                         help="also write the figure as SVG or PDF (for papers); repeatable")
@@ -164,10 +137,6 @@ def main(argv: list[str] | None = None) -> int:
         overrides = overrides_of(args.set)
     except ValueError as error:             # a variable set twice
         parser.error(str(error))
-    # With --all, autopilot.* settings are for the user's autopilot, not the paper's.
-    paper_overrides = {c: v for c, v in overrides.items()
-                       if c != COMPONENT or args.autopilot is None}
-
     if args.animate and args.stream:
         parser.error("--animate needs the run in memory; it cannot be combined with --stream")
     if args.spread is not None and args.spread < 1:
@@ -179,20 +148,26 @@ def main(argv: list[str] | None = None) -> int:
     options = Options(args.coupling, args.stop_time, args.lam, args.backend,
                       not args.no_plot, ("png", *args.figure_format), args.stream, args.animate,
                       Limits(args.step_timeout, args.run_timeout))
-    status, costs, spreads, runs = 0, {}, {}, 0
+    # (scenario, autopilot, row of Tables 1-2): with --all and --autopilot, the user's
+    # autopilot also in calm_pd's and waves_pd's place
+    runs = [(s, None, tuple(s.split("_"))) for s in names] if args.all else \
+        [(names[0], args.autopilot, None)]
+    if args.all and args.autopilot:
+        runs += [(s, args.autopilot, (s.split("_")[0], args.name or args.autopilot.stem))
+                 for s in ("calm_pd", "waves_pd")]
+    status, costs, spreads, count = 0, {}, {}, 0
     perturbed = ", ".join(".".join(p) for p in PERTURBED)
-    for run in runs_asked(names, args.all, args.autopilot, args.name):
-        out = args.out or Path("results") / run.label
-        if args.all and args.out:
-            out = args.out / run.label
+    for scenario, autopilot, table_row in runs:
+        label = scenarios.label(scenario, autopilot, args.name)
+        out = args.out / label if args.all and args.out else args.out or Path("results") / label
+        # with --all, autopilot.* settings are for the user's autopilot, not the paper's
+        settings = {c: v for c, v in overrides.items()
+                    if c != COMPONENT or autopilot or not args.autopilot}
         created = not out.exists()
         writable_folder(out)
         try:
-            system = scenarios.load(run.scenario, run.autopilot, dict(args.map), args.name,
-                                    args.fmi)
-            code, result = run_scenario(system, run.label, out,
-                                        overrides if run.autopilot else paper_overrides,
-                                        options)
+            system = scenarios.load(scenario, autopilot, dict(args.map), args.name, args.fmi)
+            code, result = run_scenario(system, label, out, settings, options)
         except (ValueError, FileNotFoundError, FmuCallError, FolderBusy, OutputError,
                 TimedOut) as error:
             say_error(error)
@@ -204,21 +179,21 @@ def main(argv: list[str] | None = None) -> int:
             return code
         if result is not None and args.spread:
             try:
-                ensemble = spread(system, overrides if run.autopilot else paper_overrides,
-                                  args.spread, args.lam, args.coupling, args.stop_time)
+                ensemble = spread(system, settings, args.spread, args.lam, args.coupling,
+                                  args.stop_time)
             except (ValueError, RuntimeError) as error:
                 print(f"error: {error}", file=sys.stderr)
                 status = max(status, 1)
             else:
                 print(f"  last-bit spread over {ensemble.runs} runs ({perturbed} moved by up "
                       f"to {args.spread} ulp): {ensemble.describe()}")
-                spreads[run.table_row], runs = ensemble.describe(), ensemble.runs
-        if result is not None and run.table_row is not None:
-            costs[run.table_row] = result
+                spreads[table_row], count = ensemble.describe(), ensemble.runs
+        if result is not None and table_row is not None:
+            costs[table_row] = result
     if args.all and costs:
         print()
         print(tables(costs, spreads, f"How far one last bit moves each figure (the largest "
-                                    f"change over {runs} runs, "
+                                    f"change over {count} runs, "
                                     f"{perturbed} moved by up to {args.spread} ulp; where "
                                     "it shows at the printed digits)"))
     return status

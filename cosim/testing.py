@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from .analysis.metrics import heading_error
-from .api import overrides_of, parse_setting, simulate
+from .api import overrides_of, parse_port_map, parse_setting, simulate
 from .core.recording import Recording
 
 
@@ -45,11 +45,10 @@ def autopilot(request: pytest.FixtureRequest) -> Path | None:
 @pytest.fixture(scope="session")
 def autopilot_map(request: pytest.FixtureRequest) -> dict[str, str]:
     """The --map options as {port: the FMU's name}."""
-    pairs = [text.partition("=") for text in request.config.getoption("--map")]
-    bad = [port for port, sep, name in pairs if not (sep and port and name)]
-    if bad:
-        raise pytest.UsageError(f"--map expects PORT=NAME, e.g. psi=heading; got {bad}")
-    return {port: name for port, _, name in pairs}
+    try:
+        return dict(parse_port_map(text) for text in request.config.getoption("--map"))
+    except ValueError as error:
+        raise pytest.UsageError(str(error)) from None
 
 
 @pytest.fixture(scope="session")

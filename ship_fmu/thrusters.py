@@ -39,9 +39,3 @@ def actuator_model(act: Actuators, n1: float, n2: float,
                 T3 + L1 + L2,
                 l_yT * (F1 - F2) + l_xT3 * T3 - l_xR * (L1 + L2))
     return forces
-
-
-def actuator_forces(act: Actuators, n1: float, n2: float, n3: float,
-                    delta: float) -> tuple[float, float, float]:
-    """tau_th = T u for both rudders at angle delta, eqs (8)-(13)."""
-    return actuator_model(act, n1, n2, n3)(delta)

@@ -15,6 +15,8 @@ import numpy as np
 
 from .data import G, RHO_WATER, Hull
 
+BAND = 0.98                     # the share of the spectrum's variance the components hold
+
 
 def spectrum(omega: np.ndarray | float, Hs: float, T0: float) -> np.ndarray | float:
     """S(omega) = A omega^-5 exp(-B omega^-4), m^2 s, eq (17), A = Hs^2 B / 4."""
@@ -28,24 +30,18 @@ def _spectrum_b(T0: float) -> float:
     return 16.0 * math.pi * math.pi * math.pi / (Tz * Tz * Tz * Tz)
 
 
-def variance_fraction_below(omega: np.ndarray | float, T0: float) -> np.ndarray | float:
-    """Share of the spectrum's variance m0 = Hs^2/16 at frequencies below omega."""
-    return np.exp(-_spectrum_b(T0) / np.asarray(omega, dtype=float) ** 4)
-
-
-def frequency_at_fraction(fraction: float, T0: float) -> float:
-    """omega = (B / -ln F)^(1/4), rad/s, in decimal arithmetic: the same on every CPU."""
+@lru_cache(maxsize=64)
+def _bins(T0: float, n: int) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """The edges of N equal-variance bins of the spectrum's central BAND: their variance
+    fractions F and frequencies omega = (B / -ln F)^(1/4), rad/s, in decimal arithmetic:
+    the same on every CPU."""
+    tail = 0.5 * (1.0 - BAND)
+    fractions = np.linspace(tail, 1.0 - tail, n + 1).tolist()
+    B = Decimal(_spectrum_b(T0))
     with localcontext() as context:
         context.prec = 34
-        quotient = Decimal(_spectrum_b(T0)) / -Decimal(fraction).ln()
-        return float(quotient.sqrt().sqrt())
-
-
-@lru_cache(maxsize=64)
-def _bins(T0: float, n: int, band_fraction: float) -> tuple[tuple[float, ...], tuple[float, ...]]:
-    tail = 0.5 * (1.0 - band_fraction)
-    fractions = np.linspace(tail, 1.0 - tail, n + 1).tolist()
-    return tuple(fractions), tuple(frequency_at_fraction(f, T0) for f in fractions)
+        edges = tuple(float((B / -Decimal(f).ln()).sqrt().sqrt()) for f in fractions)
+    return tuple(fractions), edges
 
 
 @dataclass(frozen=True)
@@ -57,19 +53,14 @@ class WaveComponents:
     phase: np.ndarray       # rad
 
     @classmethod
-    def from_spectrum(cls, Hs: float, T0: float, n: int, seed: int,
-                      band_fraction: float = 0.98) -> WaveComponents:
-        edges_fraction, edges = map(np.array, _bins(T0, n, band_fraction))
+    def from_spectrum(cls, Hs: float, T0: float, n: int, seed: int) -> WaveComponents:
+        edges_fraction, edges = map(np.array, _bins(T0, n))
         rng = np.random.default_rng(seed)
         omega = rng.uniform(edges[:-1], edges[1:])
         phase = rng.uniform(0.0, 2.0 * math.pi, n)
         m0_bins = Hs * Hs / 16.0 * np.diff(edges_fraction)
         return cls(omega=omega, k=omega * omega / G,
                    amplitude=np.sqrt(2.0 * m0_bins), phase=phase)
-
-    def phases(self, t: float, xi: float) -> np.ndarray:
-        """theta_i(t) = omega_i t - k_i xi + phi_i."""
-        return self.omega * t - self.k * xi + self.phase
 
 
 class WaveLoads:
