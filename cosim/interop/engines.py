@@ -17,10 +17,9 @@ import numpy as np
 
 from fmukit.timebase import communication_point, step_count
 
-from ..core.files import write_atomically
+from ..core.files import whole_file
 from ..core.interrupt import STOP_SIGNALS, Interrupted, StopSignals
 from ..core.system import SystemDescription, split_name
-
 from .osp import read_osp
 from .ssp import FMI2_ONLY, fmi_versions, read_package, unapplied_strings
 
@@ -30,6 +29,7 @@ TRACED = ("ship.psi", "ship.r", "ship.delta")
 
 class EngineError(RuntimeError):
     """An engine failed or produced undefined values; the message holds its output."""
+
 
 def is_osp(path: Path) -> bool:
     return path.is_dir() or path.suffix.lower() == ".xml"
@@ -194,10 +194,8 @@ def record(engine: str, ssp: str, out: str, signals: tuple[str, ...]) -> int:
 
 
 def save_trace(path: Path, result: dict[str, np.ndarray]) -> None:
-    def write(temporary: Path) -> None:
-        with open(temporary, "wb") as f:
-            np.savez(f, **result)
-    write_atomically(path, write)
+    with whole_file(path) as tmp, open(tmp, "wb") as f:
+        np.savez(f, **result)
 
 
 def log_summary(log: str, head: int = 20, tail: int = 5) -> str:
@@ -207,4 +205,3 @@ def log_summary(log: str, head: int = 20, tail: int = 5) -> str:
         return "\n".join(lines)
     return "\n".join(lines[:head] + [f"... ({len(lines) - head - tail} more lines) ..."]
                      + lines[-tail:])
-

@@ -29,13 +29,12 @@ def _with_numeric_route(system: SystemDescription, fmus: dict[str, Path]) -> Non
             continue
         declared = {v.name for v in read_description(fmus[name], name).modelVariables}
         if declared.issuperset(ROUTE_PARAMETERS):
-            route(component.parameters)
-            parameters = dict(component.parameters)
-            parameters.update(numeric_route(parameters.pop("waypoints")))
-            component.parameters = parameters
+            route(component.parameters)             # the route as the guidance takes it
+            component.parameters.update(numeric_route(component.parameters.pop("waypoints")))
 
 
-_EXPONENTS = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
+_NEUTRAL = {**dict.fromkeys(("kg", "m", "s", "A", "K", "mol", "cd", "rad"), 0),
+            "factor": 1.0, "offset": 0.0}             # a base unit's values left unwritten
 
 
 def connector_units(system: SystemDescription, fmus: dict[str, Path]) -> Units:
@@ -48,11 +47,9 @@ def connector_units(system: SystemDescription, fmus: dict[str, Path]) -> Units:
                    for v in described.modelVariables}
         connectors[name] = {c: by_name[c] for c in component.connectors if by_name.get(c)}
         for unit in described.unitDefinitions:
-            base = unit.baseUnit
-            definitions[unit.name] = {
-                **{k: getattr(base, k) for k in _EXPONENTS if base and getattr(base, k)},
-                **({"factor": base.factor} if base and base.factor != 1.0 else {}),
-                **({"offset": base.offset} if base and base.offset != 0.0 else {})}
+            definitions[unit.name] = {k: getattr(unit.baseUnit, k) for k, neutral in
+                                      _NEUTRAL.items() if unit.baseUnit and
+                                      getattr(unit.baseUnit, k) != neutral}
     for name, by_connector in connectors.items():
         for connector, unit in by_connector.items():
             if unit not in definitions:
