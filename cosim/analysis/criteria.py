@@ -106,8 +106,7 @@ class Assessment:
 
 def turning_circle_of(run: Recording) -> Assessment:
     tc = turning_circle_figures(*(run[f"ship.{n}"] for n in ("x", "y", "psi", "u", "v", "r")))
-    p = run.meta["parameters"]
-    delta = p["program"]["delta"]
+    p, delta = run.meta["parameters"], run.meta["parameters"]["program"]["delta"]
     return Assessment(tc, turning_circle_criteria(tc, delta, p["ship"]["delta_max"]), delta)
 
 

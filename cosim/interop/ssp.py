@@ -98,29 +98,30 @@ def read_package(ssp: Path) -> SystemDescription:
         return read_ssd(Path(tmp) / SSD_NAME)
 
 
-def _descriptions(path: Path) -> dict[str, ModelDescription]:
+def _described(path: Path) -> tuple[SystemDescription, dict[str, ModelDescription]]:
+    """The system of a package or an OSP folder, and each component's model description."""
     with tempfile.TemporaryDirectory() as tmp:
         if path.suffix.lower() == ".ssp":
-            system, folder = read_package(path), Path(tmp)
             with zipfile.ZipFile(path) as package:
                 package.extractall(tmp)
+            system, folder = read_ssd(Path(tmp) / SSD_NAME), Path(tmp)
         else:
             system, folder = read_osp(path), path if path.is_dir() else path.parent
-        return {name: read_description(folder / component.source, name)
-                for name, component in system.components.items()}
+        return system, {name: read_description(folder / component.source, name)
+                        for name, component in system.components.items()}
 
 
 def fmi_versions(path: Path) -> dict[str, str]:
     """Each component's FMI version ("2.0", "3.0") in a package or OSP folder."""
-    return {name: d.fmiVersion for name, d in _descriptions(path).items()}
+    return {name: d.fmiVersion for name, d in _described(path)[1].items()}
 
 
 def unapplied_strings(ssp: Path) -> dict[str, tuple[str, str]]:
     """String bindings a tool applying none would drop without a word, not at their FMU's
     default: 'component.variable': (value, default)."""
-    descriptions = _descriptions(ssp)
+    system, descriptions = _described(ssp)
     dropped = {}
-    for name, component in read_package(ssp).components.items():
+    for name, component in system.components.items():
         starts = {v.name: v.start for v in descriptions[name].modelVariables}
         dropped.update({f"{name}.{v}": (value, starts[v])
                         for v, value in component.parameters.items()
