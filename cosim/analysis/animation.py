@@ -35,9 +35,9 @@ def require_track(columns: list[str]) -> None:
                          f"{', '.join(missing)}")
 
 
-def frame_times(t: np.ndarray, fps: int = FPS, seconds: float = VIDEO_SECONDS) -> np.ndarray:
+def frame_times(t: np.ndarray) -> np.ndarray:
     """Indices of the rows shown, one per frame."""
-    frames = max(2, min(len(t), round(seconds * fps)))
+    frames = max(2, min(len(t), round(VIDEO_SECONDS * FPS)))
     return np.unique(np.round(np.linspace(0, len(t) - 1, frames)).astype(int))
 
 
@@ -51,11 +51,10 @@ def leg_text(wp_index: int, points: np.ndarray) -> str:
 
 
 def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> Path:
-    """Write the animation, whole or not at all, at ``path`` with ``fmt``'s suffix."""
-    require_track(run.columns)
+    """Write the animation, whole or not at all, at ``path`` with ``fmt``'s suffix (by default
+    ``video_format()``); ``require_track`` says whether the run can have one."""
     fmt = fmt or video_format()
-    x, y, psi, delta, t = (run["ship.x"], run["ship.y"], run["ship.psi"], run["ship.delta"],
-                           run.t)
+    t, (x, y, psi, delta) = run.t, (run[f"ship.{n}"] for n in ("x", "y", "psi", "delta"))
     fig = new_figure(figsize=(10, 5.6), dpi=90, layout="constrained")
     grid = fig.add_gridspec(2, 2, width_ratios=(1.0, 1.1))
     track, heading, rudder = (fig.add_subplot(grid[:, 0]), fig.add_subplot(grid[0, 1]),
@@ -69,6 +68,7 @@ def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> P
     track.plot([], [], "s", color="tab:red", label=f"ship outline {shown.size}")
     legs = run.meta.get("parameters", {}).get("guidance")
     points = np.array(followed_route(legs)) if legs else None
+    leg = run["guidance.wp_index"].astype(int) if legs else None
     active, = track.plot([], [], color="tab:green", linewidth=3, alpha=0.6, zorder=2,
                          label="active leg" if points is not None else None)
     legend_if_any(track)
@@ -84,7 +84,6 @@ def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> P
     for a in (heading, rudder):
         a.grid(alpha=0.3)
     fig.suptitle(title(label, run.meta), fontsize=7)
-    leg = run["guidance.wp_index"].astype(int) if "guidance.wp_index" in run.columns else None
 
     def draw(k: int) -> str:
         wake.set_data(y[:k + 1], x[:k + 1])
@@ -93,7 +92,7 @@ def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> P
             cursor.set_xdata([t[k], t[k]])
         text = (f"t = {t[k]:.0f} s   heading {math.degrees(psi[k]):.1f} deg   "
                 f"rudder {math.degrees(delta[k]):+.1f} deg")
-        if leg is None or points is None:
+        if leg is None:
             return text + "\n"
         to = min(leg[k], len(points) - 1)
         active.set_data(points[to - 1:to + 1, 1], points[to - 1:to + 1, 0])
@@ -116,26 +115,22 @@ def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> P
             artist.axes.draw_artist(artist)
         frames.append(np.asarray(fig.canvas.buffer_rgba())[:, :, :3].copy())
     with whole_file(target) as tmp:
-        _write(frames, tmp, fmt, width, height)
+        if fmt == "gif":
+            from PIL import Image
+            images = [Image.fromarray(f).quantize(colors=64, method=Image.Quantize.FASTOCTREE)
+                      for f in frames]
+            images[0].save(tmp, save_all=True, append_images=images[1:],
+                           duration=round(1000 / FPS), loop=0)
+            return target
+        ffmpeg = shutil.which("ffmpeg")
+        if ffmpeg is None:
+            raise ValueError("an MP4 needs ffmpeg, which is not installed; write a GIF")
+        encode = subprocess.run(
+            [ffmpeg, "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt", "rgb24",
+             "-s", f"{width}x{height}", "-r", str(FPS), "-i", "-", "-vf",
+             "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-pix_fmt", "yuv420p", "-f", "mp4", tmp],
+            input=b"".join(frame.tobytes() for frame in frames), capture_output=True)
+        if encode.returncode != 0:
+            raise RuntimeError(f"ffmpeg could not encode the animation: "
+                               f"{encode.stderr.decode(errors='replace').strip()}")
     return target
-
-
-def _write(frames: list[np.ndarray], path: Path, fmt: str, width: int, height: int) -> None:
-    if fmt == "gif":
-        from PIL import Image
-        images = [Image.fromarray(frame).quantize(colors=64, method=Image.Quantize.FASTOCTREE)
-                  for frame in frames]
-        images[0].save(path, save_all=True, append_images=images[1:],
-                       duration=round(1000 / FPS), loop=0)
-        return
-    ffmpeg = shutil.which("ffmpeg")
-    if ffmpeg is None:
-        raise ValueError("an MP4 needs ffmpeg, which is not installed; write a GIF")
-    encode = subprocess.run(
-        [ffmpeg, "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt", "rgb24",
-         "-s", f"{width}x{height}", "-r", str(FPS), "-i", "-", "-vf",
-         "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-pix_fmt", "yuv420p", "-f", "mp4", path],
-        input=b"".join(frame.tobytes() for frame in frames), capture_output=True)
-    if encode.returncode != 0:
-        raise RuntimeError(f"ffmpeg could not encode the animation: "
-                           f"{encode.stderr.decode(errors='replace').strip()}")

@@ -28,6 +28,5 @@ class Cost:
 
 def cost(recording: Recording, lam: float = LAMBDA) -> Cost:
     """Eq (19) with Delta psi = psi_d - psi (wrapped) and delta the actual rudder."""
-    psi_E, sum_delta2 = cost_terms(recording["guidance.psi_d"], recording["ship.psi"],
-                                   recording["ship.delta"])
-    return Cost(psi_E, sum_delta2, lam)
+    return Cost(*cost_terms(recording["guidance.psi_d"], recording["ship.psi"],
+                            recording["ship.delta"]), lam)

@@ -51,41 +51,36 @@ def length_over_speed(length: float, speed: float, scale: float = SCALE) -> floa
 
 def overshoot_limits(lv: float) -> tuple[float, float]:
     """(first, second) 10/10 overshoot limits, rad, for L/V in s at full scale (5.3.3.1-2)."""
-    if lv < 10.0:
-        first, second = 10.0, 25.0
-    elif lv >= 30.0:
-        first, second = 20.0, 40.0
-    else:
-        first, second = 5.0 + 0.5 * lv, 17.5 + 0.75 * lv
-    return math.radians(first), math.radians(second)
+    lv = min(max(lv, 10.0), 30.0)          # 10 and 25 deg below 10 s, 20 and 40 above 30 s
+    return math.radians(5.0 + 0.5 * lv), math.radians(17.5 + 0.75 * lv)
 
 
 def _is(angle: float, degrees: float) -> bool:
     return abs(angle - math.radians(degrees)) < _SAME_ANGLE
 
 
-def turning_circle_criteria(tc: TurningCircle, delta: float, delta_max: float,
-                            length: float = Hull.L) -> tuple[Criterion, ...]:
+def turning_circle_criteria(tc: TurningCircle, delta: float,
+                            delta_max: float) -> tuple[Criterion, ...]:
     """MSC.137(76) 5.3.1, at 35 deg rudder or the gear's largest; none for another angle."""
     if abs(delta - min(TURNING_RUDDER, delta_max)) >= _SAME_ANGLE:
         return ()
-    return (Criterion("advance", tc.advance / length, ADVANCE_LIMIT, "L", "5.3.1",
+    return (Criterion("advance", tc.advance / Hull.L, ADVANCE_LIMIT, "L", "5.3.1",
                       missing="none: the heading never changed by 90 deg"),
-            Criterion("tactical diameter", tc.tactical_diameter / length,
+            Criterion("tactical diameter", tc.tactical_diameter / Hull.L,
                       TACTICAL_DIAMETER_LIMIT, "L", "5.3.1",
                       missing="none: the heading never changed by 180 deg"))
 
 
-def zigzag_criteria(zz: ZigZagResult, delta: float, approach_speed: float,
-                    length: float = Hull.L, scale: float = SCALE) -> tuple[Criterion, ...]:
+def zigzag_criteria(zz: ZigZagResult, delta: float, approach_speed: float
+                    ) -> tuple[Criterion, ...]:
     """MSC.137(76) 5.3.2-3 for a 10/10 or a 20/20 zig-zag; none for another test."""
     if _is(delta, 10.0) and _is(zz.psi_switch, 10.0):
-        lv = length_over_speed(length, approach_speed, scale)
+        lv = length_over_speed(Hull.L, approach_speed)
         first, second = overshoot_limits(lv)
-        basis = (f"L/V = {lv:.1f} s at full scale (1:{scale:g}; "
-                 f"{length / approach_speed:.2f} s for the model)")
+        basis = (f"L/V = {lv:.1f} s at full scale (1:{SCALE:g}; "
+                 f"{Hull.L / approach_speed:.2f} s for the model)")
         return (Criterion("initial turning: distance by 10 deg heading change",
-                          zz.initial_turning_distance / length, INITIAL_TURNING_LIMIT, "L",
+                          zz.initial_turning_distance / Hull.L, INITIAL_TURNING_LIMIT, "L",
                           "5.3.2", missing="none: the heading never changed by 10 deg"),
                 _overshoot_criterion(zz, 1, first, "5.3.3.1", basis),
                 _overshoot_criterion(zz, 2, second, "5.3.3.2", basis))
@@ -107,13 +102,11 @@ class Assessment:
     figures: TurningCircle | ZigZagResult
     criteria: tuple[Criterion, ...]
     delta: float                # rad, the test's rudder angle
-    length: float = Hull.L      # m, the ship's
 
 
 def turning_circle_of(run: Recording) -> Assessment:
     tc = turning_circle_figures(*(run[f"ship.{n}"] for n in ("x", "y", "psi", "u", "v", "r")))
-    p = run.meta["parameters"]
-    delta = p["program"]["delta"]
+    p, delta = run.meta["parameters"], run.meta["parameters"]["program"]["delta"]
     return Assessment(tc, turning_circle_criteria(tc, delta, p["ship"]["delta_max"]), delta)
 
 

@@ -11,26 +11,13 @@ from autopilot_fmu.guidance import route as followed_route
 from ..scenarios import SCENARIO_DIR
 from .reports import PAPER_TABLES
 
-_DISPLAY = {"rad": (math.degrees(1.0), "deg"), "rad/s": (math.degrees(1.0), "deg/s"),
-            "m": (1.0, "m"), "s": (1.0, "s"), "1/s": (1.0, "1/s"), "m/s": (1.0, "m/s")}
-
 
 def value(x: Any, unit: str = "", degrees: bool = True) -> str:
     """A parameter value, 4 significant digits; angles in degrees if ``degrees``."""
-    if isinstance(x, str) or isinstance(x, bool) or x is None:
-        return str(x)
-    factor, shown = _DISPLAY.get(unit, (1.0, unit)) if degrees else (1.0, unit)
-    shown = "" if shown in ("", "1") else shown
-    text = f"{x * factor:.4g}" if isinstance(x, float) else str(x)
-    return f"{text} {shown}".strip()
-
-
-def route(guidance: dict[str, Any]) -> str:
-    try:
-        points = " ".join(f"({x:g},{y:g})" for x, y in followed_route(guidance))
-    except ValueError:                  # the guidance refuses it: shown as given
-        points = repr(guidance.get("waypoints"))
-    return f"route {points} m, acceptance radius {guidance['R_accept']:.3g} m"
+    if isinstance(x, float) and degrees and unit in ("rad", "rad/s"):
+        x, unit = x * math.degrees(1.0), unit.replace("rad", "deg")
+    text = f"{x:.4g}" if isinstance(x, float) else str(x)
+    return f"{text} {'' if unit == '1' else unit}".strip()
 
 
 def overrides(meta: dict[str, Any]) -> str:
@@ -48,7 +35,11 @@ def conditions(meta: dict[str, Any]) -> list[str]:
                      f"{meta['step_size']:g} s, {meta['coupling']} coupling, "
                      f"{meta['backend']} backend")
     if "guidance" in p:
-        lines.append(route(p["guidance"]))
+        try:
+            points = " ".join(f"({x:g},{y:g})" for x, y in followed_route(p["guidance"]))
+        except ValueError:              # the guidance refuses it: shown as given
+            points = repr(p["guidance"].get("waypoints"))
+        lines.append(f"route {points} m, acceptance radius {p['guidance']['R_accept']:.3g} m")
     if "ship" in p:
         ship = p["ship"]
         sea = "calm water" if ship.get("Hs", 0.0) == 0.0 else (
@@ -89,8 +80,7 @@ def paper_row(meta: dict[str, Any]) -> tuple[str, tuple[float, float, float]] | 
 
 
 def headline(label: str, meta: dict[str, Any]) -> str:
-    changed = changes(meta)
-    if not changed:
+    if not (changed := changes(meta)):
         return f"{label}: {meta.get('description', '')}"
     whose = "the paper's" if meta.get("system") in PAPER_TABLES else "the scenario's"
     return f"{label}: {meta.get('system', label)} changed by {changed} (not {whose} run)"

@@ -2,6 +2,7 @@
 the paper's values for its own runs; on Agg canvases without pyplot (no backend picked)."""
 from __future__ import annotations
 
+import itertools
 import math
 import textwrap
 from collections.abc import Callable
@@ -22,7 +23,6 @@ from .track import legend_if_any, track_panel
 FORMATS = ("png", "svg", "pdf")
 RUDDER_LABEL = "rudder delta (deg)\n+ turns to port"     # a positive rudder turns to port
 _VERDICT_COLOURS = {"PASS": "tab:green", "FAIL": "tab:red", "OPEN": "tab:orange"}
-_WRAP = 150                     # characters per line of a figure's text
 
 
 def new_figure(**options: Any) -> Figure:
@@ -56,18 +56,17 @@ def time_axes(fig: Figure, cells: list[Any]) -> list[Any]:
 
 
 def text_grid(width_ratios: tuple[float, float], rows: int, text: list[str]
-          ) -> tuple[Figure, Any]:
+              ) -> tuple[Figure, Any]:
     """A figure and its grid: ``rows`` rows of panels above one row of ``text``."""
     text_lines = sum(line.count("\n") + 1 for line in _wrapped(text))
     fig = new_figure(figsize=(13, 8.5 + 0.14 * text_lines), layout="constrained")
     panel = (8.0 - 0.3 * rows) / rows
-    grid = fig.add_gridspec(rows + 1, 2, width_ratios=width_ratios,
-                            height_ratios=(*[panel] * rows, 0.16 * text_lines + 0.2))
-    return fig, grid
+    return fig, fig.add_gridspec(rows + 1, 2, width_ratios=width_ratios,
+                                 height_ratios=(*[panel] * rows, 0.16 * text_lines + 0.2))
 
 
 def _wrapped(lines: list[str]) -> list[str]:
-    return [textwrap.fill(line, _WRAP, subsequent_indent="      ", break_on_hyphens=False)
+    return [textwrap.fill(line, 150, subsequent_indent="      ", break_on_hyphens=False)
             for line in lines]
 
 
@@ -75,31 +74,11 @@ def text_panel(ax: Any, lines: list[str]) -> None:
     """The report's lines, wrapped; a verdict in its colour."""
     ax.set_axis_off()
     shown = _wrapped(lines)
-    rows = sum(line.count("\n") + 1 for line in shown)
-    row = 0
-    for line in shown:
-        colour = _VERDICT_COLOURS.get(line.split(" ", 1)[0], "black")
-        ax.text(0.0, 1.0 - row / rows, line, transform=ax.transAxes, va="top", ha="left",
-                fontsize=8, family="monospace", color=colour)
-        row += line.count("\n") + 1
-
-
-def _rudder(ax: Any, run: Recording, commanded: str) -> None:
-    command = np.degrees(run[commanded])
-    ax.plot(run.t, command, color="tab:orange", linewidth=0.5, alpha=0.55, zorder=1,
-            label="commanded delta_c")
-    ax.plot(run.t, np.degrees(run["ship.delta"]), color="k", linewidth=0.9, zorder=3,
-            label="actual delta")
-    stops = math.degrees(run.meta.get("parameters", {}).get("ship", {}).get("delta_max", math.pi))
-    if np.abs(command).max() > 1.15 * stops:
-        ax.set_ylim(-1.15 * stops, 1.15 * stops)
-        for level in (-stops, stops):
-            ax.axhline(level, color="0.5", linestyle=":", linewidth=0.8, zorder=2)
-        ax.set_title(f"command up to {np.abs(command).max():.0f} deg, clipped here; "
-                     f"dotted: the stops at +-{stops:.0f} deg", loc="left", fontsize=7,
-                     color="tab:orange")
-    ax.set_ylabel(RUDDER_LABEL)
-    legend_if_any(ax)
+    heights = [line.count("\n") + 1 for line in shown]
+    for line, row in zip(shown, itertools.accumulate(heights, initial=0)):
+        ax.text(0.0, 1.0 - row / sum(heights), line, transform=ax.transAxes, va="top",
+                ha="left", fontsize=8, family="monospace",
+                color=_VERDICT_COLOURS.get(line.split(" ", 1)[0], "black"))
 
 
 def merit_table(run: Recording, lam: float = LAMBDA) -> str:
@@ -134,25 +113,33 @@ def course_keeping_figure(run: Recording, lam: float = LAMBDA) -> Figure:
     error.set_ylabel("psi_d - psi (deg)")
     r.plot(t, np.degrees(run["ship.r"]), color="k")
     r.set_ylabel("yaw rate r (deg/s)")
-    _rudder(rudder, run, "ship.delta_c")
+    command = np.degrees(run["ship.delta_c"])
+    rudder.plot(t, command, color="tab:orange", linewidth=0.5, alpha=0.55, zorder=1,
+                label="commanded delta_c")
+    rudder.plot(t, np.degrees(run["ship.delta"]), color="k", linewidth=0.9, zorder=3,
+                label="actual delta")
+    stops = math.degrees(run.meta.get("parameters", {}).get("ship", {}).get("delta_max", math.pi))
+    if np.abs(command).max() > 1.15 * stops:            # a chattering command: the rudder shown
+        rudder.set_ylim(-1.15 * stops, 1.15 * stops)
+        for level in (-stops, stops):
+            rudder.axhline(level, color="0.5", linestyle=":", linewidth=0.8, zorder=2)
+        rudder.set_title(f"command up to {np.abs(command).max():.0f} deg, clipped here; "
+                         f"dotted: the stops at +-{stops:.0f} deg", loc="left", fontsize=7,
+                         color="tab:orange")
+    rudder.set_ylabel(RUDDER_LABEL)
+    legend_if_any(rudder)
     return fig
 
 
 def save(fig: Figure, path: Path, formats: tuple[str, ...] = ("png",)) -> list[Path]:
     """Write the figure in each format (path with that suffix), each file whole or not at all."""
     written = []
-    try:
-        for fmt in formats:
-            if fmt not in FORMATS:
-                raise ValueError(f"figure format {fmt!r}: one of {', '.join(FORMATS)}")
-            target = path.with_suffix(f".{fmt}")
-            with whole_file(target) as tmp:
-                fig.savefig(tmp, dpi=120, format=fmt)
-            written.append(target)
-    finally:
-        if fig.canvas.manager is not None:     # made by pyplot (the studies' figures)
-            import matplotlib.pyplot as plt
-            plt.close(fig)
+    for fmt in formats:
+        if fmt not in FORMATS:
+            raise ValueError(f"figure format {fmt!r}: one of {', '.join(FORMATS)}")
+        written.append(path.with_suffix(f".{fmt}"))
+        with whole_file(written[-1]) as tmp:
+            fig.savefig(tmp, dpi=120, format=fmt)
     return written
 
 

@@ -2,8 +2,7 @@
 (``SystemDescription.report``, an annotation other tools ignore)."""
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Callable
+from typing import Callable, NamedTuple
 
 from matplotlib.figure import Figure
 
@@ -13,8 +12,7 @@ from .plates import turning_circle_plate, zigzag_plate
 from .reports import course_keeping_report, turning_circle_report, zigzag_report
 
 
-@dataclass(frozen=True)
-class Analysis:
+class Analysis(NamedTuple):
     """What ``cosim.run`` prints (``report``) and draws (``figure``) for a kind of scenario."""
     report: Callable[..., list[str]]
     figure: Callable[[Recording], Figure] | None = None
@@ -30,7 +28,6 @@ ANALYSES = {
 
 def analysis(kind: str) -> Analysis:
     """The analysis of a kind; ValueError naming the known kinds."""
-    try:
-        return ANALYSES[kind]
-    except KeyError:
-        raise ValueError(f"unknown report kind {kind!r}; known: {', '.join(ANALYSES)}") from None
+    if kind not in ANALYSES:
+        raise ValueError(f"unknown report kind {kind!r}; known: {', '.join(ANALYSES)}")
+    return ANALYSES[kind]

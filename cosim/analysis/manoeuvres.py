@@ -39,7 +39,7 @@ class TurningCircle:
 class Overshoot:
     """A checked turn: how far the heading went beyond the switching angle, and when."""
     angle: float     # rad, beyond the switching angle
-    time: float      # s, when the heading deviation peaked (NaN without times)
+    time: float      # s, when the heading deviation peaked
     heading: float   # rad, the heading deviation at the peak, signed
 
 
@@ -77,23 +77,17 @@ class ZigZagResult:
     @property
     def initial_turning_time(self) -> float:
         """From the first execute to the second (|psi| reached psi_switch), s."""
-        return self._between(0, 1)
+        return self.executes[1] - self.executes[0] if len(self.executes) > 1 else math.nan
 
     @property
     def time_to_check_yaw(self) -> float:
         """From the second execute to the first overshoot's peak (yaw rate zero), s."""
-        if not self.overshoots or len(self.executes) < 2:
-            return math.nan
-        return self.overshoots[0].time - self.executes[1]
+        return self.overshoots[0].time - self.executes[1] if self.overshoots else math.nan
 
     @property
     def period(self) -> float:
         """One full cycle, from the second execute to the fourth, s."""
-        return self._between(1, 3)
-
-    def _between(self, first: int, last: int) -> float:
-        return self.executes[last] - self.executes[first] if len(self.executes) > last else \
-            math.nan
+        return self.executes[3] - self.executes[1] if len(self.executes) > 3 else math.nan
 
 
 def _first_reaching(level: np.ndarray, target: float, *series: np.ndarray) -> list[float]:
@@ -108,20 +102,17 @@ def _first_reaching(level: np.ndarray, target: float, *series: np.ndarray) -> li
 
 def at_heading_change(psi: np.ndarray, target: float, *series: np.ndarray) -> list[float]:
     """Each series, interpolated where the heading first changed by ``target`` from psi[0]."""
-    psi = np.asarray(psi)
-    return _first_reaching(np.abs(psi - psi[0]), target, *map(np.asarray, series))
+    return _first_reaching(np.abs(psi - psi[0]), target, *series)
 
 
 def approach_frame(x: np.ndarray, y: np.ndarray, psi0: float) -> tuple[np.ndarray, np.ndarray]:
     """(along, across to starboard of) the approach course psi0 from the first point, m."""
-    dx, dy = np.asarray(x) - x[0], np.asarray(y) - y[0]
-    c, s = math.cos(psi0), math.sin(psi0)
+    dx, dy, c, s = x - x[0], y - y[0], math.cos(psi0), math.sin(psi0)
     return dx * c + dy * s, -dx * s + dy * c
 
 
 def fitted_circle(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
     """(x, y) of the centre and the diameter of the least-squares circle (Kasa's fit), m."""
-    x, y = np.asarray(x), np.asarray(y)
     A = np.column_stack([2.0 * x, 2.0 * y, np.ones_like(x)])
     (cx, cy, c), *_ = np.linalg.lstsq(A, x * x + y * y, rcond=None)
     return float(cx), float(cy), 2.0 * math.sqrt(c + cx * cx + cy * cy)
@@ -129,7 +120,6 @@ def fitted_circle(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
 
 def steady_circle(x: np.ndarray, y: np.ndarray, psi: np.ndarray) -> tuple[float, float, float]:
     """``fitted_circle`` of the last lap; NaNs unless it turned 540 deg."""
-    x, y, psi = map(np.asarray, (x, y, psi))
     if abs(psi[-1] - psi[0]) < 3.0 * math.pi:
         return math.nan, math.nan, math.nan
     lap = np.abs(psi[-1] - psi) <= 2.0 * math.pi
@@ -153,28 +143,25 @@ def turning_circle_figures(x, y, psi, u, v, r) -> TurningCircle:
                          heading_change=float(np.abs(psi - psi[0]).max()))
 
 
-def zigzag_figures(psi, reversals, psi_switch: float, t=None, x=None,
-                   y=None) -> ZigZagResult:
+def zigzag_figures(psi, reversals, psi_switch: float, t, x=None, y=None) -> ZigZagResult:
     """A zig-zag's figures from heading deviation psi and the program's reversal count; an
     overshoot counts once the heading turned back, else it is ``running`` (a lower bound)."""
-    psi, reversals = np.asarray(psi), np.asarray(reversals)
-    times = np.asarray(t) if t is not None else np.full(len(psi), math.nan)
+    psi, reversals, t = np.asarray(psi), np.asarray(reversals), np.asarray(t)
     reached = int(reversals.max())
 
     def peak(n: int) -> tuple[Overshoot, bool]:
         turn = np.flatnonzero(reversals == n)
         k = turn[np.argmax(np.abs(psi[turn]))]
-        return Overshoot(float(abs(psi[k]) - psi_switch), float(times[k]), float(psi[k])), \
+        return Overshoot(float(abs(psi[k]) - psi_switch), float(t[k]), float(psi[k])), \
             bool(k < turn[-1])
     overshoots = [peak(n)[0] for n in range(1, reached)]
     running = None
     if 0 < reached < 3:                       # the run ended in the first or second turn
         last, checked = peak(reached)
         overshoots, running = (overshoots + [last], None) if checked else (overshoots, last)
-    executes = () if t is None else (float(times[0]), *(
-        float(times[k]) for k in np.flatnonzero(np.diff(reversals)) + 1))
+    executes = tuple(float(t[k]) for k in [0, *(np.flatnonzero(np.diff(reversals)) + 1)])
     distance = math.nan
-    if x is not None and y is not None and np.abs(psi).max() >= psi_switch:
+    if x is not None:
         travelled = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(x), np.diff(y)))])
         distance, = _first_reaching(np.abs(psi), psi_switch, travelled)
     return ZigZagResult(reached, psi_switch, tuple(overshoots), executes, distance, running)

@@ -10,6 +10,8 @@ import numpy as np
 from autopilot_fmu.guidance import WaypointGuidance
 from ..ensemble.exact import wrap
 
+RUDDER_DEADBAND = math.radians(0.5)   # past amidships for a crossing to count: no dither
+
 
 def heading_error(psi_d: np.ndarray, psi: np.ndarray) -> np.ndarray:
     """psi_d - psi wrapped to (-pi, pi], rad, to the bit as the FMUs wrap it."""
@@ -34,9 +36,7 @@ def settling_time(t: np.ndarray, error: np.ndarray, band: float) -> float:
     outside = np.flatnonzero(np.abs(error) > band)
     if outside.size == 0:
         return float(t[0])
-    if outside[-1] == len(t) - 1:
-        return math.inf
-    return float(t[outside[-1] + 1])
+    return math.inf if outside[-1] == len(t) - 1 else float(t[outside[-1] + 1])
 
 
 def overshoot(psi: np.ndarray, psi_start: float, psi_target: float) -> float:
@@ -45,16 +45,11 @@ def overshoot(psi: np.ndarray, psi_start: float, psi_target: float) -> float:
     return max(0.0, float(np.max(direction * (np.asarray(psi) - psi_target))))
 
 
-RUDDER_DEADBAND = math.radians(0.5)   # past amidships for a crossing to count: no dither
-
-
 def rudder_reversals_per_minute(t: np.ndarray, delta: np.ndarray,
                                 deadband: float = RUDDER_DEADBAND) -> float:
     """Rudder crossings per minute, each counted once beyond ``deadband`` on the new side."""
-    delta = np.asarray(delta)
     sides = np.sign(delta)[np.abs(delta) > deadband]
-    reversals = int(np.count_nonzero(sides[1:] != sides[:-1]))
-    return reversals / ((t[-1] - t[0]) / 60.0)
+    return int(np.count_nonzero(sides[1:] != sides[:-1])) / ((t[-1] - t[0]) / 60.0)
 
 
 def mean_abs_rate(t: np.ndarray, delta: np.ndarray) -> float:

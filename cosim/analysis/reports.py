@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import math
 
+from ship_fmu.data import Hull
+
 from ..core.recording import Recording
 from .cost import LAMBDA, Cost, cost
 from .criteria import STANDARD, Assessment, Criterion, turning_circle_of, zigzag_of
@@ -35,12 +37,9 @@ def course_keeping_report(recording: Recording, lam: float = LAMBDA, **_) -> lis
 
 
 def criterion_text(c: Criterion) -> str:
-    if math.isnan(c.value):
-        value = c.missing
-    elif c.at_least:
-        value = f"at least {_amount(c.value, c.unit)}, the turn unchecked at the end of the run"
-    else:
-        value = _amount(c.value, c.unit)
+    value = c.missing if math.isnan(c.value) else _amount(c.value, c.unit)
+    if c.at_least:
+        value = f"at least {value}, the turn unchecked at the end of the run"
     basis = f"; {c.basis}" if c.basis else ""
     return (f"{c.verdict}  {c.figure} {value} (limit {_amount(c.limit, c.unit)}; {STANDARD} "
             f"{c.clause}{basis})")
@@ -50,14 +49,15 @@ def _amount(x: float, unit: str) -> str:
     return f"{math.degrees(x):.1f} deg" if unit == "rad" else f"{x:.2f} L"
 
 
-def scope(a: Assessment) -> str:
-    """What the criteria are worth here: the standard's ships, and this model's scale."""
+def _judged(a: Assessment) -> list[str]:
+    """The criteria's lines and what they are worth here: the standard's ships, this scale."""
     if not a.criteria:
-        return (f"no {STANDARD} criterion applies: it judges the 35 deg turning circle and "
-                "the 10/10 and 20/20 zig-zags")
-    return (f"{STANDARD} is written for ships of 100 m and over; CyberShip II is a 1:{SCALE:g} "
-            f"model ({a.length * SCALE:.0f} m at full scale): its criteria apply here through "
-            "Froude scaling, as an indication")
+        return [f"no {STANDARD} criterion applies: it judges the 35 deg turning circle and "
+                "the 10/10 and 20/20 zig-zags"]
+    return [*map(criterion_text, a.criteria),
+            f"{STANDARD} is written for ships of 100 m and over; CyberShip II is a 1:{SCALE:g} "
+            f"model ({Hull.L * SCALE:.0f} m at full scale): its criteria apply here through "
+            "Froude scaling, as an indication"]
 
 
 def _turning_figures(tc: TurningCircle, L: float) -> str:
@@ -72,18 +72,15 @@ def _turning_figures(tc: TurningCircle, L: float) -> str:
             f"({tc.tactical_diameter / L:.2f} L) at 180 deg")
 
 
-def _steady_diameter(tc: TurningCircle, L: float) -> str:
+def turning_circle_report(recording: Recording, **_) -> list[str]:
+    a = turning_circle_of(recording)
+    tc, L = a.figures, Hull.L
     rates = f"2U/|r| = {tc.diameter_from_rates:.3f} m"
-    if math.isnan(tc.steady_diameter):
-        return f"diameter {rates} (the run turned less than 540 deg: no lap to fit)"
-    return (f"diameter {tc.steady_diameter:.3f} m ({tc.steady_diameter / L:.2f} L, circle "
-            f"fitted to the last lap; {rates})")
-
-
-def turning_circle_lines(a: Assessment) -> list[str]:
-    tc, L = a.figures, a.length
+    steady = (f"{rates} (the run turned less than 540 deg: no lap to fit)"
+              if math.isnan(tc.steady_diameter) else f"{tc.steady_diameter:.3f} m "
+              f"({tc.steady_diameter / L:.2f} L, circle fitted to the last lap; {rates})")
     lines = [_turning_figures(tc, L),
-             f"steady turn: {_steady_diameter(tc, L)}, yaw rate "
+             f"steady turn: diameter {steady}, yaw rate "
              f"{math.degrees(tc.steady_yaw_rate):.3f} deg/s, speed {tc.steady_speed:.3f} m/s "
              f"({tc.steady_speed / tc.approach_speed:.0%} of the approach), drift angle "
              f"{math.degrees(tc.drift_angle):.1f} deg"]
@@ -92,14 +89,14 @@ def turning_circle_lines(a: Assessment) -> list[str]:
                      f"with its bow {abs(math.degrees(tc.drift_angle)):.0f} deg inside its track: "
                      f"at 180 deg heading change its course has turned only "
                      f"{math.degrees(tc.course_change_at_tactical):.0f} deg")
-    return lines + [criterion_text(c) for c in a.criteria] + [scope(a)]
+    return lines + _judged(a)
 
 
-def _zigzag_times(zz: ZigZagResult, L: float) -> str:
+def _zigzag_times(zz: ZigZagResult) -> str:
     if len(zz.executes) < 2:
         return "the heading never reached the switching angle"
     times = [f"initial turning time {zz.initial_turning_time:.1f} s (first to second execute, "
-             f"{zz.initial_turning_distance / L:.2f} L travelled)"]
+             f"{zz.initial_turning_distance / Hull.L:.2f} L travelled)"]
     if zz.overshoots:
         times.append(f"time to check yaw {zz.time_to_check_yaw:.1f} s (second execute to the "
                      f"first overshoot, at t = {zz.overshoots[0].time:.1f} s)")
@@ -108,7 +105,8 @@ def _zigzag_times(zz: ZigZagResult, L: float) -> str:
     return ", ".join(times)
 
 
-def zigzag_lines(a: Assessment, run: Recording) -> list[str]:
+def zigzag_report(recording: Recording, **_) -> list[str]:
+    a = zigzag_of(recording)
     zz = a.figures
     measured = [f"{name} overshoot {math.degrees(o.angle):.2f} deg"
                 for name, o in zip(("first", "second"), zz.overshoots)]
@@ -116,22 +114,13 @@ def zigzag_lines(a: Assessment, run: Recording) -> list[str]:
     if zz.running is not None:
         rudder = "counter-rudder" if zz.reversals else "rudder"
         lines.append(f"the turn was never checked: {zz.reversals} rudder reversal(s) of 3 in "
-                     f"the run, heading {math.degrees(run['ship.psi'][-1]):.0f} deg at t = "
-                     f"{run.t[-1]:.0f} s, still turning at "
-                     f"{math.degrees(run['ship.r'][-1]):.1f} deg/s with "
+                     f"the run, heading {math.degrees(recording['ship.psi'][-1]):.0f} deg at "
+                     f"t = {recording.t[-1]:.0f} s, still turning at "
+                     f"{math.degrees(recording['ship.r'][-1]):.1f} deg/s with "
                      f"{math.degrees(a.delta):.0f} deg of {rudder}")
     elif zz.reversals > 0 and not zz.checked:
         lines.append("the run ended before the second overshoot")
-    return lines + [_zigzag_times(zz, a.length)] + [criterion_text(c) for c in a.criteria] + \
-        [scope(a)]
-
-
-def turning_circle_report(recording: Recording, **_) -> list[str]:
-    return turning_circle_lines(turning_circle_of(recording))
-
-
-def zigzag_report(recording: Recording, **_) -> list[str]:
-    return zigzag_lines(zigzag_of(recording), recording)
+    return lines + [_zigzag_times(zz)] + _judged(a)
 
 
 def _label(sea: str, controller: str) -> str:

@@ -32,12 +32,10 @@ def waypoint_name(i: int) -> str:
 def hull_outline(x: float, y: float, psi: float, scale: float = 1.0) -> np.ndarray:
     """The ship's waterline as (east, north) corners at (x, y, psi), ``scale`` times enlarged."""
     L, B = scale * Hull.L, scale * Hull.B
-    body = np.array([(L / 2, 0.0), (L / 4, B / 2), (-L / 2, B / 2), (-L / 2, -B / 2),
-                     (L / 4, -B / 2)])                  # x forward, y starboard
+    forward, starboard = np.array([(L / 2, 0.0), (L / 4, B / 2), (-L / 2, B / 2),
+                                   (-L / 2, -B / 2), (L / 4, -B / 2)]).T
     c, s = math.cos(psi), math.sin(psi)
-    north = x + body[:, 0] * c - body[:, 1] * s
-    east = y + body[:, 0] * s + body[:, 1] * c
-    return np.column_stack([east, north])
+    return np.column_stack([y + forward * s + starboard * c, x + forward * c - starboard * s])
 
 
 def outline_scale(spacing: float, extent: float) -> int:
@@ -79,45 +77,21 @@ def outlines(run: Recording) -> Outlines:
 
 
 def _arrow(direction: float) -> Shape:
-    shape = np.array([(0, 1), (0.5, 0.15), (0.17, 0.15), (0.17, -1), (-0.17, -1),
-                      (-0.17, 0.15), (-0.5, 0.15), (0, 1)])           # east, north
+    east, north = np.array([(0, 1), (0.5, 0.15), (0.17, 0.15), (0.17, -1), (-0.17, -1),
+                            (-0.17, 0.15), (-0.5, 0.15), (0, 1)]).T
     c, s = math.cos(direction), math.sin(direction)
-    return Shape(np.column_stack([shape[:, 0] * c + shape[:, 1] * s,
-                                  -shape[:, 0] * s + shape[:, 1] * c]), closed=True)
-
-
-def _in_view(tracks: list[np.ndarray], points: np.ndarray) -> np.ndarray:
-    seen = np.concatenate(tracks)
-    low, high = seen.min(axis=0), seen.max(axis=0)
-    size = max(*(high - low), 4 * Hull.L)
-    gap = np.linalg.norm(np.maximum(0.0, np.maximum(low - points, points - high)), axis=1)
-    return gap <= size / 2
-
-
-def _dense(points: np.ndarray, pieces: int = 40) -> np.ndarray:
-    steps = np.linspace(0.0, 1.0, pieces, endpoint=False)[:, None]
-    legs = [a + steps * (b - a) for a, b in itertools.pairwise(points)]
-    return np.concatenate([*legs, points[-1:]])
-
-
-def _label_waypoints(ax: Any, points: np.ndarray, avoid: np.ndarray, reach: float,
-                     size: float) -> None:
-    def clearance(where: np.ndarray) -> float:
-        return float(np.min(np.hypot(*(avoid - where).T))) if len(avoid) else math.inf
-    for i, point in enumerate(points):
-        away = np.array(max(_DIRECTIONS, key=lambda d: clearance(
-            point + np.array(d) * (reach + 0.04 * size))))
-        ax.annotate(waypoint_name(i), tuple(point), xytext=tuple(point + away * reach * 1.1),
-                    textcoords="data", fontsize=8, fontweight="bold", color="tab:blue",
-                    ha="left" if away[0] > 0.3 else "right" if away[0] < -0.3 else "center",
-                    va="bottom" if away[1] > 0.3 else "top" if away[1] < -0.3 else "center",
-                    zorder=5)
+    return Shape(np.column_stack([east * c + north * s, -east * s + north * c]), closed=True)
 
 
 def _route(ax: Any, guidance: dict[str, Any], tracks: list[np.ndarray]) -> None:
+    """The route, its circles and its points named; framed on the tracks and the points near
+    them (within half the tracks' size), the others said in the legend."""
     points = np.array(followed_route(guidance))[:, ::-1]              # (east, north)
     reach = guidance["R_accept"]
-    near = _in_view(tracks, points)
+    seen = np.concatenate(tracks)
+    low, high = seen.min(axis=0), seen.max(axis=0)
+    gap = np.linalg.norm(np.maximum(0.0, np.maximum(low - points, points - high)), axis=1)
+    near = gap <= max(*(high - low), 4 * Hull.L) / 2
     label = "route"
     if not near.all():
         last = int(np.flatnonzero(~near)[-1])
@@ -132,8 +106,19 @@ def _route(ax: Any, guidance: dict[str, Any], tracks: list[np.ndarray]) -> None:
                              color="tab:blue", zorder=2))
     framed = np.concatenate([*tracks, points[near] - reach, points[near] + reach])
     ax.update_datalim(framed)
-    _label_waypoints(ax, points, np.concatenate([*(t[::10] for t in tracks), _dense(points)]),
-                     reach, float(np.ptp(framed, axis=0).max()))
+    size = float(np.ptp(framed, axis=0).max())
+    steps = np.linspace(0.0, 1.0, 40, endpoint=False)[:, None]
+    avoid = np.concatenate([*(t[::10] for t in tracks),                # the tracks and legs
+                            *(a + steps * (b - a) for a, b in itertools.pairwise(points)),
+                            points[-1:]])
+    for i, point in enumerate(points):          # each name on the side farthest from them
+        away = np.array(max(_DIRECTIONS, key=lambda d: np.min(np.hypot(
+            *(avoid - (point + np.array(d) * (reach + 0.04 * size))).T))))
+        ax.annotate(waypoint_name(i), tuple(point), xytext=tuple(point + away * reach * 1.1),
+                    textcoords="data", fontsize=8, fontweight="bold", color="tab:blue",
+                    ha="left" if away[0] > 0.3 else "right" if away[0] < -0.3 else "center",
+                    va="bottom" if away[1] > 0.3 else "top" if away[1] < -0.3 else "center",
+                    zorder=5)
 
 
 def track_panel(ax: Any, run: Recording, ship: bool = True,
@@ -169,17 +154,13 @@ def track_panel(ax: Any, run: Recording, ship: bool = True,
     legend_if_any(ax)
 
 
-def legend_if_any(ax: Any, **kwargs: Any) -> None:
+def legend_if_any(ax: Any) -> None:
     """A legend over no data: a track panel's below the panels, others' above their axes."""
     handles, labels = ax.get_legend_handles_labels()
-    if not handles:
-        return
-    if ax.get_label() == TRACK:
-        for old in list(ax.figure.legends):
-            old.remove()
-        ax.figure.legend(handles, labels, **{"loc": "outside lower left", "fontsize": 7,
-                                             "ncol": min(3, len(handles)),
-                                             "handleheight": 1.8, **kwargs})
-        return
-    ax.legend(**{"loc": "lower right", "bbox_to_anchor": (1.0, 1.0), "fontsize": 7,
-                 "ncol": len(handles), "frameon": False, "borderaxespad": 0.1, **kwargs})
+    if handles and ax.get_label() == TRACK:
+        ax.figure.legends.clear()                   # a track panel's legend, redrawn
+        ax.figure.legend(handles, labels, loc="outside lower left", fontsize=7,
+                         ncol=min(3, len(handles)), handleheight=1.8)
+    elif handles:
+        ax.legend(loc="lower right", bbox_to_anchor=(1.0, 1.0), fontsize=7, ncol=len(handles),
+                  frameon=False, borderaxespad=0.1)

@@ -12,15 +12,15 @@ import sys
 import tempfile
 import zipfile
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from fmukit.timebase import communication_point, step_count
 
-from ..core.files import write_atomically
+from ..core.files import whole_file
 from ..core.interrupt import STOP_SIGNALS, Interrupted, StopSignals
 from ..core.system import SystemDescription, split_name
-
 from .osp import read_osp
 from .ssp import FMI2_ONLY, fmi_versions, read_package, unapplied_strings
 
@@ -30,6 +30,7 @@ TRACED = ("ship.psi", "ship.r", "ship.delta")
 
 class EngineError(RuntimeError):
     """An engine failed or produced undefined values; the message holds its output."""
+
 
 def is_osp(path: Path) -> bool:
     return path.is_dir() or path.suffix.lower() == ".xml"
@@ -117,17 +118,15 @@ def _fmpy(ssp: Path, system: SystemDescription, n_steps: int, signals: tuple[str
 RUNNERS = {"libcosim": _libcosim, "ecos": _ecos, "fmpy": _fmpy}
 
 
-def check_package(ssp: Path, engine: str | None = None) -> None:
+def check_package(ssp: Path, engine: str) -> None:
     """EngineError naming the file, parameter or components if ``engine`` cannot run the
     package: not SSP or OSP, a value not finite, or FMUs of an FMI version it does not take."""
     try:
-        system = read_system(ssp)
-        versions = fmi_versions(ssp)
+        system, versions = read_system(ssp), fmi_versions(ssp)
     except (OSError, KeyError, ValueError, zipfile.BadZipFile) as error:
         raise EngineError(f"{ssp} is not an SSP package this project can run ({error})") \
             from None
-    newer = [f"{name} (FMI {version})" for name, version in versions.items()
-             if version != "2.0"]
+    newer = [f"{name} (FMI {version})" for name, version in versions.items() if version != "2.0"]
     if engine in FMI2_ONLY and newer:
         raise EngineError(f"{FMI2_ONLY[engine]} runs FMI 2.0 FMUs only; {ssp.name} holds "
                           f"{', '.join(newer)}: run it with ecos or OMSimulator, or export "
@@ -150,25 +149,41 @@ def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = TRACED) -> dict
     check_package(ssp, engine)
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "trace.npz"
-        child = subprocess.run([sys.executable, "-c", _CHILD, engine, str(ssp), str(out),
-                                *signals], capture_output=True, text=True, timeout=600)
-        log = log_summary(child.stdout + child.stderr)
-        number = -child.returncode if child.returncode < 0 else child.returncode - 128
-        if number in STOP_SIGNALS:       # Ctrl-C or a kill: not the engine's fault
-            raise Interrupted(number)
-        if child.returncode != 0 or not out.exists():
-            how = (f"killed by {signal.Signals(-child.returncode).name}"
-                   if child.returncode < 0 else f"exit status {child.returncode}")
-            raise EngineError(f"{engine} failed on {ssp.name} ({how}):\n{log}")
+        log = child_log(engine, ssp, [sys.executable, "-c", _CHILD, engine, str(ssp), str(out),
+                                      *signals], out)
         with np.load(out) as data:
-            result = {key: data[key] for key in data.files}
-    for name, values in result.items():
+            return finite(engine, dict(data), log)
+
+
+def child_log(who: str, ssp: Path, argv: list[str], out: Path, timeout: float = 600.0,
+              **options: Any) -> str:
+    """The output of ``argv``, a child run of ``ssp`` writing ``out``; ``Interrupted`` if a
+    signal stopped it, EngineError naming ``who`` if it failed or ran out of time."""
+    try:
+        child = subprocess.run(argv, capture_output=True, text=True, timeout=timeout, **options)
+    except subprocess.TimeoutExpired:
+        raise EngineError(f"{who} did not finish {ssp.name} within {timeout:g} s") from None
+    log = log_summary(child.stdout + child.stderr)
+    number = -child.returncode if child.returncode < 0 else child.returncode - 128
+    if number in STOP_SIGNALS:          # Ctrl-C or a kill: not the engine's fault
+        raise Interrupted(number)
+    if child.returncode != 0 or not out.exists():
+        how = (f"killed by {signal.Signals(-child.returncode).name}"
+               if child.returncode < 0 else f"exit status {child.returncode}")
+        raise EngineError(f"{who} failed on {ssp.name} ({how}):\n{log}")
+    return log
+
+
+def finite(who: str, trace: dict[str, np.ndarray], log: str) -> dict[str, np.ndarray]:
+    """``trace`` if every value in it is finite, else EngineError naming the first undefined
+    signal and when: a tool that ignores FMI statuses goes on after a failed FMU."""
+    for name, values in trace.items():
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:
-            raise EngineError(f"{engine} reported success, but {name} is undefined from "
-                              f"t = {result['time'][bad[0]]:.6g} s: an FMU refused to run "
+            raise EngineError(f"{who} reported success, but {name} is undefined from "
+                              f"t = {trace['time'][bad[0]]:.6g} s: an FMU refused to run "
                               f"and the engine did not stop.\n{log}")
-    return result
+    return trace
 
 
 _CHILD = ("import sys\nfrom cosim.interop.engines import record\n"
@@ -194,17 +209,13 @@ def record(engine: str, ssp: str, out: str, signals: tuple[str, ...]) -> int:
 
 
 def save_trace(path: Path, result: dict[str, np.ndarray]) -> None:
-    def write(temporary: Path) -> None:
-        with open(temporary, "wb") as f:
-            np.savez(f, **result)
-    write_atomically(path, write)
+    with whole_file(path) as tmp, open(tmp, "wb") as f:
+        np.savez(f, **result)
 
 
-def log_summary(log: str, head: int = 20, tail: int = 5) -> str:
-    """The first lines of a log (where the cause is) and its last ones."""
+def log_summary(log: str) -> str:
+    """The first 20 lines of a log (where the cause is) and its last 5."""
     lines = [line for line in log.strip().splitlines() if line.strip()]
-    if len(lines) <= head + tail:
-        return "\n".join(lines)
-    return "\n".join(lines[:head] + [f"... ({len(lines) - head - tail} more lines) ..."]
-                     + lines[-tail:])
-
+    if len(lines) > 25:
+        lines[20:-5] = [f"... ({len(lines) - 25} more lines) ..."]
+    return "\n".join(lines)

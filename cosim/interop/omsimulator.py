@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import csv
 import os
-import subprocess
 import sys
 import sysconfig
 import tempfile
@@ -13,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .engines import EngineError, log_summary
+from .engines import EngineError, child_log, finite
 from .ssp import read_package, unapplied_strings
 
 INTERFACES = ("cli", "api")
@@ -29,24 +28,6 @@ model.simulate()
 model.terminate()
 model.delete()
 """
-
-
-def libpython() -> str:
-    return os.path.join(sysconfig.get_config_var("LIBDIR"), sysconfig.get_config_var("LDLIBRARY"))
-
-
-def command(home: Path, interface: str, ssp: Path, result: Path, temp: Path
-            ) -> tuple[list[str], dict[str, str]]:
-    system = read_package(ssp)
-    site = sysconfig.get_paths()["purelib"]
-    if interface == "cli":
-        return ([str(home / "bin" / "OMSimulator"), f"--stopTime={system.stop_time!r}",
-                 f"--startTime={system.start_time!r}", f"--resultFile={result}",
-                 f"--tempDir={temp}", str(ssp)],
-                {"LD_PRELOAD": libpython(), "PYTHONPATH": site})
-    return ([sys.executable, "-c", _API, str(ssp), str(result), repr(system.step_size),
-             str(temp)], {"PYTHONPATH": os.pathsep.join([str(home / "lib" / "x86_64-linux-gnu"),
-                                                          site])})
 
 
 def read_result(path: Path) -> dict[str, np.ndarray]:
@@ -71,22 +52,20 @@ def run(ssp: str | Path, home: str | Path, interface: str = "cli",
     if dropped:
         raise EngineError("OMSimulator applies no String binding; it would run " + ", ".join(
             f"{v} = {default!r}, not {value!r}" for v, (value, default) in dropped.items()))
+    system, site = read_package(ssp), sysconfig.get_paths()["purelib"]
     with tempfile.TemporaryDirectory() as tmp:
         result = Path(tmp) / "result.csv"
-        argv, env = command(home, interface, ssp, result, Path(tmp))
-        try:
-            child = subprocess.run(argv, cwd=tmp, env={**os.environ, **env}, timeout=timeout,
-                                   capture_output=True, text=True, check=False)
-        except subprocess.TimeoutExpired as expired:
-            raise EngineError(f"OMSimulator ({interface}) did not finish {ssp.name} within "
-                              f"{timeout:g} s") from expired
-        log = log_summary(child.stdout + child.stderr)
-        if child.returncode != 0 or not result.exists():
-            raise EngineError(f"OMSimulator ({interface}) failed on {ssp.name} (exit status "
-                              f"{child.returncode}):\n{log}")
-        trace = read_result(result)
-    bad = [name for name, values in trace.items() if not np.isfinite(values).all()]
-    if bad:
-        raise EngineError(f"OMSimulator ({interface}) reported success, but {', '.join(bad)} "
-                          f"read NaN: an FMU failed.\n{log}")
-    return trace
+        if interface == "cli":              # its Python FMUs need libpython loaded first
+            argv = [str(home / "bin" / "OMSimulator"), f"--stopTime={system.stop_time!r}",
+                    f"--startTime={system.start_time!r}", f"--resultFile={result}",
+                    f"--tempDir={tmp}", str(ssp)]
+            env = {"LD_PRELOAD": os.path.join(sysconfig.get_config_var("LIBDIR"),
+                                              sysconfig.get_config_var("LDLIBRARY")),
+                   "PYTHONPATH": site}
+        else:
+            argv = [sys.executable, "-c", _API, str(ssp), str(result), repr(system.step_size),
+                    tmp]
+            env = {"PYTHONPATH": os.pathsep.join([str(home / "lib" / "x86_64-linux-gnu"), site])}
+        who = f"OMSimulator ({interface})"
+        log = child_log(who, ssp, argv, result, timeout, cwd=tmp, env={**os.environ, **env})
+        return finite(who, read_result(result), log)

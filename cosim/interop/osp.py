@@ -54,12 +54,6 @@ def read_osp(path: Path) -> SystemDescription:
         raise ValueError(f"cannot read OSP system structure {path}: {error}") from error
     if root.tag != _q("OspSystemStructure"):
         raise ValueError(f"{path} is not an OspSystemStructure")
-
-    def time(tag: str, default: float) -> float:
-        element = root.find(_q(tag))
-        return default if element is None else fmi_value(f"{path.name} {tag}", "Real",
-                                                         element.text or "")
-
     components = {}
     for simulator in root.iterfind(f"{_q('Simulators')}/{_q('Simulator')}"):
         name, source = simulator.get("name"), simulator.get("source")
@@ -76,8 +70,8 @@ def read_osp(path: Path) -> SystemDescription:
                               end.get("simulator", ""), end.get("name", ""))
                    for start, end in root.iterfind(f"{_q('Connections')}/"
                                                    f"{_q('VariableConnection')}")]
+    start, stop, step = (fmi_value(f"{path.name} {tag}", "Real", root.findtext(_q(tag), "0.0"))
+                         for tag in ("StartTime", "EndTime", "BaseStepSize"))
     return SystemDescription(name=path.parent.name, components=components,
-                             connections=connections, start_time=time("StartTime", 0.0),
-                             stop_time=time("EndTime", 0.0), step_size=time("BaseStepSize", 0.0),
-                             path=path)
-
+                             connections=connections, start_time=start, stop_time=stop,
+                             step_size=step, path=path)

@@ -29,13 +29,12 @@ def _with_numeric_route(system: SystemDescription, fmus: dict[str, Path]) -> Non
             continue
         declared = {v.name for v in read_description(fmus[name], name).modelVariables}
         if declared.issuperset(ROUTE_PARAMETERS):
-            route(component.parameters)
-            parameters = dict(component.parameters)
-            parameters.update(numeric_route(parameters.pop("waypoints")))
-            component.parameters = parameters
+            route(component.parameters)             # the route as the guidance takes it
+            component.parameters.update(numeric_route(component.parameters.pop("waypoints")))
 
 
-_EXPONENTS = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
+_NEUTRAL = {**dict.fromkeys(("kg", "m", "s", "A", "K", "mol", "cd", "rad"), 0),
+            "factor": 1.0, "offset": 0.0}             # a base unit's values left unwritten
 
 
 def connector_units(system: SystemDescription, fmus: dict[str, Path]) -> Units:
@@ -48,11 +47,9 @@ def connector_units(system: SystemDescription, fmus: dict[str, Path]) -> Units:
                    for v in described.modelVariables}
         connectors[name] = {c: by_name[c] for c in component.connectors if by_name.get(c)}
         for unit in described.unitDefinitions:
-            base = unit.baseUnit
-            definitions[unit.name] = {
-                **{k: getattr(base, k) for k in _EXPONENTS if base and getattr(base, k)},
-                **({"factor": base.factor} if base and base.factor != 1.0 else {}),
-                **({"offset": base.offset} if base and base.offset != 0.0 else {})}
+            definitions[unit.name] = {k: getattr(unit.baseUnit, k) for k, neutral in
+                                      _NEUTRAL.items() if unit.baseUnit and
+                                      getattr(unit.baseUnit, k) != neutral}
     for name, by_connector in connectors.items():
         for connector, unit in by_connector.items():
             if unit not in definitions:
@@ -101,29 +98,30 @@ def read_package(ssp: Path) -> SystemDescription:
         return read_ssd(Path(tmp) / SSD_NAME)
 
 
-def _descriptions(path: Path) -> dict[str, ModelDescription]:
+def _described(path: Path) -> tuple[SystemDescription, dict[str, ModelDescription]]:
+    """The system of a package or an OSP folder, and each component's model description."""
     with tempfile.TemporaryDirectory() as tmp:
         if path.suffix.lower() == ".ssp":
-            system, folder = read_package(path), Path(tmp)
             with zipfile.ZipFile(path) as package:
                 package.extractall(tmp)
+            system, folder = read_ssd(Path(tmp) / SSD_NAME), Path(tmp)
         else:
             system, folder = read_osp(path), path if path.is_dir() else path.parent
-        return {name: read_description(folder / component.source, name)
-                for name, component in system.components.items()}
+        return system, {name: read_description(folder / component.source, name)
+                        for name, component in system.components.items()}
 
 
 def fmi_versions(path: Path) -> dict[str, str]:
     """Each component's FMI version ("2.0", "3.0") in a package or OSP folder."""
-    return {name: d.fmiVersion for name, d in _descriptions(path).items()}
+    return {name: d.fmiVersion for name, d in _described(path)[1].items()}
 
 
 def unapplied_strings(ssp: Path) -> dict[str, tuple[str, str]]:
     """String bindings a tool applying none would drop without a word, not at their FMU's
     default: 'component.variable': (value, default)."""
-    descriptions = _descriptions(ssp)
+    system, descriptions = _described(ssp)
     dropped = {}
-    for name, component in read_package(ssp).components.items():
+    for name, component in system.components.items():
         starts = {v.name: v.start for v in descriptions[name].modelVariables}
         dropped.update({f"{name}.{v}": (value, starts[v])
                         for v, value in component.parameters.items()

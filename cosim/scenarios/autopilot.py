@@ -7,12 +7,10 @@ import copy
 from pathlib import Path
 
 import fmpy
-from fmpy import read_model_description
 from fmpy.model_description import ModelDescription
 
 import fmukit.autopilot
-from fmubuild.instantiate import InstantiationFailed
-from fmubuild.instantiate import instantiate_in_child
+from fmubuild.instantiate import InstantiationFailed, instantiate_in_child
 from fmukit.units import UNITS
 
 from ..core.errors import close_matches, did_you_mean
@@ -22,6 +20,8 @@ COMPONENT = "autopilot"
 PORTS = {v.name: (v.causality, v.unit) for v in fmukit.autopilot.PORTS}
 DESCRIPTIONS = {v.name: v.description for v in fmukit.autopilot.PORTS}
 PORT_TYPES = {"2.0": "Real", "3.0": "Float64"}      # FMI version: the type of its ports
+_LISTED = {c: ", ".join(f"{n} ({unit})" for n, (k, unit) in PORTS.items() if k == c)
+           for c in ("input", "output")}               # the contract in words
 
 
 class AutopilotError(ValueError):
@@ -37,24 +37,14 @@ def _listing(description: ModelDescription) -> str:
                      if k in ("input", "output", "parameter"))
 
 
-def _mapped(port: str, port_map: dict[str, str]) -> str:
-    name = port_map.get(port, port)
-    return f"'{name}' (for {port})" if name != port else f"'{port}'"
-
-
-def _contract(real: str) -> str:
-    def ports(causality: str) -> str:
-        return ", ".join(f"{n} ({unit})" for n, (c, unit) in PORTS.items() if c == causality)
-    return f"{real} inputs {ports('input')} and a {real} output {ports('output')}"
-
-
 def port_problems(description: ModelDescription, port_map: dict[str, str]) -> list[str]:
     """Every way the FMU's variables break the port contract, each with what it expects."""
     variables = {v.name: v for v in description.modelVariables}
     real = PORT_TYPES[description.fmiVersion]
     problems = []
     for port, (causality, unit) in PORTS.items():
-        name, mapped = port_map.get(port, port), _mapped(port, port_map)
+        name = port_map.get(port, port)
+        mapped = f"'{name}' (for {port})" if name != port else f"'{port}'"
         variable = variables.get(name)
         if variable is None:
             close = close_matches(name, variables)
@@ -67,17 +57,13 @@ def port_problems(description: ModelDescription, port_map: dict[str, str]) -> li
         declared = variable.unit or (variable.declaredType.unit if variable.declaredType
                                      else None)
         if declared and declared != unit:
-            problems.append(f"port {mapped} is in {declared}: expected {unit}"
-                            f"{_unit_advice(name, declared, unit)}")
+            known = UNITS.get(declared)
+            scale = (f" (1 {declared} = {known[1] / UNITS[unit][1]:.6g} {unit})"
+                     if known and known[0] == UNITS[unit][0] else "")
+            problems.append(f"port {mapped} is in {declared}: expected {unit}; the interfaces "
+                            f"are in SI units, angles in radians: declare {name} in {unit} and "
+                            f"convert inside the FMU{scale}")
     return problems
-
-
-def _unit_advice(name: str, declared: str, unit: str) -> str:
-    known = UNITS.get(declared)
-    scale = (f" (1 {declared} = {known[1] / UNITS[unit][1]:.6g} {unit})"
-             if known and known[0] == UNITS[unit][0] else "")
-    return (f"; the interfaces are in SI units, angles in radians: declare {name} in {unit} "
-            f"and convert inside the FMU{scale}")
 
 
 def check_autopilot(fmu: str | Path, port_map: dict[str, str] | None = None,
@@ -88,17 +74,15 @@ def check_autopilot(fmu: str | Path, port_map: dict[str, str] | None = None,
     if not fmu.is_file():
         raise AutopilotError(f"autopilot FMU {fmu} not found")
     try:
-        description = read_model_description(str(fmu))
+        description = fmpy.read_model_description(str(fmu))
     except Exception as error:
         raise AutopilotError(f"{fmu} is not an FMU, or not a readable one "
                              f"({type(error).__name__}: {error})") from None
-    kinds = " or ".join(PORT_TYPES)
+    must = f"an autopilot must be an FMI {' or '.join(PORT_TYPES)} co-simulation FMU"
     if description.fmiVersion not in PORT_TYPES:
-        raise AutopilotError(f"{fmu} is an FMI {description.fmiVersion} FMU; an autopilot "
-                             f"must be an FMI {kinds} co-simulation FMU")
+        raise AutopilotError(f"{fmu} is an FMI {description.fmiVersion} FMU; {must}")
     if description.coSimulation is None:
-        raise AutopilotError(f"{fmu} is a model-exchange FMU only; an autopilot must be an "
-                             f"FMI {kinds} co-simulation FMU")
+        raise AutopilotError(f"{fmu} is a model-exchange FMU only; {must}")
     platforms = [p for p in fmpy.supported_platforms(str(fmu)) if p != "c-code"]
     if fmpy.platform not in platforms:
         raise AutopilotError(f"{fmu} has no binary for this platform ({fmpy.platform}); it has "
@@ -109,11 +93,11 @@ def check_autopilot(fmu: str | Path, port_map: dict[str, str] | None = None,
         raise AutopilotError(f"{fmu}: --map names {', '.join(map(repr, unknown))}, which "
                              f"{'is not a port' if len(unknown) == 1 else 'are not ports'} "
                              f"of an autopilot ({', '.join(PORTS)}){did_you_mean(close)}")
-    problems = port_problems(description, port_map)
+    problems, real = port_problems(description, port_map), PORT_TYPES[description.fmiVersion]
     if problems:
         raise AutopilotError(f"{fmu} does not keep the autopilot contract of an FMI "
-                             f"{description.fmiVersion} FMU ("
-                             f"{_contract(PORT_TYPES[description.fmiVersion])}):\n"
+                             f"{description.fmiVersion} FMU ({real} inputs {_LISTED['input']} "
+                             f"and a {real} output {_LISTED['output']}):\n"
                              + "".join(f"  - {p}\n" for p in problems)
                              + f"It has {_listing(description)}. Map other names with --map "
                              "PORT=NAME (--map psi=heading)")
