@@ -11,6 +11,8 @@ from fmukit.timebase import communication_point, step_count
 from ship_fmu.steering_gear import rudder_target
 from ship_fmu.thrusters import actuator_model
 
+from ..core.master import Master
+from ..ensemble.members import COMPONENTS, initialise
 from .integration_error import H
 
 METHOD = "LSODA"
@@ -34,11 +36,10 @@ def monolithic(system, stop_time: float | None = None, servo_gain: float = SERVO
     or the leg's end passed) is an event: the solver stops, switches the leg and restarts.
     The SMC's eq (42) tanh boundary layer is continuous: no event.
     """
-    from .direct import build_models, shaft_speeds
-
-    models = build_models(system)
-    guidance, autopilot, ship = (models[n] for n in ("guidance", "autopilot", "ship"))
-    forces = actuator_model(ship.actuators, *shaft_speeds(system))
+    with Master(system, backend="inprocess") as master:
+        member = initialise(master, {}, 0)
+    guidance, autopilot, ship = (member.models[n] for n in COMPONENTS)
+    forces = actuator_model(ship.actuators, *member.shafts)
     p = ship.params
     smc = hasattr(autopilot, "r_z_dot")
     stop = system.stop_time if stop_time is None else stop_time

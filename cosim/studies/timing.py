@@ -97,8 +97,8 @@ def engines(repeats: int) -> dict[str, dict[str, float]]:
     per scenario with the ratios, and the times by scenario and row."""
     from .. import scenarios
     from ..core.master import Master
+    from ..ensemble.reference import run_direct
     from ..interop.ssp import export
-    from .direct import run_direct
 
     print(f"Engines on the same system, 400 s = {STEPS} macro steps of 0.1 s, median of "
           f"{repeats} runs taken in turn, on {machine()}")
@@ -109,10 +109,9 @@ def engines(repeats: int) -> dict[str, dict[str, float]]:
             ssp = export(name, Path(tmp))
             with Master(system, backend="inprocess") as inprocess, \
                     Master(system, backend="fmi") as fmi:
-                masters = {"inprocess": inprocess, "fmi": fmi}
-                require_in_process(masters["inprocess"].notes)
-                runners = {"direct": lambda: run_direct(system),
-                           **{b: _master_runner(m) for b, m in masters.items()}}
+                require_in_process(inprocess.notes)
+                runners = {"direct": lambda: run_direct(inprocess),
+                           "inprocess": _master_runner(inprocess), "fmi": _master_runner(fmi)}
                 for key, make in (("libcosim", _libcosim_runner), ("ecos", _ecos_runner)):
                     try:
                         runners[key] = make(ssp)
@@ -184,29 +183,49 @@ def fmi_call_cost(master, calls: int = 20_000) -> float:
     return (time.perf_counter() - started) / calls
 
 
+def _idle_reader(self, vrs: list[int]) -> Callable[[], list[float]]:
+    values = [0.0] * len(vrs)
+    return lambda: values
+
+
+IDLE_CALLS = {"reader": _idle_reader, "integer_reader": _idle_reader,
+              "writer": lambda self, vrs: _nothing, "stepper": lambda self: _nothing}
+"""The in-process instance's prepared calls doing nothing: the master's own work remains."""
+
+
+def _nothing(*args, **kwargs) -> None:
+    return None
+
+
 def overhead(repeats: int) -> dict[str, float]:
     """What the routes do besides the models: calm_pd with the ship's step doing nothing,
-    by hand, on the null backend and in-process; microseconds per step."""
+    by hand, by the master with its calls into the FMUs idle (``IDLE_CALLS``) and
+    in-process; microseconds per step."""
     from unittest import mock
 
     from ship_fmu.vessel import Vessel
 
     from .. import scenarios
+    from ..core.inprocess import InProcessInstance
     from ..core.master import Master
-    from .direct import run_direct
+    from ..ensemble.reference import run_direct
 
     system = scenarios.load("calm_pd")
-    with Master(system, backend="null") as null, \
-            Master(system, backend="inprocess") as inprocess:
+    with Master(system, backend="inprocess") as inprocess, \
+            Master(system, backend="inprocess") as idle:
         require_in_process(inprocess.notes)
-        with mock.patch.object(Vessel, "step", lambda self, *args, **kwargs: None):
-            times = side_by_side({"direct": lambda: run_direct(system), "null": null.run,
+
+        def idle_run() -> None:
+            with mock.patch.multiple(InProcessInstance, **IDLE_CALLS):
+                _master_runner(idle)()
+        with mock.patch.object(Vessel, "step", _nothing):
+            times = side_by_side({"direct": lambda: run_direct(inprocess), "idle": idle_run,
                                   "inprocess": _master_runner(inprocess)}, repeats)
     per_step = {key: t / STEPS * 1e6 for key, t in times.items()}
     print(f"What the routes do besides the models: calm_pd, {STEPS} steps with the ship's step "
           f"doing nothing, median of {repeats} runs taken in turn, on {machine()}")
     for key, label in (("direct", "cosim.direct (the modules wired by hand)"),
-                       ("null", "our master, no FMU behind it (null backend)"),
+                       ("idle", "our master, its calls into the FMUs idle"),
                        ("inprocess", "our master, in-process backend")):
         print(f"  {label:48} {per_step[key]:6.1f} us/step")
     print(f"  the in-process master beyond cosim.direct: "
