@@ -22,7 +22,7 @@ from ..core.master import Master
 from ..core.recording import Recording
 from ..core.ssd import SystemDescription
 from ..core.watchdog import TimeLimit, no_limit
-from .control import GuidanceArrays, autopilot_arrays
+from .control import KINDS, GuidanceArrays
 from .members import Member, coverage, initialise
 from .reference import SIGNALS as ALL_SIGNALS, step_models
 from .vessel import VesselArrays
@@ -51,15 +51,16 @@ def simulate_members(system: SystemDescription, overrides: Sequence[dict[str, di
         _, h, n_steps = master.system.steps(stop_time)
         reason = coverage(system) or selftest()
         recordings: dict[int, Recording] = {}
-        groups: dict[tuple, list[tuple[int, Member]]] = defaultdict(list)
+        groups: dict[int | None, list[tuple[int, Member]]] = defaultdict(list)
         for i, member_overrides in enumerate(overrides):
             _check(beat(f"initialising member {i} of the batch"))
             member = None if reason else initialise(master, member_overrides, n_steps)
             why = reason or _outside(member, h)
             if why:
                 recordings[i] = _alone(master, member_overrides, stop_time, signals, why)
-            else:
-                groups[_group(member)].append((i, member))
+            else:               # stepped together: in calm water, or in N wave components
+                waves = member.models["ship"].waves
+                groups[None if waves is None else len(waves.components.omega)].append((i, member))
         for members in groups.values():
             for i, recording in lockstep(members, system.start_time, h, n_steps, signals,
                                          master.units, beat):
@@ -84,12 +85,6 @@ def _outside(member: Member | None, h: float) -> str | None:
     return None
 
 
-def _group(member: Member) -> tuple:
-    """Calm water, or the number of wave components: what members stepped together share."""
-    waves = member.models["ship"].waves
-    return (0,) if waves is None else (len(waves.components.omega),)
-
-
 def _alone(master: Master, overrides: dict[str, dict[str, Any]], stop_time: float | None,
            signals: Sequence[str], why: str) -> Recording:
     master.reset()
@@ -111,9 +106,9 @@ def lockstep(members: list[tuple[int, Member]], t0: float, h: float, n_steps: in
     non-finite or the yaw rate left the autopilot's range."""
     started = time.perf_counter()
     models = [m.models for _, m in members]
-    ship = VesselArrays([m["ship"] for m in models], h, [m.shafts for _, m in members])
+    ship = VesselArrays([m["ship"] for m in models], [m.shafts for _, m in members])
     guidance = GuidanceArrays([m["guidance"] for m in models])
-    pilot = autopilot_arrays([m["autopilot"] for m in models])
+    pilot = KINDS[type(models[0]["autopilot"]).__name__]([m["autopilot"] for m in models])
     block = np.empty((n_steps + 1, len(signals), len(members)))
     rows = [ALL_SIGNALS.index(s) for s in signals]
     failed = np.zeros(len(members), dtype=bool)

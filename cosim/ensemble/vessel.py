@@ -3,6 +3,7 @@ own rates, forces and RK4 update on arrays, its branches (the gear's kink) and s
 (wave loads) rewritten on arrays operation for operation."""
 from __future__ import annotations
 
+from operator import attrgetter
 from typing import Callable, Sequence
 
 import numpy as np
@@ -38,24 +39,20 @@ class RudderArrays:
 
 class WaveArrays:
     """``ship_fmu.waves.WaveLoads`` of every member, eqs (14)-(16)."""
-    FIELDS = ("omega", "k", "phase", "slope_amplitude", "psi_w", "c_force", "c_moment")
+    SOURCES = {"omega": "components.omega", "k": "components.k", "phase": "components.phase",
+               "slope_amplitude": "_slope_amplitude", "psi_w": "psi_w", "c_force": "_c_force",
+               "c_moment": "_c_moment"}
 
     def __init__(self, vessels: Sequence[Vessel]):
-        loads = [v.waves for v in vessels]
-        self.omega = np.array([w.components.omega for w in loads])
-        self.k = np.array([w.components.k for w in loads])
-        self.phase = np.array([w.components.phase for w in loads])
-        self.slope_amplitude = np.array([w._slope_amplitude for w in loads])
-        self.psi_w = np.array([w.psi_w for w in loads])
-        self.c_force = np.array([w._c_force for w in loads])
-        self.c_moment = np.array([w._c_moment for w in loads])
+        for name, source in self.SOURCES.items():
+            setattr(self, name, np.array([attrgetter(source)(v.waves) for v in vessels]))
         self._work = (np.empty_like(self.omega), np.empty_like(self.omega))
-        self._part = {name: np.empty_like(getattr(self, name)) for name in self.FIELDS}
+        self._part = {name: np.empty_like(getattr(self, name)) for name in self.SOURCES}
 
     def take(self, lanes: np.ndarray) -> WaveArrays:
         """The members ``lanes`` only, in spare arrays valid until the next ``take``."""
         part = object.__new__(WaveArrays)
-        for name in self.FIELDS:
+        for name in self.SOURCES:
             setattr(part, name, np.take(getattr(self, name), lanes, axis=0,
                                         out=self._part[name][:len(lanes)]))
         part._work, part._part = self._work, None
@@ -133,27 +130,17 @@ class VesselArrays:
     """M vessels stepped together, built from the scalar vessels as initialised."""
     STATES = ("x", "y", "psi", "u", "v", "r", "xi")
 
-    def __init__(self, vessels: Sequence[Vessel], h: float,
-                 shafts: Sequence[tuple[float, float, float]]):
+    def __init__(self, vessels: Sequence[Vessel], shafts: Sequence[tuple[float, float, float]]):
+        """Vessels of one sea (calm, or N wave components) that cut no step into sub-steps."""
         first = vessels[0]
-        for vessel in vessels:
-            if vessel.hull != first.hull or vessel.actuators != first.actuators:
-                raise ValueError("the members' vessels differ in hull or actuators")
-            if vessel._cut_of(h)[0] != 1:
-                raise ValueError(f"a member's h_max = {vessel.params.h_max} s cuts the "
-                                 f"{h} s step")
-        waves = [v.waves is not None for v in vessels]
-        if any(waves) and not all(waves):
-            raise ValueError("the members mix calm water and waves")
         self.lanes = Lanes(first.hull, first._minv, first._m11_inv,
-                           WaveArrays(vessels) if all(waves) else None,
+                           None if first.waves is None else WaveArrays(vessels),
                            np.array([v.params.psi_w for v in vessels]),
                            _actuators(first.actuators, np.array(shafts, dtype=float)))
-        self.delta_max = np.array([v.params.delta_max for v in vessels])
-        self.delta_rate_max = np.array([v.params.delta_rate_max for v in vessels])
-        for name in self.STATES:
+        self.delta_max, self.delta_rate_max = (np.array([getattr(v.params, name) for v in vessels])
+                                               for name in ("delta_max", "delta_rate_max"))
+        for name in (*self.STATES, "delta"):
             setattr(self, name, np.array([getattr(v, name) for v in vessels]))
-        self.delta = np.array([v.delta for v in vessels])
 
     def step(self, t: float, h: float, delta_c: np.ndarray) -> None:
         """``Vessel.step``: two RK4 steps for the members whose rudder kinks in the step."""
