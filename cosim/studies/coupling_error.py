@@ -5,11 +5,16 @@ difference; then J's distance from it over communication steps of 0.4 s to 0.012
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
 
 import numpy as np
 
+from .. import scenarios
+from ..analysis.cost import LAMBDA
+from ..analysis.metrics import cost_terms
+from ..core.master import Master
 from .integration_error import H
 from .monolithic import monolithic
 
@@ -22,11 +27,6 @@ def cosimulation(name: str, step: float, coupling: str,
                  stop_time: float | None = None) -> dict[str, np.ndarray]:
     """Our master in-process at communication step ``step``, sampled on the 0.1 s grid (a
     coarser step at its own points, each standing for step / 0.1 samples: ``weight``)."""
-    import dataclasses
-
-    from .. import scenarios
-    from ..core.master import Master
-
     system = dataclasses.replace(scenarios.load(name), step_size=step)
     with Master(system, coupling=coupling, backend="inprocess") as master:
         recording = master.run(stop_time)
@@ -38,19 +38,13 @@ def cosimulation(name: str, step: float, coupling: str,
 
 def figures(run: dict[str, np.ndarray]) -> dict[str, float]:
     """psi_E, sum delta^2 and J of eq (19) on the 0.1 s grid."""
-    from ..analysis.cost import LAMBDA
-    from ..analysis.metrics import cost_terms
-
-    psi_E, sum_delta2 = cost_terms(run["psi_d"], run["psi"], run["delta"])
     weight = run.get("weight", 1.0)
-    psi_E, sum_delta2 = weight * psi_E, weight * sum_delta2
+    psi_E, sum_delta2 = (weight * f for f in cost_terms(run["psi_d"], run["psi"], run["delta"]))
     return {"psi_E": psi_E, "sum_delta2": sum_delta2, "J": psi_E + LAMBDA * sum_delta2}
 
 
 def closed_loop(name: str, stop_time: float | None = None) -> dict[str, dict]:
     """Part 2 for one run: the figures of the reference and of both couplings at 0.1 s."""
-    from .. import scenarios
-
     reference_run = monolithic(scenarios.load(name), stop_time)
     out = {"monolithic": {**figures(reference_run), "max_dpsi": 0.0}}
     for coupling in COUPLINGS:
