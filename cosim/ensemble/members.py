@@ -60,9 +60,7 @@ def initialise(master: Master, overrides: dict[str, dict[str, Any]],
         master.initialize()
     except FmuCallError:
         return None
-    slaves = {name: master.instances[name].slave for name in COMPONENTS}
-    meta = master.run_meta(n_steps)
-    meta["parameters"] = master.parameter_values
-    ship = slaves["ship"]
-    return Member({name: slave.model for name, slave in slaves.items()},
-                  (ship.n1, ship.n2, ship.n3), meta)
+    ship = master.instances["ship"].slave
+    return Member({name: master.instances[name].slave.model for name in COMPONENTS},
+                  (ship.n1, ship.n2, ship.n3),
+                  {**master.run_meta(n_steps), "parameters": master.parameter_values})

@@ -2,6 +2,7 @@
 not; ``selftest``, the kernel checked on this machine against the scalar models."""
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections import defaultdict
@@ -93,9 +94,8 @@ def _alone(master: Master, overrides: dict[str, dict[str, Any]], stop_time: floa
     recording.meta["notes"] = [*recording.meta.get("notes", []),
                                f"ran on the in-process route, not in the batch: {why}"]
     columns = [recording.columns.index(s) for s in signals]
-    return Recording(list(signals), recording.time, recording.data[:, columns], recording.rows,
-                     recording.error, recording.interrupted, recording.meta,
-                     units={s: recording.units.get(s, "") for s in signals})
+    return dataclasses.replace(recording, columns=list(signals), data=recording.data[:, columns],
+                               units={s: recording.units.get(s, "") for s in signals})
 
 
 def lockstep(members: list[tuple[int, Member]], t0: float, h: float, n_steps: int,
@@ -120,8 +120,7 @@ def lockstep(members: list[tuple[int, Member]], t0: float, h: float, n_steps: in
             delta_c = pilot.command(ship.psi, ship.r, psi_d)
             values = (psi_d, wp_index, delta_c, ship.x, ship.y, ship.psi, ship.u, ship.v,
                       ship.r, ship.delta)
-            for row, signal in enumerate(rows):
-                block[k, row] = values[signal]
+            block[k] = [values[row] for row in rows]
             failed |= ~np.isfinite(np.add.reduce(values[2:]) + ship.xi) | (np.abs(ship.r) > R_MAX)
             if k == n_steps:
                 break
@@ -142,24 +141,20 @@ STEPS, H = 100, 0.1     # 10 s: members switch legs, cross +-180 deg, some reach
 ROUTE = [(0.0, 0.0), (-1.5, 0.2), (-2.5, 2.5), (0.5, 3.0)]   # turns beyond 90 deg
 
 
-def _pilot(kind: str, psi0: float, member: int):
-    if kind == "pd":
-        return PDAutopilot(Kp=2.0 + member, Kd=50.0)
-    if kind == "pid":
-        from autopilot_fmu.pid_autopilot_slave import PIDAutopilot
-        return PIDAutopilot(Ki=0.5, e_int=math.radians(90))
-    design = SlidingModeDesign.from_model(design_model("paper", 0.3))
-    return SlidingModeAutopilot(design, psi_z=psi0, equivalent_control=kind[4:])
-
-
 def _members(kind: str, Hs: float) -> list[dict]:
+    """Four members of ``kind``: headings either side of +-180 deg, gears, gains, seeds."""
+    from autopilot_fmu.pid_autopilot_slave import PIDAutopilot
+
     out = []
     for member in range(4):
         psi0 = (-1.0) ** member * (math.pi - 0.01 * member)
         ship = Vessel(VesselParameters(psi0=psi0, Hs=Hs, wave_seed=member, T0=0.7 + 0.1 * member,
                                        delta_rate_max=math.radians(10.0 + 5.0 * member)))
-        out.append({"guidance": WaypointGuidance(ROUTE, 0.5), "ship": ship,
-                    "autopilot": _pilot(kind, psi0, member)})
+        pilot = (PDAutopilot(Kp=2.0 + member, Kd=50.0) if kind == "pd" else
+                 PIDAutopilot(Ki=0.5, e_int=math.radians(90)) if kind == "pid" else
+                 SlidingModeAutopilot(SlidingModeDesign.from_model(design_model("paper", 0.3)),
+                                      psi_z=psi0, equivalent_control=kind[4:]))
+        out.append({"guidance": WaypointGuidance(ROUTE, 0.5), "ship": ship, "autopilot": pilot})
     return out
 
 

@@ -83,17 +83,16 @@ def _no_travel(u: np.ndarray, v: np.ndarray) -> float:
 class Lanes:
     """``Vessel.rates`` and an RK4 step of ``Vessel._integrate``, for all members or some."""
 
-    def __init__(self, hull, minv: tuple, m11_inv: float, waves: WaveArrays | None,
-                 psi_w: np.ndarray, forces: list[tuple[np.ndarray | None, Callable]]):
-        self.hull, self.minv, self.m11_inv, self.waves = hull, minv, m11_inv, waves
+    def __init__(self, vessel: Vessel, waves: WaveArrays | None, psi_w: np.ndarray,
+                 forces: list[tuple[np.ndarray | None, Callable]]):
+        self.vessel, self.waves, self.psi_w = vessel, waves, psi_w   # vessel: hull and mass
         self.wave_loads, self.hypot = (waves, exact.hypot) if waves is not None else (
             calm_water, _no_travel)
-        self.psi_w = psi_w
         self._forces = forces          # (members or None for all, tau_th of delta)
 
     def take(self, lanes: np.ndarray) -> Lanes:
-        return Lanes(self.hull, self.minv, self.m11_inv,
-                     None if self.waves is None else self.waves.take(lanes), self.psi_w[lanes],
+        return Lanes(self.vessel, None if self.waves is None else self.waves.take(lanes),
+                     self.psi_w[lanes],
                      [(None if m is None else m[lanes], f) for m, f in self._forces])
 
     def forces(self, delta: np.ndarray) -> Arrays:
@@ -106,12 +105,13 @@ class Lanes:
         return tuple(out)
 
     def rates(self, t: np.ndarray | float, state: Arrays, tau_th: Arrays) -> Arrays:
-        return state_rates(self.hull, self.minv, self.m11_inv, self.wave_loads, self.psi_w, t,
-                           state, tau_th, self.hypot, np.cos, np.sin)
+        v = self.vessel
+        return state_rates(v.hull, v._minv, v._m11_inv, self.wave_loads, self.psi_w, t, state,
+                           tau_th, self.hypot, np.cos, np.sin)
 
-    def rk4(self, t: float, start: np.ndarray | float, length: np.ndarray, y: Arrays,
+    def rk4(self, t: float, start: np.ndarray | float, hs: np.ndarray, y: Arrays,
             gear: RudderArrays) -> Arrays:
-        hs = length
+        """One RK4 step of length ``hs`` from ``t + start`` (each an array or a float)."""
         hh, c = 0.5 * hs, hs / 6.0
         s = start + 0.0 * hs
         ts = t + s
@@ -133,8 +133,7 @@ class VesselArrays:
     def __init__(self, vessels: Sequence[Vessel], shafts: Sequence[tuple[float, float, float]]):
         """Vessels of one sea (calm, or N wave components) that cut no step into sub-steps."""
         first = vessels[0]
-        self.lanes = Lanes(first.hull, first._minv, first._m11_inv,
-                           None if first.waves is None else WaveArrays(vessels),
+        self.lanes = Lanes(first, None if first.waves is None else WaveArrays(vessels),
                            np.array([v.params.psi_w for v in vessels]),
                            _actuators(first.actuators, np.array(shafts, dtype=float)))
         self.delta_max, self.delta_rate_max = (np.array([getattr(v.params, name) for v in vessels])
