@@ -1,19 +1,13 @@
-"""The scorecard: your autopilot beside the paper's PD and sliding-mode ones and the PID.
-
-Every controller runs the paper's route in calm water and waves, a 40 deg course change,
-and two wave ensembles (the paper's waves, WMO sea state 4) on Dask; each criterion
-(``merit.CRITERIA``) is won or lost on its own, seed-paired against the PD
-(``scorecard_report``). ``score`` writes scorecard.md, its figures and each single run's
-files in runs/ (``cosim.outputs``).
-"""
+"""The scorecard: your autopilot beside the paper's PD and sliding-mode ones and the PID, on
+the paper's route in calm water and waves, a 40 deg course change, and two wave ensembles
+(the paper's waves, WMO sea state 4) on Dask; each criterion (``merit.CRITERIA``) won or
+lost on its own, seed-paired against the PD (``scorecard_report``)."""
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
-
-from autopilot_fmu.guidance import parse_waypoints
 
 from .. import scenarios
 from ..analysis.figures import comparison_figure
@@ -126,10 +120,9 @@ def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | Non
         progress(f"wave ensemble in {sea.name}, {seeds} seeds on Dask")
         ensembles[sea] = _run_ensemble(contenders, seeds, sea, out, scheduler, workers,
                                        backend)
-    (x0, y0), (x1, y1) = parse_waypoints(COURSE_CHANGE_ROUTE)
+    leg = math.hypot(1000.0, 1000 * math.tan(COURSE_CHANGE))     # of COURSE_CHANGE_ROUTE
     text = markdown(fmu, name, seeds, {c.name: c.paper_cost for c in contenders}, route,
-                    changes, (COURSE_CHANGE_TIME, math.hypot(x1 - x0, y1 - y0)), failures,
-                    ensembles)
+                    changes, (COURSE_CHANGE_TIME, leg), failures, ensembles)
     write_atomically(out / "scorecard.md", lambda path: path.write_text(text))
     return text
 
