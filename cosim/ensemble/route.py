@@ -52,16 +52,17 @@ def simulate_members(system: SystemDescription, overrides: Sequence[dict[str, di
         _, h, n_steps = master.system.steps(stop_time)
         reason = coverage(system) or selftest()
         recordings: dict[int, Recording] = {}
-        groups: dict[int | None, list[tuple[int, Member]]] = defaultdict(list)
+        groups: dict[tuple, list[tuple[int, Member]]] = defaultdict(list)
         for i, member_overrides in enumerate(overrides):
             _check(beat(f"initialising member {i} of the batch"))
             member = None if reason else initialise(master, member_overrides, n_steps)
             why = reason or _outside(member, h)
             if why:
                 recordings[i] = _alone(master, member_overrides, stop_time, signals, why)
-            else:               # stepped together: in calm water, or in N wave components
+            else:       # stepped together: the same shafts, in calm water or N wave components
                 waves = member.models["ship"].waves
-                groups[None if waves is None else len(waves.components.omega)].append((i, member))
+                sea = None if waves is None else len(waves.components.omega)
+                groups[sea, member.shafts].append((i, member))
         for members in groups.values():
             for i, recording in lockstep(members, system.start_time, h, n_steps, signals,
                                          master.units, beat):
@@ -106,7 +107,7 @@ def lockstep(members: list[tuple[int, Member]], t0: float, h: float, n_steps: in
     non-finite or the yaw rate left the autopilot's range."""
     started = time.perf_counter()
     models = [m.models for _, m in members]
-    ship = VesselArrays([m["ship"] for m in models], [m.shafts for _, m in members])
+    ship = VesselArrays([m["ship"] for m in models], members[0][1].shafts)
     guidance = GuidanceArrays([m["guidance"] for m in models])
     pilot = KINDS[type(models[0]["autopilot"]).__name__]([m["autopilot"] for m in models])
     block = np.empty((n_steps + 1, len(signals), len(members)))

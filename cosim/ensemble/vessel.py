@@ -84,25 +84,15 @@ class Lanes:
     """``Vessel.rates`` and an RK4 step of ``Vessel._integrate``, for all members or some."""
 
     def __init__(self, vessel: Vessel, waves: WaveArrays | None, psi_w: np.ndarray,
-                 forces: list[tuple[np.ndarray | None, Callable]]):
+                 forces: Callable[[np.ndarray], Arrays]):
         self.vessel, self.waves, self.psi_w = vessel, waves, psi_w   # vessel: hull and mass
         self.wave_loads, self.hypot = (waves, exact.hypot) if waves is not None else (
             calm_water, _no_travel)
-        self._forces = forces          # (members or None for all, tau_th of delta)
+        self.forces = forces           # tau_th of delta, the shafts' speeds held
 
     def take(self, lanes: np.ndarray) -> Lanes:
         return Lanes(self.vessel, None if self.waves is None else self.waves.take(lanes),
-                     self.psi_w[lanes],
-                     [(None if m is None else m[lanes], f) for m, f in self._forces])
-
-    def forces(self, delta: np.ndarray) -> Arrays:
-        if len(self._forces) == 1:
-            return self._forces[0][1](delta)
-        out = [np.empty_like(delta) for _ in range(3)]
-        for members, forces in self._forces:
-            for total, part in zip(out, forces(delta[members])):
-                total[members] = part
-        return tuple(out)
+                     self.psi_w[lanes], self.forces)
 
     def rates(self, t: np.ndarray | float, state: Arrays, tau_th: Arrays) -> Arrays:
         v = self.vessel
@@ -130,12 +120,13 @@ class VesselArrays:
     """M vessels stepped together, built from the scalar vessels as initialised."""
     STATES = ("x", "y", "psi", "u", "v", "r", "xi")
 
-    def __init__(self, vessels: Sequence[Vessel], shafts: Sequence[tuple[float, float, float]]):
-        """Vessels of one sea (calm, or N wave components) that cut no step into sub-steps."""
+    def __init__(self, vessels: Sequence[Vessel], shafts: tuple[float, float, float]):
+        """Vessels of one sea (calm, or N wave components) and ``shafts`` (n1, n2, n3) that
+        cut no step into sub-steps."""
         first = vessels[0]
         self.lanes = Lanes(first, None if first.waves is None else WaveArrays(vessels),
                            np.array([v.params.psi_w for v in vessels]),
-                           _actuators(first.actuators, np.array(shafts, dtype=float)))
+                           actuator_model(first.actuators, *shafts))
         self.delta_max, self.delta_rate_max = (np.array([getattr(v.params, name) for v in vessels])
                                                for name in ("delta_max", "delta_rate_max"))
         for name in (*self.STATES, "delta"):
@@ -159,10 +150,3 @@ class VesselArrays:
         for name, value in zip(self.STATES, y):
             setattr(self, name, value)
         self.delta = gear(h)
-
-
-def _actuators(actuators, shafts: np.ndarray) -> list[tuple[np.ndarray | None, Callable]]:
-    """``actuator_model`` of each distinct (n1, n2, n3), with its members (None: all)."""
-    distinct = np.unique(shafts, axis=0)
-    return [(None if len(distinct) == 1 else np.all(shafts == row, axis=1),
-             actuator_model(actuators, *map(float, row))) for row in distinct]

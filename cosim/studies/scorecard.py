@@ -18,8 +18,7 @@ from ..api import SimulationError, overrides_of
 from ..core.files import fresh_folder, write_atomically
 from ..core.recording import Recording
 from ..outputs import Options, run_and_write
-from .scorecard_report import (BASELINE, CourseChange, Paired, Sea, change, markdown, paired,
-                               pairs)
+from .scorecard_report import BASELINE, Paired, Sea, change, markdown, paired, pairs
 from .campaign import execute
 from .spec_file import controller_entry
 from .sweep_spec import Spec
@@ -75,11 +74,13 @@ class Contender:
                 f"{PAPER_TABLES[f'waves_{self.suffix}'][2]:.1f}")
 
 
-def course_change(run: Recording) -> CourseChange:
+def course_change(run: Recording) -> dict[str, float]:
+    """The run's ``merit.run_metrics``, its settling_time (s, inf if it never settles) and
+    overshoot (rad)."""
     psi = run["ship.psi"]
     error = heading_error(run["guidance.psi_d"], psi)
-    return CourseChange(settling_time(run.t, error, SETTLING_BAND),
-                        overshoot(psi, psi[0], psi[0] + COURSE_CHANGE), run_metrics(run))
+    return {**run_metrics(run), "settling_time": settling_time(run.t, error, SETTLING_BAND),
+            "overshoot": overshoot(psi, psi[0], psi[0] + COURSE_CHANGE)}
 
 
 def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | None = None,

@@ -32,13 +32,6 @@ class Sea:
 
 
 @dataclass(frozen=True)
-class CourseChange:
-    settling_time: float          # s, inf if it never settles within the run
-    overshoot: float              # rad
-    metrics: dict[str, float]     # merit.run_metrics of the run
-
-
-@dataclass(frozen=True)
 class Paired:
     """One criterion of a controller against the baseline over the seeds both ran."""
 
@@ -97,7 +90,7 @@ def completion(run: Recording) -> RouteCompletion:
 
 
 def markdown(fmu: Path, name: str, seeds: int, paper: dict[str, str],
-             route: dict[str, dict[str, Recording]], changes: dict[str, CourseChange],
+             route: dict[str, dict[str, Recording]], changes: dict[str, dict],
              course: tuple[float, float], failures: dict[tuple[str, str], str],
              ensembles: dict[Sea, list[dict]]) -> str:
     """scorecard.md: ``paper`` gives each controller's J calm / waves in the paper ('-');
@@ -237,20 +230,20 @@ def _paper_route(paper: dict[str, str], route: dict[str, dict[str, Recording]]) 
                     "![route in waves](route_waves.png)", ""]
 
 
-def _course_change(names: list[str], changes: dict[str, CourseChange], time: float,
+def _course_change(names: list[str], changes: dict[str, dict], time: float,
                    leg: float) -> list[str]:
     lines = [f"## A 40 deg course change, calm water, {time:.0f} s (lower is better)", "",
              "| controller | settling time to 2 % (s) | overshoot (deg) | rudder reversals "
              "(1/min) | mean abs rudder rate (deg/s) | max rudder (deg) | max cross-track (m) |",
              "|---|---|---|---|---|---|---|"]
     for name in names:
-        r = changes.get(name)
-        if r is None:
+        m = changes.get(name)
+        if m is None:
             lines.append(f"| {name} |" + " failed |" * 6)
             continue
-        settled = f"{r.settling_time:.1f}" if math.isfinite(r.settling_time) else f"> {time:.0f}"
-        m = r.metrics
-        lines.append(f"| {name} | {settled} | {math.degrees(r.overshoot):.2f} | "
+        settled = f"{m['settling_time']:.1f}" if math.isfinite(m["settling_time"]) else \
+            f"> {time:.0f}"
+        lines.append(f"| {name} | {settled} | {math.degrees(m['overshoot']):.2f} | "
                      f"{m['reversals_per_min']:.1f} | {m['mean_rudder_rate_deg_s']:.2f} | "
                      f"{m['max_delta_deg']:.1f} | {m['cross_track_max_m']:.2f} |")
     return lines + ["", f"The course change follows one leg of {leg:.0f} m, longer than the "
