@@ -4,7 +4,7 @@ own rates, forces and RK4 update on arrays, its branches (the gear's kink) and s
 from __future__ import annotations
 
 from operator import attrgetter
-from typing import Callable, Sequence
+from typing import Sequence
 
 import numpy as np
 
@@ -80,42 +80,6 @@ def _no_travel(u: np.ndarray, v: np.ndarray) -> float:
     return 0.0
 
 
-class Lanes:
-    """``Vessel.rates`` and an RK4 step of ``Vessel._integrate``, for all members or some."""
-
-    def __init__(self, vessel: Vessel, waves: WaveArrays | None, psi_w: np.ndarray,
-                 forces: Callable[[np.ndarray], Arrays]):
-        self.vessel, self.waves, self.psi_w = vessel, waves, psi_w   # vessel: hull and mass
-        self.wave_loads, self.hypot = (waves, exact.hypot) if waves is not None else (
-            calm_water, _no_travel)
-        self.forces = forces           # tau_th of delta, the shafts' speeds held
-
-    def take(self, lanes: np.ndarray) -> Lanes:
-        return Lanes(self.vessel, None if self.waves is None else self.waves.take(lanes),
-                     self.psi_w[lanes], self.forces)
-
-    def rates(self, t: np.ndarray | float, state: Arrays, tau_th: Arrays) -> Arrays:
-        v = self.vessel
-        return state_rates(v.hull, v._minv, v._m11_inv, self.wave_loads, self.psi_w, t, state,
-                           tau_th, self.hypot, np.cos, np.sin)
-
-    def rk4(self, t: float, start: np.ndarray | float, hs: np.ndarray, y: Arrays,
-            gear: RudderArrays) -> Arrays:
-        """One RK4 step of length ``hs`` from ``t + start`` (each an array or a float)."""
-        hh, c = 0.5 * hs, hs / 6.0
-        s = start + 0.0 * hs
-        ts = t + s
-        delta0, delta1, delta2 = gear(s), gear(s + hh), gear(s + hs)
-        tau0 = self.forces(delta0)
-        tau1 = tau0 if np.array_equal(delta1, delta0) else self.forces(delta1)
-        tau2 = tau1 if np.array_equal(delta2, delta1) else self.forces(delta2)
-        k1 = self.rates(ts, y, tau0)
-        k2 = self.rates(ts + hh, axpy(hh, k1, y), tau1)
-        k3 = self.rates(ts + hh, axpy(hh, k2, y), tau1)
-        k4 = self.rates(ts + hs, axpy(hs, k3, y), tau2)
-        return rk4_update(c, y, k1, k2, k3, k4)
-
-
 class VesselArrays:
     """M vessels stepped together, built from the scalar vessels as initialised."""
     STATES = ("x", "y", "psi", "u", "v", "r", "xi")
@@ -123,12 +87,11 @@ class VesselArrays:
     def __init__(self, vessels: Sequence[Vessel], shafts: tuple[float, float, float]):
         """Vessels of one sea (calm, or N wave components) and ``shafts`` (n1, n2, n3) that
         cut no step into sub-steps."""
-        first = vessels[0]
-        self.lanes = Lanes(first, None if first.waves is None else WaveArrays(vessels),
-                           np.array([v.params.psi_w for v in vessels]),
-                           actuator_model(first.actuators, *shafts))
-        self.delta_max, self.delta_rate_max = (np.array([getattr(v.params, name) for v in vessels])
-                                               for name in ("delta_max", "delta_rate_max"))
+        self.vessel = vessels[0]                            # the hull and mass matrix of all
+        self.forces = actuator_model(self.vessel.actuators, *shafts)
+        self.waves = None if self.vessel.waves is None else WaveArrays(vessels)
+        for name in ("psi_w", "delta_max", "delta_rate_max"):
+            setattr(self, name, np.array([getattr(v.params, name) for v in vessels]))
         for name in (*self.STATES, "delta"):
             setattr(self, name, np.array([getattr(v, name) for v in vessels]))
 
@@ -137,16 +100,40 @@ class VesselArrays:
         gear = RudderArrays(self.delta, delta_c, self.delta_max, self.delta_rate_max)
         y = tuple(getattr(self, name) for name in self.STATES)
         split = (0.0 < gear.reach) & (gear.reach < h)
-        y = self.lanes.rk4(t, 0.0, np.where(split, gear.reach, h), y, gear)
+        y = self._rk4(t, 0.0, np.where(split, gear.reach, h), y, gear, self.waves, self.psi_w)
         lanes = np.flatnonzero(split)
         if len(lanes) == len(split):
-            y = self.lanes.rk4(t, gear.reach, h - gear.reach, y, gear)
+            y = self._rk4(t, gear.reach, h - gear.reach, y, gear, self.waves, self.psi_w)
         elif len(lanes):
             part = gear.take(lanes)
-            rest = self.lanes.take(lanes).rk4(t, part.reach, h - part.reach,
-                                              tuple(a[lanes] for a in y), part)
+            rest = self._rk4(t, part.reach, h - part.reach, tuple(a[lanes] for a in y), part,
+                             None if self.waves is None else self.waves.take(lanes),
+                             self.psi_w[lanes])
             for whole, value in zip(y, rest):
                 whole[lanes] = value
         for name, value in zip(self.STATES, y):
             setattr(self, name, value)
         self.delta = gear(h)
+
+    def _rk4(self, t: float, start: np.ndarray | float, hs: np.ndarray, y: Arrays,
+             gear: RudderArrays, waves: WaveArrays | None, psi_w: np.ndarray) -> Arrays:
+        """An RK4 step of ``Vessel._integrate``, of length ``hs`` from ``t + start`` (each an
+        array or a float), of the members of ``waves``, ``psi_w`` and ``gear`` (all or some)."""
+        v, forces = self.vessel, self.forces
+        loads, hypot = (waves, exact.hypot) if waves is not None else (calm_water, _no_travel)
+
+        def rates(t: np.ndarray | float, state: Arrays, tau_th: Arrays) -> Arrays:
+            return state_rates(v.hull, v._minv, v._m11_inv, loads, psi_w, t, state, tau_th,
+                               hypot, np.cos, np.sin)
+        hh, c = 0.5 * hs, hs / 6.0
+        s = start + 0.0 * hs
+        ts = t + s
+        delta0, delta1, delta2 = gear(s), gear(s + hh), gear(s + hs)
+        tau0 = forces(delta0)
+        tau1 = tau0 if np.array_equal(delta1, delta0) else forces(delta1)
+        tau2 = tau1 if np.array_equal(delta2, delta1) else forces(delta2)
+        k1 = rates(ts, y, tau0)
+        k2 = rates(ts + hh, axpy(hh, k1, y), tau1)
+        k3 = rates(ts + hh, axpy(hh, k2, y), tau1)
+        k4 = rates(ts + hs, axpy(hs, k3, y), tau2)
+        return rk4_update(c, y, k1, k2, k3, k4)
