@@ -106,7 +106,7 @@ class SMCArrays:
         self.tracking = np.array([p.tracking for p in pilots])
         for name in ("eta_h", "phi_h", "omega_n", "zeta", "psi_z", "r_z", "_h_max"):
             setattr(self, name.lstrip("_"), _column(pilots, name))
-        self._cuts: tuple[float, np.ndarray] | None = None
+        self.cuts: np.ndarray | None = None      # sub-steps of the reference model a step
 
     def command(self, psi: np.ndarray, r: np.ndarray, psi_d: np.ndarray) -> np.ndarray:
         error = wrap(self.psi_z - psi)
@@ -119,10 +119,10 @@ class SMCArrays:
 
     def step(self, t: float, h: float, psi: np.ndarray, r: np.ndarray,
              psi_d: np.ndarray) -> None:
-        if self._cuts is None or self._cuts[0] != h:
-            self._cuts = h, np.array([substeps(h, bound, "of the reference model")
-                                      for bound in self.h_max])
-        n = self._cuts[1]
+        if self.cuts is None:                # h is the batch's, the same at every step
+            self.cuts = np.array([substeps(h, bound, "of the reference model")
+                                  for bound in self.h_max])
+        n = self.cuts
         hs = h / n
         psi_z, r_z = self.psi_z, self.r_z
         for j in range(int(n.max())):

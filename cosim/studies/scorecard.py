@@ -117,10 +117,19 @@ def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | Non
     comparison_figure(runs, out / "course_change.png",
                       "40 deg course change from straight running, calm water")
     ensembles = {}
-    for sea in SEAS:
+    for sea in SEAS:            # each in a fresh folder, with its figures
         progress(f"wave ensemble in {sea.name}, {seeds} seeds on Dask")
-        ensembles[sea] = _run_ensemble(contenders, seeds, sea, out, scheduler, workers,
-                                       backend)
+        spec = _ensemble(contenders, seeds, out, sea)
+        with fresh_folder(out / ("ensemble" if sea is SEAS[0] else f"ensemble_{sea.key}")) \
+                as folder:
+            rows = ensembles[sea] = execute(spec, folder, scheduler=scheduler, workers=workers,
+                                            progress=False, backend=backend)
+        distribution(spec, rows, out / f"criteria_{sea.key}.png", CRITERIA)
+        others = [c.name for c in contenders if c.name != BASELINE]
+        paired_figure(f"The route in {sea.name}", {
+            criterion: {n: change(criterion, *pairs(criterion, rows, n)) for n in others}
+            for criterion in CRITERIA}, BASELINE, out / f"paired_{sea.key}.png")
+        tracks(spec, rows, out / f"tracks_{sea.key}.png")
     leg = math.hypot(1000.0, 1000 * math.tan(COURSE_CHANGE))     # of COURSE_CHANGE_ROUTE
     text = markdown(fmu, name, seeds, {c.name: c.paper_cost for c in contenders}, route,
                     changes, (COURSE_CHANGE_TIME, leg), failures, ensembles)
@@ -146,23 +155,6 @@ def _ensemble(contenders: list[Contender], seeds: int, out: Path, sea: Sea = SEA
     return Spec(name=f"ensemble in {sea.name}", axes=axes,
                 controllers={n: controller_entry(e, out / "scorecard", n)
                              for n, e in entries.items()}, tracks={})   # every track
-
-
-def _run_ensemble(contenders: list[Contender], seeds: int, sea: Sea, out: Path,
-                  scheduler: str | None, workers: int | None, backend: str) -> list[dict]:
-    """Run one ensemble in a fresh folder and draw its figures; its rows."""
-    spec = _ensemble(contenders, seeds, out, sea)
-    folder = out / ("ensemble" if sea is SEAS[0] else f"ensemble_{sea.key}")
-    with fresh_folder(folder) as ensemble:
-        rows = execute(spec, ensemble, scheduler=scheduler, workers=workers, progress=False,
-                       backend=backend)
-    distribution(spec, rows, out / f"criteria_{sea.key}.png", CRITERIA)
-    others = [c.name for c in contenders if c.name != BASELINE]
-    paired_figure(f"The route in {sea.name}", {
-        criterion: {name: change(criterion, *pairs(criterion, rows, name)) for name in others}
-        for criterion in CRITERIA}, BASELINE, out / f"paired_{sea.key}.png")
-    tracks(spec, rows, out / f"tracks_{sea.key}.png")
-    return rows
 
 
 def backend_notes(fmu: Path, name: str, port_map: dict | None, backend: str) -> list[str]:
