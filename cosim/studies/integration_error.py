@@ -85,11 +85,9 @@ class Error:
 
 
 def errors(run: dict[str, np.ndarray], ref: dict[str, np.ndarray]) -> dict[str, Error]:
-    out = {}
-    for s in STATES:
-        e = np.abs(run[s] - ref[s])
-        out[s] = Error(float(e.max()), float(np.sqrt(np.mean(e * e))))
-    return out
+    """Each signal's ``Error`` against the reference."""
+    e = {s: np.abs(run[s] - ref[s]) for s in STATES}
+    return {s: Error(float(e[s].max()), float(np.sqrt(np.mean(e[s] * e[s])))) for s in STATES}
 
 
 def open_loop(program: str, t_end: float = 400.0) -> dict:
