@@ -19,7 +19,7 @@ import time
 from pathlib import Path
 
 from ._cli import entry, writable_folder
-from .core.files import whole_file
+from .core.files import write_atomically
 from .scenarios import names
 from .studies import coupling_error, cpu_variants, integration_error
 
@@ -43,7 +43,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.cpus:
         table = cpu_variants.audit_table(cpu_variants.audit(names()))
         print(table)
-        _write(out / "cpus.md", table)
+        write_atomically(out / "cpus.md", lambda path: path.write_text(table + "\n"))
         print(f"wrote {out / 'cpus.md'} ({time.perf_counter() - started:.0f} s)")
         return 0
     open_end, closed_end = (60.0, 120.0) if args.quick else (400.0, None)
@@ -64,15 +64,10 @@ def main(argv: list[str] | None = None) -> int:
     tables += ["\n## J against the communication step\n",
                coupling_error.convergence_table(converging, references)]
     print("".join(tables[-2:]), flush=True)
-    _write(out / "accuracy.md", "\n".join(tables))
+    write_atomically(out / "accuracy.md", lambda path: path.write_text("\n".join(tables) + "\n"))
     figure = coupling_error.convergence_figure(converging, out / "convergence.png")
     print(f"wrote {out / 'accuracy.md'}, {figure} ({time.perf_counter() - started:.0f} s)")
     return 0
-
-
-def _write(path: Path, text: str) -> None:
-    with whole_file(path) as temporary:
-        temporary.write_text(text + "\n")
 
 
 if __name__ == "__main__":

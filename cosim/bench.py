@@ -75,8 +75,15 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if args.command == "memory":
             memory.memory(args.hours)
-        elif args.command == "sweep":
-            _sweep(args)
+        elif args.command == "sweep":           # the parts asked for, in their order
+            if "throughput" in args.parts:
+                seas = ("waves", "calm") if args.sea == "both" else (args.sea,)
+                sweep_timing.sweep_throughput(args.runs, args.batch_runs, seas,
+                                              rounds=args.rounds)
+            if "campaign" in args.parts:
+                sweep_timing.campaign(args.campaign_runs)
+            if "memory" in args.parts:
+                memory.batch_memory(args.memory_members)
         elif args.command == "overhead":
             timing.overhead(args.repeats)
         else:
@@ -85,17 +92,6 @@ def main(argv: list[str] | None = None) -> int:
         say_error(error)
         return 2
     return 0
-
-
-def _sweep(args: argparse.Namespace) -> None:
-    """The parts of the sweep benchmark asked for, in their order."""
-    if "throughput" in args.parts:
-        seas = ("waves", "calm") if args.sea == "both" else (args.sea,)
-        sweep_timing.sweep_throughput(args.runs, args.batch_runs, seas, rounds=args.rounds)
-    if "campaign" in args.parts:
-        sweep_timing.campaign(args.campaign_runs)
-    if "memory" in args.parts:
-        memory.batch_memory(args.memory_members)
 
 
 if __name__ == "__main__":

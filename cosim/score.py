@@ -19,6 +19,8 @@ import sys
 import time
 from pathlib import Path
 
+from tqdm import tqdm
+
 from ._cli import (add_port_options, checked_autopilot, entry, say_error, say_note,
                    setting_option, writable_folder)
 from .api import overrides_of
@@ -83,31 +85,25 @@ def main(argv: list[str] | None = None) -> int:
     for note in backend_notes(args.autopilot.resolve(), name, dict(args.map), args.backend):
         say_note(note)
     started = time.perf_counter()
-    steps = 4 * 2 + 4 + len(SEAS)
-
-    from tqdm import tqdm
-    bar = tqdm(total=steps, desc="scorecard", unit="step", file=sys.stderr, disable=None,
-               bar_format="{desc}: {n}/{total} {bar} {elapsed} {postfix}")
 
     def progress(step: str) -> None:
         if bar.n or step != "calm water, PD":
             bar.update()
         bar.set_postfix_str(step)
     try:
-        overrides_of(args.set)              # refuses a variable set twice
-        text = score(args.autopilot.resolve(), name, out, args.seeds, dict(args.map),
-                     dict(args.set), args.workers, args.scheduler, progress, args.backend)
-        bar.update()
+        with tqdm(total=4 * 2 + 4 + len(SEAS), desc="scorecard", unit="step", file=sys.stderr,
+                  disable=None, bar_format="{desc}: {n}/{total} {bar} {elapsed} {postfix}") as bar:
+            overrides_of(args.set)              # refuses a variable set twice
+            text = score(args.autopilot.resolve(), name, out, args.seeds, dict(args.map),
+                         dict(args.set), args.workers, args.scheduler, progress, args.backend)
+            bar.update()
     except (ValueError, FileNotFoundError, FolderBusy, OutputError, TimedOut,
             SweepError) as error:         # SweepError: a worker runs other code
-        bar.close()
         say_error(error)
         return 1
     except NoWorkers as stopped:
-        bar.close()
         print(f"{stopped}: no scorecard written", file=sys.stderr)
         return stopped.exit_status
-    bar.close()
     print(text)
     print(f"wrote {out / 'scorecard.md'} and its figures in {time.perf_counter() - started:.0f} s")
     return 0

@@ -1,11 +1,11 @@
-"""The accuracy study's reference and RK4's convergence (cosim.studies.integration_error,
-monolithic and coupling_error)."""
+"""The accuracy study's reference and RK4's convergence (cosim.studies.integration_error and
+coupling_error)."""
 from __future__ import annotations
 
 import pytest
 
 from cosim.studies import coupling_error, integration_error
-from cosim.studies.monolithic import monolithic
+from cosim.studies.coupling_error import monolithic
 
 
 @pytest.fixture(scope="module")

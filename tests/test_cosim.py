@@ -20,8 +20,7 @@ from cosim.analysis.metrics import cost_terms
 from cosim.core.master import Master
 from cosim.core.ssd import write_ssd
 from cosim.core.wiring import WiringError
-from cosim.ensemble.reference import SIGNALS
-from cosim.studies.direct import run_direct
+from cosim.ensemble.reference import SIGNALS, run_direct
 from fmubuild import project
 from fmubuild.project import ROOT
 from helpers import fmu_variant, recorded
@@ -81,7 +80,8 @@ def test_psi_d_is_eq_18_of_the_active_leg():
 # -- equality with the plain modules ---------------------------------------------------
 @pytest.mark.parametrize("name", PAPER)
 def test_cosimulation_equals_the_plain_modules_wired_by_hand(name):
-    rec, direct = run(name), run_direct(system(name))
+    with Master(system(name), backend="inprocess") as master:
+        rec, direct = run(name), run_direct(master)
     worst = max(np.abs(rec[s] - direct[s]).max() for s in SIGNALS)
     assert worst <= 1e-9
 
@@ -393,12 +393,6 @@ def test_streamed_rows_equal_the_in_memory_recording(tmp_path):
     assert (tmp_path / "streamed.csv").read_text() == (tmp_path / "whole.csv").read_text()
 
 
-def test_the_null_backend_runs_a_scenario(fmu_paths):
-    """The benchmark's measure of the master's own cost: the master with no model behind."""
-    recording = Master(scenarios.load("calm_pd"), backend="null").run(1.0)
-    assert recording.error is None and recording.rows == 11
-
-
 def test_the_overhead_benchmark_runs_and_restores_the_ship(fmu_paths, capsys):
     """A smoke test of one benchmark (figures are printed, never asserted): it idles the
     ship's step while it measures, and must give it back."""
@@ -408,6 +402,6 @@ def test_the_overhead_benchmark_runs_and_restores_the_ship(fmu_paths, capsys):
     step = Vessel.step
     per_step = timing.overhead(1)
     assert Vessel.step is step
-    assert set(per_step) == {"direct", "null", "inprocess"}
+    assert set(per_step) == {"direct", "idle", "inprocess"}
     out = capsys.readouterr().out
     assert "the in-process master beyond cosim.direct:" in out

@@ -19,17 +19,15 @@ from .fmi import FmuInstance, read_description
 from .inprocess import InProcessInstance, fallback_note
 from .instance import FmuCallError, Instance
 from .interrupt import StopSignals
-from .null import NullInstance
 from .recording import Recorder, Recording
 from .system import SystemDescription, split_name
 from .values import declarations, parameters
 from .watchdog import TimeLimit, Watchdog, no_limit
 from .wiring import check_connections, feedthrough_order, layout
 
-BACKENDS: dict[str, type[Instance]] = {"fmi": FmuInstance, "inprocess": InProcessInstance,
-                                       "null": NullInstance}
+BACKENDS: dict[str, type[Instance]] = {"fmi": FmuInstance, "inprocess": InProcessInstance}
 """fmi: the FMUs through fmpy; inprocess: their Python classes (an FMU not current here runs
-through FMI, with a note: ``fallback_note``); null: interfaces only (``cosim.core.null``)."""
+through FMI, with a note: ``fallback_note``)."""
 RUN_BACKENDS = ("fmi", "inprocess")
 """The backends a run of a scenario may take."""
 

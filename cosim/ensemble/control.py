@@ -2,7 +2,6 @@
 built from the initialised scalar models; each member keeps its route (padded) and gains."""
 from __future__ import annotations
 
-import math
 from typing import Sequence
 
 import numpy as np
@@ -23,49 +22,36 @@ class GuidanceArrays:
     """The active leg of every member's route, switched as ``WaypointGuidance`` does."""
 
     def __init__(self, guidances: Sequence[WaypointGuidance]):
-        legs = max(len(g.points) for g in guidances) - 1
-        self.points = np.array([len(g.points) for g in guidances])
-        route = np.zeros((len(guidances), legs + 1, 2))
-        course, length = np.zeros((len(guidances), legs)), np.ones((len(guidances), legs))
+        count, legs = len(guidances), max(len(g.points) for g in guidances) - 1
+        route, self.course = np.zeros((count, legs + 1, 2)), np.zeros((count, legs))
         for i, g in enumerate(guidances):
             route[i, :len(g.points)] = g.points
-            for leg in range(len(g.points) - 1):
-                (x0, y0), (x1, y1) = g.points[leg], g.points[leg + 1]
-                course[i, leg] = g.course(leg)
-                length[i, leg] = math.hypot(x1 - x0, y1 - y0)
+            self.course[i, :len(g.points) - 1] = [g.course(leg) for leg in range(len(g.points) - 1)]
         self.start, self.end = route[:, :-1], route[:, 1:]
         self.delta = self.end - self.start                  # (dx, dy) of each leg
-        self.course, self.length = course, length
+        self.length = hypot(self.delta[..., 0], self.delta[..., 1])   # 0 past a route's end
+        self.points = np.array([len(g.points) for g in guidances])
         self.R_accept = _column(guidances, "R_accept")
         self.leg = np.array([g.leg for g in guidances])
         self.finished = np.array([g.finished for g in guidances])
-        self.members = np.arange(len(guidances))
+        self.members = np.arange(count)
 
-    def _reached(self, leg: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-        i = self.members
-        (x0, y0), (x1, y1) = self.start[i, leg].T, self.end[i, leg].T
-        dx, dy = self.delta[i, leg].T
-        length = self.length[i, leg]
-        along = ((x - x0) * dx + (y - y0) * dy) / length
-        return _within(x1 - x, y1 - y, self.R_accept) | (along >= length)
-
-    def active_leg(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(leg, finished) of every member at (x, y), from the committed legs onward."""
-        leg, finished = self.leg.copy(), self.finished.copy()
+    def outputs(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(psi_d, wp_index) at (x, y), the leg switches committed: from the committed leg,
+        the next while the circle of acceptance is reached or the leg's end passed."""
+        i, leg, finished = self.members, self.leg, self.finished.copy()
         moving = ~finished
         while moving.any():
-            moving &= self._reached(leg, x, y)
+            (x0, y0), (x1, y1), (dx, dy) = (a[i, leg].T for a in (self.start, self.end, self.delta))
+            length = self.length[i, leg]
+            along = ((x - x0) * dx + (y - y0) * dy) / length
+            moving &= _within(x1 - x, y1 - y, self.R_accept) | (along >= length)
             last = leg + 2 >= self.points
             finished |= moving & last
             leg = np.where(moving & ~last, leg + 1, leg)
             moving &= ~last
-        return leg, finished
-
-    def outputs(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(psi_d, wp_index) at (x, y), the leg switches committed."""
-        self.leg, self.finished = self.active_leg(x, y)
-        psi_d = self.course[self.members, self.leg]
-        return psi_d, np.where(self.finished, self.points, self.leg + 1)
+        self.leg, self.finished = leg, finished
+        return self.course[i, leg], np.where(finished, self.points, leg + 1)
 
 
 NEAR = 1e-12           # relative distance from the circle within which math.hypot decides
@@ -90,9 +76,8 @@ class PDArrays:
     def command(self, psi: np.ndarray, r: np.ndarray, psi_d: np.ndarray) -> np.ndarray:
         return self.Kp * wrap(psi - psi_d) + self.Kd * r
 
-    def step(self, t: float, h: float, psi: np.ndarray, r: np.ndarray,
-             psi_d: np.ndarray) -> None:
-        pass
+    def step(self, *args: object) -> None:
+        """Memoryless: nothing to step."""
 
 
 class PIDArrays:
@@ -121,7 +106,7 @@ class SMCArrays:
         self.tracking = np.array([p.tracking for p in pilots])
         for name in ("eta_h", "phi_h", "omega_n", "zeta", "psi_z", "r_z", "_h_max"):
             setattr(self, name.lstrip("_"), _column(pilots, name))
-        self._cuts: tuple[float, np.ndarray] | None = None
+        self.cuts: np.ndarray | None = None      # sub-steps of the reference model a step
 
     def command(self, psi: np.ndarray, r: np.ndarray, psi_d: np.ndarray) -> np.ndarray:
         error = wrap(self.psi_z - psi)
@@ -134,10 +119,10 @@ class SMCArrays:
 
     def step(self, t: float, h: float, psi: np.ndarray, r: np.ndarray,
              psi_d: np.ndarray) -> None:
-        if self._cuts is None or self._cuts[0] != h:
-            self._cuts = h, np.array([substeps(h, bound, "of the reference model")
-                                      for bound in self.h_max])
-        n = self._cuts[1]
+        if self.cuts is None:                # h is the batch's, the same at every step
+            self.cuts = np.array([substeps(h, bound, "of the reference model")
+                                  for bound in self.h_max])
+        n = self.cuts
         hs = h / n
         psi_z, r_z = self.psi_z, self.r_z
         for j in range(int(n.max())):
@@ -147,14 +132,6 @@ class SMCArrays:
         self.psi_z, self.r_z = psi_z, r_z
 
 
-def autopilot_arrays(pilots: Sequence) -> PDArrays | PIDArrays | SMCArrays:
-    """The array form of the members' autopilots, all of one kind; ValueError otherwise."""
-    kinds = {type(p).__name__ for p in pilots}
-    if len(kinds) != 1 or next(iter(kinds)) not in KINDS:
-        raise ValueError(f"the batch route runs one of {', '.join(KINDS)} for every member, "
-                         f"not {', '.join(sorted(kinds))}")
-    return KINDS[kinds.pop()](pilots)
-
-
 KINDS = {"PDAutopilot": PDArrays, "PIDAutopilot": PIDArrays,   # by class name: the PID's
          "SlidingModeAutopilot": SMCArrays}                    # lives in its slave
+"""The array form of each autopilot class (one class in a batch: its system's)."""

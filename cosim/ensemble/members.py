@@ -11,7 +11,6 @@ from ..core.inprocess import fallback_note
 from ..core.instance import FmuCallError
 from ..core.master import Master
 from ..core.ssd import SystemDescription
-from .control import KINDS
 
 COMPONENTS = ("guidance", "autopilot", "ship")
 WIRING = frozenset({("guidance", "psi_d", "autopilot", "psi_d"),
@@ -61,11 +60,7 @@ def initialise(master: Master, overrides: dict[str, dict[str, Any]],
         master.initialize()
     except FmuCallError:
         return None
-    slaves = {name: master.instances[name].slave for name in COMPONENTS}
-    if type(slaves["autopilot"].model).__name__ not in KINDS:
-        return None
-    meta = master.run_meta(n_steps)
-    meta["parameters"] = master.parameter_values
-    ship = slaves["ship"]
-    return Member({name: slave.model for name, slave in slaves.items()},
-                  (ship.n1, ship.n2, ship.n3), meta)
+    ship = master.instances["ship"].slave
+    return Member({name: master.instances[name].slave.model for name in COMPONENTS},
+                  (ship.n1, ship.n2, ship.n3),
+                  {**master.run_meta(n_steps), "parameters": master.parameter_values})

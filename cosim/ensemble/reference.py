@@ -1,5 +1,6 @@
 """The scalar models stepped as the master steps them (guidance -> autopilot -> ship,
-Gauss-Seidel, sampled at t_k = t_0 + k h): the reference the batch kernel is pinned to."""
+Gauss-Seidel, sampled at t_k = t_0 + k h): the reference the batch kernel is pinned to, and
+the system wired by hand that ``cosim.bench`` times (``run_direct``)."""
 from __future__ import annotations
 
 from typing import Any
@@ -7,6 +8,9 @@ from typing import Any
 import numpy as np
 
 from fmukit.timebase import communication_point
+
+from ..core.master import Master
+from .members import COMPONENTS, initialise
 
 SIGNALS = ("guidance.psi_d", "guidance.wp_index", "autopilot.delta_c", "ship.x", "ship.y",
            "ship.psi", "ship.u", "ship.v", "ship.r", "ship.delta")   # wave loads aside
@@ -35,3 +39,13 @@ def step_models(guidance: Any, autopilot: Any, ship: Any, shafts: tuple[float, f
             autopilot.step(t, h, psi_d)
         ship.step(t, h, delta_c, n1, n2, n3)
     return dict(zip(SIGNALS, out.T))
+
+
+def run_direct(master: Master, stop_time: float | None = None) -> dict[str, np.ndarray]:
+    """``SIGNALS`` of the models that ``master`` (in-process) initialises, stepped by
+    ``step_models``: without the master's calls, records and checks."""
+    t0, h, n_steps = master.system.steps(stop_time)
+    member = initialise(master, master.overrides, n_steps)
+    if member is None:
+        raise RuntimeError(f"{master.system.name}: its models cannot be stepped by hand")
+    return step_models(*(member.models[n] for n in COMPONENTS), member.shafts, t0, h, n_steps)

@@ -2,6 +2,7 @@
 not; ``selftest``, the kernel checked on this machine against the scalar models."""
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections import defaultdict
@@ -22,7 +23,7 @@ from ..core.master import Master
 from ..core.recording import Recording
 from ..core.ssd import SystemDescription
 from ..core.watchdog import TimeLimit, no_limit
-from .control import GuidanceArrays, autopilot_arrays
+from .control import KINDS, GuidanceArrays
 from .members import Member, coverage, initialise
 from .reference import SIGNALS as ALL_SIGNALS, step_models
 from .vessel import VesselArrays
@@ -58,8 +59,10 @@ def simulate_members(system: SystemDescription, overrides: Sequence[dict[str, di
             why = reason or _outside(member, h)
             if why:
                 recordings[i] = _alone(master, member_overrides, stop_time, signals, why)
-            else:
-                groups[_group(member)].append((i, member))
+            else:       # stepped together: the same shafts, in calm water or N wave components
+                waves = member.models["ship"].waves
+                sea = None if waves is None else len(waves.components.omega)
+                groups[sea, member.shafts].append((i, member))
         for members in groups.values():
             for i, recording in lockstep(members, system.start_time, h, n_steps, signals,
                                          master.units, beat):
@@ -84,12 +87,6 @@ def _outside(member: Member | None, h: float) -> str | None:
     return None
 
 
-def _group(member: Member) -> tuple:
-    """Calm water, or the number of wave components: what members stepped together share."""
-    waves = member.models["ship"].waves
-    return (0,) if waves is None else (len(waves.components.omega),)
-
-
 def _alone(master: Master, overrides: dict[str, dict[str, Any]], stop_time: float | None,
            signals: Sequence[str], why: str) -> Recording:
     master.reset()
@@ -98,9 +95,8 @@ def _alone(master: Master, overrides: dict[str, dict[str, Any]], stop_time: floa
     recording.meta["notes"] = [*recording.meta.get("notes", []),
                                f"ran on the in-process route, not in the batch: {why}"]
     columns = [recording.columns.index(s) for s in signals]
-    return Recording(list(signals), recording.time, recording.data[:, columns], recording.rows,
-                     recording.error, recording.interrupted, recording.meta,
-                     units={s: recording.units.get(s, "") for s in signals})
+    return dataclasses.replace(recording, columns=list(signals), data=recording.data[:, columns],
+                               units={s: recording.units.get(s, "") for s in signals})
 
 
 def lockstep(members: list[tuple[int, Member]], t0: float, h: float, n_steps: int,
@@ -111,9 +107,9 @@ def lockstep(members: list[tuple[int, Member]], t0: float, h: float, n_steps: in
     non-finite or the yaw rate left the autopilot's range."""
     started = time.perf_counter()
     models = [m.models for _, m in members]
-    ship = VesselArrays([m["ship"] for m in models], h, [m.shafts for _, m in members])
+    ship = VesselArrays([m["ship"] for m in models], members[0][1].shafts)
     guidance = GuidanceArrays([m["guidance"] for m in models])
-    pilot = autopilot_arrays([m["autopilot"] for m in models])
+    pilot = KINDS[type(models[0]["autopilot"]).__name__]([m["autopilot"] for m in models])
     block = np.empty((n_steps + 1, len(signals), len(members)))
     rows = [ALL_SIGNALS.index(s) for s in signals]
     failed = np.zeros(len(members), dtype=bool)
@@ -125,8 +121,7 @@ def lockstep(members: list[tuple[int, Member]], t0: float, h: float, n_steps: in
             delta_c = pilot.command(ship.psi, ship.r, psi_d)
             values = (psi_d, wp_index, delta_c, ship.x, ship.y, ship.psi, ship.u, ship.v,
                       ship.r, ship.delta)
-            for row, signal in enumerate(rows):
-                block[k, row] = values[signal]
+            block[k] = [values[row] for row in rows]
             failed |= ~np.isfinite(np.add.reduce(values[2:]) + ship.xi) | (np.abs(ship.r) > R_MAX)
             if k == n_steps:
                 break
@@ -147,24 +142,20 @@ STEPS, H = 100, 0.1     # 10 s: members switch legs, cross +-180 deg, some reach
 ROUTE = [(0.0, 0.0), (-1.5, 0.2), (-2.5, 2.5), (0.5, 3.0)]   # turns beyond 90 deg
 
 
-def _pilot(kind: str, psi0: float, member: int):
-    if kind == "pd":
-        return PDAutopilot(Kp=2.0 + member, Kd=50.0)
-    if kind == "pid":
-        from autopilot_fmu.pid_autopilot_slave import PIDAutopilot
-        return PIDAutopilot(Ki=0.5, e_int=math.radians(90))
-    design = SlidingModeDesign.from_model(design_model("paper", 0.3))
-    return SlidingModeAutopilot(design, psi_z=psi0, equivalent_control=kind[4:])
-
-
 def _members(kind: str, Hs: float) -> list[dict]:
+    """Four members of ``kind``: headings either side of +-180 deg, gears, gains, seeds."""
+    from autopilot_fmu.pid_autopilot_slave import PIDAutopilot
+
     out = []
     for member in range(4):
         psi0 = (-1.0) ** member * (math.pi - 0.01 * member)
         ship = Vessel(VesselParameters(psi0=psi0, Hs=Hs, wave_seed=member, T0=0.7 + 0.1 * member,
                                        delta_rate_max=math.radians(10.0 + 5.0 * member)))
-        out.append({"guidance": WaypointGuidance(ROUTE, 0.5), "ship": ship,
-                    "autopilot": _pilot(kind, psi0, member)})
+        pilot = (PDAutopilot(Kp=2.0 + member, Kd=50.0) if kind == "pd" else
+                 PIDAutopilot(Ki=0.5, e_int=math.radians(90)) if kind == "pid" else
+                 SlidingModeAutopilot(SlidingModeDesign.from_model(design_model("paper", 0.3)),
+                                      psi_z=psi0, equivalent_control=kind[4:]))
+        out.append({"guidance": WaypointGuidance(ROUTE, 0.5), "ship": ship, "autopilot": pilot})
     return out
 
 

@@ -3,7 +3,8 @@ own rates, forces and RK4 update on arrays, its branches (the gear's kink) and s
 (wave loads) rewritten on arrays operation for operation."""
 from __future__ import annotations
 
-from typing import Callable, Sequence
+from operator import attrgetter
+from typing import Sequence
 
 import numpy as np
 
@@ -38,24 +39,20 @@ class RudderArrays:
 
 class WaveArrays:
     """``ship_fmu.waves.WaveLoads`` of every member, eqs (14)-(16)."""
-    FIELDS = ("omega", "k", "phase", "slope_amplitude", "psi_w", "c_force", "c_moment")
+    SOURCES = {"omega": "components.omega", "k": "components.k", "phase": "components.phase",
+               "slope_amplitude": "_slope_amplitude", "psi_w": "psi_w", "c_force": "_c_force",
+               "c_moment": "_c_moment"}
 
     def __init__(self, vessels: Sequence[Vessel]):
-        loads = [v.waves for v in vessels]
-        self.omega = np.array([w.components.omega for w in loads])
-        self.k = np.array([w.components.k for w in loads])
-        self.phase = np.array([w.components.phase for w in loads])
-        self.slope_amplitude = np.array([w._slope_amplitude for w in loads])
-        self.psi_w = np.array([w.psi_w for w in loads])
-        self.c_force = np.array([w._c_force for w in loads])
-        self.c_moment = np.array([w._c_moment for w in loads])
+        for name, source in self.SOURCES.items():
+            setattr(self, name, np.array([attrgetter(source)(v.waves) for v in vessels]))
         self._work = (np.empty_like(self.omega), np.empty_like(self.omega))
-        self._part = {name: np.empty_like(getattr(self, name)) for name in self.FIELDS}
+        self._part = {name: np.empty_like(getattr(self, name)) for name in self.SOURCES}
 
     def take(self, lanes: np.ndarray) -> WaveArrays:
         """The members ``lanes`` only, in spare arrays valid until the next ``take``."""
         part = object.__new__(WaveArrays)
-        for name in self.FIELDS:
+        for name in self.SOURCES:
             setattr(part, name, np.take(getattr(self, name), lanes, axis=0,
                                         out=self._part[name][:len(lanes)]))
         part._work, part._part = self._work, None
@@ -83,100 +80,60 @@ def _no_travel(u: np.ndarray, v: np.ndarray) -> float:
     return 0.0
 
 
-class Lanes:
-    """``Vessel.rates`` and an RK4 step of ``Vessel._integrate``, for all members or some."""
-
-    def __init__(self, hull, minv: tuple, m11_inv: float, waves: WaveArrays | None,
-                 psi_w: np.ndarray, forces: list[tuple[np.ndarray | None, Callable]]):
-        self.hull, self.minv, self.m11_inv, self.waves = hull, minv, m11_inv, waves
-        self.wave_loads, self.hypot = (waves, exact.hypot) if waves is not None else (
-            calm_water, _no_travel)
-        self.psi_w = psi_w
-        self._forces = forces          # (members or None for all, tau_th of delta)
-
-    def take(self, lanes: np.ndarray) -> Lanes:
-        return Lanes(self.hull, self.minv, self.m11_inv,
-                     None if self.waves is None else self.waves.take(lanes), self.psi_w[lanes],
-                     [(None if m is None else m[lanes], f) for m, f in self._forces])
-
-    def forces(self, delta: np.ndarray) -> Arrays:
-        if len(self._forces) == 1:
-            return self._forces[0][1](delta)
-        out = [np.empty_like(delta) for _ in range(3)]
-        for members, forces in self._forces:
-            for total, part in zip(out, forces(delta[members])):
-                total[members] = part
-        return tuple(out)
-
-    def rates(self, t: np.ndarray | float, state: Arrays, tau_th: Arrays) -> Arrays:
-        return state_rates(self.hull, self.minv, self.m11_inv, self.wave_loads, self.psi_w, t,
-                           state, tau_th, self.hypot, np.cos, np.sin)
-
-    def rk4(self, t: float, start: np.ndarray | float, length: np.ndarray, y: Arrays,
-            gear: RudderArrays) -> Arrays:
-        hs = length
-        hh, c = 0.5 * hs, hs / 6.0
-        s = start + 0.0 * hs
-        ts = t + s
-        delta0, delta1, delta2 = gear(s), gear(s + hh), gear(s + hs)
-        tau0 = self.forces(delta0)
-        tau1 = tau0 if np.array_equal(delta1, delta0) else self.forces(delta1)
-        tau2 = tau1 if np.array_equal(delta2, delta1) else self.forces(delta2)
-        k1 = self.rates(ts, y, tau0)
-        k2 = self.rates(ts + hh, axpy(hh, k1, y), tau1)
-        k3 = self.rates(ts + hh, axpy(hh, k2, y), tau1)
-        k4 = self.rates(ts + hs, axpy(hs, k3, y), tau2)
-        return rk4_update(c, y, k1, k2, k3, k4)
-
-
 class VesselArrays:
     """M vessels stepped together, built from the scalar vessels as initialised."""
     STATES = ("x", "y", "psi", "u", "v", "r", "xi")
 
-    def __init__(self, vessels: Sequence[Vessel], h: float,
-                 shafts: Sequence[tuple[float, float, float]]):
-        first = vessels[0]
-        for vessel in vessels:
-            if vessel.hull != first.hull or vessel.actuators != first.actuators:
-                raise ValueError("the members' vessels differ in hull or actuators")
-            if vessel._cut_of(h)[0] != 1:
-                raise ValueError(f"a member's h_max = {vessel.params.h_max} s cuts the "
-                                 f"{h} s step")
-        waves = [v.waves is not None for v in vessels]
-        if any(waves) and not all(waves):
-            raise ValueError("the members mix calm water and waves")
-        self.lanes = Lanes(first.hull, first._minv, first._m11_inv,
-                           WaveArrays(vessels) if all(waves) else None,
-                           np.array([v.params.psi_w for v in vessels]),
-                           _actuators(first.actuators, np.array(shafts, dtype=float)))
-        self.delta_max = np.array([v.params.delta_max for v in vessels])
-        self.delta_rate_max = np.array([v.params.delta_rate_max for v in vessels])
-        for name in self.STATES:
+    def __init__(self, vessels: Sequence[Vessel], shafts: tuple[float, float, float]):
+        """Vessels of one sea (calm, or N wave components) and ``shafts`` (n1, n2, n3) that
+        cut no step into sub-steps."""
+        self.vessel = vessels[0]                            # the hull and mass matrix of all
+        self.forces = actuator_model(self.vessel.actuators, *shafts)
+        self.waves = None if self.vessel.waves is None else WaveArrays(vessels)
+        for name in ("psi_w", "delta_max", "delta_rate_max"):
+            setattr(self, name, np.array([getattr(v.params, name) for v in vessels]))
+        for name in (*self.STATES, "delta"):
             setattr(self, name, np.array([getattr(v, name) for v in vessels]))
-        self.delta = np.array([v.delta for v in vessels])
 
     def step(self, t: float, h: float, delta_c: np.ndarray) -> None:
         """``Vessel.step``: two RK4 steps for the members whose rudder kinks in the step."""
         gear = RudderArrays(self.delta, delta_c, self.delta_max, self.delta_rate_max)
         y = tuple(getattr(self, name) for name in self.STATES)
         split = (0.0 < gear.reach) & (gear.reach < h)
-        y = self.lanes.rk4(t, 0.0, np.where(split, gear.reach, h), y, gear)
+        y = self._rk4(t, 0.0, np.where(split, gear.reach, h), y, gear, self.waves, self.psi_w)
         lanes = np.flatnonzero(split)
         if len(lanes) == len(split):
-            y = self.lanes.rk4(t, gear.reach, h - gear.reach, y, gear)
+            y = self._rk4(t, gear.reach, h - gear.reach, y, gear, self.waves, self.psi_w)
         elif len(lanes):
             part = gear.take(lanes)
-            rest = self.lanes.take(lanes).rk4(t, part.reach, h - part.reach,
-                                              tuple(a[lanes] for a in y), part)
+            rest = self._rk4(t, part.reach, h - part.reach, tuple(a[lanes] for a in y), part,
+                             None if self.waves is None else self.waves.take(lanes),
+                             self.psi_w[lanes])
             for whole, value in zip(y, rest):
                 whole[lanes] = value
         for name, value in zip(self.STATES, y):
             setattr(self, name, value)
         self.delta = gear(h)
 
+    def _rk4(self, t: float, start: np.ndarray | float, hs: np.ndarray, y: Arrays,
+             gear: RudderArrays, waves: WaveArrays | None, psi_w: np.ndarray) -> Arrays:
+        """An RK4 step of ``Vessel._integrate``, of length ``hs`` from ``t + start`` (each an
+        array or a float), of the members of ``waves``, ``psi_w`` and ``gear`` (all or some)."""
+        v, forces = self.vessel, self.forces
+        loads, hypot = (waves, exact.hypot) if waves is not None else (calm_water, _no_travel)
 
-def _actuators(actuators, shafts: np.ndarray) -> list[tuple[np.ndarray | None, Callable]]:
-    """``actuator_model`` of each distinct (n1, n2, n3), with its members (None: all)."""
-    distinct = np.unique(shafts, axis=0)
-    return [(None if len(distinct) == 1 else np.all(shafts == row, axis=1),
-             actuator_model(actuators, *map(float, row))) for row in distinct]
+        def rates(t: np.ndarray | float, state: Arrays, tau_th: Arrays) -> Arrays:
+            return state_rates(v.hull, v._minv, v._m11_inv, loads, psi_w, t, state, tau_th,
+                               hypot, np.cos, np.sin)
+        hh, c = 0.5 * hs, hs / 6.0
+        s = start + 0.0 * hs
+        ts = t + s
+        delta0, delta1, delta2 = gear(s), gear(s + hh), gear(s + hs)
+        tau0 = forces(delta0)
+        tau1 = tau0 if np.array_equal(delta1, delta0) else forces(delta1)
+        tau2 = tau1 if np.array_equal(delta2, delta1) else forces(delta2)
+        k1 = rates(ts, y, tau0)
+        k2 = rates(ts + hh, axpy(hh, k1, y), tau1)
+        k3 = rates(ts + hh, axpy(hh, k2, y), tau1)
+        k4 = rates(ts + hs, axpy(hs, k3, y), tau2)
+        return rk4_update(c, y, k1, k2, k3, k4)

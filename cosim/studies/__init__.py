@@ -1,5 +1,4 @@
 """Studies on the co-simulation core: sweeps on Dask (``campaign`` runs one), the scorecard,
 the benchmarks (``timing``, ``sweep_timing``, ``memory``), the accuracy study
-(``integration_error``, ``coupling_error`` against ``monolithic``), ``cpu_variants``,
-``spread`` and the modules wired by hand (``direct``).
+(``integration_error``, ``coupling_error``), ``cpu_variants`` and ``spread``.
 """

@@ -1,13 +1,10 @@
-"""Does a run depend on the CPU? The same run under other CPUs' numpy, OpenBLAS and libm.
-
-numpy picks its SIMD loops by CPU, OpenBLAS its kernels, glibc's libm an FMA variant of
-sin, cos, exp, pow, atan2 and tanh; each can be made to choose as on another CPU
-(``NPY_DISABLE_CPU_FEATURES``, ``OPENBLAS_CORETYPE``, ``GLIBC_TUNABLES=glibc.cpu.hwcaps=-AVX2,
--FMA``), read once at start-up: so each run is a child process. Runs are compared on the
-bytes of their CSVs (every signal at every step, 12 significant digits).
-"""
+"""Does a run depend on the CPU? The same run under other CPUs' numpy dispatch, OpenBLAS
+kernels and libm FMA variants (``NPY_DISABLE_CPU_FEATURES``, ``OPENBLAS_CORETYPE``,
+``GLIBC_TUNABLES``), which are read at start-up: each run is a child process, compared on the
+bytes of its CSV (every signal at every step, 12 significant digits)."""
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -34,22 +31,17 @@ VARIANTS: dict[str, dict[str, str]] = {
 TIMEOUT = 300.0
 """s: the most one child run may take."""
 
-_CHILD = """
-import sys
-from cosim import simulate
-stop = float(sys.argv[3]) if sys.argv[3] != "-" else None
-simulate(sys.argv[1], stop_time=stop, backend="inprocess").write_csv(sys.argv[2])
-"""
+_CHILD = ("import json, sys; from cosim import simulate; simulate(sys.argv[1], stop_time="
+          "json.loads(sys.argv[3]), backend='inprocess').write_csv(sys.argv[2])")
 
 
 def run_in(variant: str, scenario: str, csv_path: Path,
            stop_time: float | None = None) -> Path:
     """Run ``scenario`` in-process in a child under ``VARIANTS[variant]``; its CSV.
     RuntimeError with the child's last words if it fails; killed after ``TIMEOUT``."""
-    env = {**os.environ, **VARIANTS[variant]}
     child = subprocess.run([sys.executable, "-c", _CHILD, scenario, str(csv_path),
-                            "-" if stop_time is None else repr(stop_time)],
-                           env=env, capture_output=True, text=True, timeout=TIMEOUT)
+                            json.dumps(stop_time)], env={**os.environ, **VARIANTS[variant]},
+                           capture_output=True, text=True, timeout=TIMEOUT)
     if child.returncode != 0:
         raise RuntimeError(f"{scenario} under {variant!r} failed (status {child.returncode}): "
                            f"{child.stderr.strip().splitlines()[-1:]}")

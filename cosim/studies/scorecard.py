@@ -1,19 +1,13 @@
-"""The scorecard: your autopilot beside the paper's PD and sliding-mode ones and the PID.
-
-Every controller runs the paper's route in calm water and waves, a 40 deg course change,
-and two wave ensembles (the paper's waves, WMO sea state 4) on Dask; each criterion
-(``merit.CRITERIA``) is won or lost on its own, seed-paired against the PD
-(``scorecard_report``). ``score`` writes scorecard.md, its figures and each single run's
-files in runs/ (``cosim.outputs``).
-"""
+"""The scorecard: your autopilot beside the paper's PD and sliding-mode ones and the PID, on
+the paper's route in calm water and waves, a 40 deg course change, and two wave ensembles
+(the paper's waves, WMO sea state 4) on Dask; each criterion (``merit.CRITERIA``) won or
+lost on its own, seed-paired against the PD (``scorecard_report``)."""
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
-
-from autopilot_fmu.guidance import parse_waypoints
 
 from .. import scenarios
 from ..analysis.figures import comparison_figure
@@ -24,8 +18,7 @@ from ..api import SimulationError, overrides_of
 from ..core.files import fresh_folder, write_atomically
 from ..core.recording import Recording
 from ..outputs import Options, run_and_write
-from .scorecard_report import (BASELINE, CourseChange, Paired, Sea, change, markdown, paired,
-                               pairs)
+from .scorecard_report import BASELINE, Paired, Sea, change, markdown, paired, pairs
 from .campaign import execute
 from .spec_file import controller_entry
 from .sweep_spec import Spec
@@ -81,11 +74,13 @@ class Contender:
                 f"{PAPER_TABLES[f'waves_{self.suffix}'][2]:.1f}")
 
 
-def course_change(run: Recording) -> CourseChange:
+def course_change(run: Recording) -> dict[str, float]:
+    """The run's ``merit.run_metrics``, its settling_time (s, inf if it never settles) and
+    overshoot (rad)."""
     psi = run["ship.psi"]
     error = heading_error(run["guidance.psi_d"], psi)
-    return CourseChange(settling_time(run.t, error, SETTLING_BAND),
-                        overshoot(psi, psi[0], psi[0] + COURSE_CHANGE), run_metrics(run))
+    return {**run_metrics(run), "settling_time": settling_time(run.t, error, SETTLING_BAND),
+            "overshoot": overshoot(psi, psi[0], psi[0] + COURSE_CHANGE)}
 
 
 def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | None = None,
@@ -122,14 +117,22 @@ def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | Non
     comparison_figure(runs, out / "course_change.png",
                       "40 deg course change from straight running, calm water")
     ensembles = {}
-    for sea in SEAS:
+    for sea in SEAS:            # each in a fresh folder, with its figures
         progress(f"wave ensemble in {sea.name}, {seeds} seeds on Dask")
-        ensembles[sea] = _run_ensemble(contenders, seeds, sea, out, scheduler, workers,
-                                       backend)
-    (x0, y0), (x1, y1) = parse_waypoints(COURSE_CHANGE_ROUTE)
+        spec = _ensemble(contenders, seeds, out, sea)
+        with fresh_folder(out / ("ensemble" if sea is SEAS[0] else f"ensemble_{sea.key}")) \
+                as folder:
+            rows = ensembles[sea] = execute(spec, folder, scheduler=scheduler, workers=workers,
+                                            progress=False, backend=backend)
+        distribution(spec, rows, out / f"criteria_{sea.key}.png", CRITERIA)
+        others = [c.name for c in contenders if c.name != BASELINE]
+        paired_figure(f"The route in {sea.name}", {
+            criterion: {n: change(criterion, *pairs(criterion, rows, n)) for n in others}
+            for criterion in CRITERIA}, BASELINE, out / f"paired_{sea.key}.png")
+        tracks(spec, rows, out / f"tracks_{sea.key}.png")
+    leg = math.hypot(1000.0, 1000 * math.tan(COURSE_CHANGE))     # of COURSE_CHANGE_ROUTE
     text = markdown(fmu, name, seeds, {c.name: c.paper_cost for c in contenders}, route,
-                    changes, (COURSE_CHANGE_TIME, math.hypot(x1 - x0, y1 - y0)), failures,
-                    ensembles)
+                    changes, (COURSE_CHANGE_TIME, leg), failures, ensembles)
     write_atomically(out / "scorecard.md", lambda path: path.write_text(text))
     return text
 
@@ -152,23 +155,6 @@ def _ensemble(contenders: list[Contender], seeds: int, out: Path, sea: Sea = SEA
     return Spec(name=f"ensemble in {sea.name}", axes=axes,
                 controllers={n: controller_entry(e, out / "scorecard", n)
                              for n, e in entries.items()}, tracks={})   # every track
-
-
-def _run_ensemble(contenders: list[Contender], seeds: int, sea: Sea, out: Path,
-                  scheduler: str | None, workers: int | None, backend: str) -> list[dict]:
-    """Run one ensemble in a fresh folder and draw its figures; its rows."""
-    spec = _ensemble(contenders, seeds, out, sea)
-    folder = out / ("ensemble" if sea is SEAS[0] else f"ensemble_{sea.key}")
-    with fresh_folder(folder) as ensemble:
-        rows = execute(spec, ensemble, scheduler=scheduler, workers=workers, progress=False,
-                       backend=backend)
-    distribution(spec, rows, out / f"criteria_{sea.key}.png", CRITERIA)
-    others = [c.name for c in contenders if c.name != BASELINE]
-    paired_figure(f"The route in {sea.name}", {
-        criterion: {name: change(criterion, *pairs(criterion, rows, name)) for name in others}
-        for criterion in CRITERIA}, BASELINE, out / f"paired_{sea.key}.png")
-    tracks(spec, rows, out / f"tracks_{sea.key}.png")
-    return rows
 
 
 def backend_notes(fmu: Path, name: str, port_map: dict | None, backend: str) -> list[str]:

@@ -4,18 +4,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..analysis.cost import Cost, cost
+from ..analysis.cost import cost
 from ..analysis.metrics import RUDDER_DEADBAND, RouteCompletion, route_completion
 from ..core.recording import Recording
+from .merit import CRITERIA, Merit, route_of, run_metrics
 from .sweep_figures import STATISTICS
-from .merit import CRITERIA, route_of, run_metrics
-
-if TYPE_CHECKING:
-    from .merit import Merit
 
 BASELINE = "PD"                 # every other controller is paired with it, seed by seed
 TIE = 0.01                      # values closer than this share of the baseline's tie
@@ -33,13 +29,6 @@ class Sea:
     @property
     def title(self) -> str:
         return f"{self.name} ({self.detail})"
-
-
-@dataclass(frozen=True)
-class CourseChange:
-    settling_time: float          # s, inf if it never settles within the run
-    overshoot: float              # rad
-    metrics: dict[str, float]     # merit.run_metrics of the run
 
 
 @dataclass(frozen=True)
@@ -97,12 +86,11 @@ def paired(criterion: Merit, rows: list[dict], controller: str,
 
 def completion(run: Recording) -> RouteCompletion:
     """Which waypoints of its route a run reached."""
-    points, R_accept = route_of(run)
-    return route_completion(run["ship.x"], run["ship.y"], points, R_accept)
+    return route_completion(run["ship.x"], run["ship.y"], *route_of(run))
 
 
 def markdown(fmu: Path, name: str, seeds: int, paper: dict[str, str],
-             route: dict[str, dict[str, Recording]], changes: dict[str, CourseChange],
+             route: dict[str, dict[str, Recording]], changes: dict[str, dict],
              course: tuple[float, float], failures: dict[tuple[str, str], str],
              ensembles: dict[Sea, list[dict]]) -> str:
     """scorecard.md: ``paper`` gives each controller's J calm / waves in the paper ('-');
@@ -129,14 +117,13 @@ def markdown(fmu: Path, name: str, seeds: int, paper: dict[str, str],
     return "\n".join(lines)
 
 
-def _cell(criterion: Merit, row: dict) -> str:
-    total = f" of {row[criterion.out_of]:.0f}" if criterion.out_of else ""
-    return criterion.format(row[criterion.column]) + total
+def _of(criterion: Merit, row: dict) -> str:
+    """' of N' for a count out of a total, '' for any other criterion."""
+    return f" of {row[criterion.out_of]:.0f}" if criterion.out_of else ""
 
 
-def _heading(criterion: Merit) -> str:
-    unit = f" ({criterion.unit})" if criterion.unit else ""
-    return f"{criterion.label}{unit}, {criterion.better}"
+def _label(criterion: Merit) -> str:
+    return criterion.label + (f" ({criterion.unit})" if criterion.unit else "")
 
 
 def _reached(done: RouteCompletion) -> str:
@@ -161,10 +148,8 @@ def _at_a_glance(names: list[str], route: dict[str, dict[str, Recording]],
         lines += [f"The route in {sea.title}:", "",
                   "| criterion | better | " + " | ".join(names[1:]) + " |",
                   "|---|---|" + "---|" * len(names[1:])]
-        for c in CRITERIA:
-            unit = f" ({c.unit})" if c.unit else ""
-            lines.append(f"| {c.label}{unit} | {c.better.split()[0]} | " + " | ".join(
-                _verdict(c, paired(c, rows, name)) for name in names[1:]) + " |")
+        lines += [f"| {_label(c)} | {c.better.split()[0]} | " + " | ".join(
+            _verdict(c, paired(c, rows, name)) for name in names[1:]) + " |" for c in CRITERIA]
         lines.append("")
     lines += ["Route completion (higher is better):", "",
               "| controller | calm water | waves | "
@@ -218,23 +203,21 @@ def _paper_route(paper: dict[str, str], route: dict[str, dict[str, Recording]]) 
     lines = ["## The paper's route (Tables 1-2, eq 19; lower is better)", "",
              "| controller | calm psi_E | calm delta_E | calm J | waves psi_E | waves delta_E "
              "| waves J | paper J calm / waves |", "|---|---|---|---|---|---|---|---|"]
-    costs = {(n, sea): cost(r) for sea, runs in route.items() for n, r in runs.items()}
     for name, theirs in paper.items():
         cells = []
         for sea in ("calm", "waves"):
-            r: Cost | None = costs.get((name, sea))
-            cells += ([f"{r.psi_E:.1f}", f"{r.delta_E:.1f}", f"{r.J:.1f}"] if r
-                      else ["failed"] * 3)
+            r = cost(route[sea][name]) if name in route[sea] else None
+            cells += [f"{r.psi_E:.1f}", f"{r.delta_E:.1f}", f"{r.J:.1f}"] if r else ["failed"] * 3
         lines.append(f"| {name} | {' | '.join(cells)} | {theirs} |")
     lines += ["", "Every criterion, one run each (the scenarios' wave seed):", "",
-              "| controller | sea | " + " | ".join(_heading(c) for c in CRITERIA) + " |",
-              "|---|---|" + "---|" * len(CRITERIA)]
+              "| controller | sea | " + " | ".join(f"{_label(c)}, {c.better}" for c in CRITERIA)
+              + " |", "|---|---|" + "---|" * len(CRITERIA)]
     misses = []
     for sea, runs in route.items():
         for name, run in runs.items():
             row = run_metrics(run)
-            lines.append(f"| {name} | {sea} | "
-                         + " | ".join(_cell(c, row) for c in CRITERIA) + " |")
+            lines.append(f"| {name} | {sea} | " + " | ".join(
+                c.format(row[c.column]) + _of(c, row) for c in CRITERIA) + " |")
             done = completion(run)
             if done.count < len(done.points):
                 missed = ", ".join(f"waypoint {k} ({x:g}, {y:g}) by {d:.1f} m"
@@ -247,20 +230,20 @@ def _paper_route(paper: dict[str, str], route: dict[str, dict[str, Recording]]) 
                     "![route in waves](route_waves.png)", ""]
 
 
-def _course_change(names: list[str], changes: dict[str, CourseChange], time: float,
+def _course_change(names: list[str], changes: dict[str, dict], time: float,
                    leg: float) -> list[str]:
     lines = [f"## A 40 deg course change, calm water, {time:.0f} s (lower is better)", "",
              "| controller | settling time to 2 % (s) | overshoot (deg) | rudder reversals "
              "(1/min) | mean abs rudder rate (deg/s) | max rudder (deg) | max cross-track (m) |",
              "|---|---|---|---|---|---|---|"]
     for name in names:
-        r = changes.get(name)
-        if r is None:
+        m = changes.get(name)
+        if m is None:
             lines.append(f"| {name} |" + " failed |" * 6)
             continue
-        settled = f"{r.settling_time:.1f}" if math.isfinite(r.settling_time) else f"> {time:.0f}"
-        m = r.metrics
-        lines.append(f"| {name} | {settled} | {math.degrees(r.overshoot):.2f} | "
+        settled = f"{m['settling_time']:.1f}" if math.isfinite(m["settling_time"]) else \
+            f"> {time:.0f}"
+        lines.append(f"| {name} | {settled} | {math.degrees(m['overshoot']):.2f} | "
                      f"{m['reversals_per_min']:.1f} | {m['mean_rudder_rate_deg_s']:.2f} | "
                      f"{m['max_delta_deg']:.1f} | {m['cross_track_max_m']:.2f} |")
     return lines + ["", f"The course change follows one leg of {leg:.0f} m, longer than the "
@@ -273,7 +256,8 @@ def _ensemble_section(sea: Sea, names: list[str], seeds: int, rows: list[dict]) 
     lines = [f"## Wave ensemble: the route in {sea.title}, {seeds} wave seeds", "",
              "Each criterion: median [IQR, 25-75 %] over the seeds that ran; waypoints "
              "reached out of the route's.", "",
-             "| controller | runs ok | " + " | ".join(_heading(c) for c in CRITERIA) + " |",
+             "| controller | runs ok | " + " | ".join(f"{_label(c)}, {c.better}" for c in CRITERIA)
+             + " |",
              "|---|---|" + "---|" * len(CRITERIA)]
     for name in names:
         mine = _ok(rows, name)
@@ -293,7 +277,6 @@ def _spread(criterion: Merit, rows: list[dict]) -> str:
     """'median [25 % - 75 %]' of the rows' values (' of N' for a count), '-' if none."""
     if not rows:
         return "-"
-    q1, median, q3 = np.percentile([r[criterion.column] for r in rows], [25, 50, 75])
-    total = f" of {rows[0][criterion.out_of]:.0f}" if criterion.out_of else ""
-    return (f"{criterion.format(median)} [{criterion.format(q1)} - "
-            f"{criterion.format(q3)}]{total}")
+    q1, median, q3 = map(criterion.format, np.percentile([r[criterion.column] for r in rows],
+                                                         [25, 50, 75]))
+    return f"{median} [{q1} - {q3}]{_of(criterion, rows[0])}"

@@ -1,12 +1,8 @@
-"""How many of a run's digits mean something? The run again with a last bit changed.
-
-The sliding-mode loop chatters, and in waves a leg switch can move by a step: a last-bit
-difference grows into percent of J, as a CPU or C library that rounds otherwise would make.
-The ensemble: the run, and the run with one parameter moved by k ulps, k = +-1 ... +-ulps:
-the initial surge speed u0 (a change the run carries) and the wave direction psi_w (a change
-to the wave loads at every step). The largest change of each figure of eq (19) over it is
-the precision a published figure of that run has.
-"""
+"""How many of a run's digits mean something? The run again with a last bit changed: the
+initial surge speed u0 (a change the run carries) and the wave direction psi_w (a change to
+the wave loads at every step), each moved by k ulps, k = +-1 ... +-ulps. The chattering
+sliding-mode loop and the switches of leg turn a last bit into percent of J, as a CPU that
+rounds otherwise would: the largest change of each figure of eq (19) is its precision."""
 from __future__ import annotations
 
 import math
@@ -37,19 +33,17 @@ class Spread:
     and another CPU's run may diverge either way)."""
 
     runs: int
-    ulps: int                       # each member moved one parameter by -ulps ... +ulps
     nominal: dict[str, float]       # figure: the unperturbed run's value
     deviation: dict[str, float]     # figure: the largest |member - nominal|
 
-    def wider_than(self, figure: str, digits: int = 2) -> bool:
-        """Whether value +- deviation shows at ``digits`` decimals."""
-        value, change = self.nominal[figure], self.deviation[figure]
-        return f"{value - change:.{digits}f}" != f"{value + change:.{digits}f}"
-
     def describe(self, digits: int = 2) -> str:
-        """'psi_E 472.76 +- 18.67, J 612.45 +- 20.18', or 'every figure as printed'."""
-        wide = [f"{f} {self.nominal[f]:.{digits}f} +- {self.deviation[f]:.{digits}f}"
-                for f in FIGURES if self.wider_than(f, digits)]
+        """'psi_E 472.76 +- 18.67, J 612.45 +- 20.18': the figures whose value +- deviation
+        shows at ``digits`` decimals; or 'every figure as printed'."""
+        wide = []
+        for f in FIGURES:
+            value, change = self.nominal[f], self.deviation[f]
+            if f"{value - change:.{digits}f}" != f"{value + change:.{digits}f}":
+                wide.append(f"{f} {value:.{digits}f} +- {change:.{digits}f}")
         return ", ".join(wide) if wide else "every figure as printed"
 
 
@@ -61,7 +55,7 @@ def spread(system: SystemDescription, overrides: dict[str, dict[str, Any]] | Non
     naming the member if a run fails."""
     if ulps < 1:
         raise ValueError(f"spread: ulps must be >= 1, got {ulps}")
-    overrides = {c: dict(v) for c, v in (overrides or {}).items()}
+    overrides = overrides or {}
     members = [(None, 0)] + [(p, k) for p in PERTURBED
                              for j in range(1, ulps + 1) for k in (-j, j)]
     costs: list[Cost] = []
@@ -88,4 +82,4 @@ def spread(system: SystemDescription, overrides: dict[str, dict[str, Any]] | Non
             costs.append(cost(recording, lam))
     nominal = {f: getattr(costs[0], f) for f in FIGURES}
     deviation = {f: max(abs(getattr(c, f) - nominal[f]) for c in costs) for f in FIGURES}
-    return Spread(len(costs), ulps, nominal, deviation)
+    return Spread(len(costs), nominal, deviation)

@@ -1,8 +1,6 @@
 """The sweep benchmark (``python -m cosim.bench sweep``): sweeps on fresh local clusters, every
 backend side by side (``sweep_throughput``) and 1,000 waves_pd runs on the batch route
-(``campaign``; its memory: ``memory.batch_memory``), each goal printed beside its figure and
-the load average before and after each part.
-"""
+(``campaign``), each goal printed beside its figure, with the load average."""
 from __future__ import annotations
 
 import math
@@ -13,7 +11,9 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+from .spec_file import controller_entry
 from .sweep_client import plan
+from .sweep_spec import Spec
 from .sweep_task import BATCH, SWEEP_BACKENDS
 from .timing import machine, peak_rss_mb, require_in_process
 
@@ -47,11 +47,6 @@ class Measure:
         """Runs per second."""
         return self.runs / self.wall
 
-    @property
-    def outside(self) -> float:
-        """s per run of worker time outside the tasks."""
-        return self.wall * self.workers / self.runs - self.simulated - self.in_task
-
 
 def sweep_throughput(runs: int = 32, batch_runs: int = 1024,
                      seas: tuple[str, ...] = tuple(SEAS), worker_counts: tuple[int, ...] = (1, 2),
@@ -60,8 +55,10 @@ def sweep_throughput(runs: int = 32, batch_runs: int = 1024,
     """Runs per second by (sea, backend, workers): the median of ``rounds`` sweeps of ``runs``
     runs (``batch_runs`` on the batch backend) taken in turn; printed with the per-core
     rates, the parallel efficiency and the goals (the median of the rounds' ratios)."""
-    _check_runs(runs, "runs")
-    _check_runs(batch_runs, "batch_runs")
+    for count, name in ((runs, "runs"), (batch_runs, "batch_runs")):
+        if count < 2 or count % 2:
+            raise ValueError(f"{name} must be an even number of runs >= 2 (half for each "
+                             f"autopilot), got {count}")
     if rounds < 1:
         raise ValueError(f"rounds must be at least 1, got {rounds}")
     print(f"sweep throughput: runs of {stop_time:g} s (waves: {' and '.join(SEAS['waves'])} "
@@ -69,24 +66,40 @@ def sweep_throughput(runs: int = 32, batch_runs: int = 1024,
           f"{runs} runs a sweep ({batch_runs} on the batch backend), each on a fresh local "
           f"cluster, on {machine()}; {load()}")
     for sea in seas:                              # before minutes of measuring the others
-        _require(sea, backends)
+        spec = _sea_spec(sea, 2, 1.0)
+        if "inprocess" in backends:
+            require_in_process(spec.backend_notes("inprocess"))
+        if BATCH in backends:
+            require_batch(spec)
     measured: dict[tuple[str, str, int], list[float]] = {}
     for _ in range(rounds):
         for workers in worker_counts:             # backends side by side, under the same load
             for sea in seas:
                 for backend in backends:
-                    with tempfile.TemporaryDirectory() as tmp:
-                        measure = timed_sweep(_sea_spec(Path(tmp), sea, batch_runs if backend ==
-                                                   BATCH else runs, stop_time), workers, backend)
-                    _print_measure(f"{sea:5} {backend:9}", measure)
-                    measured.setdefault((sea, backend, workers), []).append(measure.rate)
+                    m = timed_sweep(_sea_spec(sea, batch_runs if backend == BATCH else runs,
+                                              stop_time), workers, backend)
+                    batched = f"; batches of {sizes(m.batches)}" if m.batches else ""
+                    outside = m.wall * m.workers / m.runs - m.simulated - m.in_task
+                    print(f"  {sea:5} {backend:9} {_workers(workers):9}: {m.rate:6.2f} runs/s "
+                          f"({m.runs} runs in {m.wall:5.1f} s; cluster start-up "
+                          f"{m.startup:4.1f} s{batched}); per run: simulation "
+                          f"{m.simulated:5.3f} s, overhead in the task {m.in_task:5.3f} s "
+                          f"({m.in_task / m.simulated:4.1%}), outside it {outside:5.3f} s "
+                          f"({outside / m.simulated:4.1%}); load {m.load:.2f}")
+                    measured.setdefault((sea, backend, workers), []).append(m.rate)
     rates = {key: statistics.median(values) for key, values in measured.items()}
     _print_rates(rates, seas, worker_counts, backends, rounds)
     if BATCH in backends and "inprocess" in backends:
         for sea in seas:
-            _print_goal(sea, {w: [b / i for b, i in zip(measured[sea, BATCH, w],
-                                                        measured[sea, "inprocess", w])]
-                              for w in worker_counts})
+            ratios = {w: [b / i for b, i in zip(measured[sea, BATCH, w],
+                                                measured[sea, "inprocess", w])]
+                      for w in worker_counts}
+            medians = {w: statistics.median(r) for w, r in ratios.items()}
+            print(f"  goal, {sea}: batch runs/s per core at least {GOALS[sea]:g}x in-process: "
+                  + ", ".join(f"{medians[w]:.2f}x with {_workers(w)}" + (
+                      f" (rounds: {', '.join(f'{x:.2f}' for x in r)})" if len(r) > 1 else "")
+                      for w, r in ratios.items())
+                  + f": {verdict(all(m >= GOALS[sea] for m in medians.values()))}")
     print(f"  {load()}")
     return rates
 
@@ -99,10 +112,9 @@ def campaign(runs: int = CAMPAIGN_RUNS, workers: int = CAMPAIGN_WORKERS,
         raise ValueError(f"the campaign's runs must be at least 1, got {runs}")
     print(f"campaign: {runs} waves_pd runs of {stop_time:g} s on the batch route, a local "
           f"cluster of {_workers(workers)}, on {machine()}; {load()}")
-    with tempfile.TemporaryDirectory() as tmp:
-        spec = bench_spec(Path(tmp), {"pd": "waves_pd"}, seeds(runs), stop_time)
-        require_batch(spec)
-        measure = timed_sweep(spec, workers, BATCH)
+    spec = bench_spec({"pd": "waves_pd"}, seeds(runs), stop_time)
+    require_batch(spec)
+    measure = timed_sweep(spec, workers, BATCH)
     total = measure.wall + measure.startup
     print(f"  {measure.runs} runs in {measure.wall:.1f} s from submission to the last row "
           f"({measure.rate:.1f} runs/s, {measure.rate / workers:.1f} per core; batches of "
@@ -121,12 +133,6 @@ def campaign(runs: int = CAMPAIGN_RUNS, workers: int = CAMPAIGN_WORKERS,
     return measure
 
 
-def _check_runs(runs: int, name: str) -> None:
-    if runs < 2 or runs % 2:
-        raise ValueError(f"{name} must be an even number of runs >= 2 (half for each "
-                         f"autopilot), got {runs}")
-
-
 def verdict(met: bool) -> str:
     return "met" if met else "NOT met"
 
@@ -141,57 +147,34 @@ def sizes(sizes: tuple[int, ...]) -> str:
     return f"{low}" if low == high else f"{low}-{high}"
 
 
-def seeds(runs: int) -> dict[str, str]:
-    """The axis of ``runs`` wave seeds from 1, in TOML (in calm water: headings, 1 mrad apart,
-    since the seed changes nothing there)."""
-    return {"wave_seed": f"{{ start = 1, count = {runs} }}"}
+def seeds(runs: int) -> dict[str, list]:
+    """The axis of ``runs`` wave seeds from 1."""
+    return {"wave_seed": list(range(1, runs + 1))}
 
 
-def _headings(runs: int) -> dict[str, str]:
-    return {'"ship.psi0"': "[" + ", ".join(repr(k / 1000) for k in range(runs)) + "]"}
+def bench_spec(controllers: dict[str, str], axes: dict[str, list], stop_time: float) -> Spec:
+    """A sweep of ``controllers`` (name: scenario) over ``axes`` (name: its values)."""
+    return Spec(name="bench", controllers={name: controller_entry(scenario, Path.cwd(), name)
+                                           for name, scenario in controllers.items()},
+                axes=axes, stop_time=stop_time)
 
 
-def bench_spec(folder: Path, controllers: dict[str, str], axes: dict[str, str],
-                stop_time: float):
-    """A sweep of ``controllers`` (name: scenario) over ``axes`` (name: its TOML value)."""
-    from .sweep_spec import Spec
-
-    folder.mkdir(parents=True, exist_ok=True)
-    text = (f'name = "bench"\nstop_time = {stop_time!r}\n[controllers]\n'
-            + "".join(f'{name} = {{ scenario = "{scenario}" }}\n'
-                      for name, scenario in controllers.items())
-            + "[axes]\n" + "".join(f"{name} = {value}\n" for name, value in axes.items()))
-    path = folder / "bench.toml"
-    path.write_text(text)
-    return Spec.read(path)
+def _sea_spec(sea: str, runs: int, stop_time: float) -> Spec:
+    """The sweep of ``runs`` runs of a sea, half with each of its scenarios: over wave seeds,
+    or in calm water (where the seed changes nothing) over headings 1 mrad apart."""
+    axes = seeds(runs // 2) if sea == "waves" else {
+        "ship.psi0": [k / 1000 for k in range(runs // 2)]}
+    return bench_spec(dict(zip(("pd", "smc"), SEAS[sea])), axes, stop_time)
 
 
-def _sea_spec(folder: Path, sea: str, runs: int, stop_time: float):
-    """The sweep of ``runs`` runs of a sea: half with each of its scenarios."""
-    axis = seeds if sea == "waves" else _headings
-    return bench_spec(folder, dict(zip(("pd", "smc"), SEAS[sea])), axis(runs // 2), stop_time)
-
-
-def _require(sea: str, backends: tuple[str, ...]) -> None:
-    """RuntimeError if a backend of ``backends`` would not run the sea's sweeps as itself."""
-    with tempfile.TemporaryDirectory() as tmp:
-        spec = _sea_spec(Path(tmp), sea, 2, 1.0)
-        if "inprocess" in backends:
-            require_in_process(spec.backend_notes("inprocess"))
-        if BATCH in backends:
-            require_batch(spec)
-
-
-def require_batch(spec) -> None:
+def require_batch(spec: Spec) -> None:
     """RuntimeError if the runs of ``spec`` would not all run in batches; prints the
     self-test's time, which each worker process spends once."""
     from ..ensemble import selftest
 
     notes = spec.backend_notes(BATCH)
     first, started = selftest.cache_info().currsize == 0, time.perf_counter()
-    refusal = selftest()
-    if refusal:
-        notes.append(refusal)
+    notes += [refusal] if (refusal := selftest()) else []
     if notes:
         raise RuntimeError("the batch route cannot be measured: " + "; ".join(notes))
     if first:
@@ -199,7 +182,8 @@ def require_batch(spec) -> None:
               "per worker process (within each batch sweep's time)")
 
 
-def timed_sweep(spec, workers: int, backend: str, batch_size: int | None = None) -> Measure:
+def timed_sweep(spec: Spec, workers: int, backend: str, batch_size: int | None = None
+                ) -> Measure:
     """``spec`` run on a fresh local cluster of ``workers``; RuntimeError if a run failed,
     or, on the batch backend, ran other than in a batch."""
     from dask.distributed import Client
@@ -223,27 +207,16 @@ def timed_sweep(spec, workers: int, backend: str, batch_size: int | None = None)
     if failed:
         raise RuntimeError(f"{len(failed)} of {len(rows)} runs of the {backend} sweep failed: "
                            f"{failed[0]['error']}")
-    if backend == BATCH:
-        alone = [r for r in rows if r["backend"] != BATCH]
-        if alone:
-            raise RuntimeError(f"{len(alone)} of {len(rows)} runs of the batch sweep ran "
-                               f"alone: {alone[0]['backend']}")
-    sizes = tuple(len(b) for b in plan(spec, [spec.job(g[0], "bench", "inprocess")
-                                              for g in spec.shared_runs()],
-                                       workers, batch_size)[0]) if backend == BATCH else ()
-    simulated = math.fsum(r["sim_seconds"] for r in rows) / len(rows)
-    in_task = math.fsum(r["seconds"] - r["sim_seconds"] for r in rows) / len(rows)
-    return Measure(len(rows), workers, done - ready, ready - started, simulated, in_task,
-                   sizes, peaks, os.getloadavg()[0])
-
-
-def _print_measure(label: str, m: Measure) -> None:
-    batched = f"; batches of {sizes(m.batches)}" if m.batches else ""
-    print(f"  {label} {m.workers} worker{'s' if m.workers > 1 else ' '}: {m.rate:6.2f} runs/s "
-          f"({m.runs} runs in {m.wall:5.1f} s; cluster start-up {m.startup:4.1f} s{batched}); "
-          f"per run: simulation {m.simulated:5.3f} s, overhead in the task {m.in_task:5.3f} s "
-          f"({m.in_task / m.simulated:4.1%}), outside it {m.outside:5.3f} s "
-          f"({m.outside / m.simulated:4.1%}); load {m.load:.2f}")
+    alone = [r for r in rows if r["backend"] != BATCH] if backend == BATCH else []
+    if alone:
+        raise RuntimeError(f"{len(alone)} of {len(rows)} runs of the batch sweep ran "
+                           f"alone: {alone[0]['backend']}")
+    jobs = [spec.job(group[0], "bench", "inprocess") for group in spec.shared_runs()]
+    batches = plan(spec, jobs, workers, batch_size)[0] if backend == BATCH else []
+    return Measure(len(rows), workers, done - ready, ready - started,
+                   math.fsum(r["sim_seconds"] for r in rows) / len(rows),
+                   math.fsum(r["seconds"] - r["sim_seconds"] for r in rows) / len(rows),
+                   tuple(map(len, batches)), peaks, os.getloadavg()[0])
 
 
 def _print_rates(rates: dict[tuple[str, str, int], float], seas: tuple[str, ...],
@@ -267,14 +240,3 @@ def _print_rates(rates: dict[tuple[str, str, int], float], seas: tuple[str, ...]
                 print(f"  {sea:5} {backend} / fmi: " + ", ".join(
                     f"{rates[sea, backend, w] / rates[sea, 'fmi', w]:5.2f}x with {_workers(w)}"
                     for w in worker_counts))
-
-
-def _print_goal(sea: str, ratios: dict[int, list[float]]) -> None:
-    """The batch route's goal in ``sea``: its rate over the in-process sweep's of the same
-    round, the median of the rounds, each round's beside it."""
-    medians = {w: statistics.median(r) for w, r in ratios.items()}
-    print(f"  goal, {sea}: batch runs/s per core at least {GOALS[sea]:g}x in-process: "
-          + ", ".join(f"{medians[w]:.2f}x with {_workers(w)}"
-                      + (f" (rounds: {', '.join(f'{x:.2f}' for x in r)})" if len(r) > 1 else "")
-                      for w, r in ratios.items())
-          + f": {verdict(all(m >= GOALS[sea] for m in medians.values()))}")

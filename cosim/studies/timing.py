@@ -1,7 +1,6 @@
 """The engine benchmarks behind ``python -m cosim.bench`` (figures printed, never asserted):
 ``engines`` side by side on calm_pd and waves_pd, and ``overhead``, what the routes do
-besides the models; the helpers the other benchmarks share.
-"""
+besides the models; the helpers the other benchmarks share."""
 from __future__ import annotations
 
 import os
@@ -14,30 +13,31 @@ from pathlib import Path
 from typing import Callable
 
 STEPS = 4000
+ROWS = {"direct": "(a) cosim.direct: the modules wired by hand",
+        "inprocess": "(b) our master, in-process backend",
+        "fmi": "(c) our master, FMUs via fmpy",
+        "libcosim": "(d) OSP libcosim, same SSP",
+        "ecos": "(e) ecos, same SSP",
+        "floor": "(f) FMI floor: a + calls x cost"}
 
 
 def peak_rss_mb() -> float:
     """This process's peak resident memory, MB: Linux's VmHWM, which starts afresh with the
     process's program (``ru_maxrss`` keeps a forked parent's peak)."""
     try:
-        for line in Path("/proc/self/status").read_text().splitlines():
-            if line.startswith("VmHWM:"):
-                return int(line.split()[1]) / 1024
-    except OSError:
-        pass
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+        return next(int(line.split()[1]) / 1024 for line in
+                    Path("/proc/self/status").read_text().splitlines() if line.startswith("VmHWM:"))
+    except (OSError, StopIteration):
+        return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 
 
 def machine() -> str:
     """One line on the machine the figures come from."""
-    cpu = platform.processor() or platform.machine()
     try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
+        cpu = next(line.split(":", 1)[1].strip() for line in
+                   Path("/proc/cpuinfo").read_text().splitlines() if line.startswith("model name"))
+    except (OSError, StopIteration):
+        cpu = platform.processor() or platform.machine()
     return (f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}, "
             f"{platform.system()} {platform.release()}")
 
@@ -62,8 +62,7 @@ def _libcosim_runner(ssp: Path) -> Callable[[], None]:
     log_output_level(CosimLogLevel.ERROR)
 
     def run() -> None:
-        execution = CosimExecution.from_ssp_file(str(ssp))
-        if not execution.simulate_until(400 * 10**9):        # nanoseconds
+        if not CosimExecution.from_ssp_file(str(ssp)).simulate_until(400 * 10**9):   # ns
             raise RuntimeError("libcosim failed")
     return run
 
@@ -82,23 +81,15 @@ def _ecos_runner(ssp: Path) -> Callable[[], None]:
     return run
 
 
-ROWS = {"direct": "(a) cosim.direct: the modules wired by hand",
-        "inprocess": "(b) our master, in-process backend",
-        "fmi": "(c) our master, FMUs via fmpy",
-        "libcosim": "(d) OSP libcosim, same SSP",
-        "ecos": "(e) ecos, same SSP",
-        "floor": "(f) FMI floor: a + calls x cost"}
-
-
 def engines(repeats: int) -> dict[str, dict[str, float]]:
-    """calm_pd and waves_pd, 400 s, by (a) the modules wired by hand (``direct``), our master
-    (b) in-process and (c) through the FMUs, (d) libcosim and (e) ecos on the exported SSP
-    package, and (f) the FMI floor, (a) plus the calls per step times one's cost; one table
-    per scenario with the ratios, and the times by scenario and row."""
+    """calm_pd and waves_pd, 400 s, by (a) the modules wired by hand (``run_direct``), our
+    master (b) in-process and (c) through the FMUs, (d) libcosim and (e) ecos on the exported
+    SSP package, and (f) the FMI floor, (a) plus the calls per step times one's cost; one
+    table per scenario with the ratios, and the times by scenario and row."""
     from .. import scenarios
     from ..core.master import Master
+    from ..ensemble.reference import run_direct
     from ..interop.ssp import export
-    from .direct import run_direct
 
     print(f"Engines on the same system, 400 s = {STEPS} macro steps of 0.1 s, median of "
           f"{repeats} runs taken in turn, on {machine()}")
@@ -109,20 +100,31 @@ def engines(repeats: int) -> dict[str, dict[str, float]]:
             ssp = export(name, Path(tmp))
             with Master(system, backend="inprocess") as inprocess, \
                     Master(system, backend="fmi") as fmi:
-                masters = {"inprocess": inprocess, "fmi": fmi}
-                require_in_process(masters["inprocess"].notes)
-                runners = {"direct": lambda: run_direct(system),
-                           **{b: _master_runner(m) for b, m in masters.items()}}
+                require_in_process(inprocess.notes)
+                runners = {"direct": lambda: run_direct(inprocess),
+                           "inprocess": _master_runner(inprocess), "fmi": _master_runner(fmi)}
                 for key, make in (("libcosim", _libcosim_runner), ("ecos", _ecos_runner)):
                     try:
                         runners[key] = make(ssp)
                     except Exception as error:          # not installed here: say so
                         print(f"  {key} unavailable: {type(error).__name__}: {error}")
-                times = side_by_side(runners, repeats)
+                times = results[name] = side_by_side(runners, repeats)
                 calls, per_call = fmi_calls_per_step(fmi), fmi_call_cost(fmi)
             times["floor"] = times["direct"] + STEPS * calls * per_call
-            results[name] = times
-            _print_engines(name, times, calls, per_call)
+            print(f"\n{name}:\n  {'':44} {'wall s':>7} {'us/step':>8} {'RTF':>6} {'x (a)':>6}")
+            for key, label in ROWS.items():
+                if key in times:
+                    t = times[key]
+                    print(f"  {label:44} {t:7.3f} {t / STEPS * 1e6:8.1f} {400 / t:6.0f} "
+                          f"{t / times['direct']:6.2f}")
+            ratios = [f"b/a = {times['inprocess'] / times['direct']:.2f}",
+                      f"c/b = {times['fmi'] / times['inprocess']:.2f}",
+                      f"c/f = {times['fmi'] / times['floor']:.2f}"]
+            ratios += [f"{letter}/c = {times[k] / times['fmi']:.2f}"
+                       for letter, k in (("d", "libcosim"), ("e", "ecos")) if k in times]
+            print(f"  {'   '.join(ratios)}\n  (f): {calls} FMI calls per step x "
+                  f"{per_call * 1e6:.1f} us per call (measured on the PD FMU in the running "
+                  "loop) + the model compute (a)")
     calm, waves = results["calm_pd"], results["waves_pd"]
     print(f"\nwaves_pd / calm_pd in-process: {waves['inprocess'] / calm['inprocess']:.2f} "
           f"(cosim.direct: {waves['direct'] / calm['direct']:.2f})")
@@ -141,25 +143,6 @@ def _master_runner(master) -> Callable[[], None]:
         if master.run().error:
             raise RuntimeError(f"our master failed ({master.backend})")
     return run
-
-
-def _print_engines(name: str, times: dict[str, float], calls: int, per_call: float) -> None:
-    print(f"\n{name}:")
-    print(f"  {'':44} {'wall s':>7} {'us/step':>8} {'RTF':>6} {'x (a)':>6}")
-    for key, label in ROWS.items():
-        if key in times:
-            t = times[key]
-            print(f"  {label:44} {t:7.3f} {t / STEPS * 1e6:8.1f} {400 / t:6.0f} "
-                  f"{t / times['direct']:6.2f}")
-    ratios = [f"b/a = {times['inprocess'] / times['direct']:.2f}",
-              f"c/b = {times['fmi'] / times['inprocess']:.2f}",
-              f"c/f = {times['fmi'] / times['floor']:.2f}"]
-    ratios += [f"{letter}/c = {times[k] / times['fmi']:.2f}"
-               for letter, k in (("d", "libcosim"), ("e", "ecos"))
-               if k in times]
-    print(f"  {'   '.join(ratios)}")
-    print(f"  (f): {calls} FMI calls per step x {per_call * 1e6:.1f} us per call (measured "
-          "on the PD FMU in the running loop) + the model compute (a)")
 
 
 def fmi_calls_per_step(master) -> int:
@@ -184,29 +167,49 @@ def fmi_call_cost(master, calls: int = 20_000) -> float:
     return (time.perf_counter() - started) / calls
 
 
+def _nothing(*args, **kwargs) -> None:
+    return None
+
+
+def _idle_reader(self, vrs: list[int]) -> Callable[[], list[float]]:
+    values = [0.0] * len(vrs)
+    return lambda: values
+
+
+IDLE_CALLS = {"reader": _idle_reader, "integer_reader": _idle_reader,
+              "writer": lambda self, vrs: _nothing, "stepper": lambda self: _nothing}
+"""The in-process instance's prepared calls doing nothing: the master's own work remains."""
+
+
 def overhead(repeats: int) -> dict[str, float]:
     """What the routes do besides the models: calm_pd with the ship's step doing nothing,
-    by hand, on the null backend and in-process; microseconds per step."""
+    by hand, by the master with its calls into the FMUs idle (``IDLE_CALLS``) and
+    in-process; microseconds per step."""
     from unittest import mock
 
     from ship_fmu.vessel import Vessel
 
     from .. import scenarios
+    from ..core.inprocess import InProcessInstance
     from ..core.master import Master
-    from .direct import run_direct
+    from ..ensemble.reference import run_direct
 
     system = scenarios.load("calm_pd")
-    with Master(system, backend="null") as null, \
-            Master(system, backend="inprocess") as inprocess:
+    with Master(system, backend="inprocess") as inprocess, \
+            Master(system, backend="inprocess") as idle:
         require_in_process(inprocess.notes)
-        with mock.patch.object(Vessel, "step", lambda self, *args, **kwargs: None):
-            times = side_by_side({"direct": lambda: run_direct(system), "null": null.run,
+
+        def idle_run() -> None:
+            with mock.patch.multiple(InProcessInstance, **IDLE_CALLS):
+                _master_runner(idle)()
+        with mock.patch.object(Vessel, "step", _nothing):
+            times = side_by_side({"direct": lambda: run_direct(inprocess), "idle": idle_run,
                                   "inprocess": _master_runner(inprocess)}, repeats)
     per_step = {key: t / STEPS * 1e6 for key, t in times.items()}
     print(f"What the routes do besides the models: calm_pd, {STEPS} steps with the ship's step "
           f"doing nothing, median of {repeats} runs taken in turn, on {machine()}")
     for key, label in (("direct", "cosim.direct (the modules wired by hand)"),
-                       ("null", "our master, no FMU behind it (null backend)"),
+                       ("idle", "our master, its calls into the FMUs idle"),
                        ("inprocess", "our master, in-process backend")):
         print(f"  {label:48} {per_step[key]:6.1f} us/step")
     print(f"  the in-process master beyond cosim.direct: "
