@@ -2,26 +2,22 @@
 ``plan``), each row journaled as it completes, the workers checked and watched."""
 from __future__ import annotations
 
+import contextlib
 import logging
 import math
 import sys
 import uuid
-from contextlib import contextmanager
-from dataclasses import dataclass
-from typing import Iterator
 
 from fmukit.timebase import step_count
 
 from ..core.interrupt import Interrupted, StopSignals
 from ..core.watchdog import Limits
 from ..ensemble import SIGNALS
-from .cluster import (Completions, NoWorkers, WorkerWatch, check_workers, has_dashboard,
-                      say)
+from .cluster import Completions, NoWorkers, check_workers, has_dashboard, say
 from .journal import Journal
 from .sweep_spec import Spec
 from .sweep_task import (BATCH, Job, SweepTeardown, batch_refusal, blank_row, fmu_bytes, noted,
                          run_batch)
-
 
 MAX_BATCH = 1024
 """The most runs a batch gets unless told otherwise (``--batch-size``)."""
@@ -82,51 +78,54 @@ def plan(spec: Spec, jobs: list[Job], workers: int, size: int | None = None
     """(the batches, the runs to run alone) of a sweep on the batch backend: each system's
     runs of one stop time cut as ``batch_counts`` says, those the kernel does not cover
     (``Spec.batch_coverage``) alone."""
-    covered = spec.batch_coverage()
     groups: dict[tuple[str, float | None], list[Job]] = {}
     alone = []
     for job in jobs:
-        if covered[job.run["controller"]] is None:
+        if spec.batch_coverage()[job.run["controller"]] is None:
             groups.setdefault((job.bundle.digest, job.stop_time), []).append(job)
         else:
             alone.append(job)
-    cut = list(groups.values())
-    counts = batch_counts(cut, workers, size)
-    return [batch for group, count in zip(cut, counts) for batch in _cut(group, count)], alone
+    counts = batch_counts(list(groups.values()), workers, size)
+    return [batch for group, count in zip(groups.values(), counts)
+            for batch in _cut(group, count)], alone
 
 
 def run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, progress: bool,
                    task, backend: str, no_worker_timeout: float, limits: Limits,
                    batch_task=run_batch, batch_size: int | None = None) -> None:
     """Run ``todo`` (runs of ``spec``) on the cluster of ``connection`` (a client, and the
-    local cluster it made or None), journaling each row; both closed on every path, quietly
-    when the sweep stops early (``campaign.execute`` says the rest)."""
+    local cluster it made or None), journaling each row; both closed on every path. When
+    the sweep stops early, quietly (``campaign.execute`` says the rest), and after Ctrl-C or
+    SIGTERM a second signal ends the process at once (``StopSignals``)."""
     client, cluster = connection
     teardown = SweepTeardown(uuid.uuid4().hex[:12])
-    stopped = None
     try:
         _submit_and_journal(spec, todo, journal, client, progress, task, backend,
                             no_worker_timeout, limits, teardown, batch_task, batch_size)
-    except BaseException as error:
-        stopped = error
+    except BaseException as stopped:
+        level = logging.root.manager.disable     # distributed's loggers set their own levels
+        logging.disable(logging.CRITICAL)
+        try:
+            if isinstance(stopped, Interrupted):
+                with StopSignals() as again:
+                    again.received = stopped.signal         # the next one is the second
+                    again.keep(lambda: f"{journal.path} keeps every run done "
+                                       f"({len(journal.rows)})")
+                    _close(client, cluster, teardown)
+            else:
+                _close(client, cluster, teardown)
+        finally:
+            logging.disable(level)
         raise
-    finally:
-        with _stopping(stopped, journal):
-            _close(client, cluster, teardown)
-
-
-@dataclass
-class _Task:
-    """What a future computes: one run, or a batch of runs."""
-    jobs: list[Job]
-    batch: bool
-    why: str = ""                       # why its run is not in a batch (said in its backend)
+    _close(client, cluster, teardown)
 
 
 def _submit_and_journal(spec: Spec, todo: list[dict], journal: Journal, client, progress: bool,
                         task, backend: str, no_worker_timeout: float, limits: Limits,
                         teardown: SweepTeardown, batch_task, batch_size: int | None) -> None:
     """Check the workers, send the FMUs and ``todo``, and journal each row as it completes."""
+    from tqdm import tqdm
+
     token = teardown.sweep
     if client.run_on_scheduler(has_dashboard):
         say(f"dashboard: {client.dashboard_link}")
@@ -138,15 +137,15 @@ def _submit_and_journal(spec: Spec, todo: list[dict], journal: Journal, client, 
     shipped = {sha: client.submit(fmu_bytes, path.read_bytes(), key=f"fmu-{token}-{sha}",
                                   pure=False)
                for sha, path in spec.files().items()}
-    tasks: dict = {}
-    completions = Completions()
+    tasks: dict = {}                        # future: (its jobs, a batch?, why not in a batch)
+    completions = Completions(client, no_worker_timeout)
 
     def submit(jobs: list[Job], batch: bool, why: str = "") -> None:
         blobs = {sha: shipped[sha] for sha in jobs[0].bundle.fmu_hashes()}
         kind, what = ("batch", batch_task) if batch else ("run", task)
         future = client.submit(what, jobs if batch else jobs[0], blobs, retries=2, pure=False,
                                key=f"{kind}-{token}-{jobs[0].run['run_id']}")
-        tasks[future] = _Task(jobs, batch, why)
+        tasks[future] = jobs, batch, why
         completions.add(future)
 
     route = "inprocess" if backend == BATCH else backend      # a batch's runs alone: in-process
@@ -159,40 +158,32 @@ def _submit_and_journal(spec: Spec, todo: list[dict], journal: Journal, client, 
         submit(batch, True)
     for job in alone:
         submit([job], False)
-    bar = None
-    if progress:
-        from tqdm import tqdm
-        bar = tqdm(total=len(todo), desc=spec.name, unit="run", file=sys.stderr,
-                   disable=None)                # None: only on a terminal
-    watch = WorkerWatch(client, no_worker_timeout)
-    try:
-        for future in completions.each(watch):
-            done = tasks.pop(future)
-            try:
-                result = watch.result(future)
-            except NoWorkers:
-                raise
-            except Exception as error:      # the worker died on every retry
-                died = f"{type(error).__name__}: {error}"
-                if done.batch:              # each run alone: only a run that kills fails
-                    future.release()
-                    for job in done.jobs:
-                        submit([job], False, f"its batch's worker died, {died}")
-                    continue
-                result = {**blank_row(done.jobs[0].run, died), "backend": done.jobs[0].backend}
-            rows = result if done.batch else [result]
-            for job, row in zip(done.jobs, rows, strict=True):
-                journal.add({**(noted(row, done.why) if done.why else row),
-                             "command": spec.replay(job.run)})
-            future.release()                # done: nothing to recompute if a worker dies
-            if bar is not None:
+    with tqdm(total=len(todo), desc=spec.name, unit="run", file=sys.stderr,
+              disable=None if progress else True) as bar:   # None: only on a terminal
+        try:
+            for future in completions:
+                jobs, batch, why = tasks.pop(future)
+                try:
+                    result = completions.result(future)
+                except NoWorkers:
+                    raise
+                except Exception as error:      # the worker died on every retry
+                    died = f"{type(error).__name__}: {error}"
+                    if batch:                   # each run alone: only a run that kills fails
+                        future.release()
+                        for job in jobs:
+                            submit([job], False, f"its batch's worker died, {died}")
+                        continue
+                    result = {**blank_row(jobs[0].run, died), "backend": jobs[0].backend}
+                rows = result if batch else [result]
+                for job, row in zip(jobs, rows, strict=True):
+                    journal.add({**(noted(row, why) if why else row),
+                                 "command": spec.replay(job.run)})
+                future.release()                # done: nothing to recompute if a worker dies
                 bar.update(len(rows))
-    except NoWorkers:
-        client.cancel([*tasks, *shipped.values()])
-        raise
-    finally:
-        if bar is not None:
-            bar.close()                     # its line ended before any message
+        except NoWorkers:
+            client.cancel([*tasks, *shipped.values()])
+            raise
 
 
 def _say_batch_refusals(client) -> None:
@@ -212,35 +203,11 @@ def _say_batch_refusals(client) -> None:
 
 
 def _close(client, cluster, teardown: SweepTeardown) -> None:
-    """Close the client, and the local cluster it made; on a shared cluster, free this
-    sweep's FMUs on the workers first."""
+    """Close the client, and the local cluster it made (closing its workers frees
+    everything); on a shared cluster, free this sweep's FMUs on the workers first."""
     if cluster is None:
-        try:
+        with contextlib.suppress(Exception):     # workers gone with Ctrl-C
             client.unregister_worker_plugin(teardown.name)
-        except Exception:                   # workers gone with Ctrl-C
-            pass
     client.close()
-    if cluster is not None:                 # closing its workers frees everything
+    if cluster is not None:
         cluster.close()
-
-
-@contextmanager
-def _stopping(stopped: BaseException | None, journal: Journal) -> Iterator[None]:
-    """After the sweep stopped early: distributed's logging of the teardown silenced, and
-    after Ctrl-C or SIGTERM a second signal ends the process at once (``StopSignals``)."""
-    if stopped is None:
-        yield
-        return
-    level = logging.root.manager.disable         # distributed's loggers set their own levels
-    logging.disable(logging.CRITICAL)
-    try:
-        if isinstance(stopped, Interrupted):
-            with StopSignals() as again:
-                again.received = stopped.signal         # the next one is the second
-                again.keep(lambda: f"{journal.path} keeps every run done "
-                                   f"({len(journal.rows)})")
-                yield
-        else:
-            yield
-    finally:
-        logging.disable(level)
