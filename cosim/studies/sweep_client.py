@@ -1,12 +1,16 @@
 """A sweep's client side: runs submitted to a Dask cluster (on the batch backend in batches,
-``plan``), each row journaled as it completes, the workers checked and watched."""
+``plan``), the workers checked and watched, and each row journaled as it completes: the
+``Journal`` a sweep resumes from."""
 from __future__ import annotations
 
 import contextlib
+import json
 import logging
 import math
+import os
 import sys
 import uuid
+from pathlib import Path
 
 from fmukit.timebase import step_count
 
@@ -14,7 +18,6 @@ from ..core.interrupt import Interrupted, StopSignals
 from ..core.watchdog import Limits
 from ..ensemble import SIGNALS
 from .cluster import Completions, NoWorkers, check_workers, has_dashboard, say
-from .journal import Journal
 from .sweep_spec import Spec
 from .sweep_task import (BATCH, Job, SweepTeardown, batch_refusal, blank_row, fmu_bytes, noted,
                          run_batch)
@@ -27,6 +30,42 @@ MIN_BATCH = 32
 """The fewest runs a batch is cut down to for keeping workers busy (``batch_counts``)."""
 WAVES_SHARE = 128
 """The fewest runs a batch in waves is cut down to for giving every worker a share."""
+
+
+def read_rows(path: Path, quiet: bool = False) -> dict[str, dict]:
+    """The rows of a journal by run id (a later row for a run replaces an earlier); a line
+    that is not a whole row (a write cut short by a kill) is skipped, with a warning."""
+    rows: dict[str, dict] = {}
+    lines = path.read_text().splitlines() if path.exists() else []
+    for number, line in enumerate(lines, 1):
+        try:
+            row = json.loads(line)
+            rows[row["run_id"]] = row
+        except (ValueError, KeyError, TypeError):
+            if line.strip() and not quiet:
+                print(f"warning: {path}:{number} is not a whole journal row (a write cut "
+                      "short?); skipped, its run is done again", file=sys.stderr)
+    return rows
+
+
+class Journal:
+    """A sweep's journal, opened by its one writer (who holds the folder's ``FolderLock``):
+    its rows, and ``add``, which appends a row and flushes it to the file."""
+
+    def __init__(self, path: Path):
+        self.path, self.rows = path, read_rows(path)
+        if path.exists() and path.stat().st_size:   # a torn last line: its own
+            with open(path, "rb+") as f:
+                f.seek(-1, os.SEEK_END)
+                if f.read(1) != b"\n":
+                    f.write(b"\n")
+
+    def add(self, row: dict) -> None:
+        with open(self.path, "a") as f:
+            f.write(json.dumps(row) + "\n")
+            f.flush()
+            os.fsync(f.fileno())
+        self.rows[row["run_id"]] = row
 
 
 def batch_limit(job: Job) -> int:
