@@ -1,10 +1,6 @@
-"""What a worker needs to run a sweep's controller, shipped from the client by content.
-
-A ``Bundle`` carries a controller's system with each FMU named by its SHA-256; the FMUs
-travel once per worker, and a worker keeps them in its private cache (``fmu_cache``),
-checking a cached file against its hash each time. A worker needs the project installed,
-nothing else. The hashes make a run's identity (``Bundle.digest``).
-"""
+"""A sweep controller's system as a worker rebuilds it, each FMU named by its SHA-256: the
+FMUs travel once per worker, which keeps them in its private cache (``fmu_cache``), checked
+against their hashes when used; the hashes make a run's identity (``Bundle.digest``)."""
 from __future__ import annotations
 
 import dataclasses
@@ -34,6 +30,7 @@ class Bundle:
     digest: str                        # SHA-256 of the system and its FMUs' contents
 
     def fmu_hashes(self) -> set[str]:
+        """The SHA-256 of each of its FMUs."""
         return {Path(c.source).stem for c in self.system.components.values()}
 
 

@@ -101,8 +101,7 @@ class SweepTeardown(WorkerPlugin):
     """Frees one sweep's masters (and their temporary folders) on a worker."""
 
     def __init__(self, sweep: str):
-        self.sweep = sweep
-        self.name = f"cosim-sweep-{sweep}"
+        self.sweep, self.name = sweep, f"cosim-sweep-{sweep}"
 
     def teardown(self, worker) -> None:
         free_masters(self.sweep)
@@ -206,9 +205,10 @@ def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
     started = time.perf_counter()
     if any(job.code != code_version() for job in jobs):
         return [_other_code(job) for job in jobs]
-    refusal = batch_refusal()
-    if refusal:
-        return _one_by_one(jobs, blobs, f"the batch route is refused on this worker: {refusal}")
+    failed = batch_refusal()
+    if failed:
+        return [noted(run_one(job, blobs), f"the batch route is refused on this worker: "
+                                           f"{failed}") for job in jobs]
     watchdog = Watchdog(batch_limits(jobs[0].limits, len(jobs)))
     master, failed = None, "stopped"
     try:
@@ -226,7 +226,8 @@ def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
     finally:
         _give_back(jobs[0], master, not failed)
     if failed:
-        return _one_by_one(jobs, blobs, f"the batch failed, {failed}; run alone")
+        return [noted(run_one(job, blobs), f"the batch failed, {failed}; run alone")
+                for job in jobs]
     share = (time.perf_counter() - started) / max(1, len(members))
     rows = {}
     for job, recording in zip(members, recordings, strict=True):
@@ -239,17 +240,12 @@ def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
 
 
 def _configures(master, job: Job) -> bool:
-    """Whether ``Master.configure`` takes ``job``'s settings."""
+    """Whether ``Master.configure`` takes ``job``'s settings (``run_one`` records why not)."""
     try:
         master.configure(job.overrides)
-    except Exception:                   # run_one records why
+    except Exception:
         return False
     return True
-
-
-def _one_by_one(jobs: list[Job], blobs: dict[str, bytes], why: str) -> list[dict[str, Any]]:
-    """``run_one`` of each job, its backend saying ``why`` it did not run in a batch."""
-    return [noted(run_one(job, blobs), why) for job in jobs]
 
 
 def noted(row: dict[str, Any], why: str) -> dict[str, Any]:
