@@ -43,9 +43,9 @@ def file_hash(path: Path) -> str:
     return digest.hexdigest()
 
 
-def bundle(controller: dict[str, Any]) -> tuple[Bundle, dict[str, Path]]:
-    """The bundle of a sweep controller (scenario, autopilot, map), and each of its FMUs'
-    files by hash, for the client to ship."""
+def bundle(controller: dict[str, Any]) -> tuple[Bundle, dict[str, Path], SystemDescription]:
+    """The bundle of a sweep controller (scenario, autopilot, map), each of its FMUs' files by
+    hash, for the client to ship, and its system as loaded here."""
     system = scenarios.load(controller["scenario"], controller["autopilot"], controller["map"])
     files: dict[str, Path] = {}
     components = {}
@@ -56,7 +56,7 @@ def bundle(controller: dict[str, Any]) -> tuple[Bundle, dict[str, Path]]:
         components[name] = dataclasses.replace(component, source=f"{sha}.fmu")
     shipped = dataclasses.replace(system, components=components, path=None, fmus=None)
     content = json.dumps(dataclasses.asdict(shipped), sort_keys=True, default=str)
-    return Bundle(shipped, hashlib.sha256(content.encode()).hexdigest()), files
+    return Bundle(shipped, hashlib.sha256(content.encode()).hexdigest()), files, system
 
 
 def fmu_cache() -> Path:

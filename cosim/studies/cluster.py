@@ -163,7 +163,6 @@ class Completions:
         self.seen = False                   # a worker was counted at least once
         self.gone_since: float | None = None
         self.gone_at = ""                   # when none was first counted, for the message
-        self.next_check = 0.0
         self.check()
 
     def add(self, future) -> None:
@@ -194,12 +193,9 @@ class Completions:
                 self.check()
 
     def check(self) -> None:
-        """``NoWorkers`` if there has been no worker for ``timeout`` s (asked at most every
-        ``interval`` s)."""
+        """``NoWorkers`` if there has been no worker for ``timeout`` s (asked after each wait
+        of ``interval`` s for a future)."""
         now = time.monotonic()
-        if now < self.next_check:
-            return
-        self.next_check = now + self.interval
         try:
             workers = len(self.client.nthreads())
         except OSError:                     # the scheduler cannot be reached: no worker either

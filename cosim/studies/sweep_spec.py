@@ -6,7 +6,6 @@ nothing (``CALM_WATER_INERT`` in calm water) have one result, run once (``shared
 """
 from __future__ import annotations
 
-import dataclasses
 import hashlib
 import itertools
 import json
@@ -21,6 +20,7 @@ from fmukit.manifest import read as read_manifest
 from ..core.errors import FmuNotFound, FmuUnreadable
 from ..core.fmi import read_description
 from ..core.inprocess import fallback_note, in_process_refusal
+from ..core.ssd import SystemDescription
 from ..core.values import Declaration, declarations
 from ..core.watchdog import Limits
 from ..provenance import code_version
@@ -60,20 +60,18 @@ class Spec:
         return spec
 
     @cached_property
-    def _shipped(self) -> tuple[dict[str, Bundle], dict[str, Path]]:
-        bundles, files = {}, {}
-        for name, controller in self.controllers.items():
-            bundles[name], more = bundle(controller)
-            files.update(more)
-        return bundles, files
+    def _shipped(self) -> dict[str, tuple[Bundle, dict[str, Path], SystemDescription]]:
+        """Each controller's bundle, its FMUs by SHA-256 and its system here (read once)."""
+        return {name: bundle(controller) for name, controller in self.controllers.items()}
 
     def bundles(self) -> dict[str, Bundle]:
-        """Each controller's system with its FMUs named by content (read once)."""
-        return self._shipped[0]
+        """Each controller's system with its FMUs named by content."""
+        return {name: shipped[0] for name, shipped in self._shipped.items()}
 
     def files(self) -> dict[str, Path]:
         """Every FMU the sweep uses, by SHA-256."""
-        return self._shipped[1]
+        return {sha: path for _, files, _ in self._shipped.values()
+                for sha, path in files.items()}
 
     def _description(self, controller: str, component: str) -> tuple[Path, Any]:
         """A component's FMU in a controller's system, and its model description."""
@@ -227,12 +225,7 @@ class Spec:
     def _coverage(self) -> dict[str, str | None]:
         from ..ensemble.members import coverage
 
-        local = {}
-        for controller, shipped in self.bundles().items():      # each FMU the file here
-            local[controller] = dataclasses.replace(shipped.system, components={
-                name: dataclasses.replace(c, source=str(self.files()[Path(c.source).stem]))
-                for name, c in shipped.system.components.items()})
-        return {controller: coverage(system) for controller, system in local.items()}
+        return {name: coverage(system) for name, (_, _, system) in self._shipped.items()}
 
     def batch_coverage(self) -> dict[str, str | None]:
         """Each controller: why the batch kernel cannot run its system, None if it can."""
