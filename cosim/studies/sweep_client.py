@@ -133,73 +133,46 @@ def run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, p
                    task, backend: str, no_worker_timeout: float, limits: Limits,
                    batch_task=run_batch, batch_size: int | None = None) -> None:
     """Run ``todo`` (runs of ``spec``) on the cluster of ``connection`` (a client, and the
-    local cluster it made or None), journaling each row; both closed on every path. When
-    the sweep stops early, quietly (``campaign.execute`` says the rest), and after Ctrl-C or
-    SIGTERM a second signal ends the process at once (``StopSignals``)."""
-    client, cluster = connection
-    teardown = SweepTeardown(uuid.uuid4().hex[:12])
-    try:
-        _submit_and_journal(spec, todo, journal, client, progress, task, backend,
-                            no_worker_timeout, limits, teardown, batch_task, batch_size)
-    except BaseException as stopped:
-        level = logging.root.manager.disable     # distributed's loggers set their own levels
-        logging.disable(logging.CRITICAL)
-        try:
-            if isinstance(stopped, Interrupted):
-                with StopSignals() as again:
-                    again.received = stopped.signal         # the next one is the second
-                    again.keep(lambda: f"{journal.path} keeps every run done "
-                                       f"({len(journal.rows)})")
-                    _close(client, cluster, teardown)
-            else:
-                _close(client, cluster, teardown)
-        finally:
-            logging.disable(level)
-        raise
-    _close(client, cluster, teardown)
-
-
-def _submit_and_journal(spec: Spec, todo: list[dict], journal: Journal, client, progress: bool,
-                        task, backend: str, no_worker_timeout: float, limits: Limits,
-                        teardown: SweepTeardown, batch_task, batch_size: int | None) -> None:
-    """Check the workers, send the FMUs and ``todo``, and journal each row as it completes."""
+    local cluster it made or None): check the workers, send the FMUs and the runs, journal
+    each row as it completes; close both on every path (``_close``)."""
     from tqdm import tqdm
 
-    token = teardown.sweep
-    if client.run_on_scheduler(has_dashboard):
-        say(f"dashboard: {client.dashboard_link}")
-    check_workers(client)
-    client.register_plugin(teardown)
-    # Each FMU as a task holding its bytes, not scattered data: a task's result lost with
-    # its worker is computed again, scattered data is gone, and every run with it. Keyed
-    # by sweep: another sweep's release of a shared key would strand this one's runs.
-    shipped = {sha: client.submit(fmu_bytes, path.read_bytes(), key=f"fmu-{token}-{sha}",
-                                  pure=False)
-               for sha, path in spec.files().items()}
-    tasks: dict = {}                        # future: (its jobs, a batch?, why not in a batch)
-    completions = Completions(client, no_worker_timeout)
+    client, cluster = connection
+    teardown = SweepTeardown(uuid.uuid4().hex[:12])
+    token, tasks, shipped = teardown.sweep, {}, {}
+    try:
+        if client.run_on_scheduler(has_dashboard):
+            say(f"dashboard: {client.dashboard_link}")
+        check_workers(client)
+        client.register_plugin(teardown)
+        # Each FMU as a task holding its bytes, not scattered data: a task's result lost with
+        # its worker is computed again, scattered data is gone, and every run with it. Keyed
+        # by sweep: another sweep's release of a shared key would strand this one's runs.
+        shipped = {sha: client.submit(fmu_bytes, path.read_bytes(), key=f"fmu-{token}-{sha}",
+                                      pure=False)
+                   for sha, path in spec.files().items()}
+        completions = Completions(client, no_worker_timeout)
 
-    def submit(jobs: list[Job], batch: bool, why: str = "") -> None:
-        blobs = {sha: shipped[sha] for sha in jobs[0].bundle.fmu_hashes()}
-        kind, what = ("batch", batch_task) if batch else ("run", task)
-        future = client.submit(what, jobs if batch else jobs[0], blobs, retries=2, pure=False,
-                               key=f"{kind}-{token}-{jobs[0].run['run_id']}")
-        tasks[future] = jobs, batch, why
-        completions.add(future)
+        def submit(jobs: list[Job], batch: bool, why: str = "") -> None:
+            blobs = {sha: shipped[sha] for sha in jobs[0].bundle.fmu_hashes()}
+            kind, what = ("batch", batch_task) if batch else ("run", task)
+            future = client.submit(what, jobs if batch else jobs[0], blobs, retries=2,
+                                   pure=False, key=f"{kind}-{token}-{jobs[0].run['run_id']}")
+            tasks[future] = jobs, batch, why        # why its runs are not in a batch
+            completions.add(future)
 
-    route = "inprocess" if backend == BATCH else backend      # a batch's runs alone: in-process
-    jobs = [spec.job(run, token, route, limits) for run in todo]
-    together, alone = (plan(spec, jobs, sum(client.nthreads().values()) or 1, batch_size)
-                       if backend == BATCH else ([], jobs))
-    if together:
-        _say_batch_refusals(client)
-    for batch in together:
-        submit(batch, True)
-    for job in alone:
-        submit([job], False)
-    with tqdm(total=len(todo), desc=spec.name, unit="run", file=sys.stderr,
-              disable=None if progress else True) as bar:   # None: only on a terminal
-        try:
+        route = "inprocess" if backend == BATCH else backend  # a batch's runs alone: in-process
+        jobs = [spec.job(run, token, route, limits) for run in todo]
+        together, alone = (plan(spec, jobs, sum(client.nthreads().values()) or 1, batch_size)
+                           if backend == BATCH else ([], jobs))
+        if together:
+            _say_batch_refusals(client)
+        for batch in together:
+            submit(batch, True)
+        for job in alone:
+            submit([job], False)
+        with tqdm(total=len(todo), desc=spec.name, unit="run", file=sys.stderr,
+                  disable=None if progress else True) as bar:   # None: only on a terminal
             for future in completions:
                 jobs, batch, why = tasks.pop(future)
                 try:
@@ -220,9 +193,12 @@ def _submit_and_journal(spec: Spec, todo: list[dict], journal: Journal, client, 
                                  "command": spec.replay(job.run)})
                 future.release()                # done: nothing to recompute if a worker dies
                 bar.update(len(rows))
-        except NoWorkers:
+    except BaseException as stopped:
+        if isinstance(stopped, NoWorkers):
             client.cancel([*tasks, *shipped.values()])
-            raise
+        _close(client, cluster, teardown, journal, stopped)
+        raise
+    _close(client, cluster, teardown, journal)
 
 
 def _say_batch_refusals(client) -> None:
@@ -241,12 +217,26 @@ def _say_batch_refusals(client) -> None:
             "their batches run one run at a time on the in-process route")
 
 
-def _close(client, cluster, teardown: SweepTeardown) -> None:
+def _close(client, cluster, teardown: SweepTeardown, journal: Journal,
+           stopped: BaseException | None = None) -> None:
     """Close the client, and the local cluster it made (closing its workers frees
-    everything); on a shared cluster, free this sweep's FMUs on the workers first."""
-    if cluster is None:
-        with contextlib.suppress(Exception):     # workers gone with Ctrl-C
-            client.unregister_worker_plugin(teardown.name)
-    client.close()
-    if cluster is not None:
-        cluster.close()
+    everything); on a shared cluster, free this sweep's FMUs on the workers first. After
+    the sweep ``stopped`` early, quietly (``campaign.execute`` says the rest); after Ctrl-C
+    or SIGTERM a second signal ends the process at once (``StopSignals``)."""
+    level = logging.root.manager.disable         # distributed's loggers set their own levels
+    logging.disable(logging.CRITICAL if stopped is not None else level)
+    try:
+        with contextlib.ExitStack() as stack:
+            if isinstance(stopped, Interrupted):
+                again = stack.enter_context(StopSignals())
+                again.received = stopped.signal         # the next one is the second
+                again.keep(lambda: f"{journal.path} keeps every run done "
+                                   f"({len(journal.rows)})")
+            if cluster is None:
+                with contextlib.suppress(Exception):     # workers gone with Ctrl-C
+                    client.unregister_worker_plugin(teardown.name)
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    finally:
+        logging.disable(level)
