@@ -69,12 +69,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, default=RESULTS, help="parent folder of the results")
     parser.add_argument("--backend", choices=SWEEP_BACKENDS, default="fmi",
                         help="fmi: each run through the FMUs (default); inprocess: this "
-                             "project's FMUs as Python classes, without FMI, the same results "
-                             "(an FMU not of this checkout runs through FMI, with a note); "
-                             "batch: the runs of each PD, PID or SMC system in batches, one "
-                             "task each, stepped together as arrays: the in-process route's "
-                             "rows, bit for bit (a system it does not cover runs in-process, "
-                             "with a note)")
+                             "project's FMUs as Python classes, without FMI; batch: the runs of "
+                             "each PD, PID or SMC system in batches stepped together as arrays; "
+                             "the same rows, bit for bit (what a backend does not cover runs "
+                             "otherwise, with a note)")
     parser.add_argument("--batch-size", type=count, metavar="N",
                         help="with --backend batch: at most N runs a batch (default: as few "
                              "batches as keep every worker busy, of at most "
@@ -89,8 +87,7 @@ def main(argv: list[str] | None = None) -> int:
                         metavar="S",
                         help="a run whose FMUs take longer than S s of wall-clock time over "
                              "one step (or their instantiation) is recorded failed; a batch "
-                             "of N runs gets N times S for the whole batch (default "
-                             "%(default)g)")
+                             "of N runs gets N times S (default %(default)g)")
     parser.add_argument("--run-timeout", type=positive_seconds, metavar="S",
                         help="a run longer than S s of wall-clock time is recorded failed; a "
                              "batch of N runs gets N times S (default: no limit)")

@@ -88,12 +88,11 @@ def materialise(shipped: Bundle, blobs: dict[str, bytes]) -> SystemDescription:
     for name, component in shipped.system.components.items():
         sha = Path(component.source).stem
         target = cache / f"{sha}.fmu"
-        cached = target.exists()
-        if cached and file_hash(target) != sha:
+        corrupt = target.exists() and file_hash(target) != sha
+        if corrupt:
             print(f"warning: the FMU cache's {target} does not match its hash (a corrupt or "
                   "changed file); written again from the FMU sent", file=sys.stderr)
-            cached = False
-        if not cached:
+        if corrupt or not target.exists():
             data = blobs[sha]
             if hashlib.sha256(data).hexdigest() != sha:
                 raise ValueError(f"the FMU sent for component '{name}' does not match its "

@@ -76,11 +76,6 @@ def batch_limit(job: Job) -> int:
     return max(1, min(MAX_BATCH, BATCH_MEMORY // (len(SIGNALS) * 8 * rows)))
 
 
-def batches(jobs: list[Job], workers: int, size: int | None = None) -> list[list[Job]]:
-    """``jobs`` (of one system and stop time) cut as ``plan`` cuts a sweep of them alone."""
-    return _cut(jobs, batch_counts([jobs], workers, size)[0])
-
-
 def batch_counts(groups: list[list[Job]], workers: int, size: int | None = None) -> list[int]:
     """How many batches each group (runs of one system and stop time) is cut into: with
     ``size``, batches of at most ``size``; by default as few as ``batch_limit`` allows, in
