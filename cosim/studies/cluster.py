@@ -42,8 +42,9 @@ class NoWorkers(RuntimeError):
 
 
 def local_cluster(workers: int | None = None) -> LocalCluster:
-    """``workers`` single-threaded worker processes (default: one per core), quiet, the
-    dashboard on a free port. Worker-saturation 1.0: a run that kills its worker takes no
+    """``workers`` single-threaded worker processes (default: one per core), quiet (a row
+    says what failed; the workers' own errors, as when a second Ctrl-C leaves them without
+    their scheduler, would only be noise), the dashboard on a free port. Worker-saturation 1.0: a run that kills its worker takes no
     queued run with it. Made with SIGINT blocked, which its threads and workers inherit: a
     terminal's Ctrl-C stops the client alone, which closes the workers."""
     import dask
@@ -54,7 +55,7 @@ def local_cluster(workers: int | None = None) -> LocalCluster:
     try:
         with dask.config.set({"distributed.scheduler.worker-saturation": 1.0}):
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                   dashboard_address=":0", silence_logs=logging.ERROR)
+                                   dashboard_address=":0", silence_logs=logging.CRITICAL)
         signal.pthread_sigmask(signal.SIG_SETMASK, previous)   # a Ctrl-C meanwhile: here
     except BaseException:
         signal.pthread_sigmask(signal.SIG_SETMASK, previous)
