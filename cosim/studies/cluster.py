@@ -42,11 +42,11 @@ class NoWorkers(RuntimeError):
 
 
 def local_cluster(workers: int | None = None) -> LocalCluster:
-    """``workers`` single-threaded worker processes (default: one per core), quiet (a row
-    says what failed; the workers' own errors, as when a second Ctrl-C leaves them without
-    their scheduler, would only be noise), the dashboard on a free port. Worker-saturation 1.0: a run that kills its worker takes no
-    queued run with it. Made with SIGINT blocked, which its threads and workers inherit: a
-    terminal's Ctrl-C stops the client alone, which closes the workers."""
+    """``workers`` single-threaded worker processes (default: one per core), the dashboard
+    on a free port, quiet: a row says what failed, and the workers' own errors (as when a
+    second Ctrl-C leaves them without their scheduler) would only be noise. Worker-saturation
+    1.0: a run that kills its worker takes no queued run with it. Made with SIGINT blocked,
+    which its threads and workers inherit: a terminal's Ctrl-C stops the client alone."""
     import dask
 
     _start_resource_tracker()
