@@ -13,8 +13,7 @@ from .core.files import write_atomically
 from .core.interrupt import Interrupted
 from .core.watchdog import STEP_LIMIT_S, Limits
 from .studies import campaign
-from .studies.cluster import CONNECT_TIMEOUT
-from .studies.cluster import NoWorkers, SweepError
+from .studies.cluster import CONNECT_TIMEOUT, NoWorkers, SweepError
 from .studies.sweep_client import MAX_BATCH, MIN_BATCH
 from .studies.sweep_figures import save_figures
 from .studies.sweep_spec import MAX_RUNS, Spec
@@ -70,12 +69,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, default=RESULTS, help="parent folder of the results")
     parser.add_argument("--backend", choices=SWEEP_BACKENDS, default="fmi",
                         help="fmi: each run through the FMUs (default); inprocess: this "
-                             "project's FMUs as Python classes, without FMI, the same results "
-                             "(an FMU not of this checkout runs through FMI, with a note); "
-                             "batch: the runs of each PD, PID or SMC system in batches, one "
-                             "task each, stepped together as arrays: the in-process route's "
-                             "rows, bit for bit (a system it does not cover runs in-process, "
-                             "with a note)")
+                             "project's FMUs as Python classes, without FMI; batch: the runs of "
+                             "each PD, PID or SMC system in batches stepped together as arrays; "
+                             "the same rows, bit for bit (what a backend does not cover runs "
+                             "otherwise, with a note)")
     parser.add_argument("--batch-size", type=count, metavar="N",
                         help="with --backend batch: at most N runs a batch (default: as few "
                              "batches as keep every worker busy, of at most "
@@ -90,8 +87,7 @@ def main(argv: list[str] | None = None) -> int:
                         metavar="S",
                         help="a run whose FMUs take longer than S s of wall-clock time over "
                              "one step (or their instantiation) is recorded failed; a batch "
-                             "of N runs gets N times S for the whole batch (default "
-                             "%(default)g)")
+                             "of N runs gets N times S (default %(default)g)")
     parser.add_argument("--run-timeout", type=positive_seconds, metavar="S",
                         help="a run longer than S s of wall-clock time is recorded failed; a "
                              "batch of N runs gets N times S (default: no limit)")
@@ -111,14 +107,11 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{stopped} while reading {args.spec}: no run was started", file=sys.stderr)
         return stopped.exit_status
     out = writable_folder(args.out / spec.name)
-    resume = shlex.join([sys.executable, "-m", "cosim.sweep",
-                         *(sys.argv[1:] if argv is None else argv)])
     stage = "running the sweep"
     try:
         for note in [*spec.backend_notes(args.backend), *spec.sharing_notes()]:
             say_note(note)
-        rows = campaign.execute(spec, out, args.scheduler, args.workers,
-                                progress=not args.no_progress,
+        rows = campaign.execute(spec, out, args.scheduler, args.workers, not args.no_progress,
                                 scheduler_file=args.scheduler_file, backend=args.backend,
                                 no_worker_timeout=args.no_worker_timeout,
                                 connect_timeout=args.connect_timeout,
@@ -146,7 +139,8 @@ def main(argv: list[str] | None = None) -> int:
                   "tables and figures again", file=sys.stderr)
         return 2
     except (Interrupted, NoWorkers) as stopped:
-        return _stopped(stopped, stage, spec, out, args.csv, resume)
+        return _stopped(stopped, stage, spec, out, args.csv, shlex.join(
+            [sys.executable, "-m", "cosim.sweep", *(sys.argv[1:] if argv is None else argv)]))
     for pattern in OUTPUTS:                 # a previous spec's, not rewritten: misleading
         for stale in out.glob(pattern):
             if stale not in written:
@@ -171,12 +165,10 @@ def _stopped(stopped: Interrupted | NoWorkers, stage: str, spec: Spec, out: Path
              resume: str) -> int:
     """Say what an interrupted or workerless sweep keeps and how to resume it; its status."""
     rows = campaign.completed(spec, out)
-    written = []
-    if stage == "running the sweep" and rows:
-        written = write_tables(rows, out, csv, spec)
-    done = distinct(rows)
-    runs = len(spec.shared_runs())
-    while_ = "" if stage == "running the sweep" else f" while {stage}"
+    running = stage == "running the sweep"
+    written = write_tables(rows, out, csv, spec) if running and rows else []
+    done, runs = distinct(rows), len(spec.shared_runs())
+    while_ = "" if running else f" while {stage}"
     then = ("resumes the sweep" if sum(r["status"] == "ok" for r in done) < runs else
             "runs nothing again, and writes the tables and figures")
     print(f"{stopped}{while_}: {len(done)} of {runs} runs done, kept in "

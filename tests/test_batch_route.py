@@ -17,7 +17,7 @@ import pytest
 
 import cosim
 from cosim.studies import campaign, sweep_task
-from cosim.studies.sweep_client import _say_batch_refusals, batches, plan
+from cosim.studies.sweep_client import _say_batch_refusals, plan
 from cosim.studies.sweep_spec import Spec
 
 from helpers import fmu_variant
@@ -136,7 +136,7 @@ def test_batch_sizes_keep_every_worker_busy_within_the_memory_of_their_recording
     assert batch_limit(short) == MAX_BATCH
 
     def sizes(n, workers, size=None, job=long):
-        return [len(b) for b in batches([job] * n, workers, size)]
+        return [len(b) for b in plan(spec, [job] * n, workers, size)[0]]
     assert sizes(1000, 2) == [500, 500]
     assert sizes(3000, 2) == [600] * 5                     # at most 698 runs of 400 s
     assert sizes(3000, 2, job=short) == [1000] * 3         # at most MAX_BATCH
@@ -145,7 +145,7 @@ def test_batch_sizes_keep_every_worker_busy_within_the_memory_of_their_recording
     assert sizes(10, 4) == [10]
     assert sizes(20, 2, size=7) == [7, 6, 7]
     jobs = [replace(long, run={**long.run, "run_id": str(i)}) for i in range(23)]
-    assert sum(batches(jobs, 3, size=5), []) == jobs       # in order
+    assert sum(plan(spec, jobs, 3, size=5)[0], []) == jobs  # in order
     # A sweep of several systems: in calm water as few batches as keep the workers busy,
     # in all; in waves each system shared among the workers, down to WAVES_SHARE runs.
     calm = replace(long, overrides={**long.overrides, "ship": {**long.overrides.get("ship", {}),

@@ -1,10 +1,6 @@
-"""What a worker needs to run a sweep's controller, shipped from the client by content.
-
-A ``Bundle`` carries a controller's system with each FMU named by its SHA-256; the FMUs
-travel once per worker, and a worker keeps them in its private cache (``fmu_cache``),
-checking a cached file against its hash each time. A worker needs the project installed,
-nothing else. The hashes make a run's identity (``Bundle.digest``).
-"""
+"""A sweep controller's system as a worker rebuilds it, each FMU named by its SHA-256: the
+FMUs travel once per worker, which keeps them in its private cache (``fmu_cache``), checked
+against their hashes when used; the hashes make a run's identity (``Bundle.digest``)."""
 from __future__ import annotations
 
 import dataclasses
@@ -34,6 +30,7 @@ class Bundle:
     digest: str                        # SHA-256 of the system and its FMUs' contents
 
     def fmu_hashes(self) -> set[str]:
+        """The SHA-256 of each of its FMUs."""
         return {Path(c.source).stem for c in self.system.components.values()}
 
 
@@ -46,9 +43,9 @@ def file_hash(path: Path) -> str:
     return digest.hexdigest()
 
 
-def bundle(controller: dict[str, Any]) -> tuple[Bundle, dict[str, Path]]:
-    """The bundle of a sweep controller (scenario, autopilot, map), and each of its FMUs'
-    files by hash, for the client to ship."""
+def bundle(controller: dict[str, Any]) -> tuple[Bundle, dict[str, Path], SystemDescription]:
+    """The bundle of a sweep controller (scenario, autopilot, map), each of its FMUs' files by
+    hash, for the client to ship, and its system as loaded here."""
     system = scenarios.load(controller["scenario"], controller["autopilot"], controller["map"])
     files: dict[str, Path] = {}
     components = {}
@@ -59,7 +56,7 @@ def bundle(controller: dict[str, Any]) -> tuple[Bundle, dict[str, Path]]:
         components[name] = dataclasses.replace(component, source=f"{sha}.fmu")
     shipped = dataclasses.replace(system, components=components, path=None, fmus=None)
     content = json.dumps(dataclasses.asdict(shipped), sort_keys=True, default=str)
-    return Bundle(shipped, hashlib.sha256(content.encode()).hexdigest()), files
+    return Bundle(shipped, hashlib.sha256(content.encode()).hexdigest()), files, system
 
 
 def fmu_cache() -> Path:
@@ -91,12 +88,11 @@ def materialise(shipped: Bundle, blobs: dict[str, bytes]) -> SystemDescription:
     for name, component in shipped.system.components.items():
         sha = Path(component.source).stem
         target = cache / f"{sha}.fmu"
-        cached = target.exists()
-        if cached and file_hash(target) != sha:
+        corrupt = target.exists() and file_hash(target) != sha
+        if corrupt:
             print(f"warning: the FMU cache's {target} does not match its hash (a corrupt or "
                   "changed file); written again from the FMU sent", file=sys.stderr)
-            cached = False
-        if not cached:
+        if corrupt or not target.exists():
             data = blobs[sha]
             if hashlib.sha256(data).hexdigest() != sha:
                 raise ValueError(f"the FMU sent for component '{name}' does not match its "

@@ -8,10 +8,8 @@ from typing import Any
 
 from ..core.files import FolderBusy, FolderLock
 from ..core.watchdog import Limits
-from .cluster import CONNECT_TIMEOUT, connect
-from .journal import Journal, read_rows
-from .cluster import SweepError
-from .sweep_client import run_on_cluster
+from .cluster import CONNECT_TIMEOUT, SweepError, connect
+from .sweep_client import Journal, read_rows, run_on_cluster
 from .sweep_spec import Spec
 from .sweep_task import BATCH, SWEEP_BACKENDS, run_batch, run_one
 
@@ -38,9 +36,6 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
                          f"{SWEEP_BACKENDS[-1]}, got {backend!r}")
     if batch_size is not None and backend != BATCH:
         raise ValueError(f"batch_size is the batch backend's, not the {backend} backend's")
-    if batch_size is not None and (isinstance(batch_size, bool)
-                                   or not isinstance(batch_size, int) or batch_size < 1):
-        raise ValueError(f"batch_size must be a whole number >= 1, got {batch_size!r}")
     if not 0 < no_worker_timeout < float("inf"):
         raise ValueError(f"no_worker_timeout must be a number of seconds > 0, got "
                          f"{no_worker_timeout!r}")
@@ -71,9 +66,11 @@ def completed(spec: Spec, out: Path) -> list[dict]:
     found = {}
     for group in spec.shared_runs():
         result = _result(group, rows)
-        if result is not None:
-            for run in group:
-                found[run["run_id"]] = _as_row_of(spec, run, result)
+        for run in group if result is not None else []:
+            found[run["run_id"]] = row = {**result, **run, "ran_as": result["run_id"],
+                                          "command": spec.replay(run)}
+            if result["run_id"] != run["run_id"]:
+                row.pop("track", None)          # drawn once, by the run it is
     return [found[r["run_id"]] for r in spec.runs() if r["run_id"] in found]
 
 
@@ -81,14 +78,6 @@ def _result(group: list[dict], rows: dict[str, dict]) -> dict | None:
     """A group's row in the journal: a member's ok row, else a member's failed row, else None."""
     mine = [rows[r["run_id"]] for r in group if r["run_id"] in rows]
     return next((r for r in mine if r["status"] == "ok"), mine[0] if mine else None)
-
-
-def _as_row_of(spec: Spec, run: dict, result: dict) -> dict:
-    """``result`` (a journal row) as the row of ``run``, an equivalent run."""
-    row = {**result, **run, "ran_as": result["run_id"], "command": spec.replay(run)}
-    if result["run_id"] != run["run_id"]:
-        row.pop("track", None)          # drawn once, by the run it is
-    return row
 
 
 def run_locally(spec: Spec, run: dict[str, Any], backend: str = "fmi",

@@ -4,6 +4,7 @@ one single-threaded process (``dask worker ADDRESS --nthreads 1 --nworkers N``).
 """
 from __future__ import annotations
 
+import importlib.util
 import json
 import logging
 import os
@@ -20,12 +21,32 @@ from ..core.files import read_small_text
 from ..provenance import PACKAGE, code_version
 from .bundle import UnsafeCache, fmu_cache
 
+CONNECT_TIMEOUT = 30.0
+"""Seconds a client tries to reach an existing scheduler (Dask's own default)."""
+
+
+class ClusterError(ValueError):
+    """No cluster to run on: the scheduler cannot be reached or found, or the options that
+    say where it is or how big a local one is make no sense."""
+
+
+class SweepError(RuntimeError):
+    """The sweep cannot start: a worker runs other code, or another sweep writes its folder."""
+
+
+class NoWorkers(RuntimeError):
+    """The sweep stopped: its cluster had no worker for as long as it waits for one (the
+    runs completed stay in the journal)."""
+
+    exit_status = 3
+
 
 def local_cluster(workers: int | None = None) -> LocalCluster:
-    """``workers`` single-threaded worker processes (default: one per core), quiet, the
-    dashboard on a free port. Worker-saturation 1.0: a run that kills its worker takes no
-    queued run with it. Made with SIGINT blocked, which its threads and workers inherit: a
-    terminal's Ctrl-C stops the client alone, which closes the workers."""
+    """``workers`` single-threaded worker processes (default: one per core), the dashboard
+    on a free port, quiet: a row says what failed, and the workers' own errors (as when a
+    second Ctrl-C leaves them without their scheduler) would only be noise. Worker-saturation
+    1.0: a run that kills its worker takes no queued run with it. Made with SIGINT blocked,
+    which its threads and workers inherit: a terminal's Ctrl-C stops the client alone."""
     import dask
 
     _start_resource_tracker()
@@ -34,7 +55,7 @@ def local_cluster(workers: int | None = None) -> LocalCluster:
     try:
         with dask.config.set({"distributed.scheduler.worker-saturation": 1.0}):
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                   dashboard_address=":0", silence_logs=logging.ERROR)
+                                   dashboard_address=":0", silence_logs=logging.CRITICAL)
         signal.pthread_sigmask(signal.SIG_SETMASK, previous)   # a Ctrl-C meanwhile: here
     except BaseException:
         signal.pthread_sigmask(signal.SIG_SETMASK, previous)
@@ -58,16 +79,6 @@ def _start_resource_tracker() -> None:
         os.dup2(saved, 2)
         os.close(saved)
         os.close(null)
-
-
-class ClusterError(ValueError):
-    """No cluster to run on: the scheduler cannot be reached or found, or the options that
-    say where it is or how big a local one is make no sense."""
-
-
-CONNECT_TIMEOUT = 30.0
-"""Seconds a client tries to reach an existing scheduler (Dask's own default)."""
-SCHEDULER_FILE_BYTES = 1 << 20
 
 
 def local_workers(workers: int | None) -> tuple[int | None, str | None]:
@@ -95,7 +106,7 @@ def scheduler_address(scheduler_file: str | Path) -> str:
         raise ClusterError(f"scheduler file {path} does not exist (has the scheduler "
                            "started with --scheduler-file?)")
     try:                                # a scheduler file is a few hundred bytes
-        address = json.loads(read_small_text(path, SCHEDULER_FILE_BYTES)).get("address")
+        address = json.loads(read_small_text(path, 1 << 20)).get("address")
     except (ValueError, AttributeError) as error:
         raise ClusterError(f"scheduler file {path} is not a Dask scheduler file (JSON "
                            f"with its address): {error or 'not a JSON object'}") from None
@@ -115,63 +126,77 @@ def connect(scheduler: str | None = None, workers: int | None = None,
 
     if scheduler and scheduler_file:
         raise ClusterError("give the scheduler's address or its file, not both")
-    if not 0 < timeout < float("inf"):
-        raise ClusterError(f"the connect timeout must be a number of seconds > 0, got "
-                           f"{timeout!r}")
-    where = "--scheduler" if scheduler else "DASK_SCHEDULER_ADDRESS or Dask's config"
-    address = scheduler or (None if scheduler_file else dask.config.get("scheduler-address",
-                                                                         None))
     if scheduler_file:
         address, where = scheduler_address(scheduler_file), f"scheduler file {scheduler_file}"
-    if address:
-        if workers is not None:
-            raise ClusterError("--workers sizes a local cluster; an existing scheduler's "
-                               "workers are those started with 'dask worker'")
-        try:
-            return Client(address, timeout=timeout), None
-        except ValueError as error:
-            raise ClusterError(f"{address!r} (from {where}) is not a Dask scheduler address: "
-                               f"{error}") from None
-        except Exception as error:      # OSError, or whatever a server that is not one sent
-            raise ClusterError(f"cannot reach the Dask scheduler at {address} (from {where}) "
-                               f"within {timeout:g} s: {type(error).__name__}: "
-                               f"{str(error)[:200]}") from None
-    workers, note = local_workers(workers)
-    if note:
-        print(f"note: {note}", file=sys.stderr)
-    cluster = local_cluster(workers)
-    return Client(cluster), cluster
+    else:
+        address = scheduler or dask.config.get("scheduler-address", None)
+        where = "--scheduler" if scheduler else "DASK_SCHEDULER_ADDRESS or Dask's config"
+    if not address:
+        workers, note = local_workers(workers)
+        if note:
+            print(f"note: {note}", file=sys.stderr)
+        cluster = local_cluster(workers)
+        return Client(cluster), cluster
+    if workers is not None:
+        raise ClusterError("--workers sizes a local cluster; an existing scheduler's "
+                           "workers are those started with 'dask worker'")
+    try:
+        return Client(address, timeout=timeout), None
+    except ValueError as error:
+        raise ClusterError(f"{address!r} (from {where}) is not a Dask scheduler address: "
+                           f"{error}") from None
+    except Exception as error:          # OSError, or whatever a server that is not one sent
+        raise ClusterError(f"cannot reach the Dask scheduler at {address} (from {where}) "
+                           f"within {timeout:g} s: {type(error).__name__}: "
+                           f"{str(error)[:200]}") from None
 
 
-class SweepError(RuntimeError):
-    """The sweep cannot start: a worker runs other code, or another sweep writes its folder."""
-
-
-class NoWorkers(RuntimeError):
-    """The sweep stopped: its cluster had no worker for as long as it waits for one (the
-    runs completed stay in the journal)."""
-
-    exit_status = 3
-
-
-class WorkerWatch:
-    """``check`` raises ``NoWorkers`` once the scheduler has counted no worker for ``timeout``
-    seconds; it asks at most every ``interval`` seconds, while the client waits."""
+class Completions:
+    """Futures as they complete (more may be added meanwhile), and their results, while the
+    cluster is watched: ``NoWorkers`` once the scheduler has counted no worker for
+    ``timeout`` s (Dask's ``as_completed`` has a deadline for the whole iteration instead)."""
 
     def __init__(self, client, timeout: float):
         self.client, self.timeout = client, timeout
         self.interval = max(0.05, min(1.0, timeout / 4))   # Dask fails a shorter wait
+        self.done: queue.SimpleQueue = queue.SimpleQueue()
+        self.waiting = 0
         self.seen = False                   # a worker was counted at least once
         self.gone_since: float | None = None
         self.gone_at = ""                   # when none was first counted, for the message
-        self.next_check = 0.0
         self.check()
 
+    def add(self, future) -> None:
+        self.waiting += 1
+        future.add_done_callback(self.done.put)
+
+    def __iter__(self) -> Iterator:
+        while self.waiting:
+            try:
+                future = self.done.get(timeout=self.interval)
+            except queue.Empty:
+                self.check()
+                continue
+            self.waiting -= 1
+            yield future
+
+    def result(self, future) -> Any:
+        """``future.result()``, checking the cluster while it waits (a result is fetched from
+        its worker, and computed again if that worker has just died)."""
+        from dask.distributed import TimeoutError
+
+        while True:
+            try:
+                return future.result(timeout=self.interval)
+            except TimeoutError:
+                if future.status == "error":    # the task's own TimeoutError
+                    raise
+                self.check()
+
     def check(self) -> None:
+        """``NoWorkers`` if there has been no worker for ``timeout`` s (asked after each wait
+        of ``interval`` s for a future)."""
         now = time.monotonic()
-        if now < self.next_check:
-            return
-        self.next_check = now + self.interval
         try:
             workers = len(self.client.nthreads())
         except OSError:                     # the scheduler cannot be reached: no worker either
@@ -185,51 +210,20 @@ class WorkerWatch:
             raise NoWorkers(f"no worker in the cluster for {self.timeout:g} s ({since} "
                             f"{self.gone_at}); the sweep stopped")
 
-    def result(self, future):
-        """``future.result()``, checking the cluster while it waits (a result is fetched from
-        its worker, and computed again if that worker has just died)."""
-        from dask.distributed import TimeoutError
-
-        while True:
-            try:
-                return future.result(timeout=self.interval)
-            except TimeoutError:
-                if future.status == "error":    # the task's own TimeoutError
-                    raise
-                self.check()
-
-
-class Completions:
-    """Futures as they complete (more may be added meanwhile), the watch checked while none
-    does: Dask's ``as_completed`` has a deadline for the whole iteration instead."""
-
-    def __init__(self) -> None:
-        self.done: queue.SimpleQueue = queue.SimpleQueue()
-        self.waiting = 0
-
-    def add(self, future) -> None:
-        self.waiting += 1
-        future.add_done_callback(self.done.put)
-
-    def each(self, watch: WorkerWatch) -> Iterator:
-        """Each future added, before or while iterating, as it completes."""
-        while self.waiting:
-            try:
-                future = self.done.get(timeout=watch.interval)
-            except queue.Empty:
-                watch.check()
-                continue
-            self.waiting -= 1
-            yield future
-
 
 def say(message: str) -> None:
     print(message, file=sys.stderr, flush=True)
 
 
 def worker_facts() -> dict[str, Any]:
-    """What the client checks of a worker before it sends work."""
-    return {"code": code_version()}
+    """What the client checks of a worker before it sends work: its code, and why its FMU
+    cache is not safe to run FMUs from ("" if it is)."""
+    try:
+        fmu_cache()
+        unsafe = ""
+    except (UnsafeCache, OSError) as error:
+        unsafe = str(error)
+    return {"code": code_version(), "cache": unsafe}
 
 
 def check_workers(client) -> None:
@@ -241,47 +235,34 @@ def check_workers(client) -> None:
         facts = client.run(worker_facts, on_error="return")
     except Exception as error:              # e.g. no worker can import cosim at all
         raise SweepError(f"cannot ask the workers what they run ({error})") from None
-    wrong = []
-    for address, fact in sorted(facts.items()):
-        theirs = fact["code"] if isinstance(fact, dict) else f"none ({type(fact).__name__}: {fact})"
-        if theirs != mine:
-            wrong.append(f"  {address} runs {PACKAGE} {theirs}")
+    facts = {a: f if isinstance(f, dict) else {"code": f"none ({type(f).__name__}: {f})"}
+             for a, f in sorted(facts.items())}
+    wrong = [f"  {a} runs {PACKAGE} {f['code']}" for a, f in facts.items() if f["code"] != mine]
     if wrong:
         raise SweepError(f"workers run other code than this client ({PACKAGE} {mine}):\n"
                          + "\n".join(wrong) + "\ninstall the client's version on every worker "
                          "(a wheel: pip wheel --no-deps -w dist . ; pip install dist/*.whl)")
-    unsafe = {a: problem for a, problem in client.run(_cache_problem).items() if problem}
+    unsafe = [f"  {a}: {f['cache']}" for a, f in facts.items() if f["cache"]]
     if unsafe:
-        raise SweepError("workers whose FMU cache is not safe to run FMUs from:\n" + "\n".join(
-            f"  {address}: {problem}" for address, problem in sorted(unsafe.items())))
+        raise SweepError("workers whose FMU cache is not safe to run FMUs from:\n"
+                         + "\n".join(unsafe))
     threaded = {a: n for a, n in client.nthreads().items() if n > 1}
     if threaded:
         say(f"warning: {', '.join(f'{a} has {n} threads' for a, n in threaded.items())}; a "
-             "run holds the GIL from start to end, so threads of one worker take turns: start "
-             "workers with --nthreads 1 and more processes (--nworkers)")
+            "run holds the GIL from start to end, so threads of one worker take turns: start "
+            "workers with --nthreads 1 and more processes (--nworkers)")
     saturation = client.run_on_scheduler(_worker_saturation)
     if saturation != 1.0:
         say(f"warning: the scheduler's worker-saturation is {saturation}: it queues more than "
-             "one run per worker thread, and a worker killed by one run takes the queued ones "
-             "with it; start the scheduler with DASK_DISTRIBUTED__SCHEDULER__WORKER_SATURATION=1.0")
-
-
-def _cache_problem() -> str:
-    """Why this worker's FMU cache is unsafe (``bundle.fmu_cache``), or ""."""
-    try:
-        fmu_cache()
-    except (UnsafeCache, OSError) as error:
-        return str(error)
-    return ""
+            "one run per worker thread, and a worker killed by one run takes the queued ones "
+            "with it; start the scheduler with DASK_DISTRIBUTED__SCHEDULER__WORKER_SATURATION=1.0")
 
 
 def has_dashboard(dask_scheduler=None) -> bool:
     """Whether the scheduler serves its dashboard (which needs bokeh where it runs)."""
-    import importlib.util
     return ("dashboard" in dask_scheduler.services
             and importlib.util.find_spec("bokeh") is not None)
 
 
 def _worker_saturation(dask_scheduler=None) -> float:
-    """The running scheduler's worker-saturation."""
     return float(dask_scheduler.WORKER_SATURATION)

@@ -22,7 +22,6 @@ SEA_STATE = ("ship.Hs", "ship.T0")
 """What the sea_state axis sets: a WMO code's Hs and T0 at model scale."""
 MAX_RUNS = 100_000
 """The most runs a sweep may have unless told otherwise (``cosim.sweep --max-runs``)."""
-MAX_SPEC_BYTES = 16 << 20
 TOML_TYPES = {"Real": ((int, float), "a number"), "Integer": ((int,), "an integer"),
               "Enumeration": ((int, str), "an integer or an item's name"),
               "Boolean": ((bool,), "true or false"), "String": ((str,), "a string")}
@@ -43,7 +42,7 @@ def parse(path: Path, max_runs: int) -> dict[str, Any]:
     """The fields of a ``Spec`` from its file, each checked but against the FMUs
     (``check_values``); more than ``max_runs`` runs are refused before any is listed."""
     try:
-        data = tomllib.loads(read_small_text(path, MAX_SPEC_BYTES))
+        data = tomllib.loads(read_small_text(path, 16 << 20))
     except ValueError as error:                 # TOMLDecodeError too
         raise ValueError(f"cannot read sweep spec {path}: {error}") from None
     unknown = set(data) - {"name", "stop_time", "controllers", "axes", "plots"}
@@ -72,7 +71,18 @@ def parse(path: Path, max_runs: int) -> dict[str, Any]:
         raise ValueError(f"{path}: {factors} = {runs} runs, more than the {max_runs} a sweep "
                          "may have (cosim.sweep --max-runs)")
     controllers = {name: controller_entry(entry, path, name) for name, entry in entries.items()}
-    _check_overlaps(path, controllers, axes)
+    setters: dict[str, str] = {}                # no parameter set in two places
+    for axis, values in axes.items():
+        for target in assignments(axis, values[0]):
+            if target in setters:
+                raise ValueError(f"{path}: axes {setters[target]!r} and {axis!r} both set "
+                                 f"{target}; give it one axis")
+            setters[target] = axis
+    for controller, entry in controllers.items():
+        for target in entry["set"]:
+            if target in setters:
+                raise ValueError(f"{path}: controller {controller!r} sets {target}, which axis "
+                                 f"{setters[target]!r} sets in every run; give it one place")
     plots = _typed(path, "[plots]", data.get("plots", {}), dict, "a table")
     unknown = set(plots) - {"map", "tracks"}
     if unknown:
@@ -115,9 +125,31 @@ def check_values(spec, path: Path) -> None:
     declared: dict[tuple[str, str], Declaration] = {}
 
     def received(controller: str, target: str, value: Any, key: str) -> Any:
+        """``value`` exactly as the parameter receives it (``cosim.core.values``); ValueError
+        where the system has no such parameter, it does not take the value, or the TOML
+        value is not of its type's kind (``TOML_TYPES``)."""
+        component, _, variable = target.partition(".")
         if (controller, target) not in declared:
-            declared[controller, target] = _parameter(spec, controller, target, key, path)
-        return _received(declared[controller, target], target, value, path, key)
+            system = spec.bundles()[controller].system
+            where = f"{path}: {key} sets {target}, but in controller {controller!r}"
+            if component not in system.components:
+                raise ValueError(f"{where} there is no component {component!r} (there are "
+                                 f"{', '.join(system.components)})")
+            fmu, variables = spec.declared(controller, component)
+            parameters = [n for n, v in variables.items() if v.causality == "parameter"]
+            if variable not in parameters:
+                raise ValueError(f"{where} {component} ({fmu.name}) has no parameter "
+                                 f"{variable!r}; it has {', '.join(parameters)}")
+            declared[controller, target] = variables[variable]
+        declaration = declared[controller, target]
+        kinds, what = TOML_TYPES.get(declaration.type, ((), "nothing"))
+        if not isinstance(value, kinds) or isinstance(value, bool) != (bool in kinds):
+            raise ValueError(f"{path}: {key} = {value!r}: {target} is an FMI "
+                             f"{declaration.type}; give {what}")
+        try:
+            return checked(component, declaration, value)
+        except ValueError as error:
+            raise ValueError(f"{path}: {key}: {error}") from None
 
     for controller in spec.controllers:
         for target, value in spec.controllers[controller]["set"].items():
@@ -133,35 +165,6 @@ def check_values(spec, path: Path) -> None:
                     raise ValueError(f"{path}: axis {axis!r} has {same}: each of its runs "
                                      "would be run twice; give each value once")
                 seen[exact] = value
-
-
-def _parameter(spec, controller: str, target: str, key: str, path: Path) -> Declaration:
-    """The declaration of parameter ``target`` in a controller's system; ValueError if none."""
-    system = spec.bundles()[controller].system
-    component, _, variable = target.partition(".")
-    where = f"{path}: {key} sets {target}, but in controller {controller!r}"
-    if component not in system.components:
-        raise ValueError(f"{where} there is no component {component!r} (there are "
-                         f"{', '.join(system.components)})")
-    fmu, variables = spec.declared(controller, component)
-    parameters = [n for n, v in variables.items() if v.causality == "parameter"]
-    if variable not in parameters:
-        raise ValueError(f"{where} {component} ({fmu.name}) has no parameter "
-                         f"{variable!r}; it has {', '.join(parameters)}")
-    return variables[variable]
-
-
-def _received(declaration: Declaration, target: str, value: Any, path: Path, key: str) -> Any:
-    """``value`` exactly as the parameter receives it (``cosim.core.values``); ValueError
-    where it does not take it, or the TOML value is not of its type's kind (``TOML_TYPES``)."""
-    kinds, what = TOML_TYPES.get(declaration.type, ((), "nothing"))
-    if not isinstance(value, kinds) or isinstance(value, bool) != (bool in kinds):
-        raise ValueError(f"{path}: {key} = {value!r}: {target} is an FMI {declaration.type}; "
-                         f"give {what}")
-    try:
-        return checked(target.partition(".")[0], declaration, value)
-    except ValueError as error:
-        raise ValueError(f"{path}: {key}: {error}") from None
 
 
 def _typed(path: Path, key: str, value: Any, kind: type, what: str) -> Any:
@@ -200,23 +203,6 @@ def _axis(path: Path, name: str, values: Any, max_runs: int) -> list:
         except ValueError as error:
             raise ValueError(f"{path}: axis 'sea_state': {error}") from None
     return values
-
-
-def _check_overlaps(path: Path, controllers: dict[str, dict[str, Any]],
-                    axes: dict[str, list]) -> None:
-    """ValueError if two axes, or an axis and a controller's ``set``, set one parameter."""
-    setters: dict[str, str] = {}
-    for axis, values in axes.items():
-        for target in assignments(axis, values[0]):
-            if target in setters:
-                raise ValueError(f"{path}: axes {setters[target]!r} and {axis!r} both set "
-                                 f"{target}; give it one axis")
-            setters[target] = axis
-    for name, controller in controllers.items():
-        for target in controller["set"]:
-            if target in setters:
-                raise ValueError(f"{path}: controller {name!r} sets {target}, which axis "
-                                 f"{setters[target]!r} sets in every run; give it one place")
 
 
 def controller_entry(entry: str | dict[str, Any], spec: Path, name: str) -> dict[str, Any]:

@@ -1,27 +1,26 @@
 """A sweep's client side: runs submitted to a Dask cluster (on the batch backend in batches,
-``plan``), each row journaled as it completes, the workers checked and watched."""
+``plan``), the workers checked and watched, and each row journaled as it completes: the
+``Journal`` a sweep resumes from."""
 from __future__ import annotations
 
+import contextlib
+import json
 import logging
 import math
+import os
 import sys
 import uuid
-from contextlib import contextmanager
-from dataclasses import dataclass
-from typing import Iterator
+from pathlib import Path
 
 from fmukit.timebase import step_count
 
 from ..core.interrupt import Interrupted, StopSignals
 from ..core.watchdog import Limits
 from ..ensemble import SIGNALS
-from .cluster import (Completions, NoWorkers, WorkerWatch, check_workers, has_dashboard,
-                      say)
-from .journal import Journal
+from .cluster import Completions, NoWorkers, check_workers, has_dashboard, say
 from .sweep_spec import Spec
 from .sweep_task import (BATCH, Job, SweepTeardown, batch_refusal, blank_row, fmu_bytes, noted,
                          run_batch)
-
 
 MAX_BATCH = 1024
 """The most runs a batch gets unless told otherwise (``--batch-size``)."""
@@ -33,17 +32,48 @@ WAVES_SHARE = 128
 """The fewest runs a batch in waves is cut down to for giving every worker a share."""
 
 
+def read_rows(path: Path, quiet: bool = False) -> dict[str, dict]:
+    """The rows of a journal by run id (a later row for a run replaces an earlier); a line
+    that is not a whole row (a write cut short by a kill) is skipped, with a warning."""
+    rows: dict[str, dict] = {}
+    lines = path.read_text().splitlines() if path.exists() else []
+    for number, line in enumerate(lines, 1):
+        try:
+            row = json.loads(line)
+            rows[row["run_id"]] = row
+        except (ValueError, KeyError, TypeError):
+            if line.strip() and not quiet:
+                print(f"warning: {path}:{number} is not a whole journal row (a write cut "
+                      "short?); skipped, its run is done again", file=sys.stderr)
+    return rows
+
+
+class Journal:
+    """A sweep's journal, opened by its one writer (who holds the folder's ``FolderLock``):
+    its rows, and ``add``, which appends a row and flushes it to the file."""
+
+    def __init__(self, path: Path):
+        self.path, self.rows = path, read_rows(path)
+        if path.exists() and path.stat().st_size:   # a torn last line: its own
+            with open(path, "rb+") as f:
+                f.seek(-1, os.SEEK_END)
+                if f.read(1) != b"\n":
+                    f.write(b"\n")
+
+    def add(self, row: dict) -> None:
+        with open(self.path, "a") as f:
+            f.write(json.dumps(row) + "\n")
+            f.flush()
+            os.fsync(f.fileno())
+        self.rows[row["run_id"]] = row
+
+
 def batch_limit(job: Job) -> int:
     """The most runs a batch of ``job``'s system and stop time gets by default."""
     system = job.bundle.system
     stop = system.stop_time if job.stop_time is None else job.stop_time
     rows = step_count(system.start_time, stop, system.step_size) + 1
     return max(1, min(MAX_BATCH, BATCH_MEMORY // (len(SIGNALS) * 8 * rows)))
-
-
-def batches(jobs: list[Job], workers: int, size: int | None = None) -> list[list[Job]]:
-    """``jobs`` (of one system and stop time) cut as ``plan`` cuts a sweep of them alone."""
-    return _cut(jobs, batch_counts([jobs], workers, size)[0])
 
 
 def batch_counts(groups: list[list[Job]], workers: int, size: int | None = None) -> list[int]:
@@ -82,117 +112,88 @@ def plan(spec: Spec, jobs: list[Job], workers: int, size: int | None = None
     """(the batches, the runs to run alone) of a sweep on the batch backend: each system's
     runs of one stop time cut as ``batch_counts`` says, those the kernel does not cover
     (``Spec.batch_coverage``) alone."""
-    covered = spec.batch_coverage()
     groups: dict[tuple[str, float | None], list[Job]] = {}
     alone = []
     for job in jobs:
-        if covered[job.run["controller"]] is None:
+        if spec.batch_coverage()[job.run["controller"]] is None:
             groups.setdefault((job.bundle.digest, job.stop_time), []).append(job)
         else:
             alone.append(job)
-    cut = list(groups.values())
-    counts = batch_counts(cut, workers, size)
-    return [batch for group, count in zip(cut, counts) for batch in _cut(group, count)], alone
+    counts = batch_counts(list(groups.values()), workers, size)
+    return [batch for group, count in zip(groups.values(), counts)
+            for batch in _cut(group, count)], alone
 
 
 def run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, progress: bool,
                    task, backend: str, no_worker_timeout: float, limits: Limits,
                    batch_task=run_batch, batch_size: int | None = None) -> None:
     """Run ``todo`` (runs of ``spec``) on the cluster of ``connection`` (a client, and the
-    local cluster it made or None), journaling each row; both closed on every path, quietly
-    when the sweep stops early (``campaign.execute`` says the rest)."""
+    local cluster it made or None): check the workers, send the FMUs and the runs, journal
+    each row as it completes; close both on every path (``_close``)."""
+    from tqdm import tqdm
+
     client, cluster = connection
     teardown = SweepTeardown(uuid.uuid4().hex[:12])
-    stopped = None
+    token, tasks, shipped = teardown.sweep, {}, {}
     try:
-        _submit_and_journal(spec, todo, journal, client, progress, task, backend,
-                            no_worker_timeout, limits, teardown, batch_task, batch_size)
-    except BaseException as error:
-        stopped = error
-        raise
-    finally:
-        with _stopping(stopped, journal):
-            _close(client, cluster, teardown)
+        if client.run_on_scheduler(has_dashboard):
+            say(f"dashboard: {client.dashboard_link}")
+        check_workers(client)
+        client.register_plugin(teardown)
+        # Each FMU as a task holding its bytes, not scattered data: a task's result lost with
+        # its worker is computed again, scattered data is gone, and every run with it. Keyed
+        # by sweep: another sweep's release of a shared key would strand this one's runs.
+        shipped = {sha: client.submit(fmu_bytes, path.read_bytes(), key=f"fmu-{token}-{sha}",
+                                      pure=False)
+                   for sha, path in spec.files().items()}
+        completions = Completions(client, no_worker_timeout)
 
+        def submit(jobs: list[Job], batch: bool, why: str = "") -> None:
+            blobs = {sha: shipped[sha] for sha in jobs[0].bundle.fmu_hashes()}
+            kind, what = ("batch", batch_task) if batch else ("run", task)
+            future = client.submit(what, jobs if batch else jobs[0], blobs, retries=2,
+                                   pure=False, key=f"{kind}-{token}-{jobs[0].run['run_id']}")
+            tasks[future] = jobs, batch, why        # why its runs are not in a batch
+            completions.add(future)
 
-@dataclass
-class _Task:
-    """What a future computes: one run, or a batch of runs."""
-    jobs: list[Job]
-    batch: bool
-    why: str = ""                       # why its run is not in a batch (said in its backend)
-
-
-def _submit_and_journal(spec: Spec, todo: list[dict], journal: Journal, client, progress: bool,
-                        task, backend: str, no_worker_timeout: float, limits: Limits,
-                        teardown: SweepTeardown, batch_task, batch_size: int | None) -> None:
-    """Check the workers, send the FMUs and ``todo``, and journal each row as it completes."""
-    token = teardown.sweep
-    if client.run_on_scheduler(has_dashboard):
-        say(f"dashboard: {client.dashboard_link}")
-    check_workers(client)
-    client.register_plugin(teardown)
-    # Each FMU as a task holding its bytes, not scattered data: a task's result lost with
-    # its worker is computed again, scattered data is gone, and every run with it. Keyed
-    # by sweep: another sweep's release of a shared key would strand this one's runs.
-    shipped = {sha: client.submit(fmu_bytes, path.read_bytes(), key=f"fmu-{token}-{sha}",
-                                  pure=False)
-               for sha, path in spec.files().items()}
-    tasks: dict = {}
-    completions = Completions()
-
-    def submit(jobs: list[Job], batch: bool, why: str = "") -> None:
-        blobs = {sha: shipped[sha] for sha in jobs[0].bundle.fmu_hashes()}
-        kind, what = ("batch", batch_task) if batch else ("run", task)
-        future = client.submit(what, jobs if batch else jobs[0], blobs, retries=2, pure=False,
-                               key=f"{kind}-{token}-{jobs[0].run['run_id']}")
-        tasks[future] = _Task(jobs, batch, why)
-        completions.add(future)
-
-    route = "inprocess" if backend == BATCH else backend      # a batch's runs alone: in-process
-    jobs = [spec.job(run, token, route, limits) for run in todo]
-    together, alone = (plan(spec, jobs, sum(client.nthreads().values()) or 1, batch_size)
-                       if backend == BATCH else ([], jobs))
-    if together:
-        _say_batch_refusals(client)
-    for batch in together:
-        submit(batch, True)
-    for job in alone:
-        submit([job], False)
-    bar = None
-    if progress:
-        from tqdm import tqdm
-        bar = tqdm(total=len(todo), desc=spec.name, unit="run", file=sys.stderr,
-                   disable=None)                # None: only on a terminal
-    watch = WorkerWatch(client, no_worker_timeout)
-    try:
-        for future in completions.each(watch):
-            done = tasks.pop(future)
-            try:
-                result = watch.result(future)
-            except NoWorkers:
-                raise
-            except Exception as error:      # the worker died on every retry
-                died = f"{type(error).__name__}: {error}"
-                if done.batch:              # each run alone: only a run that kills fails
-                    future.release()
-                    for job in done.jobs:
-                        submit([job], False, f"its batch's worker died, {died}")
-                    continue
-                result = {**blank_row(done.jobs[0].run, died), "backend": done.jobs[0].backend}
-            rows = result if done.batch else [result]
-            for job, row in zip(done.jobs, rows, strict=True):
-                journal.add({**(noted(row, done.why) if done.why else row),
-                             "command": spec.replay(job.run)})
-            future.release()                # done: nothing to recompute if a worker dies
-            if bar is not None:
+        route = "inprocess" if backend == BATCH else backend  # a batch's runs alone: in-process
+        jobs = [spec.job(run, token, route, limits) for run in todo]
+        together, alone = (plan(spec, jobs, sum(client.nthreads().values()) or 1, batch_size)
+                           if backend == BATCH else ([], jobs))
+        if together:
+            _say_batch_refusals(client)
+        for batch in together:
+            submit(batch, True)
+        for job in alone:
+            submit([job], False)
+        with tqdm(total=len(todo), desc=spec.name, unit="run", file=sys.stderr,
+                  disable=None if progress else True) as bar:   # None: only on a terminal
+            for future in completions:
+                jobs, batch, why = tasks.pop(future)
+                try:
+                    result = completions.result(future)
+                except NoWorkers:
+                    raise
+                except Exception as error:      # the worker died on every retry
+                    died = f"{type(error).__name__}: {error}"
+                    if batch:                   # each run alone: only a run that kills fails
+                        future.release()
+                        for job in jobs:
+                            submit([job], False, f"its batch's worker died, {died}")
+                        continue
+                    result = {**blank_row(jobs[0].run, died), "backend": jobs[0].backend}
+                rows = result if batch else [result]
+                for job, row in zip(jobs, rows, strict=True):
+                    journal.add({**(noted(row, why) if why else row),
+                                 "command": spec.replay(job.run)})
+                future.release()                # done: nothing to recompute if a worker dies
                 bar.update(len(rows))
-    except NoWorkers:
-        client.cancel([*tasks, *shipped.values()])
+    except BaseException as stopped:
+        if isinstance(stopped, NoWorkers):
+            client.cancel([*tasks, *shipped.values()])
+        _close(client, cluster, teardown, journal, stopped)
         raise
-    finally:
-        if bar is not None:
-            bar.close()                     # its line ended before any message
+    _close(client, cluster, teardown, journal)
 
 
 def _say_batch_refusals(client) -> None:
@@ -211,36 +212,26 @@ def _say_batch_refusals(client) -> None:
             "their batches run one run at a time on the in-process route")
 
 
-def _close(client, cluster, teardown: SweepTeardown) -> None:
-    """Close the client, and the local cluster it made; on a shared cluster, free this
-    sweep's FMUs on the workers first."""
-    if cluster is None:
-        try:
-            client.unregister_worker_plugin(teardown.name)
-        except Exception:                   # workers gone with Ctrl-C
-            pass
-    client.close()
-    if cluster is not None:                 # closing its workers frees everything
-        cluster.close()
-
-
-@contextmanager
-def _stopping(stopped: BaseException | None, journal: Journal) -> Iterator[None]:
-    """After the sweep stopped early: distributed's logging of the teardown silenced, and
-    after Ctrl-C or SIGTERM a second signal ends the process at once (``StopSignals``)."""
-    if stopped is None:
-        yield
-        return
+def _close(client, cluster, teardown: SweepTeardown, journal: Journal,
+           stopped: BaseException | None = None) -> None:
+    """Close the client, and the local cluster it made (closing its workers frees
+    everything); on a shared cluster, free this sweep's FMUs on the workers first. After
+    the sweep ``stopped`` early, quietly (``campaign.execute`` says the rest); after Ctrl-C
+    or SIGTERM a second signal ends the process at once (``StopSignals``)."""
     level = logging.root.manager.disable         # distributed's loggers set their own levels
-    logging.disable(logging.CRITICAL)
+    logging.disable(logging.CRITICAL if stopped is not None else level)
     try:
-        if isinstance(stopped, Interrupted):
-            with StopSignals() as again:
+        with contextlib.ExitStack() as stack:
+            if isinstance(stopped, Interrupted):
+                again = stack.enter_context(StopSignals())
                 again.received = stopped.signal         # the next one is the second
                 again.keep(lambda: f"{journal.path} keeps every run done "
                                    f"({len(journal.rows)})")
-                yield
-        else:
-            yield
+            if cluster is None:
+                with contextlib.suppress(Exception):     # workers gone with Ctrl-C
+                    client.unregister_worker_plugin(teardown.name)
+            client.close()
+            if cluster is not None:
+                cluster.close()
     finally:
         logging.disable(level)

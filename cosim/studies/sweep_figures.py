@@ -17,21 +17,25 @@ from matplotlib.patches import Circle
 from autopilot_fmu.guidance import parse_waypoints
 
 from ..analysis.figures import save
-from ..analysis.track import waypoint_name
 from ..analysis.seastate import model_scale
+from ..analysis.track import waypoint_name
 from .merit import CRITERIA, Merit
 from .sweep_tables import distinct
-
-SEA_AXES = ("sea_state", "Hs")
-
-
-def _sea_axis(spec) -> str | None:
-    return next((a for a in SEA_AXES if a in spec.axes), None)
-
 
 STATISTICS = ("box: median and IQR (25-75 %) of the runs, whiskers: min-max; the number "
               "under each box: its median")
 """What each box of ``distribution`` shows."""
+
+
+def _panels(count: int, width: float, height: float) -> tuple[Figure, list]:
+    """A figure of ``count`` panels of ``width`` x ``height`` inches, at most four a row."""
+    columns = min(4, count)
+    fig = Figure(figsize=(width * columns, height * math.ceil(count / columns)),
+                 layout="constrained")
+    axes = fig.subplots(math.ceil(count / columns), columns, squeeze=False).flat
+    for ax in axes[count:]:
+        ax.set_visible(False)
+    return fig, axes[:count]
 
 
 def distribution(spec, rows: list[dict], path: Path,
@@ -39,21 +43,16 @@ def distribution(spec, rows: list[dict], path: Path,
     """Box plots of each criterion (J alone by default) per controller and sea state, one
     panel each, on a log scale where it spans decades; each run counted once."""
     ok = [r for r in distinct(rows) if r["status"] == "ok"]
-    sea = _sea_axis(spec)
+    sea = next((a for a in ("sea_state", "Hs") if a in spec.axes), None)
     groups = spec.axes[sea] if sea else [None]
-    boxes = len(groups) * len(spec.controllers)
-    columns = min(4, len(criteria))
-    width = max(6.0 if len(criteria) == 1 else 3.4, 0.75 * boxes + 1.2)
-    fig = Figure(figsize=(width * columns, 3.9 * math.ceil(len(criteria) / columns)),
-                 layout="constrained")
-    axes = fig.subplots(math.ceil(len(criteria) / columns), columns, squeeze=False)
-    for ax, criterion in zip(axes.flat, criteria):
+    width = max(6.0 if len(criteria) == 1 else 3.4, 0.75 * len(groups) * len(spec.controllers)
+                + 1.2)
+    fig, axes = _panels(len(criteria), width, 3.9)
+    for ax, criterion in zip(axes, criteria):
         _boxes(ax, spec, ok, criterion, sea, groups)
-    for ax in axes.flat[len(criteria):]:
-        ax.set_visible(False)
     what = "J" if len(criteria) == 1 else "each criterion"
     at = (f" and {sea}" if len(groups) > 1 else f", {sea} {groups[0]}") if sea else ""
-    caption = textwrap.fill(STATISTICS, int(12 * width * columns))   # 9 pt: ~12 a inch
+    caption = textwrap.fill(STATISTICS, int(12 * width * min(4, len(criteria))))  # 9 pt: ~12/in
     fig.suptitle(f"{spec.name}: {what} per controller{at}\n{caption}", fontsize=9)
     return save(fig, path)[0]
 
@@ -62,21 +61,20 @@ def _boxes(ax, spec, ok: list[dict], criterion: Merit, sea: str | None,
            groups: list) -> None:
     """One criterion's panel of ``distribution``."""
     positions, data, labels = [], [], []
+    step = len(spec.controllers) + 1
     for g, group in enumerate(groups):
         for c, controller in enumerate(spec.controllers):
             values = [r[criterion.column] for r in ok if r["controller"] == controller
                       and (sea is None or r[sea] == group)]
-            positions.append(g * (len(spec.controllers) + 1) + c)
+            positions.append(g * step + c)
             data.append([v for v in values if np.isfinite(v)] or [np.nan])
             labels.append(f"{controller}\n{criterion.format(float(np.median(data[-1])))}")
     ax.boxplot(data, positions=positions, widths=0.7, whis=(0, 100), showfliers=False)
     ax.set_xticks(positions, labels, fontsize=7)
-    if len(groups) > 1:                 # each group's name once, under its boxes
-        below = matplotlib.transforms.blended_transform_factory(ax.transData, ax.transAxes)
-        for g, group in enumerate(groups):
-            middle = g * (len(spec.controllers) + 1) + (len(spec.controllers) - 1) / 2
-            ax.text(middle, -0.2, f"{sea} {group}", transform=below, ha="center", va="top",
-                    fontsize=8, fontweight="bold")
+    below = matplotlib.transforms.blended_transform_factory(ax.transData, ax.transAxes)
+    for g, group in enumerate(groups if len(groups) > 1 else []):   # each name under its boxes
+        ax.text(g * step + (step - 2) / 2, -0.2, f"{sea} {group}", transform=below,
+                ha="center", va="top", fontsize=8, fontweight="bold")
     values = [v for d in data for v in d if np.isfinite(v)]
     unit = f" ({criterion.unit})" if criterion.unit else ""
     if not values:
@@ -92,7 +90,11 @@ def _boxes(ax, spec, ok: list[dict], criterion: Merit, sea: str | None,
     elif min(values) == max(values):    # all alike: a readable axis about them, from 0 if 0
         ax.set_ylim(-0.05 if values[0] == 0 else values[0] - 1, values[0] + 1)
     ax.set_xlim(min(positions) - 0.6, max(positions) + 0.6)
-    ax.set_ylabel(criterion.label + unit, fontsize=8)
+    _labels(ax, criterion, criterion.label + unit)
+
+
+def _labels(ax, criterion: Merit, ylabel: str) -> None:
+    ax.set_ylabel(ylabel, fontsize=8)
     ax.set_title(f"{criterion.label}: {criterion.better}", fontsize=9)
     ax.grid(alpha=0.3, axis="y")
 
@@ -101,14 +103,9 @@ def paired_figure(title: str, changes: dict[Merit, dict[str, np.ndarray]], basel
                   path: Path) -> Path:
     """Each criterion's paired ratios (log scale) or differences of every controller to
     ``baseline``: a dot per seed, a bar at their median, the better side shaded."""
-    columns = min(4, len(changes))
-    rows = math.ceil(len(changes) / columns)
-    fig = Figure(figsize=(3.6 * columns, 3.6 * rows), layout="constrained")
-    axes = fig.subplots(rows, columns, squeeze=False)
-    for ax, (criterion, by_controller) in zip(axes.flat, changes.items()):
+    fig, axes = _panels(len(changes), 3.6, 3.6)
+    for ax, (criterion, by_controller) in zip(axes, changes.items()):
         _paired_panel(ax, criterion, by_controller, baseline)
-    for ax in axes.flat[len(changes):]:
-        ax.set_visible(False)
     fig.suptitle(f"{title}: each controller against the {baseline} on the same sea, "
                  "one dot per wave seed, bar: median; shaded: better", fontsize=9)
     return save(fig, path)[0]
@@ -143,15 +140,13 @@ def _paired_panel(ax, criterion: Merit, by_controller: dict[str, np.ndarray],
                           10.0 ** -criterion.digits)
         low, high = -span, span
     ax.set_ylim(low, high)
-    better = (low, reference) if criterion.lower_is_better else (reference, high)
-    ax.axhspan(*better, color="tab:green", alpha=0.08)
+    ax.axhspan(*((low, reference) if criterion.lower_is_better else (reference, high)),
+               color="tab:green", alpha=0.08)
     ax.set_xticks(range(len(by_controller)), list(by_controller), fontsize=7)
     ax.set_xlim(-0.6, len(by_controller) - 0.2)
     unit = f", {criterion.unit}" if criterion.unit else ""
-    ax.set_ylabel(f"ratio to the {baseline} (log scale)" if ratio
-                  else f"difference from the {baseline}{unit}", fontsize=8)
-    ax.set_title(f"{criterion.label}: {criterion.better}", fontsize=9)
-    ax.grid(alpha=0.3, axis="y")
+    _labels(ax, criterion, f"ratio to the {baseline} (log scale)" if ratio
+            else f"difference from the {baseline}{unit}")
 
 
 def ratio_map(spec, rows: list[dict], path: Path, numerator: str = "smc",
@@ -161,26 +156,22 @@ def ratio_map(spec, rows: list[dict], path: Path, numerator: str = "smc",
         return None
     x_axis, y_axis = spec.map_axes
     xs, ys = spec.axes[x_axis], spec.axes[y_axis]
-    ratio = np.full((len(ys), len(xs)), np.nan)
-    for i, y in enumerate(ys):
-        for j, x in enumerate(xs):
-            means = []
-            for controller in (numerator, denominator):
-                J = [r["J"] for r in rows if r["status"] == "ok" and r["controller"] == controller
-                     and r[x_axis] == x and r[y_axis] == y]
-                means.append(np.mean(J) if J else np.nan)
-            ratio[i, j] = means[0] / means[1]
+
+    def mean_J(controller: str, x, y) -> float:
+        J = [r["J"] for r in rows if r["status"] == "ok" and r["controller"] == controller
+             and r[x_axis] == x and r[y_axis] == y]
+        return np.mean(J) if J else np.nan
+    ratio = np.array([[mean_J(numerator, x, y) / mean_J(denominator, x, y) for x in xs]
+                      for y in ys])
     fig = Figure(figsize=(6.5, 4.5), layout="constrained")
     ax = fig.subplots()
     image = ax.imshow(np.log2(ratio), cmap="RdBu_r", vmin=-3, vmax=3, origin="lower",
                       aspect="auto")
-    for i in range(len(ys)):
-        for j in range(len(xs)):
-            ax.text(j, i, f"{ratio[i, j]:.2f}", ha="center", va="center", fontsize=8)
+    for (i, j), value in np.ndenumerate(ratio):
+        ax.text(j, i, f"{value:.2f}", ha="center", va="center", fontsize=8)
     ax.set_xticks(range(len(xs)), [str(x) for x in xs], fontsize=8)
     ax.set_yticks(range(len(ys)), [str(y) for y in ys], fontsize=8)
-    ax.set_xlabel(x_axis)
-    ax.set_ylabel(y_axis)
+    ax.set(xlabel=x_axis, ylabel=y_axis)
     fig.colorbar(image, label=f"log2(J_{numerator} / J_{denominator})")
     ax.set_title(f"{spec.name}: J_{numerator} / J_{denominator} (< 1: {numerator} better)",
                  fontsize=10)
@@ -189,7 +180,7 @@ def ratio_map(spec, rows: list[dict], path: Path, numerator: str = "smc",
 
 def tracks(spec, rows: list[dict], path: Path) -> Path | None:
     """The tracks of the runs [plots] tracks selects, one colour per controller, the route
-    dashed."""
+    dashed, its waypoints named and their circles of acceptance dotted."""
     chosen = [r for r in rows if r.get("track")]
     if not chosen:
         return None
@@ -201,10 +192,17 @@ def tracks(spec, rows: list[dict], path: Path) -> Path | None:
         for i, track in enumerate(mine):
             ax.plot(track["y"], track["x"], color=color, linewidth=0.8, alpha=0.45,
                     label=f"{controller} ({len(mine)} runs)" if i == 0 else None)
-    route = chosen[0]["track"].get("route")
+    route, R_accept = chosen[0]["track"].get("route"), chosen[0]["track"].get("R_accept")
     if route:
-        _route(ax, np.array(parse_waypoints(route) if isinstance(route, str) else route),
-               chosen[0]["track"].get("R_accept"))
+        points = np.array(parse_waypoints(route) if isinstance(route, str) else route)
+        ax.plot(points[:, 1], points[:, 0], "--o", color="0.3", linewidth=0.8, markersize=3,
+                label="route" + (f", circles of acceptance {R_accept:g} m" if R_accept else ""))
+        for k, (x, y) in enumerate(points):
+            ax.annotate(waypoint_name(k), (y, x), xytext=(4, 4), textcoords="offset points",
+                        fontsize=8, color="0.2")
+            if R_accept:
+                ax.add_patch(Circle((y, x), R_accept, fill=False, linestyle=":", color="0.3",
+                                    linewidth=0.8))
     ax.set(xlabel="east y (m)", ylabel="north x (m)")
     ax.set_aspect("equal", adjustable="datalim")
     ax.grid(alpha=0.3)
@@ -217,25 +215,11 @@ def tracks(spec, rows: list[dict], path: Path) -> Path | None:
     return save(fig, path)[0]
 
 
-def _route(ax, points: np.ndarray, R_accept: float | None) -> None:
-    """The route dashed, its waypoints named, and their circles of acceptance dotted."""
-    ax.plot(points[:, 1], points[:, 0], "--o", color="0.3", linewidth=0.8, markersize=3,
-            label="route" + (f", circles of acceptance {R_accept:g} m" if R_accept else ""))
-    for k, (x, y) in enumerate(points):
-        ax.annotate(waypoint_name(k), (y, x), xytext=(4, 4), textcoords="offset points",
-                    fontsize=8, color="0.2")
-        if R_accept:
-            ax.add_patch(Circle((y, x), R_accept, fill=False, linestyle=":", color="0.3",
-                                    linewidth=0.8))
-
-
 def save_figures(spec, rows: list[dict], out: Path) -> list[Path]:
-    written = [distribution(spec, rows, out / "J_distribution.png")]
-    overlay = tracks(spec, rows, out / "tracks.png")
-    if overlay is not None:
-        written.append(overlay)
-    for numerator in [c for c in spec.controllers if c != "pd"]:
-        path = ratio_map(spec, rows, out / f"J_{numerator}_over_pd.png", numerator)
-        if path is not None:
-            written.append(path)
-    return written
+    """A sweep's figures: J's distribution, the tracks, each controller's map against the
+    PD; the files written."""
+    written = [distribution(spec, rows, out / "J_distribution.png"),
+               tracks(spec, rows, out / "tracks.png"),
+               *(ratio_map(spec, rows, out / f"J_{c}_over_pd.png", c)
+                 for c in spec.controllers if c != "pd")]
+    return [path for path in written if path is not None]

@@ -6,12 +6,12 @@ nothing (``CALM_WATER_INERT`` in calm water) have one result, run once (``shared
 """
 from __future__ import annotations
 
-import dataclasses
 import hashlib
 import itertools
 import json
 import shlex
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -20,10 +20,10 @@ from fmukit.manifest import read as read_manifest
 from ..core.errors import FmuNotFound, FmuUnreadable
 from ..core.fmi import read_description
 from ..core.inprocess import fallback_note, in_process_refusal
-from ..provenance import code_version
 from ..core.ssd import SystemDescription
 from ..core.values import Declaration, declarations
 from ..core.watchdog import Limits
+from ..provenance import code_version
 from .bundle import Bundle, bundle
 from .spec_file import MAX_RUNS, assignments, check_values, parse
 from .sweep_task import Job
@@ -45,16 +45,6 @@ class Spec:
     stop_time: float | None = None
     map_axes: list[str] = field(default_factory=list)
     tracks: dict[str, Any] | None = None      # which runs record their track: axis values
-    _bundles: dict[str, Bundle] | None = field(default=None, repr=False, compare=False)
-    _files: dict[str, Path] = field(default_factory=dict, repr=False, compare=False)
-    _descriptions: dict[tuple[str, str], Any] = field(default_factory=dict, repr=False,
-                                                       compare=False)
-    _ships: dict[tuple[str, str], bool] = field(default_factory=dict, repr=False, compare=False)
-    _coverage: dict[str, str | None] | None = field(default=None, repr=False, compare=False)
-
-    def wants_track(self, run: dict[str, Any]) -> bool:
-        """Whether ``run`` is one of the runs whose tracks are drawn ([plots] tracks)."""
-        return self.tracks is not None and all(run.get(k) == v for k, v in self.tracks.items())
 
     @classmethod
     def read(cls, path: str | Path, max_runs: int = MAX_RUNS) -> Spec:
@@ -69,18 +59,30 @@ class Spec:
         check_values(spec, path)
         return spec
 
+    @cached_property
+    def _shipped(self) -> dict[str, tuple[Bundle, dict[str, Path], SystemDescription]]:
+        """Each controller's bundle, its FMUs by SHA-256 and its system here (read once)."""
+        return {name: bundle(controller) for name, controller in self.controllers.items()}
+
+    def bundles(self) -> dict[str, Bundle]:
+        """Each controller's system with its FMUs named by content."""
+        return {name: shipped[0] for name, shipped in self._shipped.items()}
+
+    def files(self) -> dict[str, Path]:
+        """Every FMU the sweep uses, by SHA-256."""
+        return {sha: path for _, files, _ in self._shipped.values()
+                for sha, path in files.items()}
+
+    def _description(self, controller: str, component: str) -> tuple[Path, Any]:
+        """A component's FMU in a controller's system, and its model description."""
+        source = self.bundles()[controller].system.components[component].source
+        fmu = self.files()[Path(source).stem]
+        return fmu, read_description(fmu, component)
+
     def declared(self, controller: str, component: str) -> tuple[Path, dict[str, Declaration]]:
         """A component's FMU in a controller's system, and its variables' declarations."""
         fmu, description = self._description(controller, component)
         return fmu, declarations(description)
-
-    def _description(self, controller: str, component: str) -> tuple[Path, Any]:
-        """A component's FMU in a controller's system, and its model description (read once)."""
-        if (controller, component) not in self._descriptions:
-            source = self.bundles()[controller].system.components[component].source
-            fmu = self.files()[Path(source).stem]
-            self._descriptions[controller, component] = fmu, read_description(fmu, component)
-        return self._descriptions[controller, component]
 
     def _variable(self, controller: str, target: str):
         """The model variable ``target`` (component.variable) of a controller's system."""
@@ -88,27 +90,12 @@ class Spec:
         description = self._description(controller, component)[1]
         return next(v for v in description.modelVariables if v.name == name)
 
-    def bundles(self) -> dict[str, Bundle]:
-        """Each controller's system with its FMUs named by content (read once)."""
-        if self._bundles is None:
-            self._bundles, self._files = {}, {}
-            for name, controller in self.controllers.items():
-                self._bundles[name], files = bundle(controller)
-                self._files.update(files)
-        return self._bundles
-
-    def files(self) -> dict[str, Path]:
-        """Every FMU the sweep uses, by SHA-256."""
-        self.bundles()
-        return self._files
-
     def runs(self) -> list[dict[str, Any]]:
         """Every combination of controller and axis values, with its run id."""
-        names = list(self.axes)
         runs = []
         for controller, shipped in self.bundles().items():
-            for values in itertools.product(*(self.axes[n] for n in names)):
-                point = {"controller": controller, **dict(zip(names, values))}
+            for values in itertools.product(*self.axes.values()):
+                point = {"controller": controller, **dict(zip(self.axes, values))}
                 point["run_id"] = _digest({"system": shipped.digest,
                                            "settings": self.settings(point)[1],
                                            "stop_time": self.stop_time, "point": point})
@@ -120,42 +107,37 @@ class Spec:
         settings differ only in ``CALM_WATER_INERT`` in calm water. Each group runs once."""
         groups: dict[str, list[dict[str, Any]]] = {}
         for run in self.runs():
-            groups.setdefault(self._result_key(run), []).append(run)
+            overrides = self.settings(run)[1]
+            calm = self._calm_ships(run["controller"], overrides)
+            effective = {component: {variable: value for variable, value in values.items()
+                                     if component not in calm
+                                     or variable not in CALM_WATER_INERT}
+                         for component, values in overrides.items()}
+            key = _digest({"controller": run["controller"], "settings": effective})
+            groups.setdefault(key, []).append(run)
         return list(groups.values())
 
-    def _result_key(self, run: dict[str, Any]) -> str:
-        """A hash of the controller and the settings of ``run`` that change its result."""
-        overrides = self.settings(run)[1]
-        inert = {(ship, variable) for ship in self._calm_ships(run["controller"], overrides)
-                 for variable in CALM_WATER_INERT}
-        effective = {component: {variable: value for variable, value in values.items()
-                                 if (component, variable) not in inert}
-                     for component, values in overrides.items()}
-        return _digest({"controller": run["controller"], "settings": effective})
+    @cached_property
+    def _ships(self) -> dict[str, dict[str, Any]]:
+        """Each controller's components that are this checkout's ship FMU, with the Hs their
+        system binds or their FMU declares."""
+        ships: dict[str, dict[str, Any]] = {}
+        for controller, shipped in self.bundles().items():
+            ships[controller] = {}
+            for name, component in shipped.system.components.items():
+                fmu = self._description(controller, name)[0]
+                manifest = read_manifest(fmu)
+                if (manifest is not None and manifest.slave_module == SHIP_SLAVE
+                        and in_process_refusal(fmu) is None):
+                    Hs = component.parameters.get("Hs")
+                    ships[controller][name] = (self._variable(controller, f"{name}.Hs").start
+                                               if Hs is None else Hs)
+        return ships
 
     def _calm_ships(self, controller: str, overrides: dict[str, dict[str, Any]]) -> list[str]:
-        """The components that are this checkout's ship FMU with Hs = 0 (set, bound or by
-        default)."""
-        calm = []
-        for name, component in self.bundles()[controller].system.components.items():
-            if not self._is_our_ship(controller, name):
-                continue
-            Hs = overrides.get(name, {}).get("Hs", component.parameters.get("Hs"))
-            if Hs is None:
-                Hs = self._variable(controller, f"{name}.Hs").start
-            if float(Hs) == 0.0:
-                calm.append(name)
-        return calm
-
-    def _is_our_ship(self, controller: str, component: str) -> bool:
-        """Whether a component is this checkout's ship FMU (asked once)."""
-        if (controller, component) not in self._ships:
-            fmu = self._description(controller, component)[0]
-            manifest = read_manifest(fmu)
-            self._ships[controller, component] = (manifest is not None
-                                                  and manifest.slave_module == SHIP_SLAVE
-                                                  and in_process_refusal(fmu) is None)
-        return self._ships[controller, component]
+        """The components of a run that are this checkout's ship FMU with Hs = 0."""
+        return [name for name, Hs in self._ships[controller].items()
+                if float(overrides.get(name, {}).get("Hs", Hs)) == 0.0]
 
     def sharing_notes(self) -> list[str]:
         """What ``shared_runs`` saves, in words."""
@@ -208,17 +190,19 @@ class Spec:
         units = {}
         for axis, values in self.axes.items():
             targets = list(assignments(axis, values[0]))
-            units[axis] = (_declared_unit(self._variable(controller, targets[0]))
-                           if len(targets) == 1 else "")
+            variable = self._variable(controller, targets[0])
+            declared = variable.declaredType.unit if variable.declaredType else ""
+            units[axis] = "" if len(targets) > 1 else variable.unit or declared or ""
         return units
 
     def job(self, run: dict[str, Any], sweep: str, backend: str = "fmi",
             limits: Limits = Limits()) -> Job:
-        """What a worker needs for ``run`` (of the sweep with token ``sweep``)."""
+        """What a worker needs for ``run`` (of the sweep with token ``sweep``), recording
+        its track if [plots] tracks selects it."""
+        track = self.tracks is not None and all(run.get(k) == v for k, v in self.tracks.items())
         return Job(sweep=sweep, run=run, bundle=self.bundles()[run["controller"]],
-                   overrides=self.settings(run)[1], stop_time=self.stop_time,
-                   track=self.wants_track(run), code=code_version(), backend=backend,
-                   limits=limits)
+                   overrides=self.settings(run)[1], stop_time=self.stop_time, track=track,
+                   code=code_version(), backend=backend, limits=limits)
 
     def backend_notes(self, backend: str) -> list[str]:
         """Which components will run through FMI although ``backend`` is "inprocess" or
@@ -237,43 +221,26 @@ class Spec:
                     notes.append(f"controller {controller!r}: {note}")
         return notes
 
+    @cached_property
+    def _coverage(self) -> dict[str, str | None]:
+        from ..ensemble.members import coverage
+
+        return {name: coverage(system) for name, (_, _, system) in self._shipped.items()}
+
     def batch_coverage(self) -> dict[str, str | None]:
         """Each controller: why the batch kernel cannot run its system, None if it can."""
-        if self._coverage is None:
-            from ..ensemble.members import coverage
-
-            self._coverage = {controller: coverage(self.local_system(controller))
-                              for controller in self.controllers}
         return self._coverage
-
-    def local_system(self, controller: str) -> SystemDescription:
-        """A controller's system as its bundle holds it, each FMU the file here."""
-        shipped = self.bundles()[controller].system
-        return dataclasses.replace(shipped, components={
-            name: dataclasses.replace(component,
-                                      source=str(self.files()[Path(component.source).stem]))
-            for name, component in shipped.components.items()})
 
     def settings(self, run: dict[str, Any]) -> tuple[str, dict[str, dict[str, Any]]]:
         """(scenario, overrides by component) of one run."""
         controller = self.controllers[run["controller"]]
         overrides: dict[str, dict[str, Any]] = {}
-
-        def put(target: str, value: Any) -> None:
+        for target, value in [*controller.get("set", {}).items(),
+                              *(pair for axis in self.axes
+                                for pair in assignments(axis, run[axis]).items())]:
             component, _, variable = target.partition(".")
             overrides.setdefault(component, {})[variable] = value
-
-        for target, value in controller.get("set", {}).items():
-            put(target, value)
-        for axis in self.axes:
-            for target, value in assignments(axis, run[axis]).items():
-                put(target, value)
         return controller["scenario"], overrides
-
-
-def _declared_unit(variable) -> str:
-    """The unit a model variable declares, itself or by its type ("" for none)."""
-    return variable.unit or (variable.declaredType.unit if variable.declaredType else "") or ""
 
 
 def _digest(identity: dict[str, Any]) -> str:

@@ -1,38 +1,29 @@
 """A sweep's rows as tables: results.parquet, .csv and .json, summary.csv and the printed
 summary (each figure of merit per setting and controller, each run counted once), and
-comparison.md (every controller against the baseline, seed by seed).
+comparison.md (every controller against the PD, seed by seed).
 """
 from __future__ import annotations
 
 import itertools
 import json
+import math
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any
 
 import numpy as np
 
 from ..core.files import write_atomically
-from .sweep_spec import Spec
 from .merit import METRICS
+from .sweep_spec import Spec
 
 TIMES = {"seconds": "s", "sim_seconds": "s"}
 """A row's wall-clock times: its task's, and its run's alone (in a batch: its share)."""
-
 MONTE_CARLO = "wave_seed"
 """The axis the statistics are taken over, and that pairs runs (the same sea)."""
-
-STATISTICS = {"median": "median", "q25": "25th percentile", "q75": "75th percentile",
-              "min": "least", "max": "greatest"}
+STATISTICS = ("median", "q25", "q75", "min", "max")
 """What summary.csv gives of each figure of merit over the runs of a setting."""
-
 MOST_PRINTED = 48
 """The most lines of the printed summary's table: a larger sweep prints its axes one by one."""
-
-
-def units(spec: Spec | None, columns: list[str]) -> dict[str, str]:
-    """The unit of each column ("" for none; an axis's known with ``spec``)."""
-    known = {**(spec.units() if spec is not None else {}), **METRICS, **TIMES}
-    return {name: known.get(name, "") for name in columns}
 
 
 def headed(name: str, unit: str) -> str:
@@ -50,7 +41,8 @@ def write_tables(rows: list[dict], out: Path, csv: bool, spec: Spec | None = Non
 
     table = pa.Table.from_pylist([{k: (json.dumps(v) if isinstance(v, (list, dict)) else v)
                                    for k, v in row.items() if k != "track"} for row in rows])
-    unit = units(spec, table.column_names)
+    known = {**(spec.units() if spec is not None else {}), **METRICS, **TIMES}
+    unit = {name: known.get(name, "") for name in table.column_names}
     table = table.cast(pa.schema([field.with_metadata({"unit": unit[field.name]})
                                   for field in table.schema]))
     written = [write_atomically(out / "results.parquet", lambda p: pq.write_table(table, p)),
@@ -68,16 +60,11 @@ def write_tables(rows: list[dict], out: Path, csv: bool, spec: Spec | None = Non
     return written
 
 
-def _settings_axes(spec: Spec) -> list[str]:
-    """The axes that make a setting: all but the Monte Carlo axis."""
-    return [a for a in spec.axes if a != MONTE_CARLO]
-
-
-def _settings(spec: Spec) -> Iterator[dict[str, Any]]:
-    """Each setting of the axes other than the Monte Carlo axis, as axis: value."""
-    axes = _settings_axes(spec)
-    for values in itertools.product(*(spec.axes[a] for a in axes)):
-        yield dict(zip(axes, values))
+def _settings(spec: Spec) -> tuple[list[str], list[dict[str, Any]]]:
+    """The axes that make a setting (all but ``MONTE_CARLO``), and each setting of them."""
+    axes = [a for a in spec.axes if a != MONTE_CARLO]
+    return axes, [dict(zip(axes, values))
+                  for values in itertools.product(*(spec.axes[a] for a in axes))]
 
 
 def _in(row: dict, where: dict[str, Any]) -> bool:
@@ -85,7 +72,6 @@ def _in(row: dict, where: dict[str, Any]) -> bool:
 
 
 def _ran_as(row: dict) -> str:
-    """The run whose result the row is."""
     return row.get("ran_as", row["run_id"])
 
 
@@ -94,34 +80,28 @@ def distinct(rows: list[dict]) -> list[dict]:
     return list({_ran_as(r): r for r in rows}.values())
 
 
-def _statistics(values: np.ndarray) -> dict[str, float]:
+def _statistics(values: np.ndarray) -> list[float]:
+    """``STATISTICS`` of ``values`` (NaN for none)."""
     if not values.size:
-        return {name: np.nan for name in STATISTICS}
+        return [math.nan] * len(STATISTICS)
     q25, median, q75 = np.percentile(values, [25, 50, 75])
-    return {"median": median, "q25": q25, "q75": q75, "min": values.min(),
-            "max": values.max()}
+    return [float(v) for v in (median, q25, q75, values.min(), values.max())]
 
 
 def summary_table(spec: Spec, rows: list[dict]) -> list[list]:
     """Header and lines of summary.csv: per setting (the axes but ``MONTE_CARLO``) and
     controller, the runs ok and failed and each figure of merit's ``STATISTICS``."""
-    axes = _settings_axes(spec)
-    header = [*axes, "controller", "runs ok", "runs failed",
+    axes, settings = _settings(spec)
+    lines = [[*axes, "controller", "runs ok", "runs failed",
               *(headed(f"{metric} {name}", unit) for metric, unit in METRICS.items()
-                for name in STATISTICS)]
-    lines = []
-    for where in _settings(spec):
-        for controller in spec.controllers:
-            mine = distinct([r for r in rows if r["controller"] == controller
-                             and _in(r, where)])
-            ok = [r for r in mine if r["status"] == "ok"]
-            cells = [*(where[a] for a in axes), controller, len(ok), len(mine) - len(ok)]
-            for metric in METRICS:
-                stats = _statistics(np.array([r[metric] for r in ok if metric in r],
-                                             dtype=float))
-                cells += [float(stats[name]) for name in STATISTICS]
-            lines.append(cells)
-    return [header, *lines]
+                for name in STATISTICS)]]
+    for where, controller in itertools.product(settings, spec.controllers):
+        mine = distinct([r for r in rows if r["controller"] == controller and _in(r, where)])
+        ok = [r for r in mine if r["status"] == "ok"]
+        lines.append([*where.values(), controller, len(ok), len(mine) - len(ok), *(
+            value for metric in METRICS for value in _statistics(
+                np.array([r[metric] for r in ok if metric in r], dtype=float)))])
+    return lines
 
 
 def summary(spec: Spec, rows: list[dict], shown_failures: int = 10) -> str:
@@ -132,8 +112,7 @@ def summary(spec: Spec, rows: list[dict], shown_failures: int = 10) -> str:
     lines = [f"{spec.name}: " + (f"{len(rows)} combinations in {len(runs)} runs ({shared} "
                                  "share an equivalent run's result)" if shared else
                                  f"{len(rows)} runs")
-             + f", {len(ok)} ok, {len(runs) - len(ok)} failed"]
-    lines += _J_lines(spec, rows)
+             + f", {len(ok)} ok, {len(runs) - len(ok)} failed", *_J_lines(spec, ok)]
     failed = [r for r in runs if r["status"] != "ok"]
     for r in failed[:shown_failures]:
         axes = ", ".join(f"{a} = {r[a]}" for a in spec.axes)
@@ -145,16 +124,15 @@ def summary(spec: Spec, rows: list[dict], shown_failures: int = 10) -> str:
     return "\n".join(lines)
 
 
-def _J_lines(spec: Spec, rows: list[dict]) -> list[str]:
-    """The printed table of J: per setting and controller, or past ``MOST_PRINTED`` lines
-    per value of each axis, pooled over the others."""
-    axes = _settings_axes(spec)
-    groups = [(" ".join(str(where[a]) for a in axes), where) for where in _settings(spec)]
+def _J_lines(spec: Spec, ok: list[dict]) -> list[str]:
+    """The printed table of J over the distinct runs ``ok``: per setting and controller, or
+    past ``MOST_PRINTED`` lines per value of each axis, pooled over the others."""
+    axes, settings = _settings(spec)
+    groups = [(" ".join(str(v) for v in where.values()), where) for where in settings]
     pooled = len(groups) * len(spec.controllers) > MOST_PRINTED
     if pooled:
         groups = [(f"{a} {v}", {a: v}) for a in axes for v in spec.axes[a]]
-    per = ("per value of each axis (pooled over the other axes)" if pooled else
-           "per setting")
+    per = "per value of each axis (pooled over the other axes)" if pooled else "per setting"
     over = f"over {MONTE_CARLO}; " if MONTE_CARLO in spec.axes else ""
     label = "setting" if pooled else " ".join(axes) or "all"
     lines = [f"J of eq (19) [rad^2] {per} and controller: median, IQR (interquartile range, "
@@ -165,42 +143,38 @@ def _J_lines(spec: Spec, rows: list[dict]) -> list[str]:
     named = max(len("controller"), *(len(c) for c in spec.controllers))
     lines.append(f"  {label:<{wide}}  {'controller':<{named}}  runs    median  "
                  f"{'IQR':^19}  {'least - greatest':^19}".rstrip())
-    ok = [r for r in distinct(rows) if r["status"] == "ok"]
-    for name, where in groups:
-        for controller in spec.controllers:
-            J = np.array([r["J"] for r in ok if r["controller"] == controller
-                          and _in(r, where)], dtype=float)
-            s = _statistics(J)
-            lines.append(f"  {name:<{wide}}  {controller:<{named}}  {J.size:>4}  " + (
-                f"{s['median']:8.2f}  {s['q25']:8.2f} - {s['q75']:8.2f}  "
-                f"{s['min']:8.2f} - {s['max']:8.2f}" if J.size else f"{'-':>8}"))
+    for (name, where), controller in itertools.product(groups, spec.controllers):
+        J = np.array([r["J"] for r in ok if r["controller"] == controller and _in(r, where)],
+                     dtype=float)
+        median, q25, q75, least, greatest = _statistics(J)
+        lines.append(f"  {name:<{wide}}  {controller:<{named}}  {J.size:>4}  " + (
+            f"{median:8.2f}  {q25:8.2f} - {q75:8.2f}  {least:8.2f} - {greatest:8.2f}"
+            if J.size else f"{'-':>8}"))
     return lines
 
 
-def comparison(spec: Spec, rows: list[dict], baseline: str = "pd",
-               monte_carlo: str = MONTE_CARLO) -> str:
-    """Markdown table: per setting of the other axes, each controller's median J, its wins
-    against the baseline (a lower J on the same sea, each pair of runs counted once) and
-    the median J ratio."""
-    others = [c for c in spec.controllers if c != baseline]
-    axes = [a for a in spec.axes if a != monte_carlo]
+def comparison(spec: Spec, rows: list[dict]) -> str:
+    """Markdown table: per setting of the axes but ``MONTE_CARLO``, each controller's median
+    J, its wins against the PD (a lower J on the same sea, each pair of runs counted once)
+    and the median J ratio."""
+    others = [c for c in spec.controllers if c != "pd"]
+    axes, settings = _settings(spec)
     ok = {(r["controller"], *(json.dumps(r[a]) for a in spec.axes)): r
           for r in rows if r["status"] == "ok"}
-    seeds = spec.axes.get(monte_carlo, [None])
-    header = [*axes, f"J {baseline} median", *(f"J {c} median" for c in others),
-              *(f"{c} wins" for c in others), *(f"J {c} / J {baseline} median" for c in others)]
+    header = [*axes, "J pd median", *(f"J {c} median" for c in others),
+              *(f"{c} wins" for c in others), *(f"J {c} / J pd median" for c in others)]
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    for setting in itertools.product(*(spec.axes[a] for a in axes)):
-        where = dict(zip(axes, setting))
+    for where in settings:
         runs = {controller: [ok.get((controller, *(json.dumps(where.get(a, seed))
-                                                   for a in spec.axes))) for seed in seeds]
+                                                   for a in spec.axes)))
+                             for seed in spec.axes.get(MONTE_CARLO, [None])]
                 for controller in spec.controllers}
-        cells = [str(v) for v in setting] + [_median_J(runs[baseline])]
+        cells = [str(v) for v in where.values()] + [_median_J(runs["pd"])]
         wins, ratios = [], []
         for controller in others:
             cells.append(_median_J(runs[controller]))
             pairs = list({(_ran_as(a), _ran_as(b)): (a["J"], b["J"])
-                          for a, b in zip(runs[controller], runs[baseline])
+                          for a, b in zip(runs[controller], runs["pd"])
                           if a is not None and b is not None}.values())
             decided = [(J_c, J_b) for J_c, J_b in pairs if J_c != J_b]
             wins.append(f"{sum(J_c < J_b for J_c, J_b in decided)}/{len(decided)}")

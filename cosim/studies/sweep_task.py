@@ -1,9 +1,10 @@
 """A sweep's tasks, on a worker: one whole co-simulation from a ``Job`` and the FMUs' bytes
-(``run_one``), or the runs of one system as one array program (``run_batch``).
+(``run_one``), or the runs of one system as one array program (``run_batch``); the same row
+(``result_row``) either way, but for ``backend``, ``seconds`` and ``sim_seconds``.
 
-Both make a row with ``result_row``, so a row is the same whichever task ran it, but for
-``backend``, ``seconds`` and ``sim_seconds``. A worker keeps one master per sweep, thread,
-system and backend, reset between tasks, and freed by that sweep's ``SweepTeardown``.
+A worker keeps one master per sweep, thread, system and backend, reset between tasks. The
+sweep's ``SweepTeardown`` frees the idle ones and stops its runs under way at their next
+step, which then free their own: freed under a run, its FMUs would fail it, loudly.
 """
 from __future__ import annotations
 
@@ -16,8 +17,8 @@ from typing import Any
 from distributed import WorkerPlugin
 
 from ..core.master import RUN_BACKENDS
-from ..provenance import code_version
 from ..core.watchdog import Limits, TimeLimit, Watchdog
+from ..provenance import code_version
 from .bundle import Bundle, materialise
 from .merit import METRICS, run_metrics, track
 
@@ -40,41 +41,58 @@ class Job:
     limits: Limits = Limits()           # the run's step and run time limits
 
 
-_masters: dict[tuple[str, int, str, str], Any] = {}    # (sweep, thread, digest, backend)
-_masters_lock = threading.Lock()
+Key = tuple[str, int, str, str]                  # (sweep, thread, system digest, backend)
+_masters: dict[Key, Any] = {}                   # the idle masters
+_busy: dict[Key, Watchdog] = {}                 # the watchdogs of the runs under way
+_ended: set[str] = set()                        # the sweeps torn down in this process
+_lock = threading.Lock()
 
 
-def _master(job: Job, blobs: dict[str, bytes]):
-    from ..core.master import Master
-
-    key = _key(job)
-    with _masters_lock:
-        master = _masters.get(key)
-    if master is None:
-        master = Master(materialise(job.bundle, blobs), backend=job.backend)
-        with _masters_lock:
-            _masters[key] = master
-    else:
-        master.reset()
-    return master
-
-
-def _key(job: Job) -> tuple[str, int, str, str]:
+def _key(job: Job) -> Key:
     return job.sweep, threading.get_ident(), job.bundle.digest, job.backend
 
 
-def _drop_master(job: Job) -> None:
-    with _masters_lock:
+def _take(job: Job, blobs: dict[str, bytes], watchdog: Watchdog):
+    """This thread's idle master of ``job``'s system, reset, or a new one, for a run that
+    ``watchdog`` watches; ``_give_back`` it."""
+    from ..core.master import Master
+
+    with _lock:
+        if job.sweep in _ended:
+            raise RuntimeError("the sweep has ended")
         master = _masters.pop(_key(job), None)
-    if master is not None:
+        _busy[_key(job)] = watchdog
+    if master is None:
+        return Master(materialise(job.bundle, blobs), backend=job.backend)
+    try:
+        master.reset()
+    except BaseException:
+        master.free()
+        raise
+    return master
+
+
+def _give_back(job: Job, master, healthy: bool) -> None:
+    """Keep ``master`` for the sweep's next task; free it after a failure (its FMUs may be in
+    an error state) or once the sweep has ended."""
+    with _lock:
+        _busy.pop(_key(job), None)
+        keep = master is not None and healthy and job.sweep not in _ended
+        if keep:
+            _masters[_key(job)] = master
+    if master is not None and not keep:
         master.free()
 
 
 def free_masters(sweep: str | None = None) -> None:
-    """Free this process's cached masters: of one sweep, or all."""
-    with _masters_lock:
-        keys = [k for k in _masters if sweep is None or k[0] == sweep]
-        masters = [_masters.pop(k) for k in keys]
+    """Free this process's idle masters: of one sweep, which has ended (its runs under way
+    stop at their next step and free their own), or all."""
+    with _lock:
+        if sweep is not None:
+            _ended.add(sweep)
+            for watchdog in (w for key, w in _busy.items() if key[0] == sweep):
+                watchdog.expired = "the sweep ended"
+        masters = [_masters.pop(k) for k in list(_masters) if sweep in (None, k[0])]
     for master in masters:
         master.free()
 
@@ -83,8 +101,7 @@ class SweepTeardown(WorkerPlugin):
     """Frees one sweep's masters (and their temporary folders) on a worker."""
 
     def __init__(self, sweep: str):
-        self.sweep = sweep
-        self.name = f"cosim-sweep-{sweep}"
+        self.sweep, self.name = sweep, f"cosim-sweep-{sweep}"
 
     def teardown(self, worker) -> None:
         free_masters(self.sweep)
@@ -97,8 +114,8 @@ def ran_on(kinds: dict[str, str] | None, asked: str) -> str:
         return asked
     if len(set(kinds.values())) == 1:
         return next(iter(kinds.values()))
-    others = [f"{name}: {kind}" for name, kind in kinds.items() if kind != asked]
-    return "; ".join([asked, *others])
+    return "; ".join([asked, *(f"{name}: {kind}" for name, kind in kinds.items()
+                               if kind != asked)])
 
 
 def fmu_bytes(data: bytes) -> bytes:
@@ -112,40 +129,39 @@ def blank_row(run: dict[str, Any], error: str = "") -> dict[str, Any]:
             **{m: math.nan for m in METRICS}, "seconds": math.nan, "sim_seconds": math.nan}
 
 
+def _other_code(job: Job) -> dict[str, Any]:
+    """The failed row of a run sent by a client that runs other code than this worker."""
+    return blank_row(job.run, f"worker runs {code_version()}, the client {job.code}: "
+                              "install the client's version on every worker")
+
+
 def run_one(job: Job, blobs: dict[str, bytes]) -> dict[str, Any]:
     """One whole co-simulation's row; a failed run (past its time limits too) is recorded,
     never raised. ``seconds``: the task's wall time, ``sim_seconds``: the run's alone."""
     started = time.perf_counter()
     if job.code != code_version():          # a worker that joined after the client's check
         return _other_code(job)
-    master, watchdog = None, Watchdog(job.limits)
+    master, watchdog, recording = None, Watchdog(job.limits), None
     try:
         with watchdog:                          # a hung FMU fails its run, not the worker
             watchdog.beat("instantiating the FMUs")
-            master = _master(job, blobs)
+            master = _take(job, blobs, watchdog)
             master.configure(job.overrides)
             simulating = time.perf_counter()
             recording = master.run(job.stop_time, watchdog=watchdog)
         sim_seconds = time.perf_counter() - simulating
     except (Exception, TimeLimit) as error:  # a bad setting: not worth retrying
-        _drop_master(job)
-        reason = watchdog.expired if watchdog.expired else f"{type(error).__name__}: {error}"
-        row = blank_row(job.run, reason)
-    else:
-        if recording.error:
-            _drop_master(job)               # its FMUs may be in an error state
+        recording = None
+        row = blank_row(job.run, watchdog.expired or f"{type(error).__name__}: {error}")
+    finally:
+        _give_back(job, master, recording is not None and not recording.error)
+    if recording is not None:
         row = result_row(job, recording)
         if not recording.error:
             row["sim_seconds"] = sim_seconds
     row["backend"] = ran_on(master and master.backends, job.backend)   # same results either way
     row["seconds"] = time.perf_counter() - started
     return row
-
-
-def _other_code(job: Job) -> dict[str, Any]:
-    """The failed row of a run sent by a client that runs other code than this worker."""
-    return blank_row(job.run, f"worker runs {code_version()}, the client {job.code}: "
-                              "install the client's version on every worker")
 
 
 def result_row(job: Job, recording) -> dict[str, Any]:
@@ -189,24 +205,29 @@ def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
     started = time.perf_counter()
     if any(job.code != code_version() for job in jobs):
         return [_other_code(job) for job in jobs]
-    refusal = batch_refusal()
-    if refusal:
-        return _one_by_one(jobs, blobs, f"the batch route is refused on this worker: {refusal}")
+    failed = batch_refusal()
+    if failed:
+        return [noted(run_one(job, blobs), f"the batch route is refused on this worker: "
+                                           f"{failed}") for job in jobs]
     watchdog = Watchdog(batch_limits(jobs[0].limits, len(jobs)))
+    master, failed = None, "stopped"
     try:
         with watchdog:
             watchdog.beat("instantiating the FMUs")
-            master = _master(jobs[0], blobs)
+            master = _take(jobs[0], blobs, watchdog)
             members = [job for job in jobs if _configures(master, job)]
             watchdog.beat(f"the batch of {len(members)} runs")
             recordings = simulate_members(master.system, [job.overrides for job in members],
                                           jobs[0].stop_time, beat=watchdog.beat
                                           ) if members else []
-        if watchdog.expired:
-            raise TimeLimit(watchdog.expired)
+        failed = watchdog.expired
     except (Exception, TimeLimit) as error:
-        reason = watchdog.expired if watchdog.expired else f"{type(error).__name__}: {error}"
-        return _one_by_one(jobs, blobs, f"the batch failed, {reason}; run alone")
+        failed = watchdog.expired or f"{type(error).__name__}: {error}"
+    finally:
+        _give_back(jobs[0], master, not failed)
+    if failed:
+        return [noted(run_one(job, blobs), f"the batch failed, {failed}; run alone")
+                for job in jobs]
     share = (time.perf_counter() - started) / max(1, len(members))
     rows = {}
     for job, recording in zip(members, recordings, strict=True):
@@ -219,17 +240,12 @@ def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
 
 
 def _configures(master, job: Job) -> bool:
-    """Whether ``Master.configure`` takes ``job``'s settings."""
+    """Whether ``Master.configure`` takes ``job``'s settings (``run_one`` records why not)."""
     try:
         master.configure(job.overrides)
-    except Exception:                   # run_one records why
+    except Exception:
         return False
     return True
-
-
-def _one_by_one(jobs: list[Job], blobs: dict[str, bytes], why: str) -> list[dict[str, Any]]:
-    """``run_one`` of each job, its backend saying ``why`` it did not run in a batch."""
-    return [noted(run_one(job, blobs), why) for job in jobs]
 
 
 def noted(row: dict[str, Any], why: str) -> dict[str, Any]:
