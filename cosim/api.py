@@ -11,7 +11,6 @@ Many runs of one scenario, stepped together as arrays where the batch kernel cov
 """
 from __future__ import annotations
 
-import dataclasses
 import warnings
 from pathlib import Path
 from typing import Any, Iterable, Mapping, Sequence
@@ -146,19 +145,8 @@ def _one_at_a_time(system: SystemDescription, overrides: list[dict[str, dict[str
             if recording.error:             # its FMUs may be in an error state
                 master.free()
                 master = Master(system, backend=backend)
-            recordings.append(recording if signals is None else _holding(recording, signals))
+            recordings.append(recording if signals is None else recording.holding(signals))
     finally:
         master.free()
     return recordings
 
-
-def _holding(recording: Recording, signals: Sequence[str]) -> Recording:
-    """``recording`` with only the columns ``signals``; ValueError naming one it lacks."""
-    missing = [s for s in signals if s not in recording.columns]
-    if missing:
-        raise ValueError(f"signals {', '.join(missing)}: the run records "
-                         f"{', '.join(recording.columns)}")
-    columns = [recording.columns.index(s) for s in signals]
-    return dataclasses.replace(recording, columns=list(signals),
-                               data=recording.data[:, columns],
-                               units={s: recording.units.get(s, "") for s in signals})

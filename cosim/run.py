@@ -31,7 +31,7 @@ from .analysis.cost import LAMBDA, Cost
 from .analysis.describe import conditions, headline
 from .analysis.reports import tables
 from .api import overrides_of
-from .core.coupling import COUPLINGS
+from .core.wiring import COUPLINGS
 from .core.files import FolderBusy, OutputError
 from .core.instance import FmuCallError
 from .core.interrupt import StopSignals

@@ -34,6 +34,7 @@ process with a time limit).
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import math
 import sys
@@ -51,6 +52,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from autopilot_fmu.smc import reference_step_bound  # noqa: E402
+from cosim.core import fmi as fmi_backend  # noqa: E402
 from cosim.core.fmi import FmuInstance, fmi_version, read_description  # noqa: E402
 from cosim.core.instance import FmuCallError  # noqa: E402
 from fmubuild.project import FMU_DIRS  # noqa: E402
@@ -396,12 +398,20 @@ def _convert(v, value):
     return float(value)
 
 
+class ExtractedOnce(FmuInstance):
+    """An instance on the campaign's one extraction of its FMU (``fuzz`` caches fmpy's
+    ``extract``): extracting anew would cost more than most examples."""
+
+    def _remove_unzip_dir(self) -> None:
+        pass
+
+
 def fuzz(name: str, examples: int, seed: int | None = None, fmi: int = 2) -> dict:
     """Fuzz FMU ``name`` of FMI version ``fmi`` (its FMI 3.0 twin: fmus/fmi3/) with
     ``examples`` programs; the counts of calls by kind and status."""
     fmu_path = FMU_DIRS[fmi] / f"{name}.fmu"
     md = read_description(fmu_path, name)
-    unzipped = extract(str(fmu_path))
+    fmi_backend.extract = functools.cache(extract)
     counts: Counter = Counter()
 
     @settings(max_examples=examples, deadline=None, database=None, derandomize=seed is None,
@@ -409,7 +419,7 @@ def fuzz(name: str, examples: int, seed: int | None = None, fmi: int = 2) -> dic
     @given(programs(md))
     def check(program):
         counts["examples"] += 1
-        fmu = FmuInstance(fmu_path, name, unzip_dir=unzipped)
+        fmu = ExtractedOnce(fmu_path, name)
         try:
             run_program(fmu, Expectation(md), program, counts)
         finally:

@@ -17,6 +17,7 @@ from cosim import run as cli
 from cosim import scenarios
 from cosim.analysis.cost import LAMBDA
 from cosim.analysis.metrics import cost_terms
+from cosim.core.fmi import FmuInstance
 from cosim.core.master import Master
 from cosim.core.ssd import write_ssd
 from cosim.core.wiring import WiringError
@@ -44,8 +45,26 @@ def fmus_built(fmu_paths):
 
 
 # -- what travels along the connections ---------------------------------------------
-def test_gauss_seidel_signals_arrive_unchanged_and_in_step():
-    rec = run("calm_pd", verify_inputs=True)         # inputs as read back from the FMUs
+def run_reading_inputs_back(monkeypatch, coupling: str):
+    """calm_pd's run, each input the master sets read back from its FMU at once: as sent."""
+    writer = FmuInstance.writer
+
+    def checked_writer(instance: FmuInstance, vrs: list[int]):
+        write, read_back = writer(instance, vrs), instance.reader(vrs)
+
+        def write_and_check(values) -> None:
+            write(values)
+            assert read_back() == list(values), (instance.name, vrs)
+        return write_and_check
+    monkeypatch.setattr(FmuInstance, "writer", checked_writer)
+    with Master(system("calm_pd"), coupling=coupling) as master:
+        rec = master.run()
+    assert rec.error is None, rec.error
+    return rec
+
+
+def test_gauss_seidel_signals_arrive_unchanged_and_in_step(monkeypatch):
+    rec = run_reading_inputs_back(monkeypatch, "gauss-seidel")
     assert rec.rows == 4001 and rec.t[-1] == 400.0
     np.testing.assert_array_equal(rec["ship.delta_c"], rec["autopilot.delta_c"])
     np.testing.assert_array_equal(rec["autopilot.psi"], rec["ship.psi"])
@@ -58,8 +77,8 @@ def test_gauss_seidel_signals_arrive_unchanged_and_in_step():
     np.testing.assert_array_equal(rec["autopilot.delta_c"], sent)
 
 
-def test_jacobi_autopilot_answers_the_inputs_of_the_previous_step():
-    rec = run("calm_pd", coupling="jacobi", verify_inputs=True)
+def test_jacobi_autopilot_answers_the_inputs_of_the_previous_step(monkeypatch):
+    rec = run_reading_inputs_back(monkeypatch, "jacobi")
     np.testing.assert_array_equal(rec["ship.delta_c"], rec["autopilot.delta_c"])
     pd = PDAutopilot()
     sent = [pd.command(p, r, d) for p, r, d in

@@ -1,8 +1,5 @@
 """The master's FMI backend: an FMU of FMI 2.0 or 3.0 driven through fmpy, its log kept.
-
-The master speaks FMI 2.0's names: ``read_description`` gives FMI 3.0's Float64 and Int32 as
-Real and Integer, and an FMI 3.0 instance maps the master's calls to its own (``CALLS``).
-"""
+The master speaks FMI 2.0's names; FMI 3.0's types and calls are mapped to them."""
 from __future__ import annotations
 
 import functools
@@ -25,31 +22,27 @@ from .instance import FmuCallError, Instance, LogRecord, logged_error
 
 STATUS = ("ok", "warning", "discard", "error", "fatal", "pending")
 VERSIONS = (2, 3)
-FMI3_TYPES = {"Float64": "Real", "Int32": "Integer"}
-"""FMI 3.0 type names as the master's; Boolean and String are the same in both."""
+FMI3_TYPES = {"Float64": "Real", "Int32": "Integer"}     # Boolean and String: the same
 CALLS = {"setReal": "setFloat64", "getReal": "getFloat64",
          "setInteger": "setInt32", "getInteger": "getInt32",
          "getFMUstate": "getFMUState", "setFMUstate": "setFMUState",
          "freeFMUstate": "freeFMUState", "serializeFMUstate": "serializeFMUState",
-         "deSerializeFMUstate": "deserializeFMUState"}
-"""The master's (FMI 2.0) call names that FMI 3.0 names otherwise."""
+         "deSerializeFMUstate": "deserializeFMUState"}          # FMI 2.0's: FMI 3.0's
 RAW_TYPES = {2: (fmi2ValueReference, {"Real": ("Real", fmi2Real),
                                      "Integer": ("Integer", fmi2Integer)}),
              3: (fmi3ValueReference, {"Real": ("Float64", fmi3Float64),
                                      "Integer": ("Int32", fmi3Int32)})}
-"""By FMI version: the ctype of value references, and each master's type's name and ctype."""
 
 
 def fmi_version(description: ModelDescription) -> int:
-    """The major FMI version of a model description: 2 or 3 where ``read_description`` read it."""
+    """2 or 3, the major FMI version of a model description."""
     return int(description.fmiVersion.partition(".")[0])
 
 
 def read_description(path: str | Path, name: str = "", ours: bool = False) -> ModelDescription:
-    """An FMU's model description, FMI 3.0 type names as FMI 2.0's, read once per file
-    version (cached on path, size and mtime: treat it as read-only). FmuNotFound or
-    FmuUnreadable naming the file (``ours``: named as one the caller builds) when it is
-    missing or unreadable, ValueError unless it is a co-simulation FMU of FMI 2.0 or 3.0."""
+    """An FMU's model description, FMI 3.0 type names as FMI 2.0's, cached by file version
+    (treat it as read-only). FmuNotFound or FmuUnreadable naming the file, ValueError unless
+    it is a co-simulation FMU of FMI 2.0 or 3.0."""
     path = Path(path)
     if not path.is_file():
         raise FmuNotFound(f"FMU for '{name}' not found: {path}", ours)
@@ -83,15 +76,13 @@ def feedthrough(description: ModelDescription) -> dict[str, frozenset[str]]:
 
 
 class FmuInstance(Instance):
-    """An instantiated co-simulation FMU through fmpy's FMU2Slave or FMU3Slave. FMI 3.0 has
-    no setupExperiment, and a step that asks to end the simulation fails. FmuCallError when
-    it cannot be instantiated (its extracted files are removed)."""
+    """A co-simulation FMU instantiated through fmpy (FmuCallError if it cannot be); an FMI
+    3.0 step that asks to end the simulation fails."""
 
-    def __init__(self, path: str | Path, name: str, unzip_dir: str | Path | None = None):
+    def __init__(self, path: str | Path, name: str):
         self.description = read_description(self.path, name)
         self.fmi_version, self.guid = fmi_version(self.description), self.description.guid
-        self._owns_unzip_dir = unzip_dir is None
-        self.unzip_dir = str(unzip_dir) if unzip_dir else extract(str(self.path))
+        self.unzip_dir = extract(str(self.path))
         self.variables = {v.name: v for v in self.description.modelVariables
                           if v.causality != "independent"}      # FMI 3.0's time
         self.feedthrough = feedthrough(self.description)
@@ -142,9 +133,7 @@ class FmuInstance(Instance):
         return result
 
     def _since(self, before: int) -> list[LogRecord]:
-        """The log of the call that began when ``before`` had been logged (of the last 50),
-        each failure told once: pythonfmu's fatal message (no category) for a refusal that
-        an FMU built with fmukit logged (a cause) is left out."""
+        """The log since ``before``; pythonfmu's fatal message repeating a logged cause left out."""
         new = self.logged - before
         records = list(self.log)[-new:] if new else []
         if any(r.cause for r in records):
@@ -189,8 +178,7 @@ class FmuInstance(Instance):
         self._remove_unzip_dir()
 
     def _remove_unzip_dir(self) -> None:
-        if self._owns_unzip_dir:
-            shutil.rmtree(self.unzip_dir, ignore_errors=True)
+        shutil.rmtree(self.unzip_dir, ignore_errors=True)
 
     # Prepared calls: the raw FMI functions (fmpy's ``dll``) on preallocated ctypes arrays,
     # without fmpy's per-call wrapping, which costs more than the call itself.

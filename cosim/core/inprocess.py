@@ -1,11 +1,6 @@
-"""The master's in-process backend: the FMUs' Python classes, called without FMI.
-
-An ``InProcessInstance`` instantiates in this process the class an FMU built with fmukit was
-made from (its manifest), composed for its FMI version as its entry module composes it
-(``fmukit.compose.fmu_class``), and calls its methods directly. The FMU must be current here,
-so that a run differs from one through FMI only by the FMI layer, bit for bit; invalid
-values are refused with the same message as through FMI.
-"""
+"""The master's in-process backend: the class an FMU built with fmukit was made from,
+composed for its FMI version and called without FMI. The FMU must be current here, so that a
+run equals one through FMI bit for bit; refusals carry the same messages."""
 from __future__ import annotations
 
 import hashlib
@@ -26,10 +21,8 @@ from fmukit.slave import ModelSlave
 from .fmi import CALLS, read_description
 from .instance import FmuCallError, Instance, LogRecord, logged_error
 
-_FMI_TYPE = {float: "Real", int: "Integer", str: "String"}
-"""The master's type names (FMI 2.0's), whichever version the class is of."""
-_PYTHONFMU = ("resources/pythonfmu/", "resources/pythonfmu3/")
-"""What pythonfmu 0.7 and pythonfmu3 carry of their own."""
+_FMI_TYPE = {float: "Real", int: "Integer", str: "String"}      # FMI 2.0's, as the master's
+_PYTHONFMU = ("resources/pythonfmu/", "resources/pythonfmu3/")   # what they carry of their own
 
 
 class VariableInfo(NamedTuple):
@@ -41,8 +34,8 @@ class VariableInfo(NamedTuple):
 
 
 class Reason(str):
-    """Why an FMU runs through FMI; ``stale_module``: the slave module of an FMU built with
-    fmukit before a change of its sources (a rebuild mends it), else None."""
+    """Why an FMU runs through FMI; ``stale_module``: the slave module whose sources changed
+    since the FMU was built (a rebuild mends it), else None."""
 
     def __new__(cls, text: str, stale_module: str | None = None) -> Reason:
         reason = super().__new__(cls, text)
@@ -58,8 +51,7 @@ def slave_class(manifest: Manifest) -> type[ModelSlave]:
 
 def in_process_refusal(path: str | Path) -> Reason | None:
     """Why the FMU at ``path`` cannot run in-process, or None: it must be built with fmukit,
-    hold what its manifest lists, declare what its class declares and be current here
-    (``fmukit.manifest.staleness``), so that both routes compute the same."""
+    hold what its manifest lists, declare what its class declares and be current here."""
     stat = Path(path).stat()
     return _refusal(Path(path).resolve(), stat.st_size, stat.st_mtime_ns)
 
@@ -105,8 +97,7 @@ def _refusal(path: Path, size: int, mtime_ns: int) -> Reason | None:     # cache
 
 
 def _contents_refusal(fmu: zipfile.ZipFile, manifest: Manifest) -> str | None:
-    """Why the FMU does not hold exactly the Python modules its manifest lists (its entry
-    module among them), or None."""
+    """Why the FMU does not hold exactly the Python modules its manifest lists, or None."""
     listed = {c["file"]: c["sha256"] for c in manifest.modules.values()}
     entry = manifest.entry or manifest.modules[manifest.slave_module]
     listed[entry["file"]] = entry["sha256"]
@@ -134,14 +125,14 @@ def _canonical(element: ElementTree.Element | None) -> str:
 class InProcessInstance(Instance):
     """A slave class instantiated and driven in this process."""
 
-    def __init__(self, path: str | Path, name: str, same_sources: bool = True):
-        """ValueError if the FMU cannot run in-process (``in_process_refusal``); without
-        ``same_sources``, only if it was not built with fmukit (``cosim.studies.direct``)."""
+    def __init__(self, path: str | Path, name: str):
+        """ValueError if the FMU cannot run in-process (``in_process_refusal``)."""
         self.guid = read_description(self.path, name).guid
-        refusal, manifest = in_process_refusal(self.path), read(self.path)
-        if refusal and (same_sources or manifest is None):
+        refusal = in_process_refusal(self.path)
+        if refusal:
             raise ValueError(f"FMU '{name}' ({self.path.name}) cannot run in-process: "
                              f"{refusal}")
+        manifest = read(self.path)
         self.slave = slave_class(manifest)(instance_name=name)
         self.fmi_version = manifest.fmi
         self.variables = {var.name: VariableInfo(var.name, vr, _FMI_TYPE[var.kind],
@@ -163,8 +154,7 @@ class InProcessInstance(Instance):
 
     def _failure(self, what: str, time: float | None, error: Exception,
                  status: str = "fatal") -> FmuCallError:
-        """The refusal as FMI reports it (fatal, as pythonfmu does; error for an FMI 3.0
-        step), with the FMU's log, or a message of its own where the FMU logged none."""
+        """The refusal as FMI reports it, with the FMU's log or, if it logged no cause, ours."""
         records = self._drain()
         if not any(r.cause for r in records):
             category = error.category if isinstance(error, Refused) else None
@@ -172,8 +162,7 @@ class InProcessInstance(Instance):
         return FmuCallError(self.name, what, time, status, records)
 
     def _judge(self, what: str, time: float | None, result: Any, strict: bool) -> None:
-        """FmuCallError if a call refused (returned False or a failed FMI 3.0 step result)
-        or, ``strict``, logged an error; the log is drained either way."""
+        """FmuCallError if a call refused or, ``strict``, logged an error; drains the log."""
         records = self._drain()
         status = getattr(result, "status", None)                # an FMI 3.0 step's
         failed = "discard" if result is False else getattr(status, "name", None)
@@ -193,8 +182,7 @@ class InProcessInstance(Instance):
         return getattr(self.slave, _method_name(CALLS.get(name, name) if self.fmi_version == 3
                                                 else name))
 
-    # Prepared calls: the slave's own plans, valid until ``reset`` makes a new slave; through
-    # the FMI entry where it has none or where the plan raises (to report it as FMI would).
+    # Prepared calls: the slave's own plans (until ``reset``), else or if one raises: as FMI
     def reader(self, vrs: list[int]):
         return _prepared(self.slave.plans.real_reader(vrs), super().reader(vrs))
 
@@ -218,8 +206,7 @@ class InProcessInstance(Instance):
         return step
 
     def enter_initialization(self, start_time: float = 0.0) -> None:
-        """As through FMI: FMI 2.0's setupExperiment gives the start time; pythonfmu3 drops
-        fmi3EnterInitializationMode's."""
+        """As through FMI: pythonfmu3 drops fmi3EnterInitializationMode's start time."""
         if self.fmi_version == 2:
             self.call("setupExperiment", self.slave.setup_experiment, start_time)
         self.call("enterInitializationMode", self.slave.enter_initialization_mode)
@@ -235,7 +222,6 @@ class InProcessInstance(Instance):
 
 
 def _prepared(plan, through_fmi):
-    """``plan``, or ``through_fmi`` where there is none or where the plan raises."""
     if plan is None:
         return through_fmi
 

@@ -1,10 +1,8 @@
 """The co-simulation master: FMUs wired by a system description, stepped at a fixed step.
 
-Time is counted in integer steps, t_k = t_0 + k h in whole nanoseconds (``fmukit.timebase``),
-so a 400 s run at 0.1 s has exactly 4000 steps and 4001 rows. ``wiring`` checks, orders and
-lays out, ``coupling`` does one communication step, ``recording`` keeps the rows. A failed
-call, a time limit passed (``watchdog``) or a signal (``interrupt``) stops the run between
-steps with an error naming the FMU, the call and the time; the rows up to then are kept.
+Time is counted in integer steps, t_k = t_0 + k h in whole nanoseconds (``fmukit.timebase``):
+a 400 s run at 0.1 s has exactly 4000 steps and 4001 rows. A failure, a time limit or a
+signal stops the run between steps with an error naming the FMU, call and time; rows are kept.
 """
 from __future__ import annotations
 
@@ -14,7 +12,6 @@ from typing import Any, Callable
 
 from fmukit.timebase import communication_point
 
-from .coupling import COUPLINGS, settle
 from .fmi import FmuInstance, read_description
 from .inprocess import InProcessInstance, fallback_note
 from .instance import FmuCallError, Instance
@@ -23,13 +20,12 @@ from .recording import Recorder, Recording
 from .system import SystemDescription, split_name
 from .values import declarations, parameters
 from .watchdog import TimeLimit, Watchdog, no_limit
-from .wiring import check_connections, feedthrough_order, layout
+from .wiring import COUPLINGS, check_connections, feedthrough_order, layout, settle
 
+# fmi: the FMUs through fmpy; inprocess: their Python classes (an FMU not current here runs
+# through FMI, with a note: ``fallback_note``)
 BACKENDS: dict[str, type[Instance]] = {"fmi": FmuInstance, "inprocess": InProcessInstance}
-"""fmi: the FMUs through fmpy; inprocess: their Python classes (an FMU not current here runs
-through FMI, with a note: ``fallback_note``)."""
-RUN_BACKENDS = ("fmi", "inprocess")
-"""The backends a run of a scenario may take."""
+RUN_BACKENDS = tuple(BACKENDS)          # the backends a run of a scenario may take
 
 
 class Master(contextlib.AbstractContextManager):
@@ -37,14 +33,12 @@ class Master(contextlib.AbstractContextManager):
     manager: ``with Master(system) as master: recording = master.run()`` frees the FMUs."""
 
     def __init__(self, system: SystemDescription, coupling: str = "gauss-seidel",
-                 backend: str = "fmi", overrides: dict[str, dict[str, Any]] | None = None,
-                 verify_inputs: bool = False):
+                 backend: str = "fmi", overrides: dict[str, dict[str, Any]] | None = None):
         for what, value, known in (("coupling", coupling, COUPLINGS),
                                    ("backend", backend, BACKENDS)):
             if value not in known:
                 raise ValueError(f"{what} must be one of {', '.join(known)}, got {value!r}")
         self.system, self.coupling, self.backend = system, coupling, backend
-        self.verify_inputs = verify_inputs
         self.paths = {name: system.fmu_path(name) for name in system.components}
         self.declarations = {name: declarations(read_description(path, name, system.ours(path)))
                              for name, path in self.paths.items()}
@@ -74,8 +68,7 @@ class Master(contextlib.AbstractContextManager):
                                                      self.declarations, overrides)
 
     def _prepare(self) -> None:                 # anew after a reset
-        self.columns, nodes = layout(self.instances, self.system.connections,
-                                     self.verify_inputs)
+        self.columns, nodes = layout(self.instances, self.system.connections)
         self.nodes = [nodes[name] for name in (self.order if self.coupling == "gauss-seidel"
                                                else self.instances)]
 
@@ -113,7 +106,7 @@ class Master(contextlib.AbstractContextManager):
         ``csv_path`` the rows are streamed there in chunks (else TooManyRows if too many)."""
         t0, h, n_steps = self.system.steps(stop_time)
         recorder = self._recorder = Recorder(self.columns, n_steps + 1, csv_path, chunk_rows,
-                                             self.run_meta(n_steps), self.units)
+                                             run_meta(self, n_steps), self.units)
         exchange, values = COUPLINGS[self.coupling], [0.0] * len(self.columns)
         k, t, error, self.parameter_values = 0, t0, None, {}
         beat = watchdog.beat if watchdog is not None else no_limit
@@ -147,23 +140,6 @@ class Master(contextlib.AbstractContextManager):
             recording = recorder.close(error)
         return recording
 
-    def run_meta(self, n_steps: int) -> dict[str, Any]:
-        """What a run of ``n_steps`` records of itself as it starts (it adds ``parameters``
-        and ``wall_time_s`` as it ends)."""
-        system, (t0, h, _) = self.system, self.system.steps()
-        return {"system": system.name, "description": system.description,
-                "scenario_file": str(system.path) if system.path else None,
-                "backend": self.backend, "backends": self.backends, "notes": self.notes,
-                "coupling": self.coupling, "start_time": t0, "step_size": h,
-                "stop_time": communication_point(t0, n_steps, h),
-                "scenario_stop_time": system.stop_time,
-                "settings": self.parameters, "overrides": self.overrides,
-                "fmus": {name: {"file": str(i.path), "guid": i.guid}
-                         for name, i in self.instances.items()},
-                "parameter_units": {name: {n: i.unit(n) for n, v in i.variables.items()
-                                           if v.causality == "parameter"}
-                                    for name, i in self.instances.items()}}
-
     def abandon(self, reason: str) -> Recording | None:
         """The run under way's rows closed with ``reason``, for a watchdog (None if none)."""
         recorder, self._recorder = self._recorder, None
@@ -176,3 +152,21 @@ class Master(contextlib.AbstractContextManager):
         for instance in self.instances.values():
             instance.free()
         self.instances = {}
+
+
+def run_meta(master: Master, n_steps: int) -> dict[str, Any]:
+    """What a run of ``n_steps`` records of itself as it starts (it adds ``parameters``
+    and ``wall_time_s`` as it ends)."""
+    system, (t0, h, _) = master.system, master.system.steps()
+    return {"system": system.name, "description": system.description,
+            "scenario_file": str(system.path) if system.path else None,
+            "backend": master.backend, "backends": master.backends, "notes": master.notes,
+            "coupling": master.coupling, "start_time": t0, "step_size": h,
+            "stop_time": communication_point(t0, n_steps, h),
+            "scenario_stop_time": system.stop_time,
+            "settings": master.parameters, "overrides": master.overrides,
+            "fmus": {name: {"file": str(i.path), "guid": i.guid}
+                     for name, i in master.instances.items()},
+            "parameter_units": {name: {n: i.unit(n) for n, v in i.variables.items()
+                                       if v.causality == "parameter"}
+                                for name, i in master.instances.items()}}

@@ -1,15 +1,13 @@
-"""What a run records, row by row: held in memory, or streamed to a CSV file in chunks.
-
-Row k holds t_k and one value per column; streamed, memory stays flat however long the run
-and the ``Recording`` holds no rows itself.
-"""
+"""What a run records, row k holding t_k and one value per column: held in memory, or
+streamed to a CSV file in chunks (memory stays flat; the ``Recording`` then holds no rows)."""
 from __future__ import annotations
 
+import dataclasses
 import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, Any, Sequence
 
 import numpy as np
 
@@ -41,6 +39,16 @@ class Recording:
         if len(self.time) < self.rows:
             raise ValueError(f"the {self.rows} rows of this run were streamed to {self.path}; "
                              "read them from there")
+
+    def holding(self, columns: Sequence[str]) -> Recording:
+        """This recording with only ``columns``; ValueError naming any it lacks."""
+        missing = [c for c in columns if c not in self.columns]
+        if missing:
+            raise ValueError(f"signals {', '.join(missing)}: the run records "
+                             f"{', '.join(self.columns)}")
+        return dataclasses.replace(self, columns=list(columns),
+                                   data=self.data[:, [self.columns.index(c) for c in columns]],
+                                   units={c: self.units.get(c, "") for c in columns})
 
     def write_csv(self, path: str | Path) -> None:
         with _open_csv(path, self.columns) as file:

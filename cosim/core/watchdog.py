@@ -1,10 +1,7 @@
-"""Time limits for a run, and signals that reach it even while an FMU never returns.
-
-A ``Watchdog`` thread beside the master's loop reads SIGINT and SIGTERM from Python's wakeup
-file descriptor (written even while FMU code runs) and raises ``TimeLimit`` into an FMU call
-that passes a limit; code that runs no Python cannot take it, so after the grace the
-watchdog writes the rows kept (``salvage``), says so and ends the process.
-"""
+"""Time limits for a run, and signals that reach it even while an FMU never returns: a
+thread beside the loop reads them from Python's wakeup fd and raises ``TimeLimit`` into a call
+past a limit; if it has not returned after the grace, it salvages the rows and ends the process
+(docs/robustness.md)."""
 from __future__ import annotations
 
 import ctypes
@@ -22,8 +19,7 @@ from typing import Callable, NamedTuple
 from .instance import Instance
 from .interrupt import STOP_SIGNALS, StopSignals, give_back, take_signals
 
-STEP_LIMIT_S = 60.0
-"""The default step time limit, far above a step's or an instantiation's time."""
+STEP_LIMIT_S = 60.0          # the default step limit, far above a step's or instantiation's
 
 
 class Limits(NamedTuple):
@@ -47,8 +43,8 @@ def no_limit(what: str | float) -> None:
 
 
 class TimeLimit(BaseException):
-    """Raised in the loop's thread when a limit is passed (a BaseException: no ``except
-    Exception`` swallows it; ``Watchdog.expired`` says which)."""
+    """Raised in the loop's thread when a limit is passed (``Watchdog.expired`` says which);
+    a BaseException, so that no ``except Exception`` swallows it."""
 
     def __init__(self, *args: object):
         super().__init__(*(args or ("a time limit of the run was passed",)))
@@ -76,6 +72,10 @@ class Watchdog:
         """A step (its time, in s) or call (a phrase) begins; ``expired``: not None stops it."""
         self._beat, self._what = time.monotonic(), what
         return self.expired
+
+    def halt(self, reason: str) -> None:
+        """Have the loop stop at its next beat, with ``reason`` as its error."""
+        self.expired = reason
 
     def finishing(self, what: str) -> None:
         """The run is over and ``what`` (terminating the FMUs) begins: nothing is raised into
@@ -114,8 +114,7 @@ class Watchdog:
             return []
         return [signal.Signals(number) for number in data if number in STOP_SIGNALS]
 
-    def _deadline(self) -> tuple[float, str]:
-        """The next deadline and what passing it means ('': the run limit)."""
+    def _deadline(self) -> tuple[float, str]:              # reason '': the run limit
         what = self._what if isinstance(self._what, str) else \
             f"the step at t = {self._what:.6g} s"
         limits, candidates = self.limits, [(math.inf, "")]
@@ -183,8 +182,7 @@ class Watchdog:
 
 
 def _calling(thread_id: int) -> str | None:
-    """The FMU and call the thread is in ("FMU 'ship' in doStep"), from its stack, or None.
-    An ``Instance`` has its name from ``__new__`` on; prepared calls are closures over one."""
+    """The FMU and call the thread is in ("FMU 'ship' in doStep"), from its stack, or None."""
     frame = sys._current_frames().get(thread_id)
     while frame is not None:
         owner, what = frame.f_locals.get("self"), frame.f_locals.get("what")
@@ -195,8 +193,8 @@ def _calling(thread_id: int) -> str | None:
     return None
 
 
-def _idle(number: int, frame: object) -> None:
-    """Python's handler of SIGINT and SIGTERM while a watchdog takes them."""
+def _idle(number: int, frame: object) -> None:     # SIGINT and SIGTERM while a watchdog reads them
+    pass
 
 
 _idle.safe_in_fmu_code = True      # fmukit need not defer it (fmukit.hostsignals)

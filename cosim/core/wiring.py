@@ -1,10 +1,5 @@
-"""How the components of a system connect: checks, the Gauss-Seidel order, the loop's layout.
-
-``check_connections`` refuses a connection that does not join a Real output to a Real input;
-``feedthrough_order`` puts a component whose outputs feed through from its inputs (its model
-structure) before those it feeds; ``layout`` gives every signal a column, in blocks per
-component, and prepares each component's calls (a ``Node``).
-"""
+"""How the components of a system connect: checks, the Gauss-Seidel order, the loop's layout
+(a ``Node`` per component) and the coupling algorithms that step it."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -73,11 +68,11 @@ class Node:
         return slice(self.state.start, self.feedthrough.stop)
 
 
-def layout(instances: dict[str, Instance], connections: list[Connection],
-           verify_inputs: bool = False) -> tuple[list[str], dict[str, Node]]:
+def layout(instances: dict[str, Instance], connections: list[Connection]
+           ) -> tuple[list[str], dict[str, Node]]:
     """(columns, nodes by name): every output, then every connected input, per component.
-    A node's ``apply_inputs(values)`` sets its inputs from their sources and records them
-    in ``values``: as sent, or as read back with ``verify_inputs``."""
+    A node's ``apply_inputs(values)`` sets its inputs from their sources' columns and records
+    them, as sent, in its own."""
     columns: list[str] = []
 
     def block(name: str, variables: list) -> slice:
@@ -105,19 +100,70 @@ def layout(instances: dict[str, Instance], connections: list[Connection],
         if incoming:
             sources = [columns.index(f"{c.start_element}.{c.start_connector}")
                        for c in incoming]
-            vrs = [instances[name].vr(c.end_connector) for c in incoming]
-            node.apply_inputs = _input_applier(instances[name], vrs, sources, node.inputs,
-                                               verify_inputs)
+            write = instances[name].writer([instances[name].vr(c.end_connector)
+                                            for c in incoming])
+            node.apply_inputs = _input_applier(write, sources, node.inputs)
     return columns, nodes
 
 
-def _input_applier(instance: Instance, vrs: list[int], sources: list[int], inputs: slice,
-                   verify: bool) -> Callable[[list[float]], None]:
-    write, read_back = instance.writer(vrs), instance.reader(vrs)
+def _input_applier(write: Callable[[list[float]], None], sources: list[int],
+                   inputs: slice) -> Callable[[list[float]], None]:
     gather = itemgetter(*sources) if len(sources) > 1 else (lambda v, i=sources[0]: (v[i],))
 
     def apply(values: list[float]) -> None:
         sent = gather(values)
         write(sent)
-        values[inputs] = read_back() if verify else sent
+        values[inputs] = sent
     return apply
+
+
+# A coupling algorithm does one communication step from the nodes, the values (one per
+# column), t_k and h: after it ``values`` holds every signal at t_k and, if ``step``, every
+# FMU is at t_k + h.
+def gauss_seidel(nodes: list[Node], values: list[float], t: float, h: float,
+                 step: bool) -> None:
+    """Outputs without feedthrough (the ship's states) at t_k, then each FMU in signal-flow
+    order gets its inputs, gives its feedthrough outputs and steps (the paper's guidance ->
+    autopilot -> ship, as in its Simulink model)."""
+    for node in nodes:
+        if node.read_state:
+            values[node.state] = node.read_state()
+    for node in nodes:
+        if node.apply_inputs:
+            node.apply_inputs(values)
+        if node.read_feedthrough:
+            values[node.feedthrough] = node.read_feedthrough()
+        if node.read_integers:
+            values[node.integers] = node.read_integers()
+        if step:
+            node.step(t, h)
+
+
+def jacobi(nodes: list[Node], values: list[float], t: float, h: float, step: bool) -> None:
+    """All outputs as they stand, then all inputs, then all FMUs step (OSP libcosim's and
+    ecos's): a feedthrough signal arrives one step later per feedthrough FMU."""
+    for node in nodes:
+        if node.read_outputs:
+            values[node.outputs] = node.read_outputs()
+        if node.read_integers:
+            values[node.integers] = node.read_integers()
+    for node in nodes:
+        if node.apply_inputs:
+            node.apply_inputs(values)
+    if step:
+        for node in nodes:
+            node.step(t, h)
+
+
+COUPLINGS = {"gauss-seidel": gauss_seidel, "jacobi": jacobi}
+
+
+def settle(nodes: list[Node], columns: int) -> None:
+    """Initial outputs propagated along the connections: enough passes for any acyclic chain."""
+    values = [0.0] * columns
+    for _ in nodes:
+        for node in nodes:
+            if node.read_outputs:
+                values[node.outputs] = node.read_outputs()
+            if node.apply_inputs:
+                node.apply_inputs(values)

@@ -9,7 +9,7 @@ from fmukit.manifest import read as read_manifest
 
 from ..core.inprocess import fallback_note
 from ..core.instance import FmuCallError
-from ..core.master import Master
+from ..core.master import Master, run_meta
 from ..core.ssd import SystemDescription
 
 COMPONENTS = ("guidance", "autopilot", "ship")
@@ -63,4 +63,4 @@ def initialise(master: Master, overrides: dict[str, dict[str, Any]],
     ship = master.instances["ship"].slave
     return Member({name: master.instances[name].slave.model for name in COMPONENTS},
                   (ship.n1, ship.n2, ship.n3),
-                  {**master.run_meta(n_steps), "parameters": master.parameter_values})
+                  {**run_meta(master, n_steps), "parameters": master.parameter_values})

@@ -2,7 +2,6 @@
 not; ``selftest``, the kernel checked on this machine against the scalar models."""
 from __future__ import annotations
 
-import dataclasses
 import math
 import time
 from collections import defaultdict
@@ -94,9 +93,7 @@ def _alone(master: Master, overrides: dict[str, dict[str, Any]], stop_time: floa
     recording = master.run(stop_time)
     recording.meta["notes"] = [*recording.meta.get("notes", []),
                                f"ran on the in-process route, not in the batch: {why}"]
-    columns = [recording.columns.index(s) for s in signals]
-    return dataclasses.replace(recording, columns=list(signals), data=recording.data[:, columns],
-                               units={s: recording.units.get(s, "") for s in signals})
+    return recording.holding(signals)
 
 
 def lockstep(members: list[tuple[int, Member]], t0: float, h: float, n_steps: int,
