@@ -21,19 +21,12 @@ class FmuUnreadable(_FmuFileError, ValueError):
     """A file that is not a readable FMU."""
 
 
-CLOSE = 0.7
-"""How alike (``difflib``'s ratio) a name must be to be offered: 'ship' for 'shp' (0.86),
-not 'wave_seed' for 'wave_height' (0.6)."""
-
-
 def close_matches(name: str, names: Iterable[str]) -> list[str]:
-    """The names a user who typed ``name`` likely meant, best first: equal but for case,
-    then up to three ``CLOSE`` ones (ignoring case)."""
+    """The names a user who typed ``name`` likely meant, best first: equal but for case, then
+    up to three alike (difflib's ratio 0.7: 'ship' for 'shp', not 'wave_seed' for 'wave_height')."""
     names = list(dict.fromkeys(names))
-    folded: dict[str, str] = {}
-    for n in names:
-        folded.setdefault(n.lower(), n)
-    close = [folded[n] for n in difflib.get_close_matches(name.lower(), list(folded), 3, CLOSE)]
+    folded = {n.lower(): n for n in reversed(names)}            # the first of each
+    close = [folded[n] for n in difflib.get_close_matches(name.lower(), list(folded), 3, 0.7)]
     same = [n for n in names if n.lower() == name.lower()]
     return list(dict.fromkeys(n for n in [*same, *close] if n != name))
 

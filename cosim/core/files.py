@@ -1,9 +1,6 @@
-"""Output files written whole or not at all, and output folders written by one process at a time.
-
-A file is written under a temporary name beside its target and renamed into place once
-complete (a reader finds the old file or the new one); a failed write raises ``OutputError``,
-naming the file and what was kept.
-"""
+"""Output files written whole or not at all (under a temporary name beside the target, then
+renamed; a failure is ``OutputError``, naming the file and what was kept), and output folders
+written by one process at a time."""
 from __future__ import annotations
 
 import contextlib
@@ -22,10 +19,8 @@ except ImportError:                     # Windows: msvcrt's byte-range lock inst
     fcntl = None
     import msvcrt
 
-TEMPORARY_PREFIX = ".partial-"
-"""Temporary files beside their targets start with this (hidden, never a final name)."""
-FILE_NAME = re.compile(r"\w(?:[\w .+-]{0,98}[\w+-])?")
-"""A name given for files in an output folder (``--name``): one plain file name."""
+TEMPORARY_PREFIX = ".partial-"              # hidden, never a final name
+FILE_NAME = re.compile(r"\w(?:[\w .+-]{0,98}[\w+-])?")   # one plain file name (``--name``)
 
 
 def plain_name(value: object, what: str) -> str:
@@ -53,8 +48,7 @@ class OutputError(OSError):
 
 
 def _writing(error: OSError, place: Path) -> bool:
-    """Whether ``error`` is of writing ``place`` or into it (ENOSPC, EFBIG name no file), not
-    of reading another file."""
+    """Whether ``error`` is of writing ``place`` or into it, not of reading another file."""
     return not error.filename or Path(error.filename).resolve().is_relative_to(place.resolve())
 
 
@@ -63,8 +57,7 @@ class FolderBusy(RuntimeError):
 
 
 def read_small_text(path: Path, limit: int) -> str:
-    """The text of a small regular UTF-8 file; ValueError saying why not (missing, not a
-    regular file such as /dev/zero, over ``limit`` bytes, not UTF-8)."""
+    """The text of a regular UTF-8 file of at most ``limit`` bytes; ValueError saying why not."""
     path = Path(path)
     if not path.is_file():
         raise ValueError("no such file" if not path.exists() else "not a regular file")
@@ -78,8 +71,8 @@ def read_small_text(path: Path, limit: int) -> str:
 
 @contextlib.contextmanager
 def whole_file(target: Path) -> Iterator[Path]:
-    """``with whole_file(target) as tmp``: ``tmp`` (a new name of the same suffix, which tells
-    the format) becomes ``target`` if the block succeeds, and is removed if it fails."""
+    """``with whole_file(target) as tmp``: ``tmp`` (of the same suffix, which tells the
+    format) becomes ``target`` if the block succeeds, and is removed if it fails."""
     target = Path(target)
     if target.exists() and not target.is_file():
         raise OutputError(target, OSError(errno.EEXIST, "it exists and is not a regular file "
@@ -124,10 +117,9 @@ def fresh_folder(target: Path) -> Iterator[Path]:
 
 
 class Outputs(contextlib.AbstractContextManager):
-    """``with Outputs(folder, stale) as outputs``: files written to ``outputs.path(name)``
-    (a hidden stage in ``folder``) are renamed into ``folder`` together if the block
-    succeeds, then every ``stale`` path not rewritten is removed; if it fails (or on
-    ``discard``) the stage goes and the folder is as it was."""
+    """``with Outputs(folder, stale) as outputs``: files written to ``outputs.path(name)`` (a
+    hidden stage) are renamed into ``folder`` together if the block succeeds, and ``stale``
+    paths not rewritten removed; if it fails (or on ``discard``) the folder is as it was."""
 
     def __init__(self, folder: Path, stale: list[Path] | tuple[Path, ...] = (),
                  label: str = "outputs"):
@@ -136,8 +128,7 @@ class Outputs(contextlib.AbstractContextManager):
 
     @staticmethod
     def remove_abandoned(folder: Path, label: str) -> None:
-        """Remove the stages of ``label`` a killed process left in ``folder`` (call it holding
-        the folder's ``FolderLock``)."""
+        """Remove the stages of ``label`` a killed process left in ``folder`` (under its lock)."""
         pattern = re.compile(re.escape(f"{TEMPORARY_PREFIX}{label}-") + r"[\w]{8}")
         for entry in Path(folder).iterdir():
             if entry.is_dir() and not entry.is_symlink() and pattern.fullmatch(entry.name):
@@ -190,9 +181,8 @@ class Outputs(contextlib.AbstractContextManager):
 
 
 class FolderLock:
-    """``with FolderLock(folder)``: this process alone writes into ``folder``; FolderBusy at
-    once if another holds it. The kernel's lock (released if the process dies): on the
-    folder itself, or on Windows on a file ``.cosim-lock`` in it."""
+    """``with FolderLock(folder)``: this process alone writes into ``folder``, FolderBusy at
+    once if another does; the kernel's lock on the folder (Windows: on ``.cosim-lock`` in it)."""
 
     def __init__(self, folder: Path):
         self.folder = Path(folder)

@@ -67,12 +67,14 @@ def _description(path: Path, size: int, mtime_ns: int, ours: bool) -> ModelDescr
     return description
 
 
-def feedthrough(description: ModelDescription) -> dict[str, frozenset[str]]:
-    """Each output's inputs, from the model structure (all inputs where it declares none)."""
+def described(description: ModelDescription) -> tuple[dict[str, Any], dict[str, frozenset]]:
+    """(the variables by name but FMI 3.0's time, each output's inputs from the model
+    structure: all inputs where it declares none)."""
     inputs = frozenset(v.name for v in description.modelVariables if v.causality == "input")
-    return {o.variable.name: (frozenset(d.name for d in o.dependencies)
-                              if o.dependencies is not None else inputs)
-            for o in description.outputs}
+    return ({v.name: v for v in description.modelVariables if v.causality != "independent"},
+            {o.variable.name: (frozenset(d.name for d in o.dependencies)
+                               if o.dependencies is not None else inputs)
+             for o in description.outputs})
 
 
 class FmuInstance(Instance):
@@ -83,9 +85,7 @@ class FmuInstance(Instance):
         self.description = read_description(self.path, name)
         self.fmi_version, self.guid = fmi_version(self.description), self.description.guid
         self.unzip_dir = extract(str(self.path))
-        self.variables = {v.name: v for v in self.description.modelVariables
-                          if v.causality != "independent"}      # FMI 3.0's time
-        self.feedthrough = feedthrough(self.description)
+        self.variables, self.feedthrough = described(self.description)
         self.log: deque[LogRecord] = deque(maxlen=50)     # the last messages
         self.logged = 0                              # how many there have been
 
@@ -169,7 +169,6 @@ class FmuInstance(Instance):
         self.call("reset", self.slave.reset)
 
     def free(self) -> None:
-        """Terminate, free the instance and remove the extracted files."""
         try:
             self.slave.terminate()
         except FMICallException:
@@ -183,7 +182,6 @@ class FmuInstance(Instance):
     # Prepared calls: the raw FMI functions (fmpy's ``dll``) on preallocated ctypes arrays,
     # without fmpy's per-call wrapping, which costs more than the call itself.
     def _raw(self, verb: str, kind: str, vrs: list[int]) -> tuple[Any, Callable[[], None]]:
-        """The values array for ``vrs`` and fmi2GetReal, fmi3SetFloat64 ... on it."""
         reference, types = RAW_TYPES[self.fmi_version]
         name, ctype = types[kind]
         function = getattr(self.slave.dll, f"fmi{self.fmi_version}{verb.title()}{name}")

@@ -9,7 +9,7 @@ import re
 import zipfile
 from functools import cache
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import Any
 from xml.etree import ElementTree
 
 from fmukit.compose import fmu_class
@@ -18,19 +18,10 @@ from fmukit.manifest import Manifest, read, staleness
 from fmukit.refusals import Refused, explain, naming
 from fmukit.slave import ModelSlave
 
-from .fmi import CALLS, read_description
+from .fmi import CALLS, described, read_description
 from .instance import FmuCallError, Instance, LogRecord, logged_error
 
-_FMI_TYPE = {float: "Real", int: "Integer", str: "String"}      # FMI 2.0's, as the master's
 _PYTHONFMU = ("resources/pythonfmu/", "resources/pythonfmu3/")   # what they carry of their own
-
-
-class VariableInfo(NamedTuple):
-    name: str
-    valueReference: int
-    type: str
-    causality: str
-    unit: str
 
 
 class Reason(str):
@@ -127,20 +118,16 @@ class InProcessInstance(Instance):
 
     def __init__(self, path: str | Path, name: str):
         """ValueError if the FMU cannot run in-process (``in_process_refusal``)."""
-        self.guid = read_description(self.path, name).guid
+        description = read_description(self.path, name)
         refusal = in_process_refusal(self.path)
         if refusal:
             raise ValueError(f"FMU '{name}' ({self.path.name}) cannot run in-process: "
                              f"{refusal}")
         manifest = read(self.path)
         self.slave = slave_class(manifest)(instance_name=name)
-        self.fmi_version = manifest.fmi
-        self.variables = {var.name: VariableInfo(var.name, vr, _FMI_TYPE[var.kind],
-                                                 var.causality, var.unit if var.is_real else "")
-                          for vr, var in self.slave.registry.by_vr.items()}
-        inputs = {v.name for v in self.slave.variables if v.causality == "input"}
-        self.feedthrough = {v.name: frozenset(v.depends) & inputs
-                            for v in self.slave.variables if v.causality == "output"}
+        self.fmi_version, self.guid = manifest.fmi, description.guid
+        # as its class declares them (``in_process_refusal`` compared them)
+        self.variables, self.feedthrough = described(description)
 
     def call(self, what: str, function, *args, time: float | None = None,
              strict: bool = False) -> Any:
@@ -216,7 +203,6 @@ class InProcessInstance(Instance):
         self.slave = type(self.slave)(instance_name=self.name)
 
     def free(self) -> None:
-        """Terminate, if the slave was initialised."""
         if self.slave.sequence.phase == "step":
             self.slave.terminate()
 

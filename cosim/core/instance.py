@@ -1,9 +1,7 @@
-"""What the master needs of a component, whichever backend runs it.
-
-A backend supplies ``call``, ``fmi(name)`` (the function behind the master's FMI 2.0 call
-name, "setReal"), ``enter_initialization``, ``reset`` and ``free``, and may replace the
-prepared calls of the loop (``reader``, ``integer_reader``, ``writer``, ``stepper``).
-"""
+"""What the master needs of a component, whichever backend runs it: a backend supplies
+``call``, ``fmi(name)`` (the function behind an FMI 2.0 call name, "setReal"),
+``enter_initialization``, ``reset``, ``free`` and ``stepper`` (the loop's step), and may
+replace the loop's other prepared calls."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -11,12 +9,11 @@ from typing import Any, Callable, Iterable, NamedTuple
 
 from .values import fmi_value, no_variable
 
-_CALL_TYPE = {"Enumeration": "Integer"}
-"""The FMI 2.0 calls of a type other than its own name: fmi2SetInteger sets an Enumeration."""
+_CALL_TYPE = {"Enumeration": "Integer"}          # fmi2SetInteger sets an Enumeration
 
 
 class LogRecord(NamedTuple):
-    """One message an FMU logged: its status, its category and its text."""
+    """One message an FMU logged."""
 
     status: str                 # ok, warning, discard, error, fatal, pending
     category: str | None
@@ -54,10 +51,8 @@ def logged_error(records: Iterable[LogRecord]) -> bool:
 
 
 class Instance:
-    """One instantiated component: its variables, its feedthrough, and FMI calls.
-
-    ``path`` and ``name`` are set in ``__new__``, before any code of the backend runs: a
-    watchdog that finds an instance on the loop's stack can always name it."""
+    """One instantiated component: its variables, its feedthrough, and FMI calls. ``path``
+    and ``name`` are set in ``__new__``, so that a watchdog can always name it."""
 
     name: str
     path: Path
@@ -93,8 +88,7 @@ class Instance:
         return getattr(variable, "unit", None) or getattr(declared, "unit", None) or ""
 
     def set(self, values: dict[str, Any], time: float | None = None) -> None:
-        """Set variables by name, each through the FMI call of its type. The FMU judges
-        them; what the call could not carry exactly (``fmi_value``) is ValueError here."""
+        """Set variables by name; ValueError for a value the call cannot carry exactly."""
         for name, value in values.items():
             kind = _CALL_TYPE.get(self.variable(name).type, self.variable(name).type)
             exact = fmi_value(f"{self.name}.{name}", kind, value)
@@ -117,7 +111,7 @@ class Instance:
                 else values[name] for name in names}
 
     def parameter_values(self) -> dict[str, Any]:
-        """Every parameter's value as the FMU holds it: defaults and what was set."""
+        """Every parameter's value as the FMU holds it."""
         return self.get([n for n, v in self.variables.items() if v.causality == "parameter"])
 
     def initialize(self, parameters: dict[str, Any] | None = None,
@@ -143,6 +137,3 @@ class Instance:
 
     def writer(self, vrs: list[int]) -> Callable[[list[float]], None]:
         return lambda values: self.call("setReal", self.fmi("setReal"), vrs, values)
-
-    def stepper(self) -> Callable[[float, float], None]:
-        return self.do_step

@@ -1,9 +1,6 @@
-"""Ctrl-C and SIGTERM: a request to stop between steps, or an exception where no FMU runs.
-
-Our FMUs' Python runs in the master's interpreter, where a KeyboardInterrupt would fail an
-FMU's call: within ``StopSignals`` a signal only records itself and the master stops between
-steps (a second signal ends the process at once). ``raise_on_signals`` raises instead.
-"""
+"""Ctrl-C and SIGTERM: within ``StopSignals`` a request to stop between steps (our FMUs' Python
+runs in the master's interpreter, where a KeyboardInterrupt would fail a call; a second signal
+ends the process at once), within ``raise_on_signals`` an exception where no FMU runs."""
 from __future__ import annotations
 
 import os
@@ -44,7 +41,6 @@ class StopSignals:
 
     def __exit__(self, *exc) -> None:
         give_back(self._previous)
-        self._previous = {}
 
     def receive(self, number: signal.Signals) -> None:
         """The first signal asks the run to stop between steps; a second ends the process at
@@ -65,14 +61,13 @@ class StopSignals:
         os._exit(128 + self.received)
 
     def keep(self, keeper: Callable[[], str]) -> Callable[[], None]:
-        """Have ``keeper`` run (and say what it kept) if a second signal ends the process;
-        returns the function that forgets it."""
+        """Have ``keeper`` say what it kept if a second signal ends the process; returns the
+        function that forgets it."""
         self._keepers.append(keeper)
         return lambda: self._keepers.remove(keeper) if keeper in self._keepers else None
 
     @property
-    def exit_status(self) -> int:
-        """The shell's status for a command ended by the signal received: 130, 143."""
+    def exit_status(self) -> int:               # the shell's: 130, 143
         return 128 + self.received if self.received else 0
 
     def check(self) -> None:

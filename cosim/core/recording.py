@@ -27,18 +27,14 @@ class Recording:
     units: dict[str, str] = field(default_factory=dict)   # column: unit ("" if none)
 
     def __getitem__(self, column: str) -> np.ndarray:
-        self._require_held()
-        return self.data[:, self.columns.index(column)]
+        return self.data[:len(self.t), self.columns.index(column)]     # ``t``: if held
 
     @property
     def t(self) -> np.ndarray:
-        self._require_held()
-        return self.time
-
-    def _require_held(self) -> None:
         if len(self.time) < self.rows:
             raise ValueError(f"the {self.rows} rows of this run were streamed to {self.path}; "
                              "read them from there")
+        return self.time
 
     def holding(self, columns: Sequence[str]) -> Recording:
         """This recording with only ``columns``; ValueError naming any it lacks."""
@@ -75,12 +71,11 @@ class Recorder:
                  units: dict[str, str] | None = None):
         self.columns, self.meta, self.units = columns, meta or {}, units or {}
         self.path = None if csv_path is None else Path(csv_path)
-        size = rows if csv_path is None else min(chunk_rows, rows)
         if csv_path is None:
-            require_memory(size, len(columns) + 1)
+            require_memory(rows, len(columns) + 1)
         else:
-            self.file = _open_csv(self.path, columns)
-        self.time, self.data = np.empty(size), np.full((size, len(columns)), np.nan)
+            rows, self.file = min(chunk_rows, rows), _open_csv(self.path, columns)
+        self.time, self.data = np.empty(rows), np.full((rows, len(columns)), np.nan)
         self.held = self.written = 0         # rows in the buffer, and rows written
         self.interrupted: str | None = None
         self.started = time.perf_counter()
@@ -104,14 +99,11 @@ class Recorder:
     def close(self, error: str | None = None) -> Recording:
         """The recording, its meta with ``wall_time_s`` since this recorder began."""
         self.meta["wall_time_s"] = time.perf_counter() - self.started
-        if self.path is None:
-            return Recording(self.columns, self.time[:self.held], self.data[:self.held],
-                             self.held, error, self.interrupted, self.meta, units=self.units)
-        self._flush()
-        self.file.close()
-        return Recording(self.columns, np.empty(0), np.empty((0, len(self.columns))),
-                         self.written, error, self.interrupted, self.meta, self.path,
-                         self.units)
+        if self.path is not None:
+            self._flush()
+            self.file.close()
+        return Recording(self.columns, self.time[:self.held], self.data[:self.held], self.rows,
+                         error, self.interrupted, self.meta, self.path, self.units)
 
 
 class TooManyRows(ValueError):

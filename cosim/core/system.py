@@ -1,8 +1,5 @@
-"""A system: its components, their connections and experiment, and where its FMUs are.
-
-The core's data model of a flat co-simulation (``ssd`` reads and writes it as SSP 1.0);
-where FMUs are built is the caller's to say (``FmuFolders``).
-"""
+"""A system: its components, their connections and experiment, and where its FMUs are (the
+core's model of a flat co-simulation; ``ssd`` reads and writes it as SSP 1.0)."""
 from __future__ import annotations
 
 import copy
@@ -25,10 +22,9 @@ def split_name(name: str) -> tuple[str, str]:
 
 @dataclass(frozen=True)
 class FmuFolders:
-    """Where the caller builds its FMUs, a folder per FMI version, and their names (file
-    stems). An FMU a .ssd names is also looked for in the first folder, by its path after
-    the last folder of that name (``fmi3/ship.fmu`` for ``../../fmus/fmi3/ship.fmu``), so
-    that a .ssd copied anywhere still finds them."""
+    """Where the caller builds its FMUs, a folder per FMI version, and their names (stems).
+    A .ssd's FMU is also looked for in the first folder, by its path after the last folder
+    of that name (``fmi3/ship.fmu`` for ``../../fmus/fmi3/ship.fmu``): a copied .ssd finds it."""
     by_fmi: dict[int, Path]
     names: frozenset[str]
 
@@ -86,8 +82,8 @@ class SystemDescription:
         return parameters
 
     def steps(self, stop_time: float | None = None) -> tuple[float, float, int]:
-        """(t0, h, number of steps) of a run to ``stop_time`` (default: the system's), h on
-        the FMUs' time base; ValueError unless the stop time is a whole number of steps."""
+        """(t0, h on the time base, steps) of a run to ``stop_time`` (default: the system's);
+        ValueError unless that is a whole number of steps."""
         h = seconds(nanoseconds(self.step_size))
         return self.start_time, h, step_count(
             self.start_time, self.stop_time if stop_time is None else stop_time, h)
@@ -105,14 +101,12 @@ class SystemDescription:
                                  "time base (fmukit.timebase)")
         step_count(self.start_time, self.stop_time, self.step_size)
 
-    def ours(self, path: str | Path) -> bool:
-        """Whether ``path`` is named as one of the FMUs of ``fmus``."""
+    def ours(self, path: str | Path) -> bool:           # named as one of the FMUs of ``fmus``
         return self.fmus is not None and Path(path).stem in self.fmus.names
 
     def fmu_candidates(self, component: str) -> list[Path]:
         """Where a component's FMU may be: its source relative to the .ssd (or the current
-        folder), then in ``fmus`` (not for an absolute source: another file of its name
-        would run in its place unseen)."""
+        folder), then in ``fmus`` unless absolute (another file would run in its place unseen)."""
         source = Path(self.components[component].source)
         candidates = [((self.path.parent if self.path else Path.cwd()) / source).resolve()]
         if self.fmus is not None and not source.is_absolute():

@@ -1,10 +1,7 @@
-"""Values for FMU variables, checked against what the FMU declares before any FMU call.
-
-``fmi_value``: exactly what the FMI 2.0 call of the type carries (section 2.1.2), nothing
-rounded or wrapped; ``checked``: that value against the declaration (section 2.2.7);
-``setting``: also that a master may set the variable in initialisation mode (section
-4.2.4). A refusal names the component, the variable, the value and what the variable takes.
-"""
+"""Values for FMU variables, checked before any FMU call: ``fmi_value``, exactly what the FMI
+2.0 call carries (section 2.1.2); ``checked``, against the declaration (2.2.7); ``setting``,
+also settable in initialisation mode (4.2.4). A refusal names the variable, value and what
+it takes."""
 from __future__ import annotations
 
 import math
@@ -35,8 +32,8 @@ _TAKES = {"Real": "a Real (a double)", "Integer": "an Integer, a whole number fr
 
 @dataclass(frozen=True)
 class Declaration:
-    """What an FMU declares of one variable (FMI 2.0, section 2.2.7); min and max None
-    where undeclared, an Enumeration's items as (name, value)."""
+    """What an FMU declares of one variable (section 2.2.7); min and max None where
+    undeclared, an Enumeration's items as (name, value)."""
     name: str
     type: str
     causality: str = "parameter"
@@ -72,8 +69,8 @@ class Declaration:
 
 
 def declarations(description: ModelDescription) -> dict[str, Declaration]:
-    """Every variable's declaration in a model description (``cosim.core.fmi.read_description``,
-    schema-validated), min and max from the variable or else its declared type."""
+    """Every variable's declaration in a model description (``fmi.read_description``), min
+    and max from the variable or else its declared type."""
     out = {}
     for v in description.modelVariables:
         declared, number = v.declaredType, float if v.type == "Real" else int
@@ -86,8 +83,8 @@ def declarations(description: ModelDescription) -> dict[str, Declaration]:
     return out
 
 
-class _Refusal(ValueError):
-    """Why a value is refused: 'is not a whole number'."""
+class _Refusal(ValueError):             # why a value is refused: 'is not a whole number'
+    pass
 
 
 def fmi_value(target: str, type_name: str, value: Any) -> Value:
@@ -137,9 +134,8 @@ def _within(declaration: Declaration, value: Value) -> None:
 
 def setting(component: str, path: str | Path, declared: dict[str, Declaration], name: str,
             value: Any, elsewhere: Mapping[str, Iterable[str]] | None = None) -> Value:
-    """``checked`` for the variable ``name`` of ``component`` (its FMU at ``path``), which
-    must exist and be settable; ValueError naming what it has (and which component of
-    ``elsewhere`` has such a name)."""
+    """``checked`` for the variable ``name`` of ``component`` (its FMU at ``path``), which must
+    exist and be settable; ValueError naming what it has (and which of ``elsewhere`` has it)."""
     if name not in declared:
         raise no_variable(component, path, declared, name, elsewhere)
     declaration = declared[name]
@@ -235,10 +231,9 @@ def parameters(system: SystemDescription, paths: dict[str, Path],
                declared: dict[str, dict[str, Declaration]],
                overrides: Mapping[str, Mapping[str, Any]] | None = None
                ) -> tuple[dict[str, dict[str, Value]], dict[str, dict[str, Value]]]:
-    """The values of a run as ``setting`` returns them (FMUs at ``paths``, declaring
-    ``declared``): the system's bindings updated by ``overrides`` (component: variable:
-    value), and the overrides alone. ValueError naming the value (and the .ssd, for a
-    binding), also for an input that a connection sets."""
+    """(the system's bindings updated by ``overrides``, the overrides alone), by component,
+    as ``setting`` returns them; ValueError naming the value (and the .ssd, for a binding),
+    also for an input that a connection sets."""
     if not isinstance(overrides or {}, Mapping):
         raise ValueError(f"set: overrides must map component names to their values, got "
                          f"{overrides!r}")
