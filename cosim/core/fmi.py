@@ -41,8 +41,7 @@ def fmi_version(description: ModelDescription) -> int:
 
 def read_description(path: str | Path, name: str = "", ours: bool = False) -> ModelDescription:
     """An FMU's model description, FMI 3.0 type names as FMI 2.0's, cached by file version
-    (treat it as read-only). FmuNotFound or FmuUnreadable naming the file, ValueError unless
-    it is a co-simulation FMU of FMI 2.0 or 3.0."""
+    (read-only); FmuNotFound, FmuUnreadable or ValueError naming the file."""
     path = Path(path)
     if not path.is_file():
         raise FmuNotFound(f"FMU for '{name}' not found: {path}", ours)
@@ -90,7 +89,11 @@ class FmuInstance(Instance):
         self.logged = 0                              # how many there have been
 
         def log(*args) -> None:      # FMI 2.0's logger, FMI 3.0's logMessage: the last three
-            self._log(*args[-3:])    # are status, category, message
+            status, category, message = args[-3:]                   # of their arguments
+            self.logged += 1
+            self.log.append(LogRecord(STATUS[status] if status < len(STATUS) else str(status),
+                                      category.decode("utf-8", "replace") if category else None,
+                                      message.decode("utf-8", "replace")))
         try:                  # fmpy raises a plain Exception when it gets NULL
             self.slave = (FMU2Slave if self.fmi_version == 2 else FMU3Slave)(
                 guid=self.guid, unzipDirectory=self.unzip_dir, instanceName=name,
@@ -112,12 +115,6 @@ class FmuInstance(Instance):
                                [*self.log, LogRecord("fatal", None,
                                                      f"{type(error).__name__}: {error}")]
                                ) from error
-
-    def _log(self, status: int, category: bytes | None, message: bytes) -> None:
-        self.logged += 1
-        self.log.append(LogRecord(STATUS[status] if status < len(STATUS) else str(status),
-                                  category.decode("utf-8", "replace") if category else None,
-                                  message.decode("utf-8", "replace")))
 
     def call(self, what: str, function: Callable, *args, time: float | None = None,
              strict: bool = False, **kwargs) -> Any:

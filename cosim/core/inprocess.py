@@ -117,16 +117,11 @@ class InProcessInstance(Instance):
     """A slave class instantiated and driven in this process."""
 
     def __init__(self, path: str | Path, name: str):
-        """ValueError if the FMU cannot run in-process (``in_process_refusal``)."""
-        description = read_description(self.path, name)
-        refusal = in_process_refusal(self.path)
-        if refusal:
-            raise ValueError(f"FMU '{name}' ({self.path.name}) cannot run in-process: "
-                             f"{refusal}")
-        manifest = read(self.path)
+        """For an FMU that ``in_process_refusal`` passes (the master's ``fallback_note``): its
+        variables and feedthrough are then its class's."""
+        description, manifest = read_description(self.path, name), read(self.path)
         self.slave = slave_class(manifest)(instance_name=name)
         self.fmi_version, self.guid = manifest.fmi, description.guid
-        # as its class declares them (``in_process_refusal`` compared them)
         self.variables, self.feedthrough = described(description)
 
     def call(self, what: str, function, *args, time: float | None = None,

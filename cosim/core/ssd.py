@@ -1,9 +1,6 @@
-"""Read and write SSP 1.0 system structure descriptions (.ssd) of a flat system.
-
-The subset OSP libcosim, ecos and fmpy all read: FMU components with connectors, inline
-parameter values, connections, and a DefaultExperiment whose OSP annotation gives the step
-(``write_ssd`` gives it OpenModelica's annotation too, and ours, the kind of analysis a run
-gets). ``read_ssd`` refuses anything else, naming the file, the element and the attribute."""
+"""Read and write SSP 1.0 system structure descriptions (.ssd) of a flat system: the subset OSP
+libcosim, ecos and fmpy all read (FMU components, connectors, inline parameter values,
+connections, the step in OSP's annotation); ``read_ssd`` refuses anything else by name."""
 from __future__ import annotations
 
 import math
@@ -30,14 +27,12 @@ for _prefix, _uri in NS.items():
     ET.register_namespace(_prefix, _uri)
 
 
-def _q(prefixed: str) -> str:
-    """'ssd:System' as ElementTree names it."""
+def _q(prefixed: str) -> str:                   # 'ssd:System' as ElementTree names it
     prefix, _, tag = prefixed.partition(":")
     return f"{{{NS[prefix]}}}{tag}"
 
 
-def _local(element: ET.Element) -> str:
-    """An element's tag as the file writes it: 'ssv:Real'."""
+def _local(element: ET.Element) -> str:         # its tag as the file writes it: 'ssv:Real'
     uri, _, tag = element.tag.rpartition("}")
     prefix = next((p for p, u in NS.items() if f"{{{u}" == uri), None)
     return f"{prefix}:{tag}" if prefix else tag
@@ -93,11 +88,8 @@ class _Reader:
         if len(systems) != 1:
             raise self.error("SystemStructureDescription",
                              f"needs one System element, has {len(systems)}")
-        components: dict[str, Component] = {}
-        for i, element in enumerate(systems[0].findall("ssd:Elements/*", NS), 1):
-            if element.tag != _q("ssd:Component"):
-                raise self.error(f"System, element {i} of Elements",
-                                 f"{_local(element)} is not read: only Components (FMUs)")
+        system, components = systems[0], {}
+        for i, element in enumerate(system.findall("ssd:Elements/*", NS), 1):
             component = self.component(element, i)
             if component.name in components:
                 raise self.error(f"Component {i}", f"a second Component named "
@@ -105,9 +97,8 @@ class _Reader:
             components[component.name] = component
         if not components:
             raise self.error("System", "no Component in its Elements")
-        description = SystemDescription(name, components, self.connections(systems[0],
-                                                                            components),
-                                        description=systems[0].get("description", ""),
+        description = SystemDescription(name, components, self.connections(system, components),
+                                        description=system.get("description", ""),
                                         path=self.path, fmus=fmus)
         experiment = root.find("ssd:DefaultExperiment", NS)
         if experiment is not None:
@@ -115,6 +106,9 @@ class _Reader:
         return description
 
     def component(self, element: ET.Element, index: int) -> Component:
+        if element.tag != _q("ssd:Component"):
+            raise self.error(f"System, element {index} of Elements",
+                             f"{_local(element)} is not read: only Components (FMUs)")
         name = self.required(element, "name", f"Component {index}")
         where = f"Component '{name}'"
         if "." in name:
@@ -245,9 +239,9 @@ def _el(parent: ET.Element, path: str, **attributes: str) -> ET.Element:
 
 def write_ssd(system: SystemDescription, path: str | Path,
               sources: dict[str, str] | None = None, units: Units | None = None) -> None:
-    """Write ``system`` as a .ssd; ``sources`` replaces component sources by name; with
-    ``units``, each connector carries its unit, defined in the file's ssd:Units. The step
-    goes into OSP's FixedStepAlgorithm and OpenModelica's FixedStepMaster ('oms-ma')."""
+    """Write ``system`` as a .ssd, ``sources`` replacing component sources by name; with
+    ``units``, connectors carry units. The step goes into OSP's and OpenModelica's annotations,
+    the kind of report into ours."""
     unit_of = units.connectors if units else {}
     root = ET.Element(_q("ssd:SystemStructureDescription"), version="1.0", name=system.name)
     sys_el = _el(root, "ssd:System", name=system.name, description=system.description)

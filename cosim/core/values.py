@@ -74,12 +74,11 @@ def declarations(description: ModelDescription) -> dict[str, Declaration]:
     out = {}
     for v in description.modelVariables:
         declared, number = v.declaredType, float if v.type == "Real" else int
-        low, high = (getattr(v, bound, None) or getattr(declared, bound, None)
-                     for bound in ("min", "max"))
+        bounds = (getattr(v, bound, None) or getattr(declared, bound, None)
+                  for bound in ("min", "max"))
         items = tuple((i.name, int(i.value)) for i in getattr(declared, "items", None) or ())
         out[v.name] = Declaration(v.name, v.type, v.causality, v.variability, v.initial,
-                                  None if low is None else number(low),
-                                  None if high is None else number(high), items)
+                                  *(None if b is None else number(b) for b in bounds), items)
     return out
 
 
@@ -88,7 +87,7 @@ class _Refusal(ValueError):             # why a value is refused: 'is not a whol
 
 
 def fmi_value(target: str, type_name: str, value: Any) -> Value:
-    """``value`` as the FMI 2.0 call of ``type_name`` carries it, exactly; ValueError naming
+    """``value`` exactly as the FMI 2.0 call of ``type_name`` carries it, or ValueError naming
     ``target`` (component.variable), the value and what the type takes."""
     return _carried(target, type_name, value, _TAKES.get(type_name, ""))
 

@@ -2,7 +2,7 @@
 (a ``Node`` per component) and the coupling algorithms that step it."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from graphlib import CycleError, TopologicalSorter
 from operator import itemgetter
 from typing import Callable
@@ -47,16 +47,13 @@ def feedthrough_order(system: SystemDescription, instances: dict[str, Instance])
 
 @dataclass
 class Node:
-    """One component as the loop sees it: its column blocks and prepared calls (None where
+    """One component as the loop sees it: its output columns and prepared calls (None where
     it has nothing of that kind)."""
 
-    name: str
-    instance: Instance
     step: Callable[[float, float], None]
     state: slice                        # Real outputs, no feedthrough
     feedthrough: slice                  # Real outputs, with feedthrough
     integers: slice                     # Integer outputs
-    inputs: slice = field(default_factory=lambda: slice(0, 0))     # connected inputs
     read_state: Callable[[], list[float]] | None = None
     read_feedthrough: Callable[[], list[float]] | None = None
     read_outputs: Callable[[], list[float]] | None = None   # state and feedthrough at once
@@ -86,8 +83,8 @@ def layout(instances: dict[str, Instance], connections: list[Connection]
         state = [v.name for v in reals if not instance.feedthrough.get(v.name)]
         ft = [v.name for v in reals if instance.feedthrough.get(v.name)]
         ints = [v.name for v in outputs if v.type == "Integer"]
-        node = nodes[name] = Node(name, instance, instance.stepper(), block(name, state),
-                                  block(name, ft), block(name, ints))
+        node = nodes[name] = Node(instance.stepper(), block(name, state), block(name, ft),
+                                  block(name, ints))
         vrs = [instance.vr(v) for v in state + ft]
         node.read_state = instance.reader(vrs[:len(state)]) if state else None
         node.read_feedthrough = instance.reader(vrs[len(state):]) if ft else None
@@ -96,13 +93,13 @@ def layout(instances: dict[str, Instance], connections: list[Connection]
             if ints else None
     for name, node in nodes.items():
         incoming = [c for c in connections if c.end_element == name]
-        node.inputs = block(name, [c.end_connector for c in incoming])
+        inputs = block(name, [c.end_connector for c in incoming])
         if incoming:
             sources = [columns.index(f"{c.start_element}.{c.start_connector}")
                        for c in incoming]
             write = instances[name].writer([instances[name].vr(c.end_connector)
                                             for c in incoming])
-            node.apply_inputs = _input_applier(write, sources, node.inputs)
+            node.apply_inputs = _input_applier(write, sources, inputs)
     return columns, nodes
 
 
