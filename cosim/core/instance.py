@@ -67,8 +67,7 @@ class Instance:
 
     def call(self, what: str, function: Callable, *args, time: float | None = None,
              strict: bool = False) -> Any:
-        """Run ``function``; FmuCallError if it fails, or, ``strict``, if it returns OK but
-        logs an error."""
+        """Run ``function``; FmuCallError if it fails or, ``strict``, logs an error."""
         raise NotImplementedError
 
     def variable(self, name: str):

@@ -1,9 +1,5 @@
-"""The co-simulation master: FMUs wired by a system description, stepped at a fixed step.
-
-Time is counted in integer steps, t_k = t_0 + k h in whole nanoseconds (``fmukit.timebase``):
-a 400 s run at 0.1 s has exactly 4000 steps and 4001 rows. A failure, a time limit or a
-signal stops the run between steps with an error naming the FMU, call and time; rows are kept.
-"""
+"""The co-simulation master: FMUs wired by a system description, stepped at a fixed step
+t_k = t_0 + k h in whole nanoseconds (``fmukit.timebase``): 400 s at 0.1 s is 4001 rows."""
 from __future__ import annotations
 
 import contextlib
@@ -79,8 +75,7 @@ class Master(contextlib.AbstractContextManager):
         self._prepare()
 
     def initialize(self) -> None:
-        """Enter initialisation, set parameters (``parameter_values``: as the FMUs hold
-        them), propagate initial outputs, exit."""
+        """Enter initialisation, set parameters, propagate initial outputs, exit."""
         t0 = self.system.start_time
         for name, instance in self.instances.items():
             instance.enter_initialization(t0)
@@ -102,8 +97,8 @@ class Master(contextlib.AbstractContextManager):
             csv_path: str | Path | None = None, chunk_rows: int = 10_000,
             stop: StopSignals | None = None, watchdog: Watchdog | None = None) -> Recording:
         """Simulate to ``stop_time`` (default: the system's); an FMU failure, a signal on
-        ``stop`` or a limit of ``watchdog`` ends it early (``Recording.error``). With
-        ``csv_path`` the rows are streamed there in chunks (else TooManyRows if too many)."""
+        ``stop`` or a limit of ``watchdog`` ends it early between steps (``Recording.error``,
+        the rows kept). ``csv_path``: the rows streamed there (else TooManyRows if too many)."""
         t0, h, n_steps = self.system.steps(stop_time)
         recorder = self._recorder = Recorder(self.columns, n_steps + 1, csv_path, chunk_rows,
                                              run_meta(self, n_steps), self.units)

@@ -38,11 +38,10 @@ def _local(element: ET.Element) -> str:         # its tag as the file writes it:
     return f"{prefix}:{tag}" if prefix else tag
 
 
+@dataclass
 class _Reader:
     """Reads one .ssd; every error names the file, the element and the attribute."""
-
-    def __init__(self, path: Path):
-        self.path = path
+    path: Path
 
     def error(self, where: str, problem: str) -> ValueError:
         return ValueError(f"{self.path}: {where}: {problem}")
@@ -65,10 +64,8 @@ class _Reader:
 
     def number(self, element: ET.Element, attribute: str, where: str, default: float) -> float:
         text = element.get(attribute)
-        if text is None:
-            return default
         try:
-            value = fmi_value(attribute, "Real", text)
+            value = default if text is None else fmi_value(attribute, "Real", text)
         except ValueError:
             value = math.nan
         if not math.isfinite(value):

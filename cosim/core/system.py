@@ -89,8 +89,8 @@ class SystemDescription:
             self.start_time, self.stop_time if stop_time is None else stop_time, h)
 
     def check_times(self) -> None:
-        """ValueError unless start, stop and step are times an FMU takes, on the time base
-        (``fmukit.timebase``), with a whole number of steps from start to stop."""
+        """ValueError unless start, stop and step are on the time base, within what an FMU
+        takes, with a whole number of steps from start to stop."""
         for name, t in (("startTime", self.start_time), ("stopTime", self.stop_time),
                         ("baseStepSize", self.step_size)):
             if abs(t) > MAX_TIME:

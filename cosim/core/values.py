@@ -202,8 +202,6 @@ def _integer(value: Any) -> int:
 
 
 def _boolean(value: Any) -> bool:
-    if isinstance(value, bool):
-        return value
     if isinstance(value, str) and value.strip().lower() in _BOOLEAN:
         return _BOOLEAN[value.strip().lower()]
     if isinstance(value, numbers.Integral) and value in (0, 1):

@@ -1,7 +1,5 @@
-"""Time limits for a run, and signals that reach it even while an FMU never returns: a
-thread beside the loop reads them from Python's wakeup fd and raises ``TimeLimit`` into a call
-past a limit; if it has not returned after the grace, it salvages the rows and ends the process
-(docs/robustness.md)."""
+"""Time limits for a run, and signals that reach it even while an FMU never returns: a thread
+beside the loop raises ``TimeLimit`` into a call past a limit, or else ends the process."""
 from __future__ import annotations
 
 import ctypes

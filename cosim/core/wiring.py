@@ -67,9 +67,8 @@ class Node:
 
 def layout(instances: dict[str, Instance], connections: list[Connection]
            ) -> tuple[list[str], dict[str, Node]]:
-    """(columns, nodes by name): every output, then every connected input, per component.
-    A node's ``apply_inputs(values)`` sets its inputs from their sources' columns and records
-    them, as sent, in its own."""
+    """(columns, nodes by name): every output, then every connected input, per component;
+    ``apply_inputs(values)`` sets a node's inputs from their sources and records them as sent."""
     columns: list[str] = []
 
     def block(name: str, variables: list) -> slice:
