@@ -39,12 +39,7 @@ class OutputError(OSError):
         reason = error.strerror or str(error)
         if error.errno == errno.EFBIG:
             reason += " (a limit on file size)"
-        super().__init__(error.errno, f"cannot write {target}: {reason}"
-                                      + (f"; {kept}" if kept else ""))
-        self.target = target
-
-    def __str__(self) -> str:
-        return self.strerror
+        super().__init__(f"cannot write {target}: {reason}" + (f"; {kept}" if kept else ""))
 
 
 def _writing(error: OSError, place: Path) -> bool:
