@@ -34,7 +34,6 @@ process with a time limit).
 from __future__ import annotations
 
 import argparse
-import functools
 import json
 import math
 import sys
@@ -52,7 +51,6 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from autopilot_fmu.smc import reference_step_bound  # noqa: E402
-from cosim.core import fmi as fmi_backend  # noqa: E402
 from cosim.core.fmi import FmuInstance, fmi_version, read_description  # noqa: E402
 from cosim.core.instance import FmuCallError  # noqa: E402
 from fmubuild.project import FMU_DIRS  # noqa: E402
@@ -398,20 +396,12 @@ def _convert(v, value):
     return float(value)
 
 
-class ExtractedOnce(FmuInstance):
-    """An instance on the campaign's one extraction of its FMU (``fuzz`` caches fmpy's
-    ``extract``): extracting anew would cost more than most examples."""
-
-    def _remove_unzip_dir(self) -> None:
-        pass
-
-
 def fuzz(name: str, examples: int, seed: int | None = None, fmi: int = 2) -> dict:
     """Fuzz FMU ``name`` of FMI version ``fmi`` (its FMI 3.0 twin: fmus/fmi3/) with
     ``examples`` programs; the counts of calls by kind and status."""
     fmu_path = FMU_DIRS[fmi] / f"{name}.fmu"
     md = read_description(fmu_path, name)
-    fmi_backend.extract = functools.cache(extract)
+    unzipped = extract(str(fmu_path))
     counts: Counter = Counter()
 
     @settings(max_examples=examples, deadline=None, database=None, derandomize=seed is None,
@@ -419,7 +409,7 @@ def fuzz(name: str, examples: int, seed: int | None = None, fmi: int = 2) -> dic
     @given(programs(md))
     def check(program):
         counts["examples"] += 1
-        fmu = ExtractedOnce(fmu_path, name)
+        fmu = FmuInstance(fmu_path, name, unzip_dir=unzipped)
         try:
             run_program(fmu, Expectation(md), program, counts)
         finally:

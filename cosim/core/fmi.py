@@ -80,10 +80,12 @@ class FmuInstance(Instance):
     """A co-simulation FMU instantiated through fmpy (FmuCallError if it cannot be); an FMI
     3.0 step that asks to end the simulation fails."""
 
-    def __init__(self, path: str | Path, name: str):
+    def __init__(self, path: str | Path, name: str, unzip_dir: str | Path | None = None):
+        """``unzip_dir``: the FMU extracted there already, kept (tests/fmu_fuzz.py's)."""
         self.description = read_description(self.path, name)
         self.fmi_version, self.guid = fmi_version(self.description), self.description.guid
-        self.unzip_dir = extract(str(self.path))
+        self._owns_unzip_dir = unzip_dir is None
+        self.unzip_dir = str(unzip_dir) if unzip_dir else extract(str(self.path))
         self.variables, self.feedthrough = described(self.description)
         self.log: deque[LogRecord] = deque(maxlen=50)     # the last messages
         self.logged = 0                              # how many there have been
@@ -174,7 +176,8 @@ class FmuInstance(Instance):
         self._remove_unzip_dir()
 
     def _remove_unzip_dir(self) -> None:
-        shutil.rmtree(self.unzip_dir, ignore_errors=True)
+        if self._owns_unzip_dir:
+            shutil.rmtree(self.unzip_dir, ignore_errors=True)
 
     # Prepared calls: the raw FMI functions (fmpy's ``dll``) on preallocated ctypes arrays,
     # without fmpy's per-call wrapping, which costs more than the call itself.
