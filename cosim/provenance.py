@@ -1,6 +1,6 @@
 """What it takes to reproduce a run, written as JSON next to its CSV.
 
-Besides what the master records (``Master.run_meta``: units, parameters as held and as set,
+Besides what the master records (``master.run_meta``: units, parameters as held and as set,
 backends, step, times), each FMU's SHA-256 (and, for one built with fmukit, its sources'
 digest and whether they are this process's: ``current``), the scenario's SHA-256, the
 command, and the versions of this package (with its git commit), Python, numpy, fmpy and
