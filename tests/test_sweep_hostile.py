@@ -56,12 +56,13 @@ def spec_file(tmp_path: Path, text: str) -> Path:
 @pytest.mark.parametrize("text, said", [
     # one parameter set twice: by two axes, or by an axis and a controller's set
     ('[axes]\nwave_seed = [1]\n"ship.wave_seed" = [2]',
-     "axes 'wave_seed' and 'ship.wave_seed' both set ship.wave_seed"),
-    ("[axes]\nsea_state = [2]\nHs = [0.01]", "axes 'sea_state' and 'Hs' both set ship.Hs"),
+     "axis 'wave_seed' and axis 'ship.wave_seed' both set ship.wave_seed; give it one place"),
+    ("[axes]\nsea_state = [2]\nHs = [0.01]", "axis 'sea_state' and axis 'Hs' both set ship.Hs"),
     ('[axes]\n"ship.T0" = [1.0]\nsea_state = [2]',
-     "axes 'ship.T0' and 'sea_state' both set ship.T0"),
+     "axis 'ship.T0' and axis 'sea_state' both set ship.T0"),
     ('[controllers]\npd = { scenario = "waves_pd", set = { "ship.Hs" = 0.01 } }\n'
-     "[axes]\nsea_state = [2]", "controller 'pd' sets ship.Hs, which axis 'sea_state' sets"),
+     "[axes]\nsea_state = [2]", "axis 'sea_state' and controller 'pd' both set ship.Hs; give "
+                                 "it one place"),
     # a value twice in one axis, as the FMU receives it
     ("[axes]\nwave_seed = [1, 1, 2]", "axis 'wave_seed' has 1 twice"),
     ('[axes]\n"ship.delta_rate_max" = [1, 1.0]',
@@ -112,7 +113,7 @@ def spec_file(tmp_path: Path, text: str) -> Path:
     ("[plots]\nmap = [{ a = 1 }]", "\\[plots\\] map = \\[{'a': 1}\\]: give two different axes"),
     ("[axes]\nHs = [0.01]\n[plots]\nmap = ['Hs', 'Hs']",
      "\\[plots\\] map = \\['Hs', 'Hs'\\]: give two different axes"),
-    ("[plots]\nmaps = []", "\\[plots\\] has maps; it has map and tracks"),
+    ("[plots]\nmaps = []", "\\[plots\\] has unknown key maps; it has map, tracks"),
     ("[axes]\nwave_seed = [1, 2]\n[plots]\ntracks = { wave_seed = true }",
      "\\[plots\\] tracks selects wave_seed = True"),
     # a name that would write outside the output folder, or oddly in it

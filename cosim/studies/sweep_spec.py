@@ -73,21 +73,28 @@ class Spec:
         return {sha: path for _, files, _ in self._shipped.values()
                 for sha, path in files.items()}
 
-    def _description(self, controller: str, component: str) -> tuple[Path, Any]:
-        """A component's FMU in a controller's system, and its model description."""
-        source = self.bundles()[controller].system.components[component].source
-        fmu = self.files()[Path(source).stem]
-        return fmu, read_description(fmu, component)
+    @cached_property
+    def _fmus(self) -> dict[tuple[str, str], tuple[Path, Any, dict[str, Declaration]]]:
+        """Each (controller, component): its FMU, model description and declarations."""
+        fmus = {}
+        for controller, shipped in self.bundles().items():
+            for name, component in shipped.system.components.items():
+                fmu = self.files()[Path(component.source).stem]
+                description = read_description(fmu, name)
+                fmus[controller, name] = fmu, description, declarations(description)
+        return fmus
 
-    def declared(self, controller: str, component: str) -> tuple[Path, dict[str, Declaration]]:
-        """A component's FMU in a controller's system, and its variables' declarations."""
-        fmu, description = self._description(controller, component)
-        return fmu, declarations(description)
+    def declared(self, controller: str, component: str
+                 ) -> tuple[Path | None, dict[str, Declaration]]:
+        """A component's FMU in a controller's system and its variables' declarations
+        ((None, {}) where the system has no such component)."""
+        fmu, _, variables = self._fmus.get((controller, component), (None, None, {}))
+        return fmu, variables
 
     def _variable(self, controller: str, target: str):
         """The model variable ``target`` (component.variable) of a controller's system."""
         component, _, name = target.partition(".")
-        description = self._description(controller, component)[1]
+        description = self._fmus[controller, component][1]
         return next(v for v in description.modelVariables if v.name == name)
 
     def runs(self) -> list[dict[str, Any]]:
@@ -121,17 +128,14 @@ class Spec:
     def _ships(self) -> dict[str, dict[str, Any]]:
         """Each controller's components that are this checkout's ship FMU, with the Hs their
         system binds or their FMU declares."""
-        ships: dict[str, dict[str, Any]] = {}
-        for controller, shipped in self.bundles().items():
-            ships[controller] = {}
-            for name, component in shipped.system.components.items():
-                fmu = self._description(controller, name)[0]
-                manifest = read_manifest(fmu)
-                if (manifest is not None and manifest.slave_module == SHIP_SLAVE
-                        and in_process_refusal(fmu) is None):
-                    Hs = component.parameters.get("Hs")
-                    ships[controller][name] = (self._variable(controller, f"{name}.Hs").start
-                                               if Hs is None else Hs)
+        ships: dict[str, dict[str, Any]] = {controller: {} for controller in self.controllers}
+        for (controller, name), (fmu, _, _) in self._fmus.items():
+            manifest = read_manifest(fmu)
+            if (manifest is not None and manifest.slave_module == SHIP_SLAVE
+                    and in_process_refusal(fmu) is None):
+                Hs = self.bundles()[controller].system.components[name].parameters.get("Hs")
+                ships[controller][name] = (self._variable(controller, f"{name}.Hs").start
+                                           if Hs is None else Hs)
         return ships
 
     def _calm_ships(self, controller: str, overrides: dict[str, dict[str, Any]]) -> list[str]:
