@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import shlex
 import signal
@@ -30,18 +31,16 @@ EXAMPLES = """\
 SPEC is a TOML file of controllers, axes and plots: docs/sweeps.md documents it, the
 outputs, resuming and clusters; docs/sweeps/example.toml is a small one."""
 
+# What a finished sweep writes beside its journal (names, or globs of names).
 OUTPUTS = ("results.parquet", "results.json", "results.csv", "summary.csv", "J_distribution.png",
            "tracks.png", "J_*_over_pd.png", "comparison.md")
-"""What a finished sweep writes beside its journal (by name, or glob of names)."""
 
 
 def count(text: str) -> int:
     """A whole number >= 1, for argparse."""
-    try:
+    with contextlib.suppress(ValueError):
         if int(text) >= 1:
             return int(text)
-    except ValueError:
-        pass
     raise argparse.ArgumentTypeError(f"give a whole number >= 1, got {text!r}")
 
 
@@ -68,29 +67,25 @@ def main(argv: list[str] | None = None) -> int:
                              "(default: %(default)d)")
     parser.add_argument("--out", type=Path, default=RESULTS, help="parent folder of the results")
     parser.add_argument("--backend", choices=SWEEP_BACKENDS, default="fmi",
-                        help="fmi: each run through the FMUs (default); inprocess: this "
-                             "project's FMUs as Python classes, without FMI; batch: the runs of "
-                             "each PD, PID or SMC system in batches stepped together as arrays; "
-                             "the same rows, bit for bit (what a backend does not cover runs "
-                             "otherwise, with a note)")
+                        help="fmi (default); inprocess: our FMUs without FMI; batch: each PD, "
+                             "PID or SMC system's runs stepped together as arrays; the same "
+                             "rows, bit for bit (docs/sweeps.md)")
     parser.add_argument("--batch-size", type=count, metavar="N",
-                        help="with --backend batch: at most N runs a batch (default: as few "
-                             "batches as keep every worker busy, of at most "
-                             f"{MAX_BATCH} runs and at least {MIN_BATCH} where there are that "
-                             "many; docs/sweeps.md)")
+                        help="with --backend batch: at most N runs a batch (default: as few as "
+                             f"keep every worker busy, each of at most {MAX_BATCH} runs and, "
+                             f"where there are that many, at least {MIN_BATCH})")
     parser.add_argument("--no-worker-timeout", type=positive_seconds, metavar="SECONDS",
                         default=campaign.NO_WORKER_TIMEOUT,
                         help="stop when the cluster has had no worker for this long, keeping "
                              "every row done (exit status "
                              f"{NoWorkers.exit_status}; default: %(default)g s)")
     parser.add_argument("--step-timeout", type=positive_seconds, default=STEP_LIMIT_S,
-                        metavar="S",
-                        help="a run whose FMUs take longer than S s of wall-clock time over "
-                             "one step (or their instantiation) is recorded failed; a batch "
-                             "of N runs gets N times S (default %(default)g)")
+                        metavar="S", help="a run with a step (or instantiation) longer than S "
+                                          "s is recorded failed; a batch of N runs gets N "
+                                          "times S (default %(default)g)")
     parser.add_argument("--run-timeout", type=positive_seconds, metavar="S",
-                        help="a run longer than S s of wall-clock time is recorded failed; a "
-                             "batch of N runs gets N times S (default: no limit)")
+                        help="a run longer than S s is recorded failed; a batch of N runs gets "
+                             "N times S (default: no limit)")
     parser.add_argument("--csv", action="store_true", help="also write results.csv")
     parser.add_argument("--no-progress", action="store_true",
                         help="no progress bar (for logs)")
@@ -151,7 +146,6 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _comparison(spec: Spec, rows: list[dict]) -> str:
-    """comparison.md: what it is, and the table (``sweep_tables.comparison``)."""
     pairs = f"paired by {MONTE_CARLO} (the same sea)" if MONTE_CARLO in spec.axes else \
         "one run each"
     return (f"# {spec.name}: each controller against pd\n\n"
@@ -163,7 +157,7 @@ def _comparison(spec: Spec, rows: list[dict]) -> str:
 
 def _stopped(stopped: Interrupted | NoWorkers, stage: str, spec: Spec, out: Path, csv: bool,
              resume: str) -> int:
-    """Say what an interrupted or workerless sweep keeps and how to resume it; its status."""
+    """Say what a stopped sweep keeps and how to resume it; its exit status."""
     rows = campaign.completed(spec, out)
     running = stage == "running the sweep"
     written = write_tables(rows, out, csv, spec) if running and rows else []
@@ -177,14 +171,8 @@ def _stopped(stopped: Interrupted | NoWorkers, stage: str, spec: Spec, out: Path
     return stopped.exit_status
 
 
-def _end_at_a_signal(number: int, frame) -> None:
-    """After the command has said all: a signal while the interpreter shuts down ends the
-    process at once, without a traceback."""
-    os._exit(128 + number)
-
-
 if __name__ == "__main__":
     status = entry(main)
-    for number in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(number, _end_at_a_signal)
+    for number in (signal.SIGINT, signal.SIGTERM):      # as Python shuts down: no traceback
+        signal.signal(number, lambda number, frame: os._exit(128 + number))
     sys.exit(status)

@@ -1,7 +1,6 @@
 """Dask clusters for sweeps: a local one or an existing scheduler, its workers checked before
 any run and watched while it goes. A run holds the GIL from start to end, so a worker is
-one single-threaded process (``dask worker ADDRESS --nthreads 1 --nworkers N``).
-"""
+one single-threaded process (``dask worker ADDRESS --nthreads 1 --nworkers N``)."""
 from __future__ import annotations
 
 import importlib.util
@@ -21,13 +20,11 @@ from ..core.files import read_small_text
 from ..provenance import PACKAGE, code_version
 from .bundle import UnsafeCache, fmu_cache
 
-CONNECT_TIMEOUT = 30.0
-"""Seconds a client tries to reach an existing scheduler (Dask's own default)."""
+CONNECT_TIMEOUT = 30.0          # s a client tries to reach a scheduler (Dask's default)
 
 
 class ClusterError(ValueError):
-    """No cluster to run on: the scheduler cannot be reached or found, or the options that
-    say where it is or how big a local one is make no sense."""
+    """No cluster to run on: no scheduler reached or found, or options that make no sense."""
 
 
 class SweepError(RuntimeError):
@@ -35,21 +32,30 @@ class SweepError(RuntimeError):
 
 
 class NoWorkers(RuntimeError):
-    """The sweep stopped: its cluster had no worker for as long as it waits for one (the
-    runs completed stay in the journal)."""
+    """The sweep stopped: its cluster had no worker for as long as it waits for one."""
 
     exit_status = 3
 
 
 def local_cluster(workers: int | None = None) -> LocalCluster:
-    """``workers`` single-threaded worker processes (default: one per core), the dashboard
-    on a free port, quiet: a row says what failed, and the workers' own errors (as when a
-    second Ctrl-C leaves them without their scheduler) would only be noise. Worker-saturation
-    1.0: a run that kills its worker takes no queued run with it. Made with SIGINT blocked,
-    which its threads and workers inherit: a terminal's Ctrl-C stops the client alone."""
+    """``workers`` single-threaded worker processes (default: one per core), quiet (a row says
+    what failed), the dashboard on a free port; worker-saturation 1.0: a run that kills its
+    worker takes no queued run with it. Made with SIGINT blocked, which its threads and
+    workers inherit: a terminal's Ctrl-C stops the client alone."""
     import dask
+    from multiprocessing import resource_tracker
 
-    _start_resource_tracker()
+    # Its resource tracker started first (starting it unblocks SIGINT), quiet (it would
+    # only report semaphores leaked at a second Ctrl-C).
+    sys.stderr.flush()
+    saved, null = os.dup(2), os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(null, 2)
+        resource_tracker.ensure_running()
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+        os.close(null)
     previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     cluster = None
     try:
@@ -65,26 +71,9 @@ def local_cluster(workers: int | None = None) -> LocalCluster:
     return cluster
 
 
-def _start_resource_tracker() -> None:
-    """Start multiprocessing's resource tracker before SIGINT is blocked (starting it
-    unblocks SIGINT), quiet (it would only report semaphores leaked at a second Ctrl-C)."""
-    from multiprocessing import resource_tracker
-
-    sys.stderr.flush()
-    saved, null = os.dup(2), os.open(os.devnull, os.O_WRONLY)
-    try:
-        os.dup2(null, 2)
-        resource_tracker.ensure_running()
-    finally:
-        os.dup2(saved, 2)
-        os.close(saved)
-        os.close(null)
-
-
 def local_workers(workers: int | None) -> tuple[int | None, str | None]:
-    """The worker processes of a local cluster for the ``workers`` asked (None: one per
-    core), and a note where capped at the cores this process may use; ClusterError for
-    fewer than one."""
+    """The worker processes of a local cluster for ``workers`` (None: one per core), and a
+    note where capped at the cores this process may use; ClusterError below one."""
     from dask.system import CPU_COUNT
 
     if workers is None:
@@ -100,7 +89,7 @@ def local_workers(workers: int | None) -> tuple[int | None, str | None]:
 
 def scheduler_address(scheduler_file: str | Path) -> str:
     """The address in a scheduler file; ClusterError naming the file if it is missing,
-    unreadable or holds no address (Dask's own client waits for ever for a missing one)."""
+    unreadable or holds none (Dask's own client waits for ever for a missing one)."""
     path = Path(scheduler_file)
     if not path.exists():
         raise ClusterError(f"scheduler file {path} does not exist (has the scheduler "
@@ -118,10 +107,9 @@ def scheduler_address(scheduler_file: str | Path) -> str:
 def connect(scheduler: str | None = None, workers: int | None = None,
             scheduler_file: str | None = None, timeout: float = CONNECT_TIMEOUT
             ) -> tuple[Client, LocalCluster | None]:
-    """(a client, the local cluster or None): of an existing scheduler, found as Dask's tools
-    find it (an address, a scheduler file, DASK_SCHEDULER_ADDRESS) and reached within
-    ``timeout`` s, or of a new local cluster of ``workers``. ClusterError, naming the
-    address or file, if none is reached or found, or for ``workers`` with a scheduler."""
+    """(a client, the local cluster or None): of a scheduler found as Dask's tools find it
+    and reached within ``timeout`` s, else of a new local cluster of ``workers``;
+    ClusterError naming the address or file where none is reached."""
     import dask
 
     if scheduler and scheduler_file:
@@ -152,9 +140,9 @@ def connect(scheduler: str | None = None, workers: int | None = None,
 
 
 class Completions:
-    """Futures as they complete (more may be added meanwhile), and their results, while the
-    cluster is watched: ``NoWorkers`` once the scheduler has counted no worker for
-    ``timeout`` s (Dask's ``as_completed`` has a deadline for the whole iteration instead)."""
+    """Futures as they complete (more may be added meanwhile) and their results, raising
+    ``NoWorkers`` once the cluster has had no worker for ``timeout`` s (Dask's
+    ``as_completed`` has a deadline for the whole iteration instead)."""
 
     def __init__(self, client, timeout: float):
         self.client, self.timeout = client, timeout
@@ -181,8 +169,8 @@ class Completions:
             yield future
 
     def result(self, future) -> Any:
-        """``future.result()``, checking the cluster while it waits (a result is fetched from
-        its worker, and computed again if that worker has just died)."""
+        """``future.result()``, checking the cluster while it waits (a result lost with its
+        worker is computed again)."""
         from dask.distributed import TimeoutError
 
         while True:
@@ -194,8 +182,6 @@ class Completions:
                 self.check()
 
     def check(self) -> None:
-        """``NoWorkers`` if there has been no worker for ``timeout`` s (asked after each wait
-        of ``interval`` s for a future)."""
         now = time.monotonic()
         try:
             workers = len(self.client.nthreads())
@@ -216,8 +202,7 @@ def say(message: str) -> None:
 
 
 def worker_facts() -> dict[str, Any]:
-    """What the client checks of a worker before it sends work: its code, and why its FMU
-    cache is not safe to run FMUs from ("" if it is)."""
+    """A worker's code, and why its FMU cache is not safe to run FMUs from ("" if it is)."""
     try:
         fmu_cache()
         unsafe = ""
@@ -227,9 +212,8 @@ def worker_facts() -> dict[str, Any]:
 
 
 def check_workers(client) -> None:
-    """SweepError naming each worker that runs other code than this client, or whose FMU
-    cache is not private to its user; a warning for workers of more than one thread, or a
-    scheduler that queues more than one run per thread."""
+    """SweepError naming each worker that runs other code or whose FMU cache is not private;
+    a warning for workers of several threads, or a scheduler that queues runs."""
     mine = code_version()
     try:
         facts = client.run(worker_facts, on_error="return")
@@ -259,7 +243,6 @@ def check_workers(client) -> None:
 
 
 def has_dashboard(dask_scheduler=None) -> bool:
-    """Whether the scheduler serves its dashboard (which needs bokeh where it runs)."""
     return ("dashboard" in dask_scheduler.services
             and importlib.util.find_spec("bokeh") is not None)
 

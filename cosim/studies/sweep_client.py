@@ -1,6 +1,5 @@
 """A sweep's client side: runs submitted to a Dask cluster (on the batch backend in batches,
-``plan``), the workers checked and watched, and each row journaled as it completes: the
-``Journal`` a sweep resumes from."""
+``plan``) and each row journaled as it completes (the ``Journal`` a sweep resumes from)."""
 from __future__ import annotations
 
 import contextlib
@@ -19,22 +18,16 @@ from ..core.watchdog import Limits
 from ..ensemble import SIGNALS
 from .cluster import Completions, NoWorkers, check_workers, has_dashboard, say
 from .sweep_spec import Spec
-from .sweep_task import (BATCH, Job, SweepTeardown, batch_refusal, blank_row, fmu_bytes, noted,
-                         run_batch)
+from .sweep_task import BATCH, Job, SweepTeardown, batch_refusal, blank_row, noted, run_batch
 
-MAX_BATCH = 1024
-"""The most runs a batch gets unless told otherwise (``--batch-size``)."""
-BATCH_MEMORY = 128 << 20
-"""Bytes a batch's recorded signals may take on its worker."""
-MIN_BATCH = 32
-"""The fewest runs a batch is cut down to for keeping workers busy (``batch_counts``)."""
-WAVES_SHARE = 128
-"""The fewest runs a batch in waves is cut down to for giving every worker a share."""
+MAX_BATCH = 1024            # the most runs a batch gets unless --batch-size says
+BATCH_MEMORY = 128 << 20    # bytes a batch's recorded signals may take on its worker
+MIN_BATCH = 32              # the fewest runs a batch is cut down to for keeping workers busy
+WAVES_SHARE = 128           # the fewest a batch in waves is cut down to for sharing workers
 
 
 def read_rows(path: Path, quiet: bool = False) -> dict[str, dict]:
-    """The rows of a journal by run id (a later row for a run replaces an earlier); a line
-    that is not a whole row (a write cut short by a kill) is skipped, with a warning."""
+    """A journal's rows by run id, the last for each; a torn line is skipped, with a warning."""
     rows: dict[str, dict] = {}
     lines = path.read_text().splitlines() if path.exists() else []
     for number, line in enumerate(lines, 1):
@@ -49,8 +42,7 @@ def read_rows(path: Path, quiet: bool = False) -> dict[str, dict]:
 
 
 class Journal:
-    """A sweep's journal, opened by its one writer (who holds the folder's ``FolderLock``):
-    its rows, and ``add``, which appends a row and flushes it to the file."""
+    """A sweep's journal, opened by its one writer (who holds the folder's ``FolderLock``)."""
 
     def __init__(self, path: Path):
         self.path, self.rows = path, read_rows(path)
@@ -69,7 +61,7 @@ class Journal:
 
 
 def batch_limit(job: Job) -> int:
-    """The most runs a batch of ``job``'s system and stop time gets by default."""
+    """The most runs a batch of ``job``'s system and stop time gets by default (memory)."""
     system = job.bundle.system
     stop = system.stop_time if job.stop_time is None else job.stop_time
     rows = step_count(system.start_time, stop, system.step_size) + 1
@@ -77,11 +69,9 @@ def batch_limit(job: Job) -> int:
 
 
 def batch_counts(groups: list[list[Job]], workers: int, size: int | None = None) -> list[int]:
-    """How many batches each group (runs of one system and stop time) is cut into: with
-    ``size``, batches of at most ``size``; by default as few as ``batch_limit`` allows, in
-    waves one per worker where they keep ``WAVES_SHARE`` runs; then, while there are fewer
-    batches than ``workers``, the group of the largest batches gets one more, as long as
-    they keep ``MIN_BATCH`` runs (why: docs/sweeps.md, the batch backend)."""
+    """How many batches each group (runs of one system and stop time) is cut into: of at most
+    ``size``, or by the rule of docs/sweeps.md (the batch backend): as few as ``batch_limit``
+    allows, in waves one per worker, then one more for the largest while under ``workers``."""
     if size:
         return [math.ceil(len(group) / size) for group in groups]
     counts = [math.ceil(len(group) / batch_limit(group[0])) for group in groups]
@@ -96,26 +86,24 @@ def batch_counts(groups: list[list[Job]], workers: int, size: int | None = None)
 
 
 def _in_waves(job: Job) -> bool:
-    """Whether ``job``'s ship sails in waves (ship.Hs > 0, as set or as its system binds it)."""
     ship = job.bundle.system.parameters(job.overrides).get("ship", {})
     return float(ship.get("Hs", 0.0)) > 0.0
 
 
 def _cut(jobs: list[Job], count: int) -> list[list[Job]]:
-    """``jobs`` in ``count`` batches of near-equal size, in their order."""
     cuts = [round(k * len(jobs) / count) for k in range(count + 1)]
     return [jobs[a:b] for a, b in zip(cuts, cuts[1:])]
 
 
 def plan(spec: Spec, jobs: list[Job], workers: int, size: int | None = None
          ) -> tuple[list[list[Job]], list[Job]]:
-    """(the batches, the runs to run alone) of a sweep on the batch backend: each system's
-    runs of one stop time cut as ``batch_counts`` says, those the kernel does not cover
-    (``Spec.batch_coverage``) alone."""
+    """(the batches, the runs to run alone: those the kernel does not cover) on the batch
+    backend, each system's runs of one stop time cut as ``batch_counts`` says."""
     groups: dict[tuple[str, float | None], list[Job]] = {}
     alone = []
+    covered = spec.batch_coverage()
     for job in jobs:
-        if spec.batch_coverage()[job.run["controller"]] is None:
+        if covered[job.run["controller"]] is None:
             groups.setdefault((job.bundle.digest, job.stop_time), []).append(job)
         else:
             alone.append(job)
@@ -127,9 +115,8 @@ def plan(spec: Spec, jobs: list[Job], workers: int, size: int | None = None
 def run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, progress: bool,
                    task, backend: str, no_worker_timeout: float, limits: Limits,
                    batch_task=run_batch, batch_size: int | None = None) -> None:
-    """Run ``todo`` (runs of ``spec``) on the cluster of ``connection`` (a client, and the
-    local cluster it made or None): check the workers, send the FMUs and the runs, journal
-    each row as it completes; close both on every path (``_close``)."""
+    """Run ``todo`` on the cluster of ``connection`` (a client, and the local cluster it made
+    or None), journaling each row as it completes; close both on every path."""
     from tqdm import tqdm
 
     client, cluster = connection
@@ -143,7 +130,7 @@ def run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, p
         # Each FMU as a task holding its bytes, not scattered data: a task's result lost with
         # its worker is computed again, scattered data is gone, and every run with it. Keyed
         # by sweep: another sweep's release of a shared key would strand this one's runs.
-        shipped = {sha: client.submit(fmu_bytes, path.read_bytes(), key=f"fmu-{token}-{sha}",
+        shipped = {sha: client.submit(bytes, path.read_bytes(), key=f"fmu-{token}-{sha}",
                                       pure=False)
                    for sha, path in spec.files().items()}
         completions = Completions(client, no_worker_timeout)
@@ -197,7 +184,6 @@ def run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, p
 
 
 def _say_batch_refusals(client) -> None:
-    """A note for each reason workers give to refuse the batch route, naming them."""
     try:
         refusals = client.run(batch_refusal, on_error="return")
     except Exception:                       # a worker gone: its runs' rows will say
@@ -214,10 +200,8 @@ def _say_batch_refusals(client) -> None:
 
 def _close(client, cluster, teardown: SweepTeardown, journal: Journal,
            stopped: BaseException | None = None) -> None:
-    """Close the client, and the local cluster it made (closing its workers frees
-    everything); on a shared cluster, free this sweep's FMUs on the workers first. After
-    the sweep ``stopped`` early, quietly (``campaign.execute`` says the rest); after Ctrl-C
-    or SIGTERM a second signal ends the process at once (``StopSignals``)."""
+    """Close the client and the local cluster it made, or on a shared cluster free this
+    sweep's FMUs; quietly after the sweep ``stopped``, a second signal ending it at once."""
     level = logging.root.manager.disable         # distributed's loggers set their own levels
     logging.disable(logging.CRITICAL if stopped is not None else level)
     try:

@@ -1,9 +1,6 @@
 """A sweep's spec: its controllers, axes and runs (the file: ``spec_file``, docs/sweeps.md).
-
-A run is one controller at one combination of axis values; its id hashes everything that
-determines its result (``Spec.runs``). Combinations that differ only in settings that change
-nothing (``CALM_WATER_INERT`` in calm water) have one result, run once (``shared_runs``).
-"""
+A run's id hashes everything that determines its result; combinations that differ only in
+what changes nothing (``CALM_WATER_INERT`` in calm water) run once (``shared_runs``)."""
 from __future__ import annotations
 
 import hashlib
@@ -28,11 +25,10 @@ from .bundle import Bundle, bundle
 from .spec_file import MAX_RUNS, assignments, check_values, parse
 from .sweep_task import Job
 
-SHIP_SLAVE = "ship_fmu.ship_slave"
-"""The module of this project's ship FMU (its manifest's slave module)."""
+SHIP_SLAVE = "ship_fmu.ship_slave"        # this project's ship FMU (its manifest's module)
+# The ship's parameters that change no bit of a run in calm water (Hs = 0: no wave loads,
+# ship_fmu.vessel.Vessel; tests/test_sweep_replay.py), for this checkout's ship FMU.
 CALM_WATER_INERT = ("T0", "psi_w", "wave_seed", "wave_components")
-"""The ship's parameters that change no bit of a run in calm water (Hs = 0: no wave loads,
-``ship_fmu.vessel.Vessel``; tests/test_sweep_replay.py), for this checkout's ship FMU."""
 REPLAY = ("python", "-m", "cosim.run")
 
 
@@ -48,8 +44,8 @@ class Spec:
 
     @classmethod
     def read(cls, path: str | Path, max_runs: int = MAX_RUNS) -> Spec:
-        """Parse and check a sweep file (``spec_file``); ValueError naming the file, the key
-        and the problem (FmuNotFound or FmuUnreadable for a missing or broken FMU)."""
+        """A sweep file parsed and checked; ValueError naming the file, the key and the
+        problem (FmuNotFound or FmuUnreadable for a missing or broken FMU)."""
         path = Path(path)
         spec = cls(**parse(path, max_runs))
         try:
@@ -61,7 +57,6 @@ class Spec:
 
     @cached_property
     def _shipped(self) -> dict[str, tuple[Bundle, dict[str, Path], SystemDescription]]:
-        """Each controller's bundle, its FMUs by SHA-256 and its system here (read once)."""
         return {name: bundle(controller) for name, controller in self.controllers.items()}
 
     def bundles(self) -> dict[str, Bundle]:
@@ -75,7 +70,6 @@ class Spec:
 
     @cached_property
     def _fmus(self) -> dict[tuple[str, str], tuple[Path, Any, dict[str, Declaration]]]:
-        """Each (controller, component): its FMU, model description and declarations."""
         fmus = {}
         for controller, shipped in self.bundles().items():
             for name, component in shipped.system.components.items():
@@ -86,13 +80,11 @@ class Spec:
 
     def declared(self, controller: str, component: str
                  ) -> tuple[Path | None, dict[str, Declaration]]:
-        """A component's FMU in a controller's system and its variables' declarations
-        ((None, {}) where the system has no such component)."""
+        """A component's FMU and its variables' declarations; (None, {}) for no component."""
         fmu, _, variables = self._fmus.get((controller, component), (None, None, {}))
         return fmu, variables
 
     def _variable(self, controller: str, target: str):
-        """The model variable ``target`` (component.variable) of a controller's system."""
         component, _, name = target.partition(".")
         description = self._fmus[controller, component][1]
         return next(v for v in description.modelVariables if v.name == name)
@@ -110,8 +102,8 @@ class Spec:
         return runs
 
     def shared_runs(self) -> list[list[dict[str, Any]]]:
-        """The runs (in ``runs``' order) grouped by result: runs of one controller whose
-        settings differ only in ``CALM_WATER_INERT`` in calm water. Each group runs once."""
+        """The runs grouped by result (each group runs once): of one controller, differing
+        only in ``CALM_WATER_INERT`` in calm water."""
         groups: dict[str, list[dict[str, Any]]] = {}
         for run in self.runs():
             overrides = self.settings(run)[1]
@@ -126,8 +118,7 @@ class Spec:
 
     @cached_property
     def _ships(self) -> dict[str, dict[str, Any]]:
-        """Each controller's components that are this checkout's ship FMU, with the Hs their
-        system binds or their FMU declares."""
+        """Each controller's components that are our ship FMU: the Hs they start with."""
         ships: dict[str, dict[str, Any]] = {controller: {} for controller in self.controllers}
         for (controller, name), (fmu, _, _) in self._fmus.items():
             manifest = read_manifest(fmu)
@@ -139,7 +130,6 @@ class Spec:
         return ships
 
     def _calm_ships(self, controller: str, overrides: dict[str, dict[str, Any]]) -> list[str]:
-        """The components of a run that are this checkout's ship FMU with Hs = 0."""
         return [name for name, Hs in self._ships[controller].items()
                 if float(overrides.get(name, {}).get("Hs", Hs)) == 0.0]
 
@@ -150,15 +140,13 @@ class Spec:
             if len(group) > 1:
                 varying = tuple(a for a in self.axes
                                 if len({json.dumps(r[a]) for r in group}) > 1)
-                counts = savings.setdefault((self._calm_because(group[0]), varying), [0, 0])
-                counts[0] += 1
-                counts[1] += len(group)
+                savings.setdefault((self._calm_because(group[0]), varying), []).append(len(group))
         notes = []
-        for (why, varying), (runs, combinations) in savings.items():
+        for (why, varying), sizes in savings.items():
             axes = (f"the {varying[0]} axis does" if len(varying) == 1 else
                     f"the {', '.join(varying[:-1])} and {varying[-1]} axes do")
-            notes.append(f"{why} is calm water (Hs = 0): {axes} not apply there; "
-                         f"{runs} run{'s' if runs > 1 else ''} instead of {combinations}")
+            notes.append(f"{why} is calm water (Hs = 0): {axes} not apply there; {len(sizes)} "
+                         f"run{'s' if len(sizes) > 1 else ''} instead of {sum(sizes)}")
         return notes
 
     def _calm_because(self, run: dict[str, Any]) -> str:
@@ -171,8 +159,7 @@ class Spec:
         return f"controller {controller!r} ({self.bundles()[controller].system.name})"
 
     def replay(self, run: dict[str, Any]) -> str:
-        """The ``cosim.run`` command that reproduces ``run``'s row bit for bit (each setting
-        as ``--set``, as text that reads back as exactly its value)."""
+        """The ``cosim.run`` command that reproduces ``run``'s row bit for bit."""
         controller = self.controllers[run["controller"]]
         scenario, overrides = self.settings(run)
         words = [*REPLAY, scenario]
@@ -201,8 +188,7 @@ class Spec:
 
     def job(self, run: dict[str, Any], sweep: str, backend: str = "fmi",
             limits: Limits = Limits()) -> Job:
-        """What a worker needs for ``run`` (of the sweep with token ``sweep``), recording
-        its track if [plots] tracks selects it."""
+        """What a worker needs for ``run`` of the sweep whose token is ``sweep``."""
         track = self.tracks is not None and all(run.get(k) == v for k, v in self.tracks.items())
         return Job(sweep=sweep, run=run, bundle=self.bundles()[run["controller"]],
                    overrides=self.settings(run)[1], stop_time=self.stop_time, track=track,
@@ -248,14 +234,12 @@ class Spec:
 
 
 def _digest(identity: dict[str, Any]) -> str:
-    """A short hash of a JSON-able identity."""
     key = json.dumps(identity, sort_keys=True, default=str)
     return hashlib.sha256(key.encode()).hexdigest()[:16]
 
 
 def _exact(value: Any) -> str:
-    """A setting as ``--set`` text that reads back as exactly the value: a float's repr
-    (the shortest text of that double), true or false for a Boolean."""
+    """A setting as ``--set`` text that reads back as exactly the value."""
     if isinstance(value, bool):
         return "true" if value else "false"
     return repr(value) if isinstance(value, float) else str(value)

@@ -1,11 +1,6 @@
-"""A sweep's tasks, on a worker: one whole co-simulation from a ``Job`` and the FMUs' bytes
-(``run_one``), or the runs of one system as one array program (``run_batch``); the same row
-(``result_row``) either way, but for ``backend``, ``seconds`` and ``sim_seconds``.
-
-A worker keeps one master per sweep, thread, system and backend, reset between tasks. The
-sweep's ``SweepTeardown`` frees the idle ones and stops its runs under way at their next
-step, which then free their own: freed under a run, its FMUs would fail it, loudly.
-"""
+"""A sweep's tasks on a worker: one co-simulation (``run_one``) or a batch of one system's runs
+(``run_batch``), the same row either way. A worker keeps a master per sweep, thread, system and
+backend; ``SweepTeardown`` frees the idle ones and stops the busy at their next step."""
 from __future__ import annotations
 
 import math
@@ -22,8 +17,7 @@ from ..provenance import code_version
 from .bundle import Bundle, materialise
 from .merit import METRICS, run_metrics, track
 
-BATCH = "batch"
-"""The sweep backend that runs the runs of one system as batches (``run_batch``)."""
+BATCH = "batch"                         # the sweep backend of ``run_batch``
 SWEEP_BACKENDS = (*RUN_BACKENDS, BATCH)
 
 
@@ -53,8 +47,7 @@ def _key(job: Job) -> Key:
 
 
 def _take(job: Job, blobs: dict[str, bytes], watchdog: Watchdog):
-    """This thread's idle master of ``job``'s system, reset, or a new one, for a run that
-    ``watchdog`` watches; ``_give_back`` it."""
+    """This thread's idle master of ``job``'s system, reset, or a new one; ``_give_back`` it."""
     from ..core.master import Master
 
     with _lock:
@@ -73,8 +66,7 @@ def _take(job: Job, blobs: dict[str, bytes], watchdog: Watchdog):
 
 
 def _give_back(job: Job, master, healthy: bool) -> None:
-    """Keep ``master`` for the sweep's next task; free it after a failure (its FMUs may be in
-    an error state) or once the sweep has ended."""
+    """Keep ``master`` for the sweep's next task; free it after a failure or the sweep's end."""
     with _lock:
         _busy.pop(_key(job), None)
         keep = master is not None and healthy and job.sweep not in _ended
@@ -86,7 +78,7 @@ def _give_back(job: Job, master, healthy: bool) -> None:
 
 def free_masters(sweep: str | None = None) -> None:
     """Free this process's idle masters: of one sweep, which has ended (its runs under way
-    stop at their next step and free their own), or all."""
+    stop at their next step and free their own: freed under a run, its FMUs would fail it)."""
     with _lock:
         if sweep is not None:
             _ended.add(sweep)
@@ -108,8 +100,8 @@ class SweepTeardown(WorkerPlugin):
 
 
 def ran_on(kinds: dict[str, str] | None, asked: str) -> str:
-    """How a run's components ran (``Master.backends``): "fmi" or "inprocess" if all alike,
-    else each other named ("inprocess; autopilot: fmi"); ``asked`` without a master."""
+    """How a run's components ran: "fmi" or "inprocess" if all alike, else each other named
+    ("inprocess; autopilot: fmi"); ``asked`` without a master."""
     if not kinds:
         return asked
     if len(set(kinds.values())) == 1:
@@ -118,26 +110,20 @@ def ran_on(kinds: dict[str, str] | None, asked: str) -> str:
                                if kind != asked)])
 
 
-def fmu_bytes(data: bytes) -> bytes:
-    """An FMU's file as a task's result (a lost worker's copy is computed again)."""
-    return data
-
-
 def blank_row(run: dict[str, Any], error: str = "") -> dict[str, Any]:
-    """A result row for ``run``: failed with ``error`` if given, metrics still undefined."""
+    """A row for ``run``: failed with ``error`` if given, metrics NaN."""
     return {**run, "status": "failed" if error else "ok", "error": error,
             **{m: math.nan for m in METRICS}, "seconds": math.nan, "sim_seconds": math.nan}
 
 
 def _other_code(job: Job) -> dict[str, Any]:
-    """The failed row of a run sent by a client that runs other code than this worker."""
     return blank_row(job.run, f"worker runs {code_version()}, the client {job.code}: "
                               "install the client's version on every worker")
 
 
 def run_one(job: Job, blobs: dict[str, bytes]) -> dict[str, Any]:
-    """One whole co-simulation's row; a failed run (past its time limits too) is recorded,
-    never raised. ``seconds``: the task's wall time, ``sim_seconds``: the run's alone."""
+    """One co-simulation's row, failed (past its time limits too) rather than raised;
+    ``seconds``: the task's wall time, ``sim_seconds``: the run's alone."""
     started = time.perf_counter()
     if job.code != code_version():          # a worker that joined after the client's check
         return _other_code(job)
@@ -165,8 +151,7 @@ def run_one(job: Job, blobs: dict[str, bytes]) -> dict[str, Any]:
 
 
 def result_row(job: Job, recording) -> dict[str, Any]:
-    """The row of ``job``'s run from its recording, whichever route made it (the times and
-    the backend are the caller's to fill in)."""
+    """The row of ``job``'s run from its recording, but its times and backend."""
     if recording.error:
         return blank_row(job.run, recording.error)
     row = {**blank_row(job.run), **run_metrics(recording)}
@@ -176,8 +161,7 @@ def result_row(job: Job, recording) -> dict[str, Any]:
 
 
 def batch_refusal() -> str | None:
-    """Why this worker's numpy would not give the in-process route's bits on the batch
-    route (``cosim.ensemble.selftest``), None if it would."""
+    """Why this worker's numpy would not give the in-process bits in a batch, or None."""
     from ..ensemble import selftest
 
     try:
@@ -193,13 +177,10 @@ def batch_limits(limits: Limits, members: int) -> Limits:
 
 
 def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
-    """The rows of ``jobs`` (in-process runs of one system and stop time), in their order,
-    computed together by ``cosim.ensemble.simulate_members``; never raises for a failed run.
-
-    A row is ``run_one``'s but for ``backend``, ``seconds`` and ``sim_seconds`` (the run's
-    share). A run ``Master.configure`` refuses is left to ``run_one``; so is every run,
-    saying why in its backend, where ``batch_refusal`` refuses or the batch fails as a
-    whole (an exception, or past ``batch_limits``)."""
+    """The rows of ``jobs`` (of one system and stop time), ``run_one``'s but for ``backend``,
+    ``seconds`` and ``sim_seconds`` (the run's share), computed together. A run refused or
+    failed in the batch, or every run where the batch route is refused or fails as a whole,
+    is left to ``run_one``, its backend saying why."""
     from ..ensemble import simulate_members
 
     started = time.perf_counter()
@@ -240,7 +221,6 @@ def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
 
 
 def _configures(master, job: Job) -> bool:
-    """Whether ``Master.configure`` takes ``job``'s settings (``run_one`` records why not)."""
     try:
         master.configure(job.overrides)
     except Exception:
@@ -249,13 +229,12 @@ def _configures(master, job: Job) -> bool:
 
 
 def noted(row: dict[str, Any], why: str) -> dict[str, Any]:
-    """``row`` with ``why`` its run did not run in a batch added to its backend."""
+    """``row`` with why its run did not run in a batch added to its backend."""
     return {**row, "backend": f"{row.get('backend', 'inprocess')} (not in a batch: {why})"}
 
 
 def member_backend(meta: dict[str, Any]) -> str:
-    """A batch member's backend column: "batch", or how it ran alone and why (the kernel's
-    notes)."""
+    """A batch member's backend column: "batch", or how it ran alone and why."""
     if meta.get("backend") == BATCH:
         return BATCH
     ran = ran_on(meta.get("backends"), meta.get("backend", "inprocess"))
