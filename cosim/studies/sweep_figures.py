@@ -20,15 +20,13 @@ from ..analysis.figures import save
 from ..analysis.seastate import model_scale
 from ..analysis.track import waypoint_name
 from .merit import CRITERIA, Merit
-from .sweep_tables import distinct
+from .sweep_tables import distinct, select
 
 STATISTICS = ("box: median and IQR (25-75 %) of the runs, whiskers: min-max; the number "
-              "under each box: its median")
-"""What each box of ``distribution`` shows."""
+              "under each box: its median")         # what each box of ``distribution`` shows
 
 
 def _panels(count: int, width: float, height: float) -> tuple[Figure, list]:
-    """A figure of ``count`` panels of ``width`` x ``height`` inches, at most four a row."""
     columns = min(4, count)
     fig = Figure(figsize=(width * columns, height * math.ceil(count / columns)),
                  layout="constrained")
@@ -59,13 +57,12 @@ def distribution(spec, rows: list[dict], path: Path,
 
 def _boxes(ax, spec, ok: list[dict], criterion: Merit, sea: str | None,
            groups: list) -> None:
-    """One criterion's panel of ``distribution``."""
     positions, data, labels = [], [], []
     step = len(spec.controllers) + 1
     for g, group in enumerate(groups):
         for c, controller in enumerate(spec.controllers):
-            values = [r[criterion.column] for r in ok if r["controller"] == controller
-                      and (sea is None or r[sea] == group)]
+            values = [r[criterion.column]
+                      for r in select(ok, controller, {sea: group} if sea else {})]
             positions.append(g * step + c)
             data.append([v for v in values if np.isfinite(v)] or [np.nan])
             labels.append(f"{controller}\n{criterion.format(float(np.median(data[-1])))}")
@@ -113,7 +110,6 @@ def paired_figure(title: str, changes: dict[Merit, dict[str, np.ndarray]], basel
 
 def _paired_panel(ax, criterion: Merit, by_controller: dict[str, np.ndarray],
                   baseline: str) -> None:
-    """One criterion's panel of ``paired_figure``."""
     ratio = criterion.paired == "ratio"
     reference = 1.0 if ratio else 0.0
     values = np.concatenate([*by_controller.values(), np.array([])])
@@ -157,12 +153,11 @@ def ratio_map(spec, rows: list[dict], path: Path, numerator: str = "smc",
     x_axis, y_axis = spec.map_axes
     xs, ys = spec.axes[x_axis], spec.axes[y_axis]
 
-    def mean_J(controller: str, x, y) -> float:
-        J = [r["J"] for r in rows if r["status"] == "ok" and r["controller"] == controller
-             and r[x_axis] == x and r[y_axis] == y]
-        return np.mean(J) if J else np.nan
-    ratio = np.array([[mean_J(numerator, x, y) / mean_J(denominator, x, y) for x in xs]
-                      for y in ys])
+    ok = [r for r in rows if r["status"] == "ok"]
+    mean_J = {c: np.array([[np.mean([r["J"] for r in select(ok, c, {x_axis: x, y_axis: y})]
+                                    or [np.nan]) for x in xs] for y in ys])
+              for c in (numerator, denominator)}
+    ratio = mean_J[numerator] / mean_J[denominator]
     fig = Figure(figsize=(6.5, 4.5), layout="constrained")
     ax = fig.subplots()
     image = ax.imshow(np.log2(ratio), cmap="RdBu_r", vmin=-3, vmax=3, origin="lower",
@@ -216,8 +211,8 @@ def tracks(spec, rows: list[dict], path: Path) -> Path | None:
 
 
 def save_figures(spec, rows: list[dict], out: Path) -> list[Path]:
-    """A sweep's figures: J's distribution, the tracks, each controller's map against the
-    PD; the files written."""
+    """A sweep's figures (J's distribution, the tracks, each controller's map against the PD);
+    the files written."""
     written = [distribution(spec, rows, out / "J_distribution.png"),
                tracks(spec, rows, out / "tracks.png"),
                *(ratio_map(spec, rows, out / f"J_{c}_over_pd.png", c)

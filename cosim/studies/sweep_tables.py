@@ -1,7 +1,6 @@
 """A sweep's rows as tables: results.parquet, .csv and .json, summary.csv and the printed
 summary (each figure of merit per setting and controller, each run counted once), and
-comparison.md (every controller against the PD, seed by seed).
-"""
+comparison.md (every controller against the PD, seed by seed)."""
 from __future__ import annotations
 
 import itertools
@@ -16,14 +15,10 @@ from ..core.files import write_atomically
 from .merit import METRICS
 from .sweep_spec import Spec
 
-TIMES = {"seconds": "s", "sim_seconds": "s"}
-"""A row's wall-clock times: its task's, and its run's alone (in a batch: its share)."""
-MONTE_CARLO = "wave_seed"
-"""The axis the statistics are taken over, and that pairs runs (the same sea)."""
-STATISTICS = ("median", "q25", "q75", "min", "max")
-"""What summary.csv gives of each figure of merit over the runs of a setting."""
-MOST_PRINTED = 48
-"""The most lines of the printed summary's table: a larger sweep prints its axes one by one."""
+TIMES = {"seconds": "s", "sim_seconds": "s"}    # the task's wall time; the run's (or its share)
+MONTE_CARLO = "wave_seed"           # the axis statistics are taken over, that pairs runs
+STATISTICS = ("median", "q25", "q75", "min", "max")     # of each figure, in summary.csv
+MOST_PRINTED = 48                   # lines of the printed table, past which it pools axes
 
 
 def headed(name: str, unit: str) -> str:
@@ -67,8 +62,10 @@ def _settings(spec: Spec) -> tuple[list[str], list[dict[str, Any]]]:
                   for values in itertools.product(*(spec.axes[a] for a in axes))]
 
 
-def _in(row: dict, where: dict[str, Any]) -> bool:
-    return all(json.dumps(row[a]) == json.dumps(v) for a, v in where.items())
+def select(rows: list[dict], controller: str, where: dict[str, Any]) -> list[dict]:
+    """The rows of ``controller`` at the axis values ``where``."""
+    return [r for r in rows if r["controller"] == controller
+            and all(json.dumps(r[a]) == json.dumps(v) for a, v in where.items())]
 
 
 def _ran_as(row: dict) -> str:
@@ -81,7 +78,6 @@ def distinct(rows: list[dict]) -> list[dict]:
 
 
 def _statistics(values: np.ndarray) -> list[float]:
-    """``STATISTICS`` of ``values`` (NaN for none)."""
     if not values.size:
         return [math.nan] * len(STATISTICS)
     q25, median, q75 = np.percentile(values, [25, 50, 75])
@@ -96,7 +92,7 @@ def summary_table(spec: Spec, rows: list[dict]) -> list[list]:
               *(headed(f"{metric} {name}", unit) for metric, unit in METRICS.items()
                 for name in STATISTICS)]]
     for where, controller in itertools.product(settings, spec.controllers):
-        mine = distinct([r for r in rows if r["controller"] == controller and _in(r, where)])
+        mine = distinct(select(rows, controller, where))
         ok = [r for r in mine if r["status"] == "ok"]
         lines.append([*where.values(), controller, len(ok), len(mine) - len(ok), *(
             value for metric in METRICS for value in _statistics(
@@ -144,8 +140,7 @@ def _J_lines(spec: Spec, ok: list[dict]) -> list[str]:
     lines.append(f"  {label:<{wide}}  {'controller':<{named}}  runs    median  "
                  f"{'IQR':^19}  {'least - greatest':^19}".rstrip())
     for (name, where), controller in itertools.product(groups, spec.controllers):
-        J = np.array([r["J"] for r in ok if r["controller"] == controller and _in(r, where)],
-                     dtype=float)
+        J = np.array([r["J"] for r in select(ok, controller, where)], dtype=float)
         median, q25, q75, least, greatest = _statistics(J)
         lines.append(f"  {name:<{wide}}  {controller:<{named}}  {J.size:>4}  " + (
             f"{median:8.2f}  {q25:8.2f} - {q75:8.2f}  {least:8.2f} - {greatest:8.2f}"
@@ -154,9 +149,8 @@ def _J_lines(spec: Spec, ok: list[dict]) -> list[str]:
 
 
 def comparison(spec: Spec, rows: list[dict]) -> str:
-    """Markdown table: per setting of the axes but ``MONTE_CARLO``, each controller's median
-    J, its wins against the PD (a lower J on the same sea, each pair of runs counted once)
-    and the median J ratio."""
+    """Markdown table: per setting, each controller's median J, its wins against the PD (a
+    lower J on the same sea, each pair of runs counted once) and the median J ratio."""
     others = [c for c in spec.controllers if c != "pd"]
     axes, settings = _settings(spec)
     ok = {(r["controller"], *(json.dumps(r[a]) for a in spec.axes)): r
@@ -185,6 +179,5 @@ def comparison(spec: Spec, rows: list[dict]) -> str:
 
 
 def _median_J(found: list[dict | None]) -> str:
-    """The median J of the rows found (each run once), as a cell."""
     J = [r["J"] for r in distinct([r for r in found if r is not None])]
     return f"{np.median(J):.1f}" if J else "-"

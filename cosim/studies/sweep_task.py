@@ -142,19 +142,17 @@ def run_one(job: Job, blobs: dict[str, bytes]) -> dict[str, Any]:
     finally:
         _give_back(job, master, recording is not None and not recording.error)
     if recording is not None:
-        row = result_row(job, recording)
-        if not recording.error:
-            row["sim_seconds"] = sim_seconds
+        row = result_row(job, recording, sim_seconds)
     row["backend"] = ran_on(master and master.backends, job.backend)   # same results either way
     row["seconds"] = time.perf_counter() - started
     return row
 
 
-def result_row(job: Job, recording) -> dict[str, Any]:
-    """The row of ``job``'s run from its recording, but its times and backend."""
+def result_row(job: Job, recording, sim_seconds: float) -> dict[str, Any]:
+    """The row of ``job``'s run from its recording, but its backend and ``seconds``."""
     if recording.error:
         return blank_row(job.run, recording.error)
-    row = {**blank_row(job.run), **run_metrics(recording)}
+    row = {**blank_row(job.run), **run_metrics(recording), "sim_seconds": sim_seconds}
     if job.track:
         row["track"] = track(recording)
     return row
@@ -172,8 +170,8 @@ def batch_refusal() -> str | None:
 
 def batch_limits(limits: Limits, members: int) -> Limits:
     """A batch's time limits: each per-run limit times its ``members``."""
-    return Limits(None if limits.step is None else limits.step * members,
-                  None if limits.run is None else limits.run * members, limits.grace)
+    return Limits(*(None if limit is None else limit * members for limit in limits[:2]),
+                  limits.grace)
 
 
 def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
@@ -210,13 +208,9 @@ def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
         return [noted(run_one(job, blobs), f"the batch failed, {failed}; run alone")
                 for job in jobs]
     share = (time.perf_counter() - started) / max(1, len(members))
-    rows = {}
-    for job, recording in zip(members, recordings, strict=True):
-        row = result_row(job, recording)
-        if not recording.error:
-            row["sim_seconds"] = recording.meta["wall_time_s"]
-        rows[job.run["run_id"]] = {**row, "backend": member_backend(recording.meta),
-                                   "seconds": share}
+    rows = {job.run["run_id"]: {**result_row(job, recording, recording.meta.get("wall_time_s")),
+                                "backend": member_backend(recording.meta), "seconds": share}
+            for job, recording in zip(members, recordings, strict=True)}
     return [rows.get(job.run["run_id"]) or run_one(job, blobs) for job in jobs]
 
 
