@@ -71,20 +71,21 @@ def local_cluster(workers: int | None = None) -> LocalCluster:
     return cluster
 
 
-def local_workers(workers: int | None) -> tuple[int | None, str | None]:
-    """The worker processes of a local cluster for ``workers`` (None: one per core), and a
-    note where capped at the cores this process may use; ClusterError below one."""
+def local_workers(workers: int | None) -> int | None:
+    """The worker processes of a local cluster for ``workers`` (None: one per core), capped
+    with a note at the cores this process may use; ClusterError below one."""
     from dask.system import CPU_COUNT
 
     if workers is None:
-        return None, None
+        return None
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise ClusterError(f"--workers {workers!r}: a local cluster needs at least one worker")
-    if workers > CPU_COUNT:
-        return CPU_COUNT, (f"--workers {workers}: this machine gives this process "
-                           f"{CPU_COUNT} cores, and a run holds one core from start to end; "
-                           f"starting {CPU_COUNT} workers")
-    return workers, None
+    if workers <= CPU_COUNT:
+        return workers
+    print(f"note: --workers {workers}: this machine gives this process {CPU_COUNT} cores, and "
+          f"a run holds one core from start to end; starting {CPU_COUNT} workers",
+          file=sys.stderr)
+    return CPU_COUNT
 
 
 def scheduler_address(scheduler_file: str | Path) -> str:
@@ -120,10 +121,7 @@ def connect(scheduler: str | None = None, workers: int | None = None,
         address = scheduler or dask.config.get("scheduler-address", None)
         where = "--scheduler" if scheduler else "DASK_SCHEDULER_ADDRESS or Dask's config"
     if not address:
-        workers, note = local_workers(workers)
-        if note:
-            print(f"note: {note}", file=sys.stderr)
-        cluster = local_cluster(workers)
+        cluster = local_cluster(local_workers(workers))
         return Client(cluster), cluster
     if workers is not None:
         raise ClusterError("--workers sizes a local cluster; an existing scheduler's "
@@ -148,10 +146,8 @@ class Completions:
         self.client, self.timeout = client, timeout
         self.interval = max(0.05, min(1.0, timeout / 4))   # Dask fails a shorter wait
         self.done: queue.SimpleQueue = queue.SimpleQueue()
-        self.waiting = 0
-        self.seen = False                   # a worker was counted at least once
-        self.gone_since: float | None = None
-        self.gone_at = ""                   # when none was first counted, for the message
+        self.waiting, self.seen = 0, False          # seen: a worker was counted once
+        self.gone: tuple[float, str] | None = None  # since when none was counted
         self.check()
 
     def add(self, future) -> None:
@@ -182,19 +178,18 @@ class Completions:
                 self.check()
 
     def check(self) -> None:
-        now = time.monotonic()
         try:
             workers = len(self.client.nthreads())
         except OSError:                     # the scheduler cannot be reached: no worker either
             workers = 0
         if workers:
-            self.seen, self.gone_since = True, None
-        elif self.gone_since is None:
-            self.gone_since, self.gone_at = now, time.strftime("%Y-%m-%d %H:%M:%S")
-        elif now - self.gone_since >= self.timeout:
+            self.seen, self.gone = True, None
+        elif self.gone is None:
+            self.gone = time.monotonic(), time.strftime("%Y-%m-%d %H:%M:%S")
+        elif time.monotonic() - self.gone[0] >= self.timeout:
             since = "the last one left by" if self.seen else "none has joined since"
             raise NoWorkers(f"no worker in the cluster for {self.timeout:g} s ({since} "
-                            f"{self.gone_at}); the sweep stopped")
+                            f"{self.gone[1]}); the sweep stopped")
 
 
 def say(message: str) -> None:

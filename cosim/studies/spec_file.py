@@ -31,13 +31,10 @@ def _integer(value: Any) -> bool:
     return isinstance(value, int) and not isinstance(value, bool)
 
 
-def _seconds(value: Any) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and \
-        0 < value < math.inf
-
-
 # Each table's keys: the kind of value each takes (a type, or a test) and what to give.
-FILE_KEYS = {"name": (object, ""), "stop_time": (_seconds, "a number of seconds > 0"),
+FILE_KEYS = {"name": (object, ""),
+             "stop_time": (lambda t: (_integer(t) or isinstance(t, float)) and 0 < t < math.inf,
+                           "a number of seconds > 0"),
              "controllers": (dict, "a table"), "axes": (dict, "a table"),
              "plots": (dict, "a table")}
 PLOTS_KEYS = {"map": (list, "a list of axes"), "tracks": (dict, "a table of axis = value")}
