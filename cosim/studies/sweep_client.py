@@ -29,8 +29,7 @@ WAVES_SHARE = 128           # the fewest a batch in waves is cut down to for sha
 def read_rows(path: Path, quiet: bool = False) -> dict[str, dict]:
     """A journal's rows by run id, the last for each; a torn line is skipped, with a warning."""
     rows: dict[str, dict] = {}
-    lines = path.read_text().splitlines() if path.exists() else []
-    for number, line in enumerate(lines, 1):
+    for number, line in enumerate(path.read_text().splitlines() if path.exists() else [], 1):
         try:
             row = json.loads(line)
             rows[row["run_id"]] = row
@@ -90,11 +89,6 @@ def _in_waves(job: Job) -> bool:
     return float(ship.get("Hs", 0.0)) > 0.0
 
 
-def _cut(jobs: list[Job], count: int) -> list[list[Job]]:
-    cuts = [round(k * len(jobs) / count) for k in range(count + 1)]
-    return [jobs[a:b] for a, b in zip(cuts, cuts[1:])]
-
-
 def plan(spec: Spec, jobs: list[Job], workers: int, size: int | None = None
          ) -> tuple[list[list[Job]], list[Job]]:
     """(the batches, the runs to run alone: those the kernel does not cover) on the batch
@@ -107,9 +101,11 @@ def plan(spec: Spec, jobs: list[Job], workers: int, size: int | None = None
             groups.setdefault((job.bundle.digest, job.stop_time), []).append(job)
         else:
             alone.append(job)
-    counts = batch_counts(list(groups.values()), workers, size)
-    return [batch for group, count in zip(groups.values(), counts)
-            for batch in _cut(group, count)], alone
+    batches = []                                # each group in near-equal parts, in order
+    for group, count in zip(groups.values(), batch_counts(list(groups.values()), workers, size)):
+        cuts = [round(k * len(group) / count) for k in range(count + 1)]
+        batches += [group[a:b] for a, b in zip(cuts, cuts[1:])]
+    return batches, alone
 
 
 def run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, progress: bool,
@@ -203,19 +199,16 @@ def _close(client, cluster, teardown: SweepTeardown, journal: Journal,
     """Close the client and the local cluster it made, or on a shared cluster free this
     sweep's FMUs; quietly after the sweep ``stopped``, a second signal ending it at once."""
     level = logging.root.manager.disable         # distributed's loggers set their own levels
-    logging.disable(logging.CRITICAL if stopped is not None else level)
-    try:
-        with contextlib.ExitStack() as stack:
-            if isinstance(stopped, Interrupted):
-                again = stack.enter_context(StopSignals())
-                again.received = stopped.signal         # the next one is the second
-                again.keep(lambda: f"{journal.path} keeps every run done "
-                                   f"({len(journal.rows)})")
-            if cluster is None:
-                with contextlib.suppress(Exception):     # workers gone with Ctrl-C
-                    client.unregister_worker_plugin(teardown.name)
-            client.close()
-            if cluster is not None:
-                cluster.close()
-    finally:
-        logging.disable(level)
+    with contextlib.ExitStack() as stack:
+        stack.callback(logging.disable, level)
+        logging.disable(logging.CRITICAL if stopped is not None else level)
+        if isinstance(stopped, Interrupted):
+            again = stack.enter_context(StopSignals())
+            again.received = stopped.signal         # the next one is the second
+            again.keep(lambda: f"{journal.path} keeps every run done ({len(journal.rows)})")
+        if cluster is None:
+            with contextlib.suppress(Exception):     # workers gone with Ctrl-C
+                client.unregister_worker_plugin(teardown.name)
+        client.close()
+        if cluster is not None:
+            cluster.close()

@@ -69,13 +69,15 @@ class Spec:
                 for sha, path in files.items()}
 
     @cached_property
-    def _fmus(self) -> dict[tuple[str, str], tuple[Path, Any, dict[str, Declaration]]]:
+    def _fmus(self) -> dict[tuple[str, str], tuple[Path, dict[str, Any], dict[str, Declaration]]]:
+        """(controller, component): its FMU, model variables and their declarations."""
         fmus = {}
         for controller, shipped in self.bundles().items():
             for name, component in shipped.system.components.items():
                 fmu = self.files()[Path(component.source).stem]
                 description = read_description(fmu, name)
-                fmus[controller, name] = fmu, description, declarations(description)
+                fmus[controller, name] = (fmu, {v.name: v for v in description.modelVariables},
+                                          declarations(description))
         return fmus
 
     def declared(self, controller: str, component: str
@@ -83,11 +85,6 @@ class Spec:
         """A component's FMU and its variables' declarations; (None, {}) for no component."""
         fmu, _, variables = self._fmus.get((controller, component), (None, None, {}))
         return fmu, variables
-
-    def _variable(self, controller: str, target: str):
-        component, _, name = target.partition(".")
-        description = self._fmus[controller, component][1]
-        return next(v for v in description.modelVariables if v.name == name)
 
     def runs(self) -> list[dict[str, Any]]:
         """Every combination of controller and axis values, with its run id."""
@@ -106,12 +103,11 @@ class Spec:
         only in ``CALM_WATER_INERT`` in calm water."""
         groups: dict[str, list[dict[str, Any]]] = {}
         for run in self.runs():
-            overrides = self.settings(run)[1]
-            calm = self._calm_ships(run["controller"], overrides)
+            calm = self._calm_ships(run)
             effective = {component: {variable: value for variable, value in values.items()
                                      if component not in calm
                                      or variable not in CALM_WATER_INERT}
-                         for component, values in overrides.items()}
+                         for component, values in self.settings(run)[1].items()}
             key = _digest({"controller": run["controller"], "settings": effective})
             groups.setdefault(key, []).append(run)
         return list(groups.values())
@@ -120,17 +116,17 @@ class Spec:
     def _ships(self) -> dict[str, dict[str, Any]]:
         """Each controller's components that are our ship FMU: the Hs they start with."""
         ships: dict[str, dict[str, Any]] = {controller: {} for controller in self.controllers}
-        for (controller, name), (fmu, _, _) in self._fmus.items():
+        for (controller, name), (fmu, variables, _) in self._fmus.items():
             manifest = read_manifest(fmu)
             if (manifest is not None and manifest.slave_module == SHIP_SLAVE
                     and in_process_refusal(fmu) is None):
-                Hs = self.bundles()[controller].system.components[name].parameters.get("Hs")
-                ships[controller][name] = (self._variable(controller, f"{name}.Hs").start
-                                           if Hs is None else Hs)
+                bound = self.bundles()[controller].system.components[name].parameters
+                ships[controller][name] = bound.get("Hs", variables["Hs"].start)
         return ships
 
-    def _calm_ships(self, controller: str, overrides: dict[str, dict[str, Any]]) -> list[str]:
-        return [name for name, Hs in self._ships[controller].items()
+    def _calm_ships(self, run: dict[str, Any]) -> list[str]:
+        overrides = self.settings(run)[1]
+        return [name for name, Hs in self._ships[run["controller"]].items()
                 if float(overrides.get(name, {}).get("Hs", Hs)) == 0.0]
 
     def sharing_notes(self) -> list[str]:
@@ -151,11 +147,10 @@ class Spec:
 
     def _calm_because(self, run: dict[str, Any]) -> str:
         """What makes a run's sea calm: the axis value that sets Hs = 0, else its system."""
-        controller = run["controller"]
-        ships = self._calm_ships(controller, self.settings(run)[1])
         for axis in self.axes:
-            if any(f"{ship}.Hs" in assignments(axis, run[axis]) for ship in ships):
+            if any(f"{ship}.Hs" in assignments(axis, run[axis]) for ship in self._calm_ships(run)):
                 return f"{axis} {run[axis]}"
+        controller = run["controller"]
         return f"controller {controller!r} ({self.bundles()[controller].system.name})"
 
     def replay(self, run: dict[str, Any]) -> str:
@@ -180,10 +175,11 @@ class Spec:
         controller = next(iter(self.controllers))
         units = {}
         for axis, values in self.axes.items():
-            targets = list(assignments(axis, values[0]))
-            variable = self._variable(controller, targets[0])
+            target, *others = assignments(axis, values[0])
+            component, _, name = target.partition(".")
+            variable = self._fmus[controller, component][1][name]
             declared = variable.declaredType.unit if variable.declaredType else ""
-            units[axis] = "" if len(targets) > 1 else variable.unit or declared or ""
+            units[axis] = "" if others else variable.unit or declared or ""
         return units
 
     def job(self, run: dict[str, Any], sweep: str, backend: str = "fmi",
