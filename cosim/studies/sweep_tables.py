@@ -19,6 +19,7 @@ TIMES = {"seconds": "s", "sim_seconds": "s"}    # the task's wall time; the run'
 MONTE_CARLO = "wave_seed"           # the axis statistics are taken over, that pairs runs
 STATISTICS = ("median", "q25", "q75", "min", "max")     # of each figure, in summary.csv
 MOST_PRINTED = 48                   # lines of the printed table, past which it pools axes
+SHOWN_FAILURES = 10                 # failed runs the summary names
 
 
 def headed(name: str, unit: str) -> str:
@@ -100,29 +101,12 @@ def summary_table(spec: Spec, rows: list[dict]) -> list[list]:
     return lines
 
 
-def summary(spec: Spec, rows: list[dict], shown_failures: int = 10) -> str:
-    """Runs ok and failed; J per setting and controller; each failed run with its message."""
+def summary(spec: Spec, rows: list[dict]) -> str:
+    """Runs ok and failed; J per setting and controller (past ``MOST_PRINTED`` lines per value
+    of each axis, pooled over the others); each failed run with its message."""
     runs = distinct(rows)
     ok = [r for r in runs if r["status"] == "ok"]
     shared = len(rows) - len(runs)
-    lines = [f"{spec.name}: " + (f"{len(rows)} combinations in {len(runs)} runs ({shared} "
-                                 "share an equivalent run's result)" if shared else
-                                 f"{len(rows)} runs")
-             + f", {len(ok)} ok, {len(runs) - len(ok)} failed", *_J_lines(spec, ok)]
-    failed = [r for r in runs if r["status"] != "ok"]
-    for r in failed[:shown_failures]:
-        axes = ", ".join(f"{a} = {r[a]}" for a in spec.axes)
-        said = [line.strip() for line in r["error"].splitlines()[:2]]   # the call, the FMU's words
-        lines.append(f"  failed {r['controller']} ({axes}): {' / '.join(said)[:300]}")
-    if len(failed) > shown_failures:
-        lines.append(f"  ... and {len(failed) - shown_failures} more failed runs (results.parquet "
-                     "has every message)")
-    return "\n".join(lines)
-
-
-def _J_lines(spec: Spec, ok: list[dict]) -> list[str]:
-    """The printed table of J over the distinct runs ``ok``: per setting and controller, or
-    past ``MOST_PRINTED`` lines per value of each axis, pooled over the others."""
     axes, settings = _settings(spec)
     groups = [(" ".join(str(v) for v in where.values()), where) for where in settings]
     pooled = len(groups) * len(spec.controllers) > MOST_PRINTED
@@ -131,21 +115,33 @@ def _J_lines(spec: Spec, ok: list[dict]) -> list[str]:
     per = "per value of each axis (pooled over the other axes)" if pooled else "per setting"
     over = f"over {MONTE_CARLO}; " if MONTE_CARLO in spec.axes else ""
     label = "setting" if pooled else " ".join(axes) or "all"
-    lines = [f"J of eq (19) [rad^2] {per} and controller: median, IQR (interquartile range, "
-             f"25th to 75th percentile), least and greatest of its runs ok ({over}a run shared "
-             "by several combinations counted once)"
-             + ("; summary.csv has every setting" if pooled else "")]
     wide = max(len(label), *(len(name) for name, _ in groups))
     named = max(len("controller"), *(len(c) for c in spec.controllers))
-    lines.append(f"  {label:<{wide}}  {'controller':<{named}}  runs    median  "
-                 f"{'IQR':^19}  {'least - greatest':^19}".rstrip())
+    lines = [f"{spec.name}: " + (f"{len(rows)} combinations in {len(runs)} runs ({shared} "
+                                 "share an equivalent run's result)" if shared else
+                                 f"{len(rows)} runs")
+             + f", {len(ok)} ok, {len(runs) - len(ok)} failed",
+             f"J of eq (19) [rad^2] {per} and controller: median, IQR (interquartile range, "
+             f"25th to 75th percentile), least and greatest of its runs ok ({over}a run shared "
+             "by several combinations counted once)"
+             + ("; summary.csv has every setting" if pooled else ""),
+             f"  {label:<{wide}}  {'controller':<{named}}  runs    median  "
+             f"{'IQR':^19}  {'least - greatest':^19}".rstrip()]
     for (name, where), controller in itertools.product(groups, spec.controllers):
         J = np.array([r["J"] for r in select(ok, controller, where)], dtype=float)
         median, q25, q75, least, greatest = _statistics(J)
         lines.append(f"  {name:<{wide}}  {controller:<{named}}  {J.size:>4}  " + (
             f"{median:8.2f}  {q25:8.2f} - {q75:8.2f}  {least:8.2f} - {greatest:8.2f}"
             if J.size else f"{'-':>8}"))
-    return lines
+    failed = [r for r in runs if r["status"] != "ok"]
+    for r in failed[:SHOWN_FAILURES]:
+        at = ", ".join(f"{a} = {r[a]}" for a in spec.axes)
+        said = [line.strip() for line in r["error"].splitlines()[:2]]   # the call, the FMU's words
+        lines.append(f"  failed {r['controller']} ({at}): {' / '.join(said)[:300]}")
+    if len(failed) > SHOWN_FAILURES:
+        lines.append(f"  ... and {len(failed) - SHOWN_FAILURES} more failed runs (results.parquet "
+                     "has every message)")
+    return "\n".join(lines)
 
 
 def comparison(spec: Spec, rows: list[dict]) -> str:
