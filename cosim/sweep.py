@@ -121,7 +121,13 @@ def main(argv: list[str] | None = None) -> int:
             print("no run succeeded: no figures drawn", file=sys.stderr)
         stage = "writing comparison.md"
         if "pd" in spec.controllers and len(spec.controllers) > 1:
-            table = _comparison(spec, rows)
+            pairs = (f"paired by {MONTE_CARLO} (the same sea)" if MONTE_CARLO in spec.axes
+                     else "one run each")
+            table = (f"# {spec.name}: each controller against pd\n\nJ of eq (19) in rad^2, lower "
+                     f"is better; per setting, the median over its runs and, {pairs}, the runs "
+                     "where the controller's J is lower than pd's and the median of their "
+                     "ratio. A run shared by several combinations (every seed in calm water) "
+                     "counts once.\n\n" + comparison(spec, rows) + "\n")
             written.append(write_atomically(out / "comparison.md",
                                             lambda path: path.write_text(table)))
     except (SweepError, ValueError) as error:
@@ -143,16 +149,6 @@ def main(argv: list[str] | None = None) -> int:
     print(summary(spec, rows))
     print(f"wrote {', '.join(str(p) for p in written)}")
     return 0 if all(r["status"] == "ok" for r in rows) else 1
-
-
-def _comparison(spec: Spec, rows: list[dict]) -> str:
-    pairs = f"paired by {MONTE_CARLO} (the same sea)" if MONTE_CARLO in spec.axes else \
-        "one run each"
-    return (f"# {spec.name}: each controller against pd\n\n"
-            f"J of eq (19) in rad^2, lower is better; per setting, the median over its "
-            f"runs and, {pairs}, the runs where the controller's J is lower than pd's and "
-            "the median of their ratio. A run shared by several combinations (every seed "
-            "in calm water) counts once.\n\n" + comparison(spec, rows) + "\n")
 
 
 def _stopped(stopped: Interrupted | NoWorkers, stage: str, spec: Spec, out: Path, csv: bool,

@@ -459,7 +459,7 @@ def test_ctrl_c_during_the_runs_prints_one_line_that_says_how_to_resume(fmu_path
 @pytest.mark.parametrize("step, stage", [
     ("write_tables", "writing the tables"),
     pytest.param("save_figures", "drawing the figures", marks=pytest.mark.long),
-    pytest.param("_comparison", "writing comparison.md", marks=pytest.mark.long)])
+    pytest.param("comparison", "writing comparison.md", marks=pytest.mark.long)])
 def test_ctrl_c_after_the_runs_says_they_are_kept_and_how_to_finish(fmu_paths, tmp_path, step,
                                                                    stage):
     """The stage is made to take the signal: it signals its own process, then waits."""
