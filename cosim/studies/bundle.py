@@ -18,8 +18,7 @@ from ..core.ssd import SystemDescription
 
 
 class UnsafeCache(RuntimeError):
-    """The FMU cache is not private to this user: whoever else may write it could put code in
-    the FMUs this worker runs."""
+    """The FMU cache is not private: whoever else may write it could change the FMUs run."""
 
 
 @dataclass(frozen=True)
@@ -70,8 +69,7 @@ def fmu_cache() -> Path:
 
 
 def materialise(shipped: Bundle, blobs: dict[str, bytes]) -> SystemDescription:
-    """The bundle's system with its FMUs in this machine's cache (a cached file that does not
-    match its hash written again, with a warning)."""
+    """The bundle's system, its FMUs in this machine's cache (a corrupt one written again)."""
     cache = fmu_cache()
     components = {}
     for name, component in shipped.system.components.items():

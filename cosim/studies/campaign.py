@@ -1,5 +1,4 @@
-"""A sweep run end to end: its runs not yet done on a Dask cluster, each row journaled, and
-the rows of every combination (docs/sweeps.md)."""
+"""A sweep run end to end, resumed from its journal (docs/sweeps.md)."""
 from __future__ import annotations
 
 import sys
@@ -21,10 +20,8 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
             backend: str = "fmi", no_worker_timeout: float = NO_WORKER_TIMEOUT,
             connect_timeout: float = CONNECT_TIMEOUT, limits: Limits = Limits(),
             batch_size: int | None = None, batch_task=None) -> list[dict]:
-    """Run every run of ``spec`` without an ok row in ``out``'s journal; every row of the sweep.
-    ``task(job, blobs)`` runs one run, ``batch_task(jobs, blobs)`` a batch. After
-    ``Interrupted`` or ``NoWorkers`` the same call resumes. SweepError if a worker runs other
-    code or another sweep writes ``out``; ClusterError (a ValueError) for no cluster."""
+    """Run every run of ``spec`` without an ok row in ``out``'s journal; every row. SweepError
+    if a worker runs other code or another sweep writes ``out``; ClusterError for no cluster."""
     if backend not in SWEEP_BACKENDS:
         raise ValueError(f"backend must be {', '.join(SWEEP_BACKENDS[:-1])} or "
                          f"{SWEEP_BACKENDS[-1]}, got {backend!r}")
@@ -53,8 +50,8 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
 
 
 def completed(spec: Spec, out: Path) -> list[dict]:
-    """A row for each combination whose result is in the journal, in ``spec.runs()``' order:
-    its group's result with its own axis values, run id, ``ran_as`` and ``command``."""
+    """A row for each combination whose result is in the journal: its group's result with its
+    own axis values, run id, ``ran_as`` and ``command``."""
     rows = read_rows(out / "runs.jsonl", quiet=True)
     found = {}
     for group in spec.shared_runs():

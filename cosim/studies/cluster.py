@@ -72,8 +72,7 @@ def local_cluster(workers: int | None = None) -> LocalCluster:
 
 
 def local_workers(workers: int | None) -> int | None:
-    """The worker processes of a local cluster for ``workers`` (None: one per core), capped
-    with a note at the cores this process may use; ClusterError below one."""
+    """``workers`` (None: one per core) capped, with a note, at the cores this process has."""
     from dask.system import CPU_COUNT
 
     if workers is None:
@@ -89,8 +88,7 @@ def local_workers(workers: int | None) -> int | None:
 
 
 def scheduler_address(scheduler_file: str | Path) -> str:
-    """The address in a scheduler file; ClusterError naming the file if it is missing,
-    unreadable or holds none (Dask's own client waits for ever for a missing one)."""
+    """The address in a scheduler file, or ClusterError (Dask's client waits for ever)."""
     path = Path(scheduler_file)
     if not path.exists():
         raise ClusterError(f"scheduler file {path} does not exist (has the scheduler "
@@ -108,9 +106,8 @@ def scheduler_address(scheduler_file: str | Path) -> str:
 def connect(scheduler: str | None = None, workers: int | None = None,
             scheduler_file: str | None = None, timeout: float = CONNECT_TIMEOUT
             ) -> tuple[Client, LocalCluster | None]:
-    """(a client, the local cluster or None): of a scheduler found as Dask's tools find it
-    and reached within ``timeout`` s, else of a new local cluster of ``workers``;
-    ClusterError naming the address or file where none is reached."""
+    """(a client, its local cluster or None): of a scheduler found as Dask's tools find it,
+    else of a new local cluster; ClusterError naming the address or file if none is reached."""
     import dask
 
     if scheduler and scheduler_file:
@@ -165,8 +162,7 @@ class Completions:
             yield future
 
     def result(self, future) -> Any:
-        """``future.result()``, checking the cluster while it waits (a result lost with its
-        worker is computed again)."""
+        """``future.result()``, checking the cluster while a lost result is computed again."""
         from dask.distributed import TimeoutError
 
         while True:

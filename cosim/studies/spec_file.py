@@ -1,5 +1,5 @@
-"""A sweep file read and checked (docs/sweeps.md): what would run something else than it says
-is refused before anything runs, naming the file, the key and the value."""
+"""A sweep file read and checked: what would run something else than it says is refused before
+anything runs, naming the file, the key and the value (docs/sweeps.md)."""
 from __future__ import annotations
 
 import math
@@ -69,8 +69,7 @@ def _table(path: Path, where: str, table: dict, keys: dict[str, tuple]) -> dict:
 
 
 def parse(path: Path, max_runs: int) -> dict[str, Any]:
-    """The fields of a ``Spec`` from its file, each checked but against the FMUs
-    (``check_values``); more than ``max_runs`` runs are refused before any is listed."""
+    """A ``Spec``'s fields from its file, checked but against the FMUs (``check_values``)."""
     try:
         data = tomllib.loads(read_small_text(path, 16 << 20))
     except ValueError as error:                 # TOMLDecodeError too
@@ -117,9 +116,8 @@ def parse(path: Path, max_runs: int) -> dict[str, Any]:
 
 
 def check_values(spec, path: Path) -> None:
-    """Every controller's system has the outputs of ``MEASURED``, every parameter the axes and
-    the controllers' ``set`` name exists and takes their values, and no axis repeats a value
-    as the FMU would receive it (1 and 1.0 of a Real are one)."""
+    """Each system has ``MEASURED``, each parameter set exists and takes its values, and no
+    axis repeats a value as the FMU would receive it (1 and 1.0 of a Real are one)."""
     for controller, shipped in spec.bundles().items():
         missing = [target for target in MEASURED
                    if getattr(_declaration(spec, controller, target), "causality", "") != "output"]
@@ -201,9 +199,8 @@ def _axis(path: Path, name: str, values: Any, max_runs: int) -> list:
 
 
 def controller_entry(entry: str | dict[str, Any], spec: Path, name: str) -> dict[str, Any]:
-    """A controller entry checked, its paths made absolute (relative to the spec file): a
-    scenario (a name or a .ssd path), an autopilot FMU (in waves_pd), or a table of
-    scenario, autopilot, map (autopilot port -> the FMU's name) and set."""
+    """A controller entry (a scenario, an autopilot FMU, or a table of scenario, autopilot, map
+    and set) checked, its paths made absolute (relative to the spec file)."""
     if isinstance(entry, str):
         entry = {"autopilot": entry} if entry.endswith(".fmu") else {"scenario": entry}
     where = f"controller {name!r}"

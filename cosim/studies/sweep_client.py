@@ -91,8 +91,7 @@ def _in_waves(job: Job) -> bool:
 
 def plan(spec: Spec, jobs: list[Job], workers: int, size: int | None = None
          ) -> tuple[list[list[Job]], list[Job]]:
-    """(the batches, the runs to run alone: those the kernel does not cover) on the batch
-    backend, each system's runs of one stop time cut as ``batch_counts`` says."""
+    """(the batches, the runs the kernel does not cover) on the batch backend."""
     groups: dict[tuple[str, float | None], list[Job]] = {}
     alone = []
     covered = spec.batch_coverage()
@@ -111,8 +110,8 @@ def plan(spec: Spec, jobs: list[Job], workers: int, size: int | None = None
 def run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, progress: bool,
                    task, backend: str, no_worker_timeout: float, limits: Limits,
                    batch_task=run_batch, batch_size: int | None = None) -> None:
-    """Run ``todo`` on the cluster of ``connection`` (a client, and the local cluster it made
-    or None), journaling each row as it completes; close both on every path."""
+    """Run ``todo`` on ``connection`` (a client, and its local cluster or None), journaling
+    each row as it completes."""
     from tqdm import tqdm
 
     client, cluster = connection

@@ -200,8 +200,7 @@ def tracks(spec, rows: list[dict], path: Path) -> Path | None:
 
 
 def save_figures(spec, rows: list[dict], out: Path) -> list[Path]:
-    """A sweep's figures (J's distribution, the tracks, each controller's map against the PD);
-    the files written."""
+    """A sweep's figures: J's distribution, the tracks, each controller's map against the PD."""
     written = [distribution(spec, rows, out / "J_distribution.png"),
                tracks(spec, rows, out / "tracks.png"),
                *(ratio_map(spec, rows, out / f"J_{c}_over_pd.png", c)

@@ -1,6 +1,5 @@
-"""A sweep's spec: its controllers, axes and runs (the file: ``spec_file``, docs/sweeps.md).
-A run's id hashes everything that determines its result; combinations that differ only in
-what changes nothing (``CALM_WATER_INERT`` in calm water) run once (``shared_runs``)."""
+"""A sweep's spec: its controllers, axes and runs (docs/sweeps.md). A run's id hashes all that
+determines its result; combinations that differ only in what changes nothing run once."""
 from __future__ import annotations
 
 import hashlib
@@ -44,8 +43,7 @@ class Spec:
 
     @classmethod
     def read(cls, path: str | Path, max_runs: int = MAX_RUNS) -> Spec:
-        """A sweep file parsed and checked; ValueError naming the file, the key and the
-        problem (FmuNotFound or FmuUnreadable for a missing or broken FMU)."""
+        """A sweep file parsed and checked; ValueError naming the file, key and problem."""
         path = Path(path)
         spec = cls(**parse(path, max_runs))
         try:
@@ -99,8 +97,7 @@ class Spec:
         return runs
 
     def shared_runs(self) -> list[list[dict[str, Any]]]:
-        """The runs grouped by result (each group runs once): of one controller, differing
-        only in ``CALM_WATER_INERT`` in calm water."""
+        """The runs grouped by result: differing only in ``CALM_WATER_INERT`` in calm water."""
         groups: dict[str, list[dict[str, Any]]] = {}
         for run in self.runs():
             calm = self._calm_ships(run)
@@ -191,8 +188,7 @@ class Spec:
                    code=code_version(), backend=backend, limits=limits)
 
     def backend_notes(self, backend: str) -> list[str]:
-        """Which components will run through FMI although ``backend`` is "inprocess" or
-        "batch", and on "batch" which controllers' runs run alone, and why."""
+        """What runs through FMI on "inprocess" or "batch", and alone on "batch", and why."""
         if backend not in ("inprocess", "batch"):
             return []
         notes = []

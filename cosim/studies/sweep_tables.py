@@ -1,6 +1,5 @@
 """A sweep's rows as tables: results.parquet, .csv and .json, summary.csv and the printed
-summary (each figure of merit per setting and controller, each run counted once), and
-comparison.md (every controller against the PD, seed by seed)."""
+summary (per setting and controller, each run counted once), and comparison.md's table."""
 from __future__ import annotations
 
 import itertools
@@ -86,7 +85,7 @@ def _statistics(values: np.ndarray) -> list[float]:
 
 
 def summary_table(spec: Spec, rows: list[dict]) -> list[list]:
-    """Header and lines of summary.csv: per setting (the axes but ``MONTE_CARLO``) and
+    """summary.csv's header and lines: per setting (the axes but ``MONTE_CARLO``) and
     controller, the runs ok and failed and each figure of merit's ``STATISTICS``."""
     axes, settings = _settings(spec)
     lines = [[*axes, "controller", "runs ok", "runs failed",

@@ -77,7 +77,7 @@ def _give_back(job: Job, master, healthy: bool) -> None:
 
 
 def free_masters(sweep: str | None = None) -> None:
-    """Free this process's idle masters: of one sweep, which has ended (its runs under way
+    """Free this process's idle masters, all or of a sweep that has ended (its runs under way
     stop at their next step and free their own: freed under a run, its FMUs would fail it)."""
     with _lock:
         if sweep is not None:
@@ -175,10 +175,8 @@ def batch_limits(limits: Limits, members: int) -> Limits:
 
 
 def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
-    """The rows of ``jobs`` (of one system and stop time), ``run_one``'s but for ``backend``,
-    ``seconds`` and ``sim_seconds`` (the run's share), computed together. A run refused or
-    failed in the batch, or every run where the batch route is refused or fails as a whole,
-    is left to ``run_one``, its backend saying why."""
+    """The rows of ``jobs`` (one system and stop time) computed together, ``run_one``'s but for
+    ``backend`` and the times; where the batch cannot give a run's row, ``run_one`` does."""
     from ..ensemble import simulate_members
 
     started = time.perf_counter()
