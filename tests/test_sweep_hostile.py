@@ -84,13 +84,15 @@ def spec_file(tmp_path: Path, text: str) -> Path:
     ("[axes]\npsi_w = [-inf]", "axis 'psi_w': ship.psi_w = -inf is not finite"),
     ('[axes]\nroute = ["0,0;10,0\\u0000"]', "axis 'route': guidance.waypoints = '0,0;10,0\\\\x00' "
                                              "holds a NUL character"),
-    ("[axes]\nwave_seed = [1.5]", "axis 'wave_seed' = 1.5: ship.wave_seed is an FMI Integer; "
-                                  "give an integer"),
-    ("[axes]\nwave_seed = [true]", "axis 'wave_seed' = True: ship.wave_seed is an FMI Integer"),
-    ('[axes]\nHs = ["0.01"]', "axis 'Hs' = '0.01': ship.Hs is an FMI Real; give a number"),
-    ("[axes]\nHs = [[0.01]]", "axis 'Hs' = \\[0.01\\]: ship.Hs is an FMI Real; give a number"),
-    ("[axes]\nroute = [1]", "axis 'route' = 1: guidance.waypoints is an FMI String; give a "
-                            "string"),
+    ("[axes]\nwave_seed = [1.5]", "axis 'wave_seed' = 1.5: give an integer \\(ship.wave_seed is "
+                                  "an FMI Integer\\)"),
+    ("[axes]\nwave_seed = [true]", "axis 'wave_seed' = True: give an integer \\(ship.wave_seed "
+                                   "is an FMI Integer\\)"),
+    ('[axes]\nHs = ["0.01"]', "axis 'Hs' = '0.01': give a number \\(ship.Hs is an FMI Real\\)"),
+    ("[axes]\nHs = [[0.01]]", "axis 'Hs' = \\[0.01\\]: give a number \\(ship.Hs is an FMI "
+                              "Real\\)"),
+    ("[axes]\nroute = [1]", "axis 'route' = 1: give a string \\(guidance.waypoints is an FMI "
+                            "String\\)"),
     ("[axes]\nsea_state = [true]", "axis 'sea_state' has True: give WMO codes"),
     ("[axes]\nsea_state = [2.0]", "axis 'sea_state' has 2.0: give WMO codes"),
     # what the systems do not have

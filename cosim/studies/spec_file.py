@@ -11,7 +11,7 @@ import tomllib
 from .. import scenarios
 from ..analysis.seastate import WMO, model_scale
 from ..core.files import plain_name, read_small_text
-from ..core.values import Declaration, checked
+from ..core.values import checked
 from ..scenarios.autopilot import check_autopilot
 
 DEFAULT_CONTROLLERS = {"pd": {"scenario": "waves_pd"}, "smc": {"scenario": "waves_smc"}}
@@ -19,28 +19,21 @@ SHORTHANDS = {"wave_seed": "ship.wave_seed", "Hs": "ship.Hs", "T0": "ship.T0",
               "psi_w": "ship.psi_w", "route": "guidance.waypoints"}   # axis -> what it sets
 SEA_STATE = ("ship.Hs", "ship.T0")      # the sea_state axis: a WMO code's, at model scale
 MAX_RUNS = 100_000                      # a sweep's most runs, unless --max-runs says
-# The TOML values a parameter of each FMI type takes: one kind per type, so that each axis
-# is one column of one type in the tables.
+MEASURED = ("guidance.psi_d", "guidance.wp_index", "ship.psi", "ship.delta", "ship.x", "ship.y")
+# The kinds of value a key takes (a bool only where they name bool) and what to give: the
+# keys of each table, and the TOML values of each FMI type (one kind per type, so that each
+# axis is one column of one type in the tables).
+FILE_KEYS = {"name": ((str,), "a plain file name"),
+             "stop_time": ((int, float), "a number of seconds > 0"),
+             "controllers": ((dict,), "a table"), "axes": ((dict,), "a table"),
+             "plots": ((dict,), "a table")}
+PLOTS_KEYS = {"map": ((list,), "a list of axes"), "tracks": ((dict,), "a table of axis = value")}
+CONTROLLER_KEYS = {"scenario": ((str,), "a string"), "autopilot": ((str,), "a string"),
+                   "map": ((dict,), "a table of autopilot port = the FMU's name for it"),
+                   "set": ((dict,), "a table of component.variable = value")}
 TOML_TYPES = {"Real": ((int, float), "a number"), "Integer": ((int,), "an integer"),
               "Enumeration": ((int, str), "an integer or an item's name"),
               "Boolean": ((bool,), "true or false"), "String": ((str,), "a string")}
-MEASURED = ("guidance.psi_d", "guidance.wp_index", "ship.psi", "ship.delta", "ship.x", "ship.y")
-
-
-def _integer(value: Any) -> bool:
-    return isinstance(value, int) and not isinstance(value, bool)
-
-
-# Each table's keys: the kind of value each takes (a type, or a test) and what to give.
-FILE_KEYS = {"name": (object, ""),
-             "stop_time": (lambda t: (_integer(t) or isinstance(t, float)) and 0 < t < math.inf,
-                           "a number of seconds > 0"),
-             "controllers": (dict, "a table"), "axes": (dict, "a table"),
-             "plots": (dict, "a table")}
-PLOTS_KEYS = {"map": (list, "a list of axes"), "tracks": (dict, "a table of axis = value")}
-CONTROLLER_KEYS = {"scenario": (str, "a string"), "autopilot": (str, "a string"),
-                   "map": (dict, "a table of autopilot port = the FMU's name for it"),
-                   "set": (dict, "a table of component.variable = value")}
 
 
 def assignments(axis: str, value: Any) -> dict[str, Any]:
@@ -50,9 +43,9 @@ def assignments(axis: str, value: Any) -> dict[str, Any]:
     return {SHORTHANDS.get(axis, axis): value}
 
 
-def _given(path: Path, key: str, value: Any, kind: type | Any, what: str) -> Any:
-    """``value``, if it is of ``kind``; else ValueError naming the file, key and value."""
-    if not (isinstance(value, kind) if isinstance(kind, type) else kind(value)):
+def _given(path: Path, key: str, value: Any, kinds: tuple[type, ...], what: str) -> Any:
+    """``value`` if it is of ``kinds``, else ValueError naming the file, the key and it."""
+    if not isinstance(value, kinds) or isinstance(value, bool) != (bool in kinds):
         raise ValueError(f"{path}: {key} = {value!r}: give {what}")
     return value
 
@@ -76,6 +69,9 @@ def parse(path: Path, max_runs: int) -> dict[str, Any]:
         raise ValueError(f"cannot read sweep spec {path}: {error}") from None
     _table(path, "", data, FILE_KEYS)
     name = plain_name(data.get("name", path.stem), f"{path}: name")
+    if not 0 < data.get("stop_time", 1) < math.inf:
+        raise ValueError(f"{path}: stop_time = {data['stop_time']!r}: give a number of "
+                         "seconds > 0")
     entries = data.get("controllers", DEFAULT_CONTROLLERS)
     if not entries:
         raise ValueError(f"{path}: [controllers] is empty; name at least one controller")
@@ -120,7 +116,7 @@ def check_values(spec, path: Path) -> None:
     axis repeats a value as the FMU would receive it (1 and 1.0 of a Real are one)."""
     for controller, shipped in spec.bundles().items():
         missing = [target for target in MEASURED
-                   if getattr(_declaration(spec, controller, target), "causality", "") != "output"]
+                   if getattr(_declared(spec, controller, target), "causality", "") != "output"]
         if missing:
             raise ValueError(f"{path}: controller {controller!r}: its system "
                              f"{shipped.system.name!r} has no output {', '.join(missing)}; "
@@ -143,14 +139,14 @@ def check_values(spec, path: Path) -> None:
                 seen[exact] = value
 
 
-def _declaration(spec, controller: str, target: str) -> Declaration | None:
+def _declared(spec, controller: str, target: str):
     component, _, variable = target.partition(".")
     return spec.declared(controller, component)[1].get(variable)
 
 
 def _received(spec, path: Path, controller: str, target: str, value: Any, key: str) -> Any:
     """``value`` exactly as the parameter ``target`` receives it (``cosim.core.values``)."""
-    declaration = _declaration(spec, controller, target)
+    declaration = _declared(spec, controller, target)
     component, _, variable = target.partition(".")
     if getattr(declaration, "causality", "") != "parameter":
         where = f"{path}: {key} sets {target}, but in controller {controller!r}"
@@ -162,9 +158,7 @@ def _received(spec, path: Path, controller: str, target: str, value: Any, key: s
                          "it has " + ", ".join(n for n, v in variables.items()
                                                if v.causality == "parameter"))
     kinds, what = TOML_TYPES.get(declaration.type, ((), "nothing"))
-    if not isinstance(value, kinds) or isinstance(value, bool) != (bool in kinds):
-        raise ValueError(f"{path}: {key} = {value!r}: {target} is an FMI "
-                         f"{declaration.type}; give {what}")
+    _given(path, key, value, kinds, f"{what} ({target} is an FMI {declaration.type})")
     try:
         return checked(component, declaration, value)
     except ValueError as error:
@@ -181,7 +175,8 @@ def _axis(path: Path, name: str, values: Any, max_runs: int) -> list:
                          f"{', '.join(['sea_state', *SHORTHANDS])} nor component.variable{hint}")
     if isinstance(values, dict):
         start, count = values.get("start"), values.get("count")
-        if set(values) != {"start", "count"} or not (_integer(start) and _integer(count)) \
+        if set(values) != {"start", "count"} or not all(
+                isinstance(v, int) and not isinstance(v, bool) for v in (start, count)) \
                 or count < 1:
             raise ValueError(f"{path}: axis {name!r} = {values!r}: a range is "
                              "{ start = <integer>, count = <integer >= 1> }")
@@ -192,7 +187,7 @@ def _axis(path: Path, name: str, values: Any, max_runs: int) -> list:
     if not isinstance(values, list) or not values:
         raise ValueError(f"{path}: axis {name!r} needs a non-empty list of values")
     for code in values if name == "sea_state" else ():
-        if not _integer(code) or code not in WMO:
+        if isinstance(code, bool) or not isinstance(code, int) or code not in WMO:
             raise ValueError(f"{path}: axis 'sea_state' has {code!r}: give WMO codes, "
                              "the integers 0-6")
     return values
@@ -204,11 +199,11 @@ def controller_entry(entry: str | dict[str, Any], spec: Path, name: str) -> dict
     if isinstance(entry, str):
         entry = {"autopilot": entry} if entry.endswith(".fmu") else {"scenario": entry}
     where = f"controller {name!r}"
-    _given(spec, where, entry, dict, "a scenario, an autopilot FMU, or a table of scenario, "
-                                     "autopilot, map and set")
+    _given(spec, where, entry, (dict,), "a scenario, an autopilot FMU, or a table of scenario, "
+                                        "autopilot, map and set")
     _table(spec, where, entry, CONTROLLER_KEYS)
     for port, renamed in entry.get("map", {}).items():
-        _given(spec, f"{where} map {port!r}", renamed, str, "the FMU's name of the port")
+        _given(spec, f"{where} map {port!r}", renamed, (str,), "the FMU's name of the port")
     for target, value in entry.get("set", {}).items():
         if "." not in target or isinstance(value, dict):
             raise ValueError(f"{spec}: {where} set {target!r} = {value!r}: give "
