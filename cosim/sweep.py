@@ -130,12 +130,9 @@ def main(argv: list[str] | None = None) -> int:
                      "counts once.\n\n" + comparison(spec, rows) + "\n")
             written.append(write_atomically(out / "comparison.md",
                                             lambda path: path.write_text(table)))
-    except (SweepError, ValueError) as error:
-        say_error(error)
-        return 2
-    except OSError as error:    # the journal's folder; or OutputError: names the file
-        say_error(error)
-        if stage != "running the sweep":
+    except (SweepError, ValueError, OSError) as error:  # OSError: the journal's folder, or
+        say_error(error)                                # OutputError, which names its file
+        if isinstance(error, OSError) and stage != "running the sweep":
             print(f"  every row is kept in {out / 'runs.jsonl'}; the same command writes the "
                   "tables and figures again", file=sys.stderr)
         return 2

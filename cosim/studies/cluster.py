@@ -11,10 +11,13 @@ import queue
 import signal
 import sys
 import time
+from multiprocessing import resource_tracker
 from pathlib import Path
 from typing import Any, Iterator
 
+import dask
 from dask.distributed import Client, LocalCluster
+from dask.system import CPU_COUNT
 
 from ..core.files import read_small_text
 from ..provenance import PACKAGE, code_version
@@ -42,9 +45,6 @@ def local_cluster(workers: int | None = None) -> LocalCluster:
     what failed), the dashboard on a free port; worker-saturation 1.0: a run that kills its
     worker takes no queued run with it. Made with SIGINT blocked, which its threads and
     workers inherit: a terminal's Ctrl-C stops the client alone."""
-    import dask
-    from multiprocessing import resource_tracker
-
     # Its resource tracker started first (starting it unblocks SIGINT), quiet (it would
     # only report semaphores leaked at a second Ctrl-C).
     sys.stderr.flush()
@@ -73,8 +73,6 @@ def local_cluster(workers: int | None = None) -> LocalCluster:
 
 def local_workers(workers: int | None) -> int | None:
     """``workers`` (None: one per core) capped, with a note, at the cores this process has."""
-    from dask.system import CPU_COUNT
-
     if workers is None:
         return None
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
@@ -108,8 +106,6 @@ def connect(scheduler: str | None = None, workers: int | None = None,
             ) -> tuple[Client, LocalCluster | None]:
     """(a client, its local cluster or None): of a scheduler found as Dask's tools find it,
     else of a new local cluster; ClusterError naming the address or file if none is reached."""
-    import dask
-
     if scheduler and scheduler_file:
         raise ClusterError("give the scheduler's address or its file, not both")
     if scheduler_file:
@@ -163,8 +159,6 @@ class Completions:
 
     def result(self, future) -> Any:
         """``future.result()``, checking the cluster while a lost result is computed again."""
-        from dask.distributed import TimeoutError
-
         while True:
             try:
                 return future.result(timeout=self.interval)
@@ -204,7 +198,8 @@ def worker_facts() -> dict[str, Any]:
 
 def check_workers(client) -> None:
     """SweepError naming each worker that runs other code or whose FMU cache is not private;
-    a warning for workers of several threads, or a scheduler that queues runs."""
+    the dashboard's address; a warning for workers of several threads, or a scheduler that
+    queues runs."""
     mine = code_version()
     try:
         facts = client.run(worker_facts, on_error="return")
@@ -221,22 +216,21 @@ def check_workers(client) -> None:
     if unsafe:
         raise SweepError("workers whose FMU cache is not safe to run FMUs from:\n"
                          + "\n".join(unsafe))
+    dashboard, saturation = client.run_on_scheduler(_scheduler)
+    if dashboard:
+        say(f"dashboard: {client.dashboard_link}")
     threaded = {a: n for a, n in client.nthreads().items() if n > 1}
     if threaded:
         say(f"warning: {', '.join(f'{a} has {n} threads' for a, n in threaded.items())}; a "
             "run holds the GIL from start to end, so threads of one worker take turns: start "
             "workers with --nthreads 1 and more processes (--nworkers)")
-    saturation = client.run_on_scheduler(_worker_saturation)
     if saturation != 1.0:
         say(f"warning: the scheduler's worker-saturation is {saturation}: it queues more than "
             "one run per worker thread, and a worker killed by one run takes the queued ones "
             "with it; start the scheduler with DASK_DISTRIBUTED__SCHEDULER__WORKER_SATURATION=1.0")
 
 
-def has_dashboard(dask_scheduler=None) -> bool:
-    return ("dashboard" in dask_scheduler.services
-            and importlib.util.find_spec("bokeh") is not None)
-
-
-def _worker_saturation(dask_scheduler=None) -> float:
-    return float(dask_scheduler.WORKER_SATURATION)
+def _scheduler(dask_scheduler=None) -> tuple[bool, float]:
+    """Whether the scheduler serves its dashboard (bokeh there), its worker-saturation."""
+    return ("dashboard" in dask_scheduler.services and importlib.util.find_spec("bokeh")
+            is not None, float(dask_scheduler.WORKER_SATURATION))

@@ -12,11 +12,12 @@ import uuid
 from pathlib import Path
 
 from fmukit.timebase import step_count
+from tqdm import tqdm
 
 from ..core.interrupt import Interrupted, StopSignals
 from ..core.watchdog import Limits
 from ..ensemble import SIGNALS
-from .cluster import Completions, NoWorkers, check_workers, has_dashboard, say
+from .cluster import Completions, NoWorkers, check_workers, say
 from .sweep_spec import Spec
 from .sweep_task import BATCH, Job, SweepTeardown, batch_refusal, blank_row, noted, run_batch
 
@@ -112,14 +113,10 @@ def run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, p
                    batch_task=run_batch, batch_size: int | None = None) -> None:
     """Run ``todo`` on ``connection`` (a client, and its local cluster or None), journaling
     each row as it completes."""
-    from tqdm import tqdm
-
     client, cluster = connection
     teardown = SweepTeardown(uuid.uuid4().hex[:12])
     token, tasks, shipped = teardown.sweep, {}, {}
     try:
-        if client.run_on_scheduler(has_dashboard):
-            say(f"dashboard: {client.dashboard_link}")
         check_workers(client)
         client.register_plugin(teardown)
         # Each FMU as a task holding its bytes, not scattered data: a task's result lost with

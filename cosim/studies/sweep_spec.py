@@ -19,6 +19,7 @@ from ..core.inprocess import fallback_note, in_process_refusal
 from ..core.ssd import SystemDescription
 from ..core.values import Declaration, declarations
 from ..core.watchdog import Limits
+from ..ensemble.members import coverage
 from ..provenance import code_version
 from .bundle import Bundle, bundle
 from .spec_file import MAX_RUNS, assignments, check_values, parse
@@ -205,8 +206,6 @@ class Spec:
 
     @cached_property
     def _coverage(self) -> dict[str, str | None]:
-        from ..ensemble.members import coverage
-
         return {name: coverage(system) for name, (_, _, system) in self._shipped.items()}
 
     def batch_coverage(self) -> dict[str, str | None]:

@@ -11,7 +11,8 @@ from typing import Any
 
 from distributed import WorkerPlugin
 
-from ..core.master import RUN_BACKENDS
+from .. import ensemble
+from ..core.master import RUN_BACKENDS, Master
 from ..core.watchdog import Limits, TimeLimit, Watchdog
 from ..provenance import code_version
 from .bundle import Bundle, materialise
@@ -48,8 +49,6 @@ def _key(job: Job) -> Key:
 
 def _take(job: Job, blobs: dict[str, bytes], watchdog: Watchdog):
     """This thread's idle master of ``job``'s system, reset, or a new one; ``_give_back`` it."""
-    from ..core.master import Master
-
     with _lock:
         if job.sweep in _ended:
             raise RuntimeError("the sweep has ended")
@@ -160,10 +159,8 @@ def result_row(job: Job, recording, sim_seconds: float) -> dict[str, Any]:
 
 def batch_refusal() -> str | None:
     """Why this worker's numpy would not give the in-process bits in a batch, or None."""
-    from ..ensemble import selftest
-
     try:
-        return selftest()
+        return ensemble.selftest()
     except Exception as error:          # a self-test that cannot run refuses the route
         return f"its self-test failed: {type(error).__name__}: {error}"
 
@@ -177,8 +174,6 @@ def batch_limits(limits: Limits, members: int) -> Limits:
 def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
     """The rows of ``jobs`` (one system and stop time) computed together, ``run_one``'s but for
     ``backend`` and the times; where the batch cannot give a run's row, ``run_one`` does."""
-    from ..ensemble import simulate_members
-
     started = time.perf_counter()
     if any(job.code != code_version() for job in jobs):
         return [_other_code(job) for job in jobs]
@@ -194,9 +189,9 @@ def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
             master = _take(jobs[0], blobs, watchdog)
             members = [job for job in jobs if _configures(master, job)]
             watchdog.beat(f"the batch of {len(members)} runs")
-            recordings = simulate_members(master.system, [job.overrides for job in members],
-                                          jobs[0].stop_time, beat=watchdog.beat
-                                          ) if members else []
+            recordings = ensemble.simulate_members(
+                master.system, [job.overrides for job in members], jobs[0].stop_time,
+                beat=watchdog.beat) if members else []
         failed = watchdog.expired
     except (Exception, TimeLimit) as error:
         failed = watchdog.expired or f"{type(error).__name__}: {error}"
