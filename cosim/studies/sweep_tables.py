@@ -68,13 +68,9 @@ def select(rows: list[dict], controller: str, where: dict[str, Any]) -> list[dic
             and all(json.dumps(r[a]) == json.dumps(v) for a, v in where.items())]
 
 
-def _ran_as(row: dict) -> str:
-    return row.get("ran_as", row["run_id"])
-
-
 def distinct(rows: list[dict]) -> list[dict]:
     """One row per run: a result shared by several combinations counts once."""
-    return list({_ran_as(r): r for r in rows}.values())
+    return list({r.get("ran_as", r["run_id"]): r for r in rows}.values())
 
 
 def _statistics(values: np.ndarray) -> list[float]:
@@ -162,8 +158,8 @@ def comparison(spec: Spec, rows: list[dict]) -> str:
         wins, ratios = [], []
         for controller in others:
             cells.append(_median_J(runs[controller]))
-            pairs = list({(_ran_as(a), _ran_as(b)): (a["J"], b["J"])
-                          for a, b in zip(runs[controller], runs["pd"])
+            pairs = list({(a.get("ran_as", a["run_id"]), b.get("ran_as", b["run_id"])):
+                          (a["J"], b["J"]) for a, b in zip(runs[controller], runs["pd"])
                           if a is not None and b is not None}.values())
             decided = [(J_c, J_b) for J_c, J_b in pairs if J_c != J_b]
             wins.append(f"{sum(J_c < J_b for J_c, J_b in decided)}/{len(decided)}")

@@ -3,6 +3,7 @@
 backend; ``SweepTeardown`` frees the idle ones and stops the busy at their next step."""
 from __future__ import annotations
 
+import contextlib
 import math
 import threading
 import time
@@ -115,17 +116,13 @@ def blank_row(run: dict[str, Any], error: str = "") -> dict[str, Any]:
             **{m: math.nan for m in METRICS}, "seconds": math.nan, "sim_seconds": math.nan}
 
 
-def _other_code(job: Job) -> dict[str, Any]:
-    return blank_row(job.run, f"worker runs {code_version()}, the client {job.code}: "
-                              "install the client's version on every worker")
-
-
 def run_one(job: Job, blobs: dict[str, bytes]) -> dict[str, Any]:
     """One co-simulation's row, failed (past its time limits too) rather than raised;
     ``seconds``: the task's wall time, ``sim_seconds``: the run's alone."""
     started = time.perf_counter()
     if job.code != code_version():          # a worker that joined after the client's check
-        return _other_code(job)
+        return blank_row(job.run, f"worker runs {code_version()}, the client {job.code}: "
+                                  "install the client's version on every worker")
     master, watchdog, recording = None, Watchdog(job.limits), None
     try:
         with watchdog:                          # a hung FMU fails its run, not the worker
@@ -176,7 +173,7 @@ def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
     ``backend`` and the times; where the batch cannot give a run's row, ``run_one`` does."""
     started = time.perf_counter()
     if any(job.code != code_version() for job in jobs):
-        return [_other_code(job) for job in jobs]
+        return [run_one(job, blobs) for job in jobs]
     failed = batch_refusal()
     if failed:
         return [noted(run_one(job, blobs), f"the batch route is refused on this worker: "
@@ -187,7 +184,11 @@ def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
         with watchdog:
             watchdog.beat("instantiating the FMUs")
             master = _take(jobs[0], blobs, watchdog)
-            members = [job for job in jobs if _configures(master, job)]
+            members = []
+            for job in jobs:                    # one the master refuses: run_one says why
+                with contextlib.suppress(Exception):
+                    master.configure(job.overrides)
+                    members.append(job)
             watchdog.beat(f"the batch of {len(members)} runs")
             recordings = ensemble.simulate_members(
                 master.system, [job.overrides for job in members], jobs[0].stop_time,
@@ -205,14 +206,6 @@ def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
                                 "backend": member_backend(recording.meta), "seconds": share}
             for job, recording in zip(members, recordings, strict=True)}
     return [rows.get(job.run["run_id"]) or run_one(job, blobs) for job in jobs]
-
-
-def _configures(master, job: Job) -> bool:
-    try:
-        master.configure(job.overrides)
-    except Exception:
-        return False
-    return True
 
 
 def noted(row: dict[str, Any], why: str) -> dict[str, Any]:
