@@ -50,45 +50,39 @@ def main(argv: list[str] | None = None) -> int:
                                                  "Carlo over seeds, sea states and settings.",
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("spec", type=Path, help="sweep file (TOML)")
-    parser.add_argument("--scheduler", metavar="ADDRESS",
-                        help="an existing Dask scheduler (default: DASK_SCHEDULER_ADDRESS, "
-                             "else a local cluster)")
+    parser.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler "
+                        "(default: DASK_SCHEDULER_ADDRESS, else a local cluster)")
     parser.add_argument("--scheduler-file", metavar="FILE",
                         help="an existing Dask scheduler, from its --scheduler-file")
-    parser.add_argument("--workers", type=count,
-                        help="worker processes of the local cluster (default and most: the "
-                             "cores this process may use)")
+    parser.add_argument("--workers", type=count, help="worker processes of the local cluster "
+                        "(default and most: the cores this process may use)")
     parser.add_argument("--connect-timeout", type=positive_seconds, metavar="SECONDS",
-                        default=CONNECT_TIMEOUT,
-                        help="how long to try to reach an existing scheduler "
-                             "(default: %(default)g s)")
-    parser.add_argument("--max-runs", type=count, metavar="N", default=MAX_RUNS,
-                        help="refuse a spec of more runs, before anything is allocated "
-                             "(default: %(default)d)")
+                        default=CONNECT_TIMEOUT, help="how long to try to reach an existing "
+                        "scheduler (default: %(default)g s)")
+    parser.add_argument("--max-runs", type=count, metavar="N", default=MAX_RUNS, help="refuse "
+                        "a spec of more runs, before anything is allocated (default: %(default)d)")
     parser.add_argument("--out", type=Path, default=RESULTS, help="parent folder of the results")
-    parser.add_argument("--backend", choices=SWEEP_BACKENDS, default="fmi",
-                        help="fmi (default); inprocess: our FMUs without FMI; batch: each PD, "
-                             "PID or SMC system's runs stepped together as arrays; the same "
-                             "rows, bit for bit (docs/sweeps.md)")
-    parser.add_argument("--batch-size", type=count, metavar="N",
-                        help="with --backend batch: at most N runs a batch (default: as few as "
-                             f"keep every worker busy, each of at most {MAX_BATCH} runs and, "
-                             f"where there are that many, at least {MIN_BATCH})")
+    parser.add_argument("--backend", choices=SWEEP_BACKENDS, default="fmi", help="fmi "
+                        "(default); inprocess: our FMUs without FMI; batch: each PD, PID or SMC "
+                        "system's runs stepped together as arrays; the same rows, bit for bit "
+                        "(docs/sweeps.md)")
+    parser.add_argument("--batch-size", type=count, metavar="N", help="with --backend batch: "
+                        "at most N runs a batch (default: as few as keep every worker busy, each "
+                        f"of at most {MAX_BATCH} runs and, where there are that many, at least "
+                        f"{MIN_BATCH})")
     parser.add_argument("--no-worker-timeout", type=positive_seconds, metavar="SECONDS",
-                        default=campaign.NO_WORKER_TIMEOUT,
-                        help="stop when the cluster has had no worker for this long, keeping "
-                             "every row done (exit status "
-                             f"{NoWorkers.exit_status}; default: %(default)g s)")
+                        default=campaign.NO_WORKER_TIMEOUT, help="stop when the cluster has had "
+                        f"no worker for this long, keeping every row done (exit status "
+                        f"{NoWorkers.exit_status}; default: %(default)g s)")
     parser.add_argument("--step-timeout", type=positive_seconds, default=STEP_LIMIT_S,
                         metavar="S", help="a run with a step (or instantiation) longer than S "
-                                          "s is recorded failed; a batch of N runs gets N "
-                                          "times S (default %(default)g)")
-    parser.add_argument("--run-timeout", type=positive_seconds, metavar="S",
-                        help="a run longer than S s is recorded failed; a batch of N runs gets "
-                             "N times S (default: no limit)")
+                        "s is recorded failed; a batch of N runs gets N times S (default "
+                        "%(default)g)")
+    parser.add_argument("--run-timeout", type=positive_seconds, metavar="S", help="a run longer "
+                        "than S s is recorded failed; a batch of N runs gets N times S (default: "
+                        "no limit)")
     parser.add_argument("--csv", action="store_true", help="also write results.csv")
-    parser.add_argument("--no-progress", action="store_true",
-                        help="no progress bar (for logs)")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar (for logs)")
     args = parser.parse_args(argv)
     if args.batch_size is not None and args.backend != BATCH:
         parser.error(f"--batch-size sizes the batches of --backend batch, not of "
@@ -108,10 +102,9 @@ def main(argv: list[str] | None = None) -> int:
             say_note(note)
         rows = campaign.execute(spec, out, args.scheduler, args.workers, not args.no_progress,
                                 scheduler_file=args.scheduler_file, backend=args.backend,
-                                no_worker_timeout=args.no_worker_timeout,
-                                connect_timeout=args.connect_timeout,
                                 limits=Limits(args.step_timeout, args.run_timeout),
-                                batch_size=args.batch_size)
+                                no_worker_timeout=args.no_worker_timeout,
+                                connect_timeout=args.connect_timeout, batch_size=args.batch_size)
         stage = "writing the tables"
         written = write_tables(rows, out, args.csv, spec)
         stage = "drawing the figures"
@@ -136,9 +129,19 @@ def main(argv: list[str] | None = None) -> int:
             print(f"  every row is kept in {out / 'runs.jsonl'}; the same command writes the "
                   "tables and figures again", file=sys.stderr)
         return 2
-    except (Interrupted, NoWorkers) as stopped:
-        return _stopped(stopped, stage, spec, out, args.csv, shlex.join(
-            [sys.executable, "-m", "cosim.sweep", *(sys.argv[1:] if argv is None else argv)]))
+    except (Interrupted, NoWorkers) as stopped:     # what is kept, and how to resume
+        rows = campaign.completed(spec, out)
+        running = stage == "running the sweep"
+        written = write_tables(rows, out, args.csv, spec) if running and rows else []
+        done, runs = distinct(rows), len(spec.shared_runs())
+        then = ("resumes the sweep" if sum(r["status"] == "ok" for r in done) < runs else
+                "runs nothing again, and writes the tables and figures")
+        resume = shlex.join([sys.executable, "-m", "cosim.sweep",
+                             *(sys.argv[1:] if argv is None else argv)])
+        print(f"{stopped}{'' if running else f' while {stage}'}: {len(done)} of {runs} runs "
+              f"done, kept in {out / 'runs.jsonl'}{''.join(f', {p}' for p in written)}; this "
+              f"command {then}: {resume}", file=sys.stderr)
+        return stopped.exit_status
     for pattern in OUTPUTS:                 # a previous spec's, not rewritten: misleading
         for stale in out.glob(pattern):
             if stale not in written:
@@ -146,22 +149,6 @@ def main(argv: list[str] | None = None) -> int:
     print(summary(spec, rows))
     print(f"wrote {', '.join(str(p) for p in written)}")
     return 0 if all(r["status"] == "ok" for r in rows) else 1
-
-
-def _stopped(stopped: Interrupted | NoWorkers, stage: str, spec: Spec, out: Path, csv: bool,
-             resume: str) -> int:
-    """Say what a stopped sweep keeps and how to resume it; its exit status."""
-    rows = campaign.completed(spec, out)
-    running = stage == "running the sweep"
-    written = write_tables(rows, out, csv, spec) if running and rows else []
-    done, runs = distinct(rows), len(spec.shared_runs())
-    while_ = "" if running else f" while {stage}"
-    then = ("resumes the sweep" if sum(r["status"] == "ok" for r in done) < runs else
-            "runs nothing again, and writes the tables and figures")
-    print(f"{stopped}{while_}: {len(done)} of {runs} runs done, kept in "
-          f"{out / 'runs.jsonl'}{''.join(f', {p}' for p in written)}; this command {then}: "
-          f"{resume}", file=sys.stderr)
-    return stopped.exit_status
 
 
 if __name__ == "__main__":
