@@ -80,8 +80,7 @@ def local_workers(workers: int | None) -> int | None:
     if workers <= CPU_COUNT:
         return workers
     print(f"note: --workers {workers}: this machine gives this process {CPU_COUNT} cores, and "
-          f"a run holds one core from start to end; starting {CPU_COUNT} workers",
-          file=sys.stderr)
+          f"a run holds one core from start to end; starting {CPU_COUNT} workers", file=sys.stderr)
     return CPU_COUNT
 
 

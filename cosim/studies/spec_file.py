@@ -23,10 +23,9 @@ MEASURED = ("guidance.psi_d", "guidance.wp_index", "ship.psi", "ship.delta", "sh
 # The kinds of value a key takes (a bool only where they name bool) and what to give: the
 # keys of each table, and the TOML values of each FMI type (one kind per type, so that each
 # axis is one column of one type in the tables).
-FILE_KEYS = {"name": ((str,), "a plain file name"),
+FILE_KEYS = {"name": ((str,), "a plain file name"), "controllers": ((dict,), "a table"),
              "stop_time": ((int, float), "a number of seconds > 0"),
-             "controllers": ((dict,), "a table"), "axes": ((dict,), "a table"),
-             "plots": ((dict,), "a table")}
+             "axes": ((dict,), "a table"), "plots": ((dict,), "a table")}
 PLOTS_KEYS = {"map": ((list,), "a list of axes"), "tracks": ((dict,), "a table of axis = value")}
 CONTROLLER_KEYS = {"scenario": ((str,), "a string"), "autopilot": ((str,), "a string"),
                    "map": ((dict,), "a table of autopilot port = the FMU's name for it"),

@@ -122,9 +122,8 @@ def run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, p
         # Each FMU as a task holding its bytes, not scattered data: a task's result lost with
         # its worker is computed again, scattered data is gone, and every run with it. Keyed
         # by sweep: another sweep's release of a shared key would strand this one's runs.
-        shipped = {sha: client.submit(bytes, path.read_bytes(), key=f"fmu-{token}-{sha}",
-                                      pure=False)
-                   for sha, path in spec.files().items()}
+        shipped = {sha: client.submit(bytes, fmu.read_bytes(), key=f"fmu-{token}-{sha}", pure=False)
+                   for sha, fmu in spec.files().items()}
         completions = Completions(client, no_worker_timeout)
 
         def submit(jobs: list[Job], batch: bool, why: str = "") -> None:

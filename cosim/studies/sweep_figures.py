@@ -103,8 +103,7 @@ def paired_figure(title: str, changes: dict[Merit, dict[str, np.ndarray]], basel
         values = values[np.isfinite(values) & ((values > 0) if ratio else True)]
         for i, (controller, change) in enumerate(by_controller.items()):
             jitter = np.linspace(-0.18, 0.18, change.size) if change.size > 1 else np.zeros(1)
-            ax.plot(i + jitter[:change.size], change, "o", markersize=3, alpha=0.6,
-                    color=f"C{i}")
+            ax.plot(i + jitter[:change.size], change, "o", markersize=3, alpha=0.6, color=f"C{i}")
             if np.isfinite(change).any():
                 median = float(np.nanmedian(change))
                 ax.plot([i - 0.3, i + 0.3], [median, median], color="k", linewidth=1.5)

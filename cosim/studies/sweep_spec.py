@@ -64,8 +64,7 @@ class Spec:
 
     def files(self) -> dict[str, Path]:
         """Every FMU the sweep uses, by SHA-256."""
-        return {sha: path for _, files, _ in self._shipped.values()
-                for sha, path in files.items()}
+        return {sha: path for _, files, _ in self._shipped.values() for sha, path in files.items()}
 
     @cached_property
     def _fmus(self) -> dict[tuple[str, str], tuple[Path, dict[str, Any], dict[str, Declaration]]]:
@@ -103,8 +102,7 @@ class Spec:
         for run in self.runs():
             calm = self._calm_ships(run)
             effective = {component: {variable: value for variable, value in values.items()
-                                     if component not in calm
-                                     or variable not in CALM_WATER_INERT}
+                                     if component not in calm or variable not in CALM_WATER_INERT}
                          for component, values in self.settings(run)[1].items()}
             key = _digest({"controller": run["controller"], "settings": effective})
             groups.setdefault(key, []).append(run)
@@ -132,8 +130,7 @@ class Spec:
         savings: dict[tuple[str, tuple[str, ...]], list[int]] = {}
         for group in self.shared_runs():
             if len(group) > 1:
-                varying = tuple(a for a in self.axes
-                                if len({json.dumps(r[a]) for r in group}) > 1)
+                varying = tuple(a for a in self.axes if len({json.dumps(r[a]) for r in group}) > 1)
                 savings.setdefault((self._calm_because(group[0]), varying), []).append(len(group))
         notes = []
         for (why, varying), sizes in savings.items():
