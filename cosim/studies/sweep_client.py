@@ -95,9 +95,8 @@ def plan(spec: Spec, jobs: list[Job], workers: int, size: int | None = None
     """(the batches, the runs the kernel does not cover) on the batch backend."""
     groups: dict[tuple[str, float | None], list[Job]] = {}
     alone = []
-    covered = spec.batch_coverage()
     for job in jobs:
-        if covered[job.run["controller"]] is None:
+        if spec.batch_coverage[job.run["controller"]] is None:
             groups.setdefault((job.bundle.digest, job.stop_time), []).append(job)
         else:
             alone.append(job)

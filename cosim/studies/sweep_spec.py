@@ -157,8 +157,7 @@ class Spec:
             words += ["--autopilot", controller["autopilot"]]
             for port, renamed in controller["map"].items():
                 words += ["--map", f"{port}={renamed}"]
-        stop_time = (self.stop_time if self.stop_time is not None
-                     else self.bundles()[run["controller"]].system.stop_time)
+        stop_time = self.stop_time or self.bundles()[run["controller"]].system.stop_time
         words += ["--stop-time", _exact(stop_time)]
         for component, values in overrides.items():
             for variable, value in values.items():
@@ -191,7 +190,7 @@ class Spec:
             return []
         notes = []
         for controller, shipped in self.bundles().items():
-            why = self.batch_coverage()[controller] if backend == "batch" else None
+            why = self.batch_coverage[controller] if backend == "batch" else None
             if why:
                 notes.append(f"controller {controller!r} runs on the in-process route, one "
                              f"run per task, not in batches: {why}")
@@ -202,12 +201,9 @@ class Spec:
         return notes
 
     @cached_property
-    def _coverage(self) -> dict[str, str | None]:
-        return {name: coverage(system) for name, (_, _, system) in self._shipped.items()}
-
     def batch_coverage(self) -> dict[str, str | None]:
         """Each controller: why the batch kernel cannot run its system, None if it can."""
-        return self._coverage
+        return {name: coverage(system) for name, (_, _, system) in self._shipped.items()}
 
     def settings(self, run: dict[str, Any]) -> tuple[str, dict[str, dict[str, Any]]]:
         """(scenario, overrides by component) of one run."""
