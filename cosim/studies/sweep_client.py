@@ -46,11 +46,9 @@ class Journal:
 
     def __init__(self, path: Path):
         self.path, self.rows = path, read_rows(path)
-        if path.exists() and path.stat().st_size:   # a torn last line: its own
-            with open(path, "rb+") as f:
-                f.seek(-1, os.SEEK_END)
-                if f.read(1) != b"\n":
-                    f.write(b"\n")
+        if path.exists() and path.read_bytes()[-1:] not in (b"", b"\n"):  # a torn last line
+            with open(path, "ab") as f:
+                f.write(b"\n")
 
     def add(self, row: dict) -> None:
         with open(self.path, "a") as f:
