@@ -28,8 +28,7 @@ EXAMPLES = """\
   python -m cosim.sweep SPEC --workers 2 --csv --out results/sweeps
   python -m cosim.sweep SPEC --backend batch                   # many runs per task
 
-SPEC is a TOML file of controllers, axes and plots: docs/sweeps.md documents it, the
-outputs, resuming and clusters; docs/sweeps/example.toml is a small one."""
+SPEC: a TOML file of controllers, axes and plots (docs/sweeps.md, docs/sweeps/example.toml)."""
 
 # What a finished sweep writes beside its journal (names, or globs of names).
 OUTPUTS = ("results.parquet", "results.json", "results.csv", "summary.csv", "J_distribution.png",
@@ -46,41 +45,36 @@ def count(text: str) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m cosim.sweep", epilog=EXAMPLES,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter,
                                      description="Ensembles of co-simulations on Dask: Monte "
-                                                 "Carlo over seeds, sea states and settings.",
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+                                                 "Carlo over seeds, sea states and settings.")
     parser.add_argument("spec", type=Path, help="sweep file (TOML)")
     parser.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler "
                         "(default: DASK_SCHEDULER_ADDRESS, else a local cluster)")
-    parser.add_argument("--scheduler-file", metavar="FILE",
-                        help="an existing Dask scheduler, from its --scheduler-file")
-    parser.add_argument("--workers", type=count, help="worker processes of the local cluster "
-                        "(default and most: the cores this process may use)")
+    parser.add_argument("--scheduler-file", metavar="FILE", help="the same, from its file")
+    parser.add_argument("--workers", type=count, help="a local cluster's worker processes "
+                        "(default and most: this process's cores)")
     parser.add_argument("--connect-timeout", type=positive_seconds, metavar="SECONDS",
-                        default=CONNECT_TIMEOUT, help="how long to try to reach an existing "
-                        "scheduler (default: %(default)g s)")
-    parser.add_argument("--max-runs", type=count, metavar="N", default=MAX_RUNS, help="refuse "
-                        "a spec of more runs, before anything is allocated (default: %(default)d)")
+                        default=CONNECT_TIMEOUT, help="to reach a scheduler (default %(default)g s)")
+    parser.add_argument("--max-runs", type=count, metavar="N", default=MAX_RUNS,
+                        help="refuse a spec of more runs (default: %(default)d)")
     parser.add_argument("--out", type=Path, default=RESULTS, help="parent folder of the results")
     parser.add_argument("--backend", choices=SWEEP_BACKENDS, default="fmi", help="fmi "
-                        "(default); inprocess: our FMUs without FMI; batch: each PD, PID or SMC "
-                        "system's runs stepped together as arrays; the same rows, bit for bit "
-                        "(docs/sweeps.md)")
-    parser.add_argument("--batch-size", type=count, metavar="N", help="with --backend batch: "
-                        "at most N runs a batch (default: as few as keep every worker busy, each "
-                        f"of at most {MAX_BATCH} runs and, where there are that many, at least "
+                        "(default); inprocess: our FMUs without FMI; batch: a system's runs "
+                        "stepped together as arrays; the same rows, bit for bit")
+    parser.add_argument("--batch-size", type=count, metavar="N", help="with --backend batch: at "
+                        f"most N runs a batch (default: as few as keep every worker busy, of at "
+                        f"most {MAX_BATCH} runs and, where there are as many, at least "
                         f"{MIN_BATCH})")
     parser.add_argument("--no-worker-timeout", type=positive_seconds, metavar="SECONDS",
-                        default=campaign.NO_WORKER_TIMEOUT, help="stop when the cluster has had "
-                        f"no worker for this long, keeping every row done (exit status "
-                        f"{NoWorkers.exit_status}; default: %(default)g s)")
+                        default=campaign.NO_WORKER_TIMEOUT, help="stop, every row kept, when the "
+                        f"cluster has had no worker this long (exit {NoWorkers.exit_status}; "
+                        "default: %(default)g s)")
     parser.add_argument("--step-timeout", type=positive_seconds, default=STEP_LIMIT_S,
-                        metavar="S", help="a run with a step (or instantiation) longer than S "
-                        "s is recorded failed; a batch of N runs gets N times S (default "
-                        "%(default)g)")
-    parser.add_argument("--run-timeout", type=positive_seconds, metavar="S", help="a run longer "
-                        "than S s is recorded failed; a batch of N runs gets N times S (default: "
-                        "no limit)")
+                        metavar="S", help="fail a run with a step (or instantiation) over S s; a "
+                        "batch of N runs gets N times S (default %(default)g)")
+    parser.add_argument("--run-timeout", type=positive_seconds, metavar="S", help="fail a run "
+                        "over S s; a batch of N runs gets N times S (default: no limit)")
     parser.add_argument("--csv", action="store_true", help="also write results.csv")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar (for logs)")
     args = parser.parse_args(argv)
