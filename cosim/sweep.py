@@ -55,7 +55,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--workers", type=count, help="a local cluster's worker processes "
                         "(default and most: this process's cores)")
     parser.add_argument("--connect-timeout", type=positive_seconds, metavar="SECONDS",
-                        default=CONNECT_TIMEOUT, help="to reach a scheduler (default %(default)g s)")
+                        default=CONNECT_TIMEOUT, help="to reach a scheduler (%(default)g s)")
     parser.add_argument("--max-runs", type=count, metavar="N", default=MAX_RUNS,
                         help="refuse a spec of more runs (default: %(default)d)")
     parser.add_argument("--out", type=Path, default=RESULTS, help="parent folder of the results")
