@@ -50,8 +50,7 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
 
 
 def completed(spec: Spec, out: Path) -> list[dict]:
-    """A row for each combination whose result is in the journal: its group's result with its
-    own axis values, run id, ``ran_as`` and ``command``."""
+    """A row for each combination whose group's result is in the journal, as its own."""
     rows = read_rows(out / "runs.jsonl", quiet=True)
     found = {}
     for group in spec.shared_runs():

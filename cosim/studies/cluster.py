@@ -103,8 +103,8 @@ def scheduler_address(scheduler_file: str | Path) -> str:
 def connect(scheduler: str | None = None, workers: int | None = None,
             scheduler_file: str | None = None, timeout: float = CONNECT_TIMEOUT
             ) -> tuple[Client, LocalCluster | None]:
-    """(a client, its local cluster or None): of a scheduler found as Dask's tools find it,
-    else of a new local cluster; ClusterError naming the address or file if none is reached."""
+    """(a client, its local cluster or None) of a scheduler found as Dask's tools find it, else
+    of a new local cluster; ClusterError naming the address or file if none is reached."""
     if scheduler and scheduler_file:
         raise ClusterError("give the scheduler's address or its file, not both")
     if scheduler_file:
@@ -197,8 +197,7 @@ def worker_facts() -> dict[str, Any]:
 
 def check_workers(client) -> None:
     """SweepError naming each worker that runs other code or whose FMU cache is not private;
-    the dashboard's address; a warning for workers of several threads, or a scheduler that
-    queues runs."""
+    the dashboard; a warning for workers of several threads or a scheduler that queues runs."""
     mine = code_version()
     try:
         facts = client.run(worker_facts, on_error="return")

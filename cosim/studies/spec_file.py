@@ -193,8 +193,7 @@ def _axis(path: Path, name: str, values: Any, max_runs: int) -> list:
 
 
 def controller_entry(entry: str | dict[str, Any], spec: Path, name: str) -> dict[str, Any]:
-    """A controller entry (a scenario, an autopilot FMU, or a table of scenario, autopilot, map
-    and set) checked, its paths made absolute (relative to the spec file)."""
+    """A controller entry checked, its paths made absolute (relative to the spec file)."""
     if isinstance(entry, str):
         entry = {"autopilot": entry} if entry.endswith(".fmu") else {"scenario": entry}
     where = f"controller {name!r}"

@@ -108,8 +108,7 @@ def plan(spec: Spec, jobs: list[Job], workers: int, size: int | None = None
 def run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, progress: bool,
                    task, backend: str, no_worker_timeout: float, limits: Limits,
                    batch_task=run_batch, batch_size: int | None = None) -> None:
-    """Run ``todo`` on ``connection`` (a client, and its local cluster or None), journaling
-    each row as it completes."""
+    """Run ``todo`` on ``connection`` (client, local cluster or None), journaling each row."""
     client, cluster = connection
     teardown = SweepTeardown(uuid.uuid4().hex[:12])
     token, tasks, shipped = teardown.sweep, {}, {}
@@ -188,8 +187,7 @@ def _say_batch_refusals(client) -> None:
 
 def _close(client, cluster, teardown: SweepTeardown, journal: Journal,
            stopped: BaseException | None = None) -> None:
-    """Close the client and the local cluster it made, or on a shared cluster free this
-    sweep's FMUs; quietly after the sweep ``stopped``, a second signal ending it at once."""
+    """Close the client and its local cluster, or free this sweep's FMUs on a shared one."""
     level = logging.root.manager.disable         # distributed's loggers set their own levels
     with contextlib.ExitStack() as stack:
         stack.callback(logging.disable, level)

@@ -162,8 +162,7 @@ def ratio_map(spec, rows: list[dict], path: Path, numerator: str = "smc",
 
 
 def tracks(spec, rows: list[dict], path: Path) -> Path | None:
-    """The tracks of the runs [plots] tracks selects, one colour per controller, the route
-    dashed, its waypoints named and their circles of acceptance dotted."""
+    """The tracks of the runs [plots] tracks selects, one colour per controller, the route."""
     chosen = [r for r in rows if r.get("track")]
     if not chosen:
         return None

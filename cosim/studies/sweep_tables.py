@@ -81,8 +81,7 @@ def _statistics(values: np.ndarray) -> list[float]:
 
 
 def summary_table(spec: Spec, rows: list[dict]) -> list[list]:
-    """summary.csv's header and lines: per setting (the axes but ``MONTE_CARLO``) and
-    controller, the runs ok and failed and each figure of merit's ``STATISTICS``."""
+    """summary.csv: per setting and controller, the runs ok and failed, each ``STATISTICS``."""
     axes, settings = _settings(spec)
     lines = [[*axes, "controller", "runs ok", "runs failed",
               *(headed(f"{metric} {name}", unit) for metric, unit in METRICS.items()

@@ -100,8 +100,7 @@ class SweepTeardown(WorkerPlugin):
 
 
 def ran_on(kinds: dict[str, str] | None, asked: str) -> str:
-    """How a run's components ran: "fmi" or "inprocess" if all alike, else each other named
-    ("inprocess; autopilot: fmi"); ``asked`` without a master."""
+    """How a run's components ran: "fmi", "inprocess", or e.g. "inprocess; autopilot: fmi"."""
     if not kinds:
         return asked
     if len(set(kinds.values())) == 1:
@@ -117,8 +116,7 @@ def blank_row(run: dict[str, Any], error: str = "") -> dict[str, Any]:
 
 
 def run_one(job: Job, blobs: dict[str, bytes]) -> dict[str, Any]:
-    """One co-simulation's row, failed (past its time limits too) rather than raised;
-    ``seconds``: the task's wall time, ``sim_seconds``: the run's alone."""
+    """One co-simulation's row, a failure (past its time limits too) recorded, not raised."""
     started = time.perf_counter()
     if job.code != code_version():          # a worker that joined after the client's check
         return blank_row(job.run, f"worker runs {code_version()}, the client {job.code}: "
