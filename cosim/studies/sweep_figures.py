@@ -28,9 +28,9 @@ STATISTICS = ("box: median and IQR (25-75 %) of the runs, whiskers: min-max; the
 
 def _panels(count: int, width: float, height: float) -> tuple[Figure, list]:
     columns = min(4, count)
-    fig = Figure(figsize=(width * columns, height * math.ceil(count / columns)),
-                 layout="constrained")
-    axes = fig.subplots(math.ceil(count / columns), columns, squeeze=False).flat
+    rows = math.ceil(count / columns)
+    fig = Figure(figsize=(width * columns, height * rows), layout="constrained")
+    axes = fig.subplots(rows, columns, squeeze=False).flat
     for ax in axes[count:]:
         ax.set_visible(False)
     return fig, axes[:count]

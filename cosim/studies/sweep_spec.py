@@ -209,7 +209,7 @@ class Spec:
         """(scenario, overrides by component) of one run."""
         controller = self.controllers[run["controller"]]
         overrides: dict[str, dict[str, Any]] = {}
-        for target, value in [*controller.get("set", {}).items(),
+        for target, value in [*controller["set"].items(),
                               *(pair for axis in self.axes
                                 for pair in assignments(axis, run[axis]).items())]:
             component, _, variable = target.partition(".")

@@ -26,17 +26,16 @@ def headed(name: str, unit: str) -> str:
     return f"{name} [{unit}]" if unit else name
 
 
-def write_tables(rows: list[dict], out: Path, csv: bool, spec: Spec | None = None
-                 ) -> list[Path]:
+def write_tables(rows: list[dict], out: Path, csv: bool, spec: Spec) -> list[Path]:
     """results.parquet (units in its field metadata), results.csv with ``csv`` (units in its
-    headers), results.json (every column's unit) and, with ``spec``, summary.csv."""
+    headers), results.json (every column's unit) and summary.csv."""
     import pyarrow as pa
     import pyarrow.csv as pacsv
     import pyarrow.parquet as pq
 
     table = pa.Table.from_pylist([{k: (json.dumps(v) if isinstance(v, (list, dict)) else v)
                                    for k, v in row.items() if k != "track"} for row in rows])
-    known = {**(spec.units() if spec is not None else {}), **METRICS, **TIMES}
+    known = {**spec.units(), **METRICS, **TIMES}
     unit = {name: known.get(name, "") for name in table.column_names}
     table = table.cast(pa.schema([field.with_metadata({"unit": unit[field.name]})
                                   for field in table.schema]))
@@ -47,11 +46,9 @@ def write_tables(rows: list[dict], out: Path, csv: bool, spec: Spec | None = Non
         with_units = table.rename_columns([headed(n, unit[n]) for n in table.column_names])
         written.append(write_atomically(out / "results.csv",
                                         lambda p: pacsv.write_csv(with_units, p)))
-    if spec is not None:
-        header, *lines = summary_table(spec, rows)
-        summary = pa.Table.from_pylist([dict(zip(header, line)) for line in lines])
-        written.append(write_atomically(out / "summary.csv",
-                                        lambda p: pacsv.write_csv(summary, p)))
+    header, *lines = summary_table(spec, rows)
+    summary = pa.Table.from_pylist([dict(zip(header, line)) for line in lines])
+    written.append(write_atomically(out / "summary.csv", lambda p: pacsv.write_csv(summary, p)))
     return written
 
 
