@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import shlex
 import signal
@@ -27,73 +28,55 @@ EXAMPLES = """\
   python -m cosim.sweep SPEC --workers 2 --csv --out results/sweeps
   python -m cosim.sweep SPEC --backend batch                   # many runs per task
 
-SPEC is a TOML file of controllers, axes and plots: docs/sweeps.md documents it, the
-outputs, resuming and clusters; docs/sweeps/example.toml is a small one."""
+SPEC: a TOML file of controllers, axes and plots (docs/sweeps.md, docs/sweeps/example.toml)."""
 
+# What a finished sweep writes beside its journal (names, or globs of names).
 OUTPUTS = ("results.parquet", "results.json", "results.csv", "summary.csv", "J_distribution.png",
            "tracks.png", "J_*_over_pd.png", "comparison.md")
-"""What a finished sweep writes beside its journal (by name, or glob of names)."""
 
 
 def count(text: str) -> int:
     """A whole number >= 1, for argparse."""
-    try:
+    with contextlib.suppress(ValueError):
         if int(text) >= 1:
             return int(text)
-    except ValueError:
-        pass
     raise argparse.ArgumentTypeError(f"give a whole number >= 1, got {text!r}")
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m cosim.sweep", epilog=EXAMPLES,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter,
                                      description="Ensembles of co-simulations on Dask: Monte "
-                                                 "Carlo over seeds, sea states and settings.",
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+                                                 "Carlo over seeds, sea states and settings.")
     parser.add_argument("spec", type=Path, help="sweep file (TOML)")
-    parser.add_argument("--scheduler", metavar="ADDRESS",
-                        help="an existing Dask scheduler (default: DASK_SCHEDULER_ADDRESS, "
-                             "else a local cluster)")
-    parser.add_argument("--scheduler-file", metavar="FILE",
-                        help="an existing Dask scheduler, from its --scheduler-file")
-    parser.add_argument("--workers", type=count,
-                        help="worker processes of the local cluster (default and most: the "
-                             "cores this process may use)")
+    parser.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler "
+                        "(default: DASK_SCHEDULER_ADDRESS, else a local cluster)")
+    parser.add_argument("--scheduler-file", metavar="FILE", help="the same, from its file")
+    parser.add_argument("--workers", type=count, help="a local cluster's worker processes "
+                        "(default and most: this process's cores)")
     parser.add_argument("--connect-timeout", type=positive_seconds, metavar="SECONDS",
-                        default=CONNECT_TIMEOUT,
-                        help="how long to try to reach an existing scheduler "
-                             "(default: %(default)g s)")
+                        default=CONNECT_TIMEOUT, help="to reach a scheduler (%(default)g s)")
     parser.add_argument("--max-runs", type=count, metavar="N", default=MAX_RUNS,
-                        help="refuse a spec of more runs, before anything is allocated "
-                             "(default: %(default)d)")
+                        help="refuse a spec of more runs (default: %(default)d)")
     parser.add_argument("--out", type=Path, default=RESULTS, help="parent folder of the results")
-    parser.add_argument("--backend", choices=SWEEP_BACKENDS, default="fmi",
-                        help="fmi: each run through the FMUs (default); inprocess: this "
-                             "project's FMUs as Python classes, without FMI; batch: the runs of "
-                             "each PD, PID or SMC system in batches stepped together as arrays; "
-                             "the same rows, bit for bit (what a backend does not cover runs "
-                             "otherwise, with a note)")
-    parser.add_argument("--batch-size", type=count, metavar="N",
-                        help="with --backend batch: at most N runs a batch (default: as few "
-                             "batches as keep every worker busy, of at most "
-                             f"{MAX_BATCH} runs and at least {MIN_BATCH} where there are that "
-                             "many; docs/sweeps.md)")
+    parser.add_argument("--backend", choices=SWEEP_BACKENDS, default="fmi", help="fmi "
+                        "(default); inprocess: our FMUs without FMI; batch: a system's runs "
+                        "stepped together as arrays; the same rows, bit for bit")
+    parser.add_argument("--batch-size", type=count, metavar="N", help="with --backend batch: at "
+                        f"most N runs a batch (default: as few as keep every worker busy, of at "
+                        f"most {MAX_BATCH} runs and, where there are as many, at least "
+                        f"{MIN_BATCH})")
     parser.add_argument("--no-worker-timeout", type=positive_seconds, metavar="SECONDS",
-                        default=campaign.NO_WORKER_TIMEOUT,
-                        help="stop when the cluster has had no worker for this long, keeping "
-                             "every row done (exit status "
-                             f"{NoWorkers.exit_status}; default: %(default)g s)")
+                        default=campaign.NO_WORKER_TIMEOUT, help="stop, every row kept, when the "
+                        f"cluster has had no worker this long (exit {NoWorkers.exit_status}; "
+                        "default: %(default)g s)")
     parser.add_argument("--step-timeout", type=positive_seconds, default=STEP_LIMIT_S,
-                        metavar="S",
-                        help="a run whose FMUs take longer than S s of wall-clock time over "
-                             "one step (or their instantiation) is recorded failed; a batch "
-                             "of N runs gets N times S (default %(default)g)")
-    parser.add_argument("--run-timeout", type=positive_seconds, metavar="S",
-                        help="a run longer than S s of wall-clock time is recorded failed; a "
-                             "batch of N runs gets N times S (default: no limit)")
+                        metavar="S", help="fail a run with a step (or instantiation) over S s; a "
+                        "batch of N runs gets N times S (default %(default)g)")
+    parser.add_argument("--run-timeout", type=positive_seconds, metavar="S", help="fail a run "
+                        "over S s; a batch of N runs gets N times S (default: no limit)")
     parser.add_argument("--csv", action="store_true", help="also write results.csv")
-    parser.add_argument("--no-progress", action="store_true",
-                        help="no progress bar (for logs)")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar (for logs)")
     args = parser.parse_args(argv)
     if args.batch_size is not None and args.backend != BATCH:
         parser.error(f"--batch-size sizes the batches of --backend batch, not of "
@@ -113,10 +96,9 @@ def main(argv: list[str] | None = None) -> int:
             say_note(note)
         rows = campaign.execute(spec, out, args.scheduler, args.workers, not args.no_progress,
                                 scheduler_file=args.scheduler_file, backend=args.backend,
-                                no_worker_timeout=args.no_worker_timeout,
-                                connect_timeout=args.connect_timeout,
                                 limits=Limits(args.step_timeout, args.run_timeout),
-                                batch_size=args.batch_size)
+                                no_worker_timeout=args.no_worker_timeout,
+                                connect_timeout=args.connect_timeout, batch_size=args.batch_size)
         stage = "writing the tables"
         written = write_tables(rows, out, args.csv, spec)
         stage = "drawing the figures"
@@ -126,21 +108,34 @@ def main(argv: list[str] | None = None) -> int:
             print("no run succeeded: no figures drawn", file=sys.stderr)
         stage = "writing comparison.md"
         if "pd" in spec.controllers and len(spec.controllers) > 1:
-            table = _comparison(spec, rows)
+            pairs = (f"paired by {MONTE_CARLO} (the same sea)" if MONTE_CARLO in spec.axes
+                     else "one run each")
+            table = (f"# {spec.name}: each controller against pd\n\nJ of eq (19) in rad^2, lower "
+                     f"is better; per setting, the median over its runs and, {pairs}, the runs "
+                     "where the controller's J is lower than pd's and the median of their "
+                     "ratio. A run shared by several combinations (every seed in calm water) "
+                     "counts once.\n\n" + comparison(spec, rows) + "\n")
             written.append(write_atomically(out / "comparison.md",
                                             lambda path: path.write_text(table)))
-    except (SweepError, ValueError) as error:
-        say_error(error)
-        return 2
-    except OSError as error:    # the journal's folder; or OutputError: names the file
-        say_error(error)
-        if stage != "running the sweep":
+    except (SweepError, ValueError, OSError) as error:  # OSError: the journal's folder, or
+        say_error(error)                                # OutputError, which names its file
+        if isinstance(error, OSError) and stage != "running the sweep":
             print(f"  every row is kept in {out / 'runs.jsonl'}; the same command writes the "
                   "tables and figures again", file=sys.stderr)
         return 2
-    except (Interrupted, NoWorkers) as stopped:
-        return _stopped(stopped, stage, spec, out, args.csv, shlex.join(
-            [sys.executable, "-m", "cosim.sweep", *(sys.argv[1:] if argv is None else argv)]))
+    except (Interrupted, NoWorkers) as stopped:     # what is kept, and how to resume
+        rows = campaign.completed(spec, out)
+        running = stage == "running the sweep"
+        written = write_tables(rows, out, args.csv, spec) if running and rows else []
+        done, runs = distinct(rows), len(spec.shared_runs())
+        then = ("resumes the sweep" if sum(r["status"] == "ok" for r in done) < runs else
+                "runs nothing again, and writes the tables and figures")
+        resume = shlex.join([sys.executable, "-m", "cosim.sweep",
+                             *(sys.argv[1:] if argv is None else argv)])
+        print(f"{stopped}{'' if running else f' while {stage}'}: {len(done)} of {runs} runs "
+              f"done, kept in {out / 'runs.jsonl'}{''.join(f', {p}' for p in written)}; this "
+              f"command {then}: {resume}", file=sys.stderr)
+        return stopped.exit_status
     for pattern in OUTPUTS:                 # a previous spec's, not rewritten: misleading
         for stale in out.glob(pattern):
             if stale not in written:
@@ -150,41 +145,8 @@ def main(argv: list[str] | None = None) -> int:
     return 0 if all(r["status"] == "ok" for r in rows) else 1
 
 
-def _comparison(spec: Spec, rows: list[dict]) -> str:
-    """comparison.md: what it is, and the table (``sweep_tables.comparison``)."""
-    pairs = f"paired by {MONTE_CARLO} (the same sea)" if MONTE_CARLO in spec.axes else \
-        "one run each"
-    return (f"# {spec.name}: each controller against pd\n\n"
-            f"J of eq (19) in rad^2, lower is better; per setting, the median over its "
-            f"runs and, {pairs}, the runs where the controller's J is lower than pd's and "
-            "the median of their ratio. A run shared by several combinations (every seed "
-            "in calm water) counts once.\n\n" + comparison(spec, rows) + "\n")
-
-
-def _stopped(stopped: Interrupted | NoWorkers, stage: str, spec: Spec, out: Path, csv: bool,
-             resume: str) -> int:
-    """Say what an interrupted or workerless sweep keeps and how to resume it; its status."""
-    rows = campaign.completed(spec, out)
-    running = stage == "running the sweep"
-    written = write_tables(rows, out, csv, spec) if running and rows else []
-    done, runs = distinct(rows), len(spec.shared_runs())
-    while_ = "" if running else f" while {stage}"
-    then = ("resumes the sweep" if sum(r["status"] == "ok" for r in done) < runs else
-            "runs nothing again, and writes the tables and figures")
-    print(f"{stopped}{while_}: {len(done)} of {runs} runs done, kept in "
-          f"{out / 'runs.jsonl'}{''.join(f', {p}' for p in written)}; this command {then}: "
-          f"{resume}", file=sys.stderr)
-    return stopped.exit_status
-
-
-def _end_at_a_signal(number: int, frame) -> None:
-    """After the command has said all: a signal while the interpreter shuts down ends the
-    process at once, without a traceback."""
-    os._exit(128 + number)
-
-
 if __name__ == "__main__":
     status = entry(main)
-    for number in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(number, _end_at_a_signal)
+    for number in (signal.SIGINT, signal.SIGTERM):      # as Python shuts down: no traceback
+        signal.signal(number, lambda number, frame: os._exit(128 + number))
     sys.exit(status)

@@ -93,7 +93,7 @@ def mixed(fmu_paths, cluster, tmp_path_factory) -> tuple[Spec, dict, dict]:
 @pytest.mark.timeout(240, method="thread")
 def test_a_batch_sweep_journals_the_in_process_rows(mixed):
     spec, inprocess, batch = mixed
-    assert spec.batch_coverage() == dict.fromkeys(spec.controllers)       # all covered
+    assert spec.batch_coverage == dict.fromkeys(spec.controllers)       # all covered
     assert spec.backend_notes("batch") == []
     assert inprocess.keys() == batch.keys() == {r["run_id"] for r in spec.runs()}
     for run_id, row in batch.items():
@@ -180,7 +180,7 @@ def test_a_foreign_autopilot_runs_alone_in_process_with_a_note(fmu_paths, cluste
     spec = Spec.read(spec_file)
     why = ("autopilot (foreign.fmu) runs through FMI, not in-process: it was not built with "
            "fmukit (it has no manifest)")
-    assert spec.batch_coverage() == {"pd": None, "mine": why}
+    assert spec.batch_coverage == {"pd": None, "mine": why}
     assert spec.backend_notes("batch") == [
         f"controller 'mine' runs on the in-process route, one run per task, not in batches: "
         f"{why}"]

@@ -185,7 +185,7 @@ def test_dask_sweep_writes_resumes_and_plots(fmu_paths, tmp_path, capsys):
     redone = [json.loads(line)["run_id"] for line in
               (out / "runs.jsonl").read_text().splitlines()[4:]]
     assert sorted(redone) == sorted(json.loads(journal[i])["run_id"] for i in (0, 3))
-    written = write_tables(again, out, csv=True)
+    written = write_tables(again, out, csv=True, spec=spec)
     table = pq.read_table(written[0])
     assert table.num_rows == 4 and {"controller", "wave_seed", "J", "status"} <= set(
         table.column_names)

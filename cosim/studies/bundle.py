@@ -1,6 +1,5 @@
-"""A sweep controller's system as a worker rebuilds it, each FMU named by its SHA-256: the
-FMUs travel once per worker, which keeps them in its private cache (``fmu_cache``), checked
-against their hashes when used; the hashes make a run's identity (``Bundle.digest``)."""
+"""A sweep controller's system as a worker rebuilds it, each FMU named by its SHA-256: sent
+once per worker, kept in its private cache (``fmu_cache``) and checked when used."""
 from __future__ import annotations
 
 import dataclasses
@@ -19,8 +18,7 @@ from ..core.ssd import SystemDescription
 
 
 class UnsafeCache(RuntimeError):
-    """The FMU cache folder is not private to this user: anyone else who can write it could
-    put code in the FMUs this worker runs."""
+    """The FMU cache is not private: whoever else may write it could change the FMUs run."""
 
 
 @dataclass(frozen=True)
@@ -30,30 +28,21 @@ class Bundle:
     digest: str                        # SHA-256 of the system and its FMUs' contents
 
     def fmu_hashes(self) -> set[str]:
-        """The SHA-256 of each of its FMUs."""
         return {Path(c.source).stem for c in self.system.components.values()}
 
 
 def file_hash(path: Path) -> str:
-    """SHA-256 of a file's content."""
-    digest = hashlib.sha256()
     with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
+        return hashlib.file_digest(f, "sha256").hexdigest()
 
 
 def bundle(controller: dict[str, Any]) -> tuple[Bundle, dict[str, Path], SystemDescription]:
-    """The bundle of a sweep controller (scenario, autopilot, map), each of its FMUs' files by
-    hash, for the client to ship, and its system as loaded here."""
+    """A sweep controller's bundle, its FMUs' files by hash, and its system as loaded here."""
     system = scenarios.load(controller["scenario"], controller["autopilot"], controller["map"])
-    files: dict[str, Path] = {}
-    components = {}
-    for name, component in system.components.items():
-        path = system.fmu_path(name)
-        sha = file_hash(path)
-        files[sha] = path
-        components[name] = dataclasses.replace(component, source=f"{sha}.fmu")
+    hashes = {name: file_hash(system.fmu_path(name)) for name in system.components}
+    files = {sha: system.fmu_path(name) for name, sha in hashes.items()}
+    components = {name: dataclasses.replace(component, source=f"{hashes[name]}.fmu")
+                  for name, component in system.components.items()}
     shipped = dataclasses.replace(system, components=components, path=None, fmus=None)
     content = json.dumps(dataclasses.asdict(shipped), sort_keys=True, default=str)
     return Bundle(shipped, hashlib.sha256(content.encode()).hexdigest()), files, system
@@ -61,8 +50,7 @@ def bundle(controller: dict[str, Any]) -> tuple[Bundle, dict[str, Path], SystemD
 
 def fmu_cache() -> Path:
     """Where a worker keeps the FMUs it was sent: $COSIM_FMU_CACHE, else cosim-fmus in
-    $XDG_CACHE_HOME (default ~/.cache), made 0o700; UnsafeCache unless it is a folder of
-    this user's that no one else may write."""
+    $XDG_CACHE_HOME or ~/.cache, made 0o700; UnsafeCache unless only this user may write it."""
     folder = Path(os.environ.get("COSIM_FMU_CACHE")
                   or Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
                   / "cosim-fmus")
@@ -81,8 +69,7 @@ def fmu_cache() -> Path:
 
 
 def materialise(shipped: Bundle, blobs: dict[str, bytes]) -> SystemDescription:
-    """The bundle's system with its FMUs in this machine's cache (a cached file that does not
-    match its hash is written again, with a warning)."""
+    """The bundle's system, its FMUs in this machine's cache (a corrupt one written again)."""
     cache = fmu_cache()
     components = {}
     for name, component in shipped.system.components.items():

@@ -1,5 +1,4 @@
-"""A sweep run end to end: its runs not yet done on a Dask cluster, each row journaled, and
-the rows of every combination (docs/sweeps.md)."""
+"""A sweep run end to end, resumed from its journal (docs/sweeps.md)."""
 from __future__ import annotations
 
 import sys
@@ -13,8 +12,7 @@ from .sweep_client import Journal, read_rows, run_on_cluster
 from .sweep_spec import Spec
 from .sweep_task import BATCH, SWEEP_BACKENDS, run_batch, run_one
 
-NO_WORKER_TIMEOUT = 60.0
-"""Seconds a sweep waits while its cluster has no worker, then stops (``NoWorkers``)."""
+NO_WORKER_TIMEOUT = 60.0        # s a sweep waits while its cluster has no worker
 
 
 def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | None = None,
@@ -22,15 +20,8 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
             backend: str = "fmi", no_worker_timeout: float = NO_WORKER_TIMEOUT,
             connect_timeout: float = CONNECT_TIMEOUT, limits: Limits = Limits(),
             batch_size: int | None = None, batch_task=None) -> list[dict]:
-    """Run every run of ``spec`` without an ok row in ``out``'s journal; every row of the sweep.
-
-    ``backend``: "fmi" or "inprocess" (the master's), or "batch" (runs of a system the batch
-    kernel covers in batches of at most ``batch_size``, one ``batch_task(jobs, blobs)`` each;
-    the others alone). ``task(job, blobs) -> row`` runs one run (default ``run_one``). On
-    ``Interrupted``, or ``NoWorkers`` after ``no_worker_timeout`` s, the rows done stay in
-    the journal and the same call resumes. SweepError if a worker runs other code or another
-    sweep writes ``out``; ``cluster.ClusterError`` (a ValueError) if no cluster is reached.
-    """
+    """Run every run of ``spec`` without an ok row in ``out``'s journal; every row. SweepError
+    if a worker runs other code or another sweep writes ``out``; ClusterError for no cluster."""
     if backend not in SWEEP_BACKENDS:
         raise ValueError(f"backend must be {', '.join(SWEEP_BACKENDS[:-1])} or "
                          f"{SWEEP_BACKENDS[-1]}, got {backend!r}")
@@ -59,9 +50,7 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
 
 
 def completed(spec: Spec, out: Path) -> list[dict]:
-    """A row for each combination of ``spec`` whose result is in its journal, in the order of
-    ``spec.runs()``: its group's result (``Spec.shared_runs``) with its own axis values and
-    run id, ``ran_as`` the run whose result it is, and ``command`` (``Spec.replay``)."""
+    """A row for each combination whose group's result is in the journal, as its own."""
     rows = read_rows(out / "runs.jsonl", quiet=True)
     found = {}
     for group in spec.shared_runs():
@@ -75,15 +64,14 @@ def completed(spec: Spec, out: Path) -> list[dict]:
 
 
 def _result(group: list[dict], rows: dict[str, dict]) -> dict | None:
-    """A group's row in the journal: a member's ok row, else a member's failed row, else None."""
+    """A group's row: a member's ok row, else a member's failed row, else None."""
     mine = [rows[r["run_id"]] for r in group if r["run_id"] in rows]
     return next((r for r in mine if r["status"] == "ok"), mine[0] if mine else None)
 
 
 def run_locally(spec: Spec, run: dict[str, Any], backend: str = "fmi",
                 limits: Limits = Limits()) -> dict[str, Any]:
-    """One run of ``spec`` in this process, as a worker would do it (on "batch", as a batch
-    of one)."""
+    """One run of ``spec`` in this process, as a worker would (on "batch": a batch of one)."""
     job = spec.job(run, "local", "inprocess" if backend == BATCH else backend, limits)
     blobs = {sha: spec.files()[sha].read_bytes() for sha in job.bundle.fmu_hashes()}
     return run_batch([job], blobs)[0] if backend == BATCH else run_one(job, blobs)

@@ -1,7 +1,6 @@
 """Dask clusters for sweeps: a local one or an existing scheduler, its workers checked before
 any run and watched while it goes. A run holds the GIL from start to end, so a worker is
-one single-threaded process (``dask worker ADDRESS --nthreads 1 --nworkers N``).
-"""
+one single-threaded process (``dask worker ADDRESS --nthreads 1 --nworkers N``)."""
 from __future__ import annotations
 
 import importlib.util
@@ -12,22 +11,23 @@ import queue
 import signal
 import sys
 import time
+from multiprocessing import resource_tracker
 from pathlib import Path
 from typing import Any, Iterator
 
+import dask
 from dask.distributed import Client, LocalCluster
+from dask.system import CPU_COUNT
 
 from ..core.files import read_small_text
 from ..provenance import PACKAGE, code_version
 from .bundle import UnsafeCache, fmu_cache
 
-CONNECT_TIMEOUT = 30.0
-"""Seconds a client tries to reach an existing scheduler (Dask's own default)."""
+CONNECT_TIMEOUT = 30.0          # s a client tries to reach a scheduler (Dask's default)
 
 
 class ClusterError(ValueError):
-    """No cluster to run on: the scheduler cannot be reached or found, or the options that
-    say where it is or how big a local one is make no sense."""
+    """No cluster to run on: no scheduler reached or found, or options that make no sense."""
 
 
 class SweepError(RuntimeError):
@@ -35,21 +35,27 @@ class SweepError(RuntimeError):
 
 
 class NoWorkers(RuntimeError):
-    """The sweep stopped: its cluster had no worker for as long as it waits for one (the
-    runs completed stay in the journal)."""
+    """The sweep stopped: its cluster had no worker for as long as it waits for one."""
 
     exit_status = 3
 
 
 def local_cluster(workers: int | None = None) -> LocalCluster:
-    """``workers`` single-threaded worker processes (default: one per core), the dashboard
-    on a free port, quiet: a row says what failed, and the workers' own errors (as when a
-    second Ctrl-C leaves them without their scheduler) would only be noise. Worker-saturation
-    1.0: a run that kills its worker takes no queued run with it. Made with SIGINT blocked,
-    which its threads and workers inherit: a terminal's Ctrl-C stops the client alone."""
-    import dask
-
-    _start_resource_tracker()
+    """``workers`` single-threaded worker processes (default: one per core), quiet (a row says
+    what failed), the dashboard on a free port; worker-saturation 1.0: a run that kills its
+    worker takes no queued run with it. Made with SIGINT blocked, which its threads and
+    workers inherit: a terminal's Ctrl-C stops the client alone."""
+    # Its resource tracker started first (starting it unblocks SIGINT), quiet (it would
+    # only report semaphores leaked at a second Ctrl-C).
+    sys.stderr.flush()
+    saved, null = os.dup(2), os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(null, 2)
+        resource_tracker.ensure_running()
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+        os.close(null)
     previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     cluster = None
     try:
@@ -65,42 +71,21 @@ def local_cluster(workers: int | None = None) -> LocalCluster:
     return cluster
 
 
-def _start_resource_tracker() -> None:
-    """Start multiprocessing's resource tracker before SIGINT is blocked (starting it
-    unblocks SIGINT), quiet (it would only report semaphores leaked at a second Ctrl-C)."""
-    from multiprocessing import resource_tracker
-
-    sys.stderr.flush()
-    saved, null = os.dup(2), os.open(os.devnull, os.O_WRONLY)
-    try:
-        os.dup2(null, 2)
-        resource_tracker.ensure_running()
-    finally:
-        os.dup2(saved, 2)
-        os.close(saved)
-        os.close(null)
-
-
-def local_workers(workers: int | None) -> tuple[int | None, str | None]:
-    """The worker processes of a local cluster for the ``workers`` asked (None: one per
-    core), and a note where capped at the cores this process may use; ClusterError for
-    fewer than one."""
-    from dask.system import CPU_COUNT
-
+def local_workers(workers: int | None) -> int | None:
+    """``workers`` (None: one per core) capped, with a note, at the cores this process has."""
     if workers is None:
-        return None, None
+        return None
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise ClusterError(f"--workers {workers!r}: a local cluster needs at least one worker")
-    if workers > CPU_COUNT:
-        return CPU_COUNT, (f"--workers {workers}: this machine gives this process "
-                           f"{CPU_COUNT} cores, and a run holds one core from start to end; "
-                           f"starting {CPU_COUNT} workers")
-    return workers, None
+    if workers <= CPU_COUNT:
+        return workers
+    print(f"note: --workers {workers}: this machine gives this process {CPU_COUNT} cores, and "
+          f"a run holds one core from start to end; starting {CPU_COUNT} workers", file=sys.stderr)
+    return CPU_COUNT
 
 
 def scheduler_address(scheduler_file: str | Path) -> str:
-    """The address in a scheduler file; ClusterError naming the file if it is missing,
-    unreadable or holds no address (Dask's own client waits for ever for a missing one)."""
+    """The address in a scheduler file, or ClusterError (Dask's client waits for ever)."""
     path = Path(scheduler_file)
     if not path.exists():
         raise ClusterError(f"scheduler file {path} does not exist (has the scheduler "
@@ -118,12 +103,8 @@ def scheduler_address(scheduler_file: str | Path) -> str:
 def connect(scheduler: str | None = None, workers: int | None = None,
             scheduler_file: str | None = None, timeout: float = CONNECT_TIMEOUT
             ) -> tuple[Client, LocalCluster | None]:
-    """(a client, the local cluster or None): of an existing scheduler, found as Dask's tools
-    find it (an address, a scheduler file, DASK_SCHEDULER_ADDRESS) and reached within
-    ``timeout`` s, or of a new local cluster of ``workers``. ClusterError, naming the
-    address or file, if none is reached or found, or for ``workers`` with a scheduler."""
-    import dask
-
+    """(a client, its local cluster or None) of a scheduler found as Dask's tools find it, else
+    of a new local cluster; ClusterError naming the address or file if none is reached."""
     if scheduler and scheduler_file:
         raise ClusterError("give the scheduler's address or its file, not both")
     if scheduler_file:
@@ -132,10 +113,7 @@ def connect(scheduler: str | None = None, workers: int | None = None,
         address = scheduler or dask.config.get("scheduler-address", None)
         where = "--scheduler" if scheduler else "DASK_SCHEDULER_ADDRESS or Dask's config"
     if not address:
-        workers, note = local_workers(workers)
-        if note:
-            print(f"note: {note}", file=sys.stderr)
-        cluster = local_cluster(workers)
+        cluster = local_cluster(local_workers(workers))
         return Client(cluster), cluster
     if workers is not None:
         raise ClusterError("--workers sizes a local cluster; an existing scheduler's "
@@ -152,18 +130,16 @@ def connect(scheduler: str | None = None, workers: int | None = None,
 
 
 class Completions:
-    """Futures as they complete (more may be added meanwhile), and their results, while the
-    cluster is watched: ``NoWorkers`` once the scheduler has counted no worker for
-    ``timeout`` s (Dask's ``as_completed`` has a deadline for the whole iteration instead)."""
+    """Futures as they complete (more may be added meanwhile) and their results, raising
+    ``NoWorkers`` once the cluster has had no worker for ``timeout`` s (Dask's
+    ``as_completed`` has a deadline for the whole iteration instead)."""
 
     def __init__(self, client, timeout: float):
         self.client, self.timeout = client, timeout
         self.interval = max(0.05, min(1.0, timeout / 4))   # Dask fails a shorter wait
         self.done: queue.SimpleQueue = queue.SimpleQueue()
-        self.waiting = 0
-        self.seen = False                   # a worker was counted at least once
-        self.gone_since: float | None = None
-        self.gone_at = ""                   # when none was first counted, for the message
+        self.waiting, self.seen = 0, False          # seen: a worker was counted once
+        self.gone: tuple[float, str] | None = None  # since when none was counted
         self.check()
 
     def add(self, future) -> None:
@@ -181,10 +157,7 @@ class Completions:
             yield future
 
     def result(self, future) -> Any:
-        """``future.result()``, checking the cluster while it waits (a result is fetched from
-        its worker, and computed again if that worker has just died)."""
-        from dask.distributed import TimeoutError
-
+        """``future.result()``, checking the cluster while a lost result is computed again."""
         while True:
             try:
                 return future.result(timeout=self.interval)
@@ -194,21 +167,18 @@ class Completions:
                 self.check()
 
     def check(self) -> None:
-        """``NoWorkers`` if there has been no worker for ``timeout`` s (asked after each wait
-        of ``interval`` s for a future)."""
-        now = time.monotonic()
         try:
             workers = len(self.client.nthreads())
         except OSError:                     # the scheduler cannot be reached: no worker either
             workers = 0
         if workers:
-            self.seen, self.gone_since = True, None
-        elif self.gone_since is None:
-            self.gone_since, self.gone_at = now, time.strftime("%Y-%m-%d %H:%M:%S")
-        elif now - self.gone_since >= self.timeout:
+            self.seen, self.gone = True, None
+        elif self.gone is None:
+            self.gone = time.monotonic(), time.strftime("%Y-%m-%d %H:%M:%S")
+        elif time.monotonic() - self.gone[0] >= self.timeout:
             since = "the last one left by" if self.seen else "none has joined since"
             raise NoWorkers(f"no worker in the cluster for {self.timeout:g} s ({since} "
-                            f"{self.gone_at}); the sweep stopped")
+                            f"{self.gone[1]}); the sweep stopped")
 
 
 def say(message: str) -> None:
@@ -216,8 +186,7 @@ def say(message: str) -> None:
 
 
 def worker_facts() -> dict[str, Any]:
-    """What the client checks of a worker before it sends work: its code, and why its FMU
-    cache is not safe to run FMUs from ("" if it is)."""
+    """A worker's code, and why its FMU cache is not safe to run FMUs from ("" if it is)."""
     try:
         fmu_cache()
         unsafe = ""
@@ -227,9 +196,8 @@ def worker_facts() -> dict[str, Any]:
 
 
 def check_workers(client) -> None:
-    """SweepError naming each worker that runs other code than this client, or whose FMU
-    cache is not private to its user; a warning for workers of more than one thread, or a
-    scheduler that queues more than one run per thread."""
+    """SweepError naming each worker that runs other code or whose FMU cache is not private;
+    the dashboard; a warning for workers of several threads or a scheduler that queues runs."""
     mine = code_version()
     try:
         facts = client.run(worker_facts, on_error="return")
@@ -246,23 +214,21 @@ def check_workers(client) -> None:
     if unsafe:
         raise SweepError("workers whose FMU cache is not safe to run FMUs from:\n"
                          + "\n".join(unsafe))
+    dashboard, saturation = client.run_on_scheduler(_scheduler)
+    if dashboard:
+        say(f"dashboard: {client.dashboard_link}")
     threaded = {a: n for a, n in client.nthreads().items() if n > 1}
     if threaded:
         say(f"warning: {', '.join(f'{a} has {n} threads' for a, n in threaded.items())}; a "
             "run holds the GIL from start to end, so threads of one worker take turns: start "
             "workers with --nthreads 1 and more processes (--nworkers)")
-    saturation = client.run_on_scheduler(_worker_saturation)
     if saturation != 1.0:
         say(f"warning: the scheduler's worker-saturation is {saturation}: it queues more than "
             "one run per worker thread, and a worker killed by one run takes the queued ones "
             "with it; start the scheduler with DASK_DISTRIBUTED__SCHEDULER__WORKER_SATURATION=1.0")
 
 
-def has_dashboard(dask_scheduler=None) -> bool:
-    """Whether the scheduler serves its dashboard (which needs bokeh where it runs)."""
-    return ("dashboard" in dask_scheduler.services
-            and importlib.util.find_spec("bokeh") is not None)
-
-
-def _worker_saturation(dask_scheduler=None) -> float:
-    return float(dask_scheduler.WORKER_SATURATION)
+def _scheduler(dask_scheduler=None) -> tuple[bool, float]:
+    """Whether the scheduler serves its dashboard (bokeh there), its worker-saturation."""
+    return ("dashboard" in dask_scheduler.services and importlib.util.find_spec("bokeh")
+            is not None, float(dask_scheduler.WORKER_SATURATION))

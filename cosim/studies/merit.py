@@ -8,17 +8,15 @@ from dataclasses import dataclass
 from autopilot_fmu.guidance import R_ACCEPT, route as followed_route
 
 from ..analysis.cost import cost
-from ..analysis.metrics import (cross_track_error, fraction_at_stops, heading_error,
-                                mean_abs_rate, peak, rms, route_completion,
-                                rudder_reversals_per_minute)
+from ..analysis.metrics import (cross_track_error, fraction_at_stops, heading_error, mean_abs_rate,
+                                peak, rms, route_completion, rudder_reversals_per_minute)
 
-METRICS = {"psi_E": "rad^2", "sum_delta2": "rad^2", "J": "rad^2",
-           "rms_heading_error_deg": "deg", "reversals_per_min": "1/min", "max_delta_deg": "deg",
-           "mean_rudder_rate_deg_s": "deg/s", "at_stops_pct": "%",
-           "cross_track_rms_m": "m", "cross_track_max_m": "m",
+# The figures of merit of a run and their units, as cosim.run prints them (floats, NaN in a
+# failed run's row).
+METRICS = {"psi_E": "rad^2", "sum_delta2": "rad^2", "J": "rad^2", "rms_heading_error_deg": "deg",
+           "reversals_per_min": "1/min", "max_delta_deg": "deg", "mean_rudder_rate_deg_s": "deg/s",
+           "at_stops_pct": "%", "cross_track_rms_m": "m", "cross_track_max_m": "m",
            "waypoints_reached": "", "waypoints": "", "last_waypoint_reached": ""}
-"""The figures of merit of a run and their units, as ``cosim.run`` prints them; every value
-is a float, NaN in a failed run's row."""
 
 
 @dataclass(frozen=True)
@@ -40,14 +38,13 @@ class Merit:
         return "lower is better" if self.lower_is_better else "higher is better"
 
     def format(self, value: float, sign: str = "") -> str:
-        """``value`` to this criterion's decimals, '-' if it is not finite; ``sign="+"``
-        signs it."""
+        """``value`` to this criterion's decimals ('-' if not finite); ``sign="+"`` signs it."""
         if not math.isfinite(value):
             return "-"
         return f"{value:{sign}g}" if self.digits == 0 else f"{value:{sign}.{self.digits}f}"
 
 
-CRITERIA = (
+CRITERIA = (                        # what a scorecard compares controllers by
     Merit("J", "J of eq (19)"),
     Merit("rms_heading_error_deg", "RMS heading error psi_d - psi", paired="difference",
           digits=2),
@@ -59,19 +56,17 @@ CRITERIA = (
     Merit("waypoints_reached", "waypoints reached", lower_is_better=False,
           paired="difference", digits=0, out_of="waypoints"),
 )
-"""The criteria a scorecard compares controllers by."""
 
 
 def route_of(recording) -> tuple[list[tuple[float, float]], float]:
-    """The route the run's guidance followed (m) and its radius of acceptance (m), from the
-    parameter values the FMUs used."""
+    """The route the run's guidance followed and its radius of acceptance (m)."""
     guidance = recording.meta.get("parameters", {}).get("guidance", {})
     return followed_route(guidance), float(guidance.get("R_accept", R_ACCEPT))
 
 
-def track(recording, every: float = 1.0) -> dict:
-    """The run's track every ``every`` s, its route and radius of acceptance (tracks figure)."""
-    stride = max(1, round(every / recording.meta["step_size"]))
+def track(recording) -> dict:
+    """The run's track every 1 s, its route and radius of acceptance (the tracks figure)."""
+    stride = max(1, round(1.0 / recording.meta["step_size"]))
     points, R_accept = route_of(recording)
     return {"x": recording["ship.x"][::stride].tolist(),
             "y": recording["ship.y"][::stride].tolist(),
@@ -79,13 +74,10 @@ def track(recording, every: float = 1.0) -> dict:
 
 
 def run_metrics(recording) -> dict[str, float]:
-    """Every figure of ``METRICS``: eq (19); the RMS heading error psi_d - psi; of the actual
-    rudder ship.delta its largest angle, reversals per minute, mean absolute rate and time
-    on the stops; the RMS and largest cross-track error from the leg followed; and the
-    waypoints reached, within the circle of acceptance, of those the route has."""
+    """Every figure of ``METRICS``: eq (19), the heading error psi_d - psi, the actual rudder
+    ship.delta, the cross-track error from the leg followed and the waypoints reached."""
     c = cost(recording)
-    t, delta, x, y = (recording.t, recording["ship.delta"], recording["ship.x"],
-                      recording["ship.y"])
+    t, delta, x, y = recording.t, recording["ship.delta"], recording["ship.x"], recording["ship.y"]
     points, R_accept = route_of(recording)
     stops = recording.meta.get("parameters", {}).get("ship", {}).get("delta_max", math.inf)
     off_track = cross_track_error(x, y, recording["guidance.wp_index"], points)

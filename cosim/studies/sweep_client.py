@@ -1,6 +1,5 @@
 """A sweep's client side: runs submitted to a Dask cluster (on the batch backend in batches,
-``plan``), the workers checked and watched, and each row journaled as it completes: the
-``Journal`` a sweep resumes from."""
+``plan``) and each row journaled as it completes (the ``Journal`` a sweep resumes from)."""
 from __future__ import annotations
 
 import contextlib
@@ -13,31 +12,25 @@ import uuid
 from pathlib import Path
 
 from fmukit.timebase import step_count
+from tqdm import tqdm
 
 from ..core.interrupt import Interrupted, StopSignals
 from ..core.watchdog import Limits
 from ..ensemble import SIGNALS
-from .cluster import Completions, NoWorkers, check_workers, has_dashboard, say
+from .cluster import Completions, NoWorkers, check_workers, say
 from .sweep_spec import Spec
-from .sweep_task import (BATCH, Job, SweepTeardown, batch_refusal, blank_row, fmu_bytes, noted,
-                         run_batch)
+from .sweep_task import BATCH, Job, SweepTeardown, batch_refusal, blank_row, noted, run_batch
 
-MAX_BATCH = 1024
-"""The most runs a batch gets unless told otherwise (``--batch-size``)."""
-BATCH_MEMORY = 128 << 20
-"""Bytes a batch's recorded signals may take on its worker."""
-MIN_BATCH = 32
-"""The fewest runs a batch is cut down to for keeping workers busy (``batch_counts``)."""
-WAVES_SHARE = 128
-"""The fewest runs a batch in waves is cut down to for giving every worker a share."""
+MAX_BATCH = 1024            # the most runs a batch gets unless --batch-size says
+BATCH_MEMORY = 128 << 20    # bytes a batch's recorded signals may take on its worker
+MIN_BATCH = 32              # the fewest runs a batch is cut down to for keeping workers busy
+WAVES_SHARE = 128           # the fewest a batch in waves is cut down to for sharing workers
 
 
 def read_rows(path: Path, quiet: bool = False) -> dict[str, dict]:
-    """The rows of a journal by run id (a later row for a run replaces an earlier); a line
-    that is not a whole row (a write cut short by a kill) is skipped, with a warning."""
+    """A journal's rows by run id, the last for each; a torn line is skipped, with a warning."""
     rows: dict[str, dict] = {}
-    lines = path.read_text().splitlines() if path.exists() else []
-    for number, line in enumerate(lines, 1):
+    for number, line in enumerate(path.read_text().splitlines() if path.exists() else [], 1):
         try:
             row = json.loads(line)
             rows[row["run_id"]] = row
@@ -49,16 +42,13 @@ def read_rows(path: Path, quiet: bool = False) -> dict[str, dict]:
 
 
 class Journal:
-    """A sweep's journal, opened by its one writer (who holds the folder's ``FolderLock``):
-    its rows, and ``add``, which appends a row and flushes it to the file."""
+    """A sweep's journal, opened by its one writer (who holds the folder's ``FolderLock``)."""
 
     def __init__(self, path: Path):
         self.path, self.rows = path, read_rows(path)
-        if path.exists() and path.stat().st_size:   # a torn last line: its own
-            with open(path, "rb+") as f:
-                f.seek(-1, os.SEEK_END)
-                if f.read(1) != b"\n":
-                    f.write(b"\n")
+        if path.exists() and path.read_bytes()[-1:] not in (b"", b"\n"):  # a torn last line
+            with open(path, "ab") as f:
+                f.write(b"\n")
 
     def add(self, row: dict) -> None:
         with open(self.path, "a") as f:
@@ -69,7 +59,7 @@ class Journal:
 
 
 def batch_limit(job: Job) -> int:
-    """The most runs a batch of ``job``'s system and stop time gets by default."""
+    """The most runs a batch of ``job``'s system and stop time gets by default (memory)."""
     system = job.bundle.system
     stop = system.stop_time if job.stop_time is None else job.stop_time
     rows = step_count(system.start_time, stop, system.step_size) + 1
@@ -77,11 +67,9 @@ def batch_limit(job: Job) -> int:
 
 
 def batch_counts(groups: list[list[Job]], workers: int, size: int | None = None) -> list[int]:
-    """How many batches each group (runs of one system and stop time) is cut into: with
-    ``size``, batches of at most ``size``; by default as few as ``batch_limit`` allows, in
-    waves one per worker where they keep ``WAVES_SHARE`` runs; then, while there are fewer
-    batches than ``workers``, the group of the largest batches gets one more, as long as
-    they keep ``MIN_BATCH`` runs (why: docs/sweeps.md, the batch backend)."""
+    """How many batches each group (runs of one system and stop time) is cut into: of at most
+    ``size``, or by the rule of docs/sweeps.md (the batch backend): as few as ``batch_limit``
+    allows, in waves one per worker, then one more for the largest while under ``workers``."""
     if size:
         return [math.ceil(len(group) / size) for group in groups]
     counts = [math.ceil(len(group) / batch_limit(group[0])) for group in groups]
@@ -96,56 +84,42 @@ def batch_counts(groups: list[list[Job]], workers: int, size: int | None = None)
 
 
 def _in_waves(job: Job) -> bool:
-    """Whether ``job``'s ship sails in waves (ship.Hs > 0, as set or as its system binds it)."""
     ship = job.bundle.system.parameters(job.overrides).get("ship", {})
     return float(ship.get("Hs", 0.0)) > 0.0
 
 
-def _cut(jobs: list[Job], count: int) -> list[list[Job]]:
-    """``jobs`` in ``count`` batches of near-equal size, in their order."""
-    cuts = [round(k * len(jobs) / count) for k in range(count + 1)]
-    return [jobs[a:b] for a, b in zip(cuts, cuts[1:])]
-
-
 def plan(spec: Spec, jobs: list[Job], workers: int, size: int | None = None
          ) -> tuple[list[list[Job]], list[Job]]:
-    """(the batches, the runs to run alone) of a sweep on the batch backend: each system's
-    runs of one stop time cut as ``batch_counts`` says, those the kernel does not cover
-    (``Spec.batch_coverage``) alone."""
+    """(the batches, the runs the kernel does not cover) on the batch backend."""
     groups: dict[tuple[str, float | None], list[Job]] = {}
     alone = []
     for job in jobs:
-        if spec.batch_coverage()[job.run["controller"]] is None:
+        if spec.batch_coverage[job.run["controller"]] is None:
             groups.setdefault((job.bundle.digest, job.stop_time), []).append(job)
         else:
             alone.append(job)
-    counts = batch_counts(list(groups.values()), workers, size)
-    return [batch for group, count in zip(groups.values(), counts)
-            for batch in _cut(group, count)], alone
+    batches = []                                # each group in near-equal parts, in order
+    for group, count in zip(groups.values(), batch_counts(list(groups.values()), workers, size)):
+        cuts = [round(k * len(group) / count) for k in range(count + 1)]
+        batches += [group[a:b] for a, b in zip(cuts, cuts[1:])]
+    return batches, alone
 
 
 def run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, progress: bool,
                    task, backend: str, no_worker_timeout: float, limits: Limits,
                    batch_task=run_batch, batch_size: int | None = None) -> None:
-    """Run ``todo`` (runs of ``spec``) on the cluster of ``connection`` (a client, and the
-    local cluster it made or None): check the workers, send the FMUs and the runs, journal
-    each row as it completes; close both on every path (``_close``)."""
-    from tqdm import tqdm
-
+    """Run ``todo`` on ``connection`` (client, local cluster or None), journaling each row."""
     client, cluster = connection
     teardown = SweepTeardown(uuid.uuid4().hex[:12])
     token, tasks, shipped = teardown.sweep, {}, {}
     try:
-        if client.run_on_scheduler(has_dashboard):
-            say(f"dashboard: {client.dashboard_link}")
         check_workers(client)
         client.register_plugin(teardown)
         # Each FMU as a task holding its bytes, not scattered data: a task's result lost with
         # its worker is computed again, scattered data is gone, and every run with it. Keyed
         # by sweep: another sweep's release of a shared key would strand this one's runs.
-        shipped = {sha: client.submit(fmu_bytes, path.read_bytes(), key=f"fmu-{token}-{sha}",
-                                      pure=False)
-                   for sha, path in spec.files().items()}
+        shipped = {sha: client.submit(bytes, fmu.read_bytes(), key=f"fmu-{token}-{sha}", pure=False)
+                   for sha, fmu in spec.files().items()}
         completions = Completions(client, no_worker_timeout)
 
         def submit(jobs: list[Job], batch: bool, why: str = "") -> None:
@@ -197,7 +171,6 @@ def run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, p
 
 
 def _say_batch_refusals(client) -> None:
-    """A note for each reason workers give to refuse the batch route, naming them."""
     try:
         refusals = client.run(batch_refusal, on_error="return")
     except Exception:                       # a worker gone: its runs' rows will say
@@ -214,24 +187,18 @@ def _say_batch_refusals(client) -> None:
 
 def _close(client, cluster, teardown: SweepTeardown, journal: Journal,
            stopped: BaseException | None = None) -> None:
-    """Close the client, and the local cluster it made (closing its workers frees
-    everything); on a shared cluster, free this sweep's FMUs on the workers first. After
-    the sweep ``stopped`` early, quietly (``campaign.execute`` says the rest); after Ctrl-C
-    or SIGTERM a second signal ends the process at once (``StopSignals``)."""
+    """Close the client and its local cluster, or free this sweep's FMUs on a shared one."""
     level = logging.root.manager.disable         # distributed's loggers set their own levels
-    logging.disable(logging.CRITICAL if stopped is not None else level)
-    try:
-        with contextlib.ExitStack() as stack:
-            if isinstance(stopped, Interrupted):
-                again = stack.enter_context(StopSignals())
-                again.received = stopped.signal         # the next one is the second
-                again.keep(lambda: f"{journal.path} keeps every run done "
-                                   f"({len(journal.rows)})")
-            if cluster is None:
-                with contextlib.suppress(Exception):     # workers gone with Ctrl-C
-                    client.unregister_worker_plugin(teardown.name)
-            client.close()
-            if cluster is not None:
-                cluster.close()
-    finally:
-        logging.disable(level)
+    with contextlib.ExitStack() as stack:
+        stack.callback(logging.disable, level)
+        logging.disable(logging.CRITICAL if stopped is not None else level)
+        if isinstance(stopped, Interrupted):
+            again = stack.enter_context(StopSignals())
+            again.received = stopped.signal         # the next one is the second
+            again.keep(lambda: f"{journal.path} keeps every run done ({len(journal.rows)})")
+        if cluster is None:
+            with contextlib.suppress(Exception):     # workers gone with Ctrl-C
+                client.unregister_worker_plugin(teardown.name)
+        client.close()
+        if cluster is not None:
+            cluster.close()

@@ -1,9 +1,5 @@
-"""A sweep's spec: its controllers, axes and runs (the file: ``spec_file``, docs/sweeps.md).
-
-A run is one controller at one combination of axis values; its id hashes everything that
-determines its result (``Spec.runs``). Combinations that differ only in settings that change
-nothing (``CALM_WATER_INERT`` in calm water) have one result, run once (``shared_runs``).
-"""
+"""A sweep's spec: its controllers, axes and runs (docs/sweeps.md). A run's id hashes all that
+determines its result; combinations that differ only in what changes nothing run once."""
 from __future__ import annotations
 
 import hashlib
@@ -23,16 +19,16 @@ from ..core.inprocess import fallback_note, in_process_refusal
 from ..core.ssd import SystemDescription
 from ..core.values import Declaration, declarations
 from ..core.watchdog import Limits
+from ..ensemble.members import coverage
 from ..provenance import code_version
 from .bundle import Bundle, bundle
 from .spec_file import MAX_RUNS, assignments, check_values, parse
 from .sweep_task import Job
 
-SHIP_SLAVE = "ship_fmu.ship_slave"
-"""The module of this project's ship FMU (its manifest's slave module)."""
+SHIP_SLAVE = "ship_fmu.ship_slave"        # this project's ship FMU (its manifest's module)
+# The ship's parameters that change no bit of a run in calm water (Hs = 0: no wave loads,
+# ship_fmu.vessel.Vessel; tests/test_sweep_replay.py), for this checkout's ship FMU.
 CALM_WATER_INERT = ("T0", "psi_w", "wave_seed", "wave_components")
-"""The ship's parameters that change no bit of a run in calm water (Hs = 0: no wave loads,
-``ship_fmu.vessel.Vessel``; tests/test_sweep_replay.py), for this checkout's ship FMU."""
 REPLAY = ("python", "-m", "cosim.run")
 
 
@@ -48,8 +44,7 @@ class Spec:
 
     @classmethod
     def read(cls, path: str | Path, max_runs: int = MAX_RUNS) -> Spec:
-        """Parse and check a sweep file (``spec_file``); ValueError naming the file, the key
-        and the problem (FmuNotFound or FmuUnreadable for a missing or broken FMU)."""
+        """A sweep file parsed and checked; ValueError naming the file, key and problem."""
         path = Path(path)
         spec = cls(**parse(path, max_runs))
         try:
@@ -61,7 +56,6 @@ class Spec:
 
     @cached_property
     def _shipped(self) -> dict[str, tuple[Bundle, dict[str, Path], SystemDescription]]:
-        """Each controller's bundle, its FMUs by SHA-256 and its system here (read once)."""
         return {name: bundle(controller) for name, controller in self.controllers.items()}
 
     def bundles(self) -> dict[str, Bundle]:
@@ -70,25 +64,25 @@ class Spec:
 
     def files(self) -> dict[str, Path]:
         """Every FMU the sweep uses, by SHA-256."""
-        return {sha: path for _, files, _ in self._shipped.values()
-                for sha, path in files.items()}
+        return {sha: path for _, files, _ in self._shipped.values() for sha, path in files.items()}
 
-    def _description(self, controller: str, component: str) -> tuple[Path, Any]:
-        """A component's FMU in a controller's system, and its model description."""
-        source = self.bundles()[controller].system.components[component].source
-        fmu = self.files()[Path(source).stem]
-        return fmu, read_description(fmu, component)
+    @cached_property
+    def _fmus(self) -> dict[tuple[str, str], tuple[Path, dict[str, Any], dict[str, Declaration]]]:
+        """(controller, component): its FMU, model variables and their declarations."""
+        fmus = {}
+        for controller, shipped in self.bundles().items():
+            for name, component in shipped.system.components.items():
+                fmu = self.files()[Path(component.source).stem]
+                description = read_description(fmu, name)
+                fmus[controller, name] = (fmu, {v.name: v for v in description.modelVariables},
+                                          declarations(description))
+        return fmus
 
-    def declared(self, controller: str, component: str) -> tuple[Path, dict[str, Declaration]]:
-        """A component's FMU in a controller's system, and its variables' declarations."""
-        fmu, description = self._description(controller, component)
-        return fmu, declarations(description)
-
-    def _variable(self, controller: str, target: str):
-        """The model variable ``target`` (component.variable) of a controller's system."""
-        component, _, name = target.partition(".")
-        description = self._description(controller, component)[1]
-        return next(v for v in description.modelVariables if v.name == name)
+    def declared(self, controller: str, component: str
+                 ) -> tuple[Path | None, dict[str, Declaration]]:
+        """A component's FMU and its variables' declarations; (None, {}) for no component."""
+        fmu, _, variables = self._fmus.get((controller, component), (None, None, {}))
+        return fmu, variables
 
     def runs(self) -> list[dict[str, Any]]:
         """Every combination of controller and axis values, with its run id."""
@@ -103,40 +97,32 @@ class Spec:
         return runs
 
     def shared_runs(self) -> list[list[dict[str, Any]]]:
-        """The runs (in ``runs``' order) grouped by result: runs of one controller whose
-        settings differ only in ``CALM_WATER_INERT`` in calm water. Each group runs once."""
+        """The runs grouped by result: differing only in ``CALM_WATER_INERT`` in calm water."""
         groups: dict[str, list[dict[str, Any]]] = {}
         for run in self.runs():
-            overrides = self.settings(run)[1]
-            calm = self._calm_ships(run["controller"], overrides)
+            calm = self._calm_ships(run)
             effective = {component: {variable: value for variable, value in values.items()
-                                     if component not in calm
-                                     or variable not in CALM_WATER_INERT}
-                         for component, values in overrides.items()}
+                                     if component not in calm or variable not in CALM_WATER_INERT}
+                         for component, values in self.settings(run)[1].items()}
             key = _digest({"controller": run["controller"], "settings": effective})
             groups.setdefault(key, []).append(run)
         return list(groups.values())
 
     @cached_property
     def _ships(self) -> dict[str, dict[str, Any]]:
-        """Each controller's components that are this checkout's ship FMU, with the Hs their
-        system binds or their FMU declares."""
-        ships: dict[str, dict[str, Any]] = {}
-        for controller, shipped in self.bundles().items():
-            ships[controller] = {}
-            for name, component in shipped.system.components.items():
-                fmu = self._description(controller, name)[0]
-                manifest = read_manifest(fmu)
-                if (manifest is not None and manifest.slave_module == SHIP_SLAVE
-                        and in_process_refusal(fmu) is None):
-                    Hs = component.parameters.get("Hs")
-                    ships[controller][name] = (self._variable(controller, f"{name}.Hs").start
-                                               if Hs is None else Hs)
+        """Each controller's components that are our ship FMU: the Hs they start with."""
+        ships: dict[str, dict[str, Any]] = {controller: {} for controller in self.controllers}
+        for (controller, name), (fmu, variables, _) in self._fmus.items():
+            manifest = read_manifest(fmu)
+            if (manifest is not None and manifest.slave_module == SHIP_SLAVE
+                    and in_process_refusal(fmu) is None):
+                bound = self.bundles()[controller].system.components[name].parameters
+                ships[controller][name] = bound.get("Hs", variables["Hs"].start)
         return ships
 
-    def _calm_ships(self, controller: str, overrides: dict[str, dict[str, Any]]) -> list[str]:
-        """The components of a run that are this checkout's ship FMU with Hs = 0."""
-        return [name for name, Hs in self._ships[controller].items()
+    def _calm_ships(self, run: dict[str, Any]) -> list[str]:
+        overrides = self.settings(run)[1]
+        return [name for name, Hs in self._ships[run["controller"]].items()
                 if float(overrides.get(name, {}).get("Hs", Hs)) == 0.0]
 
     def sharing_notes(self) -> list[str]:
@@ -144,31 +130,26 @@ class Spec:
         savings: dict[tuple[str, tuple[str, ...]], list[int]] = {}
         for group in self.shared_runs():
             if len(group) > 1:
-                varying = tuple(a for a in self.axes
-                                if len({json.dumps(r[a]) for r in group}) > 1)
-                counts = savings.setdefault((self._calm_because(group[0]), varying), [0, 0])
-                counts[0] += 1
-                counts[1] += len(group)
+                varying = tuple(a for a in self.axes if len({json.dumps(r[a]) for r in group}) > 1)
+                savings.setdefault((self._calm_because(group[0]), varying), []).append(len(group))
         notes = []
-        for (why, varying), (runs, combinations) in savings.items():
+        for (why, varying), sizes in savings.items():
             axes = (f"the {varying[0]} axis does" if len(varying) == 1 else
                     f"the {', '.join(varying[:-1])} and {varying[-1]} axes do")
-            notes.append(f"{why} is calm water (Hs = 0): {axes} not apply there; "
-                         f"{runs} run{'s' if runs > 1 else ''} instead of {combinations}")
+            notes.append(f"{why} is calm water (Hs = 0): {axes} not apply there; {len(sizes)} "
+                         f"run{'s' if len(sizes) > 1 else ''} instead of {sum(sizes)}")
         return notes
 
     def _calm_because(self, run: dict[str, Any]) -> str:
         """What makes a run's sea calm: the axis value that sets Hs = 0, else its system."""
-        controller = run["controller"]
-        ships = self._calm_ships(controller, self.settings(run)[1])
         for axis in self.axes:
-            if any(f"{ship}.Hs" in assignments(axis, run[axis]) for ship in ships):
+            if any(f"{ship}.Hs" in assignments(axis, run[axis]) for ship in self._calm_ships(run)):
                 return f"{axis} {run[axis]}"
+        controller = run["controller"]
         return f"controller {controller!r} ({self.bundles()[controller].system.name})"
 
     def replay(self, run: dict[str, Any]) -> str:
-        """The ``cosim.run`` command that reproduces ``run``'s row bit for bit (each setting
-        as ``--set``, as text that reads back as exactly its value)."""
+        """The ``cosim.run`` command that reproduces ``run``'s row bit for bit."""
         controller = self.controllers[run["controller"]]
         scenario, overrides = self.settings(run)
         words = [*REPLAY, scenario]
@@ -176,8 +157,7 @@ class Spec:
             words += ["--autopilot", controller["autopilot"]]
             for port, renamed in controller["map"].items():
                 words += ["--map", f"{port}={renamed}"]
-        stop_time = (self.stop_time if self.stop_time is not None
-                     else self.bundles()[run["controller"]].system.stop_time)
+        stop_time = self.stop_time or self.bundles()[run["controller"]].system.stop_time
         words += ["--stop-time", _exact(stop_time)]
         for component, values in overrides.items():
             for variable, value in values.items():
@@ -189,29 +169,28 @@ class Spec:
         controller = next(iter(self.controllers))
         units = {}
         for axis, values in self.axes.items():
-            targets = list(assignments(axis, values[0]))
-            variable = self._variable(controller, targets[0])
+            target, *others = assignments(axis, values[0])
+            component, _, name = target.partition(".")
+            variable = self._fmus[controller, component][1][name]
             declared = variable.declaredType.unit if variable.declaredType else ""
-            units[axis] = "" if len(targets) > 1 else variable.unit or declared or ""
+            units[axis] = "" if others else variable.unit or declared or ""
         return units
 
     def job(self, run: dict[str, Any], sweep: str, backend: str = "fmi",
             limits: Limits = Limits()) -> Job:
-        """What a worker needs for ``run`` (of the sweep with token ``sweep``), recording
-        its track if [plots] tracks selects it."""
+        """What a worker needs for ``run`` of the sweep whose token is ``sweep``."""
         track = self.tracks is not None and all(run.get(k) == v for k, v in self.tracks.items())
         return Job(sweep=sweep, run=run, bundle=self.bundles()[run["controller"]],
                    overrides=self.settings(run)[1], stop_time=self.stop_time, track=track,
                    code=code_version(), backend=backend, limits=limits)
 
     def backend_notes(self, backend: str) -> list[str]:
-        """Which components will run through FMI although ``backend`` is "inprocess" or
-        "batch", and on "batch" which controllers' runs run alone, and why."""
+        """What runs through FMI on "inprocess" or "batch", and alone on "batch", and why."""
         if backend not in ("inprocess", "batch"):
             return []
         notes = []
         for controller, shipped in self.bundles().items():
-            why = self.batch_coverage()[controller] if backend == "batch" else None
+            why = self.batch_coverage[controller] if backend == "batch" else None
             if why:
                 notes.append(f"controller {controller!r} runs on the in-process route, one "
                              f"run per task, not in batches: {why}")
@@ -222,20 +201,15 @@ class Spec:
         return notes
 
     @cached_property
-    def _coverage(self) -> dict[str, str | None]:
-        from ..ensemble.members import coverage
-
-        return {name: coverage(system) for name, (_, _, system) in self._shipped.items()}
-
     def batch_coverage(self) -> dict[str, str | None]:
         """Each controller: why the batch kernel cannot run its system, None if it can."""
-        return self._coverage
+        return {name: coverage(system) for name, (_, _, system) in self._shipped.items()}
 
     def settings(self, run: dict[str, Any]) -> tuple[str, dict[str, dict[str, Any]]]:
         """(scenario, overrides by component) of one run."""
         controller = self.controllers[run["controller"]]
         overrides: dict[str, dict[str, Any]] = {}
-        for target, value in [*controller.get("set", {}).items(),
+        for target, value in [*controller["set"].items(),
                               *(pair for axis in self.axes
                                 for pair in assignments(axis, run[axis]).items())]:
             component, _, variable = target.partition(".")
@@ -244,14 +218,12 @@ class Spec:
 
 
 def _digest(identity: dict[str, Any]) -> str:
-    """A short hash of a JSON-able identity."""
     key = json.dumps(identity, sort_keys=True, default=str)
     return hashlib.sha256(key.encode()).hexdigest()[:16]
 
 
 def _exact(value: Any) -> str:
-    """A setting as ``--set`` text that reads back as exactly the value: a float's repr
-    (the shortest text of that double), true or false for a Boolean."""
+    """A setting as ``--set`` text that reads back as exactly the value."""
     if isinstance(value, bool):
         return "true" if value else "false"
     return repr(value) if isinstance(value, float) else str(value)

@@ -1,7 +1,5 @@
 """A sweep's rows as tables: results.parquet, .csv and .json, summary.csv and the printed
-summary (each figure of merit per setting and controller, each run counted once), and
-comparison.md (every controller against the PD, seed by seed).
-"""
+summary (per setting and controller, each run counted once), and comparison.md's table."""
 from __future__ import annotations
 
 import itertools
@@ -16,14 +14,11 @@ from ..core.files import write_atomically
 from .merit import METRICS
 from .sweep_spec import Spec
 
-TIMES = {"seconds": "s", "sim_seconds": "s"}
-"""A row's wall-clock times: its task's, and its run's alone (in a batch: its share)."""
-MONTE_CARLO = "wave_seed"
-"""The axis the statistics are taken over, and that pairs runs (the same sea)."""
-STATISTICS = ("median", "q25", "q75", "min", "max")
-"""What summary.csv gives of each figure of merit over the runs of a setting."""
-MOST_PRINTED = 48
-"""The most lines of the printed summary's table: a larger sweep prints its axes one by one."""
+TIMES = {"seconds": "s", "sim_seconds": "s"}    # the task's wall time; the run's (or its share)
+MONTE_CARLO = "wave_seed"           # the axis statistics are taken over, that pairs runs
+STATISTICS = ("median", "q25", "q75", "min", "max")     # of each figure, in summary.csv
+MOST_PRINTED = 48                   # lines of the printed table, past which it pools axes
+SHOWN_FAILURES = 10                 # failed runs the summary names
 
 
 def headed(name: str, unit: str) -> str:
@@ -31,17 +26,16 @@ def headed(name: str, unit: str) -> str:
     return f"{name} [{unit}]" if unit else name
 
 
-def write_tables(rows: list[dict], out: Path, csv: bool, spec: Spec | None = None
-                 ) -> list[Path]:
+def write_tables(rows: list[dict], out: Path, csv: bool, spec: Spec) -> list[Path]:
     """results.parquet (units in its field metadata), results.csv with ``csv`` (units in its
-    headers), results.json (every column's unit) and, with ``spec``, summary.csv."""
+    headers), results.json (every column's unit) and summary.csv."""
     import pyarrow as pa
     import pyarrow.csv as pacsv
     import pyarrow.parquet as pq
 
     table = pa.Table.from_pylist([{k: (json.dumps(v) if isinstance(v, (list, dict)) else v)
                                    for k, v in row.items() if k != "track"} for row in rows])
-    known = {**(spec.units() if spec is not None else {}), **METRICS, **TIMES}
+    known = {**spec.units(), **METRICS, **TIMES}
     unit = {name: known.get(name, "") for name in table.column_names}
     table = table.cast(pa.schema([field.with_metadata({"unit": unit[field.name]})
                                   for field in table.schema]))
@@ -52,11 +46,9 @@ def write_tables(rows: list[dict], out: Path, csv: bool, spec: Spec | None = Non
         with_units = table.rename_columns([headed(n, unit[n]) for n in table.column_names])
         written.append(write_atomically(out / "results.csv",
                                         lambda p: pacsv.write_csv(with_units, p)))
-    if spec is not None:
-        header, *lines = summary_table(spec, rows)
-        summary = pa.Table.from_pylist([dict(zip(header, line)) for line in lines])
-        written.append(write_atomically(out / "summary.csv",
-                                        lambda p: pacsv.write_csv(summary, p)))
+    header, *lines = summary_table(spec, rows)
+    summary = pa.Table.from_pylist([dict(zip(header, line)) for line in lines])
+    written.append(write_atomically(out / "summary.csv", lambda p: pacsv.write_csv(summary, p)))
     return written
 
 
@@ -67,21 +59,18 @@ def _settings(spec: Spec) -> tuple[list[str], list[dict[str, Any]]]:
                   for values in itertools.product(*(spec.axes[a] for a in axes))]
 
 
-def _in(row: dict, where: dict[str, Any]) -> bool:
-    return all(json.dumps(row[a]) == json.dumps(v) for a, v in where.items())
-
-
-def _ran_as(row: dict) -> str:
-    return row.get("ran_as", row["run_id"])
+def select(rows: list[dict], controller: str, where: dict[str, Any]) -> list[dict]:
+    """The rows of ``controller`` at the axis values ``where``."""
+    return [r for r in rows if r["controller"] == controller
+            and all(json.dumps(r[a]) == json.dumps(v) for a, v in where.items())]
 
 
 def distinct(rows: list[dict]) -> list[dict]:
     """One row per run: a result shared by several combinations counts once."""
-    return list({_ran_as(r): r for r in rows}.values())
+    return list({r.get("ran_as", r["run_id"]): r for r in rows}.values())
 
 
 def _statistics(values: np.ndarray) -> list[float]:
-    """``STATISTICS`` of ``values`` (NaN for none)."""
     if not values.size:
         return [math.nan] * len(STATISTICS)
     q25, median, q75 = np.percentile(values, [25, 50, 75])
@@ -89,14 +78,13 @@ def _statistics(values: np.ndarray) -> list[float]:
 
 
 def summary_table(spec: Spec, rows: list[dict]) -> list[list]:
-    """Header and lines of summary.csv: per setting (the axes but ``MONTE_CARLO``) and
-    controller, the runs ok and failed and each figure of merit's ``STATISTICS``."""
+    """summary.csv: per setting and controller, the runs ok and failed, each ``STATISTICS``."""
     axes, settings = _settings(spec)
     lines = [[*axes, "controller", "runs ok", "runs failed",
               *(headed(f"{metric} {name}", unit) for metric, unit in METRICS.items()
                 for name in STATISTICS)]]
     for where, controller in itertools.product(settings, spec.controllers):
-        mine = distinct([r for r in rows if r["controller"] == controller and _in(r, where)])
+        mine = distinct(select(rows, controller, where))
         ok = [r for r in mine if r["status"] == "ok"]
         lines.append([*where.values(), controller, len(ok), len(mine) - len(ok), *(
             value for metric in METRICS for value in _statistics(
@@ -104,29 +92,12 @@ def summary_table(spec: Spec, rows: list[dict]) -> list[list]:
     return lines
 
 
-def summary(spec: Spec, rows: list[dict], shown_failures: int = 10) -> str:
-    """Runs ok and failed; J per setting and controller; each failed run with its message."""
+def summary(spec: Spec, rows: list[dict]) -> str:
+    """Runs ok and failed; J per setting and controller (past ``MOST_PRINTED`` lines per value
+    of each axis, pooled over the others); each failed run with its message."""
     runs = distinct(rows)
     ok = [r for r in runs if r["status"] == "ok"]
     shared = len(rows) - len(runs)
-    lines = [f"{spec.name}: " + (f"{len(rows)} combinations in {len(runs)} runs ({shared} "
-                                 "share an equivalent run's result)" if shared else
-                                 f"{len(rows)} runs")
-             + f", {len(ok)} ok, {len(runs) - len(ok)} failed", *_J_lines(spec, ok)]
-    failed = [r for r in runs if r["status"] != "ok"]
-    for r in failed[:shown_failures]:
-        axes = ", ".join(f"{a} = {r[a]}" for a in spec.axes)
-        said = [line.strip() for line in r["error"].splitlines()[:2]]   # the call, the FMU's words
-        lines.append(f"  failed {r['controller']} ({axes}): {' / '.join(said)[:300]}")
-    if len(failed) > shown_failures:
-        lines.append(f"  ... and {len(failed) - shown_failures} more failed runs (results.parquet "
-                     "has every message)")
-    return "\n".join(lines)
-
-
-def _J_lines(spec: Spec, ok: list[dict]) -> list[str]:
-    """The printed table of J over the distinct runs ``ok``: per setting and controller, or
-    past ``MOST_PRINTED`` lines per value of each axis, pooled over the others."""
     axes, settings = _settings(spec)
     groups = [(" ".join(str(v) for v in where.values()), where) for where in settings]
     pooled = len(groups) * len(spec.controllers) > MOST_PRINTED
@@ -135,28 +106,38 @@ def _J_lines(spec: Spec, ok: list[dict]) -> list[str]:
     per = "per value of each axis (pooled over the other axes)" if pooled else "per setting"
     over = f"over {MONTE_CARLO}; " if MONTE_CARLO in spec.axes else ""
     label = "setting" if pooled else " ".join(axes) or "all"
-    lines = [f"J of eq (19) [rad^2] {per} and controller: median, IQR (interquartile range, "
-             f"25th to 75th percentile), least and greatest of its runs ok ({over}a run shared "
-             "by several combinations counted once)"
-             + ("; summary.csv has every setting" if pooled else "")]
     wide = max(len(label), *(len(name) for name, _ in groups))
     named = max(len("controller"), *(len(c) for c in spec.controllers))
-    lines.append(f"  {label:<{wide}}  {'controller':<{named}}  runs    median  "
-                 f"{'IQR':^19}  {'least - greatest':^19}".rstrip())
+    lines = [f"{spec.name}: " + (f"{len(rows)} combinations in {len(runs)} runs ({shared} "
+                                 "share an equivalent run's result)" if shared else
+                                 f"{len(rows)} runs")
+             + f", {len(ok)} ok, {len(runs) - len(ok)} failed",
+             f"J of eq (19) [rad^2] {per} and controller: median, IQR (interquartile range, "
+             f"25th to 75th percentile), least and greatest of its runs ok ({over}a run shared "
+             "by several combinations counted once)"
+             + ("; summary.csv has every setting" if pooled else ""),
+             f"  {label:<{wide}}  {'controller':<{named}}  runs    median  "
+             f"{'IQR':^19}  {'least - greatest':^19}".rstrip()]
     for (name, where), controller in itertools.product(groups, spec.controllers):
-        J = np.array([r["J"] for r in ok if r["controller"] == controller and _in(r, where)],
-                     dtype=float)
+        J = np.array([r["J"] for r in select(ok, controller, where)], dtype=float)
         median, q25, q75, least, greatest = _statistics(J)
         lines.append(f"  {name:<{wide}}  {controller:<{named}}  {J.size:>4}  " + (
             f"{median:8.2f}  {q25:8.2f} - {q75:8.2f}  {least:8.2f} - {greatest:8.2f}"
             if J.size else f"{'-':>8}"))
-    return lines
+    failed = [r for r in runs if r["status"] != "ok"]
+    for r in failed[:SHOWN_FAILURES]:
+        at = ", ".join(f"{a} = {r[a]}" for a in spec.axes)
+        said = [line.strip() for line in r["error"].splitlines()[:2]]   # the call, the FMU's words
+        lines.append(f"  failed {r['controller']} ({at}): {' / '.join(said)[:300]}")
+    if len(failed) > SHOWN_FAILURES:
+        lines.append(f"  ... and {len(failed) - SHOWN_FAILURES} more failed runs (results.parquet "
+                     "has every message)")
+    return "\n".join(lines)
 
 
 def comparison(spec: Spec, rows: list[dict]) -> str:
-    """Markdown table: per setting of the axes but ``MONTE_CARLO``, each controller's median
-    J, its wins against the PD (a lower J on the same sea, each pair of runs counted once)
-    and the median J ratio."""
+    """Markdown table: per setting, each controller's median J, its wins against the PD (a
+    lower J on the same sea, each pair of runs counted once) and the median J ratio."""
     others = [c for c in spec.controllers if c != "pd"]
     axes, settings = _settings(spec)
     ok = {(r["controller"], *(json.dumps(r[a]) for a in spec.axes)): r
@@ -173,8 +154,8 @@ def comparison(spec: Spec, rows: list[dict]) -> str:
         wins, ratios = [], []
         for controller in others:
             cells.append(_median_J(runs[controller]))
-            pairs = list({(_ran_as(a), _ran_as(b)): (a["J"], b["J"])
-                          for a, b in zip(runs[controller], runs["pd"])
+            pairs = list({(a.get("ran_as", a["run_id"]), b.get("ran_as", b["run_id"])):
+                          (a["J"], b["J"]) for a, b in zip(runs[controller], runs["pd"])
                           if a is not None and b is not None}.values())
             decided = [(J_c, J_b) for J_c, J_b in pairs if J_c != J_b]
             wins.append(f"{sum(J_c < J_b for J_c, J_b in decided)}/{len(decided)}")
@@ -185,6 +166,5 @@ def comparison(spec: Spec, rows: list[dict]) -> str:
 
 
 def _median_J(found: list[dict | None]) -> str:
-    """The median J of the rows found (each run once), as a cell."""
     J = [r["J"] for r in distinct([r for r in found if r is not None])]
     return f"{np.median(J):.1f}" if J else "-"

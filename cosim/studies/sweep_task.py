@@ -1,13 +1,9 @@
-"""A sweep's tasks, on a worker: one whole co-simulation from a ``Job`` and the FMUs' bytes
-(``run_one``), or the runs of one system as one array program (``run_batch``); the same row
-(``result_row``) either way, but for ``backend``, ``seconds`` and ``sim_seconds``.
-
-A worker keeps one master per sweep, thread, system and backend, reset between tasks. The
-sweep's ``SweepTeardown`` frees the idle ones and stops its runs under way at their next
-step, which then free their own: freed under a run, its FMUs would fail it, loudly.
-"""
+"""A sweep's tasks on a worker: one co-simulation (``run_one``) or a batch of one system's runs
+(``run_batch``), the same row either way. A worker keeps a master per sweep, thread, system and
+backend; ``SweepTeardown`` frees the idle ones and stops the busy at their next step."""
 from __future__ import annotations
 
+import contextlib
 import math
 import threading
 import time
@@ -16,14 +12,14 @@ from typing import Any
 
 from distributed import WorkerPlugin
 
-from ..core.master import RUN_BACKENDS
+from .. import ensemble
+from ..core.master import RUN_BACKENDS, Master
 from ..core.watchdog import Limits, TimeLimit, Watchdog
 from ..provenance import code_version
 from .bundle import Bundle, materialise
 from .merit import METRICS, run_metrics, track
 
-BATCH = "batch"
-"""The sweep backend that runs the runs of one system as batches (``run_batch``)."""
+BATCH = "batch"                         # the sweep backend of ``run_batch``
 SWEEP_BACKENDS = (*RUN_BACKENDS, BATCH)
 
 
@@ -53,10 +49,7 @@ def _key(job: Job) -> Key:
 
 
 def _take(job: Job, blobs: dict[str, bytes], watchdog: Watchdog):
-    """This thread's idle master of ``job``'s system, reset, or a new one, for a run that
-    ``watchdog`` watches; ``_give_back`` it."""
-    from ..core.master import Master
-
+    """This thread's idle master of ``job``'s system, reset, or a new one; ``_give_back`` it."""
     with _lock:
         if job.sweep in _ended:
             raise RuntimeError("the sweep has ended")
@@ -73,8 +66,7 @@ def _take(job: Job, blobs: dict[str, bytes], watchdog: Watchdog):
 
 
 def _give_back(job: Job, master, healthy: bool) -> None:
-    """Keep ``master`` for the sweep's next task; free it after a failure (its FMUs may be in
-    an error state) or once the sweep has ended."""
+    """Keep ``master`` for the sweep's next task; free it after a failure or the sweep's end."""
     with _lock:
         _busy.pop(_key(job), None)
         keep = master is not None and healthy and job.sweep not in _ended
@@ -85,8 +77,8 @@ def _give_back(job: Job, master, healthy: bool) -> None:
 
 
 def free_masters(sweep: str | None = None) -> None:
-    """Free this process's idle masters: of one sweep, which has ended (its runs under way
-    stop at their next step and free their own), or all."""
+    """Free this process's idle masters, all or of a sweep that has ended (its runs under way
+    stop at their next step and free their own: freed under a run, its FMUs would fail it)."""
     with _lock:
         if sweep is not None:
             _ended.add(sweep)
@@ -108,8 +100,7 @@ class SweepTeardown(WorkerPlugin):
 
 
 def ran_on(kinds: dict[str, str] | None, asked: str) -> str:
-    """How a run's components ran (``Master.backends``): "fmi" or "inprocess" if all alike,
-    else each other named ("inprocess; autopilot: fmi"); ``asked`` without a master."""
+    """How a run's components ran: "fmi", "inprocess", or e.g. "inprocess; autopilot: fmi"."""
     if not kinds:
         return asked
     if len(set(kinds.values())) == 1:
@@ -118,29 +109,18 @@ def ran_on(kinds: dict[str, str] | None, asked: str) -> str:
                                if kind != asked)])
 
 
-def fmu_bytes(data: bytes) -> bytes:
-    """An FMU's file as a task's result (a lost worker's copy is computed again)."""
-    return data
-
-
 def blank_row(run: dict[str, Any], error: str = "") -> dict[str, Any]:
-    """A result row for ``run``: failed with ``error`` if given, metrics still undefined."""
+    """A row for ``run``: failed with ``error`` if given, metrics NaN."""
     return {**run, "status": "failed" if error else "ok", "error": error,
             **{m: math.nan for m in METRICS}, "seconds": math.nan, "sim_seconds": math.nan}
 
 
-def _other_code(job: Job) -> dict[str, Any]:
-    """The failed row of a run sent by a client that runs other code than this worker."""
-    return blank_row(job.run, f"worker runs {code_version()}, the client {job.code}: "
-                              "install the client's version on every worker")
-
-
 def run_one(job: Job, blobs: dict[str, bytes]) -> dict[str, Any]:
-    """One whole co-simulation's row; a failed run (past its time limits too) is recorded,
-    never raised. ``seconds``: the task's wall time, ``sim_seconds``: the run's alone."""
+    """One co-simulation's row, a failure (past its time limits too) recorded, not raised."""
     started = time.perf_counter()
     if job.code != code_version():          # a worker that joined after the client's check
-        return _other_code(job)
+        return blank_row(job.run, f"worker runs {code_version()}, the client {job.code}: "
+                                  "install the client's version on every worker")
     master, watchdog, recording = None, Watchdog(job.limits), None
     try:
         with watchdog:                          # a hung FMU fails its run, not the worker
@@ -156,55 +136,42 @@ def run_one(job: Job, blobs: dict[str, bytes]) -> dict[str, Any]:
     finally:
         _give_back(job, master, recording is not None and not recording.error)
     if recording is not None:
-        row = result_row(job, recording)
-        if not recording.error:
-            row["sim_seconds"] = sim_seconds
+        row = result_row(job, recording, sim_seconds)
     row["backend"] = ran_on(master and master.backends, job.backend)   # same results either way
     row["seconds"] = time.perf_counter() - started
     return row
 
 
-def result_row(job: Job, recording) -> dict[str, Any]:
-    """The row of ``job``'s run from its recording, whichever route made it (the times and
-    the backend are the caller's to fill in)."""
+def result_row(job: Job, recording, sim_seconds: float) -> dict[str, Any]:
+    """The row of ``job``'s run from its recording, but its backend and ``seconds``."""
     if recording.error:
         return blank_row(job.run, recording.error)
-    row = {**blank_row(job.run), **run_metrics(recording)}
+    row = {**blank_row(job.run), **run_metrics(recording), "sim_seconds": sim_seconds}
     if job.track:
         row["track"] = track(recording)
     return row
 
 
 def batch_refusal() -> str | None:
-    """Why this worker's numpy would not give the in-process route's bits on the batch
-    route (``cosim.ensemble.selftest``), None if it would."""
-    from ..ensemble import selftest
-
+    """Why this worker's numpy would not give the in-process bits in a batch, or None."""
     try:
-        return selftest()
+        return ensemble.selftest()
     except Exception as error:          # a self-test that cannot run refuses the route
         return f"its self-test failed: {type(error).__name__}: {error}"
 
 
 def batch_limits(limits: Limits, members: int) -> Limits:
     """A batch's time limits: each per-run limit times its ``members``."""
-    return Limits(None if limits.step is None else limits.step * members,
-                  None if limits.run is None else limits.run * members, limits.grace)
+    return Limits(*(None if limit is None else limit * members for limit in limits[:2]),
+                  limits.grace)
 
 
 def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
-    """The rows of ``jobs`` (in-process runs of one system and stop time), in their order,
-    computed together by ``cosim.ensemble.simulate_members``; never raises for a failed run.
-
-    A row is ``run_one``'s but for ``backend``, ``seconds`` and ``sim_seconds`` (the run's
-    share). A run ``Master.configure`` refuses is left to ``run_one``; so is every run,
-    saying why in its backend, where ``batch_refusal`` refuses or the batch fails as a
-    whole (an exception, or past ``batch_limits``)."""
-    from ..ensemble import simulate_members
-
+    """The rows of ``jobs`` (one system and stop time) computed together, ``run_one``'s but for
+    ``backend`` and the times; where the batch cannot give a run's row, ``run_one`` does."""
     started = time.perf_counter()
     if any(job.code != code_version() for job in jobs):
-        return [_other_code(job) for job in jobs]
+        return [run_one(job, blobs) for job in jobs]
     failed = batch_refusal()
     if failed:
         return [noted(run_one(job, blobs), f"the batch route is refused on this worker: "
@@ -215,11 +182,15 @@ def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
         with watchdog:
             watchdog.beat("instantiating the FMUs")
             master = _take(jobs[0], blobs, watchdog)
-            members = [job for job in jobs if _configures(master, job)]
+            members = []
+            for job in jobs:                    # one the master refuses: run_one says why
+                with contextlib.suppress(Exception):
+                    master.configure(job.overrides)
+                    members.append(job)
             watchdog.beat(f"the batch of {len(members)} runs")
-            recordings = simulate_members(master.system, [job.overrides for job in members],
-                                          jobs[0].stop_time, beat=watchdog.beat
-                                          ) if members else []
+            recordings = ensemble.simulate_members(
+                master.system, [job.overrides for job in members], jobs[0].stop_time,
+                beat=watchdog.beat) if members else []
         failed = watchdog.expired
     except (Exception, TimeLimit) as error:
         failed = watchdog.expired or f"{type(error).__name__}: {error}"
@@ -229,33 +200,19 @@ def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
         return [noted(run_one(job, blobs), f"the batch failed, {failed}; run alone")
                 for job in jobs]
     share = (time.perf_counter() - started) / max(1, len(members))
-    rows = {}
-    for job, recording in zip(members, recordings, strict=True):
-        row = result_row(job, recording)
-        if not recording.error:
-            row["sim_seconds"] = recording.meta["wall_time_s"]
-        rows[job.run["run_id"]] = {**row, "backend": member_backend(recording.meta),
-                                   "seconds": share}
+    rows = {job.run["run_id"]: {**result_row(job, recording, recording.meta.get("wall_time_s")),
+                                "backend": member_backend(recording.meta), "seconds": share}
+            for job, recording in zip(members, recordings, strict=True)}
     return [rows.get(job.run["run_id"]) or run_one(job, blobs) for job in jobs]
 
 
-def _configures(master, job: Job) -> bool:
-    """Whether ``Master.configure`` takes ``job``'s settings (``run_one`` records why not)."""
-    try:
-        master.configure(job.overrides)
-    except Exception:
-        return False
-    return True
-
-
 def noted(row: dict[str, Any], why: str) -> dict[str, Any]:
-    """``row`` with ``why`` its run did not run in a batch added to its backend."""
+    """``row`` with why its run did not run in a batch added to its backend."""
     return {**row, "backend": f"{row.get('backend', 'inprocess')} (not in a batch: {why})"}
 
 
 def member_backend(meta: dict[str, Any]) -> str:
-    """A batch member's backend column: "batch", or how it ran alone and why (the kernel's
-    notes)."""
+    """A batch member's backend column: "batch", or how it ran alone and why."""
     if meta.get("backend") == BATCH:
         return BATCH
     ran = ran_on(meta.get("backends"), meta.get("backend", "inprocess"))
