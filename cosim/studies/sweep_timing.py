@@ -1,6 +1,5 @@
-"""The sweep benchmark (``python -m cosim.bench sweep``): sweeps on fresh local clusters, every
-backend side by side (``sweep_throughput``) and 1,000 waves_pd runs on the batch route
-(``campaign``), each goal printed beside its figure, with the load average."""
+"""The sweep benchmark (``python -m cosim.bench sweep``): every backend side by side and the
+batch route's campaign, each on fresh local clusters, each goal printed beside its figure."""
 from __future__ import annotations
 
 import math
@@ -18,10 +17,9 @@ from .sweep_task import BATCH, SWEEP_BACKENDS
 from .timing import machine, peak_rss_mb, require_in_process
 
 SEAS = {"waves": ("waves_pd", "waves_smc"), "calm": ("calm_pd", "calm_smc")}
-GOALS = {"waves": 5.0, "calm": 10.0}
-"""The batch route's goal: its runs per second per core over the in-process route's."""
+GOALS = {"waves": 5.0, "calm": 10.0}   # batch runs/s per core over the in-process route's
+# the campaign's goal: these runs of this stop time on these workers within this many s
 CAMPAIGN_RUNS, CAMPAIGN_STOP_TIME, CAMPAIGN_WORKERS, CAMPAIGN_GOAL = 1000, 400.0, 2, 30.0
-"""The campaign's goal: these runs of this stop time on these workers within this many s."""
 
 
 def load() -> str:
@@ -43,8 +41,7 @@ class Measure:
     load: float                 # the 1-minute load average as it ended
 
     @property
-    def rate(self) -> float:
-        """Runs per second."""
+    def rate(self) -> float:            # runs per second
         return self.runs / self.wall
 
 
@@ -52,9 +49,8 @@ def sweep_throughput(runs: int = 32, batch_runs: int = 1024,
                      seas: tuple[str, ...] = tuple(SEAS), worker_counts: tuple[int, ...] = (1, 2),
                      backends: tuple[str, ...] = SWEEP_BACKENDS, rounds: int = 1,
                      stop_time: float = 400.0) -> dict[tuple[str, str, int], float]:
-    """Runs per second by (sea, backend, workers): the median of ``rounds`` sweeps of ``runs``
-    runs (``batch_runs`` on the batch backend) taken in turn; printed with the per-core
-    rates, the parallel efficiency and the goals (the median of the rounds' ratios)."""
+    """Runs per second by (sea, backend, workers), the median of ``rounds`` sweeps taken in
+    turn; printed with the per-core rates, the parallel efficiency and the goals."""
     for count, name in ((runs, "runs"), (batch_runs, "batch_runs")):
         if count < 2 or count % 2:
             raise ValueError(f"{name} must be an even number of runs >= 2 (half for each "
@@ -106,8 +102,7 @@ def sweep_throughput(runs: int = 32, batch_runs: int = 1024,
 
 def campaign(runs: int = CAMPAIGN_RUNS, workers: int = CAMPAIGN_WORKERS,
              stop_time: float = CAMPAIGN_STOP_TIME) -> Measure:
-    """``runs`` waves_pd runs of ``stop_time`` on the batch route on ``workers``: the wall
-    time from submission to the last row, and with the start-up, against the goal."""
+    """``runs`` waves_pd runs on the batch route on ``workers``, against the goal."""
     if runs < 1:
         raise ValueError(f"the campaign's runs must be at least 1, got {runs}")
     print(f"campaign: {runs} waves_pd runs of {stop_time:g} s on the batch route, a local "
@@ -147,8 +142,7 @@ def sizes(sizes: tuple[int, ...]) -> str:
     return f"{low}" if low == high else f"{low}-{high}"
 
 
-def seeds(runs: int) -> dict[str, list]:
-    """The axis of ``runs`` wave seeds from 1."""
+def seeds(runs: int) -> dict[str, list]:        # the axis of ``runs`` wave seeds from 1
     return {"wave_seed": list(range(1, runs + 1))}
 
 
@@ -160,8 +154,8 @@ def bench_spec(controllers: dict[str, str], axes: dict[str, list], stop_time: fl
 
 
 def _sea_spec(sea: str, runs: int, stop_time: float) -> Spec:
-    """The sweep of ``runs`` runs of a sea, half with each of its scenarios: over wave seeds,
-    or in calm water (where the seed changes nothing) over headings 1 mrad apart."""
+    """``runs`` runs, half with each scenario of the sea: over wave seeds, or in calm water
+    (where the seed changes nothing) over headings 1 mrad apart."""
     axes = seeds(runs // 2) if sea == "waves" else {
         "ship.psi0": [k / 1000 for k in range(runs // 2)]}
     return bench_spec(dict(zip(("pd", "smc"), SEAS[sea])), axes, stop_time)
@@ -169,7 +163,7 @@ def _sea_spec(sea: str, runs: int, stop_time: float) -> Spec:
 
 def require_batch(spec: Spec) -> None:
     """RuntimeError if the runs of ``spec`` would not all run in batches; prints the
-    self-test's time, which each worker process spends once."""
+    self-test's time."""
     from ..ensemble import selftest
 
     notes = spec.backend_notes(BATCH)
@@ -184,8 +178,7 @@ def require_batch(spec: Spec) -> None:
 
 def timed_sweep(spec: Spec, workers: int, backend: str, batch_size: int | None = None
                 ) -> Measure:
-    """``spec`` run on a fresh local cluster of ``workers``; RuntimeError if a run failed,
-    or, on the batch backend, ran other than in a batch."""
+    """``spec`` on a fresh local cluster; RuntimeError if a run failed or left its batch."""
     from dask.distributed import Client
 
     from .campaign import execute
@@ -221,7 +214,6 @@ def timed_sweep(spec: Spec, workers: int, backend: str, batch_size: int | None =
 
 def _print_rates(rates: dict[tuple[str, str, int], float], seas: tuple[str, ...],
                  worker_counts: tuple[int, ...], backends: tuple[str, ...], rounds: int) -> None:
-    """Per-core rates and parallel efficiency, and the ratios between backends."""
     base = min(worker_counts)
     others = [w for w in worker_counts if w != base]
     print("  runs/s per core (runs/s / workers" + (f", median of {rounds} rounds" if rounds > 1
