@@ -1,6 +1,5 @@
-"""The scalar models stepped as the master steps them (guidance -> autopilot -> ship,
-Gauss-Seidel, sampled at t_k = t_0 + k h): the reference the batch kernel is pinned to, and
-the system wired by hand that ``cosim.bench`` times (``run_direct``)."""
+"""The scalar models stepped as the master steps them (Gauss-Seidel, guidance -> autopilot ->
+ship): the reference the batch kernel is pinned to, and what ``cosim.bench`` times as (a)."""
 from __future__ import annotations
 
 from typing import Any
@@ -42,8 +41,8 @@ def step_models(guidance: Any, autopilot: Any, ship: Any, shafts: tuple[float, f
 
 
 def run_direct(master: Master, stop_time: float | None = None) -> dict[str, np.ndarray]:
-    """``SIGNALS`` of the models that ``master`` (in-process) initialises, stepped by
-    ``step_models``: without the master's calls, records and checks."""
+    """``SIGNALS`` of the models ``master`` (in-process) initialises, stepped by hand: without
+    the master's calls, records and checks."""
     t0, h, n_steps = master.system.steps(stop_time)
     member = initialise(master, master.overrides, n_steps)
     if member is None:
