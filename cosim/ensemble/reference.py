@@ -18,7 +18,6 @@ SIGNALS = ("guidance.psi_d", "guidance.wp_index", "autopilot.delta_c", "ship.x",
 def step_models(guidance: Any, autopilot: Any, ship: Any, shafts: tuple[float, float, float],
                 t0: float, h: float, n_steps: int) -> dict[str, np.ndarray]:
     """Each of ``SIGNALS`` at t_0 .. t_N of initialised models, shafts (n1, n2, n3) held."""
-    n1, n2, n3 = shafts
     stepping_pilot = hasattr(autopilot, "step")
     pid = type(autopilot).__name__ == "PIDAutopilot"      # steps with its inputs, as its slave
     out = np.empty((n_steps + 1, len(SIGNALS)))
@@ -36,7 +35,7 @@ def step_models(guidance: Any, autopilot: Any, ship: Any, shafts: tuple[float, f
             autopilot.step(h, ship.psi, ship.r, psi_d)
         elif stepping_pilot:
             autopilot.step(t, h, psi_d)
-        ship.step(t, h, delta_c, n1, n2, n3)
+        ship.step(t, h, delta_c, *shafts)
     return dict(zip(SIGNALS, out.T))
 
 
