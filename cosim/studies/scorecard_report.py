@@ -194,6 +194,8 @@ def _waypoints_reached(ok: list[dict]) -> str:
 
 
 def _paper_route(paper: dict[str, str], route: dict[str, dict[str, Recording]]) -> list[str]:
+    metrics = {(sea, name): run_metrics(run) for sea, runs in route.items()
+               for name, run in runs.items()}
     lines = ["## The paper's route (Tables 1-2, eq 19; lower is better)", "", *table(
         ["controller", "calm psi_E", "calm delta_E", "calm J", "waves psi_E", "waves delta_E",
          "waves J", "paper J calm / waves"],
@@ -201,8 +203,8 @@ def _paper_route(paper: dict[str, str], route: dict[str, dict[str, Recording]]) 
           theirs] for name, theirs in paper.items())),
         "", "Every criterion, one run each (the scenarios' wave seed):", "",
         *table(["controller", "sea", *(_label(c, better=True) for c in CRITERIA)],
-               ([name, sea, *_criteria_cells(run_metrics(run))]
-                for sea, runs in route.items() for name, run in runs.items())), ""]
+               ([name, sea, *(c.format(row[c.column]) + _of(c, row) for c in CRITERIA)]
+                for (sea, name), row in metrics.items())), ""]
     for sea, runs in route.items():
         for name, run in runs.items():
             done = _completion(run)
@@ -223,10 +225,6 @@ def _cost_cells(run: Recording | None) -> list[str]:
         return ["failed"] * 3
     c = cost(run)
     return [f"{c.psi_E:.1f}", f"{c.delta_E:.1f}", f"{c.J:.1f}"]
-
-
-def _criteria_cells(row: dict) -> list[str]:
-    return [c.format(row[c.column]) + _of(c, row) for c in CRITERIA]
 
 
 def _course_change(names: list[str], changes: dict[str, dict], time: float,

@@ -20,6 +20,7 @@ SEAS = {"waves": ("waves_pd", "waves_smc"), "calm": ("calm_pd", "calm_smc")}
 GOALS = {"waves": 5.0, "calm": 10.0}   # batch runs/s per core over the in-process route's
 # the campaign's goal: these runs of this stop time on these workers within this many s
 CAMPAIGN_RUNS, CAMPAIGN_STOP_TIME, CAMPAIGN_WORKERS, CAMPAIGN_GOAL = 1000, 400.0, 2, 30.0
+WORKERS = (1, 2)            # the throughput's sweeps: on 1 and on 2 workers
 
 
 def load() -> str:
@@ -45,10 +46,9 @@ class Measure:
         return self.runs / self.wall
 
 
-def sweep_throughput(runs: int = 32, batch_runs: int = 1024,
-                     seas: tuple[str, ...] = tuple(SEAS), worker_counts: tuple[int, ...] = (1, 2),
-                     backends: tuple[str, ...] = SWEEP_BACKENDS, rounds: int = 1,
-                     stop_time: float = 400.0) -> dict[tuple[str, str, int], float]:
+def sweep_throughput(runs: int = 32, batch_runs: int = 1024, seas: tuple[str, ...] = tuple(SEAS),
+                     rounds: int = 1, stop_time: float = 400.0
+                     ) -> dict[tuple[str, str, int], float]:
     """Runs per second by (sea, backend, workers), the median of ``rounds`` sweeps taken in
     turn; printed with the per-core rates, the parallel efficiency and the goals."""
     for count, name in ((runs, "runs"), (batch_runs, "batch_runs")):
@@ -63,15 +63,13 @@ def sweep_throughput(runs: int = 32, batch_runs: int = 1024,
           f"cluster, on {machine()}; {load()}")
     for sea in seas:                              # before minutes of measuring the others
         spec = _sea_spec(sea, 2, 1.0)
-        if "inprocess" in backends:
-            require_in_process(spec.backend_notes("inprocess"))
-        if BATCH in backends:
-            require_batch(spec)
+        require_in_process(spec.backend_notes("inprocess"))
+        require_batch(spec)
     measured: dict[tuple[str, str, int], list[float]] = {}
     for _ in range(rounds):
-        for workers in worker_counts:             # backends side by side, under the same load
+        for workers in WORKERS:                   # backends side by side, under the same load
             for sea in seas:
-                for backend in backends:
+                for backend in SWEEP_BACKENDS:
                     m = timed_sweep(_sea_spec(sea, batch_runs if backend == BATCH else runs,
                                               stop_time), workers, backend)
                     batched = f"; batches of {sizes(m.batches)}" if m.batches else ""
@@ -84,18 +82,16 @@ def sweep_throughput(runs: int = 32, batch_runs: int = 1024,
                           f"({outside / m.simulated:4.1%}); load {m.load:.2f}")
                     measured.setdefault((sea, backend, workers), []).append(m.rate)
     rates = {key: statistics.median(values) for key, values in measured.items()}
-    _print_rates(rates, seas, worker_counts, backends, rounds)
-    if BATCH in backends and "inprocess" in backends:
-        for sea in seas:
-            ratios = {w: [b / i for b, i in zip(measured[sea, BATCH, w],
-                                                measured[sea, "inprocess", w])]
-                      for w in worker_counts}
-            medians = {w: statistics.median(r) for w, r in ratios.items()}
-            print(f"  goal, {sea}: batch runs/s per core at least {GOALS[sea]:g}x in-process: "
-                  + ", ".join(f"{medians[w]:.2f}x with {_workers(w)}" + (
-                      f" (rounds: {', '.join(f'{x:.2f}' for x in r)})" if len(r) > 1 else "")
-                      for w, r in ratios.items())
-                  + f": {verdict(all(m >= GOALS[sea] for m in medians.values()))}")
+    _print_rates(rates, seas, rounds)
+    for sea in seas:
+        ratios = {w: [b / i for b, i in zip(measured[sea, BATCH, w], measured[sea, "inprocess", w])]
+                  for w in WORKERS}
+        medians = {w: statistics.median(r) for w, r in ratios.items()}
+        print(f"  goal, {sea}: batch runs/s per core at least {GOALS[sea]:g}x in-process: "
+              + ", ".join(f"{medians[w]:.2f}x with {_workers(w)}" + (
+                  f" (rounds: {', '.join(f'{x:.2f}' for x in r)})" if len(r) > 1 else "")
+                  for w, r in ratios.items())
+              + f": {verdict(all(m >= GOALS[sea] for m in medians.values()))}")
     print(f"  {load()}")
     return rates
 
@@ -213,22 +209,18 @@ def timed_sweep(spec: Spec, workers: int, backend: str, batch_size: int | None =
 
 
 def _print_rates(rates: dict[tuple[str, str, int], float], seas: tuple[str, ...],
-                 worker_counts: tuple[int, ...], backends: tuple[str, ...], rounds: int) -> None:
-    base = min(worker_counts)
-    others = [w for w in worker_counts if w != base]
+                 rounds: int) -> None:
     print("  runs/s per core (runs/s / workers" + (f", median of {rounds} rounds" if rounds > 1
                                                  else "") + "):")
-    print(f"    {'':15}" + "".join(f"{_workers(w):>11}" for w in worker_counts)
-          + "".join(f"{f'efficiency {base}->{w}':>17}" for w in others))
+    print(f"    {'':15}" + "".join(f"{_workers(w):>11}" for w in WORKERS)
+          + f"{'efficiency 1->2':>17}")
     for sea in seas:
-        for backend in backends:
-            rate = {w: rates[sea, backend, w] for w in worker_counts}
-            print(f"    {sea:5} {backend:9}" + "".join(f"{rate[w] / w:11.2f}" for w in rate)
-                  + "".join(f"{rate[w] / rate[base] * base / w:17.2f}" for w in others))
+        for backend in SWEEP_BACKENDS:
+            one, two = (rates[sea, backend, w] for w in WORKERS)
+            print(f"    {sea:5} {backend:9}{one:11.2f}{two / 2:11.2f}{two / one / 2:17.2f}")
     print("    (efficiency 1.00: each worker as fast as one alone)")
     for sea in seas:
-        for backend in backends:
-            if backend != "fmi" and "fmi" in backends:
-                print(f"  {sea:5} {backend} / fmi: " + ", ".join(
-                    f"{rates[sea, backend, w] / rates[sea, 'fmi', w]:5.2f}x with {_workers(w)}"
-                    for w in worker_counts))
+        for backend in (b for b in SWEEP_BACKENDS if b != "fmi"):
+            print(f"  {sea:5} {backend} / fmi: " + ", ".join(
+                f"{rates[sea, backend, w] / rates[sea, 'fmi', w]:5.2f}x with {_workers(w)}"
+                for w in WORKERS))
