@@ -1,15 +1,11 @@
 """How large are the set-up's own numerical errors? RK4 against DOP853, co-simulation
 against a monolithic model with the controller inside the solver.
 
-    python -m cosim.accuracy            # the full study
-    python -m cosim.accuracy --quick    # shorter runs and fewer steps (CI)
-    python -m cosim.accuracy --cpus     # every scenario as other CPUs would run it: numpy,
-                                        # OpenBLAS and libm variants, bit for bit
+    python -m cosim.accuracy            # the full study (docs/reproduction.md)
+    python -m cosim.accuracy --quick    # shorter runs in calm water, fewer steps (CI)
+    python -m cosim.accuracy --cpus     # every scenario as other CPUs would run it, bit for bit
 
-Prints three tables (integration error open loop; co-simulation against the monolithic
-reference; convergence in the communication step) and writes them, with a convergence
-figure, to results/accuracy/. The quick mode's figures cover shorter runs in calm water
-only: docs/reproduction.md's are the full study's. With --cpus it writes cpus.md instead.
+Prints its tables and writes them to accuracy.md with convergence.png (with --cpus: cpus.md).
 """
 from __future__ import annotations
 
@@ -50,20 +46,21 @@ def main(argv: list[str] | None = None) -> int:
     runs = coupling_error.PAPER_RUNS[:2] if args.quick else coupling_error.PAPER_RUNS
     steps = (0.1, 0.05, 0.025) if args.quick else coupling_error.STEPS
 
-    tables = ["## Integration error, open loop (calm water)\n",
-              integration_error.open_loop_table([integration_error.open_loop(p, open_end)
-                                                 for p in ("step", "sine", "zigzag")])]
-    print("".join(tables[-2:]), flush=True)
+    tables: list[str] = []
+
+    def section(title: str, text: str) -> None:
+        tables.extend([("\n" if tables else "") + f"## {title}\n", text])
+        print("".join(tables[-2:]), flush=True)
+    section("Integration error, open loop (calm water)", integration_error.open_loop_table(
+        [integration_error.open_loop(p, open_end) for p in ("step", "sine", "zigzag")]))
     closed = {name: coupling_error.closed_loop(name, closed_end) for name in runs}
-    tables += ["\n## Co-simulation at 0.1 s against the monolithic reference\n",
-               coupling_error.closed_loop_table(closed)]
-    print("".join(tables[-2:]), flush=True)
+    section("Co-simulation at 0.1 s against the monolithic reference",
+            coupling_error.closed_loop_table(closed))
     references = {name: result["monolithic"] for name, result in closed.items()}
     converging = {name: coupling_error.convergence(name, references[name], steps, closed_end)
                   for name in runs}
-    tables += ["\n## J against the communication step\n",
-               coupling_error.convergence_table(converging, references)]
-    print("".join(tables[-2:]), flush=True)
+    section("J against the communication step",
+            coupling_error.convergence_table(converging, references))
     write_atomically(out / "accuracy.md", lambda path: path.write_text("\n".join(tables) + "\n"))
     figure = coupling_error.convergence_figure(converging, out / "convergence.png")
     print(f"wrote {out / 'accuracy.md'}, {figure} ({time.perf_counter() - started:.0f} s)")

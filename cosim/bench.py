@@ -3,17 +3,8 @@
     python -m cosim.bench                 engines side by side, calm_pd and waves_pd, 400 s
     python -m cosim.bench overhead        the masters' own work, with the ship's step idle
     python -m cosim.bench memory          a 24 h run of calm_pd streamed to disk: peak memory
-    python -m cosim.bench sweep           sweeps on a local cluster: runs per second on the
-                                          FMI, in-process and batch backends with 1 and 2
-                                          workers, in waves and calm water; 1,000 waves_pd
-                                          runs on the batch route on 2 workers; the batch
-                                          route's memory (--parts for some)
-
-The default benchmark times (a) the plain Python modules wired by hand, our master (b)
-in-process and (c) through the FMUs, (d) OSP libcosim and (e) ecos on the exported SSP
-package, in turn round after round, and (f) the floor of any FMI route: (a) plus the FMI
-calls per step times the measured cost of one. The sweep benchmark prints each goal of the
-batch route beside its figure.
+    python -m cosim.bench sweep           sweeps on a local cluster, every backend with 1 and
+                                          2 workers; the batch route's goals (--parts)
 """
 from __future__ import annotations
 
@@ -28,14 +19,10 @@ SWEEP_PARTS = ("throughput", "campaign", "memory")
 
 def _counts(text: str) -> tuple[int, ...]:
     """A comma-separated list of whole numbers >= 1."""
-    try:
-        counts = tuple(int(part) for part in text.split(","))
-    except ValueError:
-        counts = ()
-    if not counts or min(counts) < 1:
+    if not all(part.strip().isdecimal() and int(part) >= 1 for part in text.split(",")):
         raise argparse.ArgumentTypeError(f"expected whole numbers >= 1 separated by commas, "
                                          f"got {text!r}")
-    return counts
+    return tuple(map(int, text.split(",")))
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -1,16 +1,9 @@
 """Score your autopilot against the paper's PD and sliding-mode autopilots and the PID.
 
-    python -m cosim.score my.fmu [--name NAME] [--seeds N] [--map PORT=NAME] [--set ...]
-                                 [--backend inprocess|batch]
-
-Runs the paper's route in calm water and waves, a 40 deg course change, and two
-N-seed wave ensembles (the paper's waves and WMO sea state 4) on a local Dask cluster
-(or --scheduler), for your FMU and the three project autopilots. Each controller is
-scored on every criterion, with its unit and the side that is better: J of eq (19),
-RMS heading error, rudder reversals per minute and mean |rudder rate|, time on the
-rudder stops, cross-track error and waypoints reached; in the ensembles, seed-paired
-wins, losses and ties against the PD. No overall rank. Writes scorecard.md and its
-figures to results/score/NAME/ and prints it (``cosim.studies.scorecard``).
+Runs the paper's route in calm water and waves, a 40 deg course change, and two N-seed wave
+ensembles (the paper's waves, WMO sea state 4) on Dask, for your FMU and the three project
+autopilots, and scores each on every criterion on its own (docs/own_autopilot.md). Writes
+scorecard.md and its figures to results/score/NAME/ and prints it.
 """
 from __future__ import annotations
 
@@ -55,14 +48,10 @@ def main(argv: list[str] | None = None) -> int:
                                                     "(default: one per core)")
     parser.add_argument("--backend", choices=SWEEP_BACKENDS, default="fmi",
                         help="fmi: every run through the FMUs (default); inprocess: this "
-                             "project's FMUs as Python classes, without FMI, with the same "
-                             "results. Yours runs in-process only if it is one of ours built "
-                             "from this checkout; any FMU that runs through FMI instead is "
-                             "noted before the scorecard starts. batch: the single runs "
-                             "in-process, the ensembles' PD, SMC and PID runs in batches "
-                             "stepped together as arrays (the same results again); yours too "
-                             "if it is our PD, PID or SMC, else in-process, one run per task, "
-                             "with a note")
+                             "project's FMUs as Python classes, the same results; batch: the "
+                             "single runs in-process, the ensembles' stepped together as "
+                             "arrays, the same results again. An FMU that cannot run so is "
+                             "noted before the scorecard starts")
     parser.add_argument("--out", type=Path, help="output folder (default: results/score/NAME)")
     args = parser.parse_args(argv)
     if not 1 <= args.seeds <= MAX_RUNS // 4:

@@ -20,9 +20,8 @@ def _figure(pattern: str, text: str) -> float:
 @pytest.mark.timeout(120, method="thread")
 def test_throughput_prints_per_core_rates_and_the_goal_from_what_it_measured(fmu_paths,
                                                                               capsys):
-    rates = sweep_timing.sweep_throughput(2, 4, ("calm",), (1, 2), ("inprocess", "batch"),
-                                         stop_time=5.0)
-    assert set(rates) == {("calm", b, w) for b in ("inprocess", "batch") for w in (1, 2)}
+    rates = sweep_timing.sweep_throughput(2, 4, ("calm",), stop_time=5.0)
+    assert set(rates) == {("calm", b, w) for b in ("fmi", "inprocess", "batch") for w in (1, 2)}
     assert all(math.isfinite(r) and r > 0 for r in rates.values())
     out = capsys.readouterr().out
     assert out.count("load average") == 2                # before and after

@@ -168,7 +168,3 @@ def comparison(runs: dict[str, Recording], caption: str) -> Figure:
     rudder.set(ylabel=RUDDER_LABEL)
     fig.suptitle(caption, fontsize=10)
     return fig
-
-
-def comparison_figure(runs: dict[str, Recording], path: Path, title: str) -> Path:
-    return save(comparison(runs, title), path)[0]

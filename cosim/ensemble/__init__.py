@@ -1,8 +1,6 @@
-"""The batch route of sweeps and scorecards: M members of one course-keeping system stepped
-in lockstep on (M,) arrays, operation for operation in the scalar models' order (the tests pin
-every signal to the in-process route bit for bit). A member not covered (``members.coverage``)
-or failing runs alone in-process; ``selftest`` checks this machine's numpy once per process.
-"""
+"""The batch route: M members of one course-keeping system stepped in lockstep on (M,)
+arrays, operation for operation as the scalar models, so bit for bit the in-process route's
+(docs/performance.md); what the kernel does not cover runs alone in-process."""
 from .route import SIGNALS, selftest, simulate_members
 
 __all__ = ["SIGNALS", "simulate_members", "selftest"]

@@ -13,9 +13,13 @@ from fmukit.numerics import substeps
 
 from .exact import hypot, tanh, wrap
 
+NEAR = 1e-12           # relative distance from the circle within which math.hypot decides
 
-def _column(models: Sequence, name: str) -> np.ndarray:
-    return np.array([getattr(m, name) for m in models], dtype=float)
+
+def _columns(target: object, models: Sequence, names: tuple[str, ...], dtype=float) -> None:
+    """Each attribute ``name`` of the models as an (M,) array (a leading _ dropped)."""
+    for name in names:
+        setattr(target, name.lstrip("_"), np.array([getattr(m, name) for m in models], dtype))
 
 
 class GuidanceArrays:
@@ -31,9 +35,8 @@ class GuidanceArrays:
         self.delta = self.end - self.start                  # (dx, dy) of each leg
         self.length = hypot(self.delta[..., 0], self.delta[..., 1])   # 0 past a route's end
         self.points = np.array([len(g.points) for g in guidances])
-        self.R_accept = _column(guidances, "R_accept")
-        self.leg = np.array([g.leg for g in guidances])
-        self.finished = np.array([g.finished for g in guidances])
+        self.R_accept = np.array([g.R_accept for g in guidances], dtype=float)
+        _columns(self, guidances, ("leg", "finished"), None)
         self.members = np.arange(count)
 
     def outputs(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -54,9 +57,6 @@ class GuidanceArrays:
         return self.course[i, leg], np.where(finished, self.points, leg + 1)
 
 
-NEAR = 1e-12           # relative distance from the circle within which math.hypot decides
-
-
 def _within(dx: np.ndarray, dy: np.ndarray, radius: np.ndarray) -> np.ndarray:
     """``math.hypot(dx, dy) <= radius``, by the cheaper ``np.hypot`` away from the circle."""
     distance = np.hypot(dx, dy)
@@ -71,7 +71,7 @@ class PDArrays:
     """``PDAutopilot.command``, eq (20): memoryless."""
 
     def __init__(self, pilots: Sequence[PDAutopilot]):
-        self.Kp, self.Kd = _column(pilots, "Kp"), _column(pilots, "Kd")
+        _columns(self, pilots, ("Kp", "Kd"))
 
     def command(self, psi: np.ndarray, r: np.ndarray, psi_d: np.ndarray) -> np.ndarray:
         return self.Kp * wrap(psi - psi_d) + self.Kd * r
@@ -84,8 +84,7 @@ class PIDArrays:
     """``PIDAutopilot`` (pid_autopilot_slave): eq (20) with conditional integration."""
 
     def __init__(self, pilots: Sequence):
-        for name in ("Kp", "Ki", "Kd", "delta_max", "e_int", "z"):
-            setattr(self, name, _column(pilots, name))
+        _columns(self, pilots, ("Kp", "Ki", "Kd", "delta_max", "e_int", "z"))
 
     def command(self, psi: np.ndarray, r: np.ndarray, psi_d: np.ndarray) -> np.ndarray:
         return self.Kp * wrap(psi - psi_d) + self.Ki * self.z + self.Kd * r
@@ -104,8 +103,7 @@ class SMCArrays:
         self.k1, self.k2 = (np.array([p.design.K[j] for p in pilots]) for j in (0, 1))
         self.h1, self.h2 = (np.array([p.design.h[j] for p in pilots]) for j in (0, 1))
         self.tracking = np.array([p.tracking for p in pilots])
-        for name in ("eta_h", "phi_h", "omega_n", "zeta", "psi_z", "r_z", "_h_max"):
-            setattr(self, name.lstrip("_"), _column(pilots, name))
+        _columns(self, pilots, ("eta_h", "phi_h", "omega_n", "zeta", "psi_z", "r_z", "_h_max"))
         self.cuts: np.ndarray | None = None      # sub-steps of the reference model a step
 
     def command(self, psi: np.ndarray, r: np.ndarray, psi_d: np.ndarray) -> np.ndarray:
@@ -122,16 +120,14 @@ class SMCArrays:
         if self.cuts is None:                # h is the batch's, the same at every step
             self.cuts = np.array([substeps(h, bound, "of the reference model")
                                   for bound in self.h_max])
-        n = self.cuts
-        hs = h / n
+        hs = h / self.cuts
         psi_z, r_z = self.psi_z, self.r_z
-        for j in range(int(n.max())):
+        for j in range(int(self.cuts.max())):
             stepped = reference_rk4(psi_d, psi_z, r_z, hs, self.omega_n, self.zeta, wrap)
-            active = j < n
+            active = j < self.cuts
             psi_z, r_z = (np.where(active, new, old) for new, old in zip(stepped, (psi_z, r_z)))
         self.psi_z, self.r_z = psi_z, r_z
 
 
 KINDS = {"PDAutopilot": PDArrays, "PIDAutopilot": PIDArrays,   # by class name: the PID's
          "SlidingModeAutopilot": SMCArrays}                    # lives in its slave
-"""The array form of each autopilot class (one class in a batch: its system's)."""

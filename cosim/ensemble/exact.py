@@ -1,14 +1,11 @@
-"""The scalar models' functions on arrays, to the bit: ``np.hypot`` and ``np.tanh`` round
-unlike ``math``'s on some inputs, so these call ``math`` per element; ``wrap`` rebuilds
-CPython's ``math.remainder`` from the exact ``np.fmod``. sin, cos, sqrt, + - * / are numpy's
-(``selftest`` checks them)."""
+"""The scalar models' ``math`` functions on arrays, to the bit: ``np.hypot`` and ``np.tanh``
+round otherwise on some inputs, so these call ``math`` per element; ``remainder`` rebuilds
+CPython's from the exact ``np.fmod``."""
 from __future__ import annotations
 
 import math
 
 import numpy as np
-
-TWO_PI = 2.0 * math.pi
 
 _hypot = np.frompyfunc(math.hypot, 2, 1)
 _tanh = np.frompyfunc(math.tanh, 1, 1)
@@ -38,5 +35,5 @@ def remainder(x: np.ndarray, y: float) -> np.ndarray:
 
 def wrap(angle: np.ndarray) -> np.ndarray:
     """``fmukit.numerics.wrap`` of each element: the angle mod 2 pi in (-pi, pi]."""
-    wrapped = remainder(angle, TWO_PI)
+    wrapped = remainder(angle, 2.0 * math.pi)
     return np.where(wrapped == -math.pi, math.pi, wrapped)

@@ -1,5 +1,5 @@
-"""Which systems and members the batch kernel runs, each member's models initialised by the
-in-process master exactly as a run of it would be."""
+"""Which systems the batch kernel runs, and each member's models initialised by the in-process
+master exactly as a run of it would be."""
 from __future__ import annotations
 
 from dataclasses import dataclass

@@ -1,6 +1,5 @@
-"""The scalar models stepped as the master steps them (guidance -> autopilot -> ship,
-Gauss-Seidel, sampled at t_k = t_0 + k h): the reference the batch kernel is pinned to, and
-the system wired by hand that ``cosim.bench`` times (``run_direct``)."""
+"""The scalar models stepped as the master steps them (Gauss-Seidel, guidance -> autopilot ->
+ship): the reference the batch kernel is pinned to, and what ``cosim.bench`` times as (a)."""
 from __future__ import annotations
 
 from typing import Any
@@ -19,7 +18,6 @@ SIGNALS = ("guidance.psi_d", "guidance.wp_index", "autopilot.delta_c", "ship.x",
 def step_models(guidance: Any, autopilot: Any, ship: Any, shafts: tuple[float, float, float],
                 t0: float, h: float, n_steps: int) -> dict[str, np.ndarray]:
     """Each of ``SIGNALS`` at t_0 .. t_N of initialised models, shafts (n1, n2, n3) held."""
-    n1, n2, n3 = shafts
     stepping_pilot = hasattr(autopilot, "step")
     pid = type(autopilot).__name__ == "PIDAutopilot"      # steps with its inputs, as its slave
     out = np.empty((n_steps + 1, len(SIGNALS)))
@@ -37,13 +35,13 @@ def step_models(guidance: Any, autopilot: Any, ship: Any, shafts: tuple[float, f
             autopilot.step(h, ship.psi, ship.r, psi_d)
         elif stepping_pilot:
             autopilot.step(t, h, psi_d)
-        ship.step(t, h, delta_c, n1, n2, n3)
+        ship.step(t, h, delta_c, *shafts)
     return dict(zip(SIGNALS, out.T))
 
 
 def run_direct(master: Master, stop_time: float | None = None) -> dict[str, np.ndarray]:
-    """``SIGNALS`` of the models that ``master`` (in-process) initialises, stepped by
-    ``step_models``: without the master's calls, records and checks."""
+    """``SIGNALS`` of the models ``master`` (in-process) initialises, stepped by hand: without
+    the master's calls, records and checks."""
     t0, h, n_steps = master.system.steps(stop_time)
     member = initialise(master, master.overrides, n_steps)
     if member is None:

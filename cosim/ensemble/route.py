@@ -23,7 +23,7 @@ from ..core.recording import Recording
 from ..core.ssd import SystemDescription
 from ..core.watchdog import TimeLimit, no_limit
 from .control import KINDS, GuidanceArrays
-from .members import Member, coverage, initialise
+from .members import COMPONENTS, Member, coverage, initialise
 from .reference import SIGNALS as ALL_SIGNALS, step_models
 from .vessel import VesselArrays
 
@@ -164,10 +164,9 @@ def selftest() -> str | None:
         for Hs in (0.0, 0.02):
             batch = [Member(models, shafts, {"backends": {}}) for models in _members(kind, Hs)]
             recordings = lockstep(list(enumerate(batch)), 0.0, H, STEPS, ALL_SIGNALS,
-                                  {s: "" for s in ALL_SIGNALS})
+                                  dict.fromkeys(ALL_SIGNALS, ""))
             for (i, recording), models in zip(recordings, _members(kind, Hs)):
-                scalar = step_models(models["guidance"], models["autopilot"], models["ship"],
-                                     shafts, 0.0, H, STEPS)
+                scalar = step_models(*(models[n] for n in COMPONENTS), shafts, 0.0, H, STEPS)
                 for signal in ALL_SIGNALS:
                     if recording is None or recording[signal].tobytes() != scalar[signal].tobytes():
                         where = "failed" if recording is None else (

@@ -1,6 +1,6 @@
-"""``Vessel.step`` for M members: states (M,), wave components (M, N); the scalar model's
-own rates, forces and RK4 update on arrays, its branches (the gear's kink) and scalar calls
-(wave loads) rewritten on arrays operation for operation."""
+"""``Vessel.step`` for M members, states (M,) and wave components (M, N): the scalar model's
+own rates, forces and RK4 update on arrays; its branches and wave loads rewritten on arrays
+operation for operation."""
 from __future__ import annotations
 
 from operator import attrgetter
@@ -29,12 +29,6 @@ class RudderArrays:
 
     def __call__(self, s: np.ndarray | float) -> np.ndarray:
         return np.where(s >= self.reach, self.target, self.delta0 + self.velocity * s)
-
-    def take(self, lanes: np.ndarray) -> RudderArrays:
-        part = object.__new__(RudderArrays)
-        for name in ("delta0", "target", "velocity", "reach"):
-            setattr(part, name, getattr(self, name)[lanes])
-        return part
 
 
 class WaveArrays:
@@ -85,8 +79,8 @@ class VesselArrays:
     STATES = ("x", "y", "psi", "u", "v", "r", "xi")
 
     def __init__(self, vessels: Sequence[Vessel], shafts: tuple[float, float, float]):
-        """Vessels of one sea (calm, or N wave components) and ``shafts`` (n1, n2, n3) that
-        cut no step into sub-steps."""
+        """Vessels of one sea (calm, or N wave components), none cutting a step, and their
+        shafts (n1, n2, n3)."""
         self.vessel = vessels[0]                            # the hull and mass matrix of all
         self.forces = actuator_model(self.vessel.actuators, *shafts)
         self.waves = None if self.vessel.waves is None else WaveArrays(vessels)
@@ -105,7 +99,8 @@ class VesselArrays:
         if len(lanes) == len(split):
             y = self._rk4(t, gear.reach, h - gear.reach, y, gear, self.waves, self.psi_w)
         elif len(lanes):
-            part = gear.take(lanes)
+            part = RudderArrays(self.delta[lanes], delta_c[lanes], self.delta_max[lanes],
+                                self.delta_rate_max[lanes])
             rest = self._rk4(t, part.reach, h - part.reach, tuple(a[lanes] for a in y), part,
                              None if self.waves is None else self.waves.take(lanes),
                              self.psi_w[lanes])
@@ -117,8 +112,8 @@ class VesselArrays:
 
     def _rk4(self, t: float, start: np.ndarray | float, hs: np.ndarray, y: Arrays,
              gear: RudderArrays, waves: WaveArrays | None, psi_w: np.ndarray) -> Arrays:
-        """An RK4 step of ``Vessel._integrate``, of length ``hs`` from ``t + start`` (each an
-        array or a float), of the members of ``waves``, ``psi_w`` and ``gear`` (all or some)."""
+        """One RK4 step of ``Vessel._integrate``, ``hs`` from ``t + start``, of the members of
+        ``waves``, ``psi_w`` and ``gear`` (all or some)."""
         v, forces = self.vessel, self.forces
         loads, hypot = (waves, exact.hypot) if waves is not None else (calm_water, _no_travel)
 

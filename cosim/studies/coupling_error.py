@@ -1,8 +1,6 @@
-"""The accuracy study's parts 2 and 3, the coupling error closed loop: each of the paper's runs
-through our master at the 0.1 s communication step, Gauss-Seidel and Jacobi, against the
-monolithic reference (``monolithic``: guidance, autopilot and ship as one ODE, with the
-controller inside the solver) by the figures of eq (19) and the largest heading difference;
-then J's distance from it over communication steps of 0.4 s to 0.0125 s."""
+"""The accuracy study's parts 2 and 3 (docs/reproduction.md): the paper's runs by our master
+at the 0.1 s step, Gauss-Seidel and Jacobi, against a monolithic reference with the controller
+inside the solver, by the figures of eq (19); then J over communication steps."""
 from __future__ import annotations
 
 import dataclasses
@@ -21,32 +19,22 @@ from ..analysis.cost import LAMBDA
 from ..analysis.metrics import cost_terms
 from ..core.master import Master
 from ..ensemble.members import COMPONENTS, initialise
+from . import table
 from .integration_error import H
 
 PAPER_RUNS = ("calm_pd", "calm_smc", "waves_pd", "waves_smc")
 COUPLINGS = ("gauss-seidel", "jacobi")
 STEPS = (0.4, 0.2, 0.1, 0.05, 0.025, 0.0125)   # s, communication steps of part 3
-METHOD = "LSODA"
-"""Stiff where the servo slews, not elsewhere: LSODA switches between Adams and BDF."""
-MAX_STEP = 1.0
-"""s: longer steps could pass through a circle of acceptance and miss its event."""
-SERVO_GAIN = 1000.0
-"""1/s: the steering gear as a stiff servo."""
+METHOD = "LSODA"        # stiff where the servo slews, not elsewhere: Adams and BDF in turn
+MAX_STEP = 1.0          # s: a longer step could pass a circle of acceptance unseen
+SERVO_GAIN = 1000.0     # 1/s: the steering gear as a stiff servo
+TOLERANCE = 1e-9
 
 
-def monolithic(system, stop_time: float | None = None, servo_gain: float = SERVO_GAIN,
-               tolerance: float = 1e-9) -> dict[str, np.ndarray]:
-    """Guidance, autopilot and ship as one ODE, the controller evaluated at every stage of
-    the solver as a continuous Simulink block would be; sampled every 0.1 s like the
-    master's rows.
-
-    State: the ship's (x, y, psi, u, v, r, xi), the rudder angle delta and, for the SMC,
-    its reference model (psi_z, r_z). The steering gear is delta' = clip(k (sat(delta_c) -
-    delta), +-delta_rate_max), k = ``servo_gain``: it slews at the rate limit as the FMU's
-    does, else lags the command by 1/k. A waypoint switch (the circle of acceptance reached,
-    or the leg's end passed) is an event: the solver stops, switches the leg and restarts.
-    The SMC's eq (42) tanh boundary layer is continuous: no event.
-    """
+def monolithic(system, stop_time: float | None = None) -> dict[str, np.ndarray]:
+    """psi_d, psi and delta every 0.1 s of guidance, autopilot and ship as one ODE, the
+    controller evaluated at every stage of the solver; the steering gear a stiff servo, a
+    waypoint switch an event (docs/reproduction.md)."""
     with Master(system, backend="inprocess") as master:
         member = initialise(master, {}, 0)
     guidance, autopilot, ship = (member.models[n] for n in COMPONENTS)
@@ -62,7 +50,7 @@ def monolithic(system, stop_time: float | None = None, servo_gain: float = SERVO
             autopilot.psi_z, autopilot.r_z = Y[8], Y[9]
         delta_c = autopilot.command(Y[2], Y[5], psi_d)
         target = rudder_target(delta_c, p.delta_max)
-        delta_dot = min(max(servo_gain * (target - Y[7]), -p.delta_rate_max), p.delta_rate_max)
+        delta_dot = min(max(SERVO_GAIN * (target - Y[7]), -p.delta_rate_max), p.delta_rate_max)
         rates = [*ship.rates(t, tuple(Y[:7]), forces(Y[7])), delta_dot]
         if smc:
             rates += [Y[9], autopilot.r_z_dot(psi_d, Y[8], Y[9])]
@@ -78,8 +66,7 @@ def monolithic(system, stop_time: float | None = None, servo_gain: float = SERVO
         def past(t, Y, leg):
             return ((Y[0] - x0) * (x1 - x0) + (Y[1] - y0) * (y1 - y0)) / length - length
 
-        for event in (inside, past):
-            event.terminal, event.direction = True, 0.0
+        inside.terminal = past.terminal = True
         return [inside, past]
 
     Y = [ship.x, ship.y, ship.psi, ship.u, ship.v, ship.r, ship.xi, ship.delta]
@@ -89,8 +76,8 @@ def monolithic(system, stop_time: float | None = None, servo_gain: float = SERVO
     sampled: dict[float, tuple[np.ndarray, int]] = {}      # grid time: (state, leg)
     while True:
         events = [] if finished else arrival(leg)
-        solution = solve_ivp(rhs, (t, stop), Y, method=METHOD, rtol=tolerance,
-                             atol=tolerance, dense_output=True, events=events, args=(leg,),
+        solution = solve_ivp(rhs, (t, stop), Y, method=METHOD, rtol=TOLERANCE,
+                             atol=TOLERANCE, dense_output=True, events=events, args=(leg,),
                              max_step=MAX_STEP)
         end = solution.t[-1]
         for g in grid[(grid >= t) & (grid <= end)]:
@@ -110,8 +97,8 @@ def monolithic(system, stop_time: float | None = None, servo_gain: float = SERVO
 
 def cosimulation(name: str, step: float, coupling: str,
                  stop_time: float | None = None) -> dict[str, np.ndarray]:
-    """Our master in-process at communication step ``step``, sampled on the 0.1 s grid (a
-    coarser step at its own points, each standing for step / 0.1 samples: ``weight``)."""
+    """Our master in-process at ``step``, sampled on the 0.1 s grid (a coarser step at its
+    own points, each ``weight`` samples)."""
     system = dataclasses.replace(scenarios.load(name), step_size=step)
     with Master(system, coupling=coupling, backend="inprocess") as master:
         recording = master.run(stop_time)
@@ -139,14 +126,12 @@ def closed_loop(name: str, stop_time: float | None = None) -> dict[str, dict]:
 
 
 def closed_loop_table(results: dict[str, dict]) -> str:
-    lines = ["| run | model | psi_E (rad^2) | sum delta^2 (rad^2) | J "
-             "| max abs(psi - psi_ref) (deg) |", "|---|---|---:|---:|---:|---:|"]
-    for name, result in results.items():
-        for model in ("monolithic", *COUPLINGS):
-            f = result[model]
-            lines.append(f"| {name} | {model} | {f['psi_E']:.2f} | {f['sum_delta2']:.3f} | "
-                         f"{f['J']:.2f} | {math.degrees(f['max_dpsi']):.3f} |")
-    return "\n".join(lines)
+    return "\n".join(table(
+        ["run", "model", "psi_E (rad^2)", "sum delta^2 (rad^2)", "J",
+         "max abs(psi - psi_ref) (deg)"],
+        ([name, model, f"{f['psi_E']:.2f}", f"{f['sum_delta2']:.3f}", f"{f['J']:.2f}",
+          f"{math.degrees(f['max_dpsi']):.3f}"]
+         for name, result in results.items() for model, f in result.items()), 2))
 
 
 def convergence(name: str, reference_figures: dict[str, float], steps=STEPS,
@@ -154,26 +139,26 @@ def convergence(name: str, reference_figures: dict[str, float], steps=STEPS,
     """Part 3 for one run: the figures at each step and coupling, and J's relative distance
     from the monolithic value."""
     J = reference_figures["J"]
-    out: dict[str, list[dict]] = {coupling: [] for coupling in COUPLINGS}
-    for coupling in COUPLINGS:
-        for step in steps:
-            f = figures(cosimulation(name, step, coupling, stop_time))
-            out[coupling].append({"step": step, **f, "J_error": abs(f["J"] - J) / J})
-    return out
+
+    def row(coupling: str, step: float) -> dict:
+        f = figures(cosimulation(name, step, coupling, stop_time))
+        return {"step": step, **f, "J_error": abs(f["J"] - J) / J}
+    return {coupling: [row(coupling, step) for step in steps] for coupling in COUPLINGS}
 
 
 def convergence_table(results: dict[str, dict], references: dict[str, dict]) -> str:
     steps = [r["step"] for r in next(iter(next(iter(results.values())).values()))]
-    lines = ["| run | coupling | " + " | ".join(f"J at {s:g} s" for s in steps)
-             + " | order | J monolithic |", "|---|---|" + "---:|" * (len(steps) + 2)]
-    for name, by_coupling in results.items():
-        for coupling, rows in by_coupling.items():
-            errors = [r["J_error"] for r in rows]
-            order = [math.log2(a / b) for a, b in zip(errors, errors[1:]) if a > 0 and b > 0]
-            lines.append(f"| {name} | {coupling} | " + " | ".join(f"{r['J']:.2f}" for r in rows)
-                         + f" | {np.median(order) if order else math.nan:.2f} | "
-                           f"{references[name]['J']:.2f} |")
-    return "\n".join(lines)
+
+    def order(rows: list[dict]) -> float:
+        e = [r["J_error"] for r in rows]
+        found = [math.log2(a / b) for a, b in zip(e, e[1:]) if a > 0 and b > 0]
+        return np.median(found) if found else math.nan
+    return "\n".join(table(
+        ["run", "coupling", *(f"J at {s:g} s" for s in steps), "order", "J monolithic"],
+        ([name, coupling, *(f"{r['J']:.2f}" for r in rows), f"{order(rows):.2f}",
+          f"{references[name]['J']:.2f}"]
+         for name, by_coupling in results.items() for coupling, rows in by_coupling.items()),
+        2))
 
 
 def convergence_figure(results: dict[str, dict], path: Path) -> Path:

@@ -1,7 +1,6 @@
-"""Does a run depend on the CPU? The same run under other CPUs' numpy dispatch, OpenBLAS
-kernels and libm FMA variants (``NPY_DISABLE_CPU_FEATURES``, ``OPENBLAS_CORETYPE``,
-``GLIBC_TUNABLES``), which are read at start-up: each run is a child process, compared on the
-bytes of its CSV (every signal at every step, 12 significant digits)."""
+"""Does a run depend on the CPU? The same run in a child process under other CPUs' numpy
+dispatch, OpenBLAS kernels and libm FMA variants (read at start-up), compared on the bytes of
+its CSV."""
 from __future__ import annotations
 
 import json
@@ -14,8 +13,10 @@ from pathlib import Path
 
 import numpy as np
 
+from . import table
+
 _AVX512 = "AVX512F AVX512CD AVX512_SKX AVX512_CLX AVX512_CNL AVX512_ICL AVX512_SPR X86_V4"
-VARIANTS: dict[str, dict[str, str]] = {
+VARIANTS: dict[str, dict[str, str]] = {     # "default": this machine as it is
     "default": {},
     "numpy without AVX-512": {"NPY_DISABLE_CPU_FEATURES": _AVX512},
     "numpy at its baseline": {"NPY_DISABLE_CPU_FEATURES": f"X86_V3 AVX2 FMA3 {_AVX512}"},
@@ -26,10 +27,7 @@ VARIANTS: dict[str, dict[str, str]] = {
     "OpenBLAS Prescott": {"OPENBLAS_CORETYPE": "Prescott"},
     "glibc without FMA": {"GLIBC_TUNABLES": "glibc.cpu.hwcaps=-AVX2,-FMA"},
 }
-"""Environments a run is repeated in; "default" is this machine as it is."""
-
-TIMEOUT = 300.0
-"""s: the most one child run may take."""
+TIMEOUT = 300.0         # s: the most one child run may take
 
 _CHILD = ("import json, sys; from cosim import simulate; simulate(sys.argv[1], stop_time="
           "json.loads(sys.argv[3]), backend='inprocess').write_csv(sys.argv[2])")
@@ -63,11 +61,11 @@ def difference(a: Path, b: Path) -> str | None:
 
 
 def audit(scenario_names: list[str], variants: list[str] | None = None,
-          stop_time: float | None = None, workers: int = 2) -> dict[str, dict[str, str | None]]:
+          stop_time: float | None = None) -> dict[str, dict[str, str | None]]:
     """Each scenario under each variant against "default": {scenario: {variant: difference}}."""
     variants = [v for v in (variants or list(VARIANTS)) if v != "default"]
     with tempfile.TemporaryDirectory(prefix="cosim-cpus-") as folder, \
-            ThreadPoolExecutor(workers) as pool:
+            ThreadPoolExecutor(2) as pool:
         jobs = [(s, v) for s in scenario_names for v in ["default", *variants]]
         paths = dict(zip(jobs, pool.map(
             lambda i: run_in(jobs[i][1], jobs[i][0], Path(folder) / f"{i}.csv", stop_time),
@@ -78,9 +76,6 @@ def audit(scenario_names: list[str], variants: list[str] | None = None,
 
 def audit_table(results: dict[str, dict[str, str | None]]) -> str:
     """The audit as a Markdown table: 'same' or where the run first differs."""
-    variants = list(next(iter(results.values())))
-    lines = ["| scenario | " + " | ".join(variants) + " |", "|---|" + "---|" * len(variants)]
-    for scenario, by_variant in results.items():
-        lines.append(f"| {scenario} | " + " | ".join(
-            "same" if d is None else f"differs {d}" for d in by_variant.values()) + " |")
-    return "\n".join(lines)
+    return "\n".join(table(["scenario", *next(iter(results.values()))], (
+        [scenario, *("same" if d is None else f"differs {d}" for d in by_variant.values())]
+        for scenario, by_variant in results.items())))

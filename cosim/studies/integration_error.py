@@ -1,14 +1,10 @@
-"""The accuracy study's part 1, the integration error open loop: the ship (``Vessel``, the
-model the FMU wraps) under a rudder program held over each 0.1 s step, by its RK4 at h_max =
-0.1, 0.05 and 0.025 s, against DOP853 (rtol = atol = 1e-12) restarted at each communication
-point and each kink of the steering gear's response, so that no step straddles one; the
-reference's own error from a solve at half the tolerances. Programs, 400 s from straight
-running at 0.3 m/s in calm water: a 20 deg rudder step, a sine of 10 deg and 30 s, the 20/20
-zig-zag (its commands taken from one run, then fixed)."""
+"""The accuracy study's part 1 (docs/reproduction.md): the ship (``Vessel``) under a rudder
+program held over each 0.1 s step, by its RK4 at several h_max, against DOP853 restarted at
+each communication point and each kink of the steering gear's response."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -18,6 +14,8 @@ from ship_fmu.manoeuvres import RudderProgram
 from ship_fmu.steering_gear import RudderMotion
 from ship_fmu.thrusters import actuator_model
 from ship_fmu.vessel import N_PROPELLER, Vessel, VesselParameters
+
+from . import table
 
 H = 0.1                                       # s, the communication step (of parts 2-3 too)
 H_MAX = (0.1, 0.05, 0.025)                    # s, the RK4 steps compared
@@ -53,8 +51,7 @@ def rk4(delta_c: np.ndarray, h_max: float) -> dict[str, np.ndarray]:
 
 
 def reference(delta_c: np.ndarray, tolerance: float = TOLERANCE) -> dict[str, np.ndarray]:
-    """The same equations by DOP853, restarted at each communication point and at each
-    kink of the steering gear's response."""
+    """The same equations by DOP853, restarted at each communication point and kink."""
     vessel = Vessel()
     p = vessel.params
     forces = actuator_model(vessel.actuators, N_PROPELLER, N_PROPELLER, 0.0)
@@ -77,8 +74,7 @@ def reference(delta_c: np.ndarray, tolerance: float = TOLERANCE) -> dict[str, np
     return dict(zip(STATES, np.array(rows).T))
 
 
-@dataclass(frozen=True)
-class Error:
+class Error(NamedTuple):
     """Max and RMS error of one signal against the reference."""
     max: float
     rms: float
@@ -104,14 +100,14 @@ def open_loop(program: str, t_end: float = 400.0) -> dict:
 
 def open_loop_table(results: list[dict]) -> str:
     """Part 1 as a Markdown table."""
-    lines = ["| program | h_max (s) | " + " | ".join(f"max / RMS error {s}" for s in STATES)
-             + " |", "|---|---:|" + "---:|" * len(STATES)]
+    rows = []
     for result in results:
-        for h, e in result["errors"].items():
-            lines.append(f"| {result['program']} | {h:g} | " + " | ".join(
-                f"{e[s].max:.2e} / {e[s].rms:.2e}" for s in STATES) + " |")
-        lines.append(f"| {result['program']} | order | " + " | ".join(
-            ", ".join(f"{o:.2f}" for o in result["orders"][s]) for s in STATES) + " |")
-        lines.append(f"| {result['program']} | reference, tol / 2 | " + " | ".join(
-            f"{result['reference_error'][s].max:.1e}" for s in STATES) + " |")
-    return "\n".join(lines)
+        program = result["program"]
+        rows += [[program, f"{h:g}", *(f"{e[s].max:.2e} / {e[s].rms:.2e}" for s in STATES)]
+                 for h, e in result["errors"].items()]
+        rows += [[program, "order", *(", ".join(f"{o:.2f}" for o in result["orders"][s])
+                                      for s in STATES)],
+                 [program, "reference, tol / 2", *(f"{result['reference_error'][s].max:.1e}"
+                                                   for s in STATES)]]
+    return "\n".join(table(["program", "h_max (s)", *(f"max / RMS error {s}" for s in STATES)],
+                           rows, 1))

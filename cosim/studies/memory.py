@@ -1,6 +1,6 @@
-"""The memory benchmarks: a long run streamed to disk (``python -m cosim.bench memory``), and
-the batch route's memory against its members and the sweep's size (``bench sweep --parts
-memory``). Each measure of a run's own peak memory is taken in a fresh process."""
+"""The memory benchmarks: a long run streamed to disk (``bench memory``) and the batch route's
+memory against its members and the sweep's size (``bench sweep --parts memory``); a run's own
+peak memory is measured in a fresh process."""
 from __future__ import annotations
 
 import subprocess
@@ -16,16 +16,13 @@ from .timing import machine, peak_rss_mb
 
 MEMORY_MEMBERS = (64, 256, 1024, 4096)
 MEMORY_STOP_TIME = 40.0
-FLAT = 0.10
-"""A worker's peak memory is flat if the largest sweep's is within this fraction of that of
-the smallest sweep whose batches are as large."""
+FLAT = 0.10     # flat: the largest sweep's peak within this of the smallest's as large batches
 
 
-def memory(hours: float, backends: tuple[str, ...] = RUN_BACKENDS) -> None:
-    """A long calm_pd run with rows streamed to disk; peak RSS against a short run, for each
-    backend."""
+def memory(hours: float) -> None:
+    """Peak RSS of a long calm_pd run streamed to disk against a short one's, each backend."""
     print(f"Memory: calm_pd streamed to CSV in chunks of 10,000 rows, on {machine()}")
-    for backend in backends:
+    for backend in RUN_BACKENDS:
         for duration in (3600.0, hours * 3600.0):
             rows, wall, size, peak = _in_child(f"calm_pd on {backend}", "streamed_run",
                                                backend, duration)
@@ -51,8 +48,7 @@ def streamed_run(backend: str, duration: float) -> tuple[int, float, int, float]
 def batch_memory(members: tuple[int, ...] = MEMORY_MEMBERS,
                  stop_time: float = MEMORY_STOP_TIME, batch_size: int | None = None) -> dict:
     """Peak memory (MB) of waves_pd runs on the batch route: of ``simulate_members`` in a
-    fresh process for each number of ``members``, and of the one worker of a sweep of as
-    many runs; whether the worker's is flat in the sweep's size."""
+    fresh process, and of a one-worker sweep's worker, for each number of ``members``."""
     print(f"batch route memory: waves_pd runs of {stop_time:g} s, on {machine()}; {load()}")
     calls = {}
     for m in members:
@@ -88,7 +84,7 @@ def batch_memory(members: tuple[int, ...] = MEMORY_MEMBERS,
 
 def members_call(members: int, stop_time: float) -> tuple[float, float, float, float]:
     """(wall s, peak RSS before the call, peak RSS, results; MB) of ``simulate_members`` of
-    ``members`` waves_pd runs; RuntimeError if a member ran alone."""
+    ``members`` waves_pd runs; RuntimeError if one ran alone."""
     from .. import scenarios
     from ..ensemble import selftest, simulate_members
 
@@ -106,8 +102,8 @@ def members_call(members: int, stop_time: float) -> tuple[float, float, float, f
 
 
 def _in_child(what: str, function: str, *args: object) -> list[float]:
-    """What ``function(*args)`` of this module returns, run in a fresh process; RuntimeError
-    naming ``what``, with the child's last words, if it fails."""
+    """``function(*args)`` of this module run in a fresh process; RuntimeError naming
+    ``what`` with the child's last words if it fails."""
     code = f"from cosim.studies.memory import {function}; print(*{function}(*{args!r}))"
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     if done.returncode:

@@ -1,7 +1,6 @@
 """The scorecard: your autopilot beside the paper's PD and sliding-mode ones and the PID, on
-the paper's route in calm water and waves, a 40 deg course change, and two wave ensembles
-(the paper's waves, WMO sea state 4) on Dask; each criterion (``merit.CRITERIA``) won or
-lost on its own, seed-paired against the PD (``scorecard_report``)."""
+the paper's route in calm water and waves, a 40 deg course change, and two wave ensembles on
+Dask; each criterion (``merit.CRITERIA``) won or lost on its own, seed-paired against the PD."""
 from __future__ import annotations
 
 import math
@@ -10,7 +9,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from .. import scenarios
-from ..analysis.figures import comparison_figure
+from ..analysis.figures import comparison, save
 from ..analysis.metrics import heading_error, overshoot, settling_time
 from ..analysis.reports import PAPER_TABLES
 from ..analysis.seastate import WMO, model_scale
@@ -18,7 +17,8 @@ from ..api import SimulationError, overrides_of
 from ..core.files import fresh_folder, write_atomically
 from ..core.recording import Recording
 from ..outputs import Options, run_and_write
-from .scorecard_report import BASELINE, Paired, Sea, change, markdown, paired, pairs
+from .scorecard_report import (BASELINE, SEA_NAMES, Paired, Sea, change, markdown, paired,
+                               pairs)
 from .campaign import execute
 from .spec_file import controller_entry
 from .sweep_spec import Spec
@@ -31,6 +31,7 @@ __all__ = ["BASELINES", "SEAS", "Paired", "paired", "score", "backend_notes"]
 BASELINES = {"PD": "pd", "SMC": "smc", "PID": "pid"}   # display name: scenarios <sea>_<suffix>
 COURSE_CHANGE = math.radians(40.0)
 COURSE_CHANGE_ROUTE = f"0,0;1000,{1000 * math.tan(COURSE_CHANGE)!r}"   # one long leg at 40 deg
+COURSE_CHANGE_LEG = math.hypot(1000.0, 1000 * math.tan(COURSE_CHANGE))   # m
 COURSE_CHANGE_TIME = 300.0
 SETTLING_BAND = 0.02 * COURSE_CHANGE
 HEAVY_SEA = 4                   # WMO code of the second ensemble: the rudder saturates
@@ -51,27 +52,28 @@ class Contender:
     port_map: dict[str, str] | None = None
     settings: dict[str, Any] | None = None   # --set values, for the user's autopilot only
 
-    def run(self, label: str, out: Path, sea: str, stop_time: float | None = None,
-            route: str | None = None, backend: str = "fmi") -> Recording:
+    def run(self, label: str, out: Path, sea: str, backend: str, stop_time: float | None = None,
+            route: str | None = None) -> Recording:
         """One test's run, written to out/<label>_<name>.*; SimulationError if an FMU fails."""
         settings = dict(self.settings or {})
         if route is not None:
             settings["guidance.waypoints"] = route
         system = scenarios.load(f"{sea}_{self.suffix}", self.fmu, self.port_map)
         out.mkdir(parents=True, exist_ok=True)
-        outcome = run_and_write(system, f"{label}_{self.name}", out, overrides_of(settings),
-                                Options(stop_time=stop_time, backend=backend, plot=False))
-        if outcome.recording.error:
-            raise SimulationError(outcome.recording.error, outcome.recording)
-        return outcome.recording
+        recording = run_and_write(system, f"{label}_{self.name}", out, overrides_of(settings),
+                                  Options(stop_time=stop_time, backend=backend,
+                                          plot=False)).recording
+        if recording.error:
+            raise SimulationError(recording.error, recording)
+        return recording
 
     @property
     def paper_cost(self) -> str:
         """J calm / waves in the paper, for one of its controllers; '-' for any other."""
         if self.fmu is not None or f"calm_{self.suffix}" not in PAPER_TABLES:
             return "-"
-        return (f"{PAPER_TABLES[f'calm_{self.suffix}'][2]:.1f} / "
-                f"{PAPER_TABLES[f'waves_{self.suffix}'][2]:.1f}")
+        return " / ".join(f"{PAPER_TABLES[f'{sea}_{self.suffix}'][2]:.1f}"
+                          for sea in ("calm", "waves"))
 
 
 def course_change(run: Recording) -> dict[str, float]:
@@ -88,34 +90,29 @@ def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | Non
           scheduler: str | None = None,
           progress: Callable[[str], None] = lambda step: None, backend: str = "fmi") -> str:
     """Run the scorecard of ``fmu`` (called ``name``), write out/scorecard.md and figures;
-    the markdown. A failed run is reported as failed and the scorecard goes on. With
-    ``backend="batch"`` the ensembles run on the sweeps' batch backend, the rest in-process.
-    """
+    the markdown. A failed run is reported as failed and the scorecard goes on. On "batch"
+    the ensembles run on the batch backend, the rest in-process."""
     contenders = _contenders(fmu, name, port_map, settings)
     failures: dict[tuple[str, str], str] = {}
-    single = "inprocess" if backend == BATCH else backend
 
-    def tested(test: str, label: str, **kwargs: Any) -> dict[str, Recording]:
+    def tested(test: str, label: str, title: str, **kwargs: Any) -> dict[str, Recording]:
         runs = {}
         for contender in contenders:
             progress(f"{test}, {contender.name}")
             try:
-                runs[contender.name] = contender.run(label, out / "runs", **kwargs,
-                                                     backend=single)
+                runs[contender.name] = contender.run(
+                    label, out / "runs", backend="inprocess" if backend == BATCH else backend,
+                    **kwargs)
             except SimulationError as error:
                 failures[contender.name, test] = str(error).splitlines()[0]
+        save(comparison(runs, title), out / f"{label}.png")
         return runs
 
-    route = {}
-    for sea in ("calm", "waves"):
-        route[sea] = tested(f"{sea} water", f"route_{sea}", sea=sea)
-        comparison_figure(route[sea], out / f"route_{sea}.png",
-                          f"The paper's route in {'calm water' if sea == 'calm' else 'waves'}")
-    runs = tested("course change", "course_change", sea="calm", stop_time=COURSE_CHANGE_TIME,
-                  route=COURSE_CHANGE_ROUTE)
-    changes = {n: course_change(r) for n, r in runs.items()}
-    comparison_figure(runs, out / "course_change.png",
-                      "40 deg course change from straight running, calm water")
+    route = {sea: tested(f"{sea} water", f"route_{sea}", f"The paper's route in {words}",
+                         sea=sea) for sea, words in SEA_NAMES.items()}
+    changes = {n: course_change(r) for n, r in tested(
+        "course change", "course_change", "40 deg course change from straight running, calm "
+        "water", sea="calm", stop_time=COURSE_CHANGE_TIME, route=COURSE_CHANGE_ROUTE).items()}
     ensembles = {}
     for sea in SEAS:            # each in a fresh folder, with its figures
         progress(f"wave ensemble in {sea.name}, {seeds} seeds on Dask")
@@ -125,14 +122,13 @@ def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | Non
             rows = ensembles[sea] = execute(spec, folder, scheduler=scheduler, workers=workers,
                                             progress=False, backend=backend)
         distribution(spec, rows, out / f"criteria_{sea.key}.png", CRITERIA)
-        others = [c.name for c in contenders if c.name != BASELINE]
         paired_figure(f"The route in {sea.name}", {
-            criterion: {n: change(criterion, *pairs(criterion, rows, n)) for n in others}
+            criterion: {c.name: change(criterion, *pairs(criterion, rows, c.name))
+                        for c in contenders if c.name != BASELINE}
             for criterion in CRITERIA}, BASELINE, out / f"paired_{sea.key}.png")
         tracks(spec, rows, out / f"tracks_{sea.key}.png")
-    leg = math.hypot(1000.0, 1000 * math.tan(COURSE_CHANGE))     # of COURSE_CHANGE_ROUTE
     text = markdown(fmu, name, seeds, {c.name: c.paper_cost for c in contenders}, route,
-                    changes, (COURSE_CHANGE_TIME, leg), failures, ensembles)
+                    changes, (COURSE_CHANGE_TIME, COURSE_CHANGE_LEG), failures, ensembles)
     write_atomically(out / "scorecard.md", lambda path: path.write_text(text))
     return text
 

@@ -10,11 +10,13 @@ import numpy as np
 from ..analysis.cost import cost
 from ..analysis.metrics import RUDDER_DEADBAND, RouteCompletion, route_completion
 from ..core.recording import Recording
+from . import table
 from .merit import CRITERIA, Merit, route_of, run_metrics
 from .sweep_figures import STATISTICS
 
 BASELINE = "PD"                 # every other controller is paired with it, seed by seed
 TIE = 0.01                      # values closer than this share of the baseline's tie
+SEA_NAMES = {"calm": "calm water", "waves": "waves"}      # the single runs' seas
 
 
 @dataclass(frozen=True)
@@ -25,10 +27,6 @@ class Sea:
     name: str
     detail: str                          # its Hs and T0
     sea_state: int | None = None
-
-    @property
-    def title(self) -> str:
-        return f"{self.name} ({self.detail})"
 
 
 @dataclass(frozen=True)
@@ -56,10 +54,8 @@ class Paired:
 
 def pairs(criterion: Merit, rows: list[dict], controller: str,
           baseline: str = BASELINE) -> tuple[np.ndarray, np.ndarray]:
-    """(controller's, baseline's) values of ``criterion`` (of ``merit.CRITERIA``) on
-    the seeds both ran ok, paired by wave_seed."""
-    values = {name: {r["wave_seed"]: r[criterion.column] for r in rows
-                     if r["status"] == "ok" and r["controller"] == name}
+    """(controller's, baseline's) values of ``criterion`` on the seeds both ran ok."""
+    values = {name: {r["wave_seed"]: r[criterion.column] for r in _ok(rows, name)}
               for name in (controller, baseline)}
     seeds = sorted(set(values[controller]) & set(values[baseline]))
     return (np.array([values[controller][s] for s in seeds], dtype=float),
@@ -82,11 +78,6 @@ def paired(criterion: Merit, rows: list[dict], controller: str,
     changes = change(criterion, mine, base)
     return Paired(int(np.sum((margin > 0) & ~tied)), int(np.sum((margin < 0) & ~tied)),
                   int(np.sum(tied)), float(np.median(changes)) if changes.size else math.nan)
-
-
-def completion(run: Recording) -> RouteCompletion:
-    """Which waypoints of its route a run reached."""
-    return route_completion(run["ship.x"], run["ship.y"], *route_of(run))
 
 
 def markdown(fmu: Path, name: str, seeds: int, paper: dict[str, str],
@@ -117,13 +108,19 @@ def markdown(fmu: Path, name: str, seeds: int, paper: dict[str, str],
     return "\n".join(lines)
 
 
+def _label(criterion: Merit, better: bool = False) -> str:
+    """The criterion's label (unit), and with ``better`` the side that is better."""
+    unit = f" ({criterion.unit})" if criterion.unit else ""
+    return criterion.label + unit + (f", {criterion.better}" if better else "")
+
+
 def _of(criterion: Merit, row: dict) -> str:
     """' of N' for a count out of a total, '' for any other criterion."""
     return f" of {row[criterion.out_of]:.0f}" if criterion.out_of else ""
 
 
-def _label(criterion: Merit) -> str:
-    return criterion.label + (f" ({criterion.unit})" if criterion.unit else "")
+def _completion(run: Recording) -> RouteCompletion:
+    return route_completion(run["ship.x"], run["ship.y"], *route_of(run))
 
 
 def _reached(done: RouteCompletion) -> str:
@@ -145,26 +142,16 @@ def _at_a_glance(names: list[str], route: dict[str, dict[str, Recording]],
              "*mixed* neither; then the seeds won, lost and tied of those both ran, and the "
              f"median paired ratio to the {BASELINE} or difference from it.", ""]
     for sea, rows in ensembles.items():
-        lines += [f"The route in {sea.title}:", "",
-                  "| criterion | better | " + " | ".join(names[1:]) + " |",
-                  "|---|---|" + "---|" * len(names[1:])]
-        lines += [f"| {_label(c)} | {c.better.split()[0]} | " + " | ".join(
-            _verdict(c, paired(c, rows, name)) for name in names[1:]) + " |" for c in CRITERIA]
-        lines.append("")
-    lines += ["Route completion (higher is better):", "",
-              "| controller | calm water | waves | "
-              + " | ".join(f"ensemble, {sea.name}" for sea in ensembles) + " |",
-              "|---|---|---|" + "---|" * len(ensembles)]
-    for name in names:
-        cells = [_reached(completion(route[sea][name])) if name in route[sea] else "failed"
-                 for sea in ("calm", "waves")]
-        for rows in ensembles.values():
-            ok = _ok(rows, name)
-            last = sum(r["last_waypoint_reached"] == 1.0 for r in ok)
-            cells.append(f"{_waypoints_reached(ok)}; the last in {last} of {len(ok)} seeds"
-                         if ok else "no run ok")
-        lines.append(f"| {name} | {' | '.join(cells)} |")
-    lines.append("")
+        lines += [f"The route in {sea.name} ({sea.detail}):", "", *table(
+            ["criterion", "better", *names[1:]],
+            ([_label(c), c.better.split()[0], *(_verdict(c, paired(c, rows, name))
+                                                for name in names[1:])] for c in CRITERIA)), ""]
+    lines += ["Route completion (higher is better):", "", *table(
+        ["controller", *SEA_NAMES.values(), *(f"ensemble, {sea.name}" for sea in ensembles)],
+        ([name, *(_reached(_completion(route[sea][name])) if name in route[sea] else "failed"
+                  for sea in SEA_NAMES),
+          *(_ensemble_completion(_ok(rows, name)) for rows in ensembles.values())]
+         for name in names)), ""]
     for sea, rows in ensembles.items():
         for name in names:                  # a plain sentence for a route never finished
             ok = _ok(rows, name)
@@ -175,6 +162,13 @@ def _at_a_glance(names: list[str], route: dict[str, dict[str, Recording]],
                 lines.append(f"- In {sea.name}, **{name} never reached the last waypoint** "
                              f"in any of {len(ok)} seeds: it {_waypoints_reached(ok)}{held}.")
     return lines + [""]
+
+
+def _ensemble_completion(ok: list[dict]) -> str:
+    if not ok:
+        return "no run ok"
+    last = sum(r["last_waypoint_reached"] == 1.0 for r in ok)
+    return f"{_waypoints_reached(ok)}; the last in {last} of {len(ok)} seeds"
 
 
 def _verdict(criterion: Merit, p: Paired) -> str:
@@ -200,69 +194,68 @@ def _waypoints_reached(ok: list[dict]) -> str:
 
 
 def _paper_route(paper: dict[str, str], route: dict[str, dict[str, Recording]]) -> list[str]:
-    lines = ["## The paper's route (Tables 1-2, eq 19; lower is better)", "",
-             "| controller | calm psi_E | calm delta_E | calm J | waves psi_E | waves delta_E "
-             "| waves J | paper J calm / waves |", "|---|---|---|---|---|---|---|---|"]
-    for name, theirs in paper.items():
-        cells = []
-        for sea in ("calm", "waves"):
-            r = cost(route[sea][name]) if name in route[sea] else None
-            cells += [f"{r.psi_E:.1f}", f"{r.delta_E:.1f}", f"{r.J:.1f}"] if r else ["failed"] * 3
-        lines.append(f"| {name} | {' | '.join(cells)} | {theirs} |")
-    lines += ["", "Every criterion, one run each (the scenarios' wave seed):", "",
-              "| controller | sea | " + " | ".join(f"{_label(c)}, {c.better}" for c in CRITERIA)
-              + " |", "|---|---|" + "---|" * len(CRITERIA)]
-    misses = []
+    metrics = {(sea, name): run_metrics(run) for sea, runs in route.items()
+               for name, run in runs.items()}
+    lines = ["## The paper's route (Tables 1-2, eq 19; lower is better)", "", *table(
+        ["controller", "calm psi_E", "calm delta_E", "calm J", "waves psi_E", "waves delta_E",
+         "waves J", "paper J calm / waves"],
+        ([name, *_cost_cells(route["calm"].get(name)), *_cost_cells(route["waves"].get(name)),
+          theirs] for name, theirs in paper.items())),
+        "", "Every criterion, one run each (the scenarios' wave seed):", "",
+        *table(["controller", "sea", *(_label(c, better=True) for c in CRITERIA)],
+               ([name, sea, *(c.format(row[c.column]) + _of(c, row) for c in CRITERIA)]
+                for (sea, name), row in metrics.items())), ""]
     for sea, runs in route.items():
         for name, run in runs.items():
-            row = run_metrics(run)
-            lines.append(f"| {name} | {sea} | " + " | ".join(
-                c.format(row[c.column]) + _of(c, row) for c in CRITERIA) + " |")
-            done = completion(run)
+            done = _completion(run)
             if done.count < len(done.points):
                 missed = ", ".join(f"waypoint {k} ({x:g}, {y:g}) by {d:.1f} m"
                                    for k, ((x, y), d, hit) in enumerate(
                                        zip(done.points, done.closest, done.reached), start=1)
                                    if not hit)
-                misses.append(f"- {name}, {sea}: {_reached(done)}; missed {missed} "
-                              f"(circle of acceptance {done.R_accept:g} m)")
-    return lines + ["", *misses, "", "![route in calm water](route_calm.png)",
+                lines.append(f"- {name}, {sea}: {_reached(done)}; missed {missed} "
+                             f"(circle of acceptance {done.R_accept:g} m)")
+    return lines + ["", "![route in calm water](route_calm.png)",
                     "![route in waves](route_waves.png)", ""]
+
+
+def _cost_cells(run: Recording | None) -> list[str]:
+    """psi_E, delta_E and J of eq (19), or 'failed'."""
+    if run is None:
+        return ["failed"] * 3
+    c = cost(run)
+    return [f"{c.psi_E:.1f}", f"{c.delta_E:.1f}", f"{c.J:.1f}"]
 
 
 def _course_change(names: list[str], changes: dict[str, dict], time: float,
                    leg: float) -> list[str]:
-    lines = [f"## A 40 deg course change, calm water, {time:.0f} s (lower is better)", "",
-             "| controller | settling time to 2 % (s) | overshoot (deg) | rudder reversals "
-             "(1/min) | mean abs rudder rate (deg/s) | max rudder (deg) | max cross-track (m) |",
-             "|---|---|---|---|---|---|---|"]
-    for name in names:
-        m = changes.get(name)
+    def cells(m: dict | None) -> list[str]:
         if m is None:
-            lines.append(f"| {name} |" + " failed |" * 6)
-            continue
-        settled = f"{m['settling_time']:.1f}" if math.isfinite(m["settling_time"]) else \
-            f"> {time:.0f}"
-        lines.append(f"| {name} | {settled} | {math.degrees(m['overshoot']):.2f} | "
-                     f"{m['reversals_per_min']:.1f} | {m['mean_rudder_rate_deg_s']:.2f} | "
-                     f"{m['max_delta_deg']:.1f} | {m['cross_track_max_m']:.2f} |")
-    return lines + ["", f"The course change follows one leg of {leg:.0f} m, longer than the "
-                        f"ship sails in {time:.0f} s: route completion does not apply to it.",
-                    "", "![course change](course_change.png)", ""]
+            return ["failed"] * 6
+        settled = (f"{m['settling_time']:.1f}" if math.isfinite(m["settling_time"])
+                   else f"> {time:.0f}")
+        return [settled, f"{math.degrees(m['overshoot']):.2f}", f"{m['reversals_per_min']:.1f}",
+                f"{m['mean_rudder_rate_deg_s']:.2f}", f"{m['max_delta_deg']:.1f}",
+                f"{m['cross_track_max_m']:.2f}"]
+    return [f"## A 40 deg course change, calm water, {time:.0f} s (lower is better)", "",
+            *table(["controller", "settling time to 2 % (s)", "overshoot (deg)",
+                    "rudder reversals (1/min)", "mean abs rudder rate (deg/s)",
+                    "max rudder (deg)", "max cross-track (m)"],
+                   ([name, *cells(changes.get(name))] for name in names)),
+            "", f"The course change follows one leg of {leg:.0f} m, longer than the ship "
+                f"sails in {time:.0f} s: route completion does not apply to it.",
+            "", "![course change](course_change.png)", ""]
 
 
 def _ensemble_section(sea: Sea, names: list[str], seeds: int, rows: list[dict]) -> list[str]:
     """Each criterion's median and IQR per controller."""
-    lines = [f"## Wave ensemble: the route in {sea.title}, {seeds} wave seeds", "",
-             "Each criterion: median [IQR, 25-75 %] over the seeds that ran; waypoints "
+    ok = {name: _ok(rows, name) for name in names}
+    lines = [f"## Wave ensemble: the route in {sea.name} ({sea.detail}), {seeds} wave seeds",
+             "", "Each criterion: median [IQR, 25-75 %] over the seeds that ran; waypoints "
              "reached out of the route's.", "",
-             "| controller | runs ok | " + " | ".join(f"{_label(c)}, {c.better}" for c in CRITERIA)
-             + " |",
-             "|---|---|" + "---|" * len(CRITERIA)]
-    for name in names:
-        mine = _ok(rows, name)
-        lines.append(f"| {name} | {len(mine)}/{seeds} | "
-                     f"{' | '.join(_spread(c, mine) for c in CRITERIA)} |")
+             *table(["controller", "runs ok", *(_label(c, better=True) for c in CRITERIA)],
+                    ([name, f"{len(ok[name])}/{seeds}", *(_spread(c, ok[name]) for c in CRITERIA)]
+                     for name in names))]
     failed = [r for r in rows if r["status"] != "ok"]
     if failed:
         lines += ["", f"{len(failed)} runs of the ensemble failed; the first: "

@@ -1,8 +1,6 @@
-"""How many of a run's digits mean something? The run again with a last bit changed: the
-initial surge speed u0 (a change the run carries) and the wave direction psi_w (a change to
-the wave loads at every step), each moved by k ulps, k = +-1 ... +-ulps. The chattering
-sliding-mode loop and the switches of leg turn a last bit into percent of J, as a CPU that
-rounds otherwise would: the largest change of each figure of eq (19) is its precision."""
+"""How many of a run's digits mean something? The run again with the initial surge speed u0
+and the wave direction psi_w each moved by a few ulps: the largest change of each figure of
+eq (19) is its precision, as a CPU that rounds otherwise could move it."""
 from __future__ import annotations
 
 import math
@@ -14,8 +12,7 @@ from ..core.master import Master
 from ..core.ssd import SystemDescription
 
 FIGURES = ("psi_E", "delta_E", "J")
-PERTURBED = (("ship", "u0"), ("ship", "psi_w"))
-"""The parameters moved by a few ulps, one at a time."""
+PERTURBED = (("ship", "u0"), ("ship", "psi_w"))     # moved by a few ulps, one at a time
 
 
 def nudged(value: float, ulps: int) -> float:
@@ -29,8 +26,7 @@ def nudged(value: float, ulps: int) -> float:
 @dataclass(frozen=True)
 class Spread:
     """How far one last bit moves each figure of eq (19): the run's value and the largest
-    change from it over the ensemble (not its range: the run itself may lie at either end,
-    and another CPU's run may diverge either way)."""
+    change from it (not the range: another CPU's run may diverge either way)."""
 
     runs: int
     nominal: dict[str, float]       # figure: the unperturbed run's value
@@ -39,20 +35,17 @@ class Spread:
     def describe(self, digits: int = 2) -> str:
         """'psi_E 472.76 +- 18.67, J 612.45 +- 20.18': the figures whose value +- deviation
         shows at ``digits`` decimals; or 'every figure as printed'."""
-        wide = []
-        for f in FIGURES:
-            value, change = self.nominal[f], self.deviation[f]
-            if f"{value - change:.{digits}f}" != f"{value + change:.{digits}f}":
-                wide.append(f"{f} {value:.{digits}f} +- {change:.{digits}f}")
-        return ", ".join(wide) if wide else "every figure as printed"
+        value, change = self.nominal, self.deviation
+        wide = [f"{f} {value[f]:.{digits}f} +- {change[f]:.{digits}f}" for f in FIGURES
+                if f"{value[f] - change[f]:.{digits}f}" != f"{value[f] + change[f]:.{digits}f}"]
+        return ", ".join(wide) or "every figure as printed"
 
 
 def spread(system: SystemDescription, overrides: dict[str, dict[str, Any]] | None = None,
            ulps: int = 20, lam: float = LAMBDA, coupling: str = "gauss-seidel",
            stop_time: float | None = None) -> Spread:
-    """The run and 2 ulps runs for each of ``PERTURBED`` (in-process), moved by -ulps ...
-    +ulps; ValueError if ulps < 1 or the system lacks a perturbed parameter; RuntimeError
-    naming the member if a run fails."""
+    """The run and those with each of ``PERTURBED`` moved by -ulps ... +ulps, in-process;
+    ValueError if ulps < 1 or the system lacks one; RuntimeError naming a failed run."""
     if ulps < 1:
         raise ValueError(f"spread: ulps must be >= 1, got {ulps}")
     overrides = overrides or {}

@@ -1,6 +1,5 @@
-"""The sweep benchmark (``python -m cosim.bench sweep``): sweeps on fresh local clusters, every
-backend side by side (``sweep_throughput``) and 1,000 waves_pd runs on the batch route
-(``campaign``), each goal printed beside its figure, with the load average."""
+"""The sweep benchmark (``python -m cosim.bench sweep``): every backend side by side and the
+batch route's campaign, each on fresh local clusters, each goal printed beside its figure."""
 from __future__ import annotations
 
 import math
@@ -18,10 +17,10 @@ from .sweep_task import BATCH, SWEEP_BACKENDS
 from .timing import machine, peak_rss_mb, require_in_process
 
 SEAS = {"waves": ("waves_pd", "waves_smc"), "calm": ("calm_pd", "calm_smc")}
-GOALS = {"waves": 5.0, "calm": 10.0}
-"""The batch route's goal: its runs per second per core over the in-process route's."""
+GOALS = {"waves": 5.0, "calm": 10.0}   # batch runs/s per core over the in-process route's
+# the campaign's goal: these runs of this stop time on these workers within this many s
 CAMPAIGN_RUNS, CAMPAIGN_STOP_TIME, CAMPAIGN_WORKERS, CAMPAIGN_GOAL = 1000, 400.0, 2, 30.0
-"""The campaign's goal: these runs of this stop time on these workers within this many s."""
+WORKERS = (1, 2)            # the throughput's sweeps: on 1 and on 2 workers
 
 
 def load() -> str:
@@ -43,18 +42,15 @@ class Measure:
     load: float                 # the 1-minute load average as it ended
 
     @property
-    def rate(self) -> float:
-        """Runs per second."""
+    def rate(self) -> float:            # runs per second
         return self.runs / self.wall
 
 
-def sweep_throughput(runs: int = 32, batch_runs: int = 1024,
-                     seas: tuple[str, ...] = tuple(SEAS), worker_counts: tuple[int, ...] = (1, 2),
-                     backends: tuple[str, ...] = SWEEP_BACKENDS, rounds: int = 1,
-                     stop_time: float = 400.0) -> dict[tuple[str, str, int], float]:
-    """Runs per second by (sea, backend, workers): the median of ``rounds`` sweeps of ``runs``
-    runs (``batch_runs`` on the batch backend) taken in turn; printed with the per-core
-    rates, the parallel efficiency and the goals (the median of the rounds' ratios)."""
+def sweep_throughput(runs: int = 32, batch_runs: int = 1024, seas: tuple[str, ...] = tuple(SEAS),
+                     rounds: int = 1, stop_time: float = 400.0
+                     ) -> dict[tuple[str, str, int], float]:
+    """Runs per second by (sea, backend, workers), the median of ``rounds`` sweeps taken in
+    turn; printed with the per-core rates, the parallel efficiency and the goals."""
     for count, name in ((runs, "runs"), (batch_runs, "batch_runs")):
         if count < 2 or count % 2:
             raise ValueError(f"{name} must be an even number of runs >= 2 (half for each "
@@ -67,15 +63,13 @@ def sweep_throughput(runs: int = 32, batch_runs: int = 1024,
           f"cluster, on {machine()}; {load()}")
     for sea in seas:                              # before minutes of measuring the others
         spec = _sea_spec(sea, 2, 1.0)
-        if "inprocess" in backends:
-            require_in_process(spec.backend_notes("inprocess"))
-        if BATCH in backends:
-            require_batch(spec)
+        require_in_process(spec.backend_notes("inprocess"))
+        require_batch(spec)
     measured: dict[tuple[str, str, int], list[float]] = {}
     for _ in range(rounds):
-        for workers in worker_counts:             # backends side by side, under the same load
+        for workers in WORKERS:                   # backends side by side, under the same load
             for sea in seas:
-                for backend in backends:
+                for backend in SWEEP_BACKENDS:
                     m = timed_sweep(_sea_spec(sea, batch_runs if backend == BATCH else runs,
                                               stop_time), workers, backend)
                     batched = f"; batches of {sizes(m.batches)}" if m.batches else ""
@@ -88,26 +82,23 @@ def sweep_throughput(runs: int = 32, batch_runs: int = 1024,
                           f"({outside / m.simulated:4.1%}); load {m.load:.2f}")
                     measured.setdefault((sea, backend, workers), []).append(m.rate)
     rates = {key: statistics.median(values) for key, values in measured.items()}
-    _print_rates(rates, seas, worker_counts, backends, rounds)
-    if BATCH in backends and "inprocess" in backends:
-        for sea in seas:
-            ratios = {w: [b / i for b, i in zip(measured[sea, BATCH, w],
-                                                measured[sea, "inprocess", w])]
-                      for w in worker_counts}
-            medians = {w: statistics.median(r) for w, r in ratios.items()}
-            print(f"  goal, {sea}: batch runs/s per core at least {GOALS[sea]:g}x in-process: "
-                  + ", ".join(f"{medians[w]:.2f}x with {_workers(w)}" + (
-                      f" (rounds: {', '.join(f'{x:.2f}' for x in r)})" if len(r) > 1 else "")
-                      for w, r in ratios.items())
-                  + f": {verdict(all(m >= GOALS[sea] for m in medians.values()))}")
+    _print_rates(rates, seas, rounds)
+    for sea in seas:
+        ratios = {w: [b / i for b, i in zip(measured[sea, BATCH, w], measured[sea, "inprocess", w])]
+                  for w in WORKERS}
+        medians = {w: statistics.median(r) for w, r in ratios.items()}
+        print(f"  goal, {sea}: batch runs/s per core at least {GOALS[sea]:g}x in-process: "
+              + ", ".join(f"{medians[w]:.2f}x with {_workers(w)}" + (
+                  f" (rounds: {', '.join(f'{x:.2f}' for x in r)})" if len(r) > 1 else "")
+                  for w, r in ratios.items())
+              + f": {verdict(all(m >= GOALS[sea] for m in medians.values()))}")
     print(f"  {load()}")
     return rates
 
 
 def campaign(runs: int = CAMPAIGN_RUNS, workers: int = CAMPAIGN_WORKERS,
              stop_time: float = CAMPAIGN_STOP_TIME) -> Measure:
-    """``runs`` waves_pd runs of ``stop_time`` on the batch route on ``workers``: the wall
-    time from submission to the last row, and with the start-up, against the goal."""
+    """``runs`` waves_pd runs on the batch route on ``workers``, against the goal."""
     if runs < 1:
         raise ValueError(f"the campaign's runs must be at least 1, got {runs}")
     print(f"campaign: {runs} waves_pd runs of {stop_time:g} s on the batch route, a local "
@@ -147,8 +138,7 @@ def sizes(sizes: tuple[int, ...]) -> str:
     return f"{low}" if low == high else f"{low}-{high}"
 
 
-def seeds(runs: int) -> dict[str, list]:
-    """The axis of ``runs`` wave seeds from 1."""
+def seeds(runs: int) -> dict[str, list]:        # the axis of ``runs`` wave seeds from 1
     return {"wave_seed": list(range(1, runs + 1))}
 
 
@@ -160,8 +150,8 @@ def bench_spec(controllers: dict[str, str], axes: dict[str, list], stop_time: fl
 
 
 def _sea_spec(sea: str, runs: int, stop_time: float) -> Spec:
-    """The sweep of ``runs`` runs of a sea, half with each of its scenarios: over wave seeds,
-    or in calm water (where the seed changes nothing) over headings 1 mrad apart."""
+    """``runs`` runs, half with each scenario of the sea: over wave seeds, or in calm water
+    (where the seed changes nothing) over headings 1 mrad apart."""
     axes = seeds(runs // 2) if sea == "waves" else {
         "ship.psi0": [k / 1000 for k in range(runs // 2)]}
     return bench_spec(dict(zip(("pd", "smc"), SEAS[sea])), axes, stop_time)
@@ -169,7 +159,7 @@ def _sea_spec(sea: str, runs: int, stop_time: float) -> Spec:
 
 def require_batch(spec: Spec) -> None:
     """RuntimeError if the runs of ``spec`` would not all run in batches; prints the
-    self-test's time, which each worker process spends once."""
+    self-test's time."""
     from ..ensemble import selftest
 
     notes = spec.backend_notes(BATCH)
@@ -184,8 +174,7 @@ def require_batch(spec: Spec) -> None:
 
 def timed_sweep(spec: Spec, workers: int, backend: str, batch_size: int | None = None
                 ) -> Measure:
-    """``spec`` run on a fresh local cluster of ``workers``; RuntimeError if a run failed,
-    or, on the batch backend, ran other than in a batch."""
+    """``spec`` on a fresh local cluster; RuntimeError if a run failed or left its batch."""
     from dask.distributed import Client
 
     from .campaign import execute
@@ -220,23 +209,18 @@ def timed_sweep(spec: Spec, workers: int, backend: str, batch_size: int | None =
 
 
 def _print_rates(rates: dict[tuple[str, str, int], float], seas: tuple[str, ...],
-                 worker_counts: tuple[int, ...], backends: tuple[str, ...], rounds: int) -> None:
-    """Per-core rates and parallel efficiency, and the ratios between backends."""
-    base = min(worker_counts)
-    others = [w for w in worker_counts if w != base]
+                 rounds: int) -> None:
     print("  runs/s per core (runs/s / workers" + (f", median of {rounds} rounds" if rounds > 1
                                                  else "") + "):")
-    print(f"    {'':15}" + "".join(f"{_workers(w):>11}" for w in worker_counts)
-          + "".join(f"{f'efficiency {base}->{w}':>17}" for w in others))
+    print(f"    {'':15}" + "".join(f"{_workers(w):>11}" for w in WORKERS)
+          + f"{'efficiency 1->2':>17}")
     for sea in seas:
-        for backend in backends:
-            rate = {w: rates[sea, backend, w] for w in worker_counts}
-            print(f"    {sea:5} {backend:9}" + "".join(f"{rate[w] / w:11.2f}" for w in rate)
-                  + "".join(f"{rate[w] / rate[base] * base / w:17.2f}" for w in others))
+        for backend in SWEEP_BACKENDS:
+            one, two = (rates[sea, backend, w] for w in WORKERS)
+            print(f"    {sea:5} {backend:9}{one:11.2f}{two / 2:11.2f}{two / one / 2:17.2f}")
     print("    (efficiency 1.00: each worker as fast as one alone)")
     for sea in seas:
-        for backend in backends:
-            if backend != "fmi" and "fmi" in backends:
-                print(f"  {sea:5} {backend} / fmi: " + ", ".join(
-                    f"{rates[sea, backend, w] / rates[sea, 'fmi', w]:5.2f}x with {_workers(w)}"
-                    for w in worker_counts))
+        for backend in (b for b in SWEEP_BACKENDS if b != "fmi"):
+            print(f"  {sea:5} {backend} / fmi: " + ", ".join(
+                f"{rates[sea, backend, w] / rates[sea, 'fmi', w]:5.2f}x with {_workers(w)}"
+                for w in WORKERS))

@@ -1,6 +1,5 @@
-"""The engine benchmarks behind ``python -m cosim.bench`` (figures printed, never asserted):
-``engines`` side by side on calm_pd and waves_pd, and ``overhead``, what the routes do
-besides the models; the helpers the other benchmarks share."""
+"""The engine benchmarks of ``python -m cosim.bench`` (figures printed, never asserted):
+``engines`` and ``overhead``; the helpers the other benchmarks share."""
 from __future__ import annotations
 
 import os
@@ -19,11 +18,13 @@ ROWS = {"direct": "(a) cosim.direct: the modules wired by hand",
         "libcosim": "(d) OSP libcosim, same SSP",
         "ecos": "(e) ecos, same SSP",
         "floor": "(f) FMI floor: a + calls x cost"}
+RATIOS = (("b/a", "inprocess", "direct"), ("c/b", "fmi", "inprocess"), ("c/f", "fmi", "floor"),
+          ("d/c", "libcosim", "fmi"), ("e/c", "ecos", "fmi"))
 
 
 def peak_rss_mb() -> float:
-    """This process's peak resident memory, MB: Linux's VmHWM, which starts afresh with the
-    process's program (``ru_maxrss`` keeps a forked parent's peak)."""
+    """This process's peak resident memory, MB: Linux's VmHWM (``ru_maxrss`` keeps a forked
+    parent's peak)."""
     try:
         return next(int(line.split()[1]) / 1024 for line in
                     Path("/proc/self/status").read_text().splitlines() if line.startswith("VmHWM:"))
@@ -43,8 +44,8 @@ def machine() -> str:
 
 
 def side_by_side(runners: dict[str, Callable[[], object]], repeats: int) -> dict[str, float]:
-    """Median wall time of each runner, timed in turn round after round after a warm-up
-    round, so that on a shared machine they see the same load."""
+    """Median wall time of each runner, timed in turn round after round (the same load on a
+    shared machine) after a warm-up round."""
     times: dict[str, list[float]] = {key: [] for key in runners}
     for round_ in range(repeats + 1):
         for key, run in runners.items():
@@ -82,10 +83,8 @@ def _ecos_runner(ssp: Path) -> Callable[[], None]:
 
 
 def engines(repeats: int) -> dict[str, dict[str, float]]:
-    """calm_pd and waves_pd, 400 s, by (a) the modules wired by hand (``run_direct``), our
-    master (b) in-process and (c) through the FMUs, (d) libcosim and (e) ecos on the exported
-    SSP package, and (f) the FMI floor, (a) plus the calls per step times one's cost; one
-    table per scenario with the ratios, and the times by scenario and row."""
+    """calm_pd and waves_pd by each of ``ROWS`` (docs/performance.md), printed with their
+    ratios; the times by scenario and row."""
     from .. import scenarios
     from ..core.master import Master
     from ..ensemble.reference import run_direct
@@ -117,11 +116,7 @@ def engines(repeats: int) -> dict[str, dict[str, float]]:
                     t = times[key]
                     print(f"  {label:44} {t:7.3f} {t / STEPS * 1e6:8.1f} {400 / t:6.0f} "
                           f"{t / times['direct']:6.2f}")
-            ratios = [f"b/a = {times['inprocess'] / times['direct']:.2f}",
-                      f"c/b = {times['fmi'] / times['inprocess']:.2f}",
-                      f"c/f = {times['fmi'] / times['floor']:.2f}"]
-            ratios += [f"{letter}/c = {times[k] / times['fmi']:.2f}"
-                       for letter, k in (("d", "libcosim"), ("e", "ecos")) if k in times]
+            ratios = [f"{r} = {times[a] / times[b]:.2f}" for r, a, b in RATIOS if a in times]
             print(f"  {'   '.join(ratios)}\n  (f): {calls} FMI calls per step x "
                   f"{per_call * 1e6:.1f} us per call (measured on the PD FMU in the running "
                   "loop) + the model compute (a)")
@@ -132,7 +127,7 @@ def engines(repeats: int) -> dict[str, dict[str, float]]:
 
 
 def require_in_process(notes: list[str]) -> None:
-    """RuntimeError if a component meant to run in-process would run through FMI."""
+    """RuntimeError if a component would run through FMI (its ``notes``)."""
     if notes:
         raise RuntimeError("the in-process backend cannot be measured: " + "; ".join(notes))
 
@@ -153,8 +148,8 @@ def fmi_calls_per_step(master) -> int:
 
 
 def fmi_call_cost(master, calls: int = 20_000) -> float:
-    """Seconds per FMI call of the cheapest kind, setReal and getReal of one value on the
-    autopilot FMU, as the master's loop makes them."""
+    """Seconds per FMI call of the cheapest kind: setReal and getReal of one value on the
+    autopilot FMU."""
     master.reset()
     master.initialize()
     instance = master.instances["autopilot"]
@@ -176,15 +171,14 @@ def _idle_reader(self, vrs: list[int]) -> Callable[[], list[float]]:
     return lambda: values
 
 
+# the in-process instance's prepared calls doing nothing: the master's own work remains
 IDLE_CALLS = {"reader": _idle_reader, "integer_reader": _idle_reader,
               "writer": lambda self, vrs: _nothing, "stepper": lambda self: _nothing}
-"""The in-process instance's prepared calls doing nothing: the master's own work remains."""
 
 
 def overhead(repeats: int) -> dict[str, float]:
-    """What the routes do besides the models: calm_pd with the ship's step doing nothing,
-    by hand, by the master with its calls into the FMUs idle (``IDLE_CALLS``) and
-    in-process; microseconds per step."""
+    """Microseconds per step of calm_pd with the ship's step doing nothing: by hand, by the
+    master with its calls into the FMUs idle (``IDLE_CALLS``), and in-process."""
     from unittest import mock
 
     from ship_fmu.vessel import Vessel
