@@ -110,8 +110,8 @@ def test_the_imo_10_10_zigzag_is_never_checked_by_this_unstable_ship(fmu_paths, 
     assert not zigzag(math.radians(15), math.radians(15)).checked
     z16 = zigzag(math.radians(16), math.radians(16))
     assert z16.checked
-    assert math.degrees(z16.first_overshoot) == pytest.approx(64.52, abs=0.01)
-    assert math.degrees(z16.second_overshoot) == pytest.approx(8.14, abs=0.01)
+    assert math.degrees(z16.overshoots[0].angle) == pytest.approx(64.52, abs=0.01)
+    assert math.degrees(z16.overshoots[1].angle) == pytest.approx(8.14, abs=0.01)
     assert cli.main(["zigzag_10_10", "--out", str(tmp_path)]) == 0
     assert "the turn was never checked: 1 rudder reversal(s) of 3" in capsys.readouterr().out
     assert (tmp_path / "zigzag_10_10.png").stat().st_size > 50_000

@@ -134,10 +134,10 @@ def test_turning_circle_35_deg():
 
 def test_zigzag_20_20():
     zz = zigzag(math.radians(20.0), math.radians(20.0))
-    print(f"\n20/20 zig-zag: first overshoot {math.degrees(zz.first_overshoot):.2f} deg, "
-          f"second overshoot {math.degrees(zz.second_overshoot):.2f} deg")
-    assert math.degrees(zz.first_overshoot) == pytest.approx(31.655, abs=0.01)
-    assert math.degrees(zz.second_overshoot) == pytest.approx(7.250, abs=0.01)
+    print(f"\n20/20 zig-zag: first overshoot {math.degrees(zz.overshoots[0].angle):.2f} deg, "
+          f"second overshoot {math.degrees(zz.overshoots[1].angle):.2f} deg")
+    assert math.degrees(zz.overshoots[0].angle) == pytest.approx(31.655, abs=0.01)
+    assert math.degrees(zz.overshoots[1].angle) == pytest.approx(7.250, abs=0.01)
 
 
 def test_spectrum_variance_is_hs_squared_over_16():

@@ -38,7 +38,8 @@ def zigzag_plate(run: Recording, **_: Any) -> Figure:
     zz, switch = a.figures, math.degrees(a.figures.psi_switch)
     lines = zigzag_report(run)
     fig, grid = text_grid((2.2, 1.0), 3, lines)
-    heading, r = time_axes(fig, [grid[0:2, 0], grid[2, 0]])
+    heading, r = time_axes(fig, [grid[0:2, 0], grid[2, 0]], (
+        "heading psi, rudder -delta (deg, + turns to starboard)", "yaw rate r (deg/s)"))
     track_panel(fig.add_subplot(grid[0:3, 1]), run)
     t, psi = run.t, np.degrees(run["ship.psi"])
     heading.plot(t, psi, color="k", linewidth=1.4, label="heading psi")
@@ -102,11 +103,9 @@ def zigzag_plate(run: Recording, **_: Any) -> Figure:
                          arrowprops=dict(color=colour, **_BOTH_WAYS))
         heading.text(start, height + 0.015, f"{name} {time:.1f} s", transform=where,
                      ha="left", va="bottom", fontsize=7, color=colour)
-    heading.set_ylabel("heading psi, rudder -delta (deg, + turns to starboard)")
     legend_if_any(heading)
     r.plot(t, np.degrees(run["ship.r"]), color="k")
     r.axhline(0.0, color="0.6", linewidth=0.6)
-    r.set_ylabel("yaw rate r (deg/s)")
     text_panel(fig.add_subplot(grid[3, :]), lines)
     return fig
 
@@ -194,12 +193,14 @@ def turning_circle_plate(run: Recording, **_: Any) -> Figure:
     lines = turning_circle_report(run)
     fig, grid = text_grid((1.15, 1.0), 5, lines)
     _turning_track(fig.add_subplot(grid[0:5, 0]), run, tc)
-    heading, speed, drift, r, rudder = time_axes(fig, [grid[i, 1] for i in range(5)])
+    heading, speed, drift, r, rudder = time_axes(fig, [grid[i, 1] for i in range(5)], (
+        "heading psi\n(deg, 0-360)", "speed U (m/s)", "drift angle (deg)", "yaw rate r (deg/s)",
+        "rudder -delta (deg,\n+ to starboard)"))
     t, u, v = run.t, run["ship.u"], run["ship.v"]
     compass = np.degrees(run["ship.psi"]) % 360.0          # broken where it wraps
     compass[1:][np.abs(np.diff(compass)) > 180.0] = np.nan
     heading.plot(t, compass, color="k")
-    heading.set(ylim=(0, 360), yticks=(0, 90, 180, 270, 360), ylabel="heading psi\n(deg, 0-360)")
+    heading.set(ylim=(0, 360), yticks=(0, 90, 180, 270, 360))
     for target in (math.pi / 2, math.pi):
         when, = at_heading_change(run["ship.psi"], target, t)
         if math.isnan(when):
@@ -210,14 +211,10 @@ def turning_circle_plate(run: Recording, **_: Any) -> Figure:
                      transform=heading.get_xaxis_transform(), color="tab:gray")
     speed.plot(t, np.hypot(u, v), color="k")
     speed.axhline(tc.steady_speed, linestyle=":", color="tab:gray")
-    speed.set_ylabel("speed U (m/s)")
     drift.plot(t, np.degrees(np.arctan2(v, u)), color="k")
-    drift.set_ylabel("drift angle (deg)")
     r.plot(t, np.degrees(run["ship.r"]), color="k")
     r.axhline(math.degrees(tc.steady_yaw_rate), linestyle=":", color="tab:gray")
-    r.set_ylabel("yaw rate r (deg/s)")
     _rudder(rudder, run)
-    rudder.set_ylabel("rudder -delta (deg,\n+ to starboard)")
     legend_if_any(rudder)
     text_panel(fig.add_subplot(grid[5, :]), lines)
     return fig

@@ -1,6 +1,5 @@
 """The track panel every figure of a run shares: north up at equal scale, the route with its
-circles and named waypoints, the leg switches, the ship's outline at regular times (enlarged
-where it could not be seen) and the wave direction."""
+named waypoints, the leg switches, the ship's outline at regular times, the wave direction."""
 from __future__ import annotations
 
 import itertools
@@ -29,13 +28,18 @@ def waypoint_name(i: int) -> str:
     return f"WP{i + 1}"
 
 
+def to_earth(x: float, y: float, psi: float, along: Any, across: Any) -> tuple[Any, Any]:
+    """(east, north), m, of points ``along`` and ``across`` (to starboard) heading psi from
+    (x, y)."""
+    c, s = math.cos(psi), math.sin(psi)
+    return y + along * s + across * c, x + along * c - across * s
+
+
 def hull_outline(x: float, y: float, psi: float, scale: float = 1.0) -> np.ndarray:
     """The ship's waterline as (east, north) corners at (x, y, psi), ``scale`` times enlarged."""
     L, B = scale * Hull.L, scale * Hull.B
-    forward, starboard = np.array([(L / 2, 0.0), (L / 4, B / 2), (-L / 2, B / 2),
-                                   (-L / 2, -B / 2), (L / 4, -B / 2)]).T
-    c, s = math.cos(psi), math.sin(psi)
-    return np.column_stack([y + forward * s + starboard * c, x + forward * c - starboard * s])
+    return np.column_stack(to_earth(x, y, psi, *np.array([
+        (L / 2, 0.0), (L / 4, B / 2), (-L / 2, B / 2), (-L / 2, -B / 2), (L / 4, -B / 2)]).T))
 
 
 def outline_scale(spacing: float, extent: float) -> int:

@@ -1,8 +1,6 @@
 """Run an exported SSP package in ``libcosim`` (libcosimpy; also the OSP folder beside it),
-``ecos`` (ecospy) or ``fmpy`` (its SSP runner), in a child process: libcosimpy 0.0.6 aborts
-its host when an FMU fails, ecos 0.7.2 ignores FMI status codes. A crash, a failed step or
-NaN outputs become an ``EngineError`` with the child's output (time conventions:
-docs/interop.md)."""
+``ecos`` (ecospy) or ``fmpy`` (its SSP runner) in a child process: libcosimpy 0.0.6 aborts
+its host when an FMU fails, ecos 0.7.2 ignores FMI status codes (docs/interop.md)."""
 from __future__ import annotations
 
 import math
@@ -96,13 +94,8 @@ def _fmpy(ssp: Path, system: SystemDescription, n_steps: int, signals: tuple[str
           stop: StopSignals) -> dict[str, np.ndarray]:
     from fmpy.ssp.simulation import simulate_ssp
     from fmpy.ssp.ssd import Parameter, ParameterSet
-    # fmpy's runner applies no parameter bindings itself and cannot set Strings:
-    # pass the package's own values, fully qualified; a String must equal the FMU's
-    # default, or the run would not be the scenario.
-    dropped = unapplied_strings(ssp)
-    if dropped:
-        raise EngineError("fmpy's SSP runner cannot set the String " + ", ".join(
-            f"{variable} = {value!r}" for variable, (value, _) in dropped.items()))
+    # fmpy's runner applies no parameter bindings itself: pass the package's own values
+    refuse_strings(ssp, "fmpy's SSP runner")
     parameters = ParameterSet()
     for name, component in system.components.items():
         parameters.parameters.extend(
@@ -118,9 +111,17 @@ def _fmpy(ssp: Path, system: SystemDescription, n_steps: int, signals: tuple[str
 RUNNERS = {"libcosim": _libcosim, "ecos": _ecos, "fmpy": _fmpy}
 
 
+def refuse_strings(ssp: Path, who: str) -> None:
+    """EngineError if ``ssp`` binds a String away from its FMU's default: ``who`` sets none."""
+    dropped = unapplied_strings(ssp)
+    if dropped:
+        raise EngineError(f"{who} applies no String binding; it would run " + ", ".join(
+            f"{v} = {default!r}, not {value!r}" for v, (value, default) in dropped.items()))
+
+
 def check_package(ssp: Path, engine: str) -> None:
-    """EngineError naming the file, parameter or components if ``engine`` cannot run the
-    package: not SSP or OSP, a value not finite, or FMUs of an FMI version it does not take."""
+    """EngineError naming the file, parameter or components if ``engine`` cannot run it:
+    not SSP or OSP, a value not finite, or FMUs of an FMI version it does not take."""
     try:
         system, versions = read_system(ssp), fmi_versions(ssp)
     except (OSError, KeyError, ValueError, zipfile.BadZipFile) as error:
@@ -139,8 +140,8 @@ def check_package(ssp: Path, engine: str) -> None:
 
 
 def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = TRACED) -> dict[str, np.ndarray]:
-    """Run ``ssp`` in ``engine`` in a child process; EngineError with its output if it
-    fails, ``Interrupted`` if SIGINT or SIGTERM ended the child."""
+    """The traced signals of ``ssp`` run in ``engine``; EngineError with the child's output if
+    it fails, ``Interrupted`` if SIGINT or SIGTERM ended it."""
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
     ssp = Path(ssp).resolve()
@@ -163,7 +164,10 @@ def child_log(who: str, ssp: Path, argv: list[str], out: Path, timeout: float = 
         child = subprocess.run(argv, capture_output=True, text=True, timeout=timeout, **options)
     except subprocess.TimeoutExpired:
         raise EngineError(f"{who} did not finish {ssp.name} within {timeout:g} s") from None
-    log = log_summary(child.stdout + child.stderr)
+    lines = [line for line in (child.stdout + child.stderr).strip().splitlines() if line.strip()]
+    if len(lines) > 25:                 # the first 20 lines (where the cause is), the last 5
+        lines[20:-5] = [f"... ({len(lines) - 25} more lines) ..."]
+    log = "\n".join(lines)
     number = -child.returncode if child.returncode < 0 else child.returncode - 128
     if number in STOP_SIGNALS:          # Ctrl-C or a kill: not the engine's fault
         raise Interrupted(number)
@@ -211,11 +215,3 @@ def record(engine: str, ssp: str, out: str, signals: tuple[str, ...]) -> int:
 def save_trace(path: Path, result: dict[str, np.ndarray]) -> None:
     with whole_file(path) as tmp, open(tmp, "wb") as f:
         np.savez(f, **result)
-
-
-def log_summary(log: str) -> str:
-    """The first 20 lines of a log (where the cause is) and its last 5."""
-    lines = [line for line in log.strip().splitlines() if line.strip()]
-    if len(lines) > 25:
-        lines[20:-5] = [f"... ({len(lines) - 25} more lines) ..."]
-    return "\n".join(lines)

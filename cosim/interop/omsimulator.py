@@ -1,6 +1,5 @@
-"""Run an exported SSP package in OMSimulator from a build folder ``home`` (bin/OMSimulator,
-its command line; lib/x86_64-linux-gnu/OMSimulator, its Python API) in a child process with a
-time limit (docs/interop.md), and read its result file."""
+"""Run an exported SSP package in OMSimulator, a build folder ``home``, through its command
+line or its Python API in a child process with a time limit (docs/interop.md)."""
 from __future__ import annotations
 
 import csv
@@ -12,8 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .engines import EngineError, child_log, finite
-from .ssp import read_package, unapplied_strings
+from .engines import child_log, finite, refuse_strings
+from .ssp import read_package
 
 INTERFACES = ("cli", "api")
 
@@ -48,10 +47,7 @@ def run(ssp: str | Path, home: str | Path, interface: str = "cli",
     if interface not in INTERFACES:
         raise ValueError(f"interface must be one of {', '.join(INTERFACES)}, got {interface!r}")
     ssp, home = Path(ssp).resolve(), Path(home).resolve()
-    dropped = unapplied_strings(ssp)
-    if dropped:
-        raise EngineError("OMSimulator applies no String binding; it would run " + ", ".join(
-            f"{v} = {default!r}, not {value!r}" for v, (value, default) in dropped.items()))
+    refuse_strings(ssp, "OMSimulator")
     system, site = read_package(ssp), sysconfig.get_paths()["purelib"]
     with tempfile.TemporaryDirectory() as tmp:
         result = Path(tmp) / "result.csv"
