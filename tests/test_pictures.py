@@ -137,7 +137,7 @@ def test_animate_feeds_ffmpeg_whole_frames(fmu_paths, tmp_path, monkeypatch):
     fake.chmod(0o755)
     monkeypatch.setenv("PATH", f"{fake.parent}:{__import__('os').environ['PATH']}")
     run = simulate("calm_pd", stop_time=10)
-    video = animate(run, tmp_path / "calm_pd", "calm_pd")              # mp4: ffmpeg "exists"
+    video = animate(run, tmp_path / "calm_pd", "calm_pd", "mp4")       # ffmpeg "exists"
     assert video.suffix == ".mp4"
     assert video.stat().st_size == len(frame_times(run.t)) * 900 * 504 * 3
 

@@ -19,8 +19,7 @@ from fmukit.timebase import communication_point, step_count
 from ..core.files import whole_file
 from ..core.interrupt import STOP_SIGNALS, Interrupted, StopSignals
 from ..core.system import SystemDescription, split_name
-from .osp import read_osp
-from .ssp import FMI2_ONLY, fmi_versions, read_package, unapplied_strings
+from .ssp import FMI2_ONLY, described, is_osp, read_package, unapplied_strings
 
 ENGINES = ("libcosim", "ecos", "fmpy")
 TRACED = ("ship.psi", "ship.r", "ship.delta")
@@ -28,14 +27,6 @@ TRACED = ("ship.psi", "ship.r", "ship.delta")
 
 class EngineError(RuntimeError):
     """An engine failed or produced undefined values; the message holds its output."""
-
-
-def is_osp(path: Path) -> bool:
-    return path.is_dir() or path.suffix.lower() == ".xml"
-
-
-def read_system(path: Path) -> SystemDescription:
-    return read_osp(path) if is_osp(path) else read_package(path)
 
 
 def _libcosim(ssp: Path, system: SystemDescription, n_steps: int, signals: tuple[str, ...],
@@ -123,11 +114,12 @@ def check_package(ssp: Path, engine: str) -> None:
     """EngineError naming the file, parameter or components if ``engine`` cannot run it:
     not SSP or OSP, a value not finite, or FMUs of an FMI version it does not take."""
     try:
-        system, versions = read_system(ssp), fmi_versions(ssp)
+        system, descriptions = described(ssp)
     except (OSError, KeyError, ValueError, zipfile.BadZipFile) as error:
         raise EngineError(f"{ssp} is not an SSP package this project can run ({error})") \
             from None
-    newer = [f"{name} (FMI {version})" for name, version in versions.items() if version != "2.0"]
+    newer = [f"{name} (FMI {d.fmiVersion})" for name, d in descriptions.items()
+             if d.fmiVersion != "2.0"]
     if engine in FMI2_ONLY and newer:
         raise EngineError(f"{FMI2_ONLY[engine]} runs FMI 2.0 FMUs only; {ssp.name} holds "
                           f"{', '.join(newer)}: run it with ecos or OMSimulator, or export "
@@ -199,7 +191,7 @@ def record(engine: str, ssp: str, out: str, signals: tuple[str, ...]) -> int:
     stderr if it fails; 130 or 143 if SIGINT or SIGTERM stopped it (between steps)."""
     try:
         with StopSignals() as stop:
-            system = read_system(Path(ssp))
+            system = read_package(Path(ssp))
             n_steps = step_count(system.start_time, system.stop_time, system.step_size)
             result = RUNNERS[engine](Path(ssp), system, n_steps, signals, stop)
     except Interrupted as interrupted:

@@ -91,35 +91,38 @@ def export(scenario: str | Path, out: Path, overrides: dict[str, dict] | None = 
     return target
 
 
-def read_package(ssp: Path) -> SystemDescription:
-    with tempfile.TemporaryDirectory() as tmp:
-        with zipfile.ZipFile(ssp) as package:
-            package.extract(SSD_NAME, tmp)
-        return read_ssd(Path(tmp) / SSD_NAME)
+def is_osp(path: Path) -> bool:
+    return path.is_dir() or path.suffix.lower() == ".xml"
 
 
-def _described(path: Path) -> tuple[SystemDescription, dict[str, ModelDescription]]:
-    """The system of a package or an OSP folder, and each component's model description."""
+def described(path: Path) -> tuple[SystemDescription, dict[str, ModelDescription]]:
+    """The system of an SSP package or of an OSP folder or file, and each component's model
+    description."""
     with tempfile.TemporaryDirectory() as tmp:
-        if path.suffix.lower() == ".ssp":
+        if is_osp(path):
+            system, folder = read_osp(path), path if path.is_dir() else path.parent
+        else:
             with zipfile.ZipFile(path) as package:
                 package.extractall(tmp)
             system, folder = read_ssd(Path(tmp) / SSD_NAME), Path(tmp)
-        else:
-            system, folder = read_osp(path), path if path.is_dir() else path.parent
         return system, {name: read_description(folder / component.source, name)
                         for name, component in system.components.items()}
 
 
+def read_package(path: Path) -> SystemDescription:
+    """The system of an SSP package or of an OSP folder or file."""
+    return described(path)[0]
+
+
 def fmi_versions(path: Path) -> dict[str, str]:
     """Each component's FMI version ("2.0", "3.0") in a package or OSP folder."""
-    return {name: d.fmiVersion for name, d in _described(path)[1].items()}
+    return {name: d.fmiVersion for name, d in described(path)[1].items()}
 
 
 def unapplied_strings(ssp: Path) -> dict[str, tuple[str, str]]:
     """String bindings a tool applying none would drop without a word, not at their FMU's
     default: 'component.variable': (value, default)."""
-    system, descriptions = _described(ssp)
+    system, descriptions = described(ssp)
     dropped = {}
     for name, component in system.components.items():
         starts = {v.name: v.start for v in descriptions[name].modelVariables}

@@ -47,9 +47,8 @@ def port_problems(description: ModelDescription, port_map: dict[str, str]) -> li
         mapped = f"'{name}' (for {port})" if name != port else f"'{port}'"
         variable = variables.get(name)
         if variable is None:
-            close = close_matches(name, variables)
             problems.append(f"no port {mapped}: expected a {real} {causality} in {unit} "
-                            f"({DESCRIPTIONS[port]}){did_you_mean(close)}")
+                            f"({DESCRIPTIONS[port]}){did_you_mean(close_matches(name, variables))}")
             continue
         if variable.causality != causality or variable.type != real:
             problems.append(f"port {mapped} is of causality {variable.causality} and type "
