@@ -16,7 +16,7 @@ from cosim import simulate
 from cosim.analysis.animation import animate, frame_times
 from cosim.analysis.figures import RUDDER_LABEL, course_keeping_figure, save
 from cosim.analysis.track import outlines
-from cosim.analysis.manoeuvres import zigzag
+from cosim.analysis.criteria import zigzag_of
 from cosim.provenance import write_metadata
 from cosim.core.recording import Recording
 from ship_fmu.data import Hull
@@ -106,9 +106,13 @@ def test_next_to_every_csv_a_json_with_what_it_takes_to_reproduce_the_run(fmu_pa
 def test_the_imo_10_10_zigzag_is_never_checked_by_this_unstable_ship(fmu_paths, tmp_path,
                                                                      capsys):
     """With 10 deg of counter-rudder CyberShip II keeps turning; it needs 16 deg."""
-    assert not zigzag(math.radians(10), math.radians(10)).checked
-    assert not zigzag(math.radians(15), math.radians(15)).checked
-    z16 = zigzag(math.radians(16), math.radians(16))
+    def zigzag(degrees: float):
+        angle = math.radians(degrees)
+        return zigzag_of(simulate("zigzag_10_10", backend="inprocess", set={
+            "program.delta": angle, "program.psi_switch": angle})).figures
+    assert not zigzag(10).checked
+    assert not zigzag(15).checked
+    z16 = zigzag(16)
     assert z16.checked
     assert math.degrees(z16.overshoots[0].angle) == pytest.approx(64.52, abs=0.01)
     assert math.degrees(z16.overshoots[1].angle) == pytest.approx(8.14, abs=0.01)

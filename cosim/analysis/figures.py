@@ -20,7 +20,6 @@ from .describe import paper_row, title
 from .metrics import heading_error
 from .track import legend_if_any, track_panel
 
-FORMATS = ("png", "svg", "pdf")
 RUDDER_LABEL = "rudder delta (deg)\n+ turns to port"     # a positive rudder turns to port
 _VERDICT_COLOURS = {"PASS": "tab:green", "FAIL": "tab:red", "OPEN": "tab:orange"}
 
@@ -132,8 +131,6 @@ def save(fig: Figure, path: Path, formats: tuple[str, ...] = ("png",)) -> list[P
     """Write the figure in each format (path with that suffix), each file whole or not at all."""
     written = []
     for fmt in formats:
-        if fmt not in FORMATS:
-            raise ValueError(f"figure format {fmt!r}: one of {', '.join(FORMATS)}")
         written.append(path.with_suffix(f".{fmt}"))
         with whole_file(written[-1]) as tmp:
             fig.savefig(tmp, dpi=120, format=fmt)

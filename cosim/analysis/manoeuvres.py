@@ -8,10 +8,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ship_fmu.manoeuvres import RudderProgram
-from ship_fmu.trial import DT, trial
-from ship_fmu.vessel import VesselParameters
-
 TURNING_RUDDER = math.radians(35.0)   # 4.2.2: 35 deg, or the largest permissible
 
 
@@ -151,17 +147,3 @@ def zigzag_figures(psi, reversals, psi_switch: float, t, x, y) -> ZigZagResult:
     distance, = _first_reaching(np.abs(psi), psi_switch, travelled)
     return ZigZagResult(reached, psi_switch, tuple(overshoots), executes, distance, running)
 
-
-def turning_circle(delta: float = TURNING_RUDDER) -> TurningCircle:
-    """Of a 300 s trial of the ship alone, in-process (``ship_fmu.trial``)."""
-    track = trial(RudderProgram(delta, 0.0), 300.0, VesselParameters())
-    return turning_circle_figures(*(track[n] for n in ("x", "y", "psi", "u", "v", "r")))
-
-
-def zigzag(delta: float = math.radians(20.0), psi_switch: float = math.radians(20.0)
-           ) -> ZigZagResult:
-    """Of a 300 s trial of the ship alone, in-process (``ship_fmu.trial``)."""
-    track = trial(RudderProgram(delta, psi_switch), 300.0, VesselParameters())
-    t = DT * np.arange(len(track["psi"]))
-    return zigzag_figures(track["psi"], track["reversals"], psi_switch, t, track["x"],
-                          track["y"])

@@ -171,15 +171,6 @@ def _turning_track(ax: Any, run: Recording, tc: TurningCircle) -> None:
         ax.text(east, north, f"steady turning diameter {diameter:.2f} m = {diameter / L:.2f} L"
                 f"\n(circle fitted to the last lap; 2U/|r| = {tc.diameter_from_rates:.2f} m)",
                 ha="center", va="bottom", fontsize=7, color="tab:orange", zorder=7, bbox=_ROUND)
-    scale = outlines(run).scale          # the ship where its heading changed 90 and 180 deg
-    for target in (math.pi / 2, math.pi):
-        xs, ys, ps = at_heading_change(psi, target, x, y, psi)
-        if math.isnan(xs):
-            continue
-        ax.add_patch(Polygon(hull_outline(xs, ys, ps, scale), closed=True, facecolor="gold",
-                             edgecolor="k", linewidth=0.8, zorder=4))
-        ax.annotate(f"{math.degrees(target):.0f} deg heading change", (ys, xs),
-                    textcoords="offset points", xytext=(6, -12), fontsize=7, zorder=7)
 
 
 def turning_circle_plate(run: Recording, **_: Any) -> Figure:
@@ -187,19 +178,25 @@ def turning_circle_plate(run: Recording, **_: Any) -> Figure:
     tc = turning_circle_of(run).figures
     lines = turning_circle_report(run)
     fig, grid = text_grid((1.15, 1.0), 5, lines)
-    _turning_track(fig.add_subplot(grid[0:5, 0]), run, tc)
+    track = fig.add_subplot(grid[0:5, 0])
+    _turning_track(track, run, tc)
     heading, speed, drift, r, rudder = time_axes(fig, [grid[i, 1] for i in range(5)], (
         "heading psi\n(deg, 0-360)", "speed U (m/s)", "drift angle (deg)", "yaw rate r (deg/s)",
         "rudder -delta (deg,\n+ to starboard)"))
-    t, u, v = run.t, run["ship.u"], run["ship.v"]
-    compass = np.degrees(run["ship.psi"]) % 360.0          # broken where it wraps
+    t, u, v, psi = run.t, run["ship.u"], run["ship.v"], run["ship.psi"]
+    compass = np.degrees(psi) % 360.0          # broken where it wraps
     compass[1:][np.abs(np.diff(compass)) > 180.0] = np.nan
     heading.plot(t, compass, color="k")
     heading.set(ylim=(0, 360), yticks=(0, 90, 180, 270, 360))
-    for target in (math.pi / 2, math.pi):
-        when, = at_heading_change(run["ship.psi"], target, t)
+    scale = outlines(run).scale
+    for target in (math.pi / 2, math.pi):       # the ship and the time at 90 and 180 deg
+        xs, ys, ps, when = at_heading_change(psi, target, run["ship.x"], run["ship.y"], psi, t)
         if math.isnan(when):
             continue
+        track.add_patch(Polygon(hull_outline(xs, ys, ps, scale), closed=True, facecolor="gold",
+                                edgecolor="k", linewidth=0.8, zorder=4))
+        track.annotate(f"{math.degrees(target):.0f} deg heading change", (ys, xs),
+                       textcoords="offset points", xytext=(6, -12), fontsize=7, zorder=7)
         for panel in (heading, speed, drift, r, rudder):
             panel.axvline(when, color="tab:gray", linestyle=":", linewidth=0.9)
         heading.text(when, 1.0, f" {math.degrees(target):.0f} deg", va="bottom", fontsize=7,

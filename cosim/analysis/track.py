@@ -58,10 +58,7 @@ class Outlines:
     rows: list[int]
     every: float
     scale: int
-
-    @property
-    def size(self) -> str:
-        return "to scale" if self.scale == 1 else f"x{self.scale}, true heading"
+    size: str                   # the enlargement in words
 
 
 def outlines(run: Recording) -> Outlines:
@@ -77,7 +74,7 @@ def outlines(run: Recording) -> Outlines:
     for k in rows:
         if all(math.hypot(x[k] - x[j], y[k] - y[j]) > scale * Hull.L for j in drawn):
             drawn.append(k)
-    return Outlines(drawn, every, scale)
+    return Outlines(drawn, every, scale, "to scale" if scale == 1 else f"x{scale}, true heading")
 
 
 def _arrow(direction: float) -> Shape:
