@@ -51,8 +51,7 @@ def leg_text(wp_index: int, points: np.ndarray) -> str:
 
 
 def animate(run: Recording, path: Path, label: str, fmt: str) -> Path:
-    """Write the animation, whole or not at all, at ``path`` with the suffix of ``fmt``, 'gif'
-    or 'mp4' (ffmpeg's); ``require_track`` says whether the run can have one."""
+    """Write the animation at ``path`` with ``fmt``'s suffix ('gif', 'mp4'), whole or not at all."""
     t, (x, y, psi, delta) = run.t, (run[c] for c in NEEDS)
     fig = new_figure(figsize=(10, 5.6), dpi=90, layout="constrained")
     grid = fig.add_gridspec(2, 2, width_ratios=(1.0, 1.1))
@@ -101,9 +100,7 @@ def animate(run: Recording, path: Path, label: str, fmt: str) -> Path:
     for artist in dynamic:
         artist.set_animated(True)           # left out of the background drawn once
     fig.canvas.draw()
-    fig.set_layout_engine("none")           # the layout is fixed from here on
     background = fig.canvas.copy_from_bbox(fig.bbox)
-    width, height = fig.canvas.get_width_height()
     target = path.with_suffix(f".{fmt}")
     frames = []
     for k in frame_times(t):
@@ -120,9 +117,10 @@ def animate(run: Recording, path: Path, label: str, fmt: str) -> Path:
             images[0].save(tmp, save_all=True, append_images=images[1:],
                            duration=round(1000 / FPS), loop=0)
             return target
+        height, width, _ = frames[0].shape
         encode = subprocess.run(
-            [shutil.which("ffmpeg"), "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt", "rgb24",
-             "-s", f"{width}x{height}", "-r", str(FPS), "-i", "-", "-vf",
+            [shutil.which("ffmpeg"), "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt",
+             "rgb24", "-s", f"{width}x{height}", "-r", str(FPS), "-i", "-", "-vf",
              "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-pix_fmt", "yuv420p", "-f", "mp4", tmp],
             input=b"".join(frame.tobytes() for frame in frames), capture_output=True)
         if encode.returncode != 0:

@@ -1,6 +1,5 @@
-"""The figures of a standard manoeuvre from its trajectory (MSC.137(76) 4.2, MSC/Circ.1053):
-a turning circle's distances and diameters, a zig-zag's executes, overshoots and times. A
-positive rudder turns the ship to port. SI units and radians."""
+"""The figures of a standard manoeuvre from its trajectory (MSC.137(76) 4.2, MSC/Circ.1053),
+in SI units and radians; a positive rudder turns the ship to port."""
 from __future__ import annotations
 
 import math

@@ -1,6 +1,5 @@
 """IMO-style plates of a zig-zag and a turning circle (MSC/Circ.1053) with the MSC.137(76)
-criteria in the words of ``reports``. The rudder is drawn as -delta, in the heading's sense
-(a positive delta turns this ship to port)."""
+criteria in the words of ``reports``; the rudder drawn as -delta, in the heading's sense."""
 from __future__ import annotations
 
 import math
@@ -121,8 +120,7 @@ def _line(ax: Any, earth: Callable, start: tuple[float, float], end: tuple[float
 def _dimension(ax: Any, earth: Callable, start: tuple[float, float], end: tuple[float, float],
                label: str, colour: str, label_at: tuple[float, float] | None = None,
                feet: tuple[tuple[float, float], ...] = ()) -> None:
-    """A dimension line between two (along, across) points, with extension lines from its
-    ``feet``; its gid the label's first word."""
+    """A dimension line between (along, across) points, from ``feet``; gid its label's 1st word."""
     for foot, point in zip(feet, (start, end)):
         _line(ax, earth, foot, point)
     p, q = _line(ax, earth, start, end, color=colour, linewidth=1.6, zorder=6,

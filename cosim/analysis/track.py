@@ -29,8 +29,7 @@ def waypoint_name(i: int) -> str:
 
 
 def to_earth(x: float, y: float, psi: float, along: Any, across: Any) -> tuple[Any, Any]:
-    """(east, north), m, of points ``along`` and ``across`` (to starboard) heading psi from
-    (x, y)."""
+    """(east, north) of points ``along`` and ``across`` (to starboard) of (x, y) heading psi."""
     c, s = math.cos(psi), math.sin(psi)
     return y + along * s + across * c, x + along * c - across * s
 
@@ -43,8 +42,7 @@ def hull_outline(x: float, y: float, psi: float, scale: float = 1.0) -> np.ndarr
 
 
 def outline_scale(spacing: float, extent: float) -> int:
-    """The largest factor 1 ... 9, 10, 20, ... keeping an outline within 0.8 ``spacing`` and
-    ``extent`` / 12 (m)."""
+    """The largest factor 1 ... 9, 10, 20, ... keeping an outline within 0.8 spacing, extent/12."""
     limit = min(0.8 * spacing, extent / 12.0) / Hull.L
     if limit < 1.0:
         return 1
@@ -80,13 +78,11 @@ def outlines(run: Recording) -> Outlines:
 def _arrow(direction: float) -> Shape:
     east, north = np.array([(0, 1), (0.5, 0.15), (0.17, 0.15), (0.17, -1), (-0.17, -1),
                             (-0.17, 0.15), (-0.5, 0.15), (0, 1)]).T
-    c, s = math.cos(direction), math.sin(direction)
-    return Shape(np.column_stack([east * c + north * s, -east * s + north * c]), closed=True)
+    return Shape(np.column_stack(to_earth(0.0, 0.0, direction, north, east)), closed=True)
 
 
 def _route(ax: Any, guidance: dict[str, Any], tracks: list[np.ndarray]) -> None:
-    """The route, its circles and its points named; framed on the tracks and the points near
-    them (within half the tracks' size), the others said in the legend."""
+    """The route, framed on the tracks and the points near them; the others named in the legend."""
     points = np.array(followed_route(guidance))[:, ::-1]              # (east, north)
     reach = guidance["R_accept"]
     seen = np.concatenate(tracks)

@@ -111,8 +111,7 @@ def refuse_strings(ssp: Path, who: str) -> None:
 
 
 def check_package(ssp: Path, engine: str) -> None:
-    """EngineError naming the file, parameter or components if ``engine`` cannot run it:
-    not SSP or OSP, a value not finite, or FMUs of an FMI version it does not take."""
+    """EngineError naming what ``engine`` cannot run: the file, a parameter, the FMUs."""
     try:
         system, descriptions = described(ssp)
     except (OSError, KeyError, ValueError, zipfile.BadZipFile) as error:
@@ -171,8 +170,8 @@ def child_log(who: str, ssp: Path, argv: list[str], out: Path, timeout: float = 
 
 
 def finite(who: str, trace: dict[str, np.ndarray], log: str) -> dict[str, np.ndarray]:
-    """``trace`` if every value in it is finite, else EngineError naming the first undefined
-    signal and when: a tool that ignores FMI statuses goes on after a failed FMU."""
+    """``trace``, or EngineError naming its first undefined signal and when: a tool that
+    ignores FMI statuses goes on after a failed FMU."""
     for name, values in trace.items():
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:

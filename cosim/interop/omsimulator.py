@@ -42,8 +42,8 @@ def read_result(path: Path) -> dict[str, np.ndarray]:
 
 def run(ssp: str | Path, home: str | Path, interface: str = "cli",
         timeout: float = 600.0) -> dict[str, np.ndarray]:
-    """Run ``ssp`` in OMSimulator at ``home`` through ``interface``; EngineError with its
-    output if it fails, times out or would drop a String binding."""
+    """The trace of ``ssp`` run in OMSimulator at ``home`` through ``interface``, or
+    EngineError with its output."""
     if interface not in INTERFACES:
         raise ValueError(f"interface must be one of {', '.join(INTERFACES)}, got {interface!r}")
     ssp, home = Path(ssp).resolve(), Path(home).resolve()

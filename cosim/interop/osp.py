@@ -1,6 +1,5 @@
-"""OSP's OspSystemStructure.xml (libcosim's schema 0.1), written beside an SSP package: the
-times, each simulator's FMU, step and initial values, and the connections, output first.
-No OSP model description: these systems need none."""
+"""OSP's OspSystemStructure.xml (libcosim's schema 0.1) beside an SSP package: times, FMUs,
+steps, initial values and connections (output first); these systems need no model description."""
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET

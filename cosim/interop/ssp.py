@@ -1,6 +1,5 @@
-"""A scenario as one .ssp (SystemStructure.ssd and resources/<fmu>.fmu) and beside it a
-folder with OSP's OspSystemStructure.xml and the FMUs, written whole or not at all. The route
-goes as numbers: OMSimulator and fmpy's SSP runner apply no String binding."""
+"""A scenario as one .ssp (SystemStructure.ssd, resources/<fmu>.fmu) and an OSP folder beside
+it, each whole or not at all; the route as numbers, since some tools set no String."""
 from __future__ import annotations
 
 import shutil
@@ -61,8 +60,7 @@ def connector_units(system: SystemDescription, fmus: dict[str, Path]) -> Units:
 def export(scenario: str | Path, out: Path, overrides: dict[str, dict] | None = None,
            autopilot: str | Path | None = None, port_map: dict[str, str] | None = None,
            name: str | None = None, fmi: int | None = None) -> Path:
-    """Write out/<label>.ssp and out/<label>/ (OSP) of the scenario as ``scenarios.load``
-    gives it, with ``overrides`` by component."""
+    """Write out/<label>.ssp and out/<label>/ (OSP) of ``scenarios.load``'s system."""
     system = scenarios.load(scenario, autopilot, port_map, name, fmi)
     for component, values in system.parameters(overrides).items():
         system.components[component].parameters = values
@@ -96,8 +94,7 @@ def is_osp(path: Path) -> bool:
 
 
 def described(path: Path) -> tuple[SystemDescription, dict[str, ModelDescription]]:
-    """The system of an SSP package or of an OSP folder or file, and each component's model
-    description."""
+    """The system of an SSP package or OSP folder or file, and its components' descriptions."""
     with tempfile.TemporaryDirectory() as tmp:
         if is_osp(path):
             system, folder = read_osp(path), path if path.is_dir() else path.parent

@@ -67,8 +67,8 @@ def port_problems(description: ModelDescription, port_map: dict[str, str]) -> li
 
 def check_autopilot(fmu: str | Path, port_map: dict[str, str] | None = None,
                     trial: bool = False) -> ModelDescription:
-    """The FMU's model description if it keeps the port contract, else AutopilotError;
-    ``trial`` also instantiates it once in a child process."""
+    """Its model description if the FMU keeps the port contract (``trial``: and instantiates
+    in a child process), else AutopilotError."""
     fmu, port_map = Path(fmu), port_map or {}
     if not fmu.is_file():
         raise AutopilotError(f"autopilot FMU {fmu} not found")
