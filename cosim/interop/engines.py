@@ -110,8 +110,15 @@ def refuse_strings(ssp: Path, who: str) -> None:
             f"{v} = {default!r}, not {value!r}" for v, (value, default) in dropped.items()))
 
 
-def check_package(ssp: Path, engine: str) -> None:
-    """EngineError naming what ``engine`` cannot run: the file, a parameter, the FMUs."""
+def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = TRACED) -> dict[str, np.ndarray]:
+    """The traced signals of ``ssp`` run in ``engine``; EngineError naming what it cannot run
+    (the file, a parameter, the FMUs) or with the child's output if it fails, ``Interrupted``
+    if SIGINT or SIGTERM ended it."""
+    if engine not in ENGINES:
+        raise ValueError(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
+    ssp = Path(ssp).resolve()
+    if is_osp(ssp) and engine != "libcosim":
+        raise ValueError(f"{engine} reads SSP packages, not OSP's {ssp.name}; give the .ssp")
     try:
         system, descriptions = described(ssp)
     except (OSError, KeyError, ValueError, zipfile.BadZipFile) as error:
@@ -128,17 +135,6 @@ def check_package(ssp: Path, engine: str) -> None:
             if isinstance(value, float) and not math.isfinite(value):
                 raise EngineError(f"{ssp.name}: parameter {name}.{variable} = {value} is not "
                                   "finite")
-
-
-def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = TRACED) -> dict[str, np.ndarray]:
-    """The traced signals of ``ssp`` run in ``engine``; EngineError with the child's output if
-    it fails, ``Interrupted`` if SIGINT or SIGTERM ended it."""
-    if engine not in ENGINES:
-        raise ValueError(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
-    ssp = Path(ssp).resolve()
-    if is_osp(ssp) and engine != "libcosim":
-        raise ValueError(f"{engine} reads SSP packages, not OSP's {ssp.name}; give the .ssp")
-    check_package(ssp, engine)
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "trace.npz"
         log = child_log(engine, ssp, [sys.executable, "-c", _CHILD, engine, str(ssp), str(out),

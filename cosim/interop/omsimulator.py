@@ -2,7 +2,6 @@
 line or its Python API in a child process with a time limit (docs/interop.md)."""
 from __future__ import annotations
 
-import csv
 import os
 import sys
 import sysconfig
@@ -14,38 +13,32 @@ import numpy as np
 from .engines import child_log, finite, refuse_strings
 from .ssp import read_package
 
-INTERFACES = ("cli", "api")
-
 _API = """import sys
 from OMSimulator import SSP
 ssp, result, step, temp = sys.argv[1:]
 model = SSP(ssp, temp_dir=temp).instantiate()
 model.setResultFile(result)
 model.setFixedStepSize(float(step))
-model.initialize()
-model.simulate()
-model.terminate()
-model.delete()
+for call in (model.initialize, model.simulate, model.terminate, model.delete):
+    call()
 """
 
 
 def read_result(path: Path) -> dict[str, np.ndarray]:
     """'time' and each 'component.variable' of a result CSV, one row per communication
     point: the last of the two written (after the step, after the exchange)."""
-    with open(path, newline="") as f:
-        rows = list(csv.reader(f))
-    names = ["time"] + [".".join(h.split(".")[-2:]) for h in rows[0][1:]]
-    last = {float(row[0]): row for row in rows[1:]}
-    table = np.array([[float(v) for v in row] for row in last.values()])
-    return dict(zip(names, table.T))
+    header = path.read_text().split("\n", 1)[0].replace('"', "").split(",")
+    table = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    last = np.append(table[1:, 0] != table[:-1, 0], True)      # the last row of each time
+    return dict(zip(["time"] + [".".join(h.split(".")[-2:]) for h in header[1:]], table[last].T))
 
 
 def run(ssp: str | Path, home: str | Path, interface: str = "cli",
         timeout: float = 600.0) -> dict[str, np.ndarray]:
     """The trace of ``ssp`` run in OMSimulator at ``home`` through ``interface``, or
     EngineError with its output."""
-    if interface not in INTERFACES:
-        raise ValueError(f"interface must be one of {', '.join(INTERFACES)}, got {interface!r}")
+    if interface not in ("cli", "api"):
+        raise ValueError(f"interface must be one of cli, api, got {interface!r}")
     ssp, home = Path(ssp).resolve(), Path(home).resolve()
     refuse_strings(ssp, "OMSimulator")
     system, site = read_package(ssp), sysconfig.get_paths()["purelib"]
