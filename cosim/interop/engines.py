@@ -10,7 +10,7 @@ import sys
 import tempfile
 import zipfile
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -137,16 +137,16 @@ def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = TRACED) -> dict
                                   "finite")
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "trace.npz"
-        log = child_log(engine, ssp, [sys.executable, "-c", _CHILD, engine, str(ssp), str(out),
-                                      *signals], out)
-        with np.load(out) as data:
-            return finite(engine, dict(data), log)
+        return child_trace(engine, ssp, [sys.executable, "-c", _CHILD, engine, str(ssp), str(out),
+                                         *signals], out, lambda path: dict(np.load(path)))
 
 
-def child_log(who: str, ssp: Path, argv: list[str], out: Path, timeout: float = 600.0,
-              **options: Any) -> str:
-    """The output of ``argv``, a child run of ``ssp`` writing ``out``; ``Interrupted`` if a
-    signal stopped it, EngineError naming ``who`` if it failed or ran out of time."""
+def child_trace(who: str, ssp: Path, argv: list[str], out: Path,
+                read: Callable[[Path], dict[str, np.ndarray]], timeout: float = 600.0,
+                **options: Any) -> dict[str, np.ndarray]:
+    """``read(out)`` after ``argv``, a child run of ``ssp``, wrote ``out``: ``Interrupted`` if a
+    signal stopped it, EngineError naming ``who`` with its output if it failed, ran out of time
+    or left a signal undefined (a tool that ignores FMI statuses goes on after a failed FMU)."""
     try:
         child = subprocess.run(argv, capture_output=True, text=True, timeout=timeout, **options)
     except subprocess.TimeoutExpired:
@@ -162,12 +162,7 @@ def child_log(who: str, ssp: Path, argv: list[str], out: Path, timeout: float = 
         how = (f"killed by {signal.Signals(-child.returncode).name}"
                if child.returncode < 0 else f"exit status {child.returncode}")
         raise EngineError(f"{who} failed on {ssp.name} ({how}):\n{log}")
-    return log
-
-
-def finite(who: str, trace: dict[str, np.ndarray], log: str) -> dict[str, np.ndarray]:
-    """``trace``, or EngineError naming its first undefined signal and when: a tool that
-    ignores FMI statuses goes on after a failed FMU."""
+    trace = read(out)
     for name, values in trace.items():
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:

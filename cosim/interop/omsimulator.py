@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .engines import child_log, finite, refuse_strings
+from .engines import child_trace, refuse_strings
 from .ssp import read_package
 
 _API = """import sys
@@ -55,6 +55,5 @@ def run(ssp: str | Path, home: str | Path, interface: str = "cli",
             argv = [sys.executable, "-c", _API, str(ssp), str(result), repr(system.step_size),
                     tmp]
             env = {"PYTHONPATH": os.pathsep.join([str(home / "lib" / "x86_64-linux-gnu"), site])}
-        who = f"OMSimulator ({interface})"
-        log = child_log(who, ssp, argv, result, timeout, cwd=tmp, env={**os.environ, **env})
-        return finite(who, read_result(result), log)
+        return child_trace(f"OMSimulator ({interface})", ssp, argv, result, read_result,
+                           timeout, cwd=tmp, env={**os.environ, **env})
