@@ -105,8 +105,7 @@ def course_keeping_figure(run: Recording, lam: float = LAMBDA) -> Figure:
     heading.plot(t, np.degrees(run["ship.psi"]), color="k", label="psi")
     heading.plot(t, np.degrees(run["guidance.psi_d"]), "--", color="tab:red", label="psi_d")
     if "autopilot.psi_z" in run.columns:
-        heading.plot(t, np.degrees(run["autopilot.psi_z"]), ":", color="tab:blue",
-                     label="psi_z")
+        heading.plot(t, np.degrees(run["autopilot.psi_z"]), ":", color="tab:blue", label="psi_z")
     legend_if_any(heading)
     error.plot(t, np.degrees(heading_error(run["guidance.psi_d"], run["ship.psi"])), color="k")
     r.plot(t, np.degrees(run["ship.r"]), color="k")
@@ -129,10 +128,9 @@ def course_keeping_figure(run: Recording, lam: float = LAMBDA) -> Figure:
 
 def save(fig: Figure, path: Path, formats: tuple[str, ...] = ("png",)) -> list[Path]:
     """Write the figure in each format (path with that suffix), each file whole or not at all."""
-    written = []
-    for fmt in formats:
-        written.append(path.with_suffix(f".{fmt}"))
-        with whole_file(written[-1]) as tmp:
+    written = [path.with_suffix(f".{fmt}") for fmt in formats]
+    for target, fmt in zip(written, formats):
+        with whole_file(target) as tmp:
             fig.savefig(tmp, dpi=120, format=fmt)
     return written
 

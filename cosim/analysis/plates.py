@@ -28,8 +28,7 @@ _BOTH_WAYS = dict(arrowstyle="<->", shrinkA=0, shrinkB=0)
 def _rudder(ax: Any, run: Recording) -> None:
     ax.plot(run.t, -np.degrees(run["ship.delta_c"]), "--", color="tab:blue", linewidth=0.7,
             label="rudder ordered")
-    ax.plot(run.t, -np.degrees(run["ship.delta"]), color="tab:blue", linewidth=1.2,
-            label="rudder")
+    ax.plot(run.t, -np.degrees(run["ship.delta"]), color="tab:blue", linewidth=1.2, label="rudder")
 
 
 def zigzag_plate(run: Recording, **_: Any) -> Figure:
@@ -123,8 +122,7 @@ def _dimension(ax: Any, earth: Callable, start: tuple[float, float], end: tuple[
     """A dimension line between (along, across) points, from ``feet``; gid its label's 1st word."""
     for foot, point in zip(feet, (start, end)):
         _line(ax, earth, foot, point)
-    p, q = _line(ax, earth, start, end, color=colour, linewidth=1.6, zorder=6,
-                 gid=label.split()[0])
+    p, q = _line(ax, earth, start, end, color=colour, linewidth=1.6, zorder=6, gid=label.split()[0])
     ax.annotate("", xy=q, xytext=p, arrowprops=dict(arrowstyle="|-|", color=colour, shrinkA=0,
                                                     shrinkB=0, mutation_scale=6), zorder=6)
     middle = (0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1]))

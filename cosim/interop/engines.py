@@ -122,8 +122,7 @@ def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = TRACED) -> dict
     try:
         system, descriptions = described(ssp)
     except (OSError, KeyError, ValueError, zipfile.BadZipFile) as error:
-        raise EngineError(f"{ssp} is not an SSP package this project can run ({error})") \
-            from None
+        raise EngineError(f"{ssp} is not an SSP package this project can run ({error})") from None
     newer = [f"{name} (FMI {d.fmiVersion})" for name, d in descriptions.items()
              if d.fmiVersion != "2.0"]
     if engine in FMI2_ONLY and newer:

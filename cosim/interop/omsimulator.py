@@ -52,8 +52,7 @@ def run(ssp: str | Path, home: str | Path, interface: str = "cli",
                                               sysconfig.get_config_var("LDLIBRARY")),
                    "PYTHONPATH": site}
         else:
-            argv = [sys.executable, "-c", _API, str(ssp), str(result), repr(system.step_size),
-                    tmp]
+            argv = [sys.executable, "-c", _API, str(ssp), str(result), repr(system.step_size), tmp]
             env = {"PYTHONPATH": os.pathsep.join([str(home / "lib" / "x86_64-linux-gnu"), site])}
         return child_trace(f"OMSimulator ({interface})", ssp, argv, result, read_result,
                            timeout, cwd=tmp, env={**os.environ, **env})

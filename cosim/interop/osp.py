@@ -37,8 +37,7 @@ def write_osp(system: SystemDescription, path: Path, sources: dict[str, str]) ->
     connections = ET.SubElement(root, _q("Connections"))
     for c in system.connections:
         connection = ET.SubElement(connections, _q("VariableConnection"))
-        ET.SubElement(connection, _q("Variable"), simulator=c.start_element,
-                      name=c.start_connector)
+        ET.SubElement(connection, _q("Variable"), simulator=c.start_element, name=c.start_connector)
         ET.SubElement(connection, _q("Variable"), simulator=c.end_element, name=c.end_connector)
     ET.indent(root)
     ET.ElementTree(root).write(path, encoding="utf-8", xml_declaration=True)

@@ -53,8 +53,7 @@ def port_problems(description: ModelDescription, port_map: dict[str, str]) -> li
         if variable.causality != causality or variable.type != real:
             problems.append(f"port {mapped} is of causality {variable.causality} and type "
                             f"{variable.type}: expected a {real} {causality} in {unit}")
-        declared = variable.unit or (variable.declaredType.unit if variable.declaredType
-                                     else None)
+        declared = variable.unit or (variable.declaredType.unit if variable.declaredType else None)
         if declared and declared != unit:
             known = UNITS.get(declared)
             scale = (f" (1 {declared} = {known[1] / UNITS[unit][1]:.6g} {unit})"
