@@ -16,7 +16,7 @@ from cosim import simulate
 from cosim.analysis.animation import animate, frame_times
 from cosim.analysis.figures import RUDDER_LABEL, course_keeping_figure, save
 from cosim.analysis.track import outlines
-from cosim.analysis.manoeuvres import zigzag
+from cosim.analysis.criteria import zigzag_of
 from cosim.provenance import write_metadata
 from cosim.core.recording import Recording
 from ship_fmu.data import Hull
@@ -106,12 +106,16 @@ def test_next_to_every_csv_a_json_with_what_it_takes_to_reproduce_the_run(fmu_pa
 def test_the_imo_10_10_zigzag_is_never_checked_by_this_unstable_ship(fmu_paths, tmp_path,
                                                                      capsys):
     """With 10 deg of counter-rudder CyberShip II keeps turning; it needs 16 deg."""
-    assert not zigzag(math.radians(10), math.radians(10)).checked
-    assert not zigzag(math.radians(15), math.radians(15)).checked
-    z16 = zigzag(math.radians(16), math.radians(16))
+    def zigzag(degrees: float):
+        angle = math.radians(degrees)
+        return zigzag_of(simulate("zigzag_10_10", backend="inprocess", set={
+            "program.delta": angle, "program.psi_switch": angle})).figures
+    assert not zigzag(10).checked
+    assert not zigzag(15).checked
+    z16 = zigzag(16)
     assert z16.checked
-    assert math.degrees(z16.first_overshoot) == pytest.approx(64.52, abs=0.01)
-    assert math.degrees(z16.second_overshoot) == pytest.approx(8.14, abs=0.01)
+    assert math.degrees(z16.overshoots[0].angle) == pytest.approx(64.52, abs=0.01)
+    assert math.degrees(z16.overshoots[1].angle) == pytest.approx(8.14, abs=0.01)
     assert cli.main(["zigzag_10_10", "--out", str(tmp_path)]) == 0
     assert "the turn was never checked: 1 rudder reversal(s) of 3" in capsys.readouterr().out
     assert (tmp_path / "zigzag_10_10.png").stat().st_size > 50_000
@@ -137,7 +141,7 @@ def test_animate_feeds_ffmpeg_whole_frames(fmu_paths, tmp_path, monkeypatch):
     fake.chmod(0o755)
     monkeypatch.setenv("PATH", f"{fake.parent}:{__import__('os').environ['PATH']}")
     run = simulate("calm_pd", stop_time=10)
-    video = animate(run, tmp_path / "calm_pd", "calm_pd")              # mp4: ffmpeg "exists"
+    video = animate(run, tmp_path / "calm_pd", "calm_pd", "mp4")       # ffmpeg "exists"
     assert video.suffix == ".mp4"
     assert video.stat().st_size == len(frame_times(run.t)) * 900 * 504 * 3
 

@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from cosim.analysis.manoeuvres import turning_circle, zigzag
+from cosim import simulate
+from cosim.analysis.criteria import turning_circle_of, zigzag_of
 from ship_fmu.data import Actuators, Hull
 from ship_fmu.hull import coriolis_forces, damping_forces, mass_matrix
 from ship_fmu.steering_gear import RudderMotion
@@ -120,8 +121,8 @@ def test_a_step_is_cut_at_the_kink():
                                                      abs=1e-16), name
 
 
-def test_turning_circle_35_deg():
-    tc = turning_circle(math.radians(35.0))
+def test_turning_circle_35_deg(fmu_paths):
+    tc = turning_circle_of(simulate("turning_circle", backend="inprocess")).figures
     print(f"\n35 deg turning circle: advance {tc.advance:.3f} m, transfer {tc.transfer:.3f} m, "
           f"tactical diameter {tc.tactical_diameter:.3f} m ({tc.tactical_diameter / HULL.L:.2f} L), "
           f"steady yaw rate {math.degrees(tc.steady_yaw_rate):.3f} deg/s, "
@@ -132,12 +133,12 @@ def test_turning_circle_35_deg():
     assert 2.0 < tc.tactical_diameter / HULL.L < 5.0
 
 
-def test_zigzag_20_20():
-    zz = zigzag(math.radians(20.0), math.radians(20.0))
-    print(f"\n20/20 zig-zag: first overshoot {math.degrees(zz.first_overshoot):.2f} deg, "
-          f"second overshoot {math.degrees(zz.second_overshoot):.2f} deg")
-    assert math.degrees(zz.first_overshoot) == pytest.approx(31.655, abs=0.01)
-    assert math.degrees(zz.second_overshoot) == pytest.approx(7.250, abs=0.01)
+def test_zigzag_20_20(fmu_paths):
+    zz = zigzag_of(simulate("zigzag_20_20", backend="inprocess")).figures
+    print(f"\n20/20 zig-zag: first overshoot {math.degrees(zz.overshoots[0].angle):.2f} deg, "
+          f"second overshoot {math.degrees(zz.overshoots[1].angle):.2f} deg")
+    assert math.degrees(zz.overshoots[0].angle) == pytest.approx(31.655, abs=0.01)
+    assert math.degrees(zz.overshoots[1].angle) == pytest.approx(7.250, abs=0.01)
 
 
 def test_spectrum_variance_is_hs_squared_over_16():

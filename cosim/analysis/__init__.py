@@ -1,2 +1,1 @@
-"""What is computed and drawn from a recorded run: eq (19), the MSC.137(76) manoeuvres and
-criteria, reports, figures, plates and animations."""
+"""What is computed and drawn from a recorded run: eq (19), IMO manoeuvres, reports, figures."""

@@ -50,15 +50,12 @@ def leg_text(wp_index: int, points: np.ndarray) -> str:
             f"({north:g}, {east:g}) m")
 
 
-def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> Path:
-    """Write the animation, whole or not at all, at ``path`` with ``fmt``'s suffix (by default
-    ``video_format()``); ``require_track`` says whether the run can have one."""
-    fmt = fmt or video_format()
-    t, (x, y, psi, delta) = run.t, (run[f"ship.{n}"] for n in ("x", "y", "psi", "delta"))
+def animate(run: Recording, path: Path, label: str, fmt: str) -> Path:
+    """Write the animation at ``path`` with ``fmt``'s suffix ('gif', 'mp4'), whole or not at all."""
+    t, (x, y, psi, delta) = run.t, (run[c] for c in NEEDS)
     fig = new_figure(figsize=(10, 5.6), dpi=90, layout="constrained")
     grid = fig.add_gridspec(2, 2, width_ratios=(1.0, 1.1))
-    track, heading, rudder = (fig.add_subplot(grid[:, 0]), fig.add_subplot(grid[0, 1]),
-                              fig.add_subplot(grid[1, 1]))
+    track, heading, rudder = map(fig.add_subplot, (grid[:, 0], grid[0, 1], grid[1, 1]))
     track_panel(track, run, ship=False)
     track.plot(y, x, color="0.8", linewidth=0.8, zorder=1)            # the whole track, faint
     wake, = track.plot([], [], color="k", linewidth=1.2, zorder=3)
@@ -103,9 +100,7 @@ def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> P
     for artist in dynamic:
         artist.set_animated(True)           # left out of the background drawn once
     fig.canvas.draw()
-    fig.set_layout_engine("none")           # the layout is fixed from here on
     background = fig.canvas.copy_from_bbox(fig.bbox)
-    width, height = fig.canvas.get_width_height()
     target = path.with_suffix(f".{fmt}")
     frames = []
     for k in frame_times(t):
@@ -122,12 +117,10 @@ def animate(run: Recording, path: Path, label: str, fmt: str | None = None) -> P
             images[0].save(tmp, save_all=True, append_images=images[1:],
                            duration=round(1000 / FPS), loop=0)
             return target
-        ffmpeg = shutil.which("ffmpeg")
-        if ffmpeg is None:
-            raise ValueError("an MP4 needs ffmpeg, which is not installed; write a GIF")
+        height, width, _ = frames[0].shape
         encode = subprocess.run(
-            [ffmpeg, "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt", "rgb24",
-             "-s", f"{width}x{height}", "-r", str(FPS), "-i", "-", "-vf",
+            [shutil.which("ffmpeg"), "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt",
+             "rgb24", "-s", f"{width}x{height}", "-r", str(FPS), "-i", "-", "-vf",
              "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-pix_fmt", "yuv420p", "-f", "mp4", tmp],
             input=b"".join(frame.tobytes() for frame in frames), capture_output=True)
         if encode.returncode != 0:

@@ -39,10 +39,6 @@ class Criterion:
             return "FAIL"
         return "OPEN" if self.at_least or math.isnan(self.value) else "PASS"
 
-    @property
-    def passed(self) -> bool:
-        return self.verdict == "PASS"
-
 
 def length_over_speed(length: float, speed: float, scale: float = SCALE) -> float:
     """L/V at full scale, s, of a model of ``length`` m at ``speed`` m/s (Froude)."""

@@ -20,7 +20,6 @@ from .describe import paper_row, title
 from .metrics import heading_error
 from .track import legend_if_any, track_panel
 
-FORMATS = ("png", "svg", "pdf")
 RUDDER_LABEL = "rudder delta (deg)\n+ turns to port"     # a positive rudder turns to port
 _VERDICT_COLOURS = {"PASS": "tab:green", "FAIL": "tab:red", "OPEN": "tab:orange"}
 
@@ -32,25 +31,25 @@ def new_figure(**options: Any) -> Figure:
     return fig
 
 
-def _layout(panels: int, heights: tuple[float, ...] | None = None
+def _layout(ylabels: tuple[str, ...], heights: tuple[float, ...] | None = None
             ) -> tuple[Figure, Any, list[Any]]:
     fig = new_figure(figsize=(13, 8), layout="constrained")
-    grid = fig.add_gridspec(panels, 2, width_ratios=(1.0, 1.25), height_ratios=heights)
+    grid = fig.add_gridspec(len(ylabels), 2, width_ratios=(1.0, 1.25), height_ratios=heights)
     track = fig.add_subplot(grid[:, 0])
     track.grid(alpha=0.3)
-    right = time_axes(fig, [grid[i, 1] for i in range(panels)])
-    for a in right:
-        a.yaxis.label.set_size(9)
-    return fig, track, right
+    return fig, track, time_axes(fig, [grid[i, 1] for i in range(len(ylabels))], ylabels,
+                                   fontsize=9)
 
 
-def time_axes(fig: Figure, cells: list[Any]) -> list[Any]:
-    """Panels over time, one per grid cell, sharing the time axis."""
+def time_axes(fig: Figure, cells: list[Any], ylabels: tuple[str, ...], **label: Any
+              ) -> list[Any]:
+    """Panels over time, one per grid cell, sharing the time axis, with their y labels."""
     axes = [fig.add_subplot(cells[0])]
     axes += [fig.add_subplot(c, sharex=axes[0]) for c in cells[1:]]
-    for a in axes:
+    for a, ylabel in zip(axes, ylabels):
         a.grid(alpha=0.3)
         a.tick_params(labelbottom=a is axes[-1])
+        a.set_ylabel(ylabel, **label)
     axes[-1].set_xlabel("time (s)")
     return axes
 
@@ -96,23 +95,20 @@ def merit_table(run: Recording, lam: float = LAMBDA) -> str:
 
 def course_keeping_figure(run: Recording, lam: float = LAMBDA) -> Figure:
     """Track with eq (19); surge speed, heading, heading error, yaw rate and rudder."""
-    fig, track, (u, heading, error, r, rudder) = _layout(5, heights=(1, 1, 1, 1, 1.5))
+    fig, track, (u, heading, error, r, rudder) = _layout(
+        ("surge u (m/s)", "heading (deg)", "psi_d - psi (deg)", "yaw rate r (deg/s)",
+         RUDDER_LABEL), heights=(1, 1, 1, 1, 1.5))
     track_panel(track, run)
     track.set_title(merit_table(run, lam), loc="left", family="monospace", fontsize=8)
     t = run.t
     u.plot(t, run["ship.u"], color="k")
-    u.set_ylabel("surge u (m/s)")
     heading.plot(t, np.degrees(run["ship.psi"]), color="k", label="psi")
     heading.plot(t, np.degrees(run["guidance.psi_d"]), "--", color="tab:red", label="psi_d")
     if "autopilot.psi_z" in run.columns:
-        heading.plot(t, np.degrees(run["autopilot.psi_z"]), ":", color="tab:blue",
-                     label="psi_z")
-    heading.set_ylabel("heading (deg)")
+        heading.plot(t, np.degrees(run["autopilot.psi_z"]), ":", color="tab:blue", label="psi_z")
     legend_if_any(heading)
     error.plot(t, np.degrees(heading_error(run["guidance.psi_d"], run["ship.psi"])), color="k")
-    error.set_ylabel("psi_d - psi (deg)")
     r.plot(t, np.degrees(run["ship.r"]), color="k")
-    r.set_ylabel("yaw rate r (deg/s)")
     command = np.degrees(run["ship.delta_c"])
     rudder.plot(t, command, color="tab:orange", linewidth=0.5, alpha=0.55, zorder=1,
                 label="commanded delta_c")
@@ -126,19 +122,15 @@ def course_keeping_figure(run: Recording, lam: float = LAMBDA) -> Figure:
         rudder.set_title(f"command up to {np.abs(command).max():.0f} deg, clipped here; "
                          f"dotted: the stops at +-{stops:.0f} deg", loc="left", fontsize=7,
                          color="tab:orange")
-    rudder.set_ylabel(RUDDER_LABEL)
     legend_if_any(rudder)
     return fig
 
 
 def save(fig: Figure, path: Path, formats: tuple[str, ...] = ("png",)) -> list[Path]:
     """Write the figure in each format (path with that suffix), each file whole or not at all."""
-    written = []
-    for fmt in formats:
-        if fmt not in FORMATS:
-            raise ValueError(f"figure format {fmt!r}: one of {', '.join(FORMATS)}")
-        written.append(path.with_suffix(f".{fmt}"))
-        with whole_file(written[-1]) as tmp:
+    written = [path.with_suffix(f".{fmt}") for fmt in formats]
+    for target, fmt in zip(written, formats):
+        with whole_file(target) as tmp:
             fig.savefig(tmp, dpi=120, format=fmt)
     return written
 
@@ -152,7 +144,7 @@ def save_figure(run: Recording, draw: Callable[..., Figure], path: Path, label: 
 
 def comparison(runs: dict[str, Recording], caption: str) -> Figure:
     """Several controllers on one scenario: their tracks, headings and rudders, overlaid."""
-    fig, track, (heading, rudder) = _layout(2)
+    fig, track, (heading, rudder) = _layout(("heading psi (deg)", RUDDER_LABEL))
     first = next(iter(runs.values()))
     track_panel(track, first, ship=False, others=runs.values())    # the route and the waves
     heading.plot(first.t, np.degrees(first["guidance.psi_d"]), "--", color="0.4",
@@ -163,8 +155,6 @@ def comparison(runs: dict[str, Recording], caption: str) -> Figure:
         rudder.plot(run.t, np.degrees(run["ship.delta"]), color=line.get_color(),
                     linewidth=0.7)
     legend_if_any(track)
-    heading.set(ylabel="heading psi (deg)")
     legend_if_any(heading)
-    rudder.set(ylabel=RUDDER_LABEL)
     fig.suptitle(caption, fontsize=10)
     return fig

@@ -1,5 +1,4 @@
-"""Which report and figure a scenario gets, by the kind its .ssd names
-(``SystemDescription.report``, an annotation other tools ignore)."""
+"""Which report and figure a scenario gets, by the kind its .ssd names (``report``)."""
 from __future__ import annotations
 
 from typing import Callable, NamedTuple

@@ -1,16 +1,11 @@
-"""The figures of a standard manoeuvre from its trajectory (MSC.137(76) 4.2, MSC/Circ.1053):
-a turning circle's advance, transfer, tactical and steady diameters; a zig-zag's executes,
-overshoots and times. A positive rudder turns the ship to port. SI units and radians."""
+"""The figures of a standard manoeuvre from its trajectory (MSC.137(76) 4.2, MSC/Circ.1053),
+in SI units and radians; a positive rudder turns the ship to port."""
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
 
 import numpy as np
-
-from ship_fmu.manoeuvres import RudderProgram
-from ship_fmu.trial import DT, trial
-from ship_fmu.vessel import VesselParameters
 
 TURNING_RUDDER = math.radians(35.0)   # 4.2.2: 35 deg, or the largest permissible
 
@@ -30,8 +25,7 @@ class TurningCircle:
     heading_change: float = math.nan    # rad, the largest |psi - psi[0]| of the run
 
     @property
-    def diameter_from_rates(self) -> float:
-        """2 U / |r| of the steady turn, m."""
+    def diameter_from_rates(self) -> float:        # 2 U / |r| of the steady turn, m
         return 2.0 * self.steady_speed / abs(self.steady_yaw_rate)
 
 
@@ -51,8 +45,7 @@ class ZigZagResult:
     overshoots: tuple[Overshoot, ...] = ()  # one per checked turn, in order
     executes: tuple[float, ...] = ()       # s, the rudder orders: the first, then reversals
     initial_turning_distance: float = math.nan  # m travelled until |psi| reached psi_switch
-    running: Overshoot | None = None       # the first or second turn, if the run ended in
-    #                           it with the heading still going away: its overshoot so far
+    running: Overshoot | None = None       # so far, of a 1st or 2nd turn still going at the end
 
     @property
     def checked(self) -> bool:
@@ -67,26 +60,15 @@ class ZigZagResult:
         return math.nan, False
 
     @property
-    def first_overshoot(self) -> float:
-        return self.overshoots[0].angle if self.overshoots else math.nan
-
-    @property
-    def second_overshoot(self) -> float:
-        return self.overshoots[1].angle if self.checked else math.nan
-
-    @property
-    def initial_turning_time(self) -> float:
-        """From the first execute to the second (|psi| reached psi_switch), s."""
+    def initial_turning_time(self) -> float:       # s, from the first execute to the second
         return self.executes[1] - self.executes[0] if len(self.executes) > 1 else math.nan
 
     @property
-    def time_to_check_yaw(self) -> float:
-        """From the second execute to the first overshoot's peak (yaw rate zero), s."""
+    def time_to_check_yaw(self) -> float:          # s, second execute to the first overshoot
         return self.overshoots[0].time - self.executes[1] if self.overshoots else math.nan
 
     @property
-    def period(self) -> float:
-        """One full cycle, from the second execute to the fourth, s."""
+    def period(self) -> float:                     # s, one cycle: second execute to the fourth
         return self.executes[3] - self.executes[1] if len(self.executes) > 3 else math.nan
 
 
@@ -143,7 +125,7 @@ def turning_circle_figures(x, y, psi, u, v, r) -> TurningCircle:
                          heading_change=float(np.abs(psi - psi[0]).max()))
 
 
-def zigzag_figures(psi, reversals, psi_switch: float, t, x=None, y=None) -> ZigZagResult:
+def zigzag_figures(psi, reversals, psi_switch: float, t, x, y) -> ZigZagResult:
     """A zig-zag's figures from heading deviation psi and the program's reversal count; an
     overshoot counts once the heading turned back, else it is ``running`` (a lower bound)."""
     psi, reversals, t = np.asarray(psi), np.asarray(reversals), np.asarray(t)
@@ -160,22 +142,7 @@ def zigzag_figures(psi, reversals, psi_switch: float, t, x=None, y=None) -> ZigZ
         last, checked = peak(reached)
         overshoots, running = (overshoots + [last], None) if checked else (overshoots, last)
     executes = tuple(float(t[k]) for k in [0, *(np.flatnonzero(np.diff(reversals)) + 1)])
-    distance = math.nan
-    if x is not None:
-        travelled = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(x), np.diff(y)))])
-        distance, = _first_reaching(np.abs(psi), psi_switch, travelled)
+    travelled = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(x), np.diff(y)))])
+    distance, = _first_reaching(np.abs(psi), psi_switch, travelled)
     return ZigZagResult(reached, psi_switch, tuple(overshoots), executes, distance, running)
 
-
-def turning_circle(delta: float = TURNING_RUDDER, t_end: float = 300.0,
-                   params: VesselParameters = VesselParameters()) -> TurningCircle:
-    track = trial(RudderProgram(delta, 0.0), t_end, params)
-    return turning_circle_figures(*(track[n] for n in ("x", "y", "psi", "u", "v", "r")))
-
-
-def zigzag(delta: float = math.radians(20.0), psi_switch: float = math.radians(20.0),
-           t_end: float = 300.0, params: VesselParameters = VesselParameters()) -> ZigZagResult:
-    track = trial(RudderProgram(delta, psi_switch), t_end, params)
-    t = DT * np.arange(len(track["psi"]))
-    return zigzag_figures(track["psi"], track["reversals"], psi_switch, t, track["x"],
-                          track["y"])

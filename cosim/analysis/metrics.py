@@ -45,10 +45,9 @@ def overshoot(psi: np.ndarray, psi_start: float, psi_target: float) -> float:
     return max(0.0, float(np.max(direction * (np.asarray(psi) - psi_target))))
 
 
-def rudder_reversals_per_minute(t: np.ndarray, delta: np.ndarray,
-                                deadband: float = RUDDER_DEADBAND) -> float:
-    """Rudder crossings per minute, each counted once beyond ``deadband`` on the new side."""
-    sides = np.sign(delta)[np.abs(delta) > deadband]
+def rudder_reversals_per_minute(t: np.ndarray, delta: np.ndarray) -> float:
+    """Rudder crossings per minute, each counted once beyond the deadband on the new side."""
+    sides = np.sign(delta)[np.abs(delta) > RUDDER_DEADBAND]
     return int(np.count_nonzero(sides[1:] != sides[:-1])) / ((t[-1] - t[0]) / 60.0)
 
 
@@ -78,7 +77,7 @@ def cross_track_error(x: np.ndarray, y: np.ndarray, wp_index: np.ndarray,
 
 @dataclass(frozen=True)
 class RouteCompletion:
-    """How close the track came to each waypoint: reached within R_accept (the guidance
+    """How close the track came to each waypoint, reached if within R_accept (the guidance
     also moves on past a waypoint it never reached)."""
     points: tuple[tuple[float, float], ...]     # the route, m
     closest: tuple[float, ...]                  # the track's closest approach to each, m
@@ -89,8 +88,7 @@ class RouteCompletion:
         return tuple(d <= self.R_accept for d in self.closest)
 
     @property
-    def count(self) -> int:
-        """Waypoints reached, the start included."""
+    def count(self) -> int:                 # waypoints reached, the start included
         return sum(self.reached)
 
     @property

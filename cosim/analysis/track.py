@@ -1,6 +1,5 @@
 """The track panel every figure of a run shares: north up at equal scale, the route with its
-circles and named waypoints, the leg switches, the ship's outline at regular times (enlarged
-where it could not be seen) and the wave direction."""
+named waypoints, the leg switches, the ship's outline at regular times, the wave direction."""
 from __future__ import annotations
 
 import itertools
@@ -29,18 +28,21 @@ def waypoint_name(i: int) -> str:
     return f"WP{i + 1}"
 
 
+def to_earth(x: float, y: float, psi: float, along: Any, across: Any) -> tuple[Any, Any]:
+    """(east, north) of points ``along`` and ``across`` (to starboard) of (x, y) heading psi."""
+    c, s = math.cos(psi), math.sin(psi)
+    return y + along * s + across * c, x + along * c - across * s
+
+
 def hull_outline(x: float, y: float, psi: float, scale: float = 1.0) -> np.ndarray:
     """The ship's waterline as (east, north) corners at (x, y, psi), ``scale`` times enlarged."""
     L, B = scale * Hull.L, scale * Hull.B
-    forward, starboard = np.array([(L / 2, 0.0), (L / 4, B / 2), (-L / 2, B / 2),
-                                   (-L / 2, -B / 2), (L / 4, -B / 2)]).T
-    c, s = math.cos(psi), math.sin(psi)
-    return np.column_stack([y + forward * s + starboard * c, x + forward * c - starboard * s])
+    return np.column_stack(to_earth(x, y, psi, *np.array([
+        (L / 2, 0.0), (L / 4, B / 2), (-L / 2, B / 2), (-L / 2, -B / 2), (L / 4, -B / 2)]).T))
 
 
 def outline_scale(spacing: float, extent: float) -> int:
-    """The largest factor 1 ... 9, 10, 20, ... keeping an outline within 0.8 ``spacing`` and
-    ``extent`` / 12 (m)."""
+    """The largest factor 1 ... 9, 10, 20, ... keeping an outline within 0.8 spacing, extent/12."""
     limit = min(0.8 * spacing, extent / 12.0) / Hull.L
     if limit < 1.0:
         return 1
@@ -54,10 +56,7 @@ class Outlines:
     rows: list[int]
     every: float
     scale: int
-
-    @property
-    def size(self) -> str:
-        return "to scale" if self.scale == 1 else f"x{self.scale}, true heading"
+    size: str                   # the enlargement in words
 
 
 def outlines(run: Recording) -> Outlines:
@@ -73,19 +72,17 @@ def outlines(run: Recording) -> Outlines:
     for k in rows:
         if all(math.hypot(x[k] - x[j], y[k] - y[j]) > scale * Hull.L for j in drawn):
             drawn.append(k)
-    return Outlines(drawn, every, scale)
+    return Outlines(drawn, every, scale, "to scale" if scale == 1 else f"x{scale}, true heading")
 
 
 def _arrow(direction: float) -> Shape:
     east, north = np.array([(0, 1), (0.5, 0.15), (0.17, 0.15), (0.17, -1), (-0.17, -1),
                             (-0.17, 0.15), (-0.5, 0.15), (0, 1)]).T
-    c, s = math.cos(direction), math.sin(direction)
-    return Shape(np.column_stack([east * c + north * s, -east * s + north * c]), closed=True)
+    return Shape(np.column_stack(to_earth(0.0, 0.0, direction, north, east)), closed=True)
 
 
 def _route(ax: Any, guidance: dict[str, Any], tracks: list[np.ndarray]) -> None:
-    """The route, its circles and its points named; framed on the tracks and the points near
-    them (within half the tracks' size), the others said in the legend."""
+    """The route, framed on the tracks and the points near them; the others named in the legend."""
     points = np.array(followed_route(guidance))[:, ::-1]              # (east, north)
     reach = guidance["R_accept"]
     seen = np.concatenate(tracks)

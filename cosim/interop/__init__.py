@@ -1,2 +1,1 @@
-"""Interop with other FMI co-simulation tools: SSP and OSP files, runs in libcosim, ecos,
-fmpy's SSP runner (``engines``) and OMSimulator (``omsimulator``)."""
+"""Interop with other FMI tools: SSP and OSP files; runs in libcosim, ecos, fmpy, OMSimulator."""

@@ -1,8 +1,6 @@
 """Run an exported SSP package in ``libcosim`` (libcosimpy; also the OSP folder beside it),
-``ecos`` (ecospy) or ``fmpy`` (its SSP runner), in a child process: libcosimpy 0.0.6 aborts
-its host when an FMU fails, ecos 0.7.2 ignores FMI status codes. A crash, a failed step or
-NaN outputs become an ``EngineError`` with the child's output (time conventions:
-docs/interop.md)."""
+``ecos`` (ecospy) or ``fmpy`` (its SSP runner) in a child process: libcosimpy 0.0.6 aborts
+its host when an FMU fails, ecos 0.7.2 ignores FMI status codes (docs/interop.md)."""
 from __future__ import annotations
 
 import math
@@ -12,7 +10,7 @@ import sys
 import tempfile
 import zipfile
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -21,8 +19,7 @@ from fmukit.timebase import communication_point, step_count
 from ..core.files import whole_file
 from ..core.interrupt import STOP_SIGNALS, Interrupted, StopSignals
 from ..core.system import SystemDescription, split_name
-from .osp import read_osp
-from .ssp import FMI2_ONLY, fmi_versions, read_package, unapplied_strings
+from .ssp import FMI2_ONLY, described, is_osp, read_package, unapplied_strings
 
 ENGINES = ("libcosim", "ecos", "fmpy")
 TRACED = ("ship.psi", "ship.r", "ship.delta")
@@ -30,14 +27,6 @@ TRACED = ("ship.psi", "ship.r", "ship.delta")
 
 class EngineError(RuntimeError):
     """An engine failed or produced undefined values; the message holds its output."""
-
-
-def is_osp(path: Path) -> bool:
-    return path.is_dir() or path.suffix.lower() == ".xml"
-
-
-def read_system(path: Path) -> SystemDescription:
-    return read_osp(path) if is_osp(path) else read_package(path)
 
 
 def _libcosim(ssp: Path, system: SystemDescription, n_steps: int, signals: tuple[str, ...],
@@ -96,13 +85,8 @@ def _fmpy(ssp: Path, system: SystemDescription, n_steps: int, signals: tuple[str
           stop: StopSignals) -> dict[str, np.ndarray]:
     from fmpy.ssp.simulation import simulate_ssp
     from fmpy.ssp.ssd import Parameter, ParameterSet
-    # fmpy's runner applies no parameter bindings itself and cannot set Strings:
-    # pass the package's own values, fully qualified; a String must equal the FMU's
-    # default, or the run would not be the scenario.
-    dropped = unapplied_strings(ssp)
-    if dropped:
-        raise EngineError("fmpy's SSP runner cannot set the String " + ", ".join(
-            f"{variable} = {value!r}" for variable, (value, _) in dropped.items()))
+    # fmpy's runner applies no parameter bindings itself: pass the package's own values
+    refuse_strings(ssp, "fmpy's SSP runner")
     parameters = ParameterSet()
     for name, component in system.components.items():
         parameters.parameters.extend(
@@ -118,15 +102,29 @@ def _fmpy(ssp: Path, system: SystemDescription, n_steps: int, signals: tuple[str
 RUNNERS = {"libcosim": _libcosim, "ecos": _ecos, "fmpy": _fmpy}
 
 
-def check_package(ssp: Path, engine: str) -> None:
-    """EngineError naming the file, parameter or components if ``engine`` cannot run the
-    package: not SSP or OSP, a value not finite, or FMUs of an FMI version it does not take."""
+def refuse_strings(ssp: Path, who: str) -> None:
+    """EngineError if ``ssp`` binds a String away from its FMU's default: ``who`` sets none."""
+    dropped = unapplied_strings(ssp)
+    if dropped:
+        raise EngineError(f"{who} applies no String binding; it would run " + ", ".join(
+            f"{v} = {default!r}, not {value!r}" for v, (value, default) in dropped.items()))
+
+
+def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = TRACED) -> dict[str, np.ndarray]:
+    """The traced signals of ``ssp`` run in ``engine``; EngineError naming what it cannot run
+    (the file, a parameter, the FMUs) or with the child's output if it fails, ``Interrupted``
+    if SIGINT or SIGTERM ended it."""
+    if engine not in ENGINES:
+        raise ValueError(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
+    ssp = Path(ssp).resolve()
+    if is_osp(ssp) and engine != "libcosim":
+        raise ValueError(f"{engine} reads SSP packages, not OSP's {ssp.name}; give the .ssp")
     try:
-        system, versions = read_system(ssp), fmi_versions(ssp)
+        system, descriptions = described(ssp)
     except (OSError, KeyError, ValueError, zipfile.BadZipFile) as error:
-        raise EngineError(f"{ssp} is not an SSP package this project can run ({error})") \
-            from None
-    newer = [f"{name} (FMI {version})" for name, version in versions.items() if version != "2.0"]
+        raise EngineError(f"{ssp} is not an SSP package this project can run ({error})") from None
+    newer = [f"{name} (FMI {d.fmiVersion})" for name, d in descriptions.items()
+             if d.fmiVersion != "2.0"]
     if engine in FMI2_ONLY and newer:
         raise EngineError(f"{FMI2_ONLY[engine]} runs FMI 2.0 FMUs only; {ssp.name} holds "
                           f"{', '.join(newer)}: run it with ecos or OMSimulator, or export "
@@ -136,34 +134,26 @@ def check_package(ssp: Path, engine: str) -> None:
             if isinstance(value, float) and not math.isfinite(value):
                 raise EngineError(f"{ssp.name}: parameter {name}.{variable} = {value} is not "
                                   "finite")
-
-
-def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = TRACED) -> dict[str, np.ndarray]:
-    """Run ``ssp`` in ``engine`` in a child process; EngineError with its output if it
-    fails, ``Interrupted`` if SIGINT or SIGTERM ended the child."""
-    if engine not in ENGINES:
-        raise ValueError(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
-    ssp = Path(ssp).resolve()
-    if is_osp(ssp) and engine != "libcosim":
-        raise ValueError(f"{engine} reads SSP packages, not OSP's {ssp.name}; give the .ssp")
-    check_package(ssp, engine)
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "trace.npz"
-        log = child_log(engine, ssp, [sys.executable, "-c", _CHILD, engine, str(ssp), str(out),
-                                      *signals], out)
-        with np.load(out) as data:
-            return finite(engine, dict(data), log)
+        return child_trace(engine, ssp, [sys.executable, "-c", _CHILD, engine, str(ssp), str(out),
+                                         *signals], out, lambda path: dict(np.load(path)))
 
 
-def child_log(who: str, ssp: Path, argv: list[str], out: Path, timeout: float = 600.0,
-              **options: Any) -> str:
-    """The output of ``argv``, a child run of ``ssp`` writing ``out``; ``Interrupted`` if a
-    signal stopped it, EngineError naming ``who`` if it failed or ran out of time."""
+def child_trace(who: str, ssp: Path, argv: list[str], out: Path,
+                read: Callable[[Path], dict[str, np.ndarray]], timeout: float = 600.0,
+                **options: Any) -> dict[str, np.ndarray]:
+    """``read(out)`` after ``argv``, a child run of ``ssp``, wrote ``out``: ``Interrupted`` if a
+    signal stopped it, EngineError naming ``who`` with its output if it failed, ran out of time
+    or left a signal undefined (a tool that ignores FMI statuses goes on after a failed FMU)."""
     try:
         child = subprocess.run(argv, capture_output=True, text=True, timeout=timeout, **options)
     except subprocess.TimeoutExpired:
         raise EngineError(f"{who} did not finish {ssp.name} within {timeout:g} s") from None
-    log = log_summary(child.stdout + child.stderr)
+    lines = [line for line in (child.stdout + child.stderr).strip().splitlines() if line.strip()]
+    if len(lines) > 25:                 # the first 20 lines (where the cause is), the last 5
+        lines[20:-5] = [f"... ({len(lines) - 25} more lines) ..."]
+    log = "\n".join(lines)
     number = -child.returncode if child.returncode < 0 else child.returncode - 128
     if number in STOP_SIGNALS:          # Ctrl-C or a kill: not the engine's fault
         raise Interrupted(number)
@@ -171,12 +161,7 @@ def child_log(who: str, ssp: Path, argv: list[str], out: Path, timeout: float = 
         how = (f"killed by {signal.Signals(-child.returncode).name}"
                if child.returncode < 0 else f"exit status {child.returncode}")
         raise EngineError(f"{who} failed on {ssp.name} ({how}):\n{log}")
-    return log
-
-
-def finite(who: str, trace: dict[str, np.ndarray], log: str) -> dict[str, np.ndarray]:
-    """``trace`` if every value in it is finite, else EngineError naming the first undefined
-    signal and when: a tool that ignores FMI statuses goes on after a failed FMU."""
+    trace = read(out)
     for name, values in trace.items():
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:
@@ -195,7 +180,7 @@ def record(engine: str, ssp: str, out: str, signals: tuple[str, ...]) -> int:
     stderr if it fails; 130 or 143 if SIGINT or SIGTERM stopped it (between steps)."""
     try:
         with StopSignals() as stop:
-            system = read_system(Path(ssp))
+            system = read_package(Path(ssp))
             n_steps = step_count(system.start_time, system.stop_time, system.step_size)
             result = RUNNERS[engine](Path(ssp), system, n_steps, signals, stop)
     except Interrupted as interrupted:
@@ -211,11 +196,3 @@ def record(engine: str, ssp: str, out: str, signals: tuple[str, ...]) -> int:
 def save_trace(path: Path, result: dict[str, np.ndarray]) -> None:
     with whole_file(path) as tmp, open(tmp, "wb") as f:
         np.savez(f, **result)
-
-
-def log_summary(log: str) -> str:
-    """The first 20 lines of a log (where the cause is) and its last 5."""
-    lines = [line for line in log.strip().splitlines() if line.strip()]
-    if len(lines) > 25:
-        lines[20:-5] = [f"... ({len(lines) - 25} more lines) ..."]
-    return "\n".join(lines)

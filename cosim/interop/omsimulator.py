@@ -1,9 +1,7 @@
-"""Run an exported SSP package in OMSimulator from a build folder ``home`` (bin/OMSimulator,
-its command line; lib/x86_64-linux-gnu/OMSimulator, its Python API) in a child process with a
-time limit (docs/interop.md), and read its result file."""
+"""Run an exported SSP package in OMSimulator, a build folder ``home``, through its command
+line or its Python API in a child process with a time limit (docs/interop.md)."""
 from __future__ import annotations
 
-import csv
 import os
 import sys
 import sysconfig
@@ -12,10 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .engines import EngineError, child_log, finite
-from .ssp import read_package, unapplied_strings
-
-INTERFACES = ("cli", "api")
+from .engines import child_trace, refuse_strings
+from .ssp import read_package
 
 _API = """import sys
 from OMSimulator import SSP
@@ -23,35 +19,28 @@ ssp, result, step, temp = sys.argv[1:]
 model = SSP(ssp, temp_dir=temp).instantiate()
 model.setResultFile(result)
 model.setFixedStepSize(float(step))
-model.initialize()
-model.simulate()
-model.terminate()
-model.delete()
+for call in (model.initialize, model.simulate, model.terminate, model.delete):
+    call()
 """
 
 
 def read_result(path: Path) -> dict[str, np.ndarray]:
     """'time' and each 'component.variable' of a result CSV, one row per communication
     point: the last of the two written (after the step, after the exchange)."""
-    with open(path, newline="") as f:
-        rows = list(csv.reader(f))
-    names = ["time"] + [".".join(h.split(".")[-2:]) for h in rows[0][1:]]
-    last = {float(row[0]): row for row in rows[1:]}
-    table = np.array([[float(v) for v in row] for row in last.values()])
-    return dict(zip(names, table.T))
+    header = path.read_text().split("\n", 1)[0].replace('"', "").split(",")
+    table = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    last = np.append(table[1:, 0] != table[:-1, 0], True)      # the last row of each time
+    return dict(zip(["time"] + [".".join(h.split(".")[-2:]) for h in header[1:]], table[last].T))
 
 
 def run(ssp: str | Path, home: str | Path, interface: str = "cli",
         timeout: float = 600.0) -> dict[str, np.ndarray]:
-    """Run ``ssp`` in OMSimulator at ``home`` through ``interface``; EngineError with its
-    output if it fails, times out or would drop a String binding."""
-    if interface not in INTERFACES:
-        raise ValueError(f"interface must be one of {', '.join(INTERFACES)}, got {interface!r}")
+    """The trace of ``ssp`` run in OMSimulator at ``home`` through ``interface``, or
+    EngineError with its output."""
+    if interface not in ("cli", "api"):
+        raise ValueError(f"interface must be one of cli, api, got {interface!r}")
     ssp, home = Path(ssp).resolve(), Path(home).resolve()
-    dropped = unapplied_strings(ssp)
-    if dropped:
-        raise EngineError("OMSimulator applies no String binding; it would run " + ", ".join(
-            f"{v} = {default!r}, not {value!r}" for v, (value, default) in dropped.items()))
+    refuse_strings(ssp, "OMSimulator")
     system, site = read_package(ssp), sysconfig.get_paths()["purelib"]
     with tempfile.TemporaryDirectory() as tmp:
         result = Path(tmp) / "result.csv"
@@ -63,9 +52,7 @@ def run(ssp: str | Path, home: str | Path, interface: str = "cli",
                                               sysconfig.get_config_var("LDLIBRARY")),
                    "PYTHONPATH": site}
         else:
-            argv = [sys.executable, "-c", _API, str(ssp), str(result), repr(system.step_size),
-                    tmp]
+            argv = [sys.executable, "-c", _API, str(ssp), str(result), repr(system.step_size), tmp]
             env = {"PYTHONPATH": os.pathsep.join([str(home / "lib" / "x86_64-linux-gnu"), site])}
-        who = f"OMSimulator ({interface})"
-        log = child_log(who, ssp, argv, result, timeout, cwd=tmp, env={**os.environ, **env})
-        return finite(who, read_result(result), log)
+        return child_trace(f"OMSimulator ({interface})", ssp, argv, result, read_result,
+                           timeout, cwd=tmp, env={**os.environ, **env})

@@ -1,6 +1,5 @@
-"""OSP's OspSystemStructure.xml (libcosim's schema 0.1), written beside an SSP package: the
-times, each simulator's FMU, step and initial values, and the connections, output first.
-No OSP model description: these systems need none."""
+"""OSP's OspSystemStructure.xml (libcosim's schema 0.1) beside an SSP package: times, FMUs,
+steps, initial values and connections (output first); these systems need no model description."""
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
@@ -38,8 +37,7 @@ def write_osp(system: SystemDescription, path: Path, sources: dict[str, str]) ->
     connections = ET.SubElement(root, _q("Connections"))
     for c in system.connections:
         connection = ET.SubElement(connections, _q("VariableConnection"))
-        ET.SubElement(connection, _q("Variable"), simulator=c.start_element,
-                      name=c.start_connector)
+        ET.SubElement(connection, _q("Variable"), simulator=c.start_element, name=c.start_connector)
         ET.SubElement(connection, _q("Variable"), simulator=c.end_element, name=c.end_connector)
     ET.indent(root)
     ET.ElementTree(root).write(path, encoding="utf-8", xml_declaration=True)

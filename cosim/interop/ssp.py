@@ -1,6 +1,5 @@
-"""A scenario as one .ssp (SystemStructure.ssd and resources/<fmu>.fmu) and beside it a
-folder with OSP's OspSystemStructure.xml and the FMUs, written whole or not at all. The route
-goes as numbers: OMSimulator and fmpy's SSP runner apply no String binding."""
+"""A scenario as one .ssp (SystemStructure.ssd, resources/<fmu>.fmu) and an OSP folder beside
+it, each whole or not at all; the route as numbers, since some tools set no String."""
 from __future__ import annotations
 
 import shutil
@@ -61,8 +60,7 @@ def connector_units(system: SystemDescription, fmus: dict[str, Path]) -> Units:
 def export(scenario: str | Path, out: Path, overrides: dict[str, dict] | None = None,
            autopilot: str | Path | None = None, port_map: dict[str, str] | None = None,
            name: str | None = None, fmi: int | None = None) -> Path:
-    """Write out/<label>.ssp and out/<label>/ (OSP) of the scenario as ``scenarios.load``
-    gives it, with ``overrides`` by component."""
+    """Write out/<label>.ssp and out/<label>/ (OSP) of ``scenarios.load``'s system."""
     system = scenarios.load(scenario, autopilot, port_map, name, fmi)
     for component, values in system.parameters(overrides).items():
         system.components[component].parameters = values
@@ -91,35 +89,37 @@ def export(scenario: str | Path, out: Path, overrides: dict[str, dict] | None = 
     return target
 
 
-def read_package(ssp: Path) -> SystemDescription:
-    with tempfile.TemporaryDirectory() as tmp:
-        with zipfile.ZipFile(ssp) as package:
-            package.extract(SSD_NAME, tmp)
-        return read_ssd(Path(tmp) / SSD_NAME)
+def is_osp(path: Path) -> bool:
+    return path.is_dir() or path.suffix.lower() == ".xml"
 
 
-def _described(path: Path) -> tuple[SystemDescription, dict[str, ModelDescription]]:
-    """The system of a package or an OSP folder, and each component's model description."""
+def described(path: Path) -> tuple[SystemDescription, dict[str, ModelDescription]]:
+    """The system of an SSP package or OSP folder or file, and its components' descriptions."""
     with tempfile.TemporaryDirectory() as tmp:
-        if path.suffix.lower() == ".ssp":
+        if is_osp(path):
+            system, folder = read_osp(path), path if path.is_dir() else path.parent
+        else:
             with zipfile.ZipFile(path) as package:
                 package.extractall(tmp)
             system, folder = read_ssd(Path(tmp) / SSD_NAME), Path(tmp)
-        else:
-            system, folder = read_osp(path), path if path.is_dir() else path.parent
         return system, {name: read_description(folder / component.source, name)
                         for name, component in system.components.items()}
 
 
+def read_package(path: Path) -> SystemDescription:
+    """The system of an SSP package or of an OSP folder or file."""
+    return described(path)[0]
+
+
 def fmi_versions(path: Path) -> dict[str, str]:
     """Each component's FMI version ("2.0", "3.0") in a package or OSP folder."""
-    return {name: d.fmiVersion for name, d in _described(path)[1].items()}
+    return {name: d.fmiVersion for name, d in described(path)[1].items()}
 
 
 def unapplied_strings(ssp: Path) -> dict[str, tuple[str, str]]:
     """String bindings a tool applying none would drop without a word, not at their FMU's
     default: 'component.variable': (value, default)."""
-    system, descriptions = _described(ssp)
+    system, descriptions = described(ssp)
     dropped = {}
     for name, component in system.components.items():
         starts = {v.name: v.start for v in descriptions[name].modelVariables}

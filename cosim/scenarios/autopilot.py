@@ -47,15 +47,13 @@ def port_problems(description: ModelDescription, port_map: dict[str, str]) -> li
         mapped = f"'{name}' (for {port})" if name != port else f"'{port}'"
         variable = variables.get(name)
         if variable is None:
-            close = close_matches(name, variables)
             problems.append(f"no port {mapped}: expected a {real} {causality} in {unit} "
-                            f"({DESCRIPTIONS[port]}){did_you_mean(close)}")
+                            f"({DESCRIPTIONS[port]}){did_you_mean(close_matches(name, variables))}")
             continue
         if variable.causality != causality or variable.type != real:
             problems.append(f"port {mapped} is of causality {variable.causality} and type "
                             f"{variable.type}: expected a {real} {causality} in {unit}")
-        declared = variable.unit or (variable.declaredType.unit if variable.declaredType
-                                     else None)
+        declared = variable.unit or (variable.declaredType.unit if variable.declaredType else None)
         if declared and declared != unit:
             known = UNITS.get(declared)
             scale = (f" (1 {declared} = {known[1] / UNITS[unit][1]:.6g} {unit})"
@@ -68,8 +66,8 @@ def port_problems(description: ModelDescription, port_map: dict[str, str]) -> li
 
 def check_autopilot(fmu: str | Path, port_map: dict[str, str] | None = None,
                     trial: bool = False) -> ModelDescription:
-    """The FMU's model description if it keeps the port contract, else AutopilotError;
-    ``trial`` also instantiates it once in a child process."""
+    """Its model description if the FMU keeps the port contract (``trial``: and instantiates
+    in a child process), else AutopilotError."""
     fmu, port_map = Path(fmu), port_map or {}
     if not fmu.is_file():
         raise AutopilotError(f"autopilot FMU {fmu} not found")
