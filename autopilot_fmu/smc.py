@@ -1,15 +1,13 @@
-"""Sliding-mode autopilot, eqs (35)-(44), designed from the Nomoto model (33) by pole placement
-(38), h the eigenvector of A_c^T of the smaller eigenvalue, N from (40)-(41). delta_c = u_eq +
-u_sw (43), u_eq = N psi_z - K^T x (39, read to stabilise: as printed it feeds the heading back
-with the wrong sign; 'tracking': -K^T (x - x_z), docs/reproduction.md), u_sw = h^T [r_z,
-r_z_dot] - eta_h tanh(sigma_h / phi_h) (42), sigma_h = h_1 (psi_z - psi) + h_2 (r_z - r) (37)."""
+"""Sliding-mode autopilot, eqs (35)-(44), designed on the Nomoto model (33) by pole placement
+(38), h the eigenvector of A_c^T of the smaller eigenvalue, N from (40)-(41). Eq (39) is read
+to stabilise: as printed it feeds the heading back with the wrong sign (docs/fmus.md)."""
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
 from typing import Callable
 
-from fmukit.numerics import require_finite, substeps, wrap
+from fmukit.numerics import substeps, wrap
 
 from .design import NomotoModel, SwayYawModel
 
@@ -110,7 +108,6 @@ class SlidingModeAutopilot:
         if equivalent_control not in EQUIVALENT_CONTROLS:
             raise ValueError(f"parameter equivalent_control must be 'paper' (eq 39) or "
                              f"'tracking' (-K^T (x - x_z)), got {equivalent_control!r}")
-        require_finite(psi_z=psi_z, r_z=r_z)
         self.design = design
         self.tracking = equivalent_control == "tracking"
         self.eta_h, self.phi_h, self.omega_n, self.zeta = eta_h, phi_h, omega_n, zeta
@@ -127,7 +124,8 @@ class SlidingModeAutopilot:
         return h1 * wrap(self.psi_z - psi) + h2 * (self.r_z - r)
 
     def command(self, psi: float, r: float, psi_d: float) -> float:
-        """delta_c = u_eq + u_sw, eq (43), rad."""
+        """delta_c = u_eq + u_sw, eq (43), rad: u_eq (39), or -K^T (x - x_z) if 'tracking';
+        u_sw = h^T [r_z, r_z_dot] - eta_h tanh(sigma_h / phi_h) (42)."""
         (k1, k2), (h1, h2) = self.design.K, self.design.h
         u_eq = k1 * wrap(self.psi_z - psi) + k2 * ((self.r_z if self.tracking else 0.0) - r)
         u_sw = (h1 * self.r_z + h2 * self.r_z_dot(psi_d, self.psi_z, self.r_z)
@@ -135,7 +133,6 @@ class SlidingModeAutopilot:
         return u_eq + u_sw
 
     def step(self, t: float, h: float, psi_d: float) -> None:
-        require_finite(psi_d=psi_d)
         n = substeps(h, self._h_max, "of the reference model")
         hs = h / n
         psi_z, r_z = self.psi_z, self.r_z

@@ -1,8 +1,6 @@
-"""The vessel: CyberShip II hull, actuators, steering gear and waves, integrated by RK4
-with the inputs held, each step cut into ceil(h / h_max) equal sub-steps and where the rudder
-reaches its command or stop (a kink: RK4 keeps its order only on smooth pieces,
-``cosim.accuracy``). psi is not wrapped. Parameters carry the FMU's names.
-"""
+"""The vessel: CyberShip II hull, actuators, steering gear and waves, by RK4 with the inputs
+held, in equal sub-steps <= h_max, cut where the rudder reaches its command or stop (RK4 keeps
+its order only on smooth pieces, ``cosim.accuracy``). psi is not wrapped."""
 from __future__ import annotations
 
 import math
@@ -95,9 +93,7 @@ class Vessel:
 
     def step(self, t: float, h: float, delta_c: float,
              n1: float = N_PROPELLER, n2: float = N_PROPELLER, n3: float = 0.0) -> None:
-        if not (math.isfinite(delta_c) and math.isfinite(n1) and math.isfinite(n2)
-                and math.isfinite(n3)):
-            require_finite(delta_c=delta_c, n1=n1, n2=n2, n3=n3)
+        require_finite(delta_c=delta_c, n1=n1, n2=n2, n3=n3)
         p = self.params
         if h != self._h:                      # the same step, run after run: cut it once
             self._h, self._cut = h, self._cut_of(h)
