@@ -40,8 +40,7 @@ def linearised_ship(u0: float, n: float = N_PROPELLER, hull: Hull = Hull(),
                     actuators: Actuators = Actuators()) -> SwayYawModel:
     """Sway-yaw model of the ship linearised at surge speed u0, eqs (23)-(25)."""
     def hydrodynamic(v: float, r: float) -> np.ndarray:
-        forces = np.add(coriolis_forces(hull, u0, v, r), damping_forces(hull, u0, v, r))
-        return forces[1:]
+        return np.add(coriolis_forces(hull, u0, v, r), damping_forces(hull, u0, v, r))[1:]
     N = np.column_stack([_derivative(lambda v: hydrodynamic(v, 0.0), 0.0),
                          _derivative(lambda r: hydrodynamic(0.0, r), 0.0)])
     forces = actuator_model(actuators, n, n, 0.0)

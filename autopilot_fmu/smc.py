@@ -12,7 +12,6 @@ from fmukit.numerics import substeps, wrap
 from .design import NomotoModel, SwayYawModel
 
 H_MAX = 0.1                     # s, the largest RK4 step of the reference model
-EQUIVALENT_CONTROLS = ("paper", "tracking")
 
 
 def reference_step_bound(omega_n: float, zeta: float) -> float:
@@ -45,8 +44,6 @@ def reference_rk4(psi_d: float, psi_z: float, r_z: float, hs: float, omega_n: fl
 class SlidingModeDesign:
     """Gains of the sliding-mode autopilot for a Nomoto model, eqs (38)-(41)."""
     nomoto: NomotoModel
-    lambda1: float
-    lambda2: float
     K: tuple[float, float]
     h: tuple[float, float]
     N: float
@@ -70,8 +67,7 @@ class SlidingModeDesign:
         scale = math.copysign(1.0, h1) / math.hypot(h1, h2)
         # Eqs (40)-(41): [N_x; N_u] = [[A, B], [C, D]]^-1 [0; 1] = [1, 0; 0] with C = [1, 0]
         # and D = 0, so N = N_u + K^T N_x = k1.
-        return cls(nomoto=nomoto, lambda1=lambda1, lambda2=lambda2,
-                   K=(k1, k2), h=(h1 * scale, h2 * scale), N=k1)
+        return cls(nomoto=nomoto, K=(k1, k2), h=(h1 * scale, h2 * scale), N=k1)
 
 
 # The design's linear algebra written out in exactly rounded operations, not by LAPACK,
@@ -105,7 +101,7 @@ class SlidingModeAutopilot:
         ):
             if not (math.isfinite(value) and ok):
                 raise ValueError(f"parameter {name} must be finite and {rule}, got {value}")
-        if equivalent_control not in EQUIVALENT_CONTROLS:
+        if equivalent_control not in ("paper", "tracking"):
             raise ValueError(f"parameter equivalent_control must be 'paper' (eq 39) or "
                              f"'tracking' (-K^T (x - x_z)), got {equivalent_control!r}")
         self.design = design

@@ -113,19 +113,17 @@ def say_note(note: str) -> None:
         print(f"  {BUILD_HINT}", file=sys.stderr)
 
 
-def checked_autopilot(parser: argparse.ArgumentParser, args: argparse.Namespace) -> bool:
-    """Check --autopilot against the port contract before anything runs; False (the reason
-    on standard error) if it fails."""
-    if args.autopilot is None:
-        if args.map or args.name:
-            parser.error("--map and --name describe an --autopilot FMU; give one")
-        return True
+def checked_autopilot(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """Check --autopilot against the port contract before anything runs; if it fails, the
+    reason on standard error and status 2."""
+    if args.autopilot is None and (args.map or args.name):
+        parser.error("--map and --name describe an --autopilot FMU; give one")
     try:
-        check_autopilot(args.autopilot, dict(args.map), trial=True)
+        if args.autopilot is not None:
+            check_autopilot(args.autopilot, dict(args.map), trial=True)
     except AutopilotError as error:
         say_error(error)
-        return False
-    return True
+        raise SystemExit(2) from None
 
 
 def entry(main: Callable[[], int]) -> int:

@@ -1,11 +1,6 @@
-"""What it takes to reproduce a run, written as JSON next to its CSV.
-
-Besides what the master records (``Master.run_meta``: units, parameters as held and as set,
-backends, step, times), each FMU's SHA-256 (and, for one built with fmukit, its sources'
-digest and whether they are this process's: ``current``), the scenario's SHA-256, the
-command, and the versions of this package (with its git commit), Python, numpy, fmpy and
-pythonfmu. Strict JSON: a non-finite number is written as a string.
-"""
+"""What it takes to reproduce a run, as JSON next to its CSV: the master's record, each FMU's
+SHA-256 (and whether an fmukit FMU's sources are this process's), the scenario's, the command,
+the versions and git commit. Strict JSON: a non-finite number is written as a string."""
 from __future__ import annotations
 
 import functools
@@ -62,16 +57,13 @@ def _fmu(fmu: dict[str, Any]) -> dict[str, Any]:
 
 def _commit() -> str | None:
     """The git commit of this checkout, with '+changes' if it has uncommitted ones."""
-    git = ["git", "-C", str(Path(__file__).resolve().parents[1])]
     try:
-        head, dirty = (subprocess.run(git + command, capture_output=True, text=True, timeout=10)
-                       for command in (["rev-parse", "HEAD"],
-                                       ["status", "--porcelain", "--untracked-files=no"]))
+        git = subprocess.run(["git", "-C", str(Path(__file__).resolve().parents[1]), "describe",
+                              "--always", "--abbrev=40", "--dirty=+changes", "--exclude=*"],
+                             capture_output=True, text=True, timeout=10)
     except (OSError, subprocess.SubprocessError):
         return None
-    if head.returncode != 0:
-        return None
-    return head.stdout.strip() + ("+changes" if dirty.stdout.strip() else "")
+    return git.stdout.strip() if git.returncode == 0 else None
 
 
 @functools.lru_cache(maxsize=1)

@@ -10,10 +10,9 @@ Examples:
   python -m cosim.run waves_pd --autopilot my.fmu   your own autopilot in waves_pd's place
   python -m cosim.run --all --fmi 3            the same runs through the FMI 3.0 twins
 
-Each scenario is an SSP system structure file in cosim/scenarios/ (the FMUs, their
-parameters and connections). A run writes every signal at every 0.1 s step to
-SCENARIO.csv and a figure like the paper's Figs 2-3 to SCENARIO.png in the output
-folder, and prints the cost of eq (19) (or the manoeuvre's figures).
+A scenario is an SSP system structure file (cosim/scenarios/*.ssd). A run writes every
+signal at every 0.1 s step to SCENARIO.csv and a figure like the paper's Figs 2-3 to
+SCENARIO.png, and prints the cost of eq (19) (or the manoeuvre's figures).
 """
 from __future__ import annotations
 
@@ -47,7 +46,6 @@ def run_scenario(system: SystemDescription, label: str, out: Path, overrides: di
                  options: Options) -> tuple[int, Cost | None]:
     """Simulate one system, write its outputs as ``label`` and print its report; the status
     0, 1 if an FMU failed, 130 / 143 if Ctrl-C or SIGTERM stopped it (its rows written)."""
-    # from here on, a signal stops the run between steps
     with StopSignals() as stop, closing(Progress(label)) as progress:
         outcome = run_and_write(system, label, out, overrides, options, progress, stop,
                                 notes=say_note)
@@ -131,8 +129,7 @@ def main(argv: list[str] | None = None) -> int:
                              "longer than S s of wall-clock time (default: no limit)")
     args = parser.parse_args(argv)
     names = chosen_scenarios(parser, args.scenario, args.all)
-    if not checked_autopilot(parser, args):
-        return 2
+    checked_autopilot(parser, args)
     try:
         overrides = overrides_of(args.set)
     except ValueError as error:             # a variable set twice
