@@ -22,12 +22,11 @@ from .core.values import fmi_value
 from .scenarios.autopilot import AutopilotError, check_autopilot
 
 
-def chosen_scenarios(parser: argparse.ArgumentParser, scenario: str | None,
-                     paper: bool) -> list[str]:
+def chosen_scenarios(parser: argparse.ArgumentParser, args: argparse.Namespace) -> list[str]:
     """One SCENARIO (a name or a .ssd path) or --all (the paper's four), checked."""
-    if paper == bool(scenario):
+    if args.all == bool(args.scenario):
         parser.error("give one SCENARIO or --all")
-    names = list(scenarios.PAPER) if paper else [scenario]
+    names = list(scenarios.PAPER) if args.all else [args.scenario]
     for name in names:
         try:
             scenarios.path(name)

@@ -27,7 +27,7 @@ def main(argv: list[str] | None = None) -> int:
     add_fmu_options(parser, "the package carries the FMU; with --all, in each of the four "
                             "scenarios")
     args = parser.parse_args(argv)
-    names = chosen_scenarios(parser, args.scenario, args.all)
+    names = chosen_scenarios(parser, args)
     checked_autopilot(parser, args)
     out = args.out or Path("results/ssp") / ("fmi3" if args.fmi == 3 else "")
     writable_folder(out)

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import functools
 import hashlib
-import importlib.util
 import json
 import platform
 import subprocess
@@ -21,6 +20,7 @@ from fmukit.manifest import read, staleness
 from .core.recording import Recording
 
 PACKAGE = "ship-autopilot-cosim"
+ROOT = Path(__file__).resolve().parents[1]          # the checkout, or site-packages
 CODE_PACKAGES = ("cosim", "fmukit", "ship_fmu", "autopilot_fmu")
 NON_FINITE = {"NaN": "nan", "Infinity": "inf", "-Infinity": "-inf"}   # JSON's token: repr
 
@@ -58,8 +58,8 @@ def _fmu(fmu: dict[str, Any]) -> dict[str, Any]:
 def _commit() -> str | None:
     """The git commit of this checkout, with '+changes' if it has uncommitted ones."""
     try:
-        git = subprocess.run(["git", "-C", str(Path(__file__).resolve().parents[1]), "describe",
-                              "--always", "--abbrev=40", "--dirty=+changes", "--exclude=*"],
+        git = subprocess.run(["git", "-C", str(ROOT), "describe", "--always", "--abbrev=40",
+                              "--dirty=+changes", "--exclude=*"],
                              capture_output=True, text=True, timeout=10)
     except (OSError, subprocess.SubprocessError):
         return None
@@ -72,9 +72,8 @@ def code_version() -> str:
     environments with the same string run the same code, from a checkout or a wheel."""
     digest = hashlib.sha256()
     for package in CODE_PACKAGES:
-        root = Path(importlib.util.find_spec(package).submodule_search_locations[0])
-        for path in sorted(root.rglob("*.py")):
-            digest.update(f"{package}/{path.relative_to(root).as_posix()}\n".encode())
+        for path in sorted((ROOT / package).rglob("*.py")):
+            digest.update(f"{path.relative_to(ROOT).as_posix()}\n".encode())
             digest.update(path.read_bytes())
     return f"{_version(PACKAGE)} (code {digest.hexdigest()[:12]})"
 

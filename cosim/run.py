@@ -128,18 +128,17 @@ def main(argv: list[str] | None = None) -> int:
                         help="end the run with an error, keeping its rows, if it takes "
                              "longer than S s of wall-clock time (default: no limit)")
     args = parser.parse_args(argv)
-    names = chosen_scenarios(parser, args.scenario, args.all)
+    names = chosen_scenarios(parser, args)
     checked_autopilot(parser, args)
     try:
         overrides = overrides_of(args.set)
     except ValueError as error:             # a variable set twice
         parser.error(str(error))
-    if args.animate and args.stream:
-        parser.error("--animate needs the run in memory; it cannot be combined with --stream")
     if args.spread is not None and args.spread < 1:
         parser.error(f"--spread takes a number of ulps >= 1, got {args.spread}")
-    if args.spread and args.stream:
-        parser.error("--spread needs each run's report; it cannot be combined with --stream")
+    for option, needs in (("animate", "the run in memory"), ("spread", "each run's report")):
+        if getattr(args, option) and args.stream:
+            parser.error(f"--{option} needs {needs}; it cannot be combined with --stream")
     if args.animate == "mp4" and video_format() != "mp4":
         parser.error("--animate mp4 needs ffmpeg, which is not installed here; use gif")
     options = Options(args.coupling, args.stop_time, args.lam, args.backend,

@@ -64,19 +64,13 @@ def check_finite(run: Recording) -> None:
                     f"{run.t[np.argmax(~np.isfinite(run[bad[0]]))]:.1f} s)"
 
 
-def _settled(run: Recording, within: float) -> np.ndarray:
-    """Rows at least ``within`` s after the last switch of ``guidance.wp_index`` (or start)."""
-    t, leg = run.t, run["guidance.wp_index"]
-    since = np.zeros_like(t)
-    for start in [0, *(np.flatnonzero(np.diff(leg)) + 1)]:
-        since[start:] = t[start:] - t[start]
-    return since >= within
-
-
 def check_rudder_within_stops(run: Recording, within: float = 60.0) -> None:
     """Once a course change has settled (``within`` s), no rudder command beyond the stops."""
     delta_max = run.meta["parameters"]["ship"]["delta_max"]
-    command = np.where(_settled(run, within), np.abs(run["ship.delta_c"]), 0.0)
+    t, since = run.t, np.zeros_like(run.t)      # s since the last switch of wp_index
+    for start in [0, *(np.flatnonzero(np.diff(run["guidance.wp_index"])) + 1)]:
+        since[start:] = t[start:] - t[start]
+    command = np.where(since >= within, np.abs(run["ship.delta_c"]), 0.0)
     k = int(np.argmax(command))
     assert command[k] <= delta_max * (1 + 1e-12), \
         f"commanded rudder {math.degrees(command[k]):.1f} deg at t = {run.t[k]:.1f} s, " \
@@ -101,7 +95,7 @@ def check_heading_settles(run: Recording, bound: float, within: float) -> None:
     error = np.abs(heading_error(run["guidance.psi_d"], run["ship.psi"]))
     starts = [0, *(np.flatnonzero(np.diff(leg)) + 1)]
     for start, end in zip(starts, [*starts[1:], len(t)]):
-        settled = (t[start:end] >= t[start] + within)
+        settled = t[start:end] >= t[start] + within
         if not settled.any():
             continue
         worst = float(error[start:end][settled].max())
