@@ -38,7 +38,7 @@ class VesselParameters:
     wave_components: int = 50
     h_max: float = 0.1          # s, largest RK4 step
 
-    def validate(self) -> None:
+    def __post_init__(self) -> None:
         """Raise ValueError naming the first invalid parameter."""
         for f in fields(self):
             value = getattr(self, f.name)
@@ -66,11 +66,9 @@ class Vessel:
     """CyberShip II in calm water or waves, stepped with inputs held."""
     STATE = ("x", "y", "psi", "u", "v", "r", "delta", "xi", "t")
 
-    def __init__(self, params: VesselParameters = VesselParameters(),
-                 hull: Hull = Hull(), actuators: Actuators = Actuators()):
-        params.validate()
-        self.params, self.hull, self.actuators = params, hull, actuators
-        M = mass_matrix(hull).tolist()
+    def __init__(self, params: VesselParameters = VesselParameters()):
+        self.params, self.hull, self.actuators = params, Hull(), Actuators()
+        M = mass_matrix(self.hull).tolist()
         det = M[1][1] * M[2][2] - M[1][2] * M[2][1]
         self._m11_inv = 1.0 / M[0][0]
         self._minv = (M[2][2] / det, -M[1][2] / det, -M[2][1] / det, M[1][1] / det)
@@ -78,7 +76,7 @@ class Vessel:
         if params.Hs > 0.0:
             components = WaveComponents.from_spectrum(
                 params.Hs, params.T0, params.wave_components, params.wave_seed)
-            self.waves = self._wave_loads = WaveLoads(components, hull, params.psi_w)
+            self.waves = self._wave_loads = WaveLoads(components, self.hull, params.psi_w)
         self._h, self._cut = None, (1, 0.0)          # the last step size and its cut
         self._shaft_speeds, self._forces = None, None  # the last shaft speeds, their tau_th
         self.x, self.y, self.psi = params.x0, params.y0, params.psi0

@@ -65,9 +65,8 @@ class WaveLoads:
     X_w, Y_w = rho g B L T (cos, sin)(beta) sum s_i, N_w = rho g B L (L^2 - B^2) / 24
     sin(2 beta) sum s_i^2; summed in order (no matrix product), into arrays made once."""
 
-    def __init__(self, components: WaveComponents, hull: Hull, psi_w: float,
-                 rho: float = RHO_WATER):
-        h, n = hull, len(components.omega)
+    def __init__(self, components: WaveComponents, h: Hull, psi_w: float):
+        n, rho = len(components.omega), RHO_WATER
         self.components = components
         self.psi_w = psi_w
         self._c_force = rho * G * h.B * h.L * h.T
