@@ -1,5 +1,5 @@
-"""What the commands share: scenario and autopilot options, output folders, messages, the
-progress bar. Only the commands import this."""
+"""What the commands share: scenario and autopilot options, output folders, messages. Only
+the commands import this."""
 from __future__ import annotations
 
 import argparse
@@ -148,17 +148,3 @@ def writable_folder(path: Path) -> Path:
               file=sys.stderr)
         raise SystemExit(2) from None
     return path
-
-
-class Progress:
-    """A progress bar on standard error, for runs longer than a second, on a terminal only."""
-
-    def __init__(self, label: str):
-        from tqdm import tqdm
-        self.bar = tqdm(desc=label, unit="step", delay=1.0, leave=False, file=sys.stderr,
-                        disable=None)                   # None: only on a terminal
-        self.close = self.bar.close
-
-    def __call__(self, k: int, n: int) -> None:
-        self.bar.total = n
-        self.bar.update(k - self.bar.n)

@@ -18,13 +18,13 @@ from __future__ import annotations
 
 import argparse
 import sys
-from contextlib import closing
 from pathlib import Path
 
+from tqdm import tqdm
+
 from . import scenarios
-from ._cli import (Progress, add_fmu_options, checked_autopilot, chosen_scenarios, entry,
-                   number_option, positive_seconds, say_error, say_note, setting_option,
-                   writable_folder)
+from ._cli import (add_fmu_options, checked_autopilot, chosen_scenarios, entry, number_option,
+                   positive_seconds, say_error, say_note, setting_option, writable_folder)
 from .analysis.animation import video_format
 from .analysis.cost import LAMBDA, Cost
 from .analysis.describe import conditions, headline
@@ -46,7 +46,12 @@ def run_scenario(system: SystemDescription, label: str, out: Path, overrides: di
                  options: Options) -> tuple[int, Cost | None]:
     """Simulate one system, write its outputs as ``label`` and print its report; the status
     0, 1 if an FMU failed, 130 / 143 if Ctrl-C or SIGTERM stopped it (its rows written)."""
-    with StopSignals() as stop, closing(Progress(label)) as progress:
+    # a bar on standard error for runs longer than a second, on a terminal only
+    with StopSignals() as stop, tqdm(desc=label, unit="step", delay=1.0, leave=False,
+                                     file=sys.stderr, disable=None) as bar:
+        def progress(k: int, n: int) -> None:
+            bar.total = n
+            bar.update(k - bar.n)
         outcome = run_and_write(system, label, out, overrides, options, progress, stop,
                                 notes=say_note)
     recording, csv_path = outcome.recording, outcome.csv
@@ -119,8 +124,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--stream", action="store_true",
                         help="write rows to the CSV in chunks as the run goes: flat memory "
                              "for long runs; no report or figure")
-    parser.add_argument("--step-timeout", type=positive_seconds, default=STEP_LIMIT_S,
-                        metavar="S",
+    parser.add_argument("--step-timeout", type=positive_seconds, default=STEP_LIMIT_S, metavar="S",
                         help="end the run with an error if one step of the FMUs (or their "
                              f"instantiation) takes longer than S s of wall-clock time "
                              f"(default {STEP_LIMIT_S:g})")
