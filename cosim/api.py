@@ -110,7 +110,8 @@ def simulate_many(scenario: str | Path, sets: Sequence[Mapping[str, Any]],
 def _one_at_a_time(system: SystemDescription, overrides: list[dict[str, dict[str, Any]]],
                    stop_time: float | None, backend: str, signals: Sequence[str] | None
                    ) -> list[Recording]:
-    """Each member's run on one master, reset between runs, made anew after a failed one."""
+    """Each member's run on one master, reset between runs (made anew after a failed one);
+    every member's settings checked before the first runs."""
     master = Master(system, backend=backend)
     recordings = []
     try:

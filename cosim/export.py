@@ -1,7 +1,7 @@
 """Export a scenario as a self-contained SSP package for other FMI tools.
 
-The package and, beside it, the folder for OSP: ``cosim.interop.ssp`` and docs/interop.md;
-what another tool would not apply (a String value, FMI 3.0 FMUs) is said."""
+Beside the package, a folder for OSP (``cosim.interop.ssp``, docs/interop.md); what another
+tool would not apply (a String value, FMI 3.0 FMUs) is said."""
 from __future__ import annotations
 
 import argparse
