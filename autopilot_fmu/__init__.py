@@ -1,2 +1,1 @@
-"""The paper's autopilots and guidance (eqs 18-46) and the FMU classes wrapping them
-(``*_slave``); the PID in one file, as your own would be (``pid_autopilot_slave``)."""
+"""The paper's autopilots and guidance (eqs 18-46), their FMUs, and the PID in one file."""

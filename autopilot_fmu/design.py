@@ -1,8 +1,6 @@
-"""Linear design models of the sliding-mode autopilot, eqs (22)-(32), (45)-(46), of the
-sway-yaw model M nu_dot + N(u0) nu = b delta, nu = [v, r]: ``PAPER_EQ45`` as printed (its
-n_22 and b_1 do not follow from the hull data: ../shared/cybership2.md, erratum 4), or
-``linearised_ship(u0)``, the numerical Jacobian of our ship model at nu = [u0, 0, 0].
-"""
+"""Linear design models of the sliding-mode autopilot, eqs (22)-(32), (45)-(46): eq (45) as
+printed (its n_22 and b_1 do not follow from the hull data: ../shared/cybership2.md, erratum
+4), or the Jacobian of our ship model at nu = [u0, 0, 0]."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -42,8 +40,7 @@ def linearised_ship(u0: float, n: float = N_PROPELLER, hull: Hull = Hull(),
                     actuators: Actuators = Actuators()) -> SwayYawModel:
     """Sway-yaw model of the ship linearised at surge speed u0, eqs (23)-(25)."""
     def hydrodynamic(v: float, r: float) -> np.ndarray:
-        forces = np.add(coriolis_forces(hull, u0, v, r), damping_forces(hull, u0, v, r))
-        return forces[1:]
+        return np.add(coriolis_forces(hull, u0, v, r), damping_forces(hull, u0, v, r))[1:]
     N = np.column_stack([_derivative(lambda v: hydrodynamic(v, 0.0), 0.0),
                          _derivative(lambda r: hydrodynamic(0.0, r), 0.0)])
     forces = actuator_model(actuators, n, n, 0.0)
@@ -70,18 +67,13 @@ class NomotoModel:
         return cls(K_R=float(K_R), T3=float(T3), T=float(T1_plus_T2 - T3))
 
     @property
-    def K(self) -> float:
-        """Eq (31): K = -K_R."""
-        return -self.K_R
-
-    @property
     def a22(self) -> float:
         """-1/T (the paper writes a_11 after eq (34); it is a_22)."""
         return -1.0 / self.T
 
     @property
     def b2(self) -> float:
-        return self.K / self.T
+        return -self.K_R / self.T          # K / T, K = -K_R (31)
 
 
 def design_model(name: str, u0: float) -> SwayYawModel:

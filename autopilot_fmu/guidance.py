@@ -1,8 +1,6 @@
 """Waypoint guidance, eq (18): psi_d = atan2(y_{k+1} - y_k, x_{k+1} - x_k), x north. The
 next leg starts inside the circle of acceptance *or* once past the waypoint along the track
-(a circle-only rule strands a ship turning wide); past the last, the last course holds. The
-route: the String ``waypoints`` 'x0,y0;x1,y1;...' or, for hosts without String parameters
-(OMSimulator), ``n_waypoints``, ``wp<i>_x``, ``wp<i>_y`` (``route``; docs/interop.md)."""
+(a circle-only rule strands a ship turning wide); past the last, the last course holds."""
 from __future__ import annotations
 
 import math
@@ -15,13 +13,7 @@ from ship_fmu.data import Hull
 PAPER_ROUTE = "0,0;30,0;60,25;90,25"    # m; the paper gives none (docs/reproduction.md)
 R_ACCEPT = 2.0 * Hull.L                  # m, radius of the circle of acceptance
 MAX_WAYPOINTS = 16                       # points of the numeric route: wp0_x ... wp15_y
-
-
-def coordinate_names(i: int) -> tuple[str, str]:
-    return f"wp{i}_x", f"wp{i}_y"
-
-
-COORDINATES = tuple(name for i in range(MAX_WAYPOINTS) for name in coordinate_names(i))
+COORDINATES = tuple(f"wp{i}_{axis}" for i in range(MAX_WAYPOINTS) for axis in "xy")
 ROUTE_PARAMETERS = ("waypoints", "n_waypoints", *COORDINATES)   # what ``route`` reads
 
 
@@ -40,14 +32,12 @@ def parse_waypoints(text: str) -> list[tuple[float, float]]:
     """'x0,y0;x1,y1;...' (m) -> [(x0, y0), ...]; ValueError naming 'waypoints'."""
     points = []
     for i, item in enumerate(part for part in text.split(";") if part.strip()):
-        fields = item.split(",")
         try:
-            if len(fields) != 2:
-                raise ValueError
-            points.append((float(fields[0]), float(fields[1])))
+            x, y = map(float, item.split(","))
         except ValueError:
             raise ValueError(f"parameter waypoints: point {i} is {item.strip()!r}, "
                              "expected 'x,y' with two numbers in m") from None
+        points.append((x, y))
     if len(points) < 2:
         raise ValueError(f"parameter waypoints needs at least two points 'x0,y0;x1,y1', "
                          f"got {text!r}")
@@ -61,8 +51,7 @@ def numeric_route(text: str) -> dict[str, int | float]:
         raise ValueError(f"the route {text!r} has {len(points)} points; its numeric form "
                          f"holds at most {MAX_WAYPOINTS}")
     values: dict[str, int | float] = {"n_waypoints": len(points)}
-    for i, point in enumerate(points):
-        values.update(zip(coordinate_names(i), point))
+    values.update(zip(COORDINATES, [c for point in points for c in point]))
     return values
 
 

@@ -1,7 +1,7 @@
 """Waypoint guidance as an FMI 2.0 co-simulation FMU (fmus/guidance.fmu), eq (18): psi_d and
 wp_index direct feedthrough from the position, the leg switch committed at each step's end."""
-from autopilot_fmu.guidance import (MAX_WAYPOINTS, PAPER_ROUTE, R_ACCEPT, ROUTE_PARAMETERS,
-                                    WaypointGuidance, coordinate_names, route)
+from autopilot_fmu.guidance import (COORDINATES, MAX_WAYPOINTS, PAPER_ROUTE, R_ACCEPT,
+                                    ROUTE_PARAMETERS, WaypointGuidance, route)
 from fmukit.slave import ModelSlave, Var
 
 _ROUTE = ROUTE_PARAMETERS + ("R_accept",)
@@ -29,9 +29,9 @@ class GuidanceSlave(ModelSlave):
             "points of the numeric route wp0 .. wp<n-1>, 2 or more; 0: the route is the "
             "String waypoints (for hosts without String parameters)"), min=0,
             max=MAX_WAYPOINTS),
-        *(Var.parameter(name, 0.0, "m", f"waypoint {i} of the numeric route, "
-                        f"{'north' if axis == 0 else 'east'}; 0 where unused")
-          for i in range(MAX_WAYPOINTS) for axis, name in enumerate(coordinate_names(i))),
+        *(Var.parameter(name, 0.0, "m", f"waypoint {k // 2} of the numeric route, "
+                        f"{('north', 'east')[k % 2]}; 0 where unused")
+          for k, name in enumerate(COORDINATES)),
     )
 
     def build_model(self) -> WaypointGuidance:

@@ -2,13 +2,9 @@
 
     delta_c = Kp e + Ki z + Kd r,   e = psi - psi_d wrapped to (-pi, pi],   dz/dt = e
 
-eq (20) with integral action, which removes the PD's steady heading offset in
-oblique waves. z advances at each step with the error at its start (sampled at
-the communication step, as a digital autopilot is), and only while |e| < e_int
-and the command is inside the rudder stops +-delta_max or the error winds it back
-(conditional integration): it never winds up in a course change or at a stop.
-Written as your own autopilot would be: one file, nothing but fmukit
-(docs/own_autopilot.md walks through it).
+z advances with the error at each step's start, only while |e| < e_int and the command is
+inside the stops or the error winds it back: it never winds up. One file importing nothing
+but fmukit, as your own autopilot would be (docs/own_autopilot.md walks through it).
 """
 import math
 from dataclasses import dataclass

@@ -1,20 +1,17 @@
-"""Sliding-mode autopilot, eqs (35)-(44), designed from the Nomoto model (33) by pole placement
-(38), h the eigenvector of A_c^T of the smaller eigenvalue, N from (40)-(41). delta_c = u_eq +
-u_sw (43), u_eq = N psi_z - K^T x (39, read to stabilise: as printed it feeds the heading back
-with the wrong sign; 'tracking': -K^T (x - x_z), docs/reproduction.md), u_sw = h^T [r_z,
-r_z_dot] - eta_h tanh(sigma_h / phi_h) (42), sigma_h = h_1 (psi_z - psi) + h_2 (r_z - r) (37)."""
+"""Sliding-mode autopilot, eqs (35)-(44), designed on the Nomoto model (33) by pole placement
+(38), h the eigenvector of A_c^T of the smaller eigenvalue, N from (40)-(41). Eq (39) is read
+to stabilise: as printed it feeds the heading back with the wrong sign (docs/fmus.md)."""
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
 from typing import Callable
 
-from fmukit.numerics import require_finite, substeps, wrap
+from fmukit.numerics import substeps, wrap
 
 from .design import NomotoModel, SwayYawModel
 
 H_MAX = 0.1                     # s, the largest RK4 step of the reference model
-EQUIVALENT_CONTROLS = ("paper", "tracking")
 
 
 def reference_step_bound(omega_n: float, zeta: float) -> float:
@@ -47,8 +44,6 @@ def reference_rk4(psi_d: float, psi_z: float, r_z: float, hs: float, omega_n: fl
 class SlidingModeDesign:
     """Gains of the sliding-mode autopilot for a Nomoto model, eqs (38)-(41)."""
     nomoto: NomotoModel
-    lambda1: float
-    lambda2: float
     K: tuple[float, float]
     h: tuple[float, float]
     N: float
@@ -72,8 +67,7 @@ class SlidingModeDesign:
         scale = math.copysign(1.0, h1) / math.hypot(h1, h2)
         # Eqs (40)-(41): [N_x; N_u] = [[A, B], [C, D]]^-1 [0; 1] = [1, 0; 0] with C = [1, 0]
         # and D = 0, so N = N_u + K^T N_x = k1.
-        return cls(nomoto=nomoto, lambda1=lambda1, lambda2=lambda2,
-                   K=(k1, k2), h=(h1 * scale, h2 * scale), N=k1)
+        return cls(nomoto=nomoto, K=(k1, k2), h=(h1 * scale, h2 * scale), N=k1)
 
 
 # The design's linear algebra written out in exactly rounded operations, not by LAPACK,
@@ -107,10 +101,9 @@ class SlidingModeAutopilot:
         ):
             if not (math.isfinite(value) and ok):
                 raise ValueError(f"parameter {name} must be finite and {rule}, got {value}")
-        if equivalent_control not in EQUIVALENT_CONTROLS:
+        if equivalent_control not in ("paper", "tracking"):
             raise ValueError(f"parameter equivalent_control must be 'paper' (eq 39) or "
                              f"'tracking' (-K^T (x - x_z)), got {equivalent_control!r}")
-        require_finite(psi_z=psi_z, r_z=r_z)
         self.design = design
         self.tracking = equivalent_control == "tracking"
         self.eta_h, self.phi_h, self.omega_n, self.zeta = eta_h, phi_h, omega_n, zeta
@@ -127,7 +120,8 @@ class SlidingModeAutopilot:
         return h1 * wrap(self.psi_z - psi) + h2 * (self.r_z - r)
 
     def command(self, psi: float, r: float, psi_d: float) -> float:
-        """delta_c = u_eq + u_sw, eq (43), rad."""
+        """delta_c = u_eq + u_sw, eq (43), rad: u_eq (39), or -K^T (x - x_z) if 'tracking';
+        u_sw = h^T [r_z, r_z_dot] - eta_h tanh(sigma_h / phi_h) (42)."""
         (k1, k2), (h1, h2) = self.design.K, self.design.h
         u_eq = k1 * wrap(self.psi_z - psi) + k2 * ((self.r_z if self.tracking else 0.0) - r)
         u_sw = (h1 * self.r_z + h2 * self.r_z_dot(psi_d, self.psi_z, self.r_z)
@@ -135,7 +129,6 @@ class SlidingModeAutopilot:
         return u_eq + u_sw
 
     def step(self, t: float, h: float, psi_d: float) -> None:
-        require_finite(psi_d=psi_d)
         n = substeps(h, self._h_max, "of the reference model")
         hs = h / n
         psi_z, r_z = self.psi_z, self.r_z

@@ -1,5 +1,5 @@
-"""What the commands share: scenario and autopilot options, output folders, messages, the
-progress bar. Only the commands import this."""
+"""What the commands share: scenario and autopilot options, output folders, messages. Only
+the commands import this."""
 from __future__ import annotations
 
 import argparse
@@ -22,12 +22,11 @@ from .core.values import fmi_value
 from .scenarios.autopilot import AutopilotError, check_autopilot
 
 
-def chosen_scenarios(parser: argparse.ArgumentParser, scenario: str | None,
-                     paper: bool) -> list[str]:
+def chosen_scenarios(parser: argparse.ArgumentParser, args: argparse.Namespace) -> list[str]:
     """One SCENARIO (a name or a .ssd path) or --all (the paper's four), checked."""
-    if paper == bool(scenario):
+    if args.all == bool(args.scenario):
         parser.error("give one SCENARIO or --all")
-    names = list(scenarios.PAPER) if paper else [scenario]
+    names = list(scenarios.PAPER) if args.all else [args.scenario]
     for name in names:
         try:
             scenarios.path(name)
@@ -113,19 +112,17 @@ def say_note(note: str) -> None:
         print(f"  {BUILD_HINT}", file=sys.stderr)
 
 
-def checked_autopilot(parser: argparse.ArgumentParser, args: argparse.Namespace) -> bool:
-    """Check --autopilot against the port contract before anything runs; False (the reason
-    on standard error) if it fails."""
-    if args.autopilot is None:
-        if args.map or args.name:
-            parser.error("--map and --name describe an --autopilot FMU; give one")
-        return True
+def checked_autopilot(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """Check --autopilot against the port contract before anything runs; if it fails, the
+    reason on standard error and status 2."""
+    if args.autopilot is None and (args.map or args.name):
+        parser.error("--map and --name describe an --autopilot FMU; give one")
     try:
-        check_autopilot(args.autopilot, dict(args.map), trial=True)
+        if args.autopilot is not None:
+            check_autopilot(args.autopilot, dict(args.map), trial=True)
     except AutopilotError as error:
         say_error(error)
-        return False
-    return True
+        raise SystemExit(2) from None
 
 
 def entry(main: Callable[[], int]) -> int:
@@ -151,17 +148,3 @@ def writable_folder(path: Path) -> Path:
               file=sys.stderr)
         raise SystemExit(2) from None
     return path
-
-
-class Progress:
-    """A progress bar on standard error, for runs longer than a second, on a terminal only."""
-
-    def __init__(self, label: str):
-        from tqdm import tqdm
-        self.bar = tqdm(desc=label, unit="step", delay=1.0, leave=False, file=sys.stderr,
-                        disable=None)                   # None: only on a terminal
-        self.close = self.bar.close
-
-    def __call__(self, k: int, n: int) -> None:
-        self.bar.total = n
-        self.bar.update(k - self.bar.n)

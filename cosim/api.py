@@ -1,14 +1,5 @@
-"""The Python entry point: one call runs a scenario, with your autopilot if you have one.
-
-    from cosim import simulate
-    run = simulate("waves_pd", autopilot="my.fmu", set={"ship.Hs": 0.01}, stop_time=200)
-    run["ship.psi"], run.t, run.units["ship.psi"]        # heading (rad) at every 0.1 s
-
-Many runs of one scenario, stepped together as arrays where the batch kernel covers it:
-
-    from cosim import simulate_many
-    runs = simulate_many("waves_pd", [{"ship.wave_seed": s} for s in range(100)])
-"""
+"""The Python entry point: ``simulate`` runs a scenario, with your autopilot if you have one,
+``simulate_many`` many runs of one (docs/running.md, "From Python")."""
 from __future__ import annotations
 
 import warnings
@@ -30,8 +21,8 @@ class SimulationError(RuntimeError):
 
 
 def parse_setting(text: str) -> tuple[str, str]:
-    """'component.variable=value' -> ('component.variable', 'value'); the value stays text,
-    for the master to read as the variable's type. ValueError naming the text."""
+    """'component.variable=value' -> ('component.variable', 'value'), the value as text (the
+    master reads it as the variable's type)."""
     target, sep, raw = text.partition("=")
     try:
         split_name(target if sep else "")
@@ -70,14 +61,10 @@ def simulate(scenario: str | Path, autopilot: str | Path | None = None,
              set: dict[str, Any] | None = None, stop_time: float | None = None,
              coupling: str = "gauss-seidel", backend: str = "fmi",
              port_map: dict[str, str] | None = None, fmi: int | None = None) -> Recording:
-    """Run a scenario (a name or a .ssd path) and return its recording.
-
-    ``autopilot``: an FMU in place of the scenario's, its ports renamed by ``port_map``;
-    ``set``: parameter values by ``"component.variable"`` (SI units, radians). ``fmi=3``
-    runs this project's FMI 3.0 twins, ``backend="inprocess"`` its FMUs as Python classes
-    (a foreign FMU through FMI, with a warning): the same results bit for bit.
-    ValueError or FileNotFoundError for bad input; SimulationError if an FMU fails.
-    """
+    """The recording of a scenario (a name or a .ssd path): ``autopilot`` an FMU in its
+    autopilot's place, ``set`` values by "component.variable" (SI units), the rest as
+    ``cosim.run``'s options; its notes are warnings. ValueError or FileNotFoundError for bad
+    input; SimulationError if an FMU fails."""
     with Master(scenarios.load(scenario, autopilot, port_map, fmi=fmi), coupling=coupling,
                 backend=backend, overrides=overrides_of(set or {})) as master:
         for note in master.notes:
@@ -93,15 +80,10 @@ def simulate_many(scenario: str | Path, sets: Sequence[Mapping[str, Any]],
                   backend: str = "batch", port_map: dict[str, str] | None = None,
                   fmi: int | None = None, signals: Sequence[str] | None = None
                   ) -> list[Recording]:
-    """Run a scenario once for each of ``sets`` (each a ``simulate`` ``set``); the recordings
-    in order, the other arguments as ``simulate``'s.
-
-    ``backend="batch"`` steps the runs of a PD, PID or SMC course-keeping scenario together
-    as arrays, bit for bit the in-process route's, holding the columns ``signals`` (default
-    ``cosim.ensemble.reference.SIGNALS``); what the kernel does not cover runs in-process,
-    saying so in ``meta["notes"]``. A failed run raises nothing: its ``error`` says why.
-    ValueError naming ``member i`` for a setting refused before anything runs.
-    """
+    """The recordings of a scenario run once for each of ``sets`` (each ``simulate``'s
+    ``set``), in order; ``backend="batch"`` steps them together as arrays, holding
+    ``signals`` (docs/running.md). A failed run raises nothing: its ``error`` says why;
+    ValueError naming ``member i`` for a setting refused before anything runs."""
     if backend not in (*RUN_BACKENDS, "batch"):
         raise ValueError(f"backend must be fmi, inprocess or batch, got {backend!r}")
     overrides = []

@@ -1,10 +1,5 @@
-"""The command line of ``cosim.interop.engines``: run an SSP package in another engine.
-
-    python -m cosim.engines libcosim results/ssp/calm_pd.ssp --out trace.npz
-
-Runs the engine in a child process (one that aborts does not take this command with it)
-and saves the signals; a failure is status 1 with the engine's and the FMU's messages.
-"""
+"""The command line of ``cosim.interop.engines``: run an SSP package in another engine, in a
+child process, and save the signals; a failure is status 1 with the engine's messages."""
 from __future__ import annotations
 
 import argparse

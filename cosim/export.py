@@ -1,14 +1,7 @@
 """Export a scenario as a self-contained SSP package for other FMI tools.
 
-    python -m cosim.export calm_pd                 -> results/ssp/calm_pd.ssp
-    python -m cosim.export --all --out DIR         -> the paper's four scenarios
-    python -m cosim.export waves_pd --autopilot my.fmu   -> results/ssp/waves_pd-my.ssp
-    python -m cosim.export calm_pd --fmi 3         -> results/ssp/fmi3/calm_pd.ssp
-
-The package (``cosim.interop.ssp``, docs/interop.md) holds SystemStructure.ssd and every
-FMU; beside it, DIR/<label>/ holds OSP's OspSystemStructure.xml and the FMUs. What another
-tool would not apply (a String value; FMI 3.0 FMUs for FMI 2.0 tools) is said.
-"""
+Beside the package, a folder for OSP (``cosim.interop.ssp``, docs/interop.md); what another
+tool would not apply (a String value, FMI 3.0 FMUs) is said."""
 from __future__ import annotations
 
 import argparse
@@ -34,9 +27,8 @@ def main(argv: list[str] | None = None) -> int:
     add_fmu_options(parser, "the package carries the FMU; with --all, in each of the four "
                             "scenarios")
     args = parser.parse_args(argv)
-    names = chosen_scenarios(parser, args.scenario, args.all)
-    if not checked_autopilot(parser, args):
-        return 2
+    names = chosen_scenarios(parser, args)
+    checked_autopilot(parser, args)
     out = args.out or Path("results/ssp") / ("fmi3" if args.fmi == 3 else "")
     writable_folder(out)
     for name in names:

@@ -1,12 +1,6 @@
-"""A run and what it writes: the one lifecycle behind ``cosim.run`` and any library caller.
-
-``run_and_write`` runs a system with the master and writes, as ``label`` in a folder, the
-CSV (streamed with ``stream``), the metadata JSON and, for a finished run, its figure and
-animation. The new outputs are staged in a hidden folder and put in place together; only
-then are the previous run's files of that label removed, so a refused run, a full disk or
-a second Ctrl-C leaves the folder as it was. One process writes into a folder at a time.
-It prints nothing: the ``Outcome`` says what happened.
-"""
+"""A run and what it writes, the one lifecycle behind ``cosim.run`` and any library caller:
+the outputs are staged and put in place together (a refused run, a full disk or a second
+Ctrl-C leaves the folder as it was), by one process a folder at a time; nothing printed."""
 from __future__ import annotations
 
 import signal
@@ -32,7 +26,6 @@ SUFFIXES = (".csv", ".json", ".png", ".svg", ".pdf", ".gif", ".mp4")   # a run's
 @dataclass(frozen=True)
 class Options:
     """How to run and what to write."""
-
     coupling: str = "gauss-seidel"
     stop_time: float | None = None
     lam: float = LAMBDA
@@ -51,7 +44,6 @@ class TimedOut(RuntimeError):
 @dataclass
 class Outcome:
     """What a run did and wrote."""
-
     recording: Recording
     csv: Path
     written: list[Path] = field(default_factory=list)
@@ -67,18 +59,15 @@ def run_and_write(system: SystemDescription, label: str, out: Path,
                   progress: Callable[[int, int], None] | None = None,
                   stop: StopSignals | None = None,
                   notes: Callable[[str], None] = lambda note: None) -> Outcome:
-    """Run ``system`` and write its outputs as ``label`` in ``out``.
-
-    ``notes`` hears how it runs (a component through FMI, say) once the FMUs are up;
-    ``stop`` ends the run between two steps once it has a signal. ValueError,
-    FileNotFoundError, FmuCallError, TimedOut, FolderBusy or OutputError leave ``out`` as
-    it was.
-    """
+    """Run ``system`` and write its CSV, JSON and, once finished, figure and animation as
+    ``label`` in ``out``. ``notes`` hears how it runs once the FMUs are up; ``stop`` ends it
+    between steps on a signal. ValueError, FileNotFoundError, FmuCallError, TimedOut,
+    FolderBusy or OutputError leave ``out`` as it was."""
     kind = analysis(system.report)
     with FolderLock(out):
         Outputs.remove_abandoned(out, label)          # a killed run's, if any
         with Outputs(out, [out / f"{label}{suffix}" for suffix in SUFFIXES], label) as outputs:
-            forget = stop.keep(lambda: _discard(outputs, label)) if stop is not None else None
+            forget = stop.keep(lambda: _discard(outputs, label)) if stop else lambda: None
             master: Master | None = None
             finished: list[Recording] = []    # the run, once it has returned
 
@@ -128,8 +117,7 @@ def run_and_write(system: SystemDescription, label: str, out: Path,
                     _analyse(outcome, system, kind, label, outputs, options, parameters)
                 outcome.written = [outputs.final(path) for path in outcome.written]
             finally:
-                if forget is not None:
-                    forget()
+                forget()
     if options.stream:
         recording.path = outcome.csv
     if stop is not None and stop.received and not recording.interrupted:

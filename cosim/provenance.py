@@ -1,16 +1,10 @@
-"""What it takes to reproduce a run, written as JSON next to its CSV.
-
-Besides what the master records (``master.run_meta``: units, parameters as held and as set,
-backends, step, times), each FMU's SHA-256 (and, for one built with fmukit, its sources'
-digest and whether they are this process's: ``current``), the scenario's SHA-256, the
-command, and the versions of this package (with its git commit), Python, numpy, fmpy and
-pythonfmu. Strict JSON: a non-finite number is written as a string.
-"""
+"""What it takes to reproduce a run, as JSON next to its CSV: the master's record (``run_meta``), each FMU's
+SHA-256 (and whether an fmukit FMU's sources are this process's), the scenario's, the command,
+the versions and git commit. Strict JSON: a non-finite number is written as a string."""
 from __future__ import annotations
 
 import functools
 import hashlib
-import importlib.util
 import json
 import platform
 import subprocess
@@ -26,6 +20,7 @@ from fmukit.manifest import read, staleness
 from .core.recording import Recording
 
 PACKAGE = "ship-autopilot-cosim"
+ROOT = Path(__file__).resolve().parents[1]          # the checkout, or site-packages
 CODE_PACKAGES = ("cosim", "fmukit", "ship_fmu", "autopilot_fmu")
 NON_FINITE = {"NaN": "nan", "Infinity": "inf", "-Infinity": "-inf"}   # JSON's token: repr
 
@@ -62,16 +57,13 @@ def _fmu(fmu: dict[str, Any]) -> dict[str, Any]:
 
 def _commit() -> str | None:
     """The git commit of this checkout, with '+changes' if it has uncommitted ones."""
-    git = ["git", "-C", str(Path(__file__).resolve().parents[1])]
     try:
-        head, dirty = (subprocess.run(git + command, capture_output=True, text=True, timeout=10)
-                       for command in (["rev-parse", "HEAD"],
-                                       ["status", "--porcelain", "--untracked-files=no"]))
+        git = subprocess.run(["git", "-C", str(ROOT), "describe", "--always", "--abbrev=40",
+                              "--dirty=+changes", "--exclude=*"],
+                             capture_output=True, text=True, timeout=10)
     except (OSError, subprocess.SubprocessError):
         return None
-    if head.returncode != 0:
-        return None
-    return head.stdout.strip() + ("+changes" if dirty.stdout.strip() else "")
+    return git.stdout.strip() if git.returncode == 0 else None
 
 
 @functools.lru_cache(maxsize=1)
@@ -80,9 +72,8 @@ def code_version() -> str:
     environments with the same string run the same code, from a checkout or a wheel."""
     digest = hashlib.sha256()
     for package in CODE_PACKAGES:
-        root = Path(importlib.util.find_spec(package).submodule_search_locations[0])
-        for path in sorted(root.rglob("*.py")):
-            digest.update(f"{package}/{path.relative_to(root).as_posix()}\n".encode())
+        for path in sorted((ROOT / package).rglob("*.py")):
+            digest.update(f"{path.relative_to(ROOT).as_posix()}\n".encode())
             digest.update(path.read_bytes())
     return f"{_version(PACKAGE)} (code {digest.hexdigest()[:12]})"
 

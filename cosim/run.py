@@ -10,22 +10,21 @@ Examples:
   python -m cosim.run waves_pd --autopilot my.fmu   your own autopilot in waves_pd's place
   python -m cosim.run --all --fmi 3            the same runs through the FMI 3.0 twins
 
-Each scenario is an SSP system structure file in cosim/scenarios/ (the FMUs, their
-parameters and connections). A run writes every signal at every 0.1 s step to
-SCENARIO.csv and a figure like the paper's Figs 2-3 to SCENARIO.png in the output
-folder, and prints the cost of eq (19) (or the manoeuvre's figures).
+A scenario is an SSP system structure file (cosim/scenarios/*.ssd). A run writes every
+signal at every 0.1 s step to SCENARIO.csv and a figure like the paper's Figs 2-3 to
+SCENARIO.png, and prints the cost of eq (19) (or the manoeuvre's figures).
 """
 from __future__ import annotations
 
 import argparse
 import sys
-from contextlib import closing
 from pathlib import Path
 
+from tqdm import tqdm
+
 from . import scenarios
-from ._cli import (Progress, add_fmu_options, checked_autopilot, chosen_scenarios, entry,
-                   number_option, positive_seconds, say_error, say_note, setting_option,
-                   writable_folder)
+from ._cli import (add_fmu_options, checked_autopilot, chosen_scenarios, entry, number_option,
+                   positive_seconds, say_error, say_note, setting_option, writable_folder)
 from .analysis.animation import video_format
 from .analysis.cost import LAMBDA, Cost
 from .analysis.describe import conditions, headline
@@ -47,8 +46,12 @@ def run_scenario(system: SystemDescription, label: str, out: Path, overrides: di
                  options: Options) -> tuple[int, Cost | None]:
     """Simulate one system, write its outputs as ``label`` and print its report; the status
     0, 1 if an FMU failed, 130 / 143 if Ctrl-C or SIGTERM stopped it (its rows written)."""
-    # from here on, a signal stops the run between steps
-    with StopSignals() as stop, closing(Progress(label)) as progress:
+    # a bar on standard error for runs longer than a second, on a terminal only
+    with StopSignals() as stop, tqdm(desc=label, unit="step", delay=1.0, leave=False,
+                                     file=sys.stderr, disable=None) as bar:
+        def progress(k: int, n: int) -> None:
+            bar.total = n
+            bar.update(k - bar.n)
         outcome = run_and_write(system, label, out, overrides, options, progress, stop,
                                 notes=say_note)
     recording, csv_path = outcome.recording, outcome.csv
@@ -121,8 +124,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--stream", action="store_true",
                         help="write rows to the CSV in chunks as the run goes: flat memory "
                              "for long runs; no report or figure")
-    parser.add_argument("--step-timeout", type=positive_seconds, default=STEP_LIMIT_S,
-                        metavar="S",
+    parser.add_argument("--step-timeout", type=positive_seconds, default=STEP_LIMIT_S, metavar="S",
                         help="end the run with an error if one step of the FMUs (or their "
                              f"instantiation) takes longer than S s of wall-clock time "
                              f"(default {STEP_LIMIT_S:g})")
@@ -130,19 +132,17 @@ def main(argv: list[str] | None = None) -> int:
                         help="end the run with an error, keeping its rows, if it takes "
                              "longer than S s of wall-clock time (default: no limit)")
     args = parser.parse_args(argv)
-    names = chosen_scenarios(parser, args.scenario, args.all)
-    if not checked_autopilot(parser, args):
-        return 2
+    names = chosen_scenarios(parser, args)
+    checked_autopilot(parser, args)
     try:
         overrides = overrides_of(args.set)
     except ValueError as error:             # a variable set twice
         parser.error(str(error))
-    if args.animate and args.stream:
-        parser.error("--animate needs the run in memory; it cannot be combined with --stream")
     if args.spread is not None and args.spread < 1:
         parser.error(f"--spread takes a number of ulps >= 1, got {args.spread}")
-    if args.spread and args.stream:
-        parser.error("--spread needs each run's report; it cannot be combined with --stream")
+    for option, needs in (("animate", "the run in memory"), ("spread", "each run's report")):
+        if getattr(args, option) and args.stream:
+            parser.error(f"--{option} needs {needs}; it cannot be combined with --stream")
     if args.animate == "mp4" and video_format() != "mp4":
         parser.error("--animate mp4 needs ffmpeg, which is not installed here; use gif")
     options = Options(args.coupling, args.stop_time, args.lam, args.backend,

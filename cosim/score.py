@@ -64,8 +64,7 @@ def main(argv: list[str] | None = None) -> int:
                      "others': the comparison would not be fair")
     if args.workers is not None and args.workers < 1:
         parser.error(f"--workers must be at least 1, got {args.workers}")
-    if not checked_autopilot(parser, args):
-        return 2
+    checked_autopilot(parser, args)
     name = args.name or args.autopilot.stem
     if name in BASELINES:
         parser.error(f"your autopilot's name {name!r} is one of the baselines' "

@@ -1,17 +1,12 @@
-"""A pytest plugin for your autopilot: options, fixtures, and checks of the exchanged signals.
-
-Installed as a ``pytest11`` entry point; importing it has no side effect on the process:
-
-    pytest docs/own_autopilot/test_my_autopilot.py --autopilot my.fmu [--map psi=heading]
-
-The ``check_*`` functions raise AssertionError saying what is wrong, where and when.
-"""
+"""A pytest plugin for your autopilot (a ``pytest11`` entry point; importing it changes
+nothing): options, fixtures, and ``check_*`` functions on the exchanged signals, which raise
+AssertionError saying what is wrong, where and when (docs/own_autopilot.md)."""
 from __future__ import annotations
 
 import functools
 import math
 from pathlib import Path
-from typing import Any, Callable
+from typing import Callable
 
 import numpy as np
 import pytest
@@ -43,30 +38,16 @@ def autopilot(request: pytest.FixtureRequest) -> Path | None:
 
 
 @pytest.fixture(scope="session")
-def autopilot_map(request: pytest.FixtureRequest) -> dict[str, str]:
-    """The --map options as {port: the FMU's name}."""
+def cosim_simulate(request: pytest.FixtureRequest, autopilot) -> Callable[..., Recording]:
+    """``cosim.simulate`` with the autopilot, --map and --set of the command line."""
     try:
-        return dict(parse_port_map(text) for text in request.config.getoption("--map"))
-    except ValueError as error:
-        raise pytest.UsageError(str(error)) from None
-
-
-@pytest.fixture(scope="session")
-def cosim_settings(request: pytest.FixtureRequest) -> dict[str, Any]:
-    """The --set options as {"component.variable": value}."""
-    try:
+        port_map = dict(parse_port_map(text) for text in request.config.getoption("--map"))
         pairs = [parse_setting(text) for text in request.config.getoption("cosim_set")]
         overrides_of(pairs)                 # refuses a variable given twice
-        return dict(pairs)
     except ValueError as error:
         raise pytest.UsageError(str(error)) from None
-
-
-@pytest.fixture(scope="session")
-def cosim_simulate(autopilot, autopilot_map, cosim_settings) -> Callable[..., Recording]:
-    """``cosim.simulate`` with the autopilot and the settings of the command line."""
-    return functools.partial(simulate, autopilot=autopilot, port_map=autopilot_map or None,
-                             set=cosim_settings or None)
+    return functools.partial(simulate, autopilot=autopilot, port_map=port_map or None,
+                             set=dict(pairs) or None)
 
 
 @pytest.fixture(scope="session")
@@ -83,20 +64,13 @@ def check_finite(run: Recording) -> None:
                     f"{run.t[np.argmax(~np.isfinite(run[bad[0]]))]:.1f} s)"
 
 
-def _settled(run: Recording, within: float) -> np.ndarray:
-    """Rows at least ``within`` s after the last course change (a switch of
-    ``guidance.wp_index``, or the start)."""
-    t, leg = run.t, run["guidance.wp_index"]
-    since = np.zeros_like(t)
-    for start in [0, *(np.flatnonzero(np.diff(leg)) + 1)]:
-        since[start:] = t[start:] - t[start]
-    return since >= within
-
-
 def check_rudder_within_stops(run: Recording, within: float = 60.0) -> None:
     """Once a course change has settled (``within`` s), no rudder command beyond the stops."""
     delta_max = run.meta["parameters"]["ship"]["delta_max"]
-    command = np.where(_settled(run, within), np.abs(run["ship.delta_c"]), 0.0)
+    t, since = run.t, np.zeros_like(run.t)      # s since the last switch of wp_index
+    for start in [0, *(np.flatnonzero(np.diff(run["guidance.wp_index"])) + 1)]:
+        since[start:] = t[start:] - t[start]
+    command = np.where(since >= within, np.abs(run["ship.delta_c"]), 0.0)
     k = int(np.argmax(command))
     assert command[k] <= delta_max * (1 + 1e-12), \
         f"commanded rudder {math.degrees(command[k]):.1f} deg at t = {run.t[k]:.1f} s, " \
@@ -121,7 +95,7 @@ def check_heading_settles(run: Recording, bound: float, within: float) -> None:
     error = np.abs(heading_error(run["guidance.psi_d"], run["ship.psi"]))
     starts = [0, *(np.flatnonzero(np.diff(leg)) + 1)]
     for start, end in zip(starts, [*starts[1:], len(t)]):
-        settled = (t[start:end] >= t[start] + within)
+        settled = t[start:end] >= t[start] + within
         if not settled.any():
             continue
         worst = float(error[start:end][settled].max())

@@ -1,7 +1,6 @@
 """The 3-DOF manoeuvring model, eqs (1)-(6): eta_dot = R(psi) nu (1)-(2) and
 M nu_dot + C(nu) nu + D(nu) nu = tau (3), eta = [x, y, psi] (north, east, heading),
-nu = [u, v, r]; C(nu) nu and D(nu) nu as force vectors.
-"""
+nu = [u, v, r]; C(nu) nu and D(nu) nu as force vectors."""
 from __future__ import annotations
 
 import math
@@ -21,9 +20,8 @@ def kinematics(psi: float, u: float, v: float, r: float,
     return u * c - v * s, u * s + v * c, r
 
 
-def mass_matrix(hull: Hull) -> np.ndarray:
+def mass_matrix(h: Hull) -> np.ndarray:
     """System inertia matrix M = M_RB + M_A, eq (4)."""
-    h = hull
     return np.array([
         [h.m - h.X_udot, 0.0, 0.0],
         [0.0, h.m - h.Y_vdot, h.m * h.x_g - h.Y_rdot],
@@ -31,9 +29,8 @@ def mass_matrix(hull: Hull) -> np.ndarray:
     ])
 
 
-def coriolis_forces(hull: Hull, u: float, v: float, r: float) -> Vector3:
+def coriolis_forces(h: Hull, u: float, v: float, r: float) -> Vector3:
     """C(nu) nu with C = C_RB + C_A, eq (5)."""
-    h = hull
     c_rb13 = -h.m * (h.x_g * r + v)
     c_rb23 = h.m * u
     c13 = h.Y_vdot * v + 0.5 * (h.N_vdot + h.Y_rdot) * r     # C_A(1, 3)
@@ -45,10 +42,9 @@ def coriolis_forces(hull: Hull, u: float, v: float, r: float) -> Vector3:
     )
 
 
-def damping_forces(hull: Hull, u: float, v: float, r: float) -> Vector3:
+def damping_forces(h: Hull, u: float, v: float, r: float) -> Vector3:
     """D(nu) nu with D = D_L + D_NL(nu), eq (6); d_32 uses N_|r|v, as Skjetne et al.
     (2004); the paper prints Y_|r|v there."""
-    h = hull
     au, av, ar = abs(u), abs(v), abs(r)
     d11 = -(h.X_u + h.X_uu * au + h.X_uuu * u * u)
     d22 = -(h.Y_v + h.Y_vv * av + h.Y_rv * ar)

@@ -2,18 +2,12 @@
 rudder turns the ship to port, so headings go negative first."""
 from __future__ import annotations
 
-import math
-
 
 class RudderProgram:
     """Executes ``delta`` at t = 0 and reverses it each time the heading deviation passes
     -+psi_switch (a zig-zag); psi_switch = 0 holds it (a turning circle)."""
 
-    def __init__(self, delta: float = math.radians(20.0),
-                 psi_switch: float = math.radians(20.0)):
-        for name, value in (("delta", delta), ("psi_switch", psi_switch)):
-            if not (math.isfinite(value) and value >= 0.0):
-                raise ValueError(f"parameter {name} must be finite and >= 0, got {value}")
+    def __init__(self, delta: float, psi_switch: float):    # the FMU checks both: >= 0
         self.delta, self.psi_switch = delta, psi_switch
         self.sign, self.reversals = 1, 0
 

@@ -1,8 +1,6 @@
 """Propellers, bow thruster and rudders: tau_th = T u, eqs (8)-(13), n in rev/s, delta in rad.
-The paper prints T's first two rows as zeros; the real one (Sveen 2003; Skjetne 2004) puts
-T_i - D_i into surge, the bow thruster and both lifts into sway, yaw [l_yT, -l_yT, l_xT3,
--l_xR, -l_xR]. A positive rudder (n > 0) gives r < 0, psi decreasing, as eqs (20), (45) agree.
-"""
+T's first two rows, which the paper prints as zeros, are Sveen's (2003) and Skjetne's (2004);
+a positive rudder (n > 0) gives r < 0, psi decreasing, as eqs (20), (45) agree."""
 from __future__ import annotations
 
 from typing import Callable

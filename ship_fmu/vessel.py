@@ -1,8 +1,6 @@
-"""The vessel: CyberShip II hull, actuators, steering gear and waves, integrated by RK4
-with the inputs held, each step cut into ceil(h / h_max) equal sub-steps and where the rudder
-reaches its command or stop (a kink: RK4 keeps its order only on smooth pieces,
-``cosim.accuracy``). psi is not wrapped. Parameters carry the FMU's names.
-"""
+"""The vessel: CyberShip II hull, actuators, steering gear and waves, by RK4 with the inputs
+held, in equal sub-steps <= h_max, cut where the rudder reaches its command or stop (RK4 keeps
+its order only on smooth pieces, ``cosim.accuracy``). psi is not wrapped."""
 from __future__ import annotations
 
 import math
@@ -40,7 +38,7 @@ class VesselParameters:
     wave_components: int = 50
     h_max: float = 0.1          # s, largest RK4 step
 
-    def validate(self) -> None:
+    def __post_init__(self) -> None:
         """Raise ValueError naming the first invalid parameter."""
         for f in fields(self):
             value = getattr(self, f.name)
@@ -68,11 +66,9 @@ class Vessel:
     """CyberShip II in calm water or waves, stepped with inputs held."""
     STATE = ("x", "y", "psi", "u", "v", "r", "delta", "xi", "t")
 
-    def __init__(self, params: VesselParameters = VesselParameters(),
-                 hull: Hull = Hull(), actuators: Actuators = Actuators()):
-        params.validate()
-        self.params, self.hull, self.actuators = params, hull, actuators
-        M = mass_matrix(hull).tolist()
+    def __init__(self, params: VesselParameters = VesselParameters()):
+        self.params, self.hull, self.actuators = params, Hull(), Actuators()
+        M = mass_matrix(self.hull).tolist()
         det = M[1][1] * M[2][2] - M[1][2] * M[2][1]
         self._m11_inv = 1.0 / M[0][0]
         self._minv = (M[2][2] / det, -M[1][2] / det, -M[2][1] / det, M[1][1] / det)
@@ -80,7 +76,7 @@ class Vessel:
         if params.Hs > 0.0:
             components = WaveComponents.from_spectrum(
                 params.Hs, params.T0, params.wave_components, params.wave_seed)
-            self.waves = self._wave_loads = WaveLoads(components, hull, params.psi_w)
+            self.waves = self._wave_loads = WaveLoads(components, self.hull, params.psi_w)
         self._h, self._cut = None, (1, 0.0)          # the last step size and its cut
         self._shaft_speeds, self._forces = None, None  # the last shaft speeds, their tau_th
         self.x, self.y, self.psi = params.x0, params.y0, params.psi0
@@ -95,9 +91,7 @@ class Vessel:
 
     def step(self, t: float, h: float, delta_c: float,
              n1: float = N_PROPELLER, n2: float = N_PROPELLER, n3: float = 0.0) -> None:
-        if not (math.isfinite(delta_c) and math.isfinite(n1) and math.isfinite(n2)
-                and math.isfinite(n3)):
-            require_finite(delta_c=delta_c, n1=n1, n2=n2, n3=n3)
+        require_finite(delta_c=delta_c, n1=n1, n2=n2, n3=n3)
         p = self.params
         if h != self._h:                      # the same step, run after run: cut it once
             self._h, self._cut = h, self._cut_of(h)

@@ -1,9 +1,7 @@
-"""Wave loads from the modified Pierson-Moskowitz spectrum, eqs (14)-(17): N components,
-omega_i uniform in N equal-variance bins of 98 % of the spectrum (equal spacing repeats the
-sea), theta_i = omega_i t - k_i xi + phi_i with xi the travel along the waves (a vessel state:
-the encounter phase, exactly). A seed gives the same bits on every CPU: exactly rounded
-operations and decimal logarithms only, never a vectorised transcendental or BLAS.
-"""
+"""Wave loads from the modified Pierson-Moskowitz spectrum, eqs (14)-(17): omega_i uniform in
+N equal-variance bins of 98 % of it (equal spacing repeats the sea), theta_i = omega_i t - k_i xi
++ phi_i, xi the travel along the waves (a vessel state: the encounter phase, exactly). A seed
+gives the same bits on every CPU: exactly rounded operations, decimal logarithms, no BLAS."""
 from __future__ import annotations
 
 import math
@@ -32,9 +30,8 @@ def _spectrum_b(T0: float) -> float:
 
 @lru_cache(maxsize=64)
 def _bins(T0: float, n: int) -> tuple[tuple[float, ...], tuple[float, ...]]:
-    """The edges of N equal-variance bins of the spectrum's central BAND: their variance
-    fractions F and frequencies omega = (B / -ln F)^(1/4), rad/s, in decimal arithmetic:
-    the same on every CPU."""
+    """Edges of N equal-variance bins of the spectrum's central BAND: variance fractions F and
+    frequencies omega = (B / -ln F)^(1/4), rad/s, in decimal arithmetic (the same on any CPU)."""
     tail = 0.5 * (1.0 - BAND)
     fractions = np.linspace(tail, 1.0 - tail, n + 1).tolist()
     B = Decimal(_spectrum_b(T0))
@@ -68,9 +65,8 @@ class WaveLoads:
     X_w, Y_w = rho g B L T (cos, sin)(beta) sum s_i, N_w = rho g B L (L^2 - B^2) / 24
     sin(2 beta) sum s_i^2; summed in order (no matrix product), into arrays made once."""
 
-    def __init__(self, components: WaveComponents, hull: Hull, psi_w: float,
-                 rho: float = RHO_WATER):
-        h, n = hull, len(components.omega)
+    def __init__(self, components: WaveComponents, h: Hull, psi_w: float):
+        n, rho = len(components.omega), RHO_WATER
         self.components = components
         self.psi_w = psi_w
         self._c_force = rho * G * h.B * h.L * h.T

@@ -312,8 +312,10 @@ def test_a_mapped_port_in_degrees_per_second_is_named_by_both_names(degrees_pilo
 @pytest.mark.timeout(300)
 def test_cosim_run_refuses_it_before_anything_runs(fmu_paths, degrees_pilot, tmp_path,
                                                    capsys):
-    assert run_cli(["calm_pd", "--autopilot", str(degrees_pilot), "--out", str(tmp_path),
-                    "--no-plot"]) == 2
+    with pytest.raises(SystemExit) as refused:
+        run_cli(["calm_pd", "--autopilot", str(degrees_pilot), "--out", str(tmp_path),
+                 "--no-plot"])
+    assert refused.value.code == 2
     err = capsys.readouterr().err
     assert err.count("\n  - ") == 4 and "Traceback" not in err
     assert not list(tmp_path.rglob("*.csv"))

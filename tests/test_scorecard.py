@@ -162,7 +162,9 @@ def test_the_spread_of_a_criterion_over_decades_is_drawn_on_a_log_scale(tmp_path
 def test_the_scorecard_refuses_a_file_that_is_not_an_autopilot(tmp_path, capsys):
     junk = tmp_path / "junk.fmu"
     junk.write_text("no")
-    assert cli.main([str(junk), "--out", str(tmp_path / "score")]) == 2
+    with pytest.raises(SystemExit) as refused:
+        cli.main([str(junk), "--out", str(tmp_path / "score")])
+    assert refused.value.code == 2
     assert re.search(r"junk\.fmu is not an FMU", capsys.readouterr().err)
     assert not (tmp_path / "score").exists()
 
