@@ -1,6 +1,6 @@
-"""What it takes to reproduce a run, as JSON next to its CSV: the master's record (``run_meta``), each FMU's
-SHA-256 (and whether an fmukit FMU's sources are this process's), the scenario's, the command,
-the versions and git commit. Strict JSON: a non-finite number is written as a string."""
+"""What it takes to reproduce a run, as JSON next to its CSV: the master's record
+(``run_meta``), each FMU's SHA-256 (and whether an fmukit FMU's sources are this process's),
+the scenario's, the command, the versions and git commit. Strict JSON: a non-finite number is written as a string."""
 from __future__ import annotations
 
 import functools
