@@ -9,42 +9,25 @@ from typing import Any, Callable
 
 from .variables import Var
 
-Evaluate = Callable[[Callable[[Any], Any], Any], Any]
-
 
 class Registry:
-    """Every variable of a slave, by value reference, with its pythonfmu getter."""
+    """Every variable of a slave by value reference (pythonfmu's ``vars`` hold the getters)."""
 
-    def __init__(self, slave: Any, variables: tuple[Var, ...], evaluate: Evaluate):
+    def __init__(self, slave: Any, variables: tuple[Var, ...],
+                 evaluate: Callable[[Callable[[Any], Any], Any], Any]):
         self.by_vr: dict[int, Var] = {}
-        self.real_getters: dict[int, Callable[[], float]] = {}
-        self.integer_getters: dict[int, Callable[[], int]] = {}
-        self.real_inputs: dict[int, str] = {}       # Real inputs: value reference -> name
-        self.model_attributes: dict[int, str] = {}  # Real outputs that are model attributes
         for var in variables:
-            self._register(slave, var, evaluate)
+            getter = None
+            if var.causality == "output":
+                get = var.get or (lambda s, name=var.name: getattr(s._model, name))
 
-    def _register(self, slave: Any, var: Var, evaluate: Evaluate) -> None:
-        getter = None
-        if var.causality == "output":
-            get = var.get or (lambda s, name=var.name: getattr(s._model, name))
-
-            def getter(get=get, undefined=math.nan if var.is_real else 0) -> Any:
-                return evaluate(get, undefined)
-        else:
-            setattr(slave, var.name, var.start)
-        sv = slave.fmi_variable(var, getter)
-        slave.register_variable(sv)
-        vr = sv.value_reference
-        self.by_vr[vr] = var
-        if var.is_real:
-            self.real_getters[vr] = sv.getter
-            if var.causality == "input":
-                self.real_inputs[vr] = var.name
-            elif var.causality == "output" and var.get is None:
-                self.model_attributes[vr] = var.name
-        elif var.kind is int:
-            self.integer_getters[vr] = sv.getter
+                def getter(get=get, undefined=math.nan if var.is_real else 0) -> Any:
+                    return evaluate(get, undefined)
+            else:
+                setattr(slave, var.name, var.start)
+            sv = slave.fmi_variable(var, getter)
+            slave.register_variable(sv)
+            self.by_vr[sv.value_reference] = var
 
     def var(self, vr: int) -> Var:
         """The variable with value reference ``vr``; ValueError if there is none."""

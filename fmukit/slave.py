@@ -50,7 +50,9 @@ class ModelSlave:
     model_name: ClassVar[str]
     variables: ClassVar[tuple[Var, ...]]
     default_experiment = DefaultExperiment(start_time=0.0, stop_time=400.0, step_size=0.1)
-    # The adapter's: "fmi2" or "fmi3", its statuses, and ``fmukit.entry``'s compensation.
+    # The adapter's: "fmi2" or "fmi3", its statuses, ``fmukit.entry``'s compensation, and
+    # ``_host_log(kwargs)`` (the ``fmukit.hostlog.HostLog``) and ``fmi_variable(var, getter)``
+    # (pythonfmu's variable; ``getter`` reads an output).
     API: ClassVar[str]
     STATUS_ERROR: ClassVar[Any]
     STATUS_FATAL: ClassVar[Any]
@@ -69,19 +71,10 @@ class ModelSlave:
         self._model = None
         self._before_variables()
         self.registry = Registry(self, self.variables, self._output)
-        self.plans = FastPaths(self, self.registry)
+        self.plans = FastPaths(self)
         self._parameters = [v for v in self.variables if v.causality == "parameter"]
         self._check_inputs = range_check(tuple(v for v in self.variables
                                                if v.causality == "input"))
-
-    # -- the adapter's -----------------------------------------------------------
-    def _host_log(self, kwargs: dict[str, Any]) -> Any:
-        """The adapter's ``fmukit.hostlog.HostLog``, from pythonfmu's keywords."""
-        raise NotImplementedError
-
-    def fmi_variable(self, var: Var, getter: Callable[[], Any] | None) -> Any:
-        """pythonfmu's variable for ``var``; ``getter`` reads an output."""
-        raise NotImplementedError
 
     def _before_variables(self) -> None:
         """What the adapter registers before the declared variables (default: nothing)."""
@@ -254,9 +247,7 @@ class ModelSlave:
     def _set_fmu_state(self, saved: dict[str, Any]) -> None:
         state.restore(self, saved)
 
-    @staticmethod
-    def _fmu_state_from_bytes(data: bytes) -> dict[str, Any]:
-        return state.decode(data)
+    _fmu_state_from_bytes = staticmethod(state.decode)
 
 
 def _cause(error: BaseException, otherwise: str) -> str:

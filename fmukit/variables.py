@@ -1,15 +1,17 @@
 """``Var``: an FMU variable declared once, the source of its pythonfmu registration, its
-modelDescription.xml entry and the range check its values must pass.
+modelDescription.xml entry (the same in FMI 2.0 and 3.0; each adapter's ``to_xml`` puts it
+where its version wants it) and the range check its values must pass.
 """
 from __future__ import annotations
 
 import math
 import sys
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any, Callable, Iterable
+from xml.etree.ElementTree import Element
 
 from .refusals import Refused
-from .units import UNITS
+from .units import DISPLAY_UNIT, UNITS, unit_definitions
 
 
 @dataclass(frozen=True)
@@ -71,6 +73,23 @@ class Var:
     def is_real(self) -> bool:
         return self.kind is float
 
+    def type_attributes(self) -> dict[str, str]:
+        """The attributes of a numeric variable's type, in the order they are written."""
+        attributes = {}
+        if self.is_real:
+            if self.start is not None:
+                attributes["start"] = repr(float(self.start))    # shortest exact form
+            attributes["unit"] = self.unit
+            if self.unit in DISPLAY_UNIT:
+                attributes["displayUnit"] = DISPLAY_UNIT[self.unit]
+        elif self.start is not None:
+            attributes["start"] = str(int(self.start))
+        for bound in ("min", "max"):
+            value = getattr(self, bound)
+            if math.isfinite(value):
+                attributes[bound] = repr(self.kind(value))
+        return attributes
+
 
 def range_check(variables: tuple[Var, ...]) -> Callable[[Any], None]:
     """A check of the numeric ``variables`` as attributes of an object, compiled to one
@@ -86,3 +105,25 @@ def range_check(variables: tuple[Var, ...]) -> Callable[[Any], None]:
     exec(f"def check(obj):\n    if not ({' and '.join(tests) or 'True'}):\n"
          "        name_the_failure(obj)\n", namespace)
     return namespace["check"]
+
+
+def describe(root: Element, variables: tuple[Var, ...], typed: list[Element | None],
+             reference: dict[str, int]) -> tuple[Element, list[tuple[str, tuple]]]:
+    """Add each numeric variable's attributes to its ``typed`` element and <UnitDefinitions>
+    to the model description ``root``. The emptied <ModelStructure>, and for each output its
+    ``reference`` and those it depends on while stepping (its inputs: direct feedthrough)
+    and at initialisation (inputs and parameters, and its further knowns then), ordered."""
+    for element, var in zip(typed, variables):
+        if var.kind is not str:
+            element.attrib.update(var.type_attributes())
+    root.insert(list(root).index(root.find("CoSimulation")) + 1,
+                unit_definitions({v.unit for v in variables if v.is_real}))
+    structure = root.find("ModelStructure")
+    structure.clear()
+    inputs = {v.name for v in variables if v.causality == "input"}
+
+    def ordered(names: Iterable[str]) -> list[str]:
+        return [str(r) for r in sorted(reference[n] for n in names)]
+    return structure, [(str(reference[v.name]), (ordered(d for d in v.depends if d in inputs),
+                                                 ordered(v.depends + v.initial_depends)))
+                       for v in variables if v.causality == "output"]

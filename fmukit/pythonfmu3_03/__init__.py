@@ -5,20 +5,15 @@ owes to that version's defects, each active only under ``ACTIVE``:
   per exception: ``fmukit.entry`` takes the extra references;
 - every exception is fmi3Fatal: ``slave.Fmi3Entry.do_step`` returns fmi3Error for a
   refused step instead (fmi3Reset then works), and always returns a result;
-- it forwards log messages whatever the host's ``loggingOn``: ``binary.host_log`` reads the flag and
-  ``Fmi3Entry.log`` holds messages back while it is off;
+- it forwards log messages whatever the host's ``loggingOn``: ``fmukit.hostlog`` reads the
+  flag and ``Fmi3Entry.log`` holds messages back while it is off;
 - its x86_64-linux binary frees its ``shared_ptr<PyState>`` twice at exit (``binary``,
   patched by ``fmubuild.exit_fix``);
-- its modelDescription.xml lacks units, ranges, exact starts and dependencies
-  (``model_description``), and the description, author and default experiment, which it
-  reads from the instance only (``Fmi3Entry`` sets them from the class).
+- its modelDescription.xml lacks units, ranges, exact starts and dependencies, and the
+  description, author and default experiment, which it reads from the instance only
+  (``Fmi3Entry`` adds them).
 """
-from pythonfmu3 import Fmi3Causality, Fmi3Initial, Fmi3Slave, Fmi3Status, Fmi3StepResult
-from pythonfmu3 import Fmi3Variability, Float64, Int32, String
 from pythonfmu3 import __version__ as PYTHONFMU_VERSION
 
 ACTIVE = PYTHONFMU_VERSION == "0.3.4"
 """Whether the compensations apply: to pythonfmu3 0.3.4, whose defects they are for."""
-
-__all__ = ["ACTIVE", "PYTHONFMU_VERSION", "Fmi3Causality", "Fmi3Initial", "Fmi3Slave",
-           "Fmi3Status", "Fmi3StepResult", "Fmi3Variability", "Float64", "Int32", "String"]

@@ -7,16 +7,18 @@ the start time, so messages name none.
 from __future__ import annotations
 
 from typing import Any, Callable
-from xml.etree.ElementTree import Element
+from xml.etree.ElementTree import Element, SubElement
+
+from pythonfmu3 import Fmi3Causality, Fmi3Initial, Fmi3Slave, Fmi3Status, Fmi3StepResult
+from pythonfmu3 import Fmi3Variability, Float64, Int32, String
 
 from .. import state
 from ..entry import fmi_entry
-from ..registry import pythonfmu_variable
 from ..hostlog import HostLog
+from ..registry import pythonfmu_variable
 from ..slave import CATEGORIES
-from ..variables import Var
-from . import (ACTIVE, Fmi3Causality, Fmi3Initial, Fmi3Slave, Fmi3Status, Fmi3StepResult,
-               Fmi3Variability, Float64, Int32, String, binary, model_description)
+from ..variables import Var, describe
+from . import ACTIVE, binary
 
 _TYPE = {float: Float64, int: Int32, str: String}
 _FROM_CLASS = ("description", "author", "license", "version", "copyright",
@@ -32,7 +34,6 @@ class Fmi3Entry:
     """FMI 3.0 through pythonfmu3 0.3.4: the version's half of an FMU's class."""
 
     API, FMI_VERSION = "fmi3", 3
-    TYPE_NAMES = {float: "Float64", int: "Int32", str: "String"}
     STATUS_ERROR, STATUS_FATAL = Fmi3Status.error, Fmi3Status.fatal
     RELEASES_ON_EXCEPTION = ACTIVE
     log_categories = {**Fmi3Slave.log_categories, **CATEGORIES}
@@ -44,11 +45,10 @@ class Fmi3Entry:
         self.start_time = None                 # not given by pythonfmu3
 
     def _host_log(self, kwargs: dict[str, Any]) -> HostLog:
-        return binary.host_log(kwargs)
+        return HostLog(kwargs, binary.KNOWN_BINARIES, unknown=True)
 
     def _before_variables(self) -> None:
-        """``time``, registered first: value reference 0 (``model_description`` writes it
-        last)."""
+        """``time``, registered first: value reference 0 (``to_xml`` writes it last)."""
         self.time = 0.0
         self.register_variable(Float64("time", causality=Fmi3Causality.independent,
                                        variability=Fmi3Variability.continuous,
@@ -101,5 +101,23 @@ class Fmi3Entry:
         self.time = saved["time"]
 
     def to_xml(self, model_options: dict[str, str] = dict()) -> Element:
-        vr = {var.name: vr for vr, var in self.registry.by_vr.items()}
-        return model_description.complete(super().to_xml(model_options), self.variables, vr)
+        """pythonfmu3's model description with what it leaves out: <UnitDefinitions> (else
+        fmpy refuses the units), display units, min/max, exact starts (it writes 16 digits)
+        and dependencies (its bare <Output> says every output depends on every input: an
+        algebraic loop to a master). ``time`` is moved last, so that an importer reading
+        dependencies as 1-based indices (OMSimulator) reads them right."""
+        root = super().to_xml(model_options)
+        listed = root.find("ModelVariables")
+        elements = {e.get("name"): e for e in listed}
+        for independent in [e for e in listed if e.get("causality") == "independent"]:
+            listed.remove(independent)
+            listed.append(independent)
+        structure, unknowns = describe(root, self.variables,
+                                       [elements[v.name] for v in self.variables],
+                                       {v.name: vr for vr, v in self.registry.by_vr.items()})
+        for tag, when in (("Output", 0), ("InitialUnknown", 1)):
+            for reference, depends in unknowns:
+                kinds = {"dependenciesKind": " ".join(["dependent"] * len(depends[when]))}
+                SubElement(structure, tag, valueReference=reference,
+                           dependencies=" ".join(depends[when]), **(kinds if depends[when] else {}))
+        return root
