@@ -1,17 +1,21 @@
-"""``fmi_entry``, through which every FMI entry point of a slave passes: pythonfmu's error path
-made safe.
+"""Every FMI entry point's error path: pythonfmu's made safe (``fmi_entry``), and the error
+told to the user where the host does not hear it (``HostLog``).
 
 Both pythonfmus turn every exception into a fatal status, and their C++ layers release the
 instance, its class and its log queue once per exception (a use-after-free that crashes the
 host later): where the adapter says so (``RELEASES_ON_EXCEPTION``) one extra reference is
-taken on each. The refusal is logged under its category (``fmukit.<cause>``), or written to
-standard error when the host does not listen. With ``error_result`` (FMI 3.0's doStep) a
-refusal returns that result, logged as an error, instead of raising.
+taken on each. pythonfmu 0.7 forwards log messages only while the host has debug logging
+on, pythonfmu3 0.3.4 whatever the host asked: ``HostLog`` reads the host's flag in
+pythonfmu's C++ logger, in a binary the adapter knows by SHA-256 (``binary.KNOWN_BINARIES``).
 """
 from __future__ import annotations
 
 import ctypes
 import functools
+import hashlib
+import sys
+from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, Callable
 
 from .refusals import Refused, explain, naming
@@ -19,9 +23,9 @@ from .refusals import Refused, explain, naming
 
 def fmi_entry(method: Callable | None = None, *,
               error_result: Callable[[], Any] | None = None) -> Callable:
-    """Let an exception reach pythonfmu's C++ layer without corrupting the host; with
-    ``error_result``, a refusal returns ``error_result()`` instead (see the module
-    docstring). Usable as ``@fmi_entry`` and ``@fmi_entry(error_result=...)``."""
+    """``method`` made safe, its refusal logged under its category (``fmukit.<cause>``);
+    with ``@fmi_entry(error_result=...)`` (FMI 3.0's doStep) a refusal returns
+    ``error_result()``, logged as an error, instead of raising."""
     if method is None:
         return functools.partial(fmi_entry, error_result=error_result)
 
@@ -51,3 +55,59 @@ def unguarded(entry_point: Callable) -> Callable:
     """The bound method behind an ``fmi_entry``: for a host in the same process, which
     handles exceptions itself (pythonfmu's C++ layer is not there)."""
     return entry_point.__func__.__wrapped__.__get__(entry_point.__self__)
+
+
+@dataclass(frozen=True)
+class Binary:
+    """A pythonfmu binary fmukit knows inside out."""
+
+    offset: int                 # file offset of onLibraryUnload
+    code: bytes                 # its first instructions
+    patched: bytes              # what they become (fmubuild.exit_fix)
+    fixed_sha256: str           # the binary once patched
+    logger_offset: int          # where the host's logging flag is, from the logger
+    through_pointer: bool = False   # there is a pointer to the flag instead
+
+    def flag(self, logger: int) -> ctypes.c_bool | None:
+        """The host's logging flag in the logger at address ``logger``."""
+        address = logger + self.logger_offset
+        if self.through_pointer:
+            address = ctypes.c_void_p.from_address(address).value
+        return ctypes.c_bool.from_address(address) if address else None
+
+
+class HostLog:
+    """Where an FMU's errors reach its user: the host's logger (where its flag is found,
+    else if ``unknown``; always in the host's process), else standard error, never both."""
+
+    def __init__(self, kwargs: dict[str, Any], known_binaries: dict[str, Binary],
+                 unknown: bool):
+        """From pythonfmu's keywords (without a ``logger``: a host in this process)."""
+        logger, resources = kwargs.get("logger"), kwargs.get("resources")
+        self._flag = None
+        if logger and resources:
+            fixed = {b.fixed_sha256: b for b in known_binaries.values()}
+            for binary in (Path(resources).parent / "binaries").glob("*/*"):
+                try:
+                    known = fixed.get(hashlib.sha256(binary.read_bytes()).hexdigest())
+                except OSError:
+                    continue
+                if known is not None:
+                    self._flag = known.flag(logger)
+                    break
+        self._in_process, self._unknown = "logger" not in kwargs, unknown
+        self._told = ""
+
+    def hears(self) -> bool:
+        """Whether the host receives this FMU's log messages now."""
+        if self._in_process:
+            return True
+        return bool(self._flag.value) if self._flag is not None else self._unknown
+
+    def tell(self, instance_name: str, message: str) -> None:
+        """Write an error to standard error if the host will not hear it; once, not again
+        for each following call that fails for the same reason."""
+        if not self.hears() and message != self._told:
+            sys.stderr.write(naming(instance_name, message) + "\n")   # one write: hosts
+            sys.stderr.flush()                              # step FMUs in parallel threads
+            self._told = message

@@ -76,17 +76,13 @@ def defer_host_handlers() -> None:
                 signal.signal(number, _DeferringHandler(handler))
 
 
-def _c_runtime() -> ctypes.CDLL:
-    """The C library whose ``signal`` installed Python's handlers: the Universal CRT on
-    Windows (``msvcrt.dll`` has a signal table of its own), elsewhere the process's."""
-    return ctypes.CDLL("ucrtbase") if sys.platform == "win32" else ctypes.CDLL(None)
-
-
 def _restore_default_sigint() -> None:
     """Undo Python's start-up SIGINT handler at the operating-system level (Python's own
-    record of it stays as it was)."""
+    record of it stays as it was), in the C library whose ``signal`` installed it: the
+    Universal CRT on Windows (``msvcrt.dll`` has a signal table of its own), elsewhere the
+    process's."""
     if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
-        libc = _c_runtime()
+        libc = ctypes.CDLL("ucrtbase") if sys.platform == "win32" else ctypes.CDLL(None)
         libc.signal.argtypes = (ctypes.c_int, ctypes.c_void_p)
         libc.signal.restype = ctypes.c_void_p
         libc.signal(signal.SIGINT, None)      # SIG_DFL

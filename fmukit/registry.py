@@ -1,20 +1,32 @@
-"""The slave's variables registered with pythonfmu (through the adapter's ``fmi_variable``)
-and indexed by value reference. Parameters and inputs are attributes of the slave; outputs
-are read through the slave's ``evaluate(get, undefined)``.
+"""A slave's variables by value reference: registered with pythonfmu (through the adapter's
+``fmi_variable``), and the plans that read or set a list of them, made once per list (a
+master asks for the same lists at every step).
+
+A plan gives what the FMI call gives in every state of the slave (NaN once it has failed),
+so a host in the same process may call it itself; a list no plan serves gets ``None``, and
+pythonfmu serves it. Model attributes are read with one ``operator.attrgetter``; other
+values each through their reader within one ``try``, and one by one through pythonfmu's
+getters (the slave's ``evaluate``, for outputs) where that fails.
 """
 from __future__ import annotations
 
 import math
+import operator
 from typing import Any, Callable
 
 from .variables import Var
 
+Reader = Callable[[], list]
+Writer = Callable[[list[float]], None]
+
 
 class Registry:
-    """Every variable of a slave by value reference (pythonfmu's ``vars`` hold the getters)."""
+    """Every variable of a slave by value reference (``by_vr``), and its cached plans."""
 
     def __init__(self, slave: Any, variables: tuple[Var, ...],
                  evaluate: Callable[[Callable[[Any], Any], Any], Any]):
+        self._slave = slave
+        self._plans: dict[tuple, Reader | Writer | None] = {}
         self.by_vr: dict[int, Var] = {}
         for var in variables:
             getter = None
@@ -35,6 +47,77 @@ class Registry:
         if var is None:
             raise ValueError(f"no variable has value reference {vr}")
         return var
+
+    def real_reader(self, vrs: list[int]) -> Reader | None:
+        """The plan reading these Reals, or None if one is not a Real."""
+        return self._planned(float, vrs)
+
+    def integer_reader(self, vrs: list[int]) -> Reader | None:
+        """The plan reading these Integers, or None if one is not an Integer."""
+        return self._planned(int, vrs)
+
+    def input_writer(self, vrs: list[int]) -> Writer | None:
+        """The plan setting these Real inputs, or None if one is not a Real input."""
+        return self._planned(None, vrs)
+
+    def _planned(self, kind: type | None, vrs: list[int]) -> Reader | Writer | None:
+        """The plan reading ``kind`` (None: writing), compiled the first time."""
+        key = (kind, *vrs)
+        if key not in self._plans:
+            self._plans[key] = self._writer(key[1:]) if kind is None else self._reader(
+                key[1:], kind)
+        return self._plans[key]
+
+    def _reader(self, vrs: tuple[int, ...], kind: type) -> Reader | None:
+        slave, by_vr = self._slave, self.by_vr
+        if not all(vr in by_vr and by_vr[vr].kind is kind for vr in vrs):
+            return None
+        declared = [by_vr[vr] for vr in vrs]
+        getters = [slave.vars[vr].getter for vr in vrs]
+
+        def each() -> list:             # NaN (0) for each value that cannot be read
+            return [kind(get()) for get in getters]
+        if kind is float and all(v.causality == "output" and not v.get for v in declared):
+            attributes = operator.attrgetter(*(v.name for v in declared))
+            single = len(vrs) == 1
+
+            def model_attributes() -> list:   # one C-level call
+                model = slave._model
+                if model is None or slave.failure:
+                    return each()
+                values = attributes(model)
+                return [values] if single else list(values)
+            return model_attributes
+        gets = [v.get or operator.attrgetter(f"_model.{v.name}" if v.causality == "output"
+                                             else v.name) for v in declared]
+
+        def evaluated() -> list:
+            if slave._model is None or slave.failure:
+                return each()
+            try:
+                return [kind(get(slave)) for get in gets]
+            except (ValueError, ArithmeticError):
+                return each()
+        return evaluated
+
+    def _writer(self, vrs: tuple[int, ...]) -> Writer | None:
+        slave, by_vr = self._slave, self.by_vr
+        if not all(vr in by_vr and by_vr[vr].is_real and by_vr[vr].causality == "input"
+                   for vr in vrs):
+            return None
+        names = tuple(by_vr[vr].name for vr in vrs)
+        sequence, attributes = slave.sequence, vars(slave)
+        properties = any(hasattr(type(slave), name) for name in names)
+
+        def write(values: list[float]) -> None:
+            if sequence.phase == "terminated":
+                slave._set(list(vrs), values, float)     # refused, naming the input
+            if properties:                               # set them through the class
+                for name, value in zip(names, values):
+                    setattr(slave, name, float(value))
+            else:                                        # plain attributes
+                attributes.update(zip(names, map(float, values)))
+        return write
 
 
 def pythonfmu_variable(var: Var, getter: Callable[[], Any] | None, kind: type,

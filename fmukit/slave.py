@@ -1,18 +1,14 @@
-"""``ModelSlave``: the base of every FMU in this project, the same for FMI 2.0 and FMI 3.0.
-
-An FMU class lists its ``variables`` (``fmukit.variables.Var``) and supplies
-``build_model`` (from the parameters alone), ``step_model`` and, if the initial state
-depends on inputs, ``start_model``; the model supplies ``snapshot``/``restore``. The FMI
-version and pythonfmu are the adapter's, a mixin composed by the FMU's entry module or
-``fmukit.compose.fmu_class``.
+"""``ModelSlave``: the base of every FMU in this project, the same for FMI 2.0 and FMI 3.0,
+and its FMI call sequence. An FMU class lists its ``variables`` and supplies ``build_model``
+(from the parameters alone), ``step_model`` and, if the initial state depends on inputs,
+``start_model``; the model supplies ``snapshot``/``restore``. The adapter's mixin adds the
+FMI version and pythonfmu (``fmukit.compose``).
 
 Refusals (docs/robustness.md): invalid parameters are reported at exitInitializationMode
-(libcosim ends its process if that call fails) and refused at the first doStep; an
-invalid input or step, or the model's exception, fails the FMU. A failed FMU reads NaN and
-refuses every step with the first reason until reset, so a host that ignores statuses
-cannot pass the run off as results. Calls out of sequence are refused and change nothing.
-Every FMI 2.0 refusal is fmi2Fatal (pythonfmu 0.7's fmi2Discard would pass for a normal
-end); an FMI 3.0 refused step is fmi3Error, every other refusal fmi3Fatal.
+(libcosim ends its process if that call fails) and refused at the first doStep; an invalid
+input or step, or the model's exception, fails the FMU: it reads NaN and refuses every step
+with the first reason until reset, so a host that ignores statuses cannot pass the run off
+as results. Calls out of sequence are refused and change nothing.
 """
 from __future__ import annotations
 
@@ -21,17 +17,53 @@ from typing import Any, Callable, ClassVar, NoReturn
 
 from . import hostsignals, state
 from .entry import fmi_entry
-from .fastpath import FastPaths
 from .refusals import CAUSES, Refused, explain, naming, reason
 from .registry import Registry
-from .sequence import CallSequence
 from .timebase import MAX_TIME, on_time_base
 from .variables import Var, range_check
 
 __all__ = ["DefaultExperiment", "ModelSlave", "Refused", "Var"]
 
 CATEGORIES = {f"fmukit.{cause}": f"Refused: {meaning}." for cause, meaning in CAUSES.items()}
-"""The log categories of every refusal's cause, which each adapter declares."""
+"""The log categories of every refusal's cause, beside pythonfmu's."""
+_AFTER = {"instantiated": "{api}{instantiate} or {api}Reset",
+          "initialization": "{api}EnterInitializationMode",
+          "step": "{api}ExitInitializationMode", "terminated": "{api}Terminate"}
+_INSTANTIATE = {"fmi2": "Instantiate", "fmi3": "InstantiateCoSimulation"}
+
+
+class CallSequence:
+    """The phase of one FMU instance (instantiated -> initialization -> step -> terminated;
+    reset makes a new slave) and the rules of the standard (``api``: "fmi2" or "fmi3")."""
+
+    def __init__(self, api: str, phase: str = "instantiated"):
+        self.api, self.phase = api, phase
+
+    def require(self, call: str, *phases: str) -> None:
+        """Refused naming the call (``Terminate``: fmi2Terminate) and the phase unless the
+        phase is one of ``phases``."""
+        if self.phase not in phases:
+            after = " or ".join(_AFTER[p].format(api=self.api, instantiate=_INSTANTIATE[self.api])
+                                for p in phases)
+            raise Refused(f"{self.api}{call} is not allowed in phase '{self.phase}' (FMI "
+                          f"{self.api[3:]}.0 allows it after {after})", "call")
+
+    def require_step(self) -> None:
+        """Refused unless doStep is allowed now."""
+        if self.phase != "step":
+            raise Refused(f"doStep called in phase '{self.phase}': call "
+                          "exitInitializationMode first, and not after terminate", "call")
+
+    def check_settable(self, var: Var) -> None:
+        """Refused naming ``var`` if the standard forbids setting it now."""
+        if var.causality == "output":
+            raise Refused(f"{var.name} is an output and cannot be set", "call", var.name)
+        if var.causality == "parameter" and self.phase not in ("instantiated",
+                                                               "initialization"):
+            raise Refused(f"parameter {var.name} is fixed after initialisation "
+                          f"(phase '{self.phase}')", "call", var.name)
+        if self.phase == "terminated":
+            raise Refused(f"cannot set {var.name} after terminate", "call", var.name)
 
 
 @dataclass(frozen=True)
@@ -51,8 +83,8 @@ class ModelSlave:
     variables: ClassVar[tuple[Var, ...]]
     default_experiment = DefaultExperiment(start_time=0.0, stop_time=400.0, step_size=0.1)
     # The adapter's: "fmi2" or "fmi3", its statuses, ``fmukit.entry``'s compensation, and
-    # ``_host_log(kwargs)`` (the ``fmukit.hostlog.HostLog``) and ``fmi_variable(var, getter)``
-    # (pythonfmu's variable; ``getter`` reads an output).
+    # its ``_host_log(kwargs)`` (a ``fmukit.entry.HostLog``) and ``fmi_variable(var,
+    # getter)`` (pythonfmu's variable; ``getter`` reads an output).
     API: ClassVar[str]
     STATUS_ERROR: ClassVar[Any]
     STATUS_FATAL: ClassVar[Any]
@@ -61,6 +93,7 @@ class ModelSlave:
     def __init__(self, **kwargs):
         super().__init__(**kwargs)            # pythonfmu's slave, next in the FMU class's MRO
         self.modelName = self.model_name
+        self.log_categories = {**self.log_categories, **CATEGORIES}
         self.sequence = CallSequence(self.API)
         self.host_log = self._host_log(kwargs)
         self.failure: str | None = None       # why the FMU failed; until reset
@@ -70,16 +103,13 @@ class ModelSlave:
         hostsignals.defer_host_handlers()
         self._model = None
         self._before_variables()
-        self.registry = Registry(self, self.variables, self._output)
-        self.plans = FastPaths(self)
-        self._parameters = [v for v in self.variables if v.causality == "parameter"]
+        self.registry = self.plans = Registry(self, self.variables, self._output)
         self._check_inputs = range_check(tuple(v for v in self.variables
                                                if v.causality == "input"))
 
     def _before_variables(self) -> None:
         """What the adapter registers before the declared variables (default: nothing)."""
 
-    # -- model ---------------------------------------------------------------
     def build_model(self) -> Any:
         """A fresh model from the current parameter attributes."""
         raise NotImplementedError
@@ -96,6 +126,13 @@ class ModelSlave:
         model = self.build_model()
         self.start_model(model)
         return model
+
+    @property
+    def model(self) -> Any:
+        """The model; before initialisation, built from the parameters as they are."""
+        if self._model is None:
+            self._model = self._started_model()
+        return self._model
 
     def _output(self, get: Callable[[Any], Any], undefined: Any) -> Any:
         """An output's value, or NaN (0 if Integer) when it cannot be evaluated or the FMU
@@ -129,12 +166,20 @@ class ModelSlave:
         self.log(naming(self.instance_name, failure), self.STATUS_ERROR, f"fmukit.{cause}")
         self.host_log.tell(self.instance_name, failure)
 
-    @property
-    def model(self) -> Any:
-        """The model; before initialisation, built from the parameters as they are."""
-        if self._model is None:
-            self._model = self._started_model()
-        return self._model
+    def _fail(self, reason: str, cause: str, error: BaseException | None = None) -> NoReturn:
+        """Fail the FMU for ``reason`` (its ``cause``): refuse this call and every step."""
+        self.failure, self.failure_cause = reason, cause
+        raise Refused(reason, cause) from error
+
+    def interrupted(self, where: str, error: BaseException) -> Refused:
+        """Fail the FMU for a KeyboardInterrupt (or any BaseException) raised in its code
+        during ``where``; the refusal to raise."""
+        number = hostsignals.interrupt_signal(error)
+        if not self.failure:
+            cause = f"interrupted by {number.name}" if number else explain(error)
+            self.failure = f"{where}: {cause}; the FMU has failed"
+            self.failure_cause = "interrupted"
+        return Refused(self.failure, self.failure_cause)
 
     # -- FMI call sequence -----------------------------------------------------
     @fmi_entry
@@ -147,13 +192,14 @@ class ModelSlave:
         self.sequence.require("ExitInitializationMode", "initialization")
         self.sequence.phase = "step"
         try:
-            for var in self._parameters:      # the declared ranges, then the model's own rules
-                var.check(getattr(self, var.name))
+            for var in self.variables:        # the declared ranges, then the model's own rules
+                if var.causality == "parameter":
+                    var.check(getattr(self, var.name))
             self._model = self._started_model()   # ValueError names a bad parameter or input
         except Exception as error:            # reported now, refused at the first step
             at = "" if self.start_time is None else f" at t = {self.start_time}"
             self._report(f"exitInitializationMode{at}: {reason(error)}; the FMU has failed",
-                         _cause(error, "parameter"))
+                         error.cause if isinstance(error, Refused) else "parameter")
 
     @fmi_entry
     def terminate(self) -> None:
@@ -165,9 +211,7 @@ class ModelSlave:
         """One communication step (the adapter's ``do_step``); Refused for every refusal."""
         if self.failure:
             raise Refused(self.failure, self.failure_cause)
-        refusal = self.sequence.step_refusal()
-        if refusal:                           # like any call out of sequence: nothing done
-            raise Refused(refusal, "call")
+        self.sequence.require_step()          # like any call out of sequence: nothing done
         if not (0.0 < step_size <= MAX_TIME and abs(current_time) <= MAX_TIME):
             self._fail(f"doStep at t = {current_time} with communication step {step_size}: the "
                        f"step must be positive, and both within +-{MAX_TIME:g} s", "step")
@@ -180,28 +224,14 @@ class ModelSlave:
                 self.step_model(on_time_base(current_time), self._step_size[1])
         except ValueError as error:
             self._fail(f"doStep at t = {current_time}: {error}; the FMU has failed (its "
-                       f"outputs read NaN until {self.API}Reset)", _cause(error, "model"))
+                       f"outputs read NaN until {self.API}Reset)",
+                       error.cause if isinstance(error, Refused) else "model")
         except Exception as error:            # the model's own exception
             self._fail(f"doStep at t = {current_time}: {explain(error)}", "model", error)
         except BaseException as error:        # Ctrl-C or the like, raised in this FMU's code
             raise self.interrupted(f"doStep at t = {current_time}", error) from None
 
-    def interrupted(self, where: str, error: BaseException) -> Refused:
-        """Fail the FMU for a KeyboardInterrupt (or any BaseException) raised in its code
-        during ``where``; the refusal to raise."""
-        number = hostsignals.interrupt_signal(error)
-        cause = f"interrupted by {number.name}" if number else explain(error)
-        if not self.failure:
-            self.failure = f"{where}: {cause}; the FMU has failed"
-            self.failure_cause = "interrupted"
-        return Refused(self.failure, self.failure_cause)
-
-    def _fail(self, reason: str, cause: str, error: BaseException | None = None) -> NoReturn:
-        """Fail the FMU for ``reason`` (its ``cause``): refuse this call and every step."""
-        self.failure, self.failure_cause = reason, cause
-        raise Refused(reason, cause) from error
-
-    # -- setters: refuse what the standard does not allow ----------------------
+    # -- setters and getters: refuse what the standard does not allow -----------
     def _set(self, vrs: list[int], values: list, convert: type) -> None:
         for vr in vrs:
             self.sequence.check_settable(self.registry.var(vr))
@@ -229,7 +259,6 @@ class ModelSlave:
     def set_boolean(self, vrs: list[int], values: list[bool]) -> None:
         raise Refused("this FMU has no Boolean variables", "call")
 
-    # -- getters ---------------------------------------------------------------------
     @fmi_entry
     def get_string(self, vrs: list[int]) -> list[str]:
         return super().get_string(vrs)
@@ -248,8 +277,3 @@ class ModelSlave:
         state.restore(self, saved)
 
     _fmu_state_from_bytes = staticmethod(state.decode)
-
-
-def _cause(error: BaseException, otherwise: str) -> str:
-    """A refusal's own cause; ``otherwise`` for any other exception."""
-    return error.cause if isinstance(error, Refused) else otherwise

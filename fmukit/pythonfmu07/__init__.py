@@ -4,7 +4,7 @@ owes to that version's defects, each active only under ``ACTIVE``:
 - its binary releases an instance's references once per Python exception (``fmukit.entry``
   takes extra ones) and the entry module's namespace once per instantiation
   (``slave.hold_namespace``);
-- it forwards log messages only while the host has debug logging on (``fmukit.hostlog``);
+- it forwards log messages only while the host has debug logging on (``fmukit.entry.HostLog``);
 - its linux64 binary corrupts the heap at exit (``binary``, patched by ``fmubuild.exit_fix``);
 - it leaves units, ranges and dependencies out of modelDescription.xml (``slave``).
 

@@ -3,7 +3,7 @@ its exit-time heap corruption, and where its logger keeps the host's debug-loggi
 which alone decides what the host hears. With another binary the flag cannot be trusted,
 and the host is taken not to hear (``slave.Fmi2Entry``): errors go to standard error too.
 """
-from ..hostlog import Binary
+from ..entry import Binary
 
 # endbr64; jmp finalizePythonInterpreter  ->  endbr64; ret. PyLogger::log tests
 # ``cmpb $0x0, 0x8(%rdi)``: the debug-logging flag sits 8 bytes into the logger.

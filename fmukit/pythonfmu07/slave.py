@@ -1,6 +1,7 @@
 """``Fmi2Entry``: the mixin that makes a ``ModelSlave`` an FMI 2.0 FMU of pythonfmu 0.7
 (``class <Model>(Fmi2Entry, <Model>, Fmi2Slave)``: pythonfmu takes the class with the
-longest MRO). Every refusal is an exception: fmi2Fatal.
+longest MRO). Every refusal is an exception: fmi2Fatal (pythonfmu 0.7's fmi2Discard would
+pass for a normal end).
 """
 from __future__ import annotations
 
@@ -12,10 +13,8 @@ from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, In
 from pythonfmu import String
 from pythonfmu.enums import Fmi2Status
 
-from ..entry import fmi_entry
-from ..hostlog import HostLog
+from ..entry import HostLog, fmi_entry
 from ..registry import pythonfmu_variable
-from ..slave import CATEGORIES
 from ..variables import Var, describe
 from . import ACTIVE, binary
 
@@ -28,7 +27,6 @@ class Fmi2Entry:
     API, FMI_VERSION = "fmi2", 2
     STATUS_ERROR, STATUS_FATAL = Fmi2Status.error, Fmi2Status.fatal
     RELEASES_ON_EXCEPTION = ACTIVE
-    log_categories = {**Fmi2Slave.log_categories, **CATEGORIES}
 
     def _host_log(self, kwargs: dict[str, Any]) -> HostLog:
         return HostLog(kwargs, binary.KNOWN_BINARIES, unknown=False)
@@ -67,9 +65,8 @@ class Fmi2Entry:
         return super().get_integer(vrs) if read is None else read()
 
     def to_xml(self, model_options: dict[str, str] = dict()) -> Element:
-        """pythonfmu's model description with what it leaves out: units, display units,
-        min/max, exact starts, <UnitDefinitions> and a complete <ModelStructure>
-        (dependencies by 1-based index)."""
+        """pythonfmu's model description with the units, ranges, exact starts and
+        dependencies (by 1-based index) it leaves out."""
         root = super().to_xml(model_options)
         structure, unknowns = describe(root, self.variables, [
             e.find("Real" if v.is_real else "Integer")

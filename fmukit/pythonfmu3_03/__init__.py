@@ -5,7 +5,7 @@ owes to that version's defects, each active only under ``ACTIVE``:
   per exception: ``fmukit.entry`` takes the extra references;
 - every exception is fmi3Fatal: ``slave.Fmi3Entry.do_step`` returns fmi3Error for a
   refused step instead (fmi3Reset then works), and always returns a result;
-- it forwards log messages whatever the host's ``loggingOn``: ``fmukit.hostlog`` reads the
+- it forwards log messages whatever the host's ``loggingOn``: ``fmukit.entry.HostLog`` reads the
   flag and ``Fmi3Entry.log`` holds messages back while it is off;
 - its x86_64-linux binary frees its ``shared_ptr<PyState>`` twice at exit (``binary``,
   patched by ``fmubuild.exit_fix``);

@@ -4,7 +4,7 @@ which the logger itself never reads (``cppfmu::Logger::Log`` forwards every mess
 says not while logging is off). With another binary the flag is unknown, and the host is
 taken to hear (``slave.Fmi3Entry``): pythonfmu3 forwards.
 """
-from ..hostlog import Binary
+from ..entry import Binary
 
 # jmp finalizePythonInterpreter@plt  ->  ret. cppfmu::Logger holds its environment, its
 # callback and a shared_ptr<Settings>, whose pointer is 16 bytes into the logger;

@@ -13,10 +13,8 @@ from pythonfmu3 import Fmi3Causality, Fmi3Initial, Fmi3Slave, Fmi3Status, Fmi3St
 from pythonfmu3 import Fmi3Variability, Float64, Int32, String
 
 from .. import state
-from ..entry import fmi_entry
-from ..hostlog import HostLog
+from ..entry import HostLog, fmi_entry
 from ..registry import pythonfmu_variable
-from ..slave import CATEGORIES
 from ..variables import Var, describe
 from . import ACTIVE, binary
 
@@ -36,7 +34,6 @@ class Fmi3Entry:
     API, FMI_VERSION = "fmi3", 3
     STATUS_ERROR, STATUS_FATAL = Fmi3Status.error, Fmi3Status.fatal
     RELEASES_ON_EXCEPTION = ACTIVE
-    log_categories = {**Fmi3Slave.log_categories, **CATEGORIES}
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
@@ -101,11 +98,10 @@ class Fmi3Entry:
         self.time = saved["time"]
 
     def to_xml(self, model_options: dict[str, str] = dict()) -> Element:
-        """pythonfmu3's model description with what it leaves out: <UnitDefinitions> (else
-        fmpy refuses the units), display units, min/max, exact starts (it writes 16 digits)
-        and dependencies (its bare <Output> says every output depends on every input: an
-        algebraic loop to a master). ``time`` is moved last, so that an importer reading
-        dependencies as 1-based indices (OMSimulator) reads them right."""
+        """pythonfmu3's model description with <UnitDefinitions> (else fmpy refuses the
+        units), ranges, exact starts (it writes 16 digits) and dependencies (its bare
+        <Output>: every output on every input, an algebraic loop to a master); ``time`` last,
+        for an importer that reads dependencies as 1-based indices (OMSimulator)."""
         root = super().to_xml(model_options)
         listed = root.find("ModelVariables")
         elements = {e.get("name"): e for e in listed}
