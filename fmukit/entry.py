@@ -1,12 +1,11 @@
 """Every FMI entry point's error path: pythonfmu's made safe (``fmi_entry``), and the error
 told to the user where the host does not hear it (``HostLog``).
 
-Both pythonfmus turn every exception into a fatal status, and their C++ layers release the
-instance, its class and its log queue once per exception (a use-after-free that crashes the
-host later): where the adapter says so (``RELEASES_ON_EXCEPTION``) one extra reference is
-taken on each. pythonfmu 0.7 forwards log messages only while the host has debug logging
-on, pythonfmu3 0.3.4 whatever the host asked: ``HostLog`` reads the host's flag in
-pythonfmu's C++ logger, in a binary the adapter knows by SHA-256 (``binary.KNOWN_BINARIES``).
+Both pythonfmus' C++ layers release the instance, its class and its log queue once per
+exception (a use-after-free that crashes the host later): where the adapter says so
+(``RELEASES_ON_EXCEPTION``) one extra reference is taken on each. pythonfmu 0.7 forwards
+log messages only while the host has debug logging on, pythonfmu3 0.3.4 whatever the host
+asked: ``HostLog`` reads the host's flag in the binary's logger (``binary.KNOWN_BINARIES``).
 """
 from __future__ import annotations
 
@@ -23,9 +22,8 @@ from .refusals import Refused, explain, naming
 
 def fmi_entry(method: Callable | None = None, *,
               error_result: Callable[[], Any] | None = None) -> Callable:
-    """``method`` made safe, its refusal logged under its category (``fmukit.<cause>``);
-    with ``@fmi_entry(error_result=...)`` (FMI 3.0's doStep) a refusal returns
-    ``error_result()``, logged as an error, instead of raising."""
+    """``method`` made safe, a refusal logged under its category (``fmukit.<cause>``); with
+    ``error_result`` (FMI 3.0's doStep) it returns ``error_result()`` instead of raising."""
     if method is None:
         return functools.partial(fmi_entry, error_result=error_result)
 
@@ -77,12 +75,12 @@ class Binary:
 
 
 class HostLog:
-    """Where an FMU's errors reach its user: the host's logger (where its flag is found,
-    else if ``unknown``; always in the host's process), else standard error, never both."""
+    """Where an FMU's errors reach its user, from pythonfmu's keywords: the host's logger
+    (by its flag where found in a known binary, else if ``unknown``; always without a
+    ``logger``: a host in this process), else standard error, never both."""
 
     def __init__(self, kwargs: dict[str, Any], known_binaries: dict[str, Binary],
                  unknown: bool):
-        """From pythonfmu's keywords (without a ``logger``: a host in this process)."""
         logger, resources = kwargs.get("logger"), kwargs.get("resources")
         self._flag = None
         if logger and resources:

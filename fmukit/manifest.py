@@ -1,11 +1,7 @@
 """What an FMU built with fmukit carries about itself, ``resources/fmukit_manifest.json``
-(written by ``fmubuild``), and whether it is current here.
-
-The manifest names the model, its slave class, each Python module the FMU carries (file in
-the FMU, SHA-256 of its source) and their digest, the FMI version, the entry module the
-build wrote, the pythonfmu and options that built it and fmukit's version: no time, path or
-machine, so the same sources give the same manifest. Format 1 (before FMI 3.0) has no
-entry module; it is read so that ``staleness`` can say to rebuild.
+(written by ``fmubuild``; no time, path or machine, so the same sources give the same
+manifest), and whether it is current here. Format 1 (before FMI 3.0) has no entry module;
+it is read so that ``staleness`` can say to rebuild.
 """
 from __future__ import annotations
 

@@ -55,12 +55,6 @@ def explain(error: BaseException) -> str:
     return f"{where}:{frame.lineno} in {frame.name}: {type(error).__name__}: {error}"
 
 
-def reason(error: BaseException) -> str:
-    """``explain``, but a ValueError's message alone: a model raises ValueError to name the
-    value it refuses ('parameter Kp = nan is not finite')."""
-    return str(error) if isinstance(error, ValueError) else explain(error)
-
-
 @functools.cache
 def _not_users() -> tuple[Path, ...]:
     """Folders of code that is not the user's: the standard library, the installed

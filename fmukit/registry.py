@@ -1,12 +1,9 @@
 """A slave's variables by value reference: registered with pythonfmu (through the adapter's
-``fmi_variable``), and the plans that read or set a list of them, made once per list (a
-master asks for the same lists at every step).
-
-A plan gives what the FMI call gives in every state of the slave (NaN once it has failed),
-so a host in the same process may call it itself; a list no plan serves gets ``None``, and
-pythonfmu serves it. Model attributes are read with one ``operator.attrgetter``; other
-values each through their reader within one ``try``, and one by one through pythonfmu's
-getters (the slave's ``evaluate``, for outputs) where that fails.
+``fmi_variable``), and plans reading or setting a list of them, made once per list (a master
+asks for the same lists at every step). A plan gives what the FMI call gives in every state
+of the slave (NaN once it has failed), so a host in the same process may call it itself; a
+list no plan serves gets ``None`` (pythonfmu serves it). Model attributes are read with one
+``operator.attrgetter``, other values within one ``try``, else one by one as pythonfmu does.
 """
 from __future__ import annotations
 
@@ -41,13 +38,6 @@ class Registry:
             slave.register_variable(sv)
             self.by_vr[sv.value_reference] = var
 
-    def var(self, vr: int) -> Var:
-        """The variable with value reference ``vr``; ValueError if there is none."""
-        var = self.by_vr.get(vr)
-        if var is None:
-            raise ValueError(f"no variable has value reference {vr}")
-        return var
-
     def real_reader(self, vrs: list[int]) -> Reader | None:
         """The plan reading these Reals, or None if one is not a Real."""
         return self._planned(float, vrs)
@@ -73,50 +63,39 @@ class Registry:
         if not all(vr in by_vr and by_vr[vr].kind is kind for vr in vrs):
             return None
         declared = [by_vr[vr] for vr in vrs]
-        getters = [slave.vars[vr].getter for vr in vrs]
-
-        def each() -> list:             # NaN (0) for each value that cannot be read
-            return [kind(get()) for get in getters]
+        getters = [slave.vars[vr].getter for vr in vrs]     # NaN (0) where one cannot read
+        single, gets = len(vrs) == 1, None
         if kind is float and all(v.causality == "output" and not v.get for v in declared):
             attributes = operator.attrgetter(*(v.name for v in declared))
-            single = len(vrs) == 1
+        else:
+            gets = [v.get or operator.attrgetter(f"_model.{v.name}" if v.causality == "output"
+                                                 else v.name) for v in declared]
 
-            def model_attributes() -> list:   # one C-level call
-                model = slave._model
-                if model is None or slave.failure:
-                    return each()
-                values = attributes(model)
-                return [values] if single else list(values)
-            return model_attributes
-        gets = [v.get or operator.attrgetter(f"_model.{v.name}" if v.causality == "output"
-                                             else v.name) for v in declared]
-
-        def evaluated() -> list:
-            if slave._model is None or slave.failure:
-                return each()
-            try:
-                return [kind(get(slave)) for get in gets]
-            except (ValueError, ArithmeticError):
-                return each()
-        return evaluated
+        def read() -> list:
+            model = slave._model
+            if model is not None and not slave.failure:
+                try:
+                    if gets is not None:
+                        return [kind(get(slave)) for get in gets]
+                    values = attributes(model)                # one C-level call
+                    return [values] if single else list(values)
+                except (ValueError, ArithmeticError):
+                    pass
+            return [kind(get()) for get in getters]
+        return read
 
     def _writer(self, vrs: tuple[int, ...]) -> Writer | None:
         slave, by_vr = self._slave, self.by_vr
         if not all(vr in by_vr and by_vr[vr].is_real and by_vr[vr].causality == "input"
                    for vr in vrs):
             return None
-        names = tuple(by_vr[vr].name for vr in vrs)
-        sequence, attributes = slave.sequence, vars(slave)
-        properties = any(hasattr(type(slave), name) for name in names)
+        names, sequence = tuple(by_vr[vr].name for vr in vrs), slave.sequence
 
         def write(values: list[float]) -> None:
             if sequence.phase == "terminated":
                 slave._set(list(vrs), values, float)     # refused, naming the input
-            if properties:                               # set them through the class
-                for name, value in zip(names, values):
-                    setattr(slave, name, float(value))
-            else:                                        # plain attributes
-                attributes.update(zip(names, map(float, values)))
+            for name, value in zip(names, values):
+                setattr(slave, name, float(value))
         return write
 
 

@@ -12,12 +12,13 @@ as results. Calls out of sequence are refused and change nothing.
 """
 from __future__ import annotations
 
+import signal
 from dataclasses import dataclass
 from typing import Any, Callable, ClassVar, NoReturn
 
 from . import hostsignals, state
 from .entry import fmi_entry
-from .refusals import CAUSES, Refused, explain, naming, reason
+from .refusals import CAUSES, Refused, explain, naming
 from .registry import Registry
 from .timebase import MAX_TIME, on_time_base
 from .variables import Var, range_check
@@ -82,9 +83,7 @@ class ModelSlave:
     model_name: ClassVar[str]
     variables: ClassVar[tuple[Var, ...]]
     default_experiment = DefaultExperiment(start_time=0.0, stop_time=400.0, step_size=0.1)
-    # The adapter's: "fmi2" or "fmi3", its statuses, ``fmukit.entry``'s compensation, and
-    # its ``_host_log(kwargs)`` (a ``fmukit.entry.HostLog``) and ``fmi_variable(var,
-    # getter)`` (pythonfmu's variable; ``getter`` reads an output).
+    # The adapter's, with ``_host_log(kwargs)`` and ``fmi_variable(var, output_getter)``:
     API: ClassVar[str]
     STATUS_ERROR: ClassVar[Any]
     STATUS_FATAL: ClassVar[Any]
@@ -135,9 +134,8 @@ class ModelSlave:
         return self._model
 
     def _output(self, get: Callable[[Any], Any], undefined: Any) -> Any:
-        """An output's value, or NaN (0 if Integer) when it cannot be evaluated or the FMU
-        has failed: a read never fails (a failed getReal aborts libcosim); the call that
-        commits (exitInitializationMode, doStep) refuses instead."""
+        """An output's value, or NaN (0 if Integer) if the FMU has failed or it cannot be
+        evaluated: a read never fails (a failed getReal aborts libcosim)."""
         if self.failure:
             return undefined
         try:
@@ -150,8 +148,8 @@ class ModelSlave:
             return undefined
 
     def _unevaluable(self, get: Callable[[Any], Any], error: Exception) -> None:
-        """Fail the FMU for an output it cannot evaluate from valid inputs (with an invalid
-        input, the next doStep names the input instead)."""
+        """Fail the FMU for an output it cannot evaluate from valid inputs (else the next
+        doStep names the invalid input)."""
         try:
             self._check_inputs(self)
         except ValueError:
@@ -172,16 +170,18 @@ class ModelSlave:
         raise Refused(reason, cause) from error
 
     def interrupted(self, where: str, error: BaseException) -> Refused:
-        """Fail the FMU for a KeyboardInterrupt (or any BaseException) raised in its code
+        """Fail the FMU for a KeyboardInterrupt (SIGINT), an exception with a ``signal``
+        (``cosim.core.interrupt.Interrupted``) or any BaseException raised in its code
         during ``where``; the refusal to raise."""
-        number = hostsignals.interrupt_signal(error)
+        number = getattr(error, "signal",
+                         signal.SIGINT if isinstance(error, KeyboardInterrupt) else None)
         if not self.failure:
-            cause = f"interrupted by {number.name}" if number else explain(error)
+            cause = (explain(error) if number is None
+                     else f"interrupted by {signal.Signals(number).name}")
             self.failure = f"{where}: {cause}; the FMU has failed"
             self.failure_cause = "interrupted"
         return Refused(self.failure, self.failure_cause)
 
-    # -- FMI call sequence -----------------------------------------------------
     @fmi_entry
     def enter_initialization_mode(self) -> None:
         self.sequence.require("EnterInitializationMode", "instantiated")
@@ -198,7 +198,8 @@ class ModelSlave:
             self._model = self._started_model()   # ValueError names a bad parameter or input
         except Exception as error:            # reported now, refused at the first step
             at = "" if self.start_time is None else f" at t = {self.start_time}"
-            self._report(f"exitInitializationMode{at}: {reason(error)}; the FMU has failed",
+            why = str(error) if isinstance(error, ValueError) else explain(error)
+            self._report(f"exitInitializationMode{at}: {why}; the FMU has failed",
                          error.cause if isinstance(error, Refused) else "parameter")
 
     @fmi_entry
@@ -231,10 +232,12 @@ class ModelSlave:
         except BaseException as error:        # Ctrl-C or the like, raised in this FMU's code
             raise self.interrupted(f"doStep at t = {current_time}", error) from None
 
-    # -- setters and getters: refuse what the standard does not allow -----------
     def _set(self, vrs: list[int], values: list, convert: type) -> None:
+        """Set variables, refusing what the standard does not allow."""
         for vr in vrs:
-            self.sequence.check_settable(self.registry.var(vr))
+            if vr not in self.registry.by_vr:
+                raise ValueError(f"no variable has value reference {vr}")
+            self.sequence.check_settable(self.registry.by_vr[vr])
         for vr, value in zip(vrs, values):
             var = self.registry.by_vr[vr]
             if var.kind is not convert:
@@ -267,7 +270,6 @@ class ModelSlave:
     def get_boolean(self, vrs: list[int]) -> list[bool]:
         return super().get_boolean(vrs)
 
-    # -- FMU state ---------------------------------------------------------------
     @fmi_entry
     def _get_fmu_state(self) -> dict[str, Any]:
         return state.capture(self)

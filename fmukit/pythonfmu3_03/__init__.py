@@ -2,16 +2,15 @@
 owes to that version's defects, each active only under ``ACTIVE``:
 
 - its C++ ``handle_py_exception`` releases the instance, its class and its log queue once
-  per exception: ``fmukit.entry`` takes the extra references;
-- every exception is fmi3Fatal: ``slave.Fmi3Entry.do_step`` returns fmi3Error for a
-  refused step instead (fmi3Reset then works), and always returns a result;
-- it forwards log messages whatever the host's ``loggingOn``: ``fmukit.entry.HostLog`` reads the
-  flag and ``Fmi3Entry.log`` holds messages back while it is off;
+  per exception (``fmukit.entry`` takes extra references);
+- every exception is fmi3Fatal (``slave.Fmi3Entry.do_step`` returns fmi3Error for a refused
+  step instead, after which fmi3Reset works);
+- it forwards log messages whatever the host's ``loggingOn`` (``fmukit.entry.HostLog``
+  reads the flag; ``Fmi3Entry.log`` holds messages back while it is off);
 - its x86_64-linux binary frees its ``shared_ptr<PyState>`` twice at exit (``binary``,
   patched by ``fmubuild.exit_fix``);
-- its modelDescription.xml lacks units, ranges, exact starts and dependencies, and the
-  description, author and default experiment, which it reads from the instance only
-  (``Fmi3Entry`` adds them).
+- its modelDescription.xml lacks units, ranges, exact starts, dependencies, and the
+  description, author and default experiment, which it reads from the instance only.
 """
 from pythonfmu3 import __version__ as PYTHONFMU_VERSION
 

@@ -1,8 +1,6 @@
 """``Fmi3Entry``: the mixin that makes a ``ModelSlave`` an FMI 3.0 FMU of pythonfmu3 0.3.4
 (``class <Model>(Fmi3Entry, <Model>, Fmi3Slave)``: pythonfmu3 finds it by a regular
-expression on the ``class`` line). It adds the independent variable ``time`` (value
-reference 0, so a variable's reference is its FMI 2.0 twin's plus one); pythonfmu3 drops
-the start time, so messages name none.
+expression on the ``class`` line), with the independent variable ``time``.
 """
 from __future__ import annotations
 
@@ -39,13 +37,14 @@ class Fmi3Entry:
         super().__init__(**kwargs)
         for attribute in _FROM_CLASS:
             setattr(self, attribute, getattr(type(self), attribute, None))
-        self.start_time = None                 # not given by pythonfmu3
+        self.start_time = None                 # pythonfmu3 drops it: messages name none
 
     def _host_log(self, kwargs: dict[str, Any]) -> HostLog:
         return HostLog(kwargs, binary.KNOWN_BINARIES, unknown=True)
 
     def _before_variables(self) -> None:
-        """``time``, registered first: value reference 0 (``to_xml`` writes it last)."""
+        """``time``, registered first: value reference 0, so that a variable's reference is
+        its FMI 2.0 twin's plus one (``to_xml`` writes it last)."""
         self.time = 0.0
         self.register_variable(Float64("time", causality=Fmi3Causality.independent,
                                        variability=Fmi3Variability.continuous,
