@@ -53,10 +53,12 @@ class Registry:
     def _planned(self, kind: type | None, vrs: list[int]) -> Reader | Writer | None:
         """The plan reading ``kind`` (None: writing), compiled the first time."""
         key = (kind, *vrs)
-        if key not in self._plans:
-            self._plans[key] = self._writer(key[1:]) if kind is None else self._reader(
-                key[1:], kind)
-        return self._plans[key]
+        try:
+            return self._plans[key]
+        except KeyError:
+            plan = self._plans[key] = (self._writer(key[1:]) if kind is None
+                                       else self._reader(key[1:], kind))
+            return plan
 
     def _reader(self, vrs: tuple[int, ...], kind: type) -> Reader | None:
         slave, by_vr = self._slave, self.by_vr
@@ -64,21 +66,22 @@ class Registry:
             return None
         declared = [by_vr[vr] for vr in vrs]
         getters = [slave.vars[vr].getter for vr in vrs]     # NaN (0) where one cannot read
-        single, gets = len(vrs) == 1, None
+        gets = [v.get or operator.attrgetter(f"_model.{v.name}" if v.causality == "output"
+                                             else v.name) for v in declared]
+        single = len(vrs) == 1                           # a feedthrough output, typically
         if kind is float and all(v.causality == "output" and not v.get for v in declared):
-            attributes = operator.attrgetter(*(v.name for v in declared))
-        else:
-            gets = [v.get or operator.attrgetter(f"_model.{v.name}" if v.causality == "output"
-                                                 else v.name) for v in declared]
+            attributes, gets = operator.attrgetter(*(v.name for v in declared)), None
 
         def read() -> list:
             model = slave._model
             if model is not None and not slave.failure:
                 try:
-                    if gets is not None:
-                        return [kind(get(slave)) for get in gets]
-                    values = attributes(model)                # one C-level call
-                    return [values] if single else list(values)
+                    if gets is None:
+                        values = attributes(model)            # one C-level call
+                        return [values] if single else list(values)
+                    if single:
+                        return [kind(gets[0](slave))]
+                    return [kind(get(slave)) for get in gets]
                 except (ValueError, ArithmeticError):
                     pass
             return [kind(get()) for get in getters]
