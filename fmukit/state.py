@@ -1,6 +1,7 @@
 """Saved FMU states as plain dicts (pythonfmu serialises them as JSON): the phase, every
-parameter and input, the model's ``snapshot()`` and the failure, if any. Restoring rebuilds
-the model from the parameters and hands it the snapshot: the run continues bit for bit.
+registered variable but the outputs (parameters, inputs, FMI 3.0's ``time``), the model's
+``snapshot()`` and the failure, if any. Restoring rebuilds the model from the parameters and
+hands it the snapshot: the run continues bit for bit.
 """
 from __future__ import annotations
 
@@ -11,8 +12,8 @@ from typing import Any
 def capture(slave: Any) -> dict[str, Any]:
     """The whole state of a ``ModelSlave``."""
     return {"phase": slave.sequence.phase,
-            "values": {v.name: getattr(slave, v.name) for v in slave.variables
-                       if v.causality != "output"},
+            "values": {v.name: getattr(slave, v.name) for v in slave.vars.values()
+                       if v.causality.name != "output"},
             "model": slave._model.snapshot() if slave._model is not None else None,
             "failure": slave.failure, "failure_cause": slave.failure_cause}
 

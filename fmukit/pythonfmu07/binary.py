@@ -1,7 +1,6 @@
-"""pythonfmu 0.7.0's linux64 binary as fmukit knows it: where ``fmubuild.exit_fix`` patches
-its exit-time heap corruption, and where its logger keeps the host's debug-logging flag,
-which alone decides what the host hears. With another binary the flag cannot be trusted,
-and the host is taken not to hear (``slave.Fmi2Entry``): errors go to standard error too.
+"""pythonfmu 0.7.0's linux64 binary: where ``fmubuild.exit_fix`` patches its exit-time heap
+corruption, and where its logger keeps the debug-logging flag that alone decides what the
+host hears. With another binary the host is taken not to hear: errors go to standard error.
 """
 from ..entry import Binary
 

@@ -10,7 +10,6 @@ from xml.etree.ElementTree import Element, SubElement
 from pythonfmu3 import Fmi3Causality, Fmi3Initial, Fmi3Slave, Fmi3Status, Fmi3StepResult
 from pythonfmu3 import Fmi3Variability, Float64, Int32, String
 
-from .. import state
 from ..entry import HostLog, fmi_entry
 from ..registry import pythonfmu_variable
 from ..variables import Var, describe
@@ -86,15 +85,6 @@ class Fmi3Entry:
     def get_int32(self, vrs: list[int]) -> list[int]:
         read = self.plans.integer_reader(vrs)
         return super().get_int32(vrs) if read is None else read()
-
-    @fmi_entry
-    def _get_fmu_state(self) -> dict[str, Any]:
-        return {**state.capture(self), "time": self.time}
-
-    @fmi_entry
-    def _set_fmu_state(self, saved: dict[str, Any]) -> None:
-        state.restore(self, saved)
-        self.time = saved["time"]
 
     def to_xml(self, model_options: dict[str, str] = dict()) -> Element:
         """pythonfmu3's model description with <UnitDefinitions> (else fmpy refuses the
