@@ -66,13 +66,6 @@ class Binary:
     logger_offset: int          # where the host's logging flag is, from the logger
     through_pointer: bool = False   # there is a pointer to the flag instead
 
-    def flag(self, logger: int) -> ctypes.c_bool | None:
-        """The host's logging flag in the logger at address ``logger``."""
-        address = logger + self.logger_offset
-        if self.through_pointer:
-            address = ctypes.c_void_p.from_address(address).value
-        return ctypes.c_bool.from_address(address) if address else None
-
 
 class HostLog:
     """Where an FMU's errors reach its user, from pythonfmu's keywords: the host's logger
@@ -82,17 +75,13 @@ class HostLog:
     def __init__(self, kwargs: dict[str, Any], known_binaries: dict[str, Binary],
                  unknown: bool):
         logger, resources = kwargs.get("logger"), kwargs.get("resources")
-        self._flag = None
-        if logger and resources:
-            fixed = {b.fixed_sha256: b for b in known_binaries.values()}
-            for binary in (Path(resources).parent / "binaries").glob("*/*"):
-                try:
-                    known = fixed.get(hashlib.sha256(binary.read_bytes()).hexdigest())
-                except OSError:
-                    continue
-                if known is not None:
-                    self._flag = known.flag(logger)
-                    break
+        fixed = {b.fixed_sha256: b for b in known_binaries.values()}
+        binaries = (Path(resources).parent / "binaries").glob("*/*") if logger and resources else ()
+        known = next((fixed[d] for d in map(_sha256, binaries) if d in fixed), None)
+        address = None if known is None else logger + known.logger_offset
+        if known is not None and known.through_pointer:
+            address = ctypes.c_void_p.from_address(address).value
+        self._flag = ctypes.c_bool.from_address(address) if address else None
         self._in_process, self._unknown = "logger" not in kwargs, unknown
         self._told = ""
 
@@ -109,3 +98,11 @@ class HostLog:
             sys.stderr.write(naming(instance_name, message) + "\n")   # one write: hosts
             sys.stderr.flush()                              # step FMUs in parallel threads
             self._told = message
+
+
+def _sha256(path: Path) -> str | None:
+    """The file's SHA-256, None if it cannot be read."""
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError:
+        return None
