@@ -1,7 +1,5 @@
 """``python -m fmukit.build``: the build command's published name (``fmubuild.cli``); host-only."""
-import sys
-
 from fmubuild.cli import main
 
 if __name__ == "__main__":
-    sys.exit(main())
+    raise SystemExit(main())

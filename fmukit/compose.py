@@ -1,11 +1,6 @@
-"""An FMU's class composed in code, for a host that runs the model in its own process.
-
-``fmu_class(PDAutopilotSlave, 3)(instance_name="pd")`` is the class the FMU's entry module
-defines: ``class <Model>(Fmi<N>Entry, <Model>, Fmi<N>Slave)``. Without pythonfmu's
-``logger`` keyword the slave logs to ``log_queue`` only. Such a host uses ``registry.by_vr``
-(FMI 3.0's value references are FMI 2.0's plus one: ``time`` is 0), ``plans``,
-``fmukit.entry.unguarded(slave.do_step)`` (raises ``Refused``), ``TYPE_NAMES`` and
-``FMI_VERSION``.
+"""An FMU's class composed in code, as its entry module defines it, for a host that runs the
+model in its own process: the slave logs to ``log_queue`` only; the host uses ``registry``
+(FMI 3.0's value references are FMI 2.0's plus one), ``plans`` and ``fmukit.entry.unguarded``.
 """
 from __future__ import annotations
 

@@ -1,17 +1,20 @@
-"""``fmi_entry``, through which every FMI entry point of a slave passes: pythonfmu's error path
-made safe.
+"""Every FMI entry point's error path: pythonfmu's made safe (``fmi_entry``), and the error
+told to the user where the host does not hear it (``HostLog``).
 
-Both pythonfmus turn every exception into a fatal status, and their C++ layers release the
-instance, its class and its log queue once per exception (a use-after-free that crashes the
-host later): where the adapter says so (``RELEASES_ON_EXCEPTION``) one extra reference is
-taken on each. The refusal is logged under its category (``fmukit.<cause>``), or written to
-standard error when the host does not listen. With ``error_result`` (FMI 3.0's doStep) a
-refusal returns that result, logged as an error, instead of raising.
+Both pythonfmus' C++ layers release the instance, its class and its log queue once per
+exception (a use-after-free that crashes the host later): where the adapter says so
+(``RELEASES_ON_EXCEPTION``) one extra reference is taken on each. pythonfmu 0.7 forwards
+log messages only while the host has debug logging on, pythonfmu3 0.3.4 whatever the host
+asked: ``HostLog`` reads the host's flag in the binary's logger (``binary.KNOWN_BINARIES``).
 """
 from __future__ import annotations
 
 import ctypes
 import functools
+import hashlib
+import sys
+from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, Callable
 
 from .refusals import Refused, explain, naming
@@ -19,9 +22,8 @@ from .refusals import Refused, explain, naming
 
 def fmi_entry(method: Callable | None = None, *,
               error_result: Callable[[], Any] | None = None) -> Callable:
-    """Let an exception reach pythonfmu's C++ layer without corrupting the host; with
-    ``error_result``, a refusal returns ``error_result()`` instead (see the module
-    docstring). Usable as ``@fmi_entry`` and ``@fmi_entry(error_result=...)``."""
+    """``method`` made safe, a refusal logged under its category (``fmukit.<cause>``); with
+    ``error_result`` (FMI 3.0's doStep) it returns ``error_result()`` instead of raising."""
     if method is None:
         return functools.partial(fmi_entry, error_result=error_result)
 
@@ -51,3 +53,56 @@ def unguarded(entry_point: Callable) -> Callable:
     """The bound method behind an ``fmi_entry``: for a host in the same process, which
     handles exceptions itself (pythonfmu's C++ layer is not there)."""
     return entry_point.__func__.__wrapped__.__get__(entry_point.__self__)
+
+
+@dataclass(frozen=True)
+class Binary:
+    """A pythonfmu binary fmukit knows inside out."""
+
+    offset: int                 # file offset of onLibraryUnload
+    code: bytes                 # its first instructions
+    patched: bytes              # what they become (fmubuild.exit_fix)
+    fixed_sha256: str           # the binary once patched
+    logger_offset: int          # where the host's logging flag is, from the logger
+    through_pointer: bool = False   # there is a pointer to the flag instead
+
+
+class HostLog:
+    """Where an FMU's errors reach its user, from pythonfmu's keywords: the host's logger
+    (by its flag where found in a known binary, else if ``unknown``; always without a
+    ``logger``: a host in this process), else standard error, never both."""
+
+    def __init__(self, kwargs: dict[str, Any], known_binaries: dict[str, Binary],
+                 unknown: bool):
+        logger, resources = kwargs.get("logger"), kwargs.get("resources")
+        fixed = {b.fixed_sha256: b for b in known_binaries.values()}
+        binaries = (Path(resources).parent / "binaries").glob("*/*") if logger and resources else ()
+        known = next((fixed[d] for d in map(_sha256, binaries) if d in fixed), None)
+        address = None if known is None else logger + known.logger_offset
+        if known is not None and known.through_pointer:
+            address = ctypes.c_void_p.from_address(address).value
+        self._flag = ctypes.c_bool.from_address(address) if address else None
+        self._in_process, self._unknown = "logger" not in kwargs, unknown
+        self._told = ""
+
+    def hears(self) -> bool:
+        """Whether the host receives this FMU's log messages now."""
+        if self._in_process:
+            return True
+        return bool(self._flag.value) if self._flag is not None else self._unknown
+
+    def tell(self, instance_name: str, message: str) -> None:
+        """Write an error to standard error if the host will not hear it; once, not again
+        for each following call that fails for the same reason."""
+        if not self.hears() and message != self._told:
+            sys.stderr.write(naming(instance_name, message) + "\n")   # one write: hosts
+            sys.stderr.flush()                              # step FMUs in parallel threads
+            self._told = message
+
+
+def _sha256(path: Path) -> str | None:
+    """The file's SHA-256, None if it cannot be read."""
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError:
+        return None

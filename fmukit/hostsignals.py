@@ -1,13 +1,11 @@
 """Ctrl-C while an FMU computes: the host's signal handler runs in the host's code, not ours.
 
-A pythonfmu FMU runs in its host's interpreter, where a KeyboardInterrupt would surface in
-FMU code (failing the FMU) or escape to pythonfmu's C++ layer (which loses it and releases
-the instance once too often). So ``defer_host_handlers`` wraps the host's Python handlers
-of SIGINT and SIGTERM: a signal that arrives in FMU code is kept pending and signalled
-again each millisecond until the main thread runs host code. A handler with a true
-``safe_in_fmu_code`` attribute is left as it is. In a host that is not Python (pythonfmu
-started the interpreter in a thread of its own), SIGINT gets its default action back in
-the C runtime Python installed its handler with (``ucrtbase`` on Windows).
+In FMU code a KeyboardInterrupt would fail the FMU or escape to pythonfmu's C++ layer (which
+loses it and releases the instance once too often). So ``defer_host_handlers`` wraps the
+host's Python handlers of SIGINT and SIGTERM (but one with a true ``safe_in_fmu_code``): a
+signal that arrives in FMU code is signalled again each millisecond until the main thread
+runs host code. In a host that is not Python (pythonfmu started the interpreter in a thread
+of its own), SIGINT gets its default action back.
 """
 from __future__ import annotations
 
@@ -64,8 +62,8 @@ def _signal_again() -> None:
 
 
 def defer_host_handlers() -> None:
-    """Wrap the host's Python handlers of SIGINT and SIGTERM (see the module docstring);
-    in a host that is not Python, give SIGINT its default action back."""
+    """Wrap the host's Python handlers (see the module docstring), or in a host that is
+    not Python, give SIGINT its default action back."""
     if not sys.orig_argv:                     # Python embedded by pythonfmu itself
         _restore_default_sigint()
     elif threading.current_thread() is threading.main_thread():
@@ -76,25 +74,13 @@ def defer_host_handlers() -> None:
                 signal.signal(number, _DeferringHandler(handler))
 
 
-def _c_runtime() -> ctypes.CDLL:
-    """The C library whose ``signal`` installed Python's handlers: the Universal CRT on
-    Windows (``msvcrt.dll`` has a signal table of its own), elsewhere the process's."""
-    return ctypes.CDLL("ucrtbase") if sys.platform == "win32" else ctypes.CDLL(None)
-
-
 def _restore_default_sigint() -> None:
     """Undo Python's start-up SIGINT handler at the operating-system level (Python's own
-    record of it stays as it was)."""
+    record of it stays as it was), in the C library whose ``signal`` installed it: the
+    Universal CRT on Windows (``msvcrt.dll`` has a signal table of its own), elsewhere the
+    process's."""
     if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
-        libc = _c_runtime()
+        libc = ctypes.CDLL("ucrtbase") if sys.platform == "win32" else ctypes.CDLL(None)
         libc.signal.argtypes = (ctypes.c_int, ctypes.c_void_p)
         libc.signal.restype = ctypes.c_void_p
         libc.signal(signal.SIGINT, None)      # SIG_DFL
-
-
-def interrupt_signal(error: BaseException) -> signal.Signals | None:
-    """The signal behind an interrupt: SIGINT for KeyboardInterrupt, an exception's own
-    ``signal`` attribute (``cosim.core.interrupt.Interrupted``), else None."""
-    number = getattr(error, "signal", signal.SIGINT if isinstance(error, KeyboardInterrupt)
-                     else None)
-    return None if number is None else signal.Signals(number)

@@ -1,12 +1,7 @@
-"""What an FMU built with fmukit carries about itself, ``resources/fmukit_manifest.json``, and
-whether it is current here.
-
-The manifest names the model, its slave class (module, class), each Python module the FMU
-carries (file in the FMU, SHA-256 of its source) and their digest, the FMI version, the
-entry module the build wrote, the pythonfmu and options that built it and fmukit's
-version. No time, path or machine is in it: the same sources give the same manifest.
-Format 1 (before FMI 3.0) has no entry module; it is read so that ``staleness`` can say
-to rebuild. This module only reads; ``fmubuild`` writes manifests.
+"""What an FMU built with fmukit carries about itself, ``resources/fmukit_manifest.json``
+(written by ``fmubuild``; no time, path or machine, so the same sources give the same
+manifest), and whether it is current here. Format 1 (before FMI 3.0) has no entry module;
+it is read so that ``staleness`` can say to rebuild.
 """
 from __future__ import annotations
 
@@ -84,8 +79,8 @@ def staleness(manifest: Manifest,
               entry_source: Callable[[Manifest], str] | None = None) -> str | None:
     """Why the FMU is not current in this process, or None: built by another fmukit, or a
     module it carries is not importable here or has another source; with ``entry_source``
-    (the build's, ``fmubuild.manifest.entry_source``), also its entry module is not the
-    one the build writes."""
+    (``fmubuild.manifest.entry_source``), also its entry module is not the one the build
+    writes."""
     if manifest.version != version():
         return (f"it was built by fmukit {manifest.version or 'of an older version'}, this "
                 f"is fmukit {version()} (rebuild it)")

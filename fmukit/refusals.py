@@ -2,7 +2,7 @@
 
 The cause reaches the host as the log category ``fmukit.<cause>``, so a host tells a bad
 parameter from a NaN input without reading the message. An exception of the model's own
-code is located at its innermost frame in the user's code (``located``).
+code is located at its innermost frame in the user's code (``explain``).
 """
 from __future__ import annotations
 
@@ -41,27 +41,18 @@ class Refused(ValueError):
 
 def explain(error: BaseException) -> str:
     """A refusal's message, or where the model's exception was raised, its type and message
-    ('my_autopilot.py:42 in step: ZeroDivisionError: float division by zero')."""
+    ('my_autopilot.py:42 in step: ZeroDivisionError: float division by zero'): the innermost
+    frame in the user's code (else of all), its file relative to its folder on sys.path."""
     if isinstance(error, Refused):
         return str(error)
-    where = located(error)
-    return f"{where + ': ' if where else ''}{type(error).__name__}: {error}"
-
-
-def reason(error: BaseException) -> str:
-    """``explain``, but a ValueError's message alone: a model raises ValueError to name the
-    value it refuses ('parameter Kp = nan is not finite')."""
-    return str(error) if isinstance(error, ValueError) else explain(error)
-
-
-def located(error: BaseException) -> str:
-    """'file.py:42 in function' of the innermost frame in the user's code (else of all; ''
-    without a traceback), the file relative to its folder on sys.path."""
     frames = traceback.extract_tb(error.__traceback__)
     if not frames:
-        return ""
+        return f"{type(error).__name__}: {error}"
     frame = next((f for f in reversed(frames) if _users(f.filename)), frames[-1])
-    return f"{_short(frame.filename)}:{frame.lineno} in {frame.name}"
+    path = Path(frame.filename).resolve()
+    inside = [r for r in (Path(p or ".").resolve() for p in sys.path) if r in path.parents]
+    where = path.relative_to(max(inside, key=lambda r: len(r.parts))) if inside else path.name
+    return f"{where}:{frame.lineno} in {frame.name}: {type(error).__name__}: {error}"
 
 
 @functools.cache
@@ -69,22 +60,13 @@ def _not_users() -> tuple[Path, ...]:
     """Folders of code that is not the user's: the standard library, the installed
     packages (numpy, pythonfmu) and fmukit itself."""
     paths = sysconfig.get_paths()
-    return tuple({Path(paths[k]).resolve() for k in ("stdlib", "platstdlib", "purelib",
-                                                     "platlib")} | {Path(__file__).resolve().parent})
+    return (*{Path(paths[k]).resolve() for k in ("stdlib", "platstdlib", "purelib", "platlib")},
+            Path(__file__).resolve().parent)
 
 
 def _users(filename: str) -> bool:
     path = Path(filename).resolve()
     return not filename.startswith("<") and not any(f in path.parents for f in _not_users())
-
-
-def _short(filename: str) -> str:
-    """``filename`` relative to the deepest folder of sys.path that holds it, else its name."""
-    path = Path(filename).resolve()
-    roots = [Path(p or ".").resolve() for p in sys.path]
-    inside = [r for r in roots if r in path.parents]
-    return str(path.relative_to(max(inside, key=lambda r: len(r.parts)))) if inside \
-        else path.name
 
 
 def naming(instance_name: str, text: str) -> str:

@@ -1,57 +1,105 @@
-"""The slave's variables registered with pythonfmu (through the adapter's ``fmi_variable``)
-and indexed by value reference. Parameters and inputs are attributes of the slave; outputs
-are read through the slave's ``evaluate(get, undefined)``.
+"""A slave's variables by value reference: registered with pythonfmu (through the adapter's
+``fmi_variable``), and plans reading or setting a list of them, made once per list (a master
+asks for the same lists at every step). A plan gives what the FMI call gives in every state
+of the slave (NaN once it has failed), so a host in the same process may call it itself; a
+list no plan serves gets ``None`` (pythonfmu serves it). Model attributes are read with one
+``operator.attrgetter``, other values within one ``try``, else one by one as pythonfmu does.
 """
 from __future__ import annotations
 
 import math
+import operator
 from typing import Any, Callable
 
 from .variables import Var
 
-Evaluate = Callable[[Callable[[Any], Any], Any], Any]
+Reader = Callable[[], list]
+Writer = Callable[[list[float]], None]
 
 
 class Registry:
-    """Every variable of a slave, by value reference, with its pythonfmu getter."""
+    """Every variable of a slave by value reference (``by_vr``), and its cached plans."""
 
-    def __init__(self, slave: Any, variables: tuple[Var, ...], evaluate: Evaluate):
+    def __init__(self, slave: Any, variables: tuple[Var, ...],
+                 evaluate: Callable[[Callable[[Any], Any], Any], Any]):
+        self._slave = slave
+        self._plans: dict[tuple, Reader | Writer | None] = {}
         self.by_vr: dict[int, Var] = {}
-        self.real_getters: dict[int, Callable[[], float]] = {}
-        self.integer_getters: dict[int, Callable[[], int]] = {}
-        self.real_inputs: dict[int, str] = {}       # Real inputs: value reference -> name
-        self.model_attributes: dict[int, str] = {}  # Real outputs that are model attributes
         for var in variables:
-            self._register(slave, var, evaluate)
+            getter = None
+            if var.causality == "output":
+                get = var.get or (lambda s, name=var.name: getattr(s._model, name))
 
-    def _register(self, slave: Any, var: Var, evaluate: Evaluate) -> None:
-        getter = None
-        if var.causality == "output":
-            get = var.get or (lambda s, name=var.name: getattr(s._model, name))
+                def getter(get=get, undefined=math.nan if var.is_real else 0) -> Any:
+                    return evaluate(get, undefined)
+            else:
+                setattr(slave, var.name, var.start)
+            sv = slave.fmi_variable(var, getter)
+            slave.register_variable(sv)
+            self.by_vr[sv.value_reference] = var
 
-            def getter(get=get, undefined=math.nan if var.is_real else 0) -> Any:
-                return evaluate(get, undefined)
-        else:
-            setattr(slave, var.name, var.start)
-        sv = slave.fmi_variable(var, getter)
-        slave.register_variable(sv)
-        vr = sv.value_reference
-        self.by_vr[vr] = var
-        if var.is_real:
-            self.real_getters[vr] = sv.getter
-            if var.causality == "input":
-                self.real_inputs[vr] = var.name
-            elif var.causality == "output" and var.get is None:
-                self.model_attributes[vr] = var.name
-        elif var.kind is int:
-            self.integer_getters[vr] = sv.getter
+    def real_reader(self, vrs: list[int]) -> Reader | None:
+        """The plan reading these Reals, or None if one is not a Real."""
+        return self._planned(float, vrs)
 
-    def var(self, vr: int) -> Var:
-        """The variable with value reference ``vr``; ValueError if there is none."""
-        var = self.by_vr.get(vr)
-        if var is None:
-            raise ValueError(f"no variable has value reference {vr}")
-        return var
+    def integer_reader(self, vrs: list[int]) -> Reader | None:
+        """The plan reading these Integers, or None if one is not an Integer."""
+        return self._planned(int, vrs)
+
+    def input_writer(self, vrs: list[int]) -> Writer | None:
+        """The plan setting these Real inputs, or None if one is not a Real input."""
+        return self._planned(None, vrs)
+
+    def _planned(self, kind: type | None, vrs: list[int]) -> Reader | Writer | None:
+        """The plan reading ``kind`` (None: writing), compiled the first time."""
+        key = (kind, *vrs)
+        try:
+            return self._plans[key]
+        except KeyError:
+            plan = self._plans[key] = (self._writer(key[1:]) if kind is None
+                                       else self._reader(key[1:], kind))
+            return plan
+
+    def _reader(self, vrs: tuple[int, ...], kind: type) -> Reader | None:
+        slave, by_vr = self._slave, self.by_vr
+        if not all(vr in by_vr and by_vr[vr].kind is kind for vr in vrs):
+            return None
+        declared = [by_vr[vr] for vr in vrs]
+        getters = [slave.vars[vr].getter for vr in vrs]     # NaN (0) where one cannot read
+        gets = [v.get or operator.attrgetter(f"_model.{v.name}" if v.causality == "output"
+                                             else v.name) for v in declared]
+        single = len(vrs) == 1                           # a feedthrough output, typically
+        if kind is float and all(v.causality == "output" and not v.get for v in declared):
+            attributes, gets = operator.attrgetter(*(v.name for v in declared)), None
+
+        def read() -> list:
+            model = slave._model
+            if model is not None and not slave.failure:
+                try:
+                    if gets is None:
+                        values = attributes(model)            # one C-level call
+                        return [values] if single else list(values)
+                    if single:
+                        return [kind(gets[0](slave))]
+                    return [kind(get(slave)) for get in gets]
+                except (ValueError, ArithmeticError):
+                    pass
+            return [kind(get()) for get in getters]
+        return read
+
+    def _writer(self, vrs: tuple[int, ...]) -> Writer | None:
+        slave, by_vr = self._slave, self.by_vr
+        if not all(vr in by_vr and by_vr[vr].is_real and by_vr[vr].causality == "input"
+                   for vr in vrs):
+            return None
+        names, sequence = tuple(by_vr[vr].name for vr in vrs), slave.sequence
+
+        def write(values: list[float]) -> None:
+            if sequence.phase == "terminated":
+                slave._set(list(vrs), values, float)     # refused, naming the input
+            for name, value in zip(names, values):
+                setattr(slave, name, float(value))
+        return write
 
 
 def pythonfmu_variable(var: Var, getter: Callable[[], Any] | None, kind: type,

@@ -1,37 +1,70 @@
-"""``ModelSlave``: the base of every FMU in this project, the same for FMI 2.0 and FMI 3.0.
-
-An FMU class lists its ``variables`` (``fmukit.variables.Var``) and supplies
-``build_model`` (from the parameters alone), ``step_model`` and, if the initial state
-depends on inputs, ``start_model``; the model supplies ``snapshot``/``restore``. The FMI
-version and pythonfmu are the adapter's, a mixin composed by the FMU's entry module or
-``fmukit.compose.fmu_class``.
+"""``ModelSlave``: the base of every FMU in this project, the same for FMI 2.0 and FMI 3.0,
+and its FMI call sequence. An FMU class lists its ``variables`` and supplies ``build_model``
+(from the parameters alone), ``step_model`` and, if the initial state depends on inputs,
+``start_model``; the model supplies ``snapshot``/``restore``. The adapter's mixin adds the
+FMI version and pythonfmu (``fmukit.compose``).
 
 Refusals (docs/robustness.md): invalid parameters are reported at exitInitializationMode
-(libcosim ends its process if that call fails) and refused at the first doStep; an
-invalid input or step, or the model's exception, fails the FMU. A failed FMU reads NaN and
-refuses every step with the first reason until reset, so a host that ignores statuses
-cannot pass the run off as results. Calls out of sequence are refused and change nothing.
-Every FMI 2.0 refusal is fmi2Fatal (pythonfmu 0.7's fmi2Discard would pass for a normal
-end); an FMI 3.0 refused step is fmi3Error, every other refusal fmi3Fatal.
+(libcosim ends its process if that call fails) and refused at the first doStep; an invalid
+input or step, or the model's exception, fails the FMU: it reads NaN and refuses every step
+with the first reason until reset, so a host that ignores statuses cannot pass the run off
+as results. Calls out of sequence are refused and change nothing.
 """
 from __future__ import annotations
 
+import signal
 from dataclasses import dataclass
 from typing import Any, Callable, ClassVar, NoReturn
 
 from . import hostsignals, state
 from .entry import fmi_entry
-from .fastpath import FastPaths
-from .refusals import CAUSES, Refused, explain, naming, reason
+from .refusals import CAUSES, Refused, explain, naming
 from .registry import Registry
-from .sequence import CallSequence
 from .timebase import MAX_TIME, on_time_base
 from .variables import Var, range_check
 
 __all__ = ["DefaultExperiment", "ModelSlave", "Refused", "Var"]
 
 CATEGORIES = {f"fmukit.{cause}": f"Refused: {meaning}." for cause, meaning in CAUSES.items()}
-"""The log categories of every refusal's cause, which each adapter declares."""
+"""The log categories of every refusal's cause, beside pythonfmu's."""
+_AFTER = {"instantiated": "{api}{instantiate} or {api}Reset",
+          "initialization": "{api}EnterInitializationMode",
+          "step": "{api}ExitInitializationMode", "terminated": "{api}Terminate"}
+_INSTANTIATE = {"fmi2": "Instantiate", "fmi3": "InstantiateCoSimulation"}
+
+
+class CallSequence:
+    """The phase of one FMU instance (instantiated -> initialization -> step -> terminated;
+    reset makes a new slave) and the rules of the standard (``api``: "fmi2" or "fmi3")."""
+
+    def __init__(self, api: str, phase: str = "instantiated"):
+        self.api, self.phase = api, phase
+
+    def require(self, call: str, *phases: str) -> None:
+        """Refused naming the call (``Terminate``: fmi2Terminate) and the phase unless the
+        phase is one of ``phases``."""
+        if self.phase not in phases:
+            after = " or ".join(_AFTER[p].format(api=self.api, instantiate=_INSTANTIATE[self.api])
+                                for p in phases)
+            raise Refused(f"{self.api}{call} is not allowed in phase '{self.phase}' (FMI "
+                          f"{self.api[3:]}.0 allows it after {after})", "call")
+
+    def require_step(self) -> None:
+        """Refused unless doStep is allowed now."""
+        if self.phase != "step":
+            raise Refused(f"doStep called in phase '{self.phase}': call "
+                          "exitInitializationMode first, and not after terminate", "call")
+
+    def check_settable(self, var: Var) -> None:
+        """Refused naming ``var`` if the standard forbids setting it now."""
+        if var.causality == "output":
+            raise Refused(f"{var.name} is an output and cannot be set", "call", var.name)
+        if var.causality == "parameter" and self.phase not in ("instantiated",
+                                                               "initialization"):
+            raise Refused(f"parameter {var.name} is fixed after initialisation "
+                          f"(phase '{self.phase}')", "call", var.name)
+        if self.phase == "terminated":
+            raise Refused(f"cannot set {var.name} after terminate", "call", var.name)
 
 
 @dataclass(frozen=True)
@@ -50,7 +83,7 @@ class ModelSlave:
     model_name: ClassVar[str]
     variables: ClassVar[tuple[Var, ...]]
     default_experiment = DefaultExperiment(start_time=0.0, stop_time=400.0, step_size=0.1)
-    # The adapter's: "fmi2" or "fmi3", its statuses, and ``fmukit.entry``'s compensation.
+    # The adapter's, with ``_host_log(kwargs)`` and ``fmi_variable(var, output_getter)``:
     API: ClassVar[str]
     STATUS_ERROR: ClassVar[Any]
     STATUS_FATAL: ClassVar[Any]
@@ -59,6 +92,7 @@ class ModelSlave:
     def __init__(self, **kwargs):
         super().__init__(**kwargs)            # pythonfmu's slave, next in the FMU class's MRO
         self.modelName = self.model_name
+        self.log_categories = {**self.log_categories, **CATEGORIES}
         self.sequence = CallSequence(self.API)
         self.host_log = self._host_log(kwargs)
         self.failure: str | None = None       # why the FMU failed; until reset
@@ -68,25 +102,13 @@ class ModelSlave:
         hostsignals.defer_host_handlers()
         self._model = None
         self._before_variables()
-        self.registry = Registry(self, self.variables, self._output)
-        self.plans = FastPaths(self, self.registry)
-        self._parameters = [v for v in self.variables if v.causality == "parameter"]
+        self.registry = self.plans = Registry(self, self.variables, self._output)
         self._check_inputs = range_check(tuple(v for v in self.variables
                                                if v.causality == "input"))
-
-    # -- the adapter's -----------------------------------------------------------
-    def _host_log(self, kwargs: dict[str, Any]) -> Any:
-        """The adapter's ``fmukit.hostlog.HostLog``, from pythonfmu's keywords."""
-        raise NotImplementedError
-
-    def fmi_variable(self, var: Var, getter: Callable[[], Any] | None) -> Any:
-        """pythonfmu's variable for ``var``; ``getter`` reads an output."""
-        raise NotImplementedError
 
     def _before_variables(self) -> None:
         """What the adapter registers before the declared variables (default: nothing)."""
 
-    # -- model ---------------------------------------------------------------
     def build_model(self) -> Any:
         """A fresh model from the current parameter attributes."""
         raise NotImplementedError
@@ -104,10 +126,16 @@ class ModelSlave:
         self.start_model(model)
         return model
 
+    @property
+    def model(self) -> Any:
+        """The model; before initialisation, built from the parameters as they are."""
+        if self._model is None:
+            self._model = self._started_model()
+        return self._model
+
     def _output(self, get: Callable[[Any], Any], undefined: Any) -> Any:
-        """An output's value, or NaN (0 if Integer) when it cannot be evaluated or the FMU
-        has failed: a read never fails (a failed getReal aborts libcosim); the call that
-        commits (exitInitializationMode, doStep) refuses instead."""
+        """An output's value, or NaN (0 if Integer) if the FMU has failed or it cannot be
+        evaluated: a read never fails (a failed getReal aborts libcosim)."""
         if self.failure:
             return undefined
         try:
@@ -120,8 +148,8 @@ class ModelSlave:
             return undefined
 
     def _unevaluable(self, get: Callable[[Any], Any], error: Exception) -> None:
-        """Fail the FMU for an output it cannot evaluate from valid inputs (with an invalid
-        input, the next doStep names the input instead)."""
+        """Fail the FMU for an output it cannot evaluate from valid inputs (else the next
+        doStep names the invalid input)."""
         try:
             self._check_inputs(self)
         except ValueError:
@@ -136,14 +164,24 @@ class ModelSlave:
         self.log(naming(self.instance_name, failure), self.STATUS_ERROR, f"fmukit.{cause}")
         self.host_log.tell(self.instance_name, failure)
 
-    @property
-    def model(self) -> Any:
-        """The model; before initialisation, built from the parameters as they are."""
-        if self._model is None:
-            self._model = self._started_model()
-        return self._model
+    def _fail(self, reason: str, cause: str, error: BaseException | None = None) -> NoReturn:
+        """Fail the FMU for ``reason`` (its ``cause``): refuse this call and every step."""
+        self.failure, self.failure_cause = reason, cause
+        raise Refused(reason, cause) from error
 
-    # -- FMI call sequence -----------------------------------------------------
+    def interrupted(self, where: str, error: BaseException) -> Refused:
+        """Fail the FMU for a KeyboardInterrupt (SIGINT), an exception with a ``signal``
+        (``cosim.core.interrupt.Interrupted``) or any BaseException raised in its code
+        during ``where``; the refusal to raise."""
+        number = getattr(error, "signal",
+                         signal.SIGINT if isinstance(error, KeyboardInterrupt) else None)
+        if not self.failure:
+            cause = (explain(error) if number is None
+                     else f"interrupted by {signal.Signals(number).name}")
+            self.failure = f"{where}: {cause}; the FMU has failed"
+            self.failure_cause = "interrupted"
+        return Refused(self.failure, self.failure_cause)
+
     @fmi_entry
     def enter_initialization_mode(self) -> None:
         self.sequence.require("EnterInitializationMode", "instantiated")
@@ -154,13 +192,15 @@ class ModelSlave:
         self.sequence.require("ExitInitializationMode", "initialization")
         self.sequence.phase = "step"
         try:
-            for var in self._parameters:      # the declared ranges, then the model's own rules
-                var.check(getattr(self, var.name))
+            for var in self.variables:        # the declared ranges, then the model's own rules
+                if var.causality == "parameter":
+                    var.check(getattr(self, var.name))
             self._model = self._started_model()   # ValueError names a bad parameter or input
         except Exception as error:            # reported now, refused at the first step
             at = "" if self.start_time is None else f" at t = {self.start_time}"
-            self._report(f"exitInitializationMode{at}: {reason(error)}; the FMU has failed",
-                         _cause(error, "parameter"))
+            why = str(error) if isinstance(error, ValueError) else explain(error)
+            self._report(f"exitInitializationMode{at}: {why}; the FMU has failed",
+                         error.cause if isinstance(error, Refused) else "parameter")
 
     @fmi_entry
     def terminate(self) -> None:
@@ -172,9 +212,7 @@ class ModelSlave:
         """One communication step (the adapter's ``do_step``); Refused for every refusal."""
         if self.failure:
             raise Refused(self.failure, self.failure_cause)
-        refusal = self.sequence.step_refusal()
-        if refusal:                           # like any call out of sequence: nothing done
-            raise Refused(refusal, "call")
+        self.sequence.require_step()          # like any call out of sequence: nothing done
         if not (0.0 < step_size <= MAX_TIME and abs(current_time) <= MAX_TIME):
             self._fail(f"doStep at t = {current_time} with communication step {step_size}: the "
                        f"step must be positive, and both within +-{MAX_TIME:g} s", "step")
@@ -187,31 +225,19 @@ class ModelSlave:
                 self.step_model(on_time_base(current_time), self._step_size[1])
         except ValueError as error:
             self._fail(f"doStep at t = {current_time}: {error}; the FMU has failed (its "
-                       f"outputs read NaN until {self.API}Reset)", _cause(error, "model"))
+                       f"outputs read NaN until {self.API}Reset)",
+                       error.cause if isinstance(error, Refused) else "model")
         except Exception as error:            # the model's own exception
             self._fail(f"doStep at t = {current_time}: {explain(error)}", "model", error)
         except BaseException as error:        # Ctrl-C or the like, raised in this FMU's code
             raise self.interrupted(f"doStep at t = {current_time}", error) from None
 
-    def interrupted(self, where: str, error: BaseException) -> Refused:
-        """Fail the FMU for a KeyboardInterrupt (or any BaseException) raised in its code
-        during ``where``; the refusal to raise."""
-        number = hostsignals.interrupt_signal(error)
-        cause = f"interrupted by {number.name}" if number else explain(error)
-        if not self.failure:
-            self.failure = f"{where}: {cause}; the FMU has failed"
-            self.failure_cause = "interrupted"
-        return Refused(self.failure, self.failure_cause)
-
-    def _fail(self, reason: str, cause: str, error: BaseException | None = None) -> NoReturn:
-        """Fail the FMU for ``reason`` (its ``cause``): refuse this call and every step."""
-        self.failure, self.failure_cause = reason, cause
-        raise Refused(reason, cause) from error
-
-    # -- setters: refuse what the standard does not allow ----------------------
     def _set(self, vrs: list[int], values: list, convert: type) -> None:
+        """Set variables, refusing what the standard does not allow."""
         for vr in vrs:
-            self.sequence.check_settable(self.registry.var(vr))
+            if vr not in self.registry.by_vr:
+                raise ValueError(f"no variable has value reference {vr}")
+            self.sequence.check_settable(self.registry.by_vr[vr])
         for vr, value in zip(vrs, values):
             var = self.registry.by_vr[vr]
             if var.kind is not convert:
@@ -236,7 +262,6 @@ class ModelSlave:
     def set_boolean(self, vrs: list[int], values: list[bool]) -> None:
         raise Refused("this FMU has no Boolean variables", "call")
 
-    # -- getters ---------------------------------------------------------------------
     @fmi_entry
     def get_string(self, vrs: list[int]) -> list[str]:
         return super().get_string(vrs)
@@ -245,7 +270,6 @@ class ModelSlave:
     def get_boolean(self, vrs: list[int]) -> list[bool]:
         return super().get_boolean(vrs)
 
-    # -- FMU state ---------------------------------------------------------------
     @fmi_entry
     def _get_fmu_state(self) -> dict[str, Any]:
         return state.capture(self)
@@ -254,11 +278,4 @@ class ModelSlave:
     def _set_fmu_state(self, saved: dict[str, Any]) -> None:
         state.restore(self, saved)
 
-    @staticmethod
-    def _fmu_state_from_bytes(data: bytes) -> dict[str, Any]:
-        return state.decode(data)
-
-
-def _cause(error: BaseException, otherwise: str) -> str:
-    """A refusal's own cause; ``otherwise`` for any other exception."""
-    return error.cause if isinstance(error, Refused) else otherwise
+    _fmu_state_from_bytes = staticmethod(state.decode)

@@ -1,25 +1,21 @@
 """Saved FMU states as plain dicts (pythonfmu serialises them as JSON): the phase, every
-parameter and input, the model's ``snapshot()`` and the failure, if any. Restoring rebuilds
-the model from the parameters and hands it the snapshot: the run continues bit for bit.
+registered variable but the outputs (parameters, inputs, FMI 3.0's ``time``), the model's
+``snapshot()`` and the failure, if any. Restoring rebuilds the model from the parameters and
+hands it the snapshot: the run continues bit for bit.
 """
 from __future__ import annotations
 
 import json
 from typing import Any
 
-_KEYS = {"phase", "values", "model"}
-
 
 def capture(slave: Any) -> dict[str, Any]:
     """The whole state of a ``ModelSlave``."""
-    return {
-        "phase": slave.sequence.phase,
-        "values": {v.name: getattr(slave, v.name) for v in slave.variables
-                   if v.causality != "output"},
-        "model": slave._model.snapshot() if slave._model is not None else None,
-        "failure": slave.failure,
-        "failure_cause": slave.failure_cause,
-    }
+    return {"phase": slave.sequence.phase,
+            "values": {v.name: getattr(slave, v.name) for v in slave.vars.values()
+                       if v.causality.name != "output"},
+            "model": slave._model.snapshot() if slave._model is not None else None,
+            "failure": slave.failure, "failure_cause": slave.failure_cause}
 
 
 def restore(slave: Any, state: dict[str, Any]) -> None:
@@ -29,8 +25,7 @@ def restore(slave: Any, state: dict[str, Any]) -> None:
     for name, value in state["values"].items():
         setattr(slave, name, value)
     slave.sequence.phase = state["phase"]
-    slave.failure = state.get("failure")
-    slave.failure_cause = state.get("failure_cause", "model")
+    slave.failure, slave.failure_cause = state.get("failure"), state.get("failure_cause", "model")
     slave._model = None
     if state["model"] is not None:
         slave._model = slave.build_model()
@@ -42,7 +37,7 @@ def decode(data: bytes) -> dict[str, Any]:
     calls this on the class, where an exception cannot be made safe)."""
     try:
         decoded = json.loads(data.decode("utf-8"))
-        if not _KEYS <= set(decoded):
+        if not {"phase", "values", "model"} <= set(decoded):
             raise ValueError("not a state of this FMU")
         return decoded
     except (ValueError, UnicodeDecodeError, TypeError) as error:

@@ -1,15 +1,36 @@
 """``Var``: an FMU variable declared once, the source of its pythonfmu registration, its
-modelDescription.xml entry and the range check its values must pass.
+modelDescription.xml entry (``describe``, the same in FMI 2.0 and 3.0) and the range check
+its values must pass; the SI units at the FMU interfaces (``UNITS``).
 """
 from __future__ import annotations
 
 import math
 import sys
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any, Callable, Iterable
+from xml.etree.ElementTree import Element, SubElement
 
 from .refusals import Refused
-from .units import UNITS
+
+# name: (base-unit exponents (kg, m, s, rad), factor, display units {name: factor})
+UNITS: dict[str, tuple[dict[str, int], float, dict[str, float]]] = {
+    "1": ({}, 1.0, {}),
+    "m": ({"m": 1}, 1.0, {}),
+    "m/s": ({"m": 1, "s": -1}, 1.0, {}),
+    "s": ({"s": 1}, 1.0, {}),
+    "1/s": ({"s": -1}, 1.0, {}),
+    "rad": ({"rad": 1}, 1.0, {"deg": 180.0 / math.pi}),
+    "rad/s": ({"rad": 1, "s": -1}, 1.0, {"deg/s": 180.0 / math.pi}),
+    "rad/s2": ({"rad": 1, "s": -2}, 1.0, {"deg/s2": 180.0 / math.pi}),
+    "rad.s": ({"rad": 1, "s": 1}, 1.0, {"deg.s": 180.0 / math.pi}),
+    "deg": ({"rad": 1}, math.pi / 180.0, {}),
+    "deg/s": ({"rad": 1, "s": -1}, math.pi / 180.0, {}),
+    "rev/s": ({"rad": 1, "s": -1}, 2.0 * math.pi, {"rpm": 60.0}),
+    "N": ({"kg": 1, "m": 1, "s": -2}, 1.0, {}),
+    "N.m": ({"kg": 1, "m": 2, "s": -2}, 1.0, {}),
+}
+DISPLAY_UNIT = {"rad": "deg", "rad/s": "deg/s", "rad/s2": "deg/s2"}
+"""Display unit a variable of this unit shows by default."""
 
 
 @dataclass(frozen=True)
@@ -18,7 +39,7 @@ class Var:
 
     name: str
     causality: str                    # "parameter" | "input" | "output"
-    unit: str = "1"                   # key of fmukit.units.UNITS (Real only)
+    unit: str = "1"                   # key of UNITS (Real only)
     description: str = ""
     start: float | int | str | None = None
     kind: type = float                # float (Real), int (Integer) or str (String)
@@ -31,7 +52,7 @@ class Var:
     def __post_init__(self) -> None:
         if self.kind is float and self.unit not in UNITS:
             raise ValueError(f"variable {self.name}: unit {self.unit!r} is not one of "
-                             f"{', '.join(UNITS)} (fmukit/units.py)")
+                             f"{', '.join(UNITS)} (fmukit/variables.py)")
 
     @classmethod
     def parameter(cls, name: str, start: float | int | str, unit: str = "1",
@@ -86,3 +107,42 @@ def range_check(variables: tuple[Var, ...]) -> Callable[[Any], None]:
     exec(f"def check(obj):\n    if not ({' and '.join(tests) or 'True'}):\n"
          "        name_the_failure(obj)\n", namespace)
     return namespace["check"]
+
+
+def describe(root: Element, variables: tuple[Var, ...], typed: list[Element | None],
+             reference: dict[str, int]) -> tuple[Element, list[tuple[str, tuple]]]:
+    """Add to a model description ``root`` what pythonfmu leaves out: to each numeric
+    variable's ``typed`` element its start in its shortest exact form, unit, display unit
+    and range, and the <UnitDefinitions>. The emptied <ModelStructure>, and each output's
+    ``reference`` with those it depends on, ordered: while stepping (its inputs: direct
+    feedthrough) and at initialisation (inputs and parameters, and its further knowns)."""
+    for element, var in zip(typed, variables):
+        if var.kind is str:
+            continue
+        if var.start is not None:
+            element.set("start", repr(float(var.start)) if var.is_real else str(int(var.start)))
+        if var.is_real:
+            element.set("unit", var.unit)
+            if var.unit in DISPLAY_UNIT:
+                element.set("displayUnit", DISPLAY_UNIT[var.unit])
+        for bound in ("min", "max"):
+            if math.isfinite(getattr(var, bound)):
+                element.set(bound, repr(var.kind(getattr(var, bound))))
+    definitions = Element("UnitDefinitions")
+    for name in sorted({v.unit for v in variables if v.is_real}):
+        exponents, factor, display = UNITS[name]
+        unit = SubElement(definitions, "Unit", name=name)
+        base = {k: str(v) for k, v in exponents.items()}
+        SubElement(unit, "BaseUnit", base | ({"factor": repr(factor)} if factor != 1.0 else {}))
+        for display_name, display_factor in display.items():
+            SubElement(unit, "DisplayUnit", name=display_name, factor=repr(display_factor))
+    root.insert(list(root).index(root.find("CoSimulation")) + 1, definitions)
+    structure = root.find("ModelStructure")
+    structure.clear()
+    inputs = {v.name for v in variables if v.causality == "input"}
+
+    def ordered(names: Iterable[str]) -> list[str]:
+        return [str(r) for r in sorted(reference[n] for n in names)]
+    return structure, [(str(reference[v.name]), (ordered(d for d in v.depends if d in inputs),
+                                                 ordered(v.depends + v.initial_depends)))
+                       for v in variables if v.causality == "output"]

@@ -144,7 +144,8 @@ from fmpy.fmi3 import FMU3Slave
 
 described = read_model_description(sys.argv[1])
 slave = FMU3Slave(guid=described.guid, modelIdentifier=described.coSimulation.modelIdentifier,
-                  unzipDirectory=extract(sys.argv[1], os.path.abspath("x")), instanceName="host")
+                  unzipDirectory=extract(sys.argv[1], os.path.abspath(sys.argv[3])),
+                  instanceName="host")
 ctypes.CDLL(sys.argv[2])                   # after the FMU library: its destructor runs later
 libc = ctypes.CDLL(None)
 libc.malloc.restype = ctypes.c_void_p
@@ -159,7 +160,7 @@ slave.terminate()
 slave.freeInstance()
 '''
 """tests/exit_heap/host.py for FMI 3.0: load, step, free, exit, with allocator traffic after
-the FMU library's exit code."""
+the FMU library's exit code; the FMU is unpacked into the folder sys.argv[3]."""
 
 
 def _child(script: str, *args: str | Path, cwd: Path, padding: int = 0,
@@ -263,9 +264,11 @@ def late_malloc(tmp_path_factory) -> Path:
 def test_a_host_exits_with_its_heap_intact_where_without_the_exit_fix_it_aborts(
         fmi3_paths, late_malloc, tmp_path):
     """Whether malloc notices the write into a freed block depends on the heap's layout,
-    which the size of the environment shifts: the host is run with it padded more and
-    more, the FMU as built and its unfixed variant in each layout, until the variant
-    aborts. The FMU as built must exit cleanly in every layout tried."""
+    which the size of the environment and the length of the FMU folder's path shift (and
+    the FMU's own Python code: any edit of it): the host is run with the environment padded
+    more and more, in folders of three lengths, the FMU as built and its unfixed variant in
+    each layout, until the variant aborts. The FMU as built must exit cleanly in every
+    layout tried."""
     ship = fmi3_paths["ship"]
     known = next(iter(KNOWN_BINARIES.values()))
     with zipfile.ZipFile(ship) as package:
@@ -274,13 +277,15 @@ def test_a_host_exits_with_its_heap_intact_where_without_the_exit_fix_it_aborts(
                        binary[known.offset - 8:known.offset + len(known.patched)],
                        binary[known.offset - 8:known.offset] + known.code)
     for padding in range(0, 4096, 64):
-        intact = _child(EXIT_HOST, ship, late_malloc, cwd=tmp_path, padding=padding)
-        assert intact.returncode == 0, (padding, intact.stderr)
-        aborted = _child(EXIT_HOST, unfixed, late_malloc, cwd=tmp_path, padding=padding)
-        if aborted.returncode == -signal.SIGABRT:
-            assert "corrupted" in aborted.stderr
-            return
-        assert aborted.returncode == 0, (padding, aborted.stderr)
+        for folder in ("x", "x" * 9, "x" * 17):
+            intact = _child(EXIT_HOST, ship, late_malloc, folder, cwd=tmp_path, padding=padding)
+            assert intact.returncode == 0, (padding, folder, intact.stderr)
+            aborted = _child(EXIT_HOST, unfixed, late_malloc, folder, cwd=tmp_path,
+                             padding=padding)
+            if aborted.returncode == -signal.SIGABRT:
+                assert "corrupted" in aborted.stderr
+                return
+            assert aborted.returncode == 0, (padding, folder, aborted.stderr)
     pytest.fail("the unfixed binary never aborted: this test cannot tell the fix is needed")
 
 

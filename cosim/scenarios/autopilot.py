@@ -11,7 +11,7 @@ from fmpy.model_description import ModelDescription
 
 import fmukit.autopilot
 from fmubuild.instantiate import InstantiationFailed, instantiate_in_child
-from fmukit.units import UNITS
+from fmukit.variables import UNITS
 
 from ..core.errors import close_matches, did_you_mean
 from ..core.ssd import Connection, SystemDescription

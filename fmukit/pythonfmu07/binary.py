@@ -1,14 +1,8 @@
-"""pythonfmu 0.7.0's linux64 binary as fmukit knows it: where ``fmubuild.exit_fix`` patches
-its exit-time heap corruption, and where its logger keeps the host's debug-logging flag,
-which alone decides what the host hears. With another binary the flag cannot be trusted,
-and the host is taken not to hear: errors go to standard error too.
+"""pythonfmu 0.7.0's linux64 binary: where ``fmubuild.exit_fix`` patches its exit-time heap
+corruption, and where its logger keeps the debug-logging flag that alone decides what the
+host hears. With another binary the host is taken not to hear: errors go to standard error.
 """
-from __future__ import annotations
-
-import ctypes
-from typing import Any
-
-from ..hostlog import Binary, HostLog, known_binary
+from ..entry import Binary
 
 # endbr64; jmp finalizePythonInterpreter  ->  endbr64; ret. PyLogger::log tests
 # ``cmpb $0x0, 0x8(%rdi)``: the debug-logging flag sits 8 bytes into the logger.
@@ -17,14 +11,3 @@ KNOWN_BINARIES = {
         0x16F30, bytes.fromhex("f30f1efae937dcffff"), bytes.fromhex("f30f1efac337dcffff"),
         "7b771dc338b6e8ecc6a7c658f8a409e30e14e4031b61d1cfc682f3b61451ed3e", 8),
 }
-FIXED = {b.fixed_sha256: b for b in KNOWN_BINARIES.values()}
-"""The binaries as fmukit builds them, by their SHA-256."""
-
-
-def host_log(kwargs: dict[str, Any]) -> HostLog:
-    """The slave's ``HostLog`` from pythonfmu's keywords (no ``logger``: a host in this
-    process)."""
-    logger = kwargs.get("logger")
-    known = known_binary(logger, kwargs.get("resources"), FIXED)
-    flag = None if known is None else ctypes.c_bool.from_address(logger + known.logger_offset)
-    return HostLog(flag, in_process="logger" not in kwargs, unknown=False)

@@ -1,20 +1,22 @@
 """``Fmi2Entry``: the mixin that makes a ``ModelSlave`` an FMI 2.0 FMU of pythonfmu 0.7
 (``class <Model>(Fmi2Entry, <Model>, Fmi2Slave)``: pythonfmu takes the class with the
-longest MRO). Every refusal is an exception: fmi2Fatal.
+longest MRO). Every refusal is an exception: fmi2Fatal (pythonfmu 0.7's fmi2Discard would
+pass for a normal end).
 """
 from __future__ import annotations
 
 import ctypes
 from typing import Any, Callable
-from xml.etree.ElementTree import Element
+from xml.etree.ElementTree import Element, SubElement
 
-from ..entry import fmi_entry
+from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Integer, Real
+from pythonfmu import String
+from pythonfmu.enums import Fmi2Status
+
+from ..entry import HostLog, fmi_entry
 from ..registry import pythonfmu_variable
-from ..slave import CATEGORIES
-from ..variables import Var
-from ..hostlog import HostLog
-from . import (ACTIVE, Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Status, Fmi2Variability,
-               Integer, Real, String, binary, model_description)
+from ..variables import Var, describe
+from . import ACTIVE, binary
 
 _TYPE = {float: Real, int: Integer, str: String}
 
@@ -23,13 +25,11 @@ class Fmi2Entry:
     """FMI 2.0 through pythonfmu 0.7: the version's half of an FMU's class."""
 
     API, FMI_VERSION = "fmi2", 2
-    TYPE_NAMES = {float: "Real", int: "Integer", str: "String"}
     STATUS_ERROR, STATUS_FATAL = Fmi2Status.error, Fmi2Status.fatal
     RELEASES_ON_EXCEPTION = ACTIVE
-    log_categories = {**Fmi2Slave.log_categories, **CATEGORIES}
 
     def _host_log(self, kwargs: dict[str, Any]) -> HostLog:
-        return binary.host_log(kwargs)
+        return HostLog(kwargs, binary.KNOWN_BINARIES, unknown=False)
 
     def fmi_variable(self, var: Var, getter: Callable[[], Any] | None) -> Any:
         return pythonfmu_variable(var, getter, _TYPE[var.kind], Fmi2Causality,
@@ -65,8 +65,18 @@ class Fmi2Entry:
         return super().get_integer(vrs) if read is None else read()
 
     def to_xml(self, model_options: dict[str, str] = dict()) -> Element:
-        return model_description.complete(super().to_xml(model_options), self.variables)
-
+        """pythonfmu's model description with the units, ranges, exact starts and
+        dependencies (by 1-based index) it leaves out."""
+        root = super().to_xml(model_options)
+        structure, unknowns = describe(root, self.variables, [
+            e.find("Real" if v.is_real else "Integer")
+            for e, v in zip(root.find("ModelVariables"), self.variables)],
+            {v.name: i + 1 for i, v in enumerate(self.variables)})
+        for tag, when in (("Outputs", 0), ("InitialUnknowns", 1)) if unknowns else ():
+            listed = SubElement(structure, tag)
+            for reference, depends in unknowns:
+                SubElement(listed, "Unknown", index=reference, dependencies=" ".join(depends[when]))
+        return root
 
 
 def hold_namespace(namespace: dict[str, Any]) -> None:

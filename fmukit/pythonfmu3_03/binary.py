@@ -1,15 +1,9 @@
-"""pythonfmu3 0.3.4's x86_64-linux binary as fmukit knows it: where ``fmubuild.exit_fix``
-patches its exit-time use-after-free, and where its logger keeps the host's logging flag,
-which the logger itself never reads (``cppfmu::Logger::Log`` forwards every message; FMI 3.0
-says not while logging is off). With another binary the flag is unknown, and the host is
-taken to hear: pythonfmu3 forwards.
+"""pythonfmu3 0.3.4's x86_64-linux binary: where ``fmubuild.exit_fix`` patches its exit-time
+use-after-free, and where its logger keeps the host's logging flag, which the logger never
+reads (``cppfmu::Logger::Log`` forwards every message; FMI 3.0 says not while logging is
+off). With another binary the host is taken to hear: pythonfmu3 forwards.
 """
-from __future__ import annotations
-
-import ctypes
-from typing import Any
-
-from ..hostlog import Binary, HostLog, known_binary
+from ..entry import Binary
 
 # jmp finalizePythonInterpreter@plt  ->  ret. cppfmu::Logger holds its environment, its
 # callback and a shared_ptr<Settings>, whose pointer is 16 bytes into the logger;
@@ -17,18 +11,6 @@ from ..hostlog import Binary, HostLog, known_binary
 KNOWN_BINARIES = {
     "53fd71ba834c18dea2df15d7e67b3a42441e7a607757cb5ac825ff98b505b580": Binary(  # 0.3.4
         0x16B80, bytes.fromhex("e9ebbfffff"), bytes.fromhex("c3ebbfffff"),
-        "c26089da0282cd0e2fedcff896efb7379052cb4588a10cc26e013e3700ed4b05", 16),
+        "c26089da0282cd0e2fedcff896efb7379052cb4588a10cc26e013e3700ed4b05", 16,
+        through_pointer=True),
 }
-FIXED = {b.fixed_sha256: b for b in KNOWN_BINARIES.values()}
-"""The binaries as fmukit builds them, by their SHA-256."""
-
-
-def host_log(kwargs: dict[str, Any]) -> HostLog:
-    """The slave's ``HostLog`` from pythonfmu3's keywords (no ``logger``: a host in this
-    process)."""
-    logger, flag = kwargs.get("logger"), None
-    known = known_binary(logger, kwargs.get("resources"), FIXED)
-    if known is not None:
-        settings = ctypes.c_void_p.from_address(logger + known.logger_offset).value
-        flag = ctypes.c_bool.from_address(settings) if settings else None
-    return HostLog(flag, in_process="logger" not in kwargs, unknown=True)

@@ -1,22 +1,19 @@
 """``Fmi3Entry``: the mixin that makes a ``ModelSlave`` an FMI 3.0 FMU of pythonfmu3 0.3.4
 (``class <Model>(Fmi3Entry, <Model>, Fmi3Slave)``: pythonfmu3 finds it by a regular
-expression on the ``class`` line). It adds the independent variable ``time`` (value
-reference 0, so a variable's reference is its FMI 2.0 twin's plus one); pythonfmu3 drops
-the start time, so messages name none.
+expression on the ``class`` line), with the independent variable ``time``.
 """
 from __future__ import annotations
 
 from typing import Any, Callable
-from xml.etree.ElementTree import Element
+from xml.etree.ElementTree import Element, SubElement
 
-from .. import state
-from ..entry import fmi_entry
+from pythonfmu3 import Fmi3Causality, Fmi3Initial, Fmi3Slave, Fmi3Status, Fmi3StepResult
+from pythonfmu3 import Fmi3Variability, Float64, Int32, String
+
+from ..entry import HostLog, fmi_entry
 from ..registry import pythonfmu_variable
-from ..hostlog import HostLog
-from ..slave import CATEGORIES
-from ..variables import Var
-from . import (ACTIVE, Fmi3Causality, Fmi3Initial, Fmi3Slave, Fmi3Status, Fmi3StepResult,
-               Fmi3Variability, Float64, Int32, String, binary, model_description)
+from ..variables import Var, describe
+from . import ACTIVE, binary
 
 _TYPE = {float: Float64, int: Int32, str: String}
 _FROM_CLASS = ("description", "author", "license", "version", "copyright",
@@ -32,23 +29,21 @@ class Fmi3Entry:
     """FMI 3.0 through pythonfmu3 0.3.4: the version's half of an FMU's class."""
 
     API, FMI_VERSION = "fmi3", 3
-    TYPE_NAMES = {float: "Float64", int: "Int32", str: "String"}
     STATUS_ERROR, STATUS_FATAL = Fmi3Status.error, Fmi3Status.fatal
     RELEASES_ON_EXCEPTION = ACTIVE
-    log_categories = {**Fmi3Slave.log_categories, **CATEGORIES}
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
         for attribute in _FROM_CLASS:
             setattr(self, attribute, getattr(type(self), attribute, None))
-        self.start_time = None                 # not given by pythonfmu3
+        self.start_time = None                 # pythonfmu3 drops it: messages name none
 
     def _host_log(self, kwargs: dict[str, Any]) -> HostLog:
-        return binary.host_log(kwargs)
+        return HostLog(kwargs, binary.KNOWN_BINARIES, unknown=True)
 
     def _before_variables(self) -> None:
-        """``time``, registered first: value reference 0 (``model_description`` writes it
-        last)."""
+        """``time``, registered first: value reference 0, so that a variable's reference is
+        its FMI 2.0 twin's plus one (``to_xml`` writes it last)."""
         self.time = 0.0
         self.register_variable(Float64("time", causality=Fmi3Causality.independent,
                                        variability=Fmi3Variability.continuous,
@@ -91,15 +86,23 @@ class Fmi3Entry:
         read = self.plans.integer_reader(vrs)
         return super().get_int32(vrs) if read is None else read()
 
-    @fmi_entry
-    def _get_fmu_state(self) -> dict[str, Any]:
-        return {**state.capture(self), "time": self.time}
-
-    @fmi_entry
-    def _set_fmu_state(self, saved: dict[str, Any]) -> None:
-        state.restore(self, saved)
-        self.time = saved["time"]
-
     def to_xml(self, model_options: dict[str, str] = dict()) -> Element:
-        vr = {var.name: vr for vr, var in self.registry.by_vr.items()}
-        return model_description.complete(super().to_xml(model_options), self.variables, vr)
+        """pythonfmu3's model description with <UnitDefinitions> (else fmpy refuses the
+        units), ranges, exact starts (it writes 16 digits) and dependencies (its bare
+        <Output>: every output on every input, an algebraic loop to a master); ``time`` last,
+        for an importer that reads dependencies as 1-based indices (OMSimulator)."""
+        root = super().to_xml(model_options)
+        listed = root.find("ModelVariables")
+        elements = {e.get("name"): e for e in listed}
+        for independent in [e for e in listed if e.get("causality") == "independent"]:
+            listed.remove(independent)
+            listed.append(independent)
+        structure, unknowns = describe(root, self.variables,
+                                       [elements[v.name] for v in self.variables],
+                                       {v.name: vr for vr, v in self.registry.by_vr.items()})
+        for tag, when in (("Output", 0), ("InitialUnknown", 1)):
+            for reference, depends in unknowns:
+                kinds = {"dependenciesKind": " ".join(["dependent"] * len(depends[when]))}
+                SubElement(structure, tag, valueReference=reference,
+                           dependencies=" ".join(depends[when]), **(kinds if depends[when] else {}))
+        return root
