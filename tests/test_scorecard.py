@@ -56,10 +56,10 @@ def _reached(csv) -> int:
 
 
 def test_the_scorecard_names_the_criteria_each_autopilot_wins_and_loses(fmu_paths, tmp_path,
-                                                                        capsys):
+                                                                        capsys, scheduler):
     out = tmp_path / "score"
     assert cli.main([str(fmu_paths["pd_autopilot"]), "--name", "mine", *MINE, "--seeds", "2",
-                     "--workers", "1", "--out", str(out), "--backend", "inprocess"]) == 0
+                     "--scheduler", scheduler, "--out", str(out), "--backend", "inprocess"]) == 0
     text = (out / "scorecard.md").read_text()
     assert text in capsys.readouterr().out
     # results up front: per sea, every criterion with its side, each controller's verdict
@@ -178,11 +178,11 @@ def test_the_scorecard_refuses_a_name_that_is_a_baseline_s(fmu_paths, tmp_path, 
 
 
 def test_an_autopilot_that_fails_is_scored_as_failed_and_the_rest_goes_on(tmp_path, capsys,
-                                                                         faulty_fmu):
+                                                                         faulty_fmu, scheduler):
     failing = faulty_fmu("idle_pilot")
     out = tmp_path / "score"
     assert cli.main([str(failing), "--set", "autopilot.fail_time=150", "--seeds", "1",
-                     "--workers", "1", "--out", str(out), "--backend", "inprocess"]) == 0
+                     "--scheduler", scheduler, "--out", str(out), "--backend", "inprocess"]) == 0
     err = capsys.readouterr().err
     assert ("note: controller 'idle_pilot': autopilot (idle_pilot.fmu) runs through FMI, not "
             "in-process: its module idle_pilot_slave is not importable here") in err

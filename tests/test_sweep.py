@@ -162,11 +162,11 @@ def test_task_records_a_failed_run_with_its_message(fmu_paths, tmp_path):
 
 
 @pytest.mark.timeout(180, method="thread")
-def test_dask_sweep_writes_resumes_and_plots(fmu_paths, tmp_path, capsys):
+def test_dask_sweep_writes_resumes_and_plots(fmu_paths, tmp_path, capsys, scheduler):
     spec = Spec.read(write_spec(tmp_path, SMALL))
     out = tmp_path / "out"
     out.mkdir()
-    rows = campaign.execute(spec, out, workers=2, progress=False)
+    rows = campaign.execute(spec, out, scheduler, progress=False)
     assert [r["status"] for r in rows] == ["ok"] * 4
     journal = (out / "runs.jsonl").read_text().splitlines()
     assert len(journal) == 4
@@ -209,10 +209,13 @@ def test_a_journal_has_one_writer(fmu_paths, tmp_path):
 @pytest.mark.timeout(600, method="thread")
 def test_a_worker_killed_on_every_retry_is_recorded_as_failed(fmu_paths, tmp_path):
     """The nanny restarts the worker each time; were it to fail to (as it once did in CI, on
-    another machine), the sweep stops for want of a worker and the test fails, naming that."""
+    another machine), the sweep stops for want of a worker and the test fails, naming that.
+    It waits for a worker as long as its time limit allows: a restart on a busy machine
+    took longer than the sweep's default minute."""
     from sweep_faults import killing_task
     spec = Spec.read(write_spec(tmp_path, 'stop_time = 5\n[axes]\nwave_seed = [1, 2]\n'))
-    rows = campaign.execute(spec, tmp_path, workers=1, progress=False, task=killing_task)
+    rows = campaign.execute(spec, tmp_path, workers=1, progress=False, task=killing_task,
+                            no_worker_timeout=500)
     by_seed = {(r["controller"], r["wave_seed"]): r for r in rows}
     assert by_seed[("pd", 1)]["status"] == "ok"
     assert by_seed[("pd", 2)]["status"] == "failed"
