@@ -8,9 +8,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
-from .analysis.animation import animate, require_track
 from .analysis.cost import LAMBDA, Cost, cost
-from .analysis.figures import save_figure
 from .analysis.kinds import Analysis, analysis
 from .core.files import FolderLock, Outputs
 from .core.interrupt import StopSignals
@@ -96,6 +94,7 @@ def run_and_write(system: SystemDescription, label: str, out: Path,
                         for note in master.notes:
                             notes(note)
                         if options.animate:
+                            from .analysis.animation import require_track   # matplotlib
                             require_track(master.columns)
                         with outputs.writing(f"{label}.csv") as csv_path:
                             recording = master.run(options.stop_time, progress=progress,
@@ -147,6 +146,8 @@ def _analyse(outcome: Outcome, system: SystemDescription, kind: Analysis, label:
     """Report, figure, animation and cost of a finished run whose rows are written."""
     recording = outcome.recording
     outcome.report = kind.report(recording, lam=options.lam, parameters=parameters)
+    from .analysis.animation import animate           # matplotlib, only where it draws
+    from .analysis.figures import save_figure
     if options.plot and kind.figure is not None:
         with outputs.writing(f"{label}.{options.formats[0]}") as path:
             outcome.written += save_figure(recording, kind.figure, path.with_suffix(""),

@@ -17,6 +17,7 @@ SCENARIO.png, and prints the cost of eq (19) (or the manoeuvre's figures).
 from __future__ import annotations
 
 import argparse
+import shutil
 import sys
 from pathlib import Path
 
@@ -25,7 +26,6 @@ from tqdm import tqdm
 from . import scenarios
 from ._cli import (add_fmu_options, checked_autopilot, chosen_scenarios, entry, number_option,
                    positive_seconds, say_error, say_note, setting_option, writable_folder)
-from .analysis.animation import video_format
 from .analysis.cost import LAMBDA, Cost
 from .analysis.describe import conditions, headline
 from .analysis.reports import tables
@@ -40,6 +40,11 @@ from .core.watchdog import STEP_LIMIT_S, Limits
 from .outputs import Options, TimedOut, run_and_write
 from .scenarios.autopilot import COMPONENT
 from .studies.spread import PERTURBED, spread
+
+
+def video_format() -> str:
+    """'mp4' where ffmpeg is installed, else 'gif'."""
+    return "mp4" if shutil.which("ffmpeg") else "gif"
 
 
 def run_scenario(system: SystemDescription, label: str, out: Path, overrides: dict,

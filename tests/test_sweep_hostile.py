@@ -458,18 +458,19 @@ def test_ctrl_c_during_the_runs_prints_one_line_that_says_how_to_resume(fmu_path
 
 
 @pytest.mark.timeout(300, method="thread")
-@pytest.mark.parametrize("step, stage", [
-    ("write_tables", "writing the tables"),
-    pytest.param("save_figures", "drawing the figures", marks=pytest.mark.long),
-    pytest.param("comparison", "writing comparison.md", marks=pytest.mark.long)])
-def test_ctrl_c_after_the_runs_says_they_are_kept_and_how_to_finish(fmu_paths, tmp_path, step,
-                                                                   stage):
+@pytest.mark.parametrize("module, step, stage", [
+    ("cosim.sweep", "write_tables", "writing the tables"),
+    pytest.param("cosim.studies.sweep_figures", "save_figures", "drawing the figures",
+                 marks=pytest.mark.long),
+    pytest.param("cosim.sweep", "comparison", "writing comparison.md", marks=pytest.mark.long)])
+def test_ctrl_c_after_the_runs_says_they_are_kept_and_how_to_finish(fmu_paths, tmp_path, module,
+                                                                   step, stage):
     """The stage is made to take the signal: it signals its own process, then waits."""
     spec = spec_file(tmp_path, 'name = "late"\nstop_time = 5\n[axes]\nwave_seed = [1]\n')
     code = ("import os, signal, sys, time\nimport cosim.sweep as command\n"
-            "from cosim._cli import entry\n"
+            f"import {module} as stage\nfrom cosim._cli import entry\n"
             f"def {step}(*args, **kwargs):\n    os.kill(os.getpid(), signal.SIGINT)\n"
-            f"    time.sleep(60)\ncommand.{step} = {step}\nsys.exit(entry(command.main))\n")
+            f"    time.sleep(60)\nstage.{step} = {step}\nsys.exit(entry(command.main))\n")
     with _sweep_child(tmp_path, spec, code) as child:
         _, stderr = child.communicate(timeout=240)
     assert child.returncode == 130, stderr
