@@ -11,9 +11,5 @@ def table(header: Sequence[str], rows: Iterable[Sequence[str]],
     """A Markdown table's lines; columns after the first ``text_columns`` (default: none)
     aligned right."""
     left = len(header) if text_columns is None else text_columns
-    rule = "|" + "---|" * left + "---:|" * (len(header) - left)
-    return [_row(header), rule, *map(_row, rows)]
-
-
-def _row(cells: Sequence[str]) -> str:
-    return "| " + " | ".join(cells) + " |"
+    lines = ["| " + " | ".join(cells) + " |" for cells in (header, *rows)]
+    return [lines[0], "|" + "---|" * left + "---:|" * (len(header) - left), *lines[1:]]

@@ -17,8 +17,7 @@ from ..api import SimulationError, overrides_of
 from ..core.files import fresh_folder, write_atomically
 from ..core.recording import Recording
 from ..outputs import Options, run_and_write
-from .scorecard_report import (BASELINE, SEA_NAMES, Paired, Sea, change, markdown, paired,
-                               pairs)
+from .scorecard_report import BASELINE, SEA_NAMES, Paired, Sea, change, markdown, paired, pairs
 from .campaign import execute
 from .spec_file import controller_entry
 from .sweep_spec import Spec
@@ -156,5 +155,5 @@ def _ensemble(contenders: list[Contender], seeds: int, out: Path, sea: Sea = SEA
 def backend_notes(fmu: Path, name: str, port_map: dict | None, backend: str) -> list[str]:
     """Which of the scorecard's FMUs run through FMI although ``backend`` asks otherwise,
     and on "batch" which contenders' ensemble runs run alone (``Spec.backend_notes``)."""
-    return _ensemble(_contenders(fmu, name, port_map, None), 1, fmu.parent).backend_notes(
-        backend)
+    spec = _ensemble(_contenders(fmu, name, port_map, None), 1, fmu.parent)
+    return spec.backend_notes(backend)

@@ -143,9 +143,9 @@ def _master_runner(master) -> Callable[[], None]:
     return run
 
 
-def fmi_call_cost(master, calls: int = 20_000) -> float:
-    """Seconds per FMI call of the cheapest kind: setReal and getReal of one value on the
-    autopilot FMU."""
+def fmi_call_cost(master) -> float:
+    """Seconds per FMI call of the cheapest kind: setReal, getReal of one autopilot value."""
+    calls = 20_000
     master.reset()
     master.initialize()
     instance = master.instances["autopilot"]
