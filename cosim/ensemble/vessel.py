@@ -1,6 +1,5 @@
 """``Vessel.step`` for M members, states (M,) and wave components (M, N): the scalar model's
-own rates, forces and RK4 update on arrays; its branches and wave loads rewritten on arrays
-operation for operation."""
+rates, forces and RK4 update on arrays; its branches and wave loads rewritten op for op."""
 from __future__ import annotations
 
 from operator import attrgetter

@@ -1,6 +1,5 @@
-"""Studies on the co-simulation core: sweeps on Dask (``campaign`` runs one), the scorecard,
-the benchmarks (``timing``, ``sweep_timing``, ``memory``), the accuracy study
-(``integration_error``, ``coupling_error``), ``cpu_variants`` and ``spread``."""
+"""Studies on the co-simulation core: sweeps, scorecard, benchmarks, accuracy
+(docs/architecture.md lists the modules); ``table`` for their Markdown."""
 from __future__ import annotations
 
 from typing import Iterable, Sequence
