@@ -65,8 +65,7 @@ def main(argv: list[str] | None = None) -> int:
         elif args.command == "sweep":           # the parts asked for, in their order
             if "throughput" in args.parts:
                 seas = ("waves", "calm") if args.sea == "both" else (args.sea,)
-                sweep_timing.sweep_throughput(args.runs, args.batch_runs, seas,
-                                              rounds=args.rounds)
+                sweep_timing.sweep_throughput(args.runs, args.batch_runs, seas, args.rounds)
             if "campaign" in args.parts:
                 sweep_timing.campaign(args.campaign_runs)
             if "memory" in args.parts:

@@ -208,9 +208,6 @@ def test_batch_size_is_refused_without_the_batch_backend(capsys):
         command.main(["spec.toml", "--batch-size", "10"])
     assert "--batch-size sizes the batches of --backend batch, not of --backend fmi" in \
         capsys.readouterr().err
-    with pytest.raises(ValueError, match="batch_size is the batch backend's, not the "
-                                         "inprocess backend's"):
-        campaign.execute(None, Path("."), backend="inprocess", batch_size=3)
 
 
 # -- one batch in this process: its members' failures and its own --------------------------

@@ -254,7 +254,7 @@ def _check_published(cell: str, value: str) -> None:
         assert abs(float(value) - float(number)) <= float(change), (cell, value)
 
 
-def test_the_spread_of_a_run_is_how_far_a_last_bit_moves_it():
+def test_the_spread_of_a_run_is_how_far_a_last_bit_moves_it(capsys):
     """Calm water amplifies no last bit; the chattering SMC in waves does, within 60 s."""
     from cosim.studies.spread import nudged, spread
 
@@ -265,8 +265,9 @@ def test_the_spread_of_a_run_is_how_far_a_last_bit_moves_it():
     waves = spread(system("waves_smc"), ulps=1, stop_time=60.0)
     assert waves.runs == 5 and max(waves.deviation.values()) > 0.0
     assert all(waves.nominal[f] - waves.deviation[f] > 0.0 for f in ("psi_E", "J"))
-    with pytest.raises(ValueError, match="ulps must be >= 1"):
-        spread(system("calm_pd"), ulps=0)
+    with pytest.raises(SystemExit):
+        cli.main(["calm_pd", "--spread", "0"])
+    assert "--spread takes a number of ulps >= 1, got 0" in capsys.readouterr().err
 
 
 def test_stop_time_and_set_reach_the_fmus(tmp_path):

@@ -260,13 +260,15 @@ def test_a_sweep_left_without_a_worker_stops_keeps_its_rows_and_says_why(
 
 
 @pytest.mark.timeout(30, method="thread")
-def test_a_sweep_on_a_cluster_that_never_had_a_worker_stops_too(fmu_paths, tmp_path):
+def test_a_sweep_on_a_cluster_that_never_had_a_worker_stops_too(fmu_paths, tmp_path, capsys):
+    from cosim import sweep as command
     from cosim.studies.cluster import local_cluster
 
-    spec = Spec.read(write_spec(tmp_path, 'stop_time = 5\n[axes]\nwave_seed = [1]\n'))
-    with pytest.raises(ValueError, match="no_worker_timeout must be a number of seconds > 0, "
-                                         "got 0"):
-        campaign.execute(spec, tmp_path, progress=False, no_worker_timeout=0)
+    path = write_spec(tmp_path, 'stop_time = 5\n[axes]\nwave_seed = [1]\n')
+    with pytest.raises(SystemExit):
+        command.main([str(path), "--no-worker-timeout", "0"])
+    assert "expected a positive number of seconds, got '0'" in capsys.readouterr().err
+    spec = Spec.read(path)
     cluster = local_cluster(0)
     try:
         with pytest.raises(NoWorkers, match=r"no worker in the cluster for 0.5 s \(none "

@@ -18,7 +18,7 @@ from .. import scenarios
 from ..analysis.cost import LAMBDA
 from ..analysis.metrics import cost_terms
 from ..core.master import Master
-from ..ensemble.members import COMPONENTS, initialise
+from ..ensemble.reference import COMPONENTS, initialise
 from . import table
 from .integration_error import H
 

@@ -1,6 +1,5 @@
 """The memory benchmarks: a long run streamed to disk (``bench memory``) and the batch route's
-memory against its members and the sweep's size (``bench sweep --parts memory``); a run's own
-peak memory is measured in a fresh process."""
+against its members and the sweep's size (``bench sweep --parts memory``), in fresh processes."""
 from __future__ import annotations
 
 import subprocess

@@ -82,7 +82,20 @@ def sweep_throughput(runs: int = 32, batch_runs: int = 1024, seas: tuple[str, ..
                           f"({outside / m.simulated:4.1%}); load {m.load:.2f}")
                     measured.setdefault((sea, backend, workers), []).append(m.rate)
     rates = {key: statistics.median(values) for key, values in measured.items()}
-    _print_rates(rates, seas, rounds)
+    print("  runs/s per core (runs/s / workers" + (f", median of {rounds} rounds" if rounds > 1
+                                                 else "") + "):")
+    print(f"    {'':15}" + "".join(f"{_workers(w):>11}" for w in WORKERS)
+          + f"{'efficiency 1->2':>17}")
+    for sea in seas:
+        for backend in SWEEP_BACKENDS:
+            one, two = (rates[sea, backend, w] for w in WORKERS)
+            print(f"    {sea:5} {backend:9}{one:11.2f}{two / 2:11.2f}{two / one / 2:17.2f}")
+    print("    (efficiency 1.00: each worker as fast as one alone)")
+    for sea in seas:
+        for backend in SWEEP_BACKENDS[1:]:
+            print(f"  {sea:5} {backend} / fmi: " + ", ".join(
+                f"{rates[sea, backend, w] / rates[sea, 'fmi', w]:5.2f}x with {_workers(w)}"
+                for w in WORKERS))
     for sea in seas:
         ratios = {w: [b / i for b, i in zip(measured[sea, BATCH, w], measured[sea, "inprocess", w])]
                   for w in WORKERS}
@@ -206,21 +219,3 @@ def timed_sweep(spec: Spec, workers: int, backend: str, batch_size: int | None =
                    math.fsum(r["sim_seconds"] for r in rows) / len(rows),
                    math.fsum(r["seconds"] - r["sim_seconds"] for r in rows) / len(rows),
                    tuple(map(len, batches)), peaks, os.getloadavg()[0])
-
-
-def _print_rates(rates: dict[tuple[str, str, int], float], seas: tuple[str, ...],
-                 rounds: int) -> None:
-    print("  runs/s per core (runs/s / workers" + (f", median of {rounds} rounds" if rounds > 1
-                                                 else "") + "):")
-    print(f"    {'':15}" + "".join(f"{_workers(w):>11}" for w in WORKERS)
-          + f"{'efficiency 1->2':>17}")
-    for sea in seas:
-        for backend in SWEEP_BACKENDS:
-            one, two = (rates[sea, backend, w] for w in WORKERS)
-            print(f"    {sea:5} {backend:9}{one:11.2f}{two / 2:11.2f}{two / one / 2:17.2f}")
-    print("    (efficiency 1.00: each worker as fast as one alone)")
-    for sea in seas:
-        for backend in (b for b in SWEEP_BACKENDS if b != "fmi"):
-            print(f"  {sea:5} {backend} / fmi: " + ", ".join(
-                f"{rates[sea, backend, w] / rates[sea, 'fmi', w]:5.2f}x with {_workers(w)}"
-                for w in WORKERS))

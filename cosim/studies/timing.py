@@ -108,7 +108,10 @@ def engines(repeats: int) -> dict[str, dict[str, float]]:
                     except Exception as error:          # not installed here: say so
                         print(f"  {key} unavailable: {type(error).__name__}: {error}")
                 times = results[name] = side_by_side(runners, repeats)
-                calls, per_call = fmi_calls_per_step(fmi), fmi_call_cost(fmi)
+                calls = sum(bool(call) for node in fmi.nodes for call in (   # a step's calls
+                    node.read_state, node.apply_inputs, node.read_feedthrough,
+                    node.read_integers, node.step))
+                per_call = fmi_call_cost(fmi)
             times["floor"] = times["direct"] + STEPS * calls * per_call
             print(f"\n{name}:\n  {'':44} {'wall s':>7} {'us/step':>8} {'RTF':>6} {'x (a)':>6}")
             for key, label in ROWS.items():
@@ -140,16 +143,9 @@ def _master_runner(master) -> Callable[[], None]:
     return run
 
 
-def fmi_calls_per_step(master) -> int:
-    """FMI calls one Gauss-Seidel step of ``master`` makes."""
-    return sum(bool(call) for node in master.nodes
-               for call in (node.read_state, node.apply_inputs, node.read_feedthrough,
-                            node.read_integers, node.step))
-
-
-def fmi_call_cost(master, calls: int = 20_000) -> float:
-    """Seconds per FMI call of the cheapest kind: setReal and getReal of one value on the
-    autopilot FMU."""
+def fmi_call_cost(master) -> float:
+    """Seconds per FMI call of the cheapest kind: setReal, getReal of one autopilot value."""
+    calls = 20_000
     master.reset()
     master.initialize()
     instance = master.instances["autopilot"]
