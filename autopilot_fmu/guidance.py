@@ -93,7 +93,6 @@ class WaypointGuidance:
         self.R_accept = R_accept
         self.leg = 0                      # active leg: from points[leg] to points[leg + 1]
         self.finished = False
-        self._last: tuple = (None, None)  # the last evaluation (an FMU asks 3 times)
 
     def _reached(self, leg: int, x: float, y: float) -> bool:
         (x0, y0), (x1, y1) = self.points[leg], self.points[leg + 1]
@@ -104,9 +103,6 @@ class WaypointGuidance:
 
     def active_leg(self, x: float, y: float) -> tuple[int, bool]:
         """(leg, finished) at position (x, y), from the committed leg onward."""
-        key = (x, y, self.leg, self.finished)
-        if self._last[0] == key:
-            return self._last[1]
         require_finite(x=x, y=y)
         leg, finished = self.leg, self.finished
         while not finished and self._reached(leg, x, y):
@@ -114,7 +110,6 @@ class WaypointGuidance:
                 leg += 1
             else:
                 finished = True
-        self._last = (key, (leg, finished))
         return leg, finished
 
     def course(self, leg: int) -> float:
