@@ -1,6 +1,5 @@
-"""A pytest plugin for your autopilot (a ``pytest11`` entry point; importing it changes
-nothing): options, fixtures, and ``check_*`` functions on the exchanged signals, which raise
-AssertionError saying what is wrong, where and when (docs/own_autopilot.md)."""
+"""A pytest plugin for your autopilot (docs/own_autopilot.md): options, fixtures, and
+``check_*`` functions that raise AssertionError saying what is wrong, where and when."""
 from __future__ import annotations
 
 import functools
