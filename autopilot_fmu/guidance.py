@@ -56,9 +56,8 @@ def numeric_route(text: str) -> dict[str, int | float]:
 
 
 def route(parameters: Mapping[str, Any]) -> list[tuple[float, float]]:
-    """The route of the guidance's parameters by name (absent: defaults); ValueError naming
-    them unless n_waypoints = 0 with every wp<i> unset (the String), or n >= 2 with wp0 ..
-    wp<n-1> and ``waypoints`` at its default or the same points."""
+    """The route of the guidance's parameters by name (absent: defaults): the String if
+    n_waypoints = 0, else wp0 .. wp<n-1>; ValueError naming them if they contradict."""
     text = parameters.get("waypoints", PAPER_ROUTE)
     count = parameters.get("n_waypoints", 0)
     coordinates = [float(parameters.get(name, 0.0)) for name in COORDINATES]

@@ -87,8 +87,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("scenario", nargs="?",
                         help=f"one of: {', '.join(scenarios.names())}; or a path to a .ssd file")
     parser.add_argument("--all", action="store_true",
-                        help="run the paper's four scenarios and print Tables 1-2 beside the "
-                             "paper's")
+                        help="run the paper's four scenarios, print Tables 1-2 beside the paper's")
     parser.add_argument("--out", type=Path,
                         help="output folder (default: results/SCENARIO, or results/ with --all)")
     parser.add_argument("--stop-time", type=number_option, metavar="T",
@@ -103,10 +102,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--lambda", dest="lam", type=number_option, default=LAMBDA,
                         help=f"weight of eq (19) (default {LAMBDA:.4f}, calibrated on calm_pd)")
     parser.add_argument("--backend", choices=RUN_BACKENDS, default="fmi",
-                        help="fmi: load the FMUs through FMI (default); inprocess: call the "
-                             "FMUs' Python classes, without FMI, with the same results bit for "
-                             "bit (an FMU not built from this checkout's sources runs through "
-                             "FMI, with a note)")
+                        help="fmi: load the FMUs through FMI (default); inprocess: call their "
+                             "Python classes, the same results bit for bit (an FMU not built "
+                             "from this checkout's sources runs through FMI, with a note)")
     add_fmu_options(parser, "with --all it also runs in calm_pd's and waves_pd's place, as an "
                             "extra row of Tables 1-2")
     parser.add_argument("--no-plot", action="store_true", help="skip the figure")
@@ -126,11 +124,11 @@ def main(argv: list[str] | None = None) -> int:
                              "for long runs; no report or figure")
     parser.add_argument("--step-timeout", type=positive_seconds, default=STEP_LIMIT_S, metavar="S",
                         help="end the run with an error if one step of the FMUs (or their "
-                             f"instantiation) takes longer than S s of wall-clock time "
-                             f"(default {STEP_LIMIT_S:g})")
+                             f"instantiation) takes over S s of wall-clock time (default "
+                             f"{STEP_LIMIT_S:g})")
     parser.add_argument("--run-timeout", type=positive_seconds, metavar="S",
-                        help="end the run with an error, keeping its rows, if it takes "
-                             "longer than S s of wall-clock time (default: no limit)")
+                        help="end the run with an error, keeping its rows, after S s of "
+                             "wall-clock time (default: no limit)")
     args = parser.parse_args(argv)
     names = chosen_scenarios(parser, args)
     checked_autopilot(parser, args)
@@ -191,11 +189,10 @@ def main(argv: list[str] | None = None) -> int:
         if result is not None and table_row is not None:
             costs[table_row] = result
     if args.all and costs:
-        print()
-        print(tables(costs, spreads, f"How far one last bit moves each figure (the largest "
-                                    f"change over {count} runs, "
-                                    f"{perturbed} moved by up to {args.spread} ulp; where "
-                                    "it shows at the printed digits)"))
+        title = (f"How far one last bit moves each figure (the largest change over {count} "
+                 f"runs, {perturbed} moved by up to {args.spread} ulp; where it shows at the "
+                 "printed digits)")
+        print("\n" + tables(costs, spreads, title))
     return status
 
 

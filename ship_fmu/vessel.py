@@ -38,8 +38,7 @@ class VesselParameters:
     wave_components: int = 50
     h_max: float = 0.1          # s, largest RK4 step
 
-    def __post_init__(self) -> None:
-        """Raise ValueError naming the first invalid parameter."""
+    def __post_init__(self) -> None:               # ValueError naming the first invalid one
         for f in fields(self):
             value = getattr(self, f.name)
             if not math.isfinite(value):
