@@ -5,8 +5,7 @@ Examples:
   python -m cosim.run waves_smc --out /tmp/w   the sliding-mode autopilot in waves
   python -m cosim.run calm_pd --set ship.Hs=0.003 --set autopilot.Kd=30
   python -m cosim.run --all                    the paper's four runs, Tables 1-2
-  python -m cosim.run --all --spread           ... with how far one last bit moves each
-                                               figure (as docs/reproduction.md)
+  python -m cosim.run --all --spread           ... and how far one last bit moves each figure
   python -m cosim.run waves_pd --autopilot my.fmu   your own autopilot in waves_pd's place
   python -m cosim.run --all --fmi 3            the same runs through the FMI 3.0 twins
 
