@@ -1,8 +1,6 @@
 """Waypoint guidance, eq (18): psi_d = atan2(y_{k+1} - y_k, x_{k+1} - x_k), x north. The
 next leg starts inside the circle of acceptance *or* once past the waypoint along the track
 (a circle-only rule strands a ship turning wide); past the last, the last course holds."""
-from __future__ import annotations
-
 import math
 from collections.abc import Mapping, Sequence
 from typing import Any

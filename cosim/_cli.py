@@ -1,7 +1,5 @@
 """What the commands share: scenario and autopilot options, output folders, messages. Only
 the commands import this."""
-from __future__ import annotations
-
 import argparse
 import functools
 import math

@@ -1,7 +1,5 @@
 """The Python entry point: ``simulate`` runs a scenario, with your autopilot if you have one,
 ``simulate_many`` many runs of one (docs/running.md, "From Python")."""
-from __future__ import annotations
-
 import warnings
 from pathlib import Path
 from typing import Any, Iterable, Mapping, Sequence

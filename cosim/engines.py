@@ -1,7 +1,5 @@
 """Run an SSP package in another engine (``cosim.interop.engines``) and save the signals; a
 failure is status 1 with the engine's messages."""
-from __future__ import annotations
-
 import argparse
 import sys
 from pathlib import Path

@@ -1,8 +1,6 @@
 """A run and what it writes, the one lifecycle behind ``cosim.run`` and any library caller:
 the outputs are staged and put in place together (a refused run, a full disk or a second
 Ctrl-C leaves the folder as it was), by one process a folder at a time; nothing printed."""
-from __future__ import annotations
-
 import signal
 from dataclasses import dataclass, field
 from pathlib import Path

@@ -1,7 +1,5 @@
 """What it takes to reproduce a run, as strict JSON next to its CSV: the master's record, the
 FMUs' and scenario's SHA-256, the command, the versions and git commit."""
-from __future__ import annotations
-
 import functools
 import hashlib
 import json

@@ -13,8 +13,6 @@ A scenario is an SSP system structure file (cosim/scenarios/*.ssd). A run writes
 signal at every 0.1 s step to SCENARIO.csv and a figure like the paper's Figs 2-3 to
 SCENARIO.png, and prints the cost of eq (19) (or the manoeuvre's figures).
 """
-from __future__ import annotations
-
 import argparse
 import sys
 from pathlib import Path

@@ -1,7 +1,5 @@
 """A pytest plugin for your autopilot (docs/own_autopilot.md): options, fixtures, and
 ``check_*`` functions that raise AssertionError saying what is wrong, where and when."""
-from __future__ import annotations
-
 import functools
 import math
 from pathlib import Path

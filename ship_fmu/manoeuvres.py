@@ -1,6 +1,4 @@
 """The rudder program of a turning circle or a zig-zag test (IMO MSC.137(76))."""
-from __future__ import annotations
-
 
 class RudderProgram:
     """Executes ``delta`` at t = 0 (positive: to port, headings go negative first) and

@@ -1,7 +1,5 @@
 """Steering gear: the rudder follows the command within +-delta_max at a limited rate, exact
 at any instant; 20 deg/s is the IMO rate (2.3 deg/s) Froude-scaled to 1:70."""
-from __future__ import annotations
-
 import math
 
 DELTA_MAX = math.radians(35.0)

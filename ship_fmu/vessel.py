@@ -1,8 +1,6 @@
 """The vessel: CyberShip II hull, actuators, steering gear and waves, by RK4 with the inputs
 held, in equal sub-steps <= h_max, cut where the rudder reaches its command or stop (RK4 keeps
 its order only on smooth pieces, ``cosim.accuracy``). psi is not wrapped."""
-from __future__ import annotations
-
 import math
 from dataclasses import dataclass, fields
 from typing import Callable
