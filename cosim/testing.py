@@ -92,10 +92,8 @@ def check_heading_settles(run: Recording, bound: float, within: float) -> None:
     error = np.abs(heading_error(run["guidance.psi_d"], run["ship.psi"]))
     starts = [0, *(np.flatnonzero(np.diff(leg)) + 1)]
     for start, end in zip(starts, [*starts[1:], len(t)]):
-        settled = t[start:end] >= t[start] + within
-        if not settled.any():
-            continue
-        worst = float(error[start:end][settled].max())
+        settled = error[start:end][t[start:end] >= t[start] + within]
+        worst = float(settled.max(initial=0.0))       # errors are >= 0; no settled step: 0
         assert worst <= bound, \
             f"heading error {math.degrees(worst):.2f} deg on the leg to waypoint " \
             f"{int(leg[start])} (from t = {t[start]:.1f} s), {within:g} s after the course " \
