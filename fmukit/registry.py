@@ -1,9 +1,7 @@
-"""A slave's variables by value reference: registered with pythonfmu (through the adapter's
-``fmi_variable``), and plans reading or setting a list of them, made once per list (a master
-asks for the same lists at every step). A plan gives what the FMI call gives in every state
-of the slave (NaN once it has failed), so a host in the same process may call it itself; a
-list no plan serves gets ``None`` (pythonfmu serves it). Model attributes are read with one
-``operator.attrgetter``, other values within one ``try``, else one by one as pythonfmu does.
+"""A slave's variables by value reference, registered with pythonfmu, and plans reading or
+setting a list of them, made once per list (a master asks for the same lists at every step).
+A plan gives what the FMI call gives in every state of the slave, so a host in this process
+may call it; a list no plan serves gets ``None`` (pythonfmu serves it).
 """
 from __future__ import annotations
 
@@ -43,7 +41,6 @@ class Registry:
         return self._planned(float, vrs)
 
     def integer_reader(self, vrs: list[int]) -> Reader | None:
-        """The plan reading these Integers, or None if one is not an Integer."""
         return self._planned(int, vrs)
 
     def input_writer(self, vrs: list[int]) -> Writer | None:
@@ -51,7 +48,6 @@ class Registry:
         return self._planned(None, vrs)
 
     def _planned(self, kind: type | None, vrs: list[int]) -> Reader | Writer | None:
-        """The plan reading ``kind`` (None: writing), compiled the first time."""
         key = (kind, *vrs)
         try:
             return self._plans[key]

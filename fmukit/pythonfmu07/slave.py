@@ -1,7 +1,5 @@
-"""``Fmi2Entry``: the mixin that makes a ``ModelSlave`` an FMI 2.0 FMU of pythonfmu 0.7
-(``class <Model>(Fmi2Entry, <Model>, Fmi2Slave)``: pythonfmu takes the class with the
-longest MRO). Every refusal is an exception: fmi2Fatal (pythonfmu 0.7's fmi2Discard would
-pass for a normal end).
+"""``Fmi2Entry``: the mixin that makes a ``ModelSlave`` an FMI 2.0 FMU of pythonfmu 0.7.
+Every refusal is an exception: fmi2Fatal (pythonfmu 0.7's fmi2Discard would pass for an end).
 """
 from __future__ import annotations
 
@@ -23,7 +21,6 @@ _TYPE = {float: Real, int: Integer, str: String}
 
 class Fmi2Entry:
     """FMI 2.0 through pythonfmu 0.7: the version's half of an FMU's class."""
-
     API, FMI_VERSION = "fmi2", 2
     STATUS_ERROR, STATUS_FATAL = Fmi2Status.error, Fmi2Status.fatal
     RELEASES_ON_EXCEPTION = ACTIVE
@@ -65,8 +62,7 @@ class Fmi2Entry:
         return super().get_integer(vrs) if read is None else read()
 
     def to_xml(self, model_options: dict[str, str] = dict()) -> Element:
-        """pythonfmu's model description with the units, ranges, exact starts and
-        dependencies (by 1-based index) it leaves out."""
+        """pythonfmu's model description with what it leaves out (``describe``)."""
         root = super().to_xml(model_options)
         structure, unknowns = describe(root, self.variables, [
             e.find("Real" if v.is_real else "Integer")
@@ -80,8 +76,7 @@ class Fmi2Entry:
 
 
 def hold_namespace(namespace: dict[str, Any]) -> None:
-    """One more reference on an FMU entry module's namespace, each time its code runs:
-    pythonfmu 0.7's ``findClass`` reruns the module at every instantiation and releases
-    the namespace ``PyModule_GetDict`` only lent it (the second instance would segfault)."""
+    """One more reference on an FMU entry module's namespace each time it runs: pythonfmu
+    0.7 reruns it at every instantiation and releases the namespace it was only lent."""
     if ACTIVE:
         ctypes.pythonapi.Py_IncRef(ctypes.py_object(namespace))
