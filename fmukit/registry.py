@@ -26,7 +26,7 @@ class Registry:
         for var in variables:
             getter = None
             if var.causality == "output":
-                get = var.get or (lambda s, name=var.name: getattr(s._model, name))
+                get = var.get or (lambda s, name=var.name: getattr(s.model, name))
 
                 def getter(get=get, undefined=math.nan if var.is_real else 0) -> Any:
                     return evaluate(get, undefined)
@@ -49,12 +49,9 @@ class Registry:
 
     def _planned(self, kind: type | None, vrs: list[int]) -> Reader | Writer | None:
         key = (kind, *vrs)
-        try:
-            return self._plans[key]
-        except KeyError:
-            plan = self._plans[key] = (self._writer(key[1:]) if kind is None
-                                       else self._reader(key[1:], kind))
-            return plan
+        if key not in self._plans:
+            self._plans[key] = self._writer(key[1:]) if kind is None else self._reader(key[1:], kind)
+        return self._plans[key]
 
     def _reader(self, vrs: tuple[int, ...], kind: type) -> Reader | None:
         slave, by_vr = self._slave, self.by_vr
@@ -75,8 +72,6 @@ class Registry:
                     if gets is None:
                         values = attributes(model)            # one C-level call
                         return [values] if single else list(values)
-                    if single:
-                        return [kind(gets[0](slave))]
                     return [kind(get(slave)) for get in gets]
                 except (ValueError, ArithmeticError):
                     pass

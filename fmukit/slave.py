@@ -39,11 +39,6 @@ class CallSequence:
             raise Refused(f"{self.api}{call} is not allowed in phase '{self.phase}' (FMI "
                           f"{self.api[3:]}.0 allows it after {after})", "call")
 
-    def require_step(self) -> None:
-        if self.phase != "step":
-            raise Refused(f"doStep called in phase '{self.phase}': call "
-                          "exitInitializationMode first, and not after terminate", "call")
-
     def check_settable(self, var: Var) -> None:
         """Refused naming ``var`` if the standard forbids setting it now."""
         if var.causality == "output":
@@ -128,8 +123,6 @@ class ModelSlave:
         if self.failure:
             return undefined
         try:
-            if self._model is None:
-                self._model = self._started_model()
             return get(self)
         except (ValueError, ArithmeticError) as error:
             if self.sequence.phase == "step":
@@ -197,7 +190,9 @@ class ModelSlave:
     def _step(self, current_time: float, step_size: float) -> None:
         if self.failure:
             raise Refused(self.failure, self.failure_cause)
-        self.sequence.require_step()          # like any call out of sequence: nothing done
+        if self.sequence.phase != "step":     # like any call out of sequence: nothing done
+            raise Refused(f"doStep called in phase '{self.sequence.phase}': call "
+                          "exitInitializationMode first, and not after terminate", "call")
         if not (0.0 < step_size <= MAX_TIME and abs(current_time) <= MAX_TIME):
             self._fail(f"doStep at t = {current_time} with communication step {step_size}: the "
                        f"step must be positive, and both within +-{MAX_TIME:g} s", "step")
