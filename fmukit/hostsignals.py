@@ -11,6 +11,7 @@ import signal
 import sys
 import threading
 import time
+import traceback
 from types import FrameType
 from typing import Callable
 
@@ -21,12 +22,8 @@ _pending: set[signal.Signals] = set()   # arrived while FMU code ran; not yet ha
 
 
 def _in_fmu_code(frame: FrameType | None) -> bool:
-    while frame is not None:
-        code = frame.f_code
-        if code.co_name == "entry" and code.co_filename == _ENTRY_FILE:
-            return True
-        frame = frame.f_back
-    return False
+    return frame is not None and any(f.f_code.co_name == "entry" and f.f_code.co_filename
+                                     == _ENTRY_FILE for f, _ in traceback.walk_stack(frame))
 
 
 class _DeferringHandler:

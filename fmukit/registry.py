@@ -5,6 +5,7 @@ may call it; a list no plan serves gets ``None`` (pythonfmu serves it).
 """
 from __future__ import annotations
 
+import functools
 import math
 import operator
 from typing import Any, Callable
@@ -27,9 +28,7 @@ class Registry:
             getter = None
             if var.causality == "output":
                 get = var.get or (lambda s, name=var.name: getattr(s.model, name))
-
-                def getter(get=get, undefined=math.nan if var.is_real else 0) -> Any:
-                    return evaluate(get, undefined)
+                getter = functools.partial(evaluate, get, math.nan if var.is_real else 0)
             else:
                 setattr(slave, var.name, var.start)
             sv = slave.fmi_variable(var, getter)

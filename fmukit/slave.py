@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from typing import Any, Callable, ClassVar, NoReturn
 
 from . import hostsignals, state
-from .entry import fmi_entry
+from .entry import HostLog, fmi_entry
 from .refusals import CAUSES, Refused, explain, naming
 from .registry import Registry
 from .timebase import MAX_TIME, on_time_base
@@ -69,7 +69,8 @@ class ModelSlave:
     model_name: ClassVar[str]
     variables: ClassVar[tuple[Var, ...]]
     default_experiment = DefaultExperiment(start_time=0.0, stop_time=400.0, step_size=0.1)
-    # The adapter's, with ``_host_log(kwargs)`` and ``fmi_variable(var, output_getter)``:
+    # The adapter's, with ``KNOWN_BINARIES``, ``HEARS_UNKNOWN`` (does the host of another
+    # binary hear?) and ``fmi_variable(var, output_getter)``:
     API: ClassVar[str]
     STATUS_ERROR: ClassVar[Any]
     STATUS_FATAL: ClassVar[Any]
@@ -80,7 +81,7 @@ class ModelSlave:
         self.modelName = self.model_name
         self.log_categories = {**self.log_categories, **CATEGORIES}
         self.sequence = CallSequence(self.API)
-        self.host_log = self._host_log(kwargs)
+        self.host_log = HostLog(kwargs, self.KNOWN_BINARIES, self.HEARS_UNKNOWN)
         self.failure: str | None = None       # why the FMU failed; until reset
         self.failure_cause = "model"          # its cause (fmukit.refusals.CAUSES)
         self.start_time: float | None = 0.0   # of the experiment, for messages (None: unknown)

@@ -11,7 +11,7 @@ from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, In
 from pythonfmu import String
 from pythonfmu.enums import Fmi2Status
 
-from ..entry import HostLog, fmi_entry
+from ..entry import fmi_entry
 from ..registry import pythonfmu_variable
 from ..variables import Var, describe
 from . import ACTIVE, binary
@@ -24,9 +24,7 @@ class Fmi2Entry:
     API, FMI_VERSION = "fmi2", 2
     STATUS_ERROR, STATUS_FATAL = Fmi2Status.error, Fmi2Status.fatal
     RELEASES_ON_EXCEPTION = ACTIVE
-
-    def _host_log(self, kwargs: dict[str, Any]) -> HostLog:
-        return HostLog(kwargs, binary.KNOWN_BINARIES, unknown=False)
+    KNOWN_BINARIES, HEARS_UNKNOWN = binary.KNOWN_BINARIES, False
 
     def fmi_variable(self, var: Var, getter: Callable[[], Any] | None) -> Any:
         return pythonfmu_variable(var, getter, _TYPE[var.kind], Fmi2Causality,

@@ -9,7 +9,7 @@ from xml.etree.ElementTree import Element, SubElement
 from pythonfmu3 import Fmi3Causality, Fmi3Initial, Fmi3Slave, Fmi3Status, Fmi3StepResult
 from pythonfmu3 import Fmi3Variability, Float64, Int32, String
 
-from ..entry import HostLog, fmi_entry
+from ..entry import fmi_entry
 from ..registry import pythonfmu_variable
 from ..variables import Var, describe
 from . import ACTIVE, binary
@@ -28,15 +28,13 @@ class Fmi3Entry:
     API, FMI_VERSION = "fmi3", 3
     STATUS_ERROR, STATUS_FATAL = Fmi3Status.error, Fmi3Status.fatal
     RELEASES_ON_EXCEPTION = ACTIVE
+    KNOWN_BINARIES, HEARS_UNKNOWN = binary.KNOWN_BINARIES, True
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
         for attribute in _FROM_CLASS:
             setattr(self, attribute, getattr(type(self), attribute, None))
         self.start_time = None                 # pythonfmu3 drops it: messages name none
-
-    def _host_log(self, kwargs: dict[str, Any]) -> HostLog:
-        return HostLog(kwargs, binary.KNOWN_BINARIES, unknown=True)
 
     def _before_variables(self) -> None:
         """``time`` at value reference 0: a variable's is its FMI 2.0 twin's plus one."""
