@@ -66,7 +66,7 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
                     module = ".".join(relative.with_suffix("").parts)
                     staged[module.removesuffix(".__init__")] = stage / relative
         # pythonfmu imports the script by its name: not a module of that name imported before
-        shadowed = sys.modules.pop(script.stem, None)
+        sys.modules.pop(script.stem, None)
         try:
             sys.path.insert(0, str(stage))
             slave = _slave_class(script.stem)
@@ -99,9 +99,6 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
             why = str(error).replace(str(stage / script.name), str(script))
             raise ValueError(f"cannot build an FMU from {script}: "
                              f"{type(error).__name__}: {why}") from error
-        finally:
-            if shadowed is not None:
-                sys.modules[script.stem] = shadowed
         fmu = dest if dest.suffix == ".fmu" else dest / Path(built).name
         with zipfile.ZipFile(built) as package:     # the Linux binary with its exit fixed
             entries = {name: exit_fix.patch(package.read(name), f"{fmu}:{name}", fmi)
@@ -234,13 +231,14 @@ def _carried(file: Path, stage: Path) -> dict[str, str]:      # its entry in the
 
 @contextlib.contextmanager
 def _imports_undone() -> Iterator[None]:
-    """sys.path restored and the modules imported from the build's folders forgotten."""
-    path, modules = list(sys.path), set(sys.modules)
+    """sys.path and earlier modules restored; modules from the build's folders forgotten."""
+    path, modules = list(sys.path), dict(sys.modules)
     try:
         yield
     finally:
         sys.path[:] = path
-        for name in set(sys.modules) - modules:
+        for name in sys.modules.keys() - modules.keys():
             file = getattr(sys.modules[name], "__file__", None)
             if file and not os.path.exists(file):
                 del sys.modules[name]
+        sys.modules.update(modules)
