@@ -79,9 +79,8 @@ class HostLog:
 
     def hears(self) -> bool:
         """Whether the host receives this FMU's log messages now."""
-        if self._in_process:
-            return True
-        return bool(self._flag.value) if self._flag is not None else self._unknown
+        return self._in_process or (bool(self._flag.value) if self._flag is not None
+                                    else self._unknown)
 
     def tell(self, instance_name: str, message: str) -> None:
         """Write an error to standard error if the host will not hear it, once per reason."""
