@@ -49,7 +49,8 @@ class Registry:
     def _planned(self, kind: type | None, vrs: list[int]) -> Reader | Writer | None:
         key = (kind, *vrs)
         if key not in self._plans:
-            self._plans[key] = self._writer(key[1:]) if kind is None else self._reader(key[1:], kind)
+            self._plans[key] = (self._writer(key[1:]) if kind is None
+                                else self._reader(key[1:], kind))
         return self._plans[key]
 
     def _reader(self, vrs: tuple[int, ...], kind: type) -> Reader | None:
