@@ -1,6 +1,6 @@
 """The package's own rules of shape (docs/architecture.md), read from its sources: no import
-cycle, a core that knows nothing of the project, library code that imports no command, no
-module over 300 lines, the master and the slave base class within their budgets."""
+cycle, a core that knows nothing of the project, cosim's layers, library code that imports no
+command, no module over 300 lines, the master and the slave base class within their budgets."""
 from __future__ import annotations
 
 import ast
@@ -12,7 +12,11 @@ from fmubuild.project import ROOT
 
 PACKAGES = ("cosim", "fmukit", "fmubuild", "ship_fmu", "autopilot_fmu")
 COMMANDS = {"cosim.run", "cosim.sweep", "cosim.export", "cosim.bench", "cosim.engines",
-            "cosim.score", "cosim.accuracy", "fmukit.build", "fmubuild.cli"}
+            "cosim.score", "cosim.accuracy", "cosim._cli", "fmukit.build", "fmubuild.cli"}
+LAYERS = (("cosim.core",), ("cosim.ensemble",), ("cosim.scenarios",), ("cosim.analysis",),
+          ("cosim.interop",), ("cosim", "cosim.api", "cosim.outputs", "cosim.provenance",
+                               "cosim.testing"), ("cosim.studies",))
+"""cosim's layers, lowest first: a module imports only from its own layer and those below."""
 MAX_LINES = 300
 CLASS_BUDGETS = {("cosim/core/master.py", "Master"): 150, ("fmukit/slave.py", "ModelSlave"): 220}
 
@@ -74,6 +78,18 @@ def test_the_core_imports_nothing_of_the_project_but_the_fmu_runtime():
             named += [n.right.value for n in ast.walk(tree) if isinstance(n, ast.BinOp)
                       and isinstance(n.right, ast.Constant) and n.right.value == "fmus"]
             assert named == [], name
+
+
+def _layer(name: str) -> int | None:
+    return next((k for k, layer in enumerate(LAYERS) for top in layer
+                 if name == top or (top != "cosim" and name.startswith(top + "."))), None)
+
+
+def test_cosim_modules_import_only_from_their_layer_and_those_below():
+    upward = {(m, i) for m, imported in GRAPH.items() if _layer(m) is not None
+              for i in imported if i.startswith("cosim") and i not in COMMANDS
+              and (_layer(i) is None or _layer(i) > _layer(m))}
+    assert upward == set()
 
 
 def test_library_modules_import_no_command():
