@@ -218,6 +218,7 @@ def test_a_worker_count_that_makes_no_sense_is_refused_or_capped(capsys):
 
 @pytest.mark.timeout(60, method="thread")
 def test_the_command_ends_bad_cluster_options_in_one_line(tmp_path):
+    """What the command says, in this process (a test of messages, not of processes)."""
     spec = spec_file(tmp_path, "stop_time = 5\n[axes]\nwave_seed = [1]\n")
     for options, said in [(["--scheduler", "tcp://127.0.0.1:9", "--connect-timeout", "1"],
                            "error: cannot reach the Dask scheduler at tcp://127.0.0.1:9"),
@@ -225,9 +226,7 @@ def test_the_command_ends_bad_cluster_options_in_one_line(tmp_path):
                            f"error: scheduler file {tmp_path / 'none.json'} does not exist"),
                           (["--workers", "0"], "argument --workers: give a whole number >= 1"),
                           (["--max-runs", "-1"], "argument --max-runs: give a whole number")]:
-        child = subprocess.run([sys.executable, "-m", "cosim.sweep", str(spec), "--out",
-                                str(tmp_path / "out"), *options],
-                               capture_output=True, text=True, timeout=50)
+        child = command(sweep_command.main, str(spec), "--out", str(tmp_path / "out"), *options)
         assert child.returncode == 2 and said in child.stderr, child
         assert "Traceback" not in child.stderr
     assert not list((tmp_path / "out").rglob("*.*"))         # no file of any kind
