@@ -21,7 +21,7 @@ from cosim.studies.cluster import NoWorkers, SweepError
 from cosim.studies.merit import METRICS
 from cosim.studies.sweep_spec import Spec
 from cosim.studies.sweep_tables import comparison, write_tables
-from helpers import reference_seconds
+from helpers import command, reference_seconds
 
 EXAMPLE = Path(__file__).resolve().parent.parent / "docs" / "sweeps" / "example.toml"
 
@@ -305,15 +305,14 @@ def test_two_sweeps_on_one_cluster_both_finish_with_every_row(fmu_paths, tmp_pat
     assert all(r["status"] == "ok" for rows in done for r in rows), done
 
 
-def test_when_every_run_fails_the_summary_still_names_each_failure(fmu_paths, tmp_path):
-    import subprocess
-    import sys
+def test_when_every_run_fails_the_summary_still_names_each_failure(fmu_paths, tmp_path,
+                                                                  scheduler):
+    from cosim import sweep as sweep_command
 
     # each value in its range, the two together against the ship's rule: the FMU's refusal
     spec = write_spec(tmp_path, 'name = "bad"\nstop_time = 5\n[axes]\nHs = [0.1]\nT0 = [0.2]\n')
-    child = subprocess.run([sys.executable, "-m", "cosim.sweep", str(spec), "--workers", "1",
-                            "--out", str(tmp_path / "out"), "--no-progress"],
-                           capture_output=True, text=True, timeout=300)
+    child = command(sweep_command.main, str(spec), "--scheduler", scheduler, "--out",
+                    str(tmp_path / "out"), "--no-progress")
     assert child.returncode == 1, child.stderr
     assert "bad: 2 runs, 0 ok, 2 failed" in child.stdout
     for controller in ("pd", "smc"):
