@@ -143,10 +143,6 @@ class FmuInstance(Instance):
         if status > 1:                      # discard, error, fatal
             raise FmuCallError(self.name, what, time, STATUS[status], self._since(before))
 
-    def _terminated(self, t: float, before: int) -> FmuCallError:
-        return FmuCallError(self.name, "doStep", t, "OK but asked to end the simulation "
-                            "(terminateSimulation)", self._since(before))
-
     def fmi(self, name: str):
         return getattr(self.slave, CALLS.get(name, name) if self.fmi_version == 3 else name)
 
@@ -157,12 +153,6 @@ class FmuInstance(Instance):
         else:
             self.call("enterInitializationMode", self.slave.enterInitializationMode,
                       startTime=start_time)
-
-    def do_step(self, t: float, h: float) -> None:
-        before = self.logged
-        result = self.call("doStep", self.slave.doStep, t, h, time=t)
-        if self.fmi_version == 3 and result[1]:          # terminateSimulation
-            raise self._terminated(t, before)
 
     def reset(self) -> None:
         self.call("reset", self.slave.reset)
@@ -234,5 +224,6 @@ class FmuInstance(Instance):
             if status:
                 self._status("doStep", status, before, t)
             if terminate.value:
-                raise self._terminated(t, before)
+                raise FmuCallError(self.name, "doStep", t, "OK but asked to end the simulation "
+                                   "(terminateSimulation)", self._since(before))
         return step
