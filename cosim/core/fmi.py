@@ -2,6 +2,7 @@
 The master speaks FMI 2.0's names; FMI 3.0's types and calls are mapped to them."""
 from __future__ import annotations
 
+import contextlib
 import functools
 import shutil
 from collections import deque
@@ -158,10 +159,8 @@ class FmuInstance(Instance):
         self.call("reset", self.slave.reset)
 
     def free(self) -> None:
-        try:
+        with contextlib.suppress(FMICallException):
             self.slave.terminate()
-        except FMICallException:
-            pass
         self.slave.freeInstance()
         self._remove_unzip_dir()
 

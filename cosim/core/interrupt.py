@@ -31,7 +31,6 @@ class StopSignals:
 
     def __init__(self) -> None:
         self.received: signal.Signals | None = None
-        self._previous: dict = {}
         self._keepers: list[Callable[[], str]] = []
         self._ending = threading.Lock()
 

@@ -94,13 +94,13 @@ class Master(contextlib.AbstractContextManager):
 
     def run(self, stop_time: float | None = None,
             progress: Callable[[int, int], None] | None = None,
-            csv_path: str | Path | None = None, chunk_rows: int = 10_000,
-            stop: StopSignals | None = None, watchdog: Watchdog | None = None) -> Recording:
+            csv_path: str | Path | None = None, stop: StopSignals | None = None,
+            watchdog: Watchdog | None = None) -> Recording:
         """Simulate to ``stop_time`` (default: the system's); an FMU failure, a signal on
         ``stop`` or a limit of ``watchdog`` ends it early between steps (``Recording.error``,
         the rows kept). ``csv_path``: the rows streamed there (else TooManyRows if too many)."""
         t0, h, n_steps = self.system.steps(stop_time)
-        recorder = self._recorder = Recorder(self.columns, n_steps + 1, csv_path, chunk_rows,
+        recorder = self._recorder = Recorder(self.columns, n_steps + 1, csv_path,
                                              run_meta(self, n_steps), self.units)
         exchange, values = COUPLINGS[self.coupling], [0.0] * len(self.columns)
         k, t, error, self.parameter_values = 0, t0, None, {}

@@ -1,7 +1,6 @@
-"""Values for FMU variables, checked before any FMU call: ``fmi_value``, exactly what the FMI
-2.0 call carries (section 2.1.2); ``checked``, against the declaration (2.2.7); ``setting``,
-also settable in initialisation mode (4.2.4). A refusal names the variable, value and what
-it takes."""
+"""Values for FMU variables, checked before any FMU call: exactly what the FMI 2.0 call carries
+(section 2.1.2), within the declaration (2.2.7), settable in initialisation mode (4.2.4). A
+refusal names the variable, the value and what it takes."""
 from __future__ import annotations
 
 import math
@@ -82,8 +81,8 @@ def declarations(description: ModelDescription) -> dict[str, Declaration]:
     return out
 
 
-class _Refusal(ValueError):             # why a value is refused: 'is not a whole number'
-    pass
+class _Refusal(ValueError):
+    """Why a value is refused: 'is not a whole number'."""
 
 
 def fmi_value(target: str, type_name: str, value: Any) -> Value:
