@@ -89,8 +89,7 @@ class _Reader:
         for i, element in enumerate(system.findall("ssd:Elements/*", NS), 1):
             component = self.component(element, i)
             if component.name in components:
-                raise self.error(f"Component {i}", f"a second Component named "
-                                                   f"'{component.name}'")
+                raise self.error(f"Component {i}", f"a second Component named '{component.name}'")
             components[component.name] = component
         if not components:
             raise self.error("System", "no Component in its Elements")
@@ -172,8 +171,7 @@ class _Reader:
                                             f"does not have; it has {', '.join(components)}")
             end = (connection.end_element, connection.end_connector)
             if end in fed:
-                raise self.error(where, f"{'.'.join(end)} is fed already by Connection "
-                                        f"{fed[end]}")
+                raise self.error(where, f"{'.'.join(end)} is fed already by Connection {fed[end]}")
             fed[end] = i
             connections.append(connection)
         return connections
