@@ -18,8 +18,7 @@ from .values import declarations, parameters
 from .watchdog import TimeLimit, Watchdog, no_limit
 from .wiring import COUPLINGS, check_connections, feedthrough_order, layout, settle
 
-# fmi: the FMUs through fmpy; inprocess: their Python classes (an FMU not current here runs
-# through FMI, with a note: ``fallback_note``)
+# the FMUs through fmpy, or their Python classes (else through FMI, with a ``fallback_note``)
 BACKENDS: dict[str, type[Instance]] = {"fmi": FmuInstance, "inprocess": InProcessInstance}
 RUN_BACKENDS = tuple(BACKENDS)          # the backends a run of a scenario may take
 

@@ -20,12 +20,10 @@ def check_connections(system: SystemDescription, instances: dict[str, Instance])
     for c in system.connections:
         for element, connector, kind in ((c.start_element, c.start_connector, "output"),
                                          (c.end_element, c.end_connector, "input")):
-            instance = instances[element]
-            if connector not in instance.variables:
-                raise WiringError(f"connection {c}: FMU '{element}' "
-                                  f"({instance.path.name}) has no variable '{connector}'; "
-                                  f"it has {', '.join(instance.variables)}")
-            variable = instance.variables[connector]
+            try:
+                variable = instances[element].variable(connector)
+            except ValueError as error:
+                raise WiringError(f"connection {c}: {error}") from None
             if variable.causality != kind or variable.type != "Real":
                 raise WiringError(f"connection {c}: {element}.{connector} is a "
                                   f"{variable.type} {variable.causality}; a connection "
@@ -49,7 +47,6 @@ def feedthrough_order(system: SystemDescription, instances: dict[str, Instance])
 class Node:
     """One component as the loop sees it: its output columns and prepared calls (None where
     it has nothing of that kind)."""
-
     step: Callable[[float, float], None]
     state: slice                        # Real outputs, no feedthrough
     feedthrough: slice                  # Real outputs, with feedthrough
