@@ -106,9 +106,8 @@ def fresh_folder(target: Path) -> Iterator[Path]:
 
 
 class Outputs(contextlib.AbstractContextManager):
-    """``with Outputs(folder, stale) as outputs``: files written to ``outputs.path(name)`` (a
-    hidden stage) are renamed into ``folder`` together if the block succeeds, and ``stale``
-    paths not rewritten removed; if it fails (or on ``discard``) the folder is as it was."""
+    """``with Outputs(folder, stale) as outputs``: the files of ``outputs.writing`` enter
+    ``folder`` together, and the ``stale`` not rewritten go, if the block succeeds (none else)."""
 
     def __init__(self, folder: Path, stale: list[Path] | tuple[Path, ...] = (),
                  label: str = "outputs"):

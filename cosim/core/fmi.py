@@ -24,11 +24,8 @@ from .instance import FmuCallError, Instance, LogRecord, logged_error
 STATUS = ("ok", "warning", "discard", "error", "fatal", "pending")
 VERSIONS = (2, 3)
 FMI3_TYPES = {"Float64": "Real", "Int32": "Integer"}     # Boolean and String: the same
-CALLS = {"setReal": "setFloat64", "getReal": "getFloat64",
-         "setInteger": "setInt32", "getInteger": "getInt32",
-         "getFMUstate": "getFMUState", "setFMUstate": "setFMUState",
-         "freeFMUstate": "freeFMUState", "serializeFMUstate": "serializeFMUState",
-         "deSerializeFMUstate": "deserializeFMUState"}          # FMI 2.0's: FMI 3.0's
+CALLS = {"setReal": "setFloat64", "getReal": "getFloat64",      # FMI 2.0's: FMI 3.0's
+         "setInteger": "setInt32", "getInteger": "getInt32"}
 RAW_TYPES = {2: (fmi2ValueReference, {"Real": ("Real", fmi2Real),
                                      "Integer": ("Integer", fmi2Integer)}),
              3: (fmi3ValueReference, {"Real": ("Float64", fmi3Float64),
@@ -78,8 +75,7 @@ def described(description: ModelDescription) -> tuple[dict[str, Any], dict[str, 
 
 
 class FmuInstance(Instance):
-    """A co-simulation FMU instantiated through fmpy (FmuCallError if it cannot be); an FMI
-    3.0 step that asks to end the simulation fails."""
+    """A co-simulation FMU through fmpy; an FMI 3.0 step asking to end the simulation fails."""
 
     def __init__(self, path: str | Path, name: str, unzip_dir: str | Path | None = None):
         """``unzip_dir``: the FMU extracted there already, kept (tests/fmu_fuzz.py's)."""

@@ -117,8 +117,7 @@ class InProcessInstance(Instance):
     """A slave class instantiated and driven in this process."""
 
     def __init__(self, path: str | Path, name: str):
-        """For an FMU that ``in_process_refusal`` passes (the master's ``fallback_note``): its
-        variables and feedthrough are then its class's."""
+        """For an FMU that ``in_process_refusal`` passes: its variables are its class's."""
         description, manifest = read_description(self.path, name), read(self.path)
         self.slave = slave_class(manifest)(instance_name=name)
         self.fmi_version, self.guid = manifest.fmi, description.guid

@@ -60,8 +60,7 @@ class StopSignals:
         os._exit(128 + self.received)
 
     def keep(self, keeper: Callable[[], str]) -> Callable[[], None]:
-        """Have ``keeper`` say what it kept if a second signal ends the process; returns the
-        function that forgets it."""
+        """Have ``keeper`` say what it kept if a second signal ends the process; returns an undo."""
         self._keepers.append(keeper)
         return lambda: self._keepers.remove(keeper) if keeper in self._keepers else None
 

@@ -149,8 +149,7 @@ class Master(contextlib.AbstractContextManager):
 
 
 def run_meta(master: Master, n_steps: int) -> dict[str, Any]:
-    """What a run of ``n_steps`` records of itself as it starts (it adds ``parameters``
-    and ``wall_time_s`` as it ends)."""
+    """A run's metadata as it starts (``parameters`` and ``wall_time_s`` are added at its end)."""
     system, (t0, h, _) = master.system, master.system.steps()
     return {"system": system.name, "description": system.description,
             "scenario_file": str(system.path) if system.path else None,

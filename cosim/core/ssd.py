@@ -234,9 +234,8 @@ def _el(parent: ET.Element, path: str, **attributes: str) -> ET.Element:
 
 def write_ssd(system: SystemDescription, path: str | Path,
               sources: dict[str, str] | None = None, units: Units | None = None) -> None:
-    """Write ``system`` as a .ssd, ``sources`` replacing component sources by name; with
-    ``units``, connectors carry units. The step goes into OSP's and OpenModelica's annotations,
-    the kind of report into ours."""
+    """Write ``system`` as a .ssd, ``sources`` replacing component sources by name, ``units`` on
+    connectors; the step in OSP's and OpenModelica's annotations, the report's kind in ours."""
     unit_of = units.connectors if units else {}
     root = ET.Element(_q("ssd:SystemStructureDescription"), version="1.0", name=system.name)
     sys_el = _el(root, "ssd:System", name=system.name, description=system.description)

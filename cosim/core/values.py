@@ -227,9 +227,8 @@ def parameters(system: SystemDescription, paths: dict[str, Path],
                declared: dict[str, dict[str, Declaration]],
                overrides: Mapping[str, Mapping[str, Any]] | None = None
                ) -> tuple[dict[str, dict[str, Value]], dict[str, dict[str, Value]]]:
-    """(the system's bindings updated by ``overrides``, the overrides alone), by component,
-    as ``setting`` returns them; ValueError naming the value (and the .ssd, for a binding),
-    also for an input that a connection sets."""
+    """(the system's bindings updated by ``overrides``, the overrides alone), by component, as
+    ``setting`` returns them; ValueError naming the value (and the .ssd, for a binding)."""
     if not isinstance(overrides or {}, Mapping):
         raise ValueError(f"set: overrides must map component names to their values, got "
                          f"{overrides!r}")

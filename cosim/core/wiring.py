@@ -45,8 +45,7 @@ def feedthrough_order(system: SystemDescription, instances: dict[str, Instance])
 
 @dataclass
 class Node:
-    """One component as the loop sees it: its output columns and prepared calls (None where
-    it has nothing of that kind)."""
+    """One component as the loop sees it: its output columns and prepared calls (or None)."""
     step: Callable[[float, float], None]
     state: slice                        # Real outputs, no feedthrough
     feedthrough: slice                  # Real outputs, with feedthrough
@@ -116,8 +115,7 @@ def _input_applier(write: Callable[[list[float]], None], sources: list[int],
 def gauss_seidel(nodes: list[Node], values: list[float], t: float, h: float,
                  step: bool) -> None:
     """Outputs without feedthrough (the ship's states) at t_k, then each FMU in signal-flow
-    order gets its inputs, gives its feedthrough outputs and steps (the paper's guidance ->
-    autopilot -> ship, as in its Simulink model)."""
+    order (the paper's guidance -> autopilot -> ship) takes inputs, gives outputs, steps."""
     for node in nodes:
         if node.read_state:
             values[node.state] = node.read_state()
