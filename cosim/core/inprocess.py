@@ -50,10 +50,8 @@ def in_process_refusal(path: str | Path) -> Reason | None:
 def fallback_note(name: str, path: str | Path) -> Reason | None:
     """The note for component ``name`` whose FMU must run through FMI, not in-process."""
     refusal = in_process_refusal(path)
-    if refusal is None:
-        return None
-    return Reason(f"{name} ({Path(path).name}) runs through FMI, not in-process: {refusal}",
-                  refusal.stale_module)
+    return refusal and Reason(f"{name} ({Path(path).name}) runs through FMI, not in-process: "
+                              f"{refusal}", refusal.stale_module)
 
 
 @cache
