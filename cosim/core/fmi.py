@@ -24,8 +24,11 @@ from .instance import FmuCallError, Instance, LogRecord, logged_error
 STATUS = ("ok", "warning", "discard", "error", "fatal", "pending")
 VERSIONS = (2, 3)
 FMI3_TYPES = {"Float64": "Real", "Int32": "Integer"}     # Boolean and String: the same
-CALLS = {"setReal": "setFloat64", "getReal": "getFloat64",      # FMI 2.0's: FMI 3.0's
-         "setInteger": "setInt32", "getInteger": "getInt32"}
+CALLS = {"setReal": "setFloat64", "getReal": "getFloat64",
+         "setInteger": "setInt32", "getInteger": "getInt32",
+         "getFMUstate": "getFMUState", "setFMUstate": "setFMUState",
+         "freeFMUstate": "freeFMUState", "serializeFMUstate": "serializeFMUState",
+         "deSerializeFMUstate": "deserializeFMUState"}          # FMI 2.0's: FMI 3.0's
 RAW_TYPES = {2: (fmi2ValueReference, {"Real": ("Real", fmi2Real),
                                      "Integer": ("Integer", fmi2Integer)}),
              3: (fmi3ValueReference, {"Real": ("Float64", fmi3Float64),
