@@ -397,13 +397,14 @@ def test_fmu_error_mid_run_names_fmu_call_and_time_and_keeps_the_rows(tmp_path, 
     assert len(rows) == 500 and rows[-1].startswith("49.9")
 
 
-def test_streamed_rows_equal_the_in_memory_recording(tmp_path):
+def test_streamed_rows_equal_the_in_memory_recording(tmp_path, monkeypatch):
     """Rows written in chunks as the run goes are the rows a whole recording writes."""
+    monkeypatch.setattr("cosim.core.recording.CHUNK_ROWS", 64)
     master = Master(system("waves_smc"))
     try:
         whole = master.run(30.0)
         master.reset()
-        streamed = master.run(30.0, csv_path=tmp_path / "streamed.csv", chunk_rows=64)
+        streamed = master.run(30.0, csv_path=tmp_path / "streamed.csv")
     finally:
         master.free()
     whole.write_csv(tmp_path / "whole.csv")

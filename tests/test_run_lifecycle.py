@@ -157,7 +157,7 @@ def test_whole_file_and_outputs_leave_nothing_when_interrupted(tmp_path):
         raise KeyboardInterrupt
     (tmp_path / "x.csv").write_text("old")
     with pytest.raises(KeyboardInterrupt), Outputs(tmp_path, [tmp_path / "x.csv"]) as outputs:
-        outputs.path("x.csv").write_text("new")
+        (outputs.stage / "x.csv").write_text("new")
         raise KeyboardInterrupt
     assert _folder(tmp_path) == {"x.ssp": b"old", "x.csv": b"old"}
     with pytest.raises(OutputError, match=f"cannot write {tmp_path / 'x.json'}"), \
