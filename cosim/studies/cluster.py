@@ -1,6 +1,5 @@
-"""Dask clusters for sweeps: a local one or an existing scheduler, its workers checked before
-any run and watched while it goes. A run holds the GIL from start to end, so a worker is
-one single-threaded process (``dask worker ADDRESS --nthreads 1 --nworkers N``)."""
+"""Dask clusters for sweeps, their workers checked before any run and watched while it goes. A
+run holds the GIL throughout: a worker is one single-threaded process (``--nthreads 1``)."""
 from __future__ import annotations
 
 import importlib.util
@@ -41,12 +40,9 @@ class NoWorkers(RuntimeError):
 
 
 def local_cluster(workers: int | None = None) -> LocalCluster:
-    """``workers`` single-threaded worker processes (default: one per core), quiet (a row says
-    what failed), the dashboard on a free port; worker-saturation 1.0: a run that kills its
-    worker takes no queued run with it. Made with SIGINT blocked, which its threads and
-    workers inherit: a terminal's Ctrl-C stops the client alone."""
-    # Its resource tracker started first (starting it unblocks SIGINT), quiet (it would
-    # only report semaphores leaked at a second Ctrl-C).
+    """Quiet single-threaded workers (default: one per core), worker-saturation 1.0 (a run that
+    kills its worker takes no queued run with it), made with SIGINT blocked: a Ctrl-C stops the
+    client alone. Its resource tracker is started first (that unblocks SIGINT) and muted."""
     sys.stderr.flush()
     saved, null = os.dup(2), os.open(os.devnull, os.O_WRONLY)
     try:
@@ -103,8 +99,8 @@ def scheduler_address(scheduler_file: str | Path) -> str:
 def connect(scheduler: str | None = None, workers: int | None = None,
             scheduler_file: str | None = None, timeout: float = CONNECT_TIMEOUT
             ) -> tuple[Client, LocalCluster | None]:
-    """(a client, its local cluster or None) of a scheduler found as Dask's tools find it, else
-    of a new local cluster; ClusterError naming the address or file if none is reached."""
+    """(client, local cluster or None): a scheduler found as Dask's tools find it, else a new
+    local cluster; ClusterError naming the address or file if none is reached."""
     if scheduler and scheduler_file:
         raise ClusterError("give the scheduler's address or its file, not both")
     if scheduler_file:
@@ -130,9 +126,8 @@ def connect(scheduler: str | None = None, workers: int | None = None,
 
 
 class Completions:
-    """Futures as they complete (more may be added meanwhile) and their results, raising
-    ``NoWorkers`` once the cluster has had no worker for ``timeout`` s (Dask's
-    ``as_completed`` has a deadline for the whole iteration instead)."""
+    """Futures as they complete (more may be added), raising ``NoWorkers`` once the cluster has
+    had no worker for ``timeout`` s (Dask's ``as_completed`` has one deadline for all)."""
 
     def __init__(self, client, timeout: float):
         self.client, self.timeout = client, timeout
@@ -196,8 +191,8 @@ def worker_facts() -> dict[str, Any]:
 
 
 def check_workers(client) -> None:
-    """SweepError naming each worker that runs other code or whose FMU cache is not private;
-    the dashboard; a warning for workers of several threads or a scheduler that queues runs."""
+    """SweepError naming each worker of other code or an unsafe FMU cache; says the dashboard,
+    and warns of workers of several threads or a scheduler that queues runs."""
     mine = code_version()
     try:
         facts = client.run(worker_facts, on_error="return")
@@ -228,7 +223,6 @@ def check_workers(client) -> None:
             "with it; start the scheduler with DASK_DISTRIBUTED__SCHEDULER__WORKER_SATURATION=1.0")
 
 
-def _scheduler(dask_scheduler=None) -> tuple[bool, float]:
-    """Whether the scheduler serves its dashboard (bokeh there), its worker-saturation."""
+def _scheduler(dask_scheduler=None) -> tuple[bool, float]:      # dashboard served, saturation
     return ("dashboard" in dask_scheduler.services and importlib.util.find_spec("bokeh")
             is not None, float(dask_scheduler.WORKER_SATURATION))

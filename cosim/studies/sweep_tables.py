@@ -27,8 +27,8 @@ def headed(name: str, unit: str) -> str:
 
 
 def write_tables(rows: list[dict], out: Path, csv: bool, spec: Spec) -> list[Path]:
-    """results.parquet (units in its field metadata), results.csv with ``csv`` (units in its
-    headers), results.json (every column's unit) and summary.csv."""
+    """results.parquet (units in its field metadata), results.csv if ``csv`` (units in its
+    headers), results.json (every column's unit) and summary.csv; the paths."""
     import pyarrow as pa
     import pyarrow.csv as pacsv
     import pyarrow.parquet as pq
@@ -52,8 +52,7 @@ def write_tables(rows: list[dict], out: Path, csv: bool, spec: Spec) -> list[Pat
     return written
 
 
-def _settings(spec: Spec) -> tuple[list[str], list[dict[str, Any]]]:
-    """The axes that make a setting (all but ``MONTE_CARLO``), and each setting of them."""
+def _settings(spec: Spec) -> tuple[list[str], list[dict[str, Any]]]:   # axes but MONTE_CARLO
     axes = [a for a in spec.axes if a != MONTE_CARLO]
     return axes, [dict(zip(axes, values))
                   for values in itertools.product(*(spec.axes[a] for a in axes))]

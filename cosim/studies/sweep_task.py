@@ -1,6 +1,5 @@
 """A sweep's tasks on a worker: one co-simulation (``run_one``) or a batch of one system's runs
-(``run_batch``), the same row either way. A worker keeps a master per sweep, thread, system and
-backend; ``SweepTeardown`` frees the idle ones and stops the busy at their next step."""
+(``run_batch``), the same row either way; masters kept per sweep, thread, system and backend."""
 from __future__ import annotations
 
 import contextlib
@@ -49,7 +48,6 @@ def _key(job: Job) -> Key:
 
 
 def _take(job: Job, blobs: dict[str, bytes], watchdog: Watchdog):
-    """This thread's idle master of ``job``'s system, reset, or a new one; ``_give_back`` it."""
     with _lock:
         if job.sweep in _ended:
             raise RuntimeError("the sweep has ended")
@@ -66,7 +64,6 @@ def _take(job: Job, blobs: dict[str, bytes], watchdog: Watchdog):
 
 
 def _give_back(job: Job, master, healthy: bool) -> None:
-    """Keep ``master`` for the sweep's next task; free it after a failure or the sweep's end."""
     with _lock:
         _busy.pop(_key(job), None)
         keep = master is not None and healthy and job.sweep not in _ended
@@ -129,14 +126,12 @@ def run_one(job: Job, blobs: dict[str, bytes]) -> dict[str, Any]:
             master.configure(job.overrides)
             simulating = time.perf_counter()
             recording = master.run(job.stop_time, watchdog=watchdog)
-        sim_seconds = time.perf_counter() - simulating
+        row = result_row(job, recording, time.perf_counter() - simulating)
     except (Exception, TimeLimit) as error:  # a bad setting: not worth retrying
         recording = None
         row = blank_row(job.run, watchdog.expired or f"{type(error).__name__}: {error}")
     finally:
         _give_back(job, master, recording is not None and not recording.error)
-    if recording is not None:
-        row = result_row(job, recording, sim_seconds)
     row["backend"] = ran_on(master and master.backends, job.backend)   # same results either way
     row["seconds"] = time.perf_counter() - started
     return row
