@@ -99,8 +99,7 @@ def scheduler_address(scheduler_file: str | Path) -> str:
 def connect(scheduler: str | None = None, workers: int | None = None,
             scheduler_file: str | None = None, timeout: float = CONNECT_TIMEOUT
             ) -> tuple[Client, LocalCluster | None]:
-    """(client, local cluster or None): a scheduler found as Dask's tools find it, else a new
-    local cluster; ClusterError naming the address or file if none is reached."""
+    """(client, local cluster or None) of the scheduler Dask's tools find, else a local one."""
     if scheduler and scheduler_file:
         raise ClusterError("give the scheduler's address or its file, not both")
     if scheduler_file:
@@ -133,8 +132,7 @@ class Completions:
         self.client, self.timeout = client, timeout
         self.interval = max(0.05, min(1.0, timeout / 4))   # Dask fails a shorter wait
         self.done: queue.SimpleQueue = queue.SimpleQueue()
-        self.waiting, self.seen = 0, False          # seen: a worker was counted once
-        self.gone: tuple[float, str] | None = None  # since when none was counted
+        self.waiting, self.seen, self.gone = 0, False, None  # gone: since when none counted
         self.check()
 
     def add(self, future) -> None:

@@ -73,8 +73,7 @@ def track(recording) -> dict:
 
 
 def run_metrics(recording) -> dict[str, float]:
-    """Every figure of ``METRICS``: eq (19), the heading error psi_d - psi, the actual rudder
-    ship.delta, the cross-track error from the leg followed and the waypoints reached."""
+    """Every figure of ``METRICS`` (eq (19), psi_d - psi, the rudder ship.delta, the route)."""
     c = cost(recording)
     t, delta, x, y = recording.t, recording["ship.delta"], recording["ship.x"], recording["ship.y"]
     points, R_accept = route_of(recording)

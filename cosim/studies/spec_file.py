@@ -109,8 +109,7 @@ def parse(path: Path, max_runs: int) -> dict[str, Any]:
 
 
 def check_values(spec, path: Path) -> None:
-    """Each system has ``MEASURED``, each parameter set exists and takes its values, and no
-    axis repeats a value as the FMU would receive it (1 and 1.0 of a Real are one)."""
+    """Each system has ``MEASURED``; each parameter set exists, takes its values, none twice."""
     for controller, shipped in spec.bundles().items():
         missing = [target for target in MEASURED
                    if getattr(_declared(spec, controller, target), "causality", "") != "output"]

@@ -67,8 +67,7 @@ def batch_limit(job: Job) -> int:
 
 
 def batch_counts(groups: list[list[Job]], workers: int, size: int | None = None) -> list[int]:
-    """How many batches each group (one system and stop time) is cut into: of at most ``size``,
-    else by the rule of docs/sweeps.md (the batch backend)."""
+    """Batches per group (one system and stop time): of ``size``, else as docs/sweeps.md says."""
     if size:
         return [math.ceil(len(group) / size) for group in groups]
     counts = [math.ceil(len(group) / batch_limit(group[0])) for group in groups]

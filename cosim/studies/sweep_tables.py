@@ -72,8 +72,7 @@ def distinct(rows: list[dict]) -> list[dict]:
 def _statistics(values: np.ndarray) -> list[float]:
     if not values.size:
         return [math.nan] * len(STATISTICS)
-    q25, median, q75 = np.percentile(values, [25, 50, 75])
-    return [float(v) for v in (median, q25, q75, values.min(), values.max())]
+    return [float(v) for v in np.percentile(values, [50, 25, 75, 0, 100])]   # as STATISTICS
 
 
 def summary_table(spec: Spec, rows: list[dict]) -> list[list]:
@@ -92,8 +91,7 @@ def summary_table(spec: Spec, rows: list[dict]) -> list[list]:
 
 
 def summary(spec: Spec, rows: list[dict]) -> str:
-    """Runs ok and failed; J per setting and controller (past ``MOST_PRINTED`` lines per value
-    of each axis, pooled over the others); each failed run with its message."""
+    """Runs ok and failed, J per setting (or axis value) and controller, the failed runs."""
     runs = distinct(rows)
     ok = [r for r in runs if r["status"] == "ok"]
     shared = len(rows) - len(runs)
@@ -135,8 +133,7 @@ def summary(spec: Spec, rows: list[dict]) -> str:
 
 
 def comparison(spec: Spec, rows: list[dict]) -> str:
-    """Markdown table: per setting, each controller's median J, its wins against the PD (a
-    lower J on the same sea, each pair of runs counted once) and the median J ratio."""
+    """Markdown table: per setting, each controller's median J, wins and J ratio to the PD."""
     others = [c for c in spec.controllers if c != "pd"]
     axes, settings = _settings(spec)
     ok = {(r["controller"], *(json.dumps(r[a]) for a in spec.axes)): r

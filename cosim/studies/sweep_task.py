@@ -74,8 +74,7 @@ def _give_back(job: Job, master, healthy: bool) -> None:
 
 
 def free_masters(sweep: str | None = None) -> None:
-    """Free this process's idle masters, all or of a sweep that has ended (its runs under way
-    stop at their next step and free their own: freed under a run, its FMUs would fail it)."""
+    """Free the idle masters, all or an ended sweep's (whose busy ones stop and free their own)."""
     with _lock:
         if sweep is not None:
             _ended.add(sweep)
@@ -162,8 +161,7 @@ def batch_limits(limits: Limits, members: int) -> Limits:
 
 
 def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
-    """The rows of ``jobs`` (one system and stop time) computed together, ``run_one``'s but for
-    ``backend`` and the times; where the batch cannot give a run's row, ``run_one`` does."""
+    """``run_one``'s rows of ``jobs`` (one system and stop time) computed together, or alone."""
     started = time.perf_counter()
     if any(job.code != code_version() for job in jobs):
         return [run_one(job, blobs) for job in jobs]
