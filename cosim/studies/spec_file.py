@@ -170,8 +170,7 @@ def _axis(path: Path, name: str, values: Any, max_runs: int) -> list:
                          f"{', '.join(['sea_state', *SHORTHANDS])} nor component.variable{hint}")
     if isinstance(values, dict):
         start, count = values.get("start"), values.get("count")
-        if set(values) != {"start", "count"} or not all(
-                isinstance(v, int) and not isinstance(v, bool) for v in (start, count)) \
+        if set(values) != {"start", "count"} or any(type(v) is not int for v in (start, count)) \
                 or count < 1:
             raise ValueError(f"{path}: axis {name!r} = {values!r}: a range is "
                              "{ start = <integer>, count = <integer >= 1> }")
