@@ -20,7 +20,6 @@ from .studies.sweep_spec import MAX_RUNS, Spec
 from .studies.sweep_task import BATCH, SWEEP_BACKENDS
 from .studies.sweep_tables import MONTE_CARLO, comparison, distinct, summary, write_tables
 
-RESULTS = Path("results/sweeps")
 EXAMPLES = """\
   python -m cosim.sweep docs/sweeps/smc_vs_pd.toml             # local cluster, 1 worker/core
   python -m cosim.sweep SPEC --scheduler tcp://host:8786       # an existing Dask cluster
@@ -29,9 +28,8 @@ EXAMPLES = """\
 
 SPEC: a TOML file of controllers, axes and plots (docs/sweeps.md, docs/sweeps/example.toml)."""
 
-# What a finished sweep writes beside its journal (names, or globs of names).
 OUTPUTS = ("results.parquet", "results.json", "results.csv", "summary.csv", "J_distribution.png",
-           "tracks.png", "J_*_over_pd.png", "comparison.md")
+           "tracks.png", "J_*_over_pd.png", "comparison.md")    # written beside the journal
 
 
 def count(text: str) -> int:
@@ -57,7 +55,8 @@ def main(argv: list[str] | None = None) -> int:
                         default=CONNECT_TIMEOUT, help="to reach a scheduler (%(default)g s)")
     parser.add_argument("--max-runs", type=count, metavar="N", default=MAX_RUNS,
                         help="refuse a spec of more runs (default: %(default)d)")
-    parser.add_argument("--out", type=Path, default=RESULTS, help="parent folder of the results")
+    parser.add_argument("--out", type=Path, default=Path("results/sweeps"),
+                        help="parent folder of the results")
     parser.add_argument("--backend", choices=SWEEP_BACKENDS, default="fmi", help="fmi "
                         "(default); inprocess: our FMUs without FMI; batch: a system's runs "
                         "stepped together as arrays; the same rows, bit for bit")

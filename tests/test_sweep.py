@@ -84,7 +84,7 @@ def test_settings_map_axes_to_fmu_parameters(tmp_path):
     ("stop_time = 'long'", "stop_time = 'long': give a number"),
     ("stop = 400", "unknown key stop"),
     ("[controllers]\npd = 3", "controller 'pd' = 3: give a scenario"),
-    ("[plots]\nmap = 'Hs'", "\\[plots\\] map = 'Hs': give a list"),
+    ("[plots]\nmap = 'Hs'", "\\[plots\\] map = 'Hs': give two different axes"),
 ])
 def test_bad_spec_is_refused_by_name(tmp_path, text, fragment):
     with pytest.raises(ValueError, match=fragment):

@@ -1,6 +1,5 @@
-"""Dask clusters for sweeps: a local one or an existing scheduler, its workers checked before
-any run and watched while it goes. A run holds the GIL from start to end, so a worker is
-one single-threaded process (``dask worker ADDRESS --nthreads 1 --nworkers N``)."""
+"""Dask clusters for sweeps, their workers checked before any run and watched while it goes. A
+run holds the GIL throughout: a worker is one single-threaded process (``--nthreads 1``)."""
 from __future__ import annotations
 
 import importlib.util
@@ -41,12 +40,9 @@ class NoWorkers(RuntimeError):
 
 
 def local_cluster(workers: int | None = None) -> LocalCluster:
-    """``workers`` single-threaded worker processes (default: one per core), quiet (a row says
-    what failed), the dashboard on a free port; worker-saturation 1.0: a run that kills its
-    worker takes no queued run with it. Made with SIGINT blocked, which its threads and
-    workers inherit: a terminal's Ctrl-C stops the client alone."""
-    # Its resource tracker started first (starting it unblocks SIGINT), quiet (it would
-    # only report semaphores leaked at a second Ctrl-C).
+    """Quiet single-threaded workers (default: one per core), worker-saturation 1.0 (a run that
+    kills its worker takes no queued run with it), made with SIGINT blocked: a Ctrl-C stops the
+    client alone. Its resource tracker is started first (that unblocks SIGINT) and muted."""
     sys.stderr.flush()
     saved, null = os.dup(2), os.open(os.devnull, os.O_WRONLY)
     try:
@@ -73,12 +69,10 @@ def local_cluster(workers: int | None = None) -> LocalCluster:
 
 def local_workers(workers: int | None) -> int | None:
     """``workers`` (None: one per core) capped, with a note, at the cores this process has."""
-    if workers is None:
-        return None
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-        raise ClusterError(f"--workers {workers!r}: a local cluster needs at least one worker")
-    if workers <= CPU_COUNT:
+    if workers is None or (type(workers) is int and 1 <= workers <= CPU_COUNT):
         return workers
+    if type(workers) is not int or workers < 1:     # a bool too
+        raise ClusterError(f"--workers {workers!r}: a local cluster needs at least one worker")
     print(f"note: --workers {workers}: this machine gives this process {CPU_COUNT} cores, and "
           f"a run holds one core from start to end; starting {CPU_COUNT} workers", file=sys.stderr)
     return CPU_COUNT
@@ -103,8 +97,7 @@ def scheduler_address(scheduler_file: str | Path) -> str:
 def connect(scheduler: str | None = None, workers: int | None = None,
             scheduler_file: str | None = None, timeout: float = CONNECT_TIMEOUT
             ) -> tuple[Client, LocalCluster | None]:
-    """(a client, its local cluster or None) of a scheduler found as Dask's tools find it, else
-    of a new local cluster; ClusterError naming the address or file if none is reached."""
+    """(client, local cluster or None) of the scheduler Dask's tools find, else a local one."""
     if scheduler and scheduler_file:
         raise ClusterError("give the scheduler's address or its file, not both")
     if scheduler_file:
@@ -130,16 +123,14 @@ def connect(scheduler: str | None = None, workers: int | None = None,
 
 
 class Completions:
-    """Futures as they complete (more may be added meanwhile) and their results, raising
-    ``NoWorkers`` once the cluster has had no worker for ``timeout`` s (Dask's
-    ``as_completed`` has a deadline for the whole iteration instead)."""
+    """Futures as they complete (more may be added), raising ``NoWorkers`` once the cluster has
+    had no worker for ``timeout`` s (Dask's ``as_completed`` has one deadline for all)."""
 
     def __init__(self, client, timeout: float):
         self.client, self.timeout = client, timeout
         self.interval = max(0.05, min(1.0, timeout / 4))   # Dask fails a shorter wait
         self.done: queue.SimpleQueue = queue.SimpleQueue()
-        self.waiting, self.seen = 0, False          # seen: a worker was counted once
-        self.gone: tuple[float, str] | None = None  # since when none was counted
+        self.waiting, self.seen, self.gone = 0, False, None  # gone: since when none counted
         self.check()
 
     def add(self, future) -> None:
@@ -196,8 +187,8 @@ def worker_facts() -> dict[str, Any]:
 
 
 def check_workers(client) -> None:
-    """SweepError naming each worker that runs other code or whose FMU cache is not private;
-    the dashboard; a warning for workers of several threads or a scheduler that queues runs."""
+    """SweepError naming each worker of other code or an unsafe FMU cache; says the dashboard,
+    and warns of workers of several threads or a scheduler that queues runs."""
     mine = code_version()
     try:
         facts = client.run(worker_facts, on_error="return")
@@ -228,7 +219,6 @@ def check_workers(client) -> None:
             "with it; start the scheduler with DASK_DISTRIBUTED__SCHEDULER__WORKER_SATURATION=1.0")
 
 
-def _scheduler(dask_scheduler=None) -> tuple[bool, float]:
-    """Whether the scheduler serves its dashboard (bokeh there), its worker-saturation."""
+def _scheduler(dask_scheduler=None) -> tuple[bool, float]:      # dashboard served, saturation
     return ("dashboard" in dask_scheduler.services and importlib.util.find_spec("bokeh")
             is not None, float(dask_scheduler.WORKER_SATURATION))

@@ -11,8 +11,7 @@ from ..analysis.cost import cost
 from ..analysis.metrics import (cross_track_error, fraction_at_stops, heading_error, mean_abs_rate,
                                 peak, rms, route_completion, rudder_reversals_per_minute)
 
-# The figures of merit of a run and their units, as cosim.run prints them (floats, NaN in a
-# failed run's row).
+# A run's figures of merit and their units, as cosim.run prints them (NaN in a failed run's row)
 METRICS = {"psi_E": "rad^2", "sum_delta2": "rad^2", "J": "rad^2", "rms_heading_error_deg": "deg",
            "reversals_per_min": "1/min", "max_delta_deg": "deg", "mean_rudder_rate_deg_s": "deg/s",
            "at_stops_pct": "%", "cross_track_rms_m": "m", "cross_track_max_m": "m",
@@ -74,8 +73,7 @@ def track(recording) -> dict:
 
 
 def run_metrics(recording) -> dict[str, float]:
-    """Every figure of ``METRICS``: eq (19), the heading error psi_d - psi, the actual rudder
-    ship.delta, the cross-track error from the leg followed and the waypoints reached."""
+    """Every figure of ``METRICS`` (eq (19), psi_d - psi, the rudder ship.delta, the route)."""
     c = cost(recording)
     t, delta, x, y = recording.t, recording["ship.delta"], recording["ship.x"], recording["ship.y"]
     points, R_accept = route_of(recording)

@@ -20,13 +20,15 @@ SHORTHANDS = {"wave_seed": "ship.wave_seed", "Hs": "ship.Hs", "T0": "ship.T0",
 SEA_STATE = ("ship.Hs", "ship.T0")      # the sea_state axis: a WMO code's, at model scale
 MAX_RUNS = 100_000                      # a sweep's most runs, unless --max-runs says
 MEASURED = ("guidance.psi_d", "guidance.wp_index", "ship.psi", "ship.delta", "ship.x", "ship.y")
-# The kinds of value a key takes (a bool only where they name bool) and what to give: the
-# keys of each table, and the TOML values of each FMI type (one kind per type, so that each
-# axis is one column of one type in the tables).
+# The kinds of value a key takes (a bool only where they name bool), what to give, and what
+# else it must be: the keys of each table, and the TOML values of each FMI type (one kind per
+# type, so that each axis is one column of one type in the tables).
 FILE_KEYS = {"name": ((str,), "a plain file name"), "controllers": ((dict,), "a table"),
-             "stop_time": ((int, float), "a number of seconds > 0"),
+             "stop_time": ((int, float), "a number of seconds > 0", lambda v: 0 < v < math.inf),
              "axes": ((dict,), "a table"), "plots": ((dict,), "a table")}
-PLOTS_KEYS = {"map": ((list,), "a list of axes"), "tracks": ((dict,), "a table of axis = value")}
+PLOTS_KEYS = {"map": ((list,), "two different axes", lambda v: not v or (len(v) == 2
+                                                                       and v[0] != v[1])),
+              "tracks": ((dict,), "a table of axis = value")}
 CONTROLLER_KEYS = {"scenario": ((str,), "a string"), "autopilot": ((str,), "a string"),
                    "map": ((dict,), "a table of autopilot port = the FMU's name for it"),
                    "set": ((dict,), "a table of component.variable = value")}
@@ -42,9 +44,10 @@ def assignments(axis: str, value: Any) -> dict[str, Any]:
     return {SHORTHANDS.get(axis, axis): value}
 
 
-def _given(path: Path, key: str, value: Any, kinds: tuple[type, ...], what: str) -> Any:
-    """``value`` if it is of ``kinds``, else ValueError naming the file, the key and it."""
-    if not isinstance(value, kinds) or isinstance(value, bool) != (bool in kinds):
+def _given(path: Path, key: str, value: Any, kinds: tuple[type, ...], what: str,
+           ok=lambda value: True) -> Any:
+    """``value`` if it is of ``kinds`` and ``ok``, else ValueError naming the file, key and it."""
+    if not isinstance(value, kinds) or isinstance(value, bool) != (bool in kinds) or not ok(value):
         raise ValueError(f"{path}: {key} = {value!r}: give {what}")
     return value
 
@@ -68,9 +71,6 @@ def parse(path: Path, max_runs: int) -> dict[str, Any]:
         raise ValueError(f"cannot read sweep spec {path}: {error}") from None
     _table(path, "", data, FILE_KEYS)
     name = plain_name(data.get("name", path.stem), f"{path}: name")
-    if not 0 < data.get("stop_time", 1) < math.inf:
-        raise ValueError(f"{path}: stop_time = {data['stop_time']!r}: give a number of "
-                         "seconds > 0")
     entries = data.get("controllers", DEFAULT_CONTROLLERS)
     if not entries:
         raise ValueError(f"{path}: [controllers] is empty; name at least one controller")
@@ -95,8 +95,6 @@ def parse(path: Path, max_runs: int) -> dict[str, Any]:
             setters.update(dict.fromkeys(targets, who))
     plots = _table(path, "[plots]", data.get("plots", {}), PLOTS_KEYS)
     map_axes = plots.get("map", [])
-    if map_axes and (len(map_axes) != 2 or map_axes[0] == map_axes[1]):
-        raise ValueError(f"{path}: [plots] map = {map_axes!r}: give two different axes")
     for axis in map_axes:
         if not isinstance(axis, str) or axis not in axes:
             raise ValueError(f"{path}: [plots] map names {axis!r}, which is not an axis")
@@ -111,8 +109,7 @@ def parse(path: Path, max_runs: int) -> dict[str, Any]:
 
 
 def check_values(spec, path: Path) -> None:
-    """Each system has ``MEASURED``, each parameter set exists and takes its values, and no
-    axis repeats a value as the FMU would receive it (1 and 1.0 of a Real are one)."""
+    """Each system has ``MEASURED``; each parameter set exists, takes its values, none twice."""
     for controller, shipped in spec.bundles().items():
         missing = [target for target in MEASURED
                    if getattr(_declared(spec, controller, target), "causality", "") != "output"]
@@ -144,7 +141,6 @@ def _declared(spec, controller: str, target: str):
 
 
 def _received(spec, path: Path, controller: str, target: str, value: Any, key: str) -> Any:
-    """``value`` exactly as the parameter ``target`` receives it (``cosim.core.values``)."""
     declaration = _declared(spec, controller, target)
     component, _, variable = target.partition(".")
     if getattr(declaration, "causality", "") != "parameter":
@@ -174,8 +170,7 @@ def _axis(path: Path, name: str, values: Any, max_runs: int) -> list:
                          f"{', '.join(['sea_state', *SHORTHANDS])} nor component.variable{hint}")
     if isinstance(values, dict):
         start, count = values.get("start"), values.get("count")
-        if set(values) != {"start", "count"} or not all(
-                isinstance(v, int) and not isinstance(v, bool) for v in (start, count)) \
+        if set(values) != {"start", "count"} or any(type(v) is not int for v in (start, count)) \
                 or count < 1:
             raise ValueError(f"{path}: axis {name!r} = {values!r}: a range is "
                              "{ start = <integer>, count = <integer >= 1> }")

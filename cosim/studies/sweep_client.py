@@ -67,9 +67,7 @@ def batch_limit(job: Job) -> int:
 
 
 def batch_counts(groups: list[list[Job]], workers: int, size: int | None = None) -> list[int]:
-    """How many batches each group (runs of one system and stop time) is cut into: of at most
-    ``size``, or by the rule of docs/sweeps.md (the batch backend): as few as ``batch_limit``
-    allows, in waves one per worker, then one more for the largest while under ``workers``."""
+    """Batches per group (one system and stop time): of ``size``, else as docs/sweeps.md says."""
     if size:
         return [math.ceil(len(group) / size) for group in groups]
     counts = [math.ceil(len(group) / batch_limit(group[0])) for group in groups]
@@ -91,13 +89,11 @@ def _in_waves(job: Job) -> bool:
 def plan(spec: Spec, jobs: list[Job], workers: int, size: int | None = None
          ) -> tuple[list[list[Job]], list[Job]]:
     """(the batches, the runs the kernel does not cover) on the batch backend."""
-    groups: dict[tuple[str, float | None], list[Job]] = {}
-    alone = []
-    for job in jobs:
-        if spec.batch_coverage[job.run["controller"]] is None:
-            groups.setdefault((job.bundle.digest, job.stop_time), []).append(job)
-        else:
-            alone.append(job)
+    groups: dict[tuple[str, float | None] | None, list[Job]] = {}
+    for job in jobs:                            # None: the runs the kernel does not cover
+        covered = spec.batch_coverage[job.run["controller"]] is None
+        groups.setdefault((job.bundle.digest, job.stop_time) if covered else None, []).append(job)
+    alone = groups.pop(None, [])
     batches = []                                # each group in near-equal parts, in order
     for group, count in zip(groups.values(), batch_counts(list(groups.values()), workers, size)):
         cuts = [round(k * len(group) / count) for k in range(count + 1)]
@@ -115,9 +111,8 @@ def run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, p
     try:
         check_workers(client)
         client.register_plugin(teardown)
-        # Each FMU as a task holding its bytes, not scattered data: a task's result lost with
-        # its worker is computed again, scattered data is gone, and every run with it. Keyed
-        # by sweep: another sweep's release of a shared key would strand this one's runs.
+        # FMUs as tasks, not scattered data (a task lost with its worker is computed again),
+        # keyed by sweep (another sweep's release of a shared key would strand these runs).
         shipped = {sha: client.submit(bytes, fmu.read_bytes(), key=f"fmu-{token}-{sha}", pure=False)
                    for sha, fmu in spec.files().items()}
         completions = Completions(client, no_worker_timeout)
@@ -186,8 +181,7 @@ def _say_batch_refusals(client) -> None:
 
 
 def _close(client, cluster, teardown: SweepTeardown, journal: Journal,
-           stopped: BaseException | None = None) -> None:
-    """Close the client and its local cluster, or free this sweep's FMUs on a shared one."""
+           stopped: BaseException | None = None) -> None:      # a shared cluster: FMUs freed
     level = logging.root.manager.disable         # distributed's loggers set their own levels
     with contextlib.ExitStack() as stack:
         stack.callback(logging.disable, level)

@@ -133,14 +133,13 @@ def paired_figure(title: str, changes: dict[Merit, dict[str, np.ndarray]], basel
     return save(fig, path)[0]
 
 
-def ratio_map(spec, rows: list[dict], path: Path, numerator: str = "smc",
-              denominator: str = "pd") -> Path | None:
-    """Mean J of one controller over the other's, over the two map axes (other axes pooled)."""
+def ratio_map(spec, rows: list[dict], path: Path, numerator: str) -> Path | None:
+    """Mean J of ``numerator`` over the PD's, over the two map axes (other axes pooled)."""
+    denominator = "pd"
     if len(spec.map_axes) != 2 or not {numerator, denominator} <= set(spec.controllers):
         return None
     x_axis, y_axis = spec.map_axes
     xs, ys = spec.axes[x_axis], spec.axes[y_axis]
-
     ok = [r for r in rows if r["status"] == "ok"]
     mean_J = {c: np.array([[np.mean([r["J"] for r in select(ok, c, {x_axis: x, y_axis: y})]
                                     or [np.nan]) for x in xs] for y in ys])

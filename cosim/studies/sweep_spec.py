@@ -26,10 +26,8 @@ from .spec_file import MAX_RUNS, assignments, check_values, parse
 from .sweep_task import Job
 
 SHIP_SLAVE = "ship_fmu.ship_slave"        # this project's ship FMU (its manifest's module)
-# The ship's parameters that change no bit of a run in calm water (Hs = 0: no wave loads,
-# ship_fmu.vessel.Vessel; tests/test_sweep_replay.py), for this checkout's ship FMU.
+# Our ship's parameters that change no bit of a run in calm water (Hs = 0: no wave loads)
 CALM_WATER_INERT = ("T0", "psi_w", "wave_seed", "wave_components")
-REPLAY = ("python", "-m", "cosim.run")
 
 
 @dataclass
@@ -68,7 +66,6 @@ class Spec:
 
     @cached_property
     def _fmus(self) -> dict[tuple[str, str], tuple[Path, dict[str, Any], dict[str, Declaration]]]:
-        """(controller, component): its FMU, model variables and their declarations."""
         fmus = {}
         for controller, shipped in self.bundles().items():
             for name, component in shipped.system.components.items():
@@ -109,8 +106,7 @@ class Spec:
         return list(groups.values())
 
     @cached_property
-    def _ships(self) -> dict[str, dict[str, Any]]:
-        """Each controller's components that are our ship FMU: the Hs they start with."""
+    def _ships(self) -> dict[str, dict[str, Any]]:       # our ship components: the Hs they have
         ships: dict[str, dict[str, Any]] = {controller: {} for controller in self.controllers}
         for (controller, name), (fmu, variables, _) in self._fmus.items():
             manifest = read_manifest(fmu)
@@ -141,7 +137,6 @@ class Spec:
         return notes
 
     def _calm_because(self, run: dict[str, Any]) -> str:
-        """What makes a run's sea calm: the axis value that sets Hs = 0, else its system."""
         for axis in self.axes:
             if any(f"{ship}.Hs" in assignments(axis, run[axis]) for ship in self._calm_ships(run)):
                 return f"{axis} {run[axis]}"
@@ -152,7 +147,7 @@ class Spec:
         """The ``cosim.run`` command that reproduces ``run``'s row bit for bit."""
         controller = self.controllers[run["controller"]]
         scenario, overrides = self.settings(run)
-        words = [*REPLAY, scenario]
+        words = ["python", "-m", "cosim.run", scenario]
         if controller["autopilot"] is not None:
             words += ["--autopilot", controller["autopilot"]]
             for port, renamed in controller["map"].items():

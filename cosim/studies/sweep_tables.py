@@ -27,8 +27,8 @@ def headed(name: str, unit: str) -> str:
 
 
 def write_tables(rows: list[dict], out: Path, csv: bool, spec: Spec) -> list[Path]:
-    """results.parquet (units in its field metadata), results.csv with ``csv`` (units in its
-    headers), results.json (every column's unit) and summary.csv."""
+    """results.parquet (units in its field metadata), results.csv if ``csv`` (units in its
+    headers), results.json (every column's unit) and summary.csv; the paths."""
     import pyarrow as pa
     import pyarrow.csv as pacsv
     import pyarrow.parquet as pq
@@ -52,8 +52,7 @@ def write_tables(rows: list[dict], out: Path, csv: bool, spec: Spec) -> list[Pat
     return written
 
 
-def _settings(spec: Spec) -> tuple[list[str], list[dict[str, Any]]]:
-    """The axes that make a setting (all but ``MONTE_CARLO``), and each setting of them."""
+def _settings(spec: Spec) -> tuple[list[str], list[dict[str, Any]]]:   # axes but MONTE_CARLO
     axes = [a for a in spec.axes if a != MONTE_CARLO]
     return axes, [dict(zip(axes, values))
                   for values in itertools.product(*(spec.axes[a] for a in axes))]
@@ -73,8 +72,7 @@ def distinct(rows: list[dict]) -> list[dict]:
 def _statistics(values: np.ndarray) -> list[float]:
     if not values.size:
         return [math.nan] * len(STATISTICS)
-    q25, median, q75 = np.percentile(values, [25, 50, 75])
-    return [float(v) for v in (median, q25, q75, values.min(), values.max())]
+    return [float(v) for v in np.percentile(values, [50, 25, 75, 0, 100])]   # as STATISTICS
 
 
 def summary_table(spec: Spec, rows: list[dict]) -> list[list]:
@@ -93,8 +91,7 @@ def summary_table(spec: Spec, rows: list[dict]) -> list[list]:
 
 
 def summary(spec: Spec, rows: list[dict]) -> str:
-    """Runs ok and failed; J per setting and controller (past ``MOST_PRINTED`` lines per value
-    of each axis, pooled over the others); each failed run with its message."""
+    """Runs ok and failed, J per setting (or axis value) and controller, the failed runs."""
     runs = distinct(rows)
     ok = [r for r in runs if r["status"] == "ok"]
     shared = len(rows) - len(runs)
@@ -136,8 +133,7 @@ def summary(spec: Spec, rows: list[dict]) -> str:
 
 
 def comparison(spec: Spec, rows: list[dict]) -> str:
-    """Markdown table: per setting, each controller's median J, its wins against the PD (a
-    lower J on the same sea, each pair of runs counted once) and the median J ratio."""
+    """Markdown table: per setting, each controller's median J, wins and J ratio to the PD."""
     others = [c for c in spec.controllers if c != "pd"]
     axes, settings = _settings(spec)
     ok = {(r["controller"], *(json.dumps(r[a]) for a in spec.axes)): r

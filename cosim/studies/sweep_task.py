@@ -1,6 +1,5 @@
 """A sweep's tasks on a worker: one co-simulation (``run_one``) or a batch of one system's runs
-(``run_batch``), the same row either way. A worker keeps a master per sweep, thread, system and
-backend; ``SweepTeardown`` frees the idle ones and stops the busy at their next step."""
+(``run_batch``), the same row either way; masters kept per sweep, thread, system and backend."""
 from __future__ import annotations
 
 import contextlib
@@ -49,7 +48,6 @@ def _key(job: Job) -> Key:
 
 
 def _take(job: Job, blobs: dict[str, bytes], watchdog: Watchdog):
-    """This thread's idle master of ``job``'s system, reset, or a new one; ``_give_back`` it."""
     with _lock:
         if job.sweep in _ended:
             raise RuntimeError("the sweep has ended")
@@ -66,7 +64,6 @@ def _take(job: Job, blobs: dict[str, bytes], watchdog: Watchdog):
 
 
 def _give_back(job: Job, master, healthy: bool) -> None:
-    """Keep ``master`` for the sweep's next task; free it after a failure or the sweep's end."""
     with _lock:
         _busy.pop(_key(job), None)
         keep = master is not None and healthy and job.sweep not in _ended
@@ -77,8 +74,7 @@ def _give_back(job: Job, master, healthy: bool) -> None:
 
 
 def free_masters(sweep: str | None = None) -> None:
-    """Free this process's idle masters, all or of a sweep that has ended (its runs under way
-    stop at their next step and free their own: freed under a run, its FMUs would fail it)."""
+    """Free the idle masters, all or an ended sweep's (whose busy ones stop and free their own)."""
     with _lock:
         if sweep is not None:
             _ended.add(sweep)
@@ -129,14 +125,12 @@ def run_one(job: Job, blobs: dict[str, bytes]) -> dict[str, Any]:
             master.configure(job.overrides)
             simulating = time.perf_counter()
             recording = master.run(job.stop_time, watchdog=watchdog)
-        sim_seconds = time.perf_counter() - simulating
+        row = result_row(job, recording, time.perf_counter() - simulating)
     except (Exception, TimeLimit) as error:  # a bad setting: not worth retrying
         recording = None
         row = blank_row(job.run, watchdog.expired or f"{type(error).__name__}: {error}")
     finally:
         _give_back(job, master, recording is not None and not recording.error)
-    if recording is not None:
-        row = result_row(job, recording, sim_seconds)
     row["backend"] = ran_on(master and master.backends, job.backend)   # same results either way
     row["seconds"] = time.perf_counter() - started
     return row
@@ -167,8 +161,7 @@ def batch_limits(limits: Limits, members: int) -> Limits:
 
 
 def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
-    """The rows of ``jobs`` (one system and stop time) computed together, ``run_one``'s but for
-    ``backend`` and the times; where the batch cannot give a run's row, ``run_one`` does."""
+    """``run_one``'s rows of ``jobs`` (one system and stop time) computed together, or alone."""
     started = time.perf_counter()
     if any(job.code != code_version() for job in jobs):
         return [run_one(job, blobs) for job in jobs]
