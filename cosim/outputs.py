@@ -11,7 +11,7 @@ from typing import Any, Callable
 from .analysis.animation import animate, require_track
 from .analysis.cost import LAMBDA, Cost, cost
 from .analysis.figures import save_figure
-from .analysis.kinds import Analysis, analysis
+from .analysis.plates import Analysis, analysis
 from .core.files import FolderLock, Outputs
 from .core.interrupt import StopSignals
 from .core.master import Master

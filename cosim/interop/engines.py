@@ -1,6 +1,5 @@
-"""Run an exported SSP package in ``libcosim`` (libcosimpy; also the OSP folder beside it),
-``ecos`` (ecospy) or ``fmpy`` (its SSP runner) in a child process: libcosimpy 0.0.6 aborts
-its host when an FMU fails, ecos 0.7.2 ignores FMI status codes (docs/interop.md)."""
+"""Run an SSP package (libcosim: or its OSP folder) in libcosim, ecos or fmpy in a child process:
+libcosimpy 0.0.6 aborts its host when an FMU fails, ecos 0.7.2 ignores FMI statuses."""
 from __future__ import annotations
 
 import math
@@ -111,9 +110,8 @@ def refuse_strings(ssp: Path, who: str) -> None:
 
 
 def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = TRACED) -> dict[str, np.ndarray]:
-    """The traced signals of ``ssp`` run in ``engine``; EngineError naming what it cannot run
-    (the file, a parameter, the FMUs) or with the child's output if it fails, ``Interrupted``
-    if SIGINT or SIGTERM ended it."""
+    """The traced signals of ``ssp`` run in ``engine``; EngineError naming what it cannot run or
+    with the child's output if it fails, ``Interrupted`` if SIGINT or SIGTERM ended it."""
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
     ssp = Path(ssp).resolve()
@@ -130,10 +128,9 @@ def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = TRACED) -> dict
                           f"{', '.join(newer)}: run it with ecos or OMSimulator, or export "
                           "the FMI 2.0 package (python -m cosim.export without --fmi 3)")
     for name, component in system.components.items():
-        for variable, value in component.parameters.items():
-            if isinstance(value, float) and not math.isfinite(value):
-                raise EngineError(f"{ssp.name}: parameter {name}.{variable} = {value} is not "
-                                  "finite")
+        for variable, x in component.parameters.items():
+            if isinstance(x, float) and not math.isfinite(x):
+                raise EngineError(f"{ssp.name}: parameter {name}.{variable} = {x} is not finite")
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "trace.npz"
         return child_trace(engine, ssp, [sys.executable, "-c", _CHILD, engine, str(ssp), str(out),
@@ -143,9 +140,8 @@ def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = TRACED) -> dict
 def child_trace(who: str, ssp: Path, argv: list[str], out: Path,
                 read: Callable[[Path], dict[str, np.ndarray]], timeout: float = 600.0,
                 **options: Any) -> dict[str, np.ndarray]:
-    """``read(out)`` after ``argv``, a child run of ``ssp``, wrote ``out``: ``Interrupted`` if a
-    signal stopped it, EngineError naming ``who`` with its output if it failed, ran out of time
-    or left a signal undefined (a tool that ignores FMI statuses goes on after a failed FMU)."""
+    """``read(out)`` once ``argv`` ran ``ssp``: ``Interrupted`` if a signal stopped it, else
+    EngineError with its output if it failed, ran out of time or left a signal undefined."""
     try:
         child = subprocess.run(argv, capture_output=True, text=True, timeout=timeout, **options)
     except subprocess.TimeoutExpired:

@@ -1,5 +1,5 @@
-"""Run an exported SSP package in OMSimulator, a build folder ``home``, through its command
-line or its Python API in a child process with a time limit (docs/interop.md)."""
+"""Run an SSP package in OMSimulator (a build folder), its command line or Python API, in a
+child process with a time limit (docs/interop.md)."""
 from __future__ import annotations
 
 import os
@@ -25,8 +25,7 @@ for call in (model.initialize, model.simulate, model.terminate, model.delete):
 
 
 def read_result(path: Path) -> dict[str, np.ndarray]:
-    """'time' and each 'component.variable' of a result CSV, one row per communication
-    point: the last of the two written (after the step, after the exchange)."""
+    """'time' and each 'component.variable' of a result CSV, at each time its last row."""
     header = path.read_text().split("\n", 1)[0].replace('"', "").split(",")
     table = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
     last = np.append(table[1:, 0] != table[:-1, 0], True)      # the last row of each time
@@ -35,8 +34,7 @@ def read_result(path: Path) -> dict[str, np.ndarray]:
 
 def run(ssp: str | Path, home: str | Path, interface: str = "cli",
         timeout: float = 600.0) -> dict[str, np.ndarray]:
-    """The trace of ``ssp`` run in OMSimulator at ``home`` through ``interface``, or
-    EngineError with its output."""
+    """The trace of ``ssp`` run in OMSimulator at ``home``, or EngineError with its output."""
     if interface not in ("cli", "api"):
         raise ValueError(f"interface must be one of cli, api, got {interface!r}")
     ssp, home = Path(ssp).resolve(), Path(home).resolve()
