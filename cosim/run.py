@@ -27,8 +27,7 @@ from ._cli import (add_fmu_options, checked_autopilot, chosen_scenarios, entry, 
                    positive_seconds, say_error, say_note, setting_option, writable_folder)
 from .analysis.animation import video_format
 from .analysis.cost import LAMBDA, Cost
-from .analysis.describe import conditions, headline
-from .analysis.reports import tables
+from .analysis.reports import conditions, headline, tables
 from .api import overrides_of
 from .core.wiring import COUPLINGS
 from .core.files import FolderBusy, OutputError

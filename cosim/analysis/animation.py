@@ -13,8 +13,8 @@ from autopilot_fmu.guidance import route as followed_route
 
 from ..core.files import whole_file
 from ..core.recording import Recording
-from .describe import title
 from .figures import RUDDER_LABEL, new_figure
+from .reports import title
 from .track import hull_outline, legend_if_any, outlines, track_panel, waypoint_name
 
 FPS = 10

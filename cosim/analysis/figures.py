@@ -16,8 +16,8 @@ from matplotlib.figure import Figure
 from ..core.files import whole_file
 from ..core.recording import Recording
 from .cost import LAMBDA, cost
-from .describe import paper_row, title
 from .metrics import heading_error
+from .reports import paper_row, title
 from .track import legend_if_any, track_panel
 
 RUDDER_LABEL = "rudder delta (deg)\n+ turns to port"     # a positive rudder turns to port
