@@ -1,5 +1,4 @@
-"""Figures of a run, in degrees: the track panel beside the signals over time, eq (19) and
-the paper's values for its own runs; on Agg canvases without pyplot (no backend picked)."""
+"""Figures of a run, in degrees: the track panel beside the signals over time, with eq (19)."""
 from __future__ import annotations
 
 import itertools

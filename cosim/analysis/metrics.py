@@ -77,8 +77,7 @@ def cross_track_error(x: np.ndarray, y: np.ndarray, wp_index: np.ndarray,
 
 @dataclass(frozen=True)
 class RouteCompletion:
-    """How close the track came to each waypoint, reached if within R_accept (the guidance
-    also moves on past a waypoint it never reached)."""
+    """How close the track came to each waypoint, reached if within R_accept."""
     points: tuple[tuple[float, float], ...]     # the route, m
     closest: tuple[float, ...]                  # the track's closest approach to each, m
     R_accept: float                             # radius of the circle of acceptance, m

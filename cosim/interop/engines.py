@@ -172,8 +172,8 @@ _CHILD = ("import sys\nfrom cosim.interop.engines import record\n"
 
 
 def record(engine: str, ssp: str, out: str, signals: tuple[str, ...]) -> int:
-    """The child's side of ``run``: the trace saved to ``out`` (.npz); 1 and the reason on
-    stderr if it fails; 130 or 143 if SIGINT or SIGTERM stopped it (between steps)."""
+    """The child's side of ``run``: 0 and the trace in ``out`` (.npz), 1 and the reason on
+    stderr, or 130 / 143 if SIGINT or SIGTERM stopped it."""
     try:
         with StopSignals() as stop:
             system = read_package(Path(ssp))
