@@ -1,11 +1,13 @@
-"""Run an SSP package (libcosim: or its OSP folder) in libcosim, ecos or fmpy in a child process:
-libcosimpy 0.0.6 aborts its host when an FMU fails, ecos 0.7.2 ignores FMI statuses."""
+"""Run an SSP package (libcosim: or its OSP folder) in libcosim, ecos, fmpy or OMSimulator, in a
+child process: libcosimpy 0.0.6 aborts its host when an FMU fails, ecos 0.7.2 ignores statuses."""
 from __future__ import annotations
 
 import math
+import os
 import signal
 import subprocess
 import sys
+import sysconfig
 import tempfile
 import zipfile
 from pathlib import Path
@@ -192,3 +194,47 @@ def record(engine: str, ssp: str, out: str, signals: tuple[str, ...]) -> int:
 def save_trace(path: Path, result: dict[str, np.ndarray]) -> None:
     with whole_file(path) as tmp, open(tmp, "wb") as f:
         np.savez(f, **result)
+
+
+_OMS_API = """import sys
+from OMSimulator import SSP
+ssp, result, step, temp = sys.argv[1:]
+model = SSP(ssp, temp_dir=temp).instantiate()
+model.setResultFile(result)
+model.setFixedStepSize(float(step))
+for call in (model.initialize, model.simulate, model.terminate, model.delete):
+    call()
+"""
+
+
+def omsimulator_result(path: Path) -> dict[str, np.ndarray]:
+    """'time' and each 'component.variable' of a result CSV, at each time its last row."""
+    header = path.read_text().split("\n", 1)[0].replace('"', "").split(",")
+    table = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    last = np.append(table[1:, 0] != table[:-1, 0], True)      # the last row of each time
+    return dict(zip(["time"] + [".".join(h.split(".")[-2:]) for h in header[1:]], table[last].T))
+
+
+def run_omsimulator(ssp: str | Path, home: str | Path, interface: str = "cli",
+                    timeout: float = 600.0) -> dict[str, np.ndarray]:
+    """The trace of ``ssp`` run in OMSimulator at ``home``, or EngineError with its output."""
+    if interface not in ("cli", "api"):
+        raise ValueError(f"interface must be one of cli, api, got {interface!r}")
+    ssp, home = Path(ssp).resolve(), Path(home).resolve()
+    refuse_strings(ssp, "OMSimulator")
+    system, site = read_package(ssp), sysconfig.get_paths()["purelib"]
+    with tempfile.TemporaryDirectory() as tmp:
+        result = Path(tmp) / "result.csv"
+        if interface == "cli":              # its Python FMUs need libpython loaded first
+            argv = [str(home / "bin" / "OMSimulator"), f"--stopTime={system.stop_time!r}",
+                    f"--startTime={system.start_time!r}", f"--resultFile={result}",
+                    f"--tempDir={tmp}", str(ssp)]
+            env = {"LD_PRELOAD": os.path.join(sysconfig.get_config_var("LIBDIR"),
+                                              sysconfig.get_config_var("LDLIBRARY")),
+                   "PYTHONPATH": site}
+        else:
+            argv = [sys.executable, "-c", _OMS_API, str(ssp), str(result),
+                    repr(system.step_size), tmp]
+            env = {"PYTHONPATH": os.pathsep.join([str(home / "lib" / "x86_64-linux-gnu"), site])}
+        return child_trace(f"OMSimulator ({interface})", ssp, argv, result, omsimulator_result,
+                           timeout, cwd=tmp, env={**os.environ, **env})
