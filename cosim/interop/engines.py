@@ -105,8 +105,7 @@ RUNNERS = {"libcosim": _libcosim, "ecos": _ecos, "fmpy": _fmpy}
 
 def refuse_strings(ssp: Path, who: str) -> None:
     """EngineError if ``ssp`` binds a String away from its FMU's default: ``who`` sets none."""
-    dropped = unapplied_strings(ssp)
-    if dropped:
+    if dropped := unapplied_strings(ssp):
         raise EngineError(f"{who} applies no String binding; it would run " + ", ".join(
             f"{v} = {default!r}, not {value!r}" for v, (value, default) in dropped.items()))
 

@@ -85,8 +85,7 @@ def check_autopilot(fmu: str | Path, port_map: dict[str, str] | None = None,
     if fmpy.platform not in platforms:
         raise AutopilotError(f"{fmu} has no binary for this platform ({fmpy.platform}); it has "
                              f"{', '.join(platforms) or 'none'}")
-    unknown = sorted(set(port_map) - set(PORTS))
-    if unknown:
+    if unknown := sorted(set(port_map) - set(PORTS)):
         close = [m for u in unknown for m in close_matches(u, PORTS)]
         raise AutopilotError(f"{fmu}: --map names {', '.join(map(repr, unknown))}, which "
                              f"{'is not a port' if len(unknown) == 1 else 'are not ports'} "
