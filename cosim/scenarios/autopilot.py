@@ -1,6 +1,5 @@
-"""Your own autopilot in the paper's scenarios: an FMI 2.0 or 3.0 co-simulation FMU with inputs
-psi (rad), r (rad/s), psi_d (rad), output delta_c (rad) (docs/own_autopilot.md). A port in
-another unit is refused, not converted: a run never rests on a guess."""
+"""Your own autopilot in the paper's scenarios (docs/own_autopilot.md): the port contract checked,
+a port in another unit refused, not converted (a run never rests on a guess)."""
 from __future__ import annotations
 
 import copy
