@@ -13,9 +13,9 @@ from matplotlib.patches import Circle, Polygon
 from ship_fmu.data import Hull
 
 from ..core.recording import Recording
-from .criteria import turning_circle_of, zigzag_of
 from .figures import course_keeping_figure, text_grid, text_panel, time_axes
-from .manoeuvres import approach_frame, at_heading_change, steady_circle
+from .manoeuvres import (approach_frame, at_heading_change, steady_circle, turning_circle_of,
+                         zigzag_of)
 from .reports import course_keeping_report, turning_circle_report, zigzag_report
 from .track import hull_outline, legend_if_any, outlines, to_earth, track_panel
 

@@ -12,8 +12,8 @@ from ship_fmu.data import Hull
 from ..core.recording import Recording
 from ..scenarios import SCENARIO_DIR
 from .cost import LAMBDA, Cost, cost
-from .criteria import STANDARD, Assessment, Criterion, turning_circle_of, zigzag_of
-from .manoeuvres import TurningCircle, ZigZagResult
+from .manoeuvres import (STANDARD, Assessment, Criterion, TurningCircle, ZigZagResult,
+                         turning_circle_of, zigzag_of)
 from .metrics import RUDDER_DEADBAND, at_stops, rudder_reversals_per_minute
 from .seastate import SCALE
 
