@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from .analysis.animation import animate, require_track
-from .analysis.cost import LAMBDA, Cost, cost
+from .analysis.metrics import LAMBDA, Cost, cost
 from .analysis.figures import save_figure
 from .analysis.plates import Analysis, analysis
 from .core.files import FolderLock, Outputs

@@ -26,7 +26,7 @@ from . import scenarios
 from ._cli import (add_fmu_options, checked_autopilot, chosen_scenarios, entry, number_option,
                    positive_seconds, say_error, say_note, setting_option, writable_folder)
 from .analysis.animation import video_format
-from .analysis.cost import LAMBDA, Cost
+from .analysis.metrics import LAMBDA, Cost
 from .analysis.reports import conditions, headline, tables
 from .api import overrides_of
 from .core.wiring import COUPLINGS

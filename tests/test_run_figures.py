@@ -12,7 +12,7 @@ from matplotlib.text import Text
 
 from cosim import simulate
 from cosim.analysis.animation import leg_text
-from cosim.analysis.cost import cost
+from cosim.analysis.metrics import cost
 from cosim.analysis.figures import RUDDER_LABEL, comparison, course_keeping_figure
 from cosim.analysis.track import outline_scale, waypoint_name
 from cosim.analysis.reports import PAPER_TABLES, paper_row, title

@@ -14,8 +14,7 @@ from matplotlib.figure import Figure
 
 from ..core.files import whole_file
 from ..core.recording import Recording
-from .cost import LAMBDA, cost
-from .metrics import heading_error
+from .metrics import LAMBDA, cost, heading_error
 from .reports import paper_row, title
 from .track import legend_if_any, track_panel
 

@@ -11,10 +11,10 @@ from ship_fmu.data import Hull
 
 from ..core.recording import Recording
 from ..scenarios import SCENARIO_DIR
-from .cost import LAMBDA, Cost, cost
 from .manoeuvres import (STANDARD, Assessment, Criterion, TurningCircle, ZigZagResult,
                          turning_circle_of, zigzag_of)
-from .metrics import RUDDER_DEADBAND, at_stops, rudder_reversals_per_minute
+from .metrics import (LAMBDA, RUDDER_DEADBAND, Cost, at_stops, cost,
+                      rudder_reversals_per_minute)
 from .seastate import SCALE
 
 PAPER_TABLES = {   # Tomera (2010), Tables 1 and 2: psi_E, delta_E, J

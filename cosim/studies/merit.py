@@ -7,9 +7,9 @@ from dataclasses import dataclass
 
 from autopilot_fmu.guidance import R_ACCEPT, route as followed_route
 
-from ..analysis.cost import cost
-from ..analysis.metrics import (cross_track_error, fraction_at_stops, heading_error, mean_abs_rate,
-                                peak, rms, route_completion, rudder_reversals_per_minute)
+from ..analysis.metrics import (cost, cross_track_error, fraction_at_stops, heading_error,
+                                mean_abs_rate, peak, rms, route_completion,
+                                rudder_reversals_per_minute)
 
 # The figures of merit of a run and their units, as cosim.run prints them (floats, NaN in a
 # failed run's row).
