@@ -54,6 +54,8 @@ class NomotoModel:
     K_R: float      # eq (29)
     T3: float       # eq (30)
     T: float        # T1 + T2 - T3, s
+    a22: float      # -1/T (the paper writes a_11 after eq (34); it is a_22)
+    b2: float       # K / T, K = -K_R (31)
 
     @classmethod
     def from_sway_yaw(cls, model: SwayYawModel) -> NomotoModel:
@@ -62,18 +64,10 @@ class NomotoModel:
         b1, b2 = model.b
         det_N = n11 * n22 - n12 * n21
         T1_plus_T2 = (n11 * m22 + n22 * m11 - n12 * m21 - n21 * m12) / det_N   # (28)
-        K_R = (n21 * b1 - n11 * b2) / det_N                                     # (29)
+        K_R = float((n21 * b1 - n11 * b2) / det_N)                              # (29)
         T3 = (m21 * b1 - m11 * b2) / det_N / K_R                                # (30)
-        return cls(K_R=float(K_R), T3=float(T3), T=float(T1_plus_T2 - T3))
-
-    @property
-    def a22(self) -> float:
-        """-1/T (the paper writes a_11 after eq (34); it is a_22)."""
-        return -1.0 / self.T
-
-    @property
-    def b2(self) -> float:
-        return -self.K_R / self.T          # K / T, K = -K_R (31)
+        T = float(T1_plus_T2 - T3)
+        return cls(K_R=K_R, T3=float(T3), T=T, a22=-1.0 / T, b2=-K_R / T)
 
 
 def design_model(name: str, u0: float) -> SwayYawModel:

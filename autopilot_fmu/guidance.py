@@ -1,8 +1,6 @@
 """Waypoint guidance, eq (18): psi_d = atan2(y_{k+1} - y_k, x_{k+1} - x_k), x north. The
 next leg starts inside the circle of acceptance *or* once past the waypoint along the track
 (a circle-only rule strands a ship turning wide); past the last, the last course holds."""
-from __future__ import annotations
-
 import math
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -56,9 +54,8 @@ def numeric_route(text: str) -> dict[str, int | float]:
 
 
 def route(parameters: Mapping[str, Any]) -> list[tuple[float, float]]:
-    """The route of the guidance's parameters by name (absent: defaults); ValueError naming
-    them unless n_waypoints = 0 with every wp<i> unset (the String), or n >= 2 with wp0 ..
-    wp<n-1> and ``waypoints`` at its default or the same points."""
+    """The route of the guidance's parameters by name (absent: defaults): the String if
+    n_waypoints = 0, else wp0 .. wp<n-1>; ValueError naming them if they contradict."""
     text = parameters.get("waypoints", PAPER_ROUTE)
     count = parameters.get("n_waypoints", 0)
     coordinates = [float(parameters.get(name, 0.0)) for name in COORDINATES]
@@ -93,7 +90,6 @@ class WaypointGuidance:
         self.R_accept = R_accept
         self.leg = 0                      # active leg: from points[leg] to points[leg + 1]
         self.finished = False
-        self._last: tuple = (None, None)  # the last evaluation (an FMU asks 3 times)
 
     def _reached(self, leg: int, x: float, y: float) -> bool:
         (x0, y0), (x1, y1) = self.points[leg], self.points[leg + 1]
@@ -104,9 +100,6 @@ class WaypointGuidance:
 
     def active_leg(self, x: float, y: float) -> tuple[int, bool]:
         """(leg, finished) at position (x, y), from the committed leg onward."""
-        key = (x, y, self.leg, self.finished)
-        if self._last[0] == key:
-            return self._last[1]
         require_finite(x=x, y=y)
         leg, finished = self.leg, self.finished
         while not finished and self._reached(leg, x, y):
@@ -114,7 +107,6 @@ class WaypointGuidance:
                 leg += 1
             else:
                 finished = True
-        self._last = (key, (leg, finished))
         return leg, finished
 
     def course(self, leg: int) -> float:

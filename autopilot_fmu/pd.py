@@ -1,7 +1,5 @@
 """PD autopilot, eq (20): delta_c = K_P (psi - psi_d) + K_D r, stabilising as printed (a
 positive rudder turns this ship to port); the error wrapped to (-pi, pi]: the short way."""
-from __future__ import annotations
-
 from dataclasses import dataclass
 
 from fmukit.numerics import wrap

@@ -130,11 +130,9 @@ class SlidingModeAutopilot:
 
     def step(self, t: float, h: float, psi_d: float) -> None:
         n = substeps(h, self._h_max, "of the reference model")
-        hs = h / n
-        psi_z, r_z = self.psi_z, self.r_z
         for _ in range(n):
-            psi_z, r_z = reference_rk4(psi_d, psi_z, r_z, hs, self.omega_n, self.zeta)
-        self.psi_z, self.r_z = psi_z, r_z
+            self.psi_z, self.r_z = reference_rk4(psi_d, self.psi_z, self.r_z, h / n,
+                                                 self.omega_n, self.zeta)
 
     def snapshot(self) -> dict[str, float]:
         return {"psi_z": self.psi_z, "r_z": self.r_z}

@@ -1,7 +1,5 @@
 """What the commands share: scenario and autopilot options, output folders, messages. Only
 the commands import this."""
-from __future__ import annotations
-
 import argparse
 import functools
 import math
@@ -70,8 +68,7 @@ def positive_seconds(text: str) -> float:
 
 
 def add_fmu_options(parser: argparse.ArgumentParser, also: str) -> None:
-    """The FMUs a scenario runs: --fmi 2|3 (which version of this project's), --autopilot
-    FMU, --map and --name; ``also`` says what --all does with the autopilot."""
+    """--fmi, --autopilot, --map and --name; ``also`` says what --all does with the autopilot."""
     parser.add_argument("--fmi", type=int, choices=sorted(FMU_DIRS),
                         help="run this project's FMI 2.0 FMUs (fmus/) or their FMI 3.0 twins "
                              "(fmus/fmi3/, built by python -m fmukit.build --fmi 3) in place "
@@ -113,8 +110,7 @@ def say_note(note: str) -> None:
 
 
 def checked_autopilot(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
-    """Check --autopilot against the port contract before anything runs; if it fails, the
-    reason on standard error and status 2."""
+    """Check --autopilot against the port contract before anything runs (else status 2)."""
     if args.autopilot is None and (args.map or args.name):
         parser.error("--map and --name describe an --autopilot FMU; give one")
     try:
@@ -126,8 +122,8 @@ def checked_autopilot(parser: argparse.ArgumentParser, args: argparse.Namespace)
 
 
 def entry(main: Callable[[], int]) -> int:
-    """Run a command's main as Unix tools end: quietly when its output pipe closes; on
-    Ctrl-C or SIGTERM with "interrupted" and status 130 or 143, not a traceback."""
+    """Run a command's main: quiet when its output pipe closes; on Ctrl-C or SIGTERM,
+    "interrupted" and status 130 or 143, not a traceback."""
     signal.signal(signal.SIGPIPE, signal.SIG_DFL)
     try:
         with raise_on_signals():

@@ -1,7 +1,5 @@
 """The Python entry point: ``simulate`` runs a scenario, with your autopilot if you have one,
 ``simulate_many`` many runs of one (docs/running.md, "From Python")."""
-from __future__ import annotations
-
 import warnings
 from pathlib import Path
 from typing import Any, Iterable, Mapping, Sequence
@@ -21,8 +19,7 @@ class SimulationError(RuntimeError):
 
 
 def parse_setting(text: str) -> tuple[str, str]:
-    """'component.variable=value' -> ('component.variable', 'value'), the value as text (the
-    master reads it as the variable's type)."""
+    """'component.variable=value' -> ('component.variable', 'value'), the value as text."""
     target, sep, raw = text.partition("=")
     try:
         split_name(target if sep else "")
@@ -41,8 +38,8 @@ def parse_port_map(text: str) -> tuple[str, str]:
 
 def overrides_of(settings: Mapping[str, Any] | Iterable[tuple[str, Any]]
                  ) -> dict[str, dict[str, Any]]:
-    """{'ship.Hs': 0.01} (or pairs) -> {'ship': {'Hs': 0.01}}; ValueError for a key that is
-    not 'component.variable' or a variable given twice."""
+    """{'ship.Hs': 0.01} (or pairs) -> {'ship': {'Hs': 0.01}}; ValueError for a bad key or a
+    variable given twice."""
     pairs = settings.items() if isinstance(settings, Mapping) else settings
     overrides: dict[str, dict[str, Any]] = {}
     for target, value in pairs:
@@ -63,8 +60,7 @@ def simulate(scenario: str | Path, autopilot: str | Path | None = None,
              port_map: dict[str, str] | None = None, fmi: int | None = None) -> Recording:
     """The recording of a scenario (a name or a .ssd path): ``autopilot`` an FMU in its
     autopilot's place, ``set`` values by "component.variable" (SI units), the rest as
-    ``cosim.run``'s options; its notes are warnings. ValueError or FileNotFoundError for bad
-    input; SimulationError if an FMU fails."""
+    ``cosim.run``'s options. ValueError for bad input; SimulationError if an FMU fails."""
     with Master(scenarios.load(scenario, autopilot, port_map, fmi=fmi), coupling=coupling,
                 backend=backend, overrides=overrides_of(set or {})) as master:
         for note in master.notes:
@@ -81,9 +77,8 @@ def simulate_many(scenario: str | Path, sets: Sequence[Mapping[str, Any]],
                   fmi: int | None = None, signals: Sequence[str] | None = None
                   ) -> list[Recording]:
     """The recordings of a scenario run once for each of ``sets`` (each ``simulate``'s
-    ``set``), in order; ``backend="batch"`` steps them together as arrays, holding
-    ``signals`` (docs/running.md). A failed run raises nothing: its ``error`` says why;
-    ValueError naming ``member i`` for a setting refused before anything runs."""
+    ``set``), in order; "batch" steps them together as arrays, holding ``signals``. A failed
+    run raises nothing (its ``error`` says why); a refused setting, ValueError naming its member."""
     if backend not in (*RUN_BACKENDS, "batch"):
         raise ValueError(f"backend must be fmi, inprocess or batch, got {backend!r}")
     overrides = []
@@ -109,8 +104,7 @@ def simulate_many(scenario: str | Path, sets: Sequence[Mapping[str, Any]],
 def _one_at_a_time(system: SystemDescription, overrides: list[dict[str, dict[str, Any]]],
                    stop_time: float | None, backend: str, signals: Sequence[str] | None
                    ) -> list[Recording]:
-    """Each member's run on one master, reset between runs (made anew after a failed one);
-    every member's settings checked before the first runs."""
+    """Each member's run on one master, reset between runs, made anew after a failed one."""
     master = Master(system, backend=backend)
     recordings = []
     try:

@@ -5,6 +5,7 @@
     python -m cosim.bench memory          a 24 h run of calm_pd streamed to disk: peak memory
     python -m cosim.bench sweep           sweeps on a local cluster, every backend with 1 and
                                           2 workers; the batch route's goals (--parts)
+    python -m cosim.bench all             the four in turn, as docs/performance.md records them
 """
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ from ._cli import entry, say_error
 from .studies import memory, sweep_timing, timing
 
 SWEEP_PARTS = ("throughput", "campaign", "memory")
+BENCHMARKS = ("engines", "overhead", "memory", "sweep")
 
 
 def _counts(text: str) -> tuple[int, ...]:
@@ -23,6 +25,23 @@ def _counts(text: str) -> tuple[int, ...]:
         raise argparse.ArgumentTypeError(f"expected whole numbers >= 1 separated by commas, "
                                          f"got {text!r}")
     return tuple(map(int, text.split(",")))
+
+
+def _benchmark(name: str, args: argparse.Namespace, repeats: int) -> None:
+    if name == "memory":
+        memory.memory(args.hours)
+    elif name == "sweep":                       # the parts asked for, in their order
+        if "throughput" in args.parts:
+            seas = ("waves", "calm") if args.sea == "both" else (args.sea,)
+            sweep_timing.sweep_throughput(args.runs, args.batch_runs, seas, rounds=args.rounds)
+        if "campaign" in args.parts:
+            sweep_timing.campaign(args.campaign_runs)
+        if "memory" in args.parts:
+            memory.batch_memory(args.memory_members)
+    elif name == "overhead":
+        timing.overhead(repeats)
+    else:
+        timing.engines(repeats)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -58,23 +77,14 @@ def main(argv: list[str] | None = None) -> int:
     sweep.add_argument("--memory-members", type=_counts, default=memory.MEMORY_MEMBERS,
                        help="members of the memory measurement, comma-separated (default "
                             + ",".join(map(str, memory.MEMORY_MEMBERS)) + ")")
+    commands.add_parser("all", parents=[repeats], help="engines, overhead, memory and sweep in "
+                                                      "turn, each with its defaults")
     args = parser.parse_args(argv)
+    own = {"memory": mem, "sweep": sweep}
     try:
-        if args.command == "memory":
-            memory.memory(args.hours)
-        elif args.command == "sweep":           # the parts asked for, in their order
-            if "throughput" in args.parts:
-                seas = ("waves", "calm") if args.sea == "both" else (args.sea,)
-                sweep_timing.sweep_throughput(args.runs, args.batch_runs, seas,
-                                              rounds=args.rounds)
-            if "campaign" in args.parts:
-                sweep_timing.campaign(args.campaign_runs)
-            if "memory" in args.parts:
-                memory.batch_memory(args.memory_members)
-        elif args.command == "overhead":
-            timing.overhead(args.repeats)
-        else:
-            timing.engines(args.repeats)
+        for name in BENCHMARKS if args.command == "all" else (args.command or "engines",):
+            _benchmark(name, args if name == args.command or name not in own
+                       else own[name].parse_args([]), args.repeats)
     except (RuntimeError, ValueError, FileNotFoundError) as error:   # e.g. stale FMUs
         say_error(error)
         return 2

@@ -1,7 +1,5 @@
-"""The command line of ``cosim.interop.engines``: run an SSP package in another engine, in a
-child process, and save the signals; a failure is status 1 with the engine's messages."""
-from __future__ import annotations
-
+"""Run an SSP package in another engine (``cosim.interop.engines``) and save the signals; a
+failure is status 1 with the engine's messages."""
 import argparse
 import sys
 from pathlib import Path

@@ -2,8 +2,6 @@
 
 Beside the package, a folder for OSP (``cosim.interop.ssp``, docs/interop.md); what another
 tool would not apply (a String value, FMI 3.0 FMUs) is said."""
-from __future__ import annotations
-
 import argparse
 import sys
 from pathlib import Path

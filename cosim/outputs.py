@@ -1,17 +1,13 @@
 """A run and what it writes, the one lifecycle behind ``cosim.run`` and any library caller:
 the outputs are staged and put in place together (a refused run, a full disk or a second
 Ctrl-C leaves the folder as it was), by one process a folder at a time; nothing printed."""
-from __future__ import annotations
-
 import signal
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
-from .analysis.animation import animate, require_track
+from .analysis.kinds import Analysis, analysis
 from .analysis.metrics import LAMBDA, Cost, cost
-from .analysis.figures import save_figure
-from .analysis.plates import Analysis, analysis
 from .core.files import FolderLock, Outputs
 from .core.interrupt import StopSignals
 from .core.master import Master
@@ -60,9 +56,8 @@ def run_and_write(system: SystemDescription, label: str, out: Path,
                   stop: StopSignals | None = None,
                   notes: Callable[[str], None] = lambda note: None) -> Outcome:
     """Run ``system`` and write its CSV, JSON and, once finished, figure and animation as
-    ``label`` in ``out``. ``notes`` hears how it runs once the FMUs are up; ``stop`` ends it
-    between steps on a signal. ValueError, FileNotFoundError, FmuCallError, TimedOut,
-    FolderBusy or OutputError leave ``out`` as it was."""
+    ``label`` in ``out``; ``stop`` ends it between steps on a signal. An exception (ValueError,
+    FileNotFoundError, FmuCallError, TimedOut, FolderBusy, OutputError) leaves ``out`` as it was."""
     kind = analysis(system.report)
     with FolderLock(out):
         Outputs.remove_abandoned(out, label)          # a killed run's, if any
@@ -96,6 +91,7 @@ def run_and_write(system: SystemDescription, label: str, out: Path,
                         for note in master.notes:
                             notes(note)
                         if options.animate:
+                            from .analysis.animation import require_track   # matplotlib
                             require_track(master.columns)
                         with outputs.writing(f"{label}.csv") as csv_path:
                             recording = master.run(options.stop_time, progress=progress,
@@ -126,14 +122,12 @@ def run_and_write(system: SystemDescription, label: str, out: Path,
 
 
 def _discard(outputs: Outputs, label: str) -> str:
-    """Remove this run's unfinished outputs; say what is kept."""
     outputs.discard()
     return f"the earlier outputs of {label} in {outputs.folder}, if any, are as they were"
 
 
 def _write_rows(recording: Recording, outputs: Outputs, label: str, streamed: bool
                 ) -> list[Path]:
-    """The CSV (unless the rows were streamed to it) and the metadata JSON, staged."""
     with outputs.writing(f"{label}.csv") as csv_path:
         if not streamed:
             recording.write_csv(csv_path)
@@ -144,9 +138,10 @@ def _write_rows(recording: Recording, outputs: Outputs, label: str, streamed: bo
 
 def _analyse(outcome: Outcome, system: SystemDescription, kind: Analysis, label: str,
              outputs: Outputs, options: Options, parameters: dict) -> None:
-    """Report, figure, animation and cost of a finished run whose rows are written."""
     recording = outcome.recording
     outcome.report = kind.report(recording, lam=options.lam, parameters=parameters)
+    from .analysis.animation import animate           # matplotlib, only where it draws
+    from .analysis.figures import save_figure
     if options.plot and kind.figure is not None:
         with outputs.writing(f"{label}.{options.formats[0]}") as path:
             outcome.written += save_figure(recording, kind.figure, path.with_suffix(""),

@@ -1,8 +1,5 @@
-"""What it takes to reproduce a run, as JSON next to its CSV: the master's record
-(``run_meta``), each FMU's SHA-256 (and whether an fmukit FMU's sources are this process's),
-the scenario's, the command, the versions and git commit. Strict JSON: a non-finite number is written as a string."""
-from __future__ import annotations
-
+"""What it takes to reproduce a run, as strict JSON next to its CSV: the master's record, the
+FMUs' and scenario's SHA-256, the command, the versions and git commit."""
 import functools
 import hashlib
 import json
@@ -40,8 +37,7 @@ def _sha256(path: str) -> str | None:
 
 
 def _fmu(fmu: dict[str, Any]) -> dict[str, Any]:
-    """An FMU's entry with its SHA-256; for one built with fmukit, its sources' digest and
-    whether they are this process's (``fmukit.manifest.staleness``)."""
+    """An FMU's entry with its SHA-256; for one built with fmukit, whether it is current."""
     entry = {**fmu, "sha256": _sha256(fmu["file"])}
     try:
         manifest = read(fmu["file"])
@@ -68,8 +64,8 @@ def _commit() -> str | None:
 
 @functools.lru_cache(maxsize=1)
 def code_version() -> str:
-    """This package's version and a SHA-256 of its Python sources (12 digits): two
-    environments with the same string run the same code, from a checkout or a wheel."""
+    """This package's version and a SHA-256 of its Python sources: the same string, the same
+    code."""
     digest = hashlib.sha256()
     for package in CODE_PACKAGES:
         for path in sorted((ROOT / package).rglob("*.py")):
@@ -92,7 +88,7 @@ def write_metadata(recording: Recording, path: str | Path) -> Path:
         versions={PACKAGE: _version(PACKAGE), "commit": _commit(),
                   "python": platform.python_version(), "numpy": _version("numpy"),
                   "fmpy": _version("fmpy"), "pythonfmu": _version("pythonfmu")})
-    # through JSON once with its NaN and Infinity tokens, read back as strings
+    # a non-finite number becomes a string
     strict = json.loads(json.dumps(meta), parse_constant=NON_FINITE.get)
     path = Path(path)
     path.write_text(json.dumps(strict, indent=1, allow_nan=False) + "\n")

@@ -5,8 +5,7 @@ Examples:
   python -m cosim.run waves_smc --out /tmp/w   the sliding-mode autopilot in waves
   python -m cosim.run calm_pd --set ship.Hs=0.003 --set autopilot.Kd=30
   python -m cosim.run --all                    the paper's four runs, Tables 1-2
-  python -m cosim.run --all --spread           ... with how far one last bit moves each
-                                               figure (as docs/reproduction.md)
+  python -m cosim.run --all --spread           ... and how far one last bit moves each figure
   python -m cosim.run waves_pd --autopilot my.fmu   your own autopilot in waves_pd's place
   python -m cosim.run --all --fmi 3            the same runs through the FMI 3.0 twins
 
@@ -14,9 +13,8 @@ A scenario is an SSP system structure file (cosim/scenarios/*.ssd). A run writes
 signal at every 0.1 s step to SCENARIO.csv and a figure like the paper's Figs 2-3 to
 SCENARIO.png, and prints the cost of eq (19) (or the manoeuvre's figures).
 """
-from __future__ import annotations
-
 import argparse
+import shutil
 import sys
 from pathlib import Path
 
@@ -25,7 +23,6 @@ from tqdm import tqdm
 from . import scenarios
 from ._cli import (add_fmu_options, checked_autopilot, chosen_scenarios, entry, number_option,
                    positive_seconds, say_error, say_note, setting_option, writable_folder)
-from .analysis.animation import video_format
 from .analysis.metrics import LAMBDA, Cost
 from .analysis.reports import conditions, headline, tables
 from .api import overrides_of
@@ -39,6 +36,11 @@ from .core.watchdog import STEP_LIMIT_S, Limits
 from .outputs import Options, TimedOut, run_and_write
 from .scenarios.autopilot import COMPONENT
 from .studies.spread import PERTURBED, spread
+
+
+def video_format() -> str:
+    """'mp4' where ffmpeg is installed, else 'gif'."""
+    return "mp4" if shutil.which("ffmpeg") else "gif"
 
 
 def run_scenario(system: SystemDescription, label: str, out: Path, overrides: dict,
@@ -86,8 +88,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("scenario", nargs="?",
                         help=f"one of: {', '.join(scenarios.names())}; or a path to a .ssd file")
     parser.add_argument("--all", action="store_true",
-                        help="run the paper's four scenarios and print Tables 1-2 beside the "
-                             "paper's")
+                        help="run the paper's four scenarios, print Tables 1-2 beside the paper's")
     parser.add_argument("--out", type=Path,
                         help="output folder (default: results/SCENARIO, or results/ with --all)")
     parser.add_argument("--stop-time", type=number_option, metavar="T",
@@ -102,10 +103,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--lambda", dest="lam", type=number_option, default=LAMBDA,
                         help=f"weight of eq (19) (default {LAMBDA:.4f}, calibrated on calm_pd)")
     parser.add_argument("--backend", choices=RUN_BACKENDS, default="fmi",
-                        help="fmi: load the FMUs through FMI (default); inprocess: call the "
-                             "FMUs' Python classes, without FMI, with the same results bit for "
-                             "bit (an FMU not built from this checkout's sources runs through "
-                             "FMI, with a note)")
+                        help="fmi: load the FMUs through FMI (default); inprocess: call their "
+                             "Python classes, the same results bit for bit (an FMU not built "
+                             "from this checkout's sources runs through FMI, with a note)")
     add_fmu_options(parser, "with --all it also runs in calm_pd's and waves_pd's place, as an "
                             "extra row of Tables 1-2")
     parser.add_argument("--no-plot", action="store_true", help="skip the figure")
@@ -125,11 +125,11 @@ def main(argv: list[str] | None = None) -> int:
                              "for long runs; no report or figure")
     parser.add_argument("--step-timeout", type=positive_seconds, default=STEP_LIMIT_S, metavar="S",
                         help="end the run with an error if one step of the FMUs (or their "
-                             f"instantiation) takes longer than S s of wall-clock time "
-                             f"(default {STEP_LIMIT_S:g})")
+                             f"instantiation) takes over S s of wall-clock time (default "
+                             f"{STEP_LIMIT_S:g})")
     parser.add_argument("--run-timeout", type=positive_seconds, metavar="S",
-                        help="end the run with an error, keeping its rows, if it takes "
-                             "longer than S s of wall-clock time (default: no limit)")
+                        help="end the run with an error, keeping its rows, after S s of "
+                             "wall-clock time (default: no limit)")
     args = parser.parse_args(argv)
     names = chosen_scenarios(parser, args)
     checked_autopilot(parser, args)
@@ -190,11 +190,10 @@ def main(argv: list[str] | None = None) -> int:
         if result is not None and table_row is not None:
             costs[table_row] = result
     if args.all and costs:
-        print()
-        print(tables(costs, spreads, f"How far one last bit moves each figure (the largest "
-                                    f"change over {count} runs, "
-                                    f"{perturbed} moved by up to {args.spread} ulp; where "
-                                    "it shows at the printed digits)"))
+        title = (f"How far one last bit moves each figure (the largest change over {count} "
+                 f"runs, {perturbed} moved by up to {args.spread} ulp; where it shows at the "
+                 "printed digits)")
+        print("\n" + tables(costs, spreads, title))
     return status
 
 

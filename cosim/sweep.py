@@ -16,7 +16,6 @@ from .core.watchdog import STEP_LIMIT_S, Limits
 from .studies import campaign
 from .studies.cluster import CONNECT_TIMEOUT, NoWorkers, SweepError
 from .studies.sweep_client import MAX_BATCH, MIN_BATCH
-from .studies.sweep_figures import save_figures
 from .studies.sweep_spec import MAX_RUNS, Spec
 from .studies.sweep_task import BATCH, SWEEP_BACKENDS
 from .studies.sweep_tables import MONTE_CARLO, comparison, distinct, summary, write_tables
@@ -103,6 +102,7 @@ def main(argv: list[str] | None = None) -> int:
         written = write_tables(rows, out, args.csv, spec)
         stage = "drawing the figures"
         if any(r["status"] == "ok" for r in rows):
+            from .studies.sweep_figures import save_figures      # matplotlib: only to draw
             written += save_figures(spec, rows, out)
         else:
             print("no run succeeded: no figures drawn", file=sys.stderr)

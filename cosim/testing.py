@@ -1,8 +1,5 @@
-"""A pytest plugin for your autopilot (a ``pytest11`` entry point; importing it changes
-nothing): options, fixtures, and ``check_*`` functions on the exchanged signals, which raise
-AssertionError saying what is wrong, where and when (docs/own_autopilot.md)."""
-from __future__ import annotations
-
+"""A pytest plugin for your autopilot (docs/own_autopilot.md): options, fixtures, and
+``check_*`` functions that raise AssertionError saying what is wrong, where and when."""
 import functools
 import math
 from pathlib import Path
@@ -95,10 +92,8 @@ def check_heading_settles(run: Recording, bound: float, within: float) -> None:
     error = np.abs(heading_error(run["guidance.psi_d"], run["ship.psi"]))
     starts = [0, *(np.flatnonzero(np.diff(leg)) + 1)]
     for start, end in zip(starts, [*starts[1:], len(t)]):
-        settled = t[start:end] >= t[start] + within
-        if not settled.any():
-            continue
-        worst = float(error[start:end][settled].max())
+        settled = error[start:end][t[start:end] >= t[start] + within]
+        worst = float(settled.max(initial=0.0))       # errors are >= 0; no settled step: 0
         assert worst <= bound, \
             f"heading error {math.degrees(worst):.2f} deg on the leg to waypoint " \
             f"{int(leg[start])} (from t = {t[start]:.1f} s), {within:g} s after the course " \

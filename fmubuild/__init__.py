@@ -1,2 +1,1 @@
-"""Building FMUs, on the host (no FMU carries this package); ``cli`` is ``python -m fmukit.build``.
-"""
+"""Building FMUs, on the host; ``cli`` is ``python -m fmukit.build``."""

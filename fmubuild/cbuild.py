@@ -1,6 +1,5 @@
-"""FMUs written in C, compiled with the system compiler (``$CC``, else cc or gcc) and, where
-mingw-w64 is installed, for 64-bit Windows, reproducibly; zipped with their sources and
-validated. Without a compiler: ``NoCompiler``, and the Python FMUs are unaffected.
+"""FMUs written in C, compiled reproducibly with the system compiler and, where mingw-w64 is
+installed, for 64-bit Windows; zipped with their sources and validated.
 """
 from __future__ import annotations
 
@@ -46,7 +45,7 @@ class NoCompiler(RuntimeError):
 
 
 def c_compiler() -> str | None:
-    """The C compiler to use: $CC if set (and found), else cc or gcc; None if there is none."""
+    """$CC if set (and found), else cc or gcc; None if there is none."""
     if os.environ.get("CC"):
         return shutil.which(os.environ["CC"])
     return shutil.which("cc") or shutil.which("gcc")
@@ -60,8 +59,8 @@ def sources(name: str, fmi: int = 2) -> list[Path]:
 
 
 def build_c(name: str, dest: Path | None = None, fmi: int = 2) -> Path:
-    """Compile the C FMU ``name`` as FMI ``fmi`` into dest/name.fmu (default: ``FMU_DIRS``)
-    for this platform and, with mingw-w64, 64-bit Windows; validated; its path."""
+    """The C FMU ``name`` built as FMI ``fmi`` into dest/name.fmu (default: ``FMU_DIRS``);
+    NoCompiler without a compiler."""
     import fmpy
     if (compiler := c_compiler()) is None:
         raise NoCompiler(f"no C compiler found (set CC, or install gcc): {name}.fmu, an "

@@ -5,11 +5,8 @@
     python -m fmukit.build ship                     # only some
     python -m fmukit.build my_autopilot.py --out DIR   # your script -> DIR/<model_name>.fmu
 
-The same scripts give FMI 2.0 and 3.0 FMUs. The C FMU needs a C compiler (else it is
-skipped, with a note). A script's FMU carries what it imports of fmukit and what --include
-names, and is written beside the script (FMI 3.0: in its folder fmi3) unless --out says
-where; a script that does not parse, imports a module of your own without --include, or
-exits when imported is refused with one message. See docs/own_autopilot.md.
+The C FMU needs a C compiler (else it is skipped, with a note). A script's FMU carries what
+it imports of fmukit and what --include names. See docs/own_autopilot.md.
 """
 from __future__ import annotations
 
@@ -63,8 +60,8 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _build_script(script: Path, includes: list[Path], out: Path | None, fmi: int) -> Path:
-    """A user's script built as FMI ``fmi`` into ``out`` (default: its folder, for FMI 3.0
-    its folder fmi3); ValueError naming what is missing, what it would not carry, its exit."""
+    """A user's script built into ``out``; ValueError naming what is missing, what it would
+    not carry, or its exit."""
     if not script.is_file():
         raise ValueError(f"{script} does not exist")
     for include in includes:
@@ -86,9 +83,8 @@ def _build_script(script: Path, includes: list[Path], out: Path | None, fmi: int
 
 
 def _uncarried(script: Path, includes: list[Path]) -> str | None:
-    """What to do about the modules ``script`` or ``includes`` import (outside a try catching
-    ImportError) that a host would not have: not fmukit, included, standard, or installed here
-    (this checkout and the local folders do not count); None if there is none."""
+    """What to do about the modules ``script`` or ``includes`` import unconditionally that a
+    host would lack (not included, standard, or installed here), or None."""
     provided = {"fmukit", *(p.stem if p.is_file() else p.name for p in includes)}
     local = [script.resolve().parent, Path.cwd().resolve(), ROOT,
              *(p.resolve().parent for p in includes)]
@@ -124,7 +120,6 @@ def _uncarried(script: Path, includes: list[Path]) -> str | None:
 
 
 def _shown(path: Path) -> str:
-    """A path as a command typed here takes it: relative where it lies inside this folder."""
     absolute = Path(path).resolve()
     return os.path.relpath(absolute) if Path.cwd().resolve() in absolute.parents else str(absolute)
 

@@ -1,6 +1,5 @@
 """FMI cross-check reference files of every Python FMU and its FMI 3.0 twin (docs/interop.md),
-simulated by fmpy apart from this checkout; committed, replayed by tests/test_crosscheck.py.
-Regenerate them, saying why in the commit, only when results change.
+simulated by fmpy; regenerate them, saying why in the commit, only when results change.
 
     python -m fmubuild.crosscheck            # both versions: fmus/crosscheck/2.0/..., 3.0/...
     python -m fmubuild.crosscheck --fmi 3    # only the FMI 3.0 twins (fmus/fmi3/)
@@ -56,14 +55,13 @@ CASES = {
 
 
 def files(name: str, fmi: int = 2) -> dict[str, Path]:
-    """The cross-check folder of FMU ``name``'s FMI ``fmi`` (2 or 3) twin and its files."""
+    """The cross-check folder of FMU ``name``'s FMI ``fmi`` twin and its files."""
     folder = CROSSCHECK_DIRS[fmi] / name
     return {"dir": folder, "fmu": folder / f"{name}.fmu", "in": folder / f"{name}_in.csv",
             "ref": folder / f"{name}_ref.csv", "opt": folder / f"{name}_ref.opt"}
 
 
 def read_opt(path: Path) -> dict[str, float]:
-    """The key, value pairs of a _ref.opt file."""
     pairs = (line.split(",", 1) for line in path.read_text().splitlines() if "," in line)
     return {key.strip(): float(value) for key, value in pairs}
 

@@ -1,6 +1,5 @@
-"""What an FMU says of itself, derived from its entries alone (the same sources give the same
-bytes): the generation tool and the identity the model does not declare, its page (its
-sources' docstrings, every variable, what a host needs, an example with fmpy) and its icon.
+"""What an FMU says of itself, derived from its entries alone (the same sources, the same
+bytes): generation tool and identity in its model description, its page and its icon.
 """
 from __future__ import annotations
 
@@ -56,8 +55,7 @@ def describe(entries: Mapping[str, bytes], generation_tool: str, identity: Mappi
              overview: str, sources: Mapping[str, str],
              hosts: Mapping[str, str]) -> dict[str, bytes]:
     """``entries`` with the model description's ``generation_tool`` and ``identity``, the
-    page (``overview``: the model's docstring; ``sources``: module: docstring; ``hosts``:
-    platform: what a host needs, in HTML, {python} this project's Pythons) and the icon."""
+    page (``sources``: module: docstring; ``hosts``: platform: HTML) and the icon."""
     root = fromstring(entries["modelDescription.xml"])
     root.set("generationTool", generation_tool)
     root.attrib.pop("generationDateAndTime", None)       # the same sources, the same bytes
@@ -118,8 +116,6 @@ def index_html(model: ModelDescription, overview: str, sources: Mapping[str, str
 
 def _variables(variables: list[ModelVariable], columns: tuple[str, ...],
                feedthrough: Mapping[str, list[str]] | None = None) -> str:
-    """A table of ``variables``: name, type, unit, ``columns`` and meaning; for outputs
-    (``feedthrough``), the inputs each depends on at once."""
     if not variables:
         return "<p>None.</p>"
     heads = ["name", "type", "unit", *("default" if c == "start" else c for c in columns),
@@ -136,8 +132,7 @@ def _variables(variables: list[ModelVariable], columns: tuple[str, ...],
 
 
 def _example(model: ModelDescription, inputs: list[ModelVariable]) -> str:
-    """fmpy's command line and Python running the FMU alone, its first input that starts
-    at 0 held at 0.1 instead (clipped to its range)."""
+    """fmpy running the FMU alone, its first input that starts at 0 held at 0.1 instead."""
     name = model.modelName
     held = next((v for v in inputs if v.type in ("Real", "Float64")
                  and float(v.start or 1) == 0), None)
@@ -170,8 +165,8 @@ def _inline(text: str) -> str:
 
 
 def model_png(model: ModelDescription) -> bytes:
-    """model.png of ``model``: a vessel (outputs x, y, psi) as CyberShip II's waterline to
-    scale, any other model as a block with its ports; no software or time in the file."""
+    """model.png: a vessel (outputs x, y, psi) as CyberShip II's waterline to scale, any
+    other model as a block with its ports."""
     inputs, outputs = ([v.name for v in model.modelVariables if v.causality == c]
                        for c in ("input", "output"))
     name = model.modelName

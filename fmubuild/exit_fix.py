@@ -1,10 +1,7 @@
-"""A fix for pythonfmu's Linux binaries, which corrupt their host's heap at process exit:
-pythonfmu 0.7.0's and pythonfmu3 0.3.4's keep their Python state in a global
-``std::shared_ptr<PyState>``, which its static destructor frees at exit, after which
-``onLibraryUnload`` (``.fini_array``) assigns to the dead pointer, corrupting malloc's free
-lists (an intermittent SIGABRT of every host that loaded an FMU). The destructor already
-shuts Python down, so ``onLibraryUnload`` becomes a plain return, in a binary the adapter
-knows by SHA-256 (``KNOWN_BINARIES`` of its ``binary``); any other fails the build.
+"""A fix for pythonfmu's Linux binaries: their static destructor frees the global
+``shared_ptr<PyState>`` at exit, then ``onLibraryUnload`` assigns to the dead pointer (an
+intermittent SIGABRT of every host). The destructor already shuts Python down, so
+``onLibraryUnload`` becomes a plain return, in a binary the adapter knows by SHA-256.
 """
 from __future__ import annotations
 
@@ -16,7 +13,7 @@ from .routes import ROUTES
 
 def patch(binary: bytes, where: str, fmi: int = 2) -> bytes:
     """The binary with ``onLibraryUnload`` made a no-op; RuntimeError naming ``where`` if
-    it is not the binary of FMI ``fmi``'s pythonfmu that fmukit knows."""
+    fmukit does not know it."""
     route, digest = ROUTES[fmi], hashlib.sha256(binary).hexdigest()
     fix = importlib.import_module(f"{route.adapter}.binary").KNOWN_BINARIES.get(digest)
     if fix is None:

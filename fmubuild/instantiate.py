@@ -1,6 +1,5 @@
 """An FMU instantiated once with fmpy in a child process, since pythonfmu's C++ takes its
-host down when the script fails to import; ``isolated`` leaves this checkout off the child's
-path, as on a host that has only the FMU.
+host down when the script fails to import.
 """
 from __future__ import annotations
 
@@ -46,8 +45,8 @@ def _last_lines(text: str | bytes | None) -> list[str]:
 
 
 def instantiate_in_child(fmu: str | Path, isolated: bool = False, timeout: float = 120.0) -> None:
-    """Instantiate and free ``fmu`` in a child process; InstantiationFailed if that fails,
-    or if it has not ended after ``timeout`` seconds (the child is killed then)."""
+    """Instantiate and free ``fmu`` in a child process (``isolated``: without this checkout,
+    as on a host); InstantiationFailed if that fails or outlasts ``timeout`` (s)."""
     fmu = Path(fmu).resolve()
     with tempfile.TemporaryDirectory() as elsewhere:
         try:

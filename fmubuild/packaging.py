@@ -1,8 +1,5 @@
-"""A slave script written with fmukit built into an FMU that carries exactly its model (the
-script, what it imports of fmukit and this project, the ``--include``s), reproducibly. A
-package whose __init__.py holds only a docstring is carried as a namespace package: a
-non-Python host runs all its Python FMUs in one interpreter, where the first FMU to import a
-package would otherwise own it.
+"""A slave script built into an FMU that carries exactly its model (the script, what it
+imports of fmukit and this project, the ``--include``s), reproducibly.
 """
 from __future__ import annotations
 
@@ -42,9 +39,9 @@ def build(name: str, dest: Path | None = None, fmi: int = 2) -> Path:
 
 def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
                  identity: Mapping[str, str] | None = None, fmi: int = 2) -> Path:
-    """The slave in ``script`` built as FMI ``fmi`` into ``dest`` (a .fmu, or a folder);
-    ``packages``: project package names (carried as imported) and paths (carried whole).
-    ValueError naming the script if it cannot be built; RuntimeError if invalid."""
+    """The slave in ``script`` built into ``dest`` (a .fmu, or a folder); ``packages``:
+    package names (carried as imported) and paths (carried whole). ValueError naming the
+    script if it cannot be built; RuntimeError if invalid."""
     route, script, dest = ROUTES[fmi], Path(script), Path(dest)
     adapter = importlib.import_module(route.adapter)
     if not adapter.ACTIVE:
@@ -69,7 +66,7 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
                     module = ".".join(relative.with_suffix("").parts)
                     staged[module.removesuffix(".__init__")] = stage / relative
         # pythonfmu imports the script by its name: not a module of that name imported before
-        shadowed = sys.modules.pop(script.stem, None)
+        sys.modules.pop(script.stem, None)
         try:
             sys.path.insert(0, str(stage))
             slave = _slave_class(script.stem)
@@ -83,7 +80,8 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
             for module, found in needed_modules([script, entry], project).items():
                 if found.name != "__init__.py" or not all(
                         isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant)
-                        for node in parsed(found).body):        # not only a docstring
+                        for node in parsed(found).body):  # else a namespace package: a
+                    # host runs its FMUs in one interpreter, where the first would own it
                     staged[module] = _copy(found, stage / found.relative_to(ROOT))
             modules = {m: _carried(path, stage) for m, path in sorted(staged.items())}
             manifest = Manifest(model_name, slave_module, slave.__name__, modules,
@@ -101,9 +99,6 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
             why = str(error).replace(str(stage / script.name), str(script))
             raise ValueError(f"cannot build an FMU from {script}: "
                              f"{type(error).__name__}: {why}") from error
-        finally:
-            if shadowed is not None:
-                sys.modules[script.stem] = shadowed
         fmu = dest if dest.suffix == ".fmu" else dest / Path(built).name
         with zipfile.ZipFile(built) as package:     # the Linux binary with its exit fixed
             entries = {name: exit_fix.patch(package.read(name), f"{fmu}:{name}", fmi)
@@ -127,9 +122,8 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
 
 
 def write_fmu(fmu: Path, entries: Mapping[str, bytes], derive_guid: bool = False) -> Path:
-    """``fmu`` written whole and reproducibly (in name order, fixed times and modes) from
-    ``entries`` (name: bytes), and validated by fmpy; with ``derive_guid``, its GUID (FMI 3.0:
-    instantiation token) derived from its contents."""
+    """``fmu`` written reproducibly from ``entries`` (name: bytes), validated by fmpy; with
+    ``derive_guid``, its GUID (instantiation token) derived from its contents."""
     from fmpy.validation import validate_fmu
     if derive_guid:
         blank = {**entries, "modelDescription.xml": _GUID.sub(
@@ -181,9 +175,8 @@ def needed_modules(scripts: Iterable[Path], packages: Iterable[str]) -> dict[str
 
 
 def imports(path: Path, package: str = "") -> Iterator[tuple[str, bool]]:
-    """(module, optional) for each import in ``path``, a module of ``package`` (a script's
-    relative imports are left out): for ``from a import b``, a and a.b (b may be a module);
-    optional if inside a try that catches ImportError."""
+    """(module, optional) for each import in ``path``, a module of ``package``: for ``from a
+    import b``, a and a.b; optional if inside a try that catches ImportError."""
     tree = parsed(path)
     optional = {id(node) for block in ast.walk(tree) if isinstance(block, ast.Try)
                 and any(handler.type is None or _IMPORT_ERRORS & {
@@ -201,8 +194,7 @@ def imports(path: Path, package: str = "") -> Iterator[tuple[str, bool]]:
 
 
 def parsed(path: Path) -> ast.Module:
-    """The syntax tree of ``path``; ValueError naming the file and line, with the line and a
-    caret under the error."""
+    """The syntax tree of ``path``; ValueError naming the file and line, with a caret."""
     try:
         return ast.parse(path.read_bytes(), str(path))
     except SyntaxError as error:
@@ -212,8 +204,7 @@ def parsed(path: Path) -> ast.Module:
 
 
 def _slave_class(module_name: str) -> type:
-    """The script's ModelSlave subclass with the longest MRO (as pythonfmu chooses);
-    ValueError if there is none, or no single one."""
+    """The script's ModelSlave subclass with the longest MRO (as pythonfmu chooses)."""
     module = importlib.import_module(module_name)
     model_slave = importlib.import_module("fmukit.slave").ModelSlave   # the script's fmukit
     classes = [c for _, c in inspect.getmembers(module, inspect.isclass)
@@ -240,14 +231,14 @@ def _carried(file: Path, stage: Path) -> dict[str, str]:      # its entry in the
 
 @contextlib.contextmanager
 def _imports_undone() -> Iterator[None]:
-    """sys.path restored, and the modules building imported from temporary folders, gone
-    since, forgotten: the next build or in-process run finds no stale module."""
-    path, modules = list(sys.path), set(sys.modules)
+    """sys.path and earlier modules restored; modules from the build's folders forgotten."""
+    path, modules = list(sys.path), dict(sys.modules)
     try:
         yield
     finally:
         sys.path[:] = path
-        for name in set(sys.modules) - modules:
+        for name in sys.modules.keys() - modules.keys():
             file = getattr(sys.modules[name], "__file__", None)
             if file and not os.path.exists(file):
                 del sys.modules[name]
+        sys.modules.update(modules)

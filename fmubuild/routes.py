@@ -1,7 +1,5 @@
-"""The FMI versions fmubuild builds, each by the one pythonfmu version its fmukit adapter
-knows, and the entry module written into each FMU (``<model_name>_fmi<N>.py``, named in
-``slavemodule.txt``): the slave class composed with the adapter's mixin and pythonfmu's
-slave class, as ``fmukit.compose.fmu_class`` does in code.
+"""The FMI versions fmubuild builds, each by the one pythonfmu version its adapter knows, and
+the entry module written into each FMU: the slave class composed as ``fmukit.compose`` does.
 """
 from __future__ import annotations
 
@@ -54,6 +52,6 @@ ROUTES = {
 
 
 def entry_source(manifest: Manifest) -> str:
-    """The entry module this build writes for ``manifest``'s FMU (``fmukit.manifest.staleness``)."""
+    """The entry module this build writes for ``manifest``'s FMU."""
     module = Path(manifest.modules[manifest.slave_module]["file"]).stem
     return ROUTES[manifest.fmi].entry_source(manifest.model_name, module, manifest.slave_class)

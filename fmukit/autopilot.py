@@ -1,6 +1,5 @@
 """The autopilot port contract: inputs ``psi`` (rad), ``r`` (rad/s), ``psi_d`` (rad); output
-``delta_c`` (rad), positive turning the ship to port. ``cosim.scenarios.autopilot`` checks a
-user's FMU against ``PORTS``; an autopilot written with fmukit declares
+``delta_c`` (rad), positive turning the ship to port. An autopilot written with fmukit declares
 ``variables = (*INPUTS, rudder_command(depends=..., get=...), ...)``.
 """
 from __future__ import annotations
@@ -23,5 +22,4 @@ def rudder_command(depends: tuple[str, ...], get: Callable[[Any], float],
     return Var.output("delta_c", "rad", description, depends=depends, get=get)
 
 
-PORTS = (*INPUTS, rudder_command((), lambda slave: 0.0))
-"""The four ports, in order: what a user's autopilot must have."""
+PORTS = (*INPUTS, rudder_command((), lambda slave: 0.0))    # what a user's autopilot must have

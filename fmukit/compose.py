@@ -1,6 +1,5 @@
 """An FMU's class composed in code, as its entry module defines it, for a host that runs the
-model in its own process: the slave logs to ``log_queue`` only; the host uses ``registry``
-(FMI 3.0's value references are FMI 2.0's plus one), ``plans`` and ``fmukit.entry.unguarded``.
+model in its own process (it uses ``registry``, ``plans`` and ``fmukit.entry.unguarded``).
 """
 from __future__ import annotations
 
@@ -9,8 +8,7 @@ import importlib
 
 from .slave import ModelSlave
 
-ADAPTERS = {2: "fmukit.pythonfmu07.slave", 3: "fmukit.pythonfmu3_03.slave"}
-"""FMI version: the adapter module that defines ``Fmi<version>Entry`` and ``Fmi<version>Slave``."""
+ADAPTERS = {2: "fmukit.pythonfmu07.slave", 3: "fmukit.pythonfmu3_03.slave"}   # FMI version: adapter
 
 
 @functools.cache

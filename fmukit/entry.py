@@ -1,11 +1,6 @@
-"""Every FMI entry point's error path: pythonfmu's made safe (``fmi_entry``), and the error
-told to the user where the host does not hear it (``HostLog``).
-
-Both pythonfmus' C++ layers release the instance, its class and its log queue once per
-exception (a use-after-free that crashes the host later): where the adapter says so
-(``RELEASES_ON_EXCEPTION``) one extra reference is taken on each. pythonfmu 0.7 forwards
-log messages only while the host has debug logging on, pythonfmu3 0.3.4 whatever the host
-asked: ``HostLog`` reads the host's flag in the binary's logger (``binary.KNOWN_BINARIES``).
+"""Every FMI entry point's error path made safe (``fmi_entry``: both pythonfmus' C++ layers
+release the instance, its class and its log queue once per exception), and the error told to
+the user where the host does not hear it (``HostLog``, reading the host's flag in the binary).
 """
 from __future__ import annotations
 
@@ -22,8 +17,8 @@ from .refusals import Refused, explain, naming
 
 def fmi_entry(method: Callable | None = None, *,
               error_result: Callable[[], Any] | None = None) -> Callable:
-    """``method`` made safe, a refusal logged under its category (``fmukit.<cause>``); with
-    ``error_result`` (FMI 3.0's doStep) it returns ``error_result()`` instead of raising."""
+    """``method`` made safe, a refusal logged as ``fmukit.<cause>``; with ``error_result``
+    (FMI 3.0's doStep) it returns ``error_result()`` instead of raising."""
     if method is None:
         return functools.partial(fmi_entry, error_result=error_result)
 
@@ -50,15 +45,13 @@ def fmi_entry(method: Callable | None = None, *,
 
 
 def unguarded(entry_point: Callable) -> Callable:
-    """The bound method behind an ``fmi_entry``: for a host in the same process, which
-    handles exceptions itself (pythonfmu's C++ layer is not there)."""
+    """The bound method behind an ``fmi_entry``, for a host in this process."""
     return entry_point.__func__.__wrapped__.__get__(entry_point.__self__)
 
 
 @dataclass(frozen=True)
 class Binary:
     """A pythonfmu binary fmukit knows inside out."""
-
     offset: int                 # file offset of onLibraryUnload
     code: bytes                 # its first instructions
     patched: bytes              # what they become (fmubuild.exit_fix)
@@ -68,9 +61,8 @@ class Binary:
 
 
 class HostLog:
-    """Where an FMU's errors reach its user, from pythonfmu's keywords: the host's logger
-    (by its flag where found in a known binary, else if ``unknown``; always without a
-    ``logger``: a host in this process), else standard error, never both."""
+    """Where an FMU's errors reach its user: the host's logger (by its flag in a known
+    binary, else if ``unknown``; always in this process), else standard error, never both."""
 
     def __init__(self, kwargs: dict[str, Any], known_binaries: dict[str, Binary],
                  unknown: bool):
@@ -87,13 +79,11 @@ class HostLog:
 
     def hears(self) -> bool:
         """Whether the host receives this FMU's log messages now."""
-        if self._in_process:
-            return True
-        return bool(self._flag.value) if self._flag is not None else self._unknown
+        return self._in_process or (bool(self._flag.value) if self._flag is not None
+                                    else self._unknown)
 
     def tell(self, instance_name: str, message: str) -> None:
-        """Write an error to standard error if the host will not hear it; once, not again
-        for each following call that fails for the same reason."""
+        """Write an error to standard error if the host will not hear it, once per reason."""
         if not self.hears() and message != self._told:
             sys.stderr.write(naming(instance_name, message) + "\n")   # one write: hosts
             sys.stderr.flush()                              # step FMUs in parallel threads
@@ -101,7 +91,6 @@ class HostLog:
 
 
 def _sha256(path: Path) -> str | None:
-    """The file's SHA-256, None if it cannot be read."""
     try:
         return hashlib.sha256(path.read_bytes()).hexdigest()
     except OSError:

@@ -1,11 +1,6 @@
-"""Ctrl-C while an FMU computes: the host's signal handler runs in the host's code, not ours.
-
-In FMU code a KeyboardInterrupt would fail the FMU or escape to pythonfmu's C++ layer (which
-loses it and releases the instance once too often). So ``defer_host_handlers`` wraps the
-host's Python handlers of SIGINT and SIGTERM (but one with a true ``safe_in_fmu_code``): a
-signal that arrives in FMU code is signalled again each millisecond until the main thread
-runs host code. In a host that is not Python (pythonfmu started the interpreter in a thread
-of its own), SIGINT gets its default action back.
+"""Ctrl-C while an FMU computes: the host's signal handler runs in the host's code, not ours
+(in FMU code a KeyboardInterrupt would escape to pythonfmu's C++ layer, which loses it and
+releases the instance once too often): the signal is raised again until the host's code runs.
 """
 from __future__ import annotations
 
@@ -16,6 +11,7 @@ import signal
 import sys
 import threading
 import time
+import traceback
 from types import FrameType
 from typing import Callable
 
@@ -26,13 +22,8 @@ _pending: set[signal.Signals] = set()   # arrived while FMU code ran; not yet ha
 
 
 def _in_fmu_code(frame: FrameType | None) -> bool:
-    """Whether ``frame`` runs inside an FMI entry point of a ModelSlave."""
-    while frame is not None:
-        code = frame.f_code
-        if code.co_name == "entry" and code.co_filename == _ENTRY_FILE:
-            return True
-        frame = frame.f_back
-    return False
+    return frame is not None and any(f.f_code.co_name == "entry" and f.f_code.co_filename
+                                     == _ENTRY_FILE for f, _ in traceback.walk_stack(frame))
 
 
 class _DeferringHandler:
@@ -62,8 +53,8 @@ def _signal_again() -> None:
 
 
 def defer_host_handlers() -> None:
-    """Wrap the host's Python handlers (see the module docstring), or in a host that is
-    not Python, give SIGINT its default action back."""
+    """Wrap the host's Python handlers of SIGINT and SIGTERM (not one with a true
+    ``safe_in_fmu_code``); in a host that is not Python, give SIGINT its default action back."""
     if not sys.orig_argv:                     # Python embedded by pythonfmu itself
         _restore_default_sigint()
     elif threading.current_thread() is threading.main_thread():
@@ -75,10 +66,8 @@ def defer_host_handlers() -> None:
 
 
 def _restore_default_sigint() -> None:
-    """Undo Python's start-up SIGINT handler at the operating-system level (Python's own
-    record of it stays as it was), in the C library whose ``signal`` installed it: the
-    Universal CRT on Windows (``msvcrt.dll`` has a signal table of its own), elsewhere the
-    process's."""
+    """Undo Python's start-up SIGINT handler in the C library that installed it (Windows: the
+    Universal CRT, not msvcrt.dll); Python's own record of it stays."""
     if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
         libc = ctypes.CDLL("ucrtbase") if sys.platform == "win32" else ctypes.CDLL(None)
         libc.signal.argtypes = (ctypes.c_int, ctypes.c_void_p)

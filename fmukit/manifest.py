@@ -1,7 +1,6 @@
-"""What an FMU built with fmukit carries about itself, ``resources/fmukit_manifest.json``
-(written by ``fmubuild``; no time, path or machine, so the same sources give the same
-manifest), and whether it is current here. Format 1 (before FMI 3.0) has no entry module;
-it is read so that ``staleness`` can say to rebuild.
+"""What an FMU built with fmukit carries about itself (no time, path or machine: the same
+sources, the same manifest), and whether it is current here. Format 1 (before FMI 3.0) is
+read so that ``staleness`` can say to rebuild.
 """
 from __future__ import annotations
 
@@ -16,8 +15,7 @@ from typing import Callable
 
 MANIFEST = "resources/fmukit_manifest.json"
 FORMAT = 2
-DISTRIBUTION = "ship-autopilot-cosim"
-"""The distribution fmukit is part of: its version is fmukit's."""
+DISTRIBUTION = "ship-autopilot-cosim"      # its version is fmukit's
 
 
 @dataclass(frozen=True)
@@ -43,7 +41,6 @@ class Manifest:
 
 
 def version() -> str:
-    """fmukit's version: its installed distribution's."""
     return metadata.version(DISTRIBUTION)
 
 
@@ -58,8 +55,7 @@ def digest_of(modules: dict[str, str]) -> str:
 
 
 def read(fmu: str | Path) -> Manifest | None:
-    """The manifest of an FMU, None if it has none (not built with fmukit); ValueError
-    naming the file if it cannot be read."""
+    """The manifest of an FMU, None if it has none; ValueError naming the file if unreadable."""
     with zipfile.ZipFile(fmu) as package:
         if MANIFEST not in package.namelist():
             return None
@@ -77,10 +73,8 @@ def read(fmu: str | Path) -> Manifest | None:
 
 def staleness(manifest: Manifest,
               entry_source: Callable[[Manifest], str] | None = None) -> str | None:
-    """Why the FMU is not current in this process, or None: built by another fmukit, or a
-    module it carries is not importable here or has another source; with ``entry_source``
-    (``fmubuild.manifest.entry_source``), also its entry module is not the one the build
-    writes."""
+    """Why the FMU is not current in this process (another fmukit, a module it carries
+    missing or changed, with ``entry_source`` its entry module changed), or None."""
     if manifest.version != version():
         return (f"it was built by fmukit {manifest.version or 'of an older version'}, this "
                 f"is fmukit {version()} (rebuild it)")

@@ -7,8 +7,7 @@ import math
 
 from .refusals import Refused
 
-MAX_SUBSTEPS = 100_000
-"""Most integration steps one communication step may take."""
+MAX_SUBSTEPS = 100_000     # integration steps one communication step may take
 
 
 def wrap(angle: float) -> float:
@@ -26,7 +25,7 @@ def require_finite(**values: float) -> None:
 
 def substeps(h: float, h_max: float, what: str) -> int:
     """Equal integration steps that cut a communication step h into pieces <= h_max;
-    ``what`` names them in the error ("of at most h_max = 0.1 s")."""
+    ``what`` names them in the error."""
     n = max(1, math.ceil(h / h_max - 1e-9))
     if n > MAX_SUBSTEPS:
         raise ValueError(f"a communication step of {h} s needs {n} RK4 steps {what}; "

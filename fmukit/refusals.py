@@ -1,8 +1,5 @@
-"""``Refused``: how an FMU refuses a call, with a message and its cause as data.
-
-The cause reaches the host as the log category ``fmukit.<cause>``, so a host tells a bad
-parameter from a NaN input without reading the message. An exception of the model's own
-code is located at its innermost frame in the user's code (``explain``).
+"""``Refused``: how an FMU refuses a call, with a message and its cause as data (the log
+category ``fmukit.<cause>``: a host tells a bad parameter from a NaN input without reading).
 """
 from __future__ import annotations
 
@@ -21,7 +18,6 @@ CAUSES = {
     "model": "the model raised an exception",
     "interrupted": "a signal (Ctrl-C, SIGTERM) arrived while the FMU computed",
 }
-"""Every cause, and what it means: the LogCategories ``fmukit.<cause>``."""
 
 
 class Refused(ValueError):
@@ -35,14 +31,12 @@ class Refused(ValueError):
 
     @property
     def category(self) -> str:
-        """The log category the host reads the cause from."""
-        return f"fmukit.{self.cause}"
+            return f"fmukit.{self.cause}"
 
 
 def explain(error: BaseException) -> str:
-    """A refusal's message, or where the model's exception was raised, its type and message
-    ('my_autopilot.py:42 in step: ZeroDivisionError: float division by zero'): the innermost
-    frame in the user's code (else of all), its file relative to its folder on sys.path."""
+    """A refusal's message, or the model's exception located at its innermost frame in the
+    user's code ('my_autopilot.py:42 in step: ZeroDivisionError: float division by zero')."""
     if isinstance(error, Refused):
         return str(error)
     frames = traceback.extract_tb(error.__traceback__)
@@ -57,8 +51,7 @@ def explain(error: BaseException) -> str:
 
 @functools.cache
 def _not_users() -> tuple[Path, ...]:
-    """Folders of code that is not the user's: the standard library, the installed
-    packages (numpy, pythonfmu) and fmukit itself."""
+    """Folders of code not the user's: the standard library, installed packages, fmukit."""
     paths = sysconfig.get_paths()
     return (*{Path(paths[k]).resolve() for k in ("stdlib", "platstdlib", "purelib", "platlib")},
             Path(__file__).resolve().parent)
@@ -70,6 +63,5 @@ def _users(filename: str) -> bool:
 
 
 def naming(instance_name: str, text: str) -> str:
-    """A message as it leaves the FMU: naming the FMU, for hosts whose logs do not
-    (libcosim's shows neither the instance nor the call; standard error nothing)."""
+    """A message as it leaves the FMU, naming it (libcosim's log and standard error do not)."""
     return f"{instance_name}: {text}"

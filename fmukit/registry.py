@@ -1,12 +1,11 @@
-"""A slave's variables by value reference: registered with pythonfmu (through the adapter's
-``fmi_variable``), and plans reading or setting a list of them, made once per list (a master
-asks for the same lists at every step). A plan gives what the FMI call gives in every state
-of the slave (NaN once it has failed), so a host in the same process may call it itself; a
-list no plan serves gets ``None`` (pythonfmu serves it). Model attributes are read with one
-``operator.attrgetter``, other values within one ``try``, else one by one as pythonfmu does.
+"""A slave's variables by value reference, registered with pythonfmu, and plans reading or
+setting a list of them, made once per list (a master asks for the same lists at every step).
+A plan gives what the FMI call gives in every state of the slave, so a host in this process
+may call it; a list no plan serves gets ``None`` (pythonfmu serves it).
 """
 from __future__ import annotations
 
+import functools
 import math
 import operator
 from typing import Any, Callable
@@ -28,10 +27,8 @@ class Registry:
         for var in variables:
             getter = None
             if var.causality == "output":
-                get = var.get or (lambda s, name=var.name: getattr(s._model, name))
-
-                def getter(get=get, undefined=math.nan if var.is_real else 0) -> Any:
-                    return evaluate(get, undefined)
+                get = var.get or (lambda s, name=var.name: getattr(s.model, name))
+                getter = functools.partial(evaluate, get, math.nan if var.is_real else 0)
             else:
                 setattr(slave, var.name, var.start)
             sv = slave.fmi_variable(var, getter)
@@ -43,7 +40,6 @@ class Registry:
         return self._planned(float, vrs)
 
     def integer_reader(self, vrs: list[int]) -> Reader | None:
-        """The plan reading these Integers, or None if one is not an Integer."""
         return self._planned(int, vrs)
 
     def input_writer(self, vrs: list[int]) -> Writer | None:
@@ -51,14 +47,11 @@ class Registry:
         return self._planned(None, vrs)
 
     def _planned(self, kind: type | None, vrs: list[int]) -> Reader | Writer | None:
-        """The plan reading ``kind`` (None: writing), compiled the first time."""
         key = (kind, *vrs)
-        try:
-            return self._plans[key]
-        except KeyError:
-            plan = self._plans[key] = (self._writer(key[1:]) if kind is None
-                                       else self._reader(key[1:], kind))
-            return plan
+        if key not in self._plans:
+            self._plans[key] = (self._writer(key[1:]) if kind is None
+                                else self._reader(key[1:], kind))
+        return self._plans[key]
 
     def _reader(self, vrs: tuple[int, ...], kind: type) -> Reader | None:
         slave, by_vr = self._slave, self.by_vr
@@ -79,8 +72,6 @@ class Registry:
                     if gets is None:
                         values = attributes(model)            # one C-level call
                         return [values] if single else list(values)
-                    if single:
-                        return [kind(gets[0](slave))]
                     return [kind(get(slave)) for get in gets]
                 except (ValueError, ArithmeticError):
                     pass

@@ -1,14 +1,6 @@
-"""``ModelSlave``: the base of every FMU in this project, the same for FMI 2.0 and FMI 3.0,
-and its FMI call sequence. An FMU class lists its ``variables`` and supplies ``build_model``
-(from the parameters alone), ``step_model`` and, if the initial state depends on inputs,
-``start_model``; the model supplies ``snapshot``/``restore``. The adapter's mixin adds the
-FMI version and pythonfmu (``fmukit.compose``).
-
-Refusals (docs/robustness.md): invalid parameters are reported at exitInitializationMode
-(libcosim ends its process if that call fails) and refused at the first doStep; an invalid
-input or step, or the model's exception, fails the FMU: it reads NaN and refuses every step
-with the first reason until reset, so a host that ignores statuses cannot pass the run off
-as results. Calls out of sequence are refused and change nothing.
+"""``ModelSlave``: the base of every FMU here (FMI 2.0 and 3.0) and its FMI call sequence.
+A failed FMU reads NaN and refuses every step with the first reason until reset, so a host
+that ignores statuses cannot pass the run off as results (docs/robustness.md).
 """
 from __future__ import annotations
 
@@ -17,7 +9,7 @@ from dataclasses import dataclass
 from typing import Any, Callable, ClassVar, NoReturn
 
 from . import hostsignals, state
-from .entry import fmi_entry
+from .entry import HostLog, fmi_entry
 from .refusals import CAUSES, Refused, explain, naming
 from .registry import Registry
 from .timebase import MAX_TIME, on_time_base
@@ -26,7 +18,6 @@ from .variables import Var, range_check
 __all__ = ["DefaultExperiment", "ModelSlave", "Refused", "Var"]
 
 CATEGORIES = {f"fmukit.{cause}": f"Refused: {meaning}." for cause, meaning in CAUSES.items()}
-"""The log categories of every refusal's cause, beside pythonfmu's."""
 _AFTER = {"instantiated": "{api}{instantiate} or {api}Reset",
           "initialization": "{api}EnterInitializationMode",
           "step": "{api}ExitInitializationMode", "terminated": "{api}Terminate"}
@@ -35,25 +26,18 @@ _INSTANTIATE = {"fmi2": "Instantiate", "fmi3": "InstantiateCoSimulation"}
 
 class CallSequence:
     """The phase of one FMU instance (instantiated -> initialization -> step -> terminated;
-    reset makes a new slave) and the rules of the standard (``api``: "fmi2" or "fmi3")."""
+    reset makes a new slave) and what the standard allows in it."""
 
     def __init__(self, api: str, phase: str = "instantiated"):
         self.api, self.phase = api, phase
 
     def require(self, call: str, *phases: str) -> None:
-        """Refused naming the call (``Terminate``: fmi2Terminate) and the phase unless the
-        phase is one of ``phases``."""
+        """Refused naming the call and the phase unless the phase is one of ``phases``."""
         if self.phase not in phases:
             after = " or ".join(_AFTER[p].format(api=self.api, instantiate=_INSTANTIATE[self.api])
                                 for p in phases)
             raise Refused(f"{self.api}{call} is not allowed in phase '{self.phase}' (FMI "
                           f"{self.api[3:]}.0 allows it after {after})", "call")
-
-    def require_step(self) -> None:
-        """Refused unless doStep is allowed now."""
-        if self.phase != "step":
-            raise Refused(f"doStep called in phase '{self.phase}': call "
-                          "exitInitializationMode first, and not after terminate", "call")
 
     def check_settable(self, var: Var) -> None:
         """Refused naming ``var`` if the standard forbids setting it now."""
@@ -78,12 +62,15 @@ class DefaultExperiment:
 
 
 class ModelSlave:
-    """Base of every FMU in this project; see the module docstring."""
+    """Base of every FMU: it lists its ``variables`` and supplies ``build_model`` (from the
+    parameters alone), ``step_model`` and, if the initial state depends on inputs,
+    ``start_model``; the model supplies ``snapshot``/``restore``."""
 
     model_name: ClassVar[str]
     variables: ClassVar[tuple[Var, ...]]
     default_experiment = DefaultExperiment(start_time=0.0, stop_time=400.0, step_size=0.1)
-    # The adapter's, with ``_host_log(kwargs)`` and ``fmi_variable(var, output_getter)``:
+    # The adapter's, with ``KNOWN_BINARIES``, ``HEARS_UNKNOWN`` (does the host of another
+    # binary hear?) and ``fmi_variable(var, output_getter)``:
     API: ClassVar[str]
     STATUS_ERROR: ClassVar[Any]
     STATUS_FATAL: ClassVar[Any]
@@ -94,11 +81,10 @@ class ModelSlave:
         self.modelName = self.model_name
         self.log_categories = {**self.log_categories, **CATEGORIES}
         self.sequence = CallSequence(self.API)
-        self.host_log = self._host_log(kwargs)
+        self.host_log = HostLog(kwargs, self.KNOWN_BINARIES, self.HEARS_UNKNOWN)
         self.failure: str | None = None       # why the FMU failed; until reset
         self.failure_cause = "model"          # its cause (fmukit.refusals.CAUSES)
         self.start_time: float | None = 0.0   # of the experiment, for messages (None: unknown)
-        self._step_size = (None, None)        # the last step size given, on the time base
         hostsignals.defer_host_handlers()
         self._model = None
         self._before_variables()
@@ -106,8 +92,8 @@ class ModelSlave:
         self._check_inputs = range_check(tuple(v for v in self.variables
                                                if v.causality == "input"))
 
-    def _before_variables(self) -> None:
-        """What the adapter registers before the declared variables (default: nothing)."""
+    def _before_variables(self) -> None:     # the adapter's, registered first
+        pass
 
     def build_model(self) -> Any:
         """A fresh model from the current parameter attributes."""
@@ -118,8 +104,8 @@ class ModelSlave:
         raise NotImplementedError
 
     def start_model(self, model: Any) -> None:
-        """Set a model's initial state from the inputs at initialisation (default: none);
-        apart from build_model, since restoring a state must not depend on the inputs."""
+        """Set a model's initial state from the inputs (apart from build_model: restoring a
+        state must not depend on them)."""
 
     def _started_model(self) -> Any:
         model = self.build_model()
@@ -134,13 +120,10 @@ class ModelSlave:
         return self._model
 
     def _output(self, get: Callable[[Any], Any], undefined: Any) -> Any:
-        """An output's value, or NaN (0 if Integer) if the FMU has failed or it cannot be
-        evaluated: a read never fails (a failed getReal aborts libcosim)."""
+        """An output's value, else ``undefined``: a read never fails (libcosim aborts)."""
         if self.failure:
             return undefined
         try:
-            if self._model is None:
-                self._model = self._started_model()
             return get(self)
         except (ValueError, ArithmeticError) as error:
             if self.sequence.phase == "step":
@@ -148,8 +131,7 @@ class ModelSlave:
             return undefined
 
     def _unevaluable(self, get: Callable[[Any], Any], error: Exception) -> None:
-        """Fail the FMU for an output it cannot evaluate from valid inputs (else the next
-        doStep names the invalid input)."""
+        """Fail the FMU for an output it cannot evaluate from valid inputs."""
         try:
             self._check_inputs(self)
         except ValueError:
@@ -165,14 +147,12 @@ class ModelSlave:
         self.host_log.tell(self.instance_name, failure)
 
     def _fail(self, reason: str, cause: str, error: BaseException | None = None) -> NoReturn:
-        """Fail the FMU for ``reason`` (its ``cause``): refuse this call and every step."""
         self.failure, self.failure_cause = reason, cause
         raise Refused(reason, cause) from error
 
     def interrupted(self, where: str, error: BaseException) -> Refused:
-        """Fail the FMU for a KeyboardInterrupt (SIGINT), an exception with a ``signal``
-        (``cosim.core.interrupt.Interrupted``) or any BaseException raised in its code
-        during ``where``; the refusal to raise."""
+        """The refusal to raise for a BaseException (Ctrl-C, one with a ``signal``) raised
+        in the FMU's code during ``where``; it fails the FMU."""
         number = getattr(error, "signal",
                          signal.SIGINT if isinstance(error, KeyboardInterrupt) else None)
         if not self.failure:
@@ -209,20 +189,19 @@ class ModelSlave:
         self.sequence.phase = "terminated"
 
     def _step(self, current_time: float, step_size: float) -> None:
-        """One communication step (the adapter's ``do_step``); Refused for every refusal."""
         if self.failure:
             raise Refused(self.failure, self.failure_cause)
-        self.sequence.require_step()          # like any call out of sequence: nothing done
+        if self.sequence.phase != "step":     # like any call out of sequence: nothing done
+            raise Refused(f"doStep called in phase '{self.sequence.phase}': call "
+                          "exitInitializationMode first, and not after terminate", "call")
         if not (0.0 < step_size <= MAX_TIME and abs(current_time) <= MAX_TIME):
             self._fail(f"doStep at t = {current_time} with communication step {step_size}: the "
                        f"step must be positive, and both within +-{MAX_TIME:g} s", "step")
         try:
             self._check_inputs(self)
-            # On the nanosecond time base a step under 0.5 ns (OMSimulator's last) is none.
-            if step_size != self._step_size[0]:
-                self._step_size = (step_size, on_time_base(step_size))
-            if self._step_size[1] > 0.0:
-                self.step_model(on_time_base(current_time), self._step_size[1])
+            h = on_time_base(step_size)       # under 0.5 ns (OMSimulator's last): none
+            if h > 0.0:
+                self.step_model(on_time_base(current_time), h)
         except ValueError as error:
             self._fail(f"doStep at t = {current_time}: {error}; the FMU has failed (its "
                        f"outputs read NaN until {self.API}Reset)",
@@ -233,7 +212,6 @@ class ModelSlave:
             raise self.interrupted(f"doStep at t = {current_time}", error) from None
 
     def _set(self, vrs: list[int], values: list, convert: type) -> None:
-        """Set variables, refusing what the standard does not allow."""
         for vr in vrs:
             if vr not in self.registry.by_vr:
                 raise ValueError(f"no variable has value reference {vr}")
@@ -247,7 +225,6 @@ class ModelSlave:
                 self._model = None
 
     def _set_floats(self, vrs: list[int], values: list[float]) -> None:
-        """Set Reals (the adapter's setReal or setFloat64)."""
         write = self.plans.input_writer(vrs)  # inputs only: always settable until terminate
         if write is None:
             self._set(vrs, values, float)

@@ -1,7 +1,5 @@
-"""Saved FMU states as plain dicts (pythonfmu serialises them as JSON): the phase, every
-registered variable but the outputs (parameters, inputs, FMI 3.0's ``time``), the model's
-``snapshot()`` and the failure, if any. Restoring rebuilds the model from the parameters and
-hands it the snapshot: the run continues bit for bit.
+"""Saved FMU states as plain dicts (pythonfmu serialises them as JSON). Restoring rebuilds
+the model from the parameters and hands it its ``snapshot()``: the run continues bit for bit.
 """
 from __future__ import annotations
 
@@ -10,7 +8,7 @@ from typing import Any
 
 
 def capture(slave: Any) -> dict[str, Any]:
-    """The whole state of a ``ModelSlave``."""
+    """The whole state of a ``ModelSlave``: phase, variables but outputs, model, failure."""
     return {"phase": slave.sequence.phase,
             "values": {v.name: getattr(slave, v.name) for v in slave.vars.values()
                        if v.causality.name != "output"},

@@ -1,15 +1,10 @@
-"""The time base: communication points and steps in whole nanoseconds.
-
-Masters form time differently (libcosim counts nanoseconds, fmpy adds floats), and chaotic
-models amplify the last bits. Every FMU here rounds time and step to whole nanoseconds, and
-the master computes t_k = t_0 + k h in integer nanoseconds: masters that agree to within
-half a nanosecond drive the FMUs bit for bit alike.
+"""The time base: FMUs round time and step to whole nanoseconds and masters compute
+t_k = t_0 + k h in integer nanoseconds, so masters that form time differently (libcosim
+counts nanoseconds, fmpy adds floats) drive the FMUs bit for bit alike.
 """
 NANOSECONDS = 1_000_000_000
-MAX_TIME = 1e15
-"""Largest |t| an FMU accepts, s: 30 million years, and far from overflow in nanoseconds."""
-EXACT_TIME = 2**53 / NANOSECONDS
-"""Largest |t|, s, whose every whole nanosecond a float holds (about 104 days)."""
+MAX_TIME = 1e15                         # s: largest |t| an FMU accepts (30 million years)
+EXACT_TIME = 2**53 / NANOSECONDS        # s: largest |t| whose every nanosecond a float holds
 
 
 def nanoseconds(t: float) -> int:

@@ -1,6 +1,5 @@
-"""``Var``: an FMU variable declared once, the source of its pythonfmu registration, its
-modelDescription.xml entry (``describe``, the same in FMI 2.0 and 3.0) and the range check
-its values must pass; the SI units at the FMU interfaces (``UNITS``).
+"""``Var``: an FMU variable declared once, the source of its registration, its
+modelDescription.xml entry (``describe``) and its range check; the SI units (``UNITS``).
 """
 from __future__ import annotations
 
@@ -29,14 +28,12 @@ UNITS: dict[str, tuple[dict[str, int], float, dict[str, float]]] = {
     "N": ({"kg": 1, "m": 1, "s": -2}, 1.0, {}),
     "N.m": ({"kg": 1, "m": 2, "s": -2}, 1.0, {}),
 }
-DISPLAY_UNIT = {"rad": "deg", "rad/s": "deg/s", "rad/s2": "deg/s2"}
-"""Display unit a variable of this unit shows by default."""
+DISPLAY_UNIT = {"rad": "deg", "rad/s": "deg/s", "rad/s2": "deg/s2"}     # shown by default
 
 
 @dataclass(frozen=True)
 class Var:
     """One FMU variable, declared once. Build it with the class methods."""
-
     name: str
     causality: str                    # "parameter" | "input" | "output"
     unit: str = "1"                   # key of UNITS (Real only)
@@ -95,8 +92,7 @@ class Var:
 
 def range_check(variables: tuple[Var, ...]) -> Callable[[Any], None]:
     """A check of the numeric ``variables`` as attributes of an object, compiled to one
-    expression (ranges clipped to the finite doubles, which no NaN passes); a failure is
-    Refused by ``Var.check``. Every step checks its inputs so."""
+    expression (every step checks its inputs so); a failure is Refused by ``Var.check``."""
     tests = [f"{max(v.min, -sys.float_info.max)!r} <= obj.{v.name} <= "
              f"{min(v.max, sys.float_info.max)!r}" for v in variables]
 
@@ -111,11 +107,9 @@ def range_check(variables: tuple[Var, ...]) -> Callable[[Any], None]:
 
 def describe(root: Element, variables: tuple[Var, ...], typed: list[Element | None],
              reference: dict[str, int]) -> tuple[Element, list[tuple[str, tuple]]]:
-    """Add to a model description ``root`` what pythonfmu leaves out: to each numeric
-    variable's ``typed`` element its start in its shortest exact form, unit, display unit
-    and range, and the <UnitDefinitions>. The emptied <ModelStructure>, and each output's
-    ``reference`` with those it depends on, ordered: while stepping (its inputs: direct
-    feedthrough) and at initialisation (inputs and parameters, and its further knowns)."""
+    """Add to ``root`` what pythonfmu leaves out: exact starts, units and ranges on the
+    ``typed`` elements, and <UnitDefinitions>. The emptied <ModelStructure>, and each output's
+    ``reference`` with those it depends on while stepping and at initialisation."""
     for element, var in zip(typed, variables):
         if var.kind is str:
             continue

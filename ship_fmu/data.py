@@ -1,8 +1,6 @@
 """CyberShip II model data, which the paper cites but does not print: hull from Skjetne,
 Smogeli and Fossen (2004); propellers and rudders from Sveen (2003), as MSS ``initCS2.m``;
 lever arms from Skjetne (2004). Fossen's signs: X_u < 0 is damping."""
-from __future__ import annotations
-
 from dataclasses import dataclass
 
 G = 9.81                        # m/s^2

@@ -1,8 +1,6 @@
 """The 3-DOF manoeuvring model, eqs (1)-(6): eta_dot = R(psi) nu (1)-(2) and
 M nu_dot + C(nu) nu + D(nu) nu = tau (3), eta = [x, y, psi] (north, east, heading),
 nu = [u, v, r]; C(nu) nu and D(nu) nu as force vectors."""
-from __future__ import annotations
-
 import math
 from typing import Callable
 

@@ -1,11 +1,8 @@
-"""The rudder program of a turning circle or a zig-zag test (IMO MSC.137(76)); a positive
-rudder turns the ship to port, so headings go negative first."""
-from __future__ import annotations
-
+"""The rudder program of a turning circle or a zig-zag test (IMO MSC.137(76))."""
 
 class RudderProgram:
-    """Executes ``delta`` at t = 0 and reverses it each time the heading deviation passes
-    -+psi_switch (a zig-zag); psi_switch = 0 holds it (a turning circle)."""
+    """Executes ``delta`` at t = 0 (positive: to port, headings go negative first) and
+    reverses it each time the heading deviation passes -+psi_switch; 0 holds it."""
 
     def __init__(self, delta: float, psi_switch: float):    # the FMU checks both: >= 0
         self.delta, self.psi_switch = delta, psi_switch

@@ -1,8 +1,5 @@
 """Steering gear: the rudder follows the command within +-delta_max at a limited rate, exact
-at any instant (a run does not depend on how a step is cut); 20 deg/s is the IMO full-scale
-rate (about 2.3 deg/s) Froude-scaled to 1:70."""
-from __future__ import annotations
-
+at any instant; 20 deg/s is the IMO rate (2.3 deg/s) Froude-scaled to 1:70."""
 import math
 
 DELTA_MAX = math.radians(35.0)

@@ -1,8 +1,6 @@
 """Propellers, bow thruster and rudders: tau_th = T u, eqs (8)-(13), n in rev/s, delta in rad.
 T's first two rows, which the paper prints as zeros, are Sveen's (2003) and Skjetne's (2004);
 a positive rudder (n > 0) gives r < 0, psi decreasing, as eqs (20), (45) agree."""
-from __future__ import annotations
-
 from typing import Callable
 
 from .data import Actuators

@@ -1,8 +1,6 @@
 """The vessel: CyberShip II hull, actuators, steering gear and waves, by RK4 with the inputs
 held, in equal sub-steps <= h_max, cut where the rudder reaches its command or stop (RK4 keeps
 its order only on smooth pieces, ``cosim.accuracy``). psi is not wrapped."""
-from __future__ import annotations
-
 import math
 from dataclasses import dataclass, fields
 from typing import Callable
@@ -38,8 +36,7 @@ class VesselParameters:
     wave_components: int = 50
     h_max: float = 0.1          # s, largest RK4 step
 
-    def __post_init__(self) -> None:
-        """Raise ValueError naming the first invalid parameter."""
+    def __post_init__(self) -> None:               # ValueError naming the first invalid one
         for f in fields(self):
             value = getattr(self, f.name)
             if not math.isfinite(value):
@@ -73,12 +70,11 @@ class Vessel:
         self._m11_inv = 1.0 / M[0][0]
         self._minv = (M[2][2] / det, -M[1][2] / det, -M[2][1] / det, M[1][1] / det)
         self.waves, self._wave_loads = None, calm_water
+        self._shaft_speeds, self._forces = None, None  # the last shaft speeds, their tau_th
         if params.Hs > 0.0:
             components = WaveComponents.from_spectrum(
                 params.Hs, params.T0, params.wave_components, params.wave_seed)
             self.waves = self._wave_loads = WaveLoads(components, self.hull, params.psi_w)
-        self._h, self._cut = None, (1, 0.0)          # the last step size and its cut
-        self._shaft_speeds, self._forces = None, None  # the last shaft speeds, their tau_th
         self.x, self.y, self.psi = params.x0, params.y0, params.psi0
         self.u, self.v, self.r = params.u0, params.v0, params.r0
         self.delta = self.xi = self.t = 0.0
@@ -93,8 +89,6 @@ class Vessel:
              n1: float = N_PROPELLER, n2: float = N_PROPELLER, n3: float = 0.0) -> None:
         require_finite(delta_c=delta_c, n1=n1, n2=n2, n3=n3)
         p = self.params
-        if h != self._h:                      # the same step, run after run: cut it once
-            self._h, self._cut = h, self._cut_of(h)
         if (n1, n2, n3) != self._shaft_speeds:
             self._shaft_speeds, self._forces = (n1, n2, n3), actuator_model(
                 self.actuators, n1, n2, n3)
@@ -113,7 +107,7 @@ class Vessel:
     def _integrate(self, t: float, start: float, length: float, y: State,
                    gear: RudderMotion) -> State:
         """RK4 over [t + start, t + start + length] in equal sub-steps <= h_max."""
-        n_sub, hs = self._cut if length == self._h else self._cut_of(length)
+        n_sub, hs = self._cut_of(length)
         hh, c = 0.5 * hs, hs / 6.0
         forces, rates = self._forces, self.rates
         for j in range(n_sub):

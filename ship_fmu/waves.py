@@ -30,8 +30,8 @@ def _spectrum_b(T0: float) -> float:
 
 @lru_cache(maxsize=64)
 def _bins(T0: float, n: int) -> tuple[tuple[float, ...], tuple[float, ...]]:
-    """Edges of N equal-variance bins of the spectrum's central BAND: variance fractions F and
-    frequencies omega = (B / -ln F)^(1/4), rad/s, in decimal arithmetic (the same on any CPU)."""
+    """Variance fractions F and frequencies omega = (B / -ln F)^(1/4) (rad/s, decimal) of
+    the edges of N equal-variance bins of the spectrum's central BAND."""
     tail = 0.5 * (1.0 - BAND)
     fractions = np.linspace(tail, 1.0 - tail, n + 1).tolist()
     B = Decimal(_spectrum_b(T0))

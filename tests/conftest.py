@@ -119,6 +119,19 @@ def fmu_cache(tmp_path_factory) -> Iterator[Path]:
         yield folder
 
 
+@pytest.fixture(scope="session")
+def scheduler(fmu_cache) -> Iterator[str]:
+    """The address of one local Dask cluster of two workers, for the tests that only need
+    somewhere to run a sweep (those about clusters and workers make their own)."""
+    from cosim.studies.cluster import local_cluster
+
+    cluster = local_cluster(2)
+    try:
+        yield cluster.scheduler_address
+    finally:
+        cluster.close()
+
+
 def _stale(path: Path) -> bool:
     """Missing, built without a manifest, or not current: a module it carries differs
     from this checkout's."""

@@ -6,6 +6,7 @@ import pytest
 
 from cosim.studies import coupling_error, integration_error
 from cosim.studies.coupling_error import monolithic
+from helpers import command
 
 
 @pytest.fixture(scope="module")
@@ -49,11 +50,9 @@ def test_cosimulation_converges_to_the_monolithic_model_as_the_step_shrinks():
 
 
 def test_the_quick_study_prints_and_writes_its_tables(tmp_path):
-    import subprocess
-    import sys
+    from cosim import accuracy
 
-    child = subprocess.run([sys.executable, "-m", "cosim.accuracy", "--quick", "--out",
-                            str(tmp_path)], capture_output=True, text=True, timeout=600)
+    child = command(accuracy.main, "--quick", "--out", str(tmp_path))
     assert child.returncode == 0, child.stderr
     report = (tmp_path / "accuracy.md").read_text()
     for title in ("Integration error, open loop", "monolithic reference",

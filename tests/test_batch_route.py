@@ -208,9 +208,6 @@ def test_batch_size_is_refused_without_the_batch_backend(capsys):
         command.main(["spec.toml", "--batch-size", "10"])
     assert "--batch-size sizes the batches of --backend batch, not of --backend fmi" in \
         capsys.readouterr().err
-    with pytest.raises(ValueError, match="batch_size is the batch backend's, not the "
-                                         "inprocess backend's"):
-        campaign.execute(None, Path("."), backend="inprocess", batch_size=3)
 
 
 # -- one batch in this process: its members' failures and its own --------------------------
@@ -288,69 +285,35 @@ def test_a_batch_that_fails_as_a_whole_runs_each_member_alone(members, monkeypat
 def test_a_batch_past_its_time_limit_in_the_kernel_stops_and_runs_each_member_alone(
         members, monkeypatch):
     """The kernel asks the watchdog at every step: past the batch's run limit (its runs'
-    limits together) it stops at the next step, and the runs run alone within theirs."""
+    limits together) it stops at the next step, and the runs run alone within theirs. The
+    limits are four times what a run takes here now, so that a busy machine meets them."""
     from cosim.core.watchdog import Limits
     from cosim.ensemble.vessel import VesselArrays
 
     jobs, blobs = members
-    jobs = [dataclasses.replace(job, limits=Limits(run=0.25)) for job in jobs[:2]]
+    started = time.monotonic()
+    sweep_task.run_one(jobs[0], blobs)
+    limit = max(0.25, math.ceil(80 * (time.monotonic() - started)) / 20)     # 0.05 s steps
+    jobs = [dataclasses.replace(job, limits=Limits(run=limit)) for job in jobs[:2]]
     alone = [sweep_task.run_one(job, blobs) for job in jobs]
     assert sweep_task.batch_refusal() is None       # the self-test, before the kernel is slowed
     step, steps = VesselArrays.step, []
 
-    def slow(self, *args):                  # 300 steps of 5 ms: 1.5 s, past 2 x 0.25 s
+    def slow(self, *args):                  # 300 steps: three times the batch's limit
         steps.append(time.monotonic())
-        time.sleep(0.005)
+        time.sleep(6 * limit / 300)
         return step(self, *args)
     monkeypatch.setattr(VesselArrays, "step", slow)
     started = time.monotonic()
     together = sweep_task.run_batch(jobs, blobs)
-    assert steps[-1] - started < 0.5 + 0.1         # stopped at the step after its limit
     assert len(steps) < 300
+    late = [t for t in steps if t - started > 2 * limit]
+    assert len(late) <= 2                           # stopped at the step after its limit
     for ours, theirs in zip(together, alone, strict=True):
         assert_same_row(ours, theirs)
         assert ours["backend"] == (f"{theirs['backend']} (not in a batch: the batch failed, "
-                                   "the run did not end within its time limit of 0.5 s; "
-                                   "run alone)")
-
-
-def test_a_worker_whose_self_test_refuses_runs_its_batches_alone(members, monkeypatch, capsys):
-    jobs, blobs = members
-    monkeypatch.setattr(sweep_task, "batch_refusal", lambda: "numpy rounds otherwise here")
-    rows = sweep_task.run_batch(jobs[:2], blobs)
-    assert [r["backend"] for r in rows] == ["inprocess (not in a batch: the batch route is "
-                                            "refused on this worker: numpy rounds otherwise "
-                                            "here)"] * 2
-    for ours, job in zip(rows, jobs[:2], strict=True):
-        assert_same_row(ours, sweep_task.run_one(job, blobs))
-
-    class Client:                                   # what the client hears from its workers
-        def run(self, function, on_error):
-            return {"tcp://b:2": "numpy rounds otherwise here", "tcp://c:3": None,
-                    "tcp://a:1": "numpy rounds otherwise here"}
-    _say_batch_refusals(Client())
-    assert capsys.readouterr().err == (
-        "note: the batch route is refused on 2 workers (tcp://a:1, tcp://b:2): numpy rounds "
-        "otherwise here; their batches run one run at a time on the in-process route\n")
-
-
-def test_a_batch_of_a_time_that_is_no_whole_step_fails_each_run_as_in_process(members):
-    jobs, blobs = members
-    jobs = [dataclasses.replace(job, stop_time=20.05) for job in jobs[:2]]
-    alone = [sweep_task.run_one(job, blobs) for job in jobs]
-    for ours, theirs in zip(sweep_task.run_batch(jobs, blobs), alone, strict=True):
-        assert_same_row(ours, theirs)
-        assert ours["status"] == "failed" and "whole number" in ours["error"]
-
-
-def test_a_run_in_this_process_is_the_same_as_a_batch_of_one(fmu_paths, tmp_path):
-    spec = Spec.read(write_spec(tmp_path, 'stop_time = 10\n[controllers]\n'
-                                                'smc = "waves_smc"\n[axes]\nwave_seed = [3]\n'))
-    run = spec.runs()[0]
-    alone = campaign.run_locally(spec, run, "batch")
-    assert alone["backend"] == "batch" and alone["status"] == "ok"
-    assert_same_row(alone, campaign.run_locally(spec, run, "inprocess"))
-    sweep_task.free_masters()
+                                   f"the run did not end within its time limit of "
+                                   f"{2 * limit:g} s; run alone)")
 
 
 # -- a batch whose worker dies ---------------------------------------------------------------

@@ -253,7 +253,7 @@ def _check_published(cell: str, value: str) -> None:
         assert abs(float(value) - float(number)) <= float(change), (cell, value)
 
 
-def test_the_spread_of_a_run_is_how_far_a_last_bit_moves_it():
+def test_the_spread_of_a_run_is_how_far_a_last_bit_moves_it(capsys):
     """Calm water amplifies no last bit; the chattering SMC in waves does, within 60 s."""
     from cosim.studies.spread import nudged, spread
 
@@ -264,8 +264,9 @@ def test_the_spread_of_a_run_is_how_far_a_last_bit_moves_it():
     waves = spread(system("waves_smc"), ulps=1, stop_time=60.0)
     assert waves.runs == 5 and max(waves.deviation.values()) > 0.0
     assert all(waves.nominal[f] - waves.deviation[f] > 0.0 for f in ("psi_E", "J"))
-    with pytest.raises(ValueError, match="ulps must be >= 1"):
-        spread(system("calm_pd"), ulps=0)
+    with pytest.raises(SystemExit):
+        cli.main(["calm_pd", "--spread", "0"])
+    assert "--spread takes a number of ulps >= 1, got 0" in capsys.readouterr().err
 
 
 def test_stop_time_and_set_reach_the_fmus(tmp_path):
@@ -395,13 +396,14 @@ def test_fmu_error_mid_run_names_fmu_call_and_time_and_keeps_the_rows(tmp_path, 
     assert len(rows) == 500 and rows[-1].startswith("49.9")
 
 
-def test_streamed_rows_equal_the_in_memory_recording(tmp_path):
+def test_streamed_rows_equal_the_in_memory_recording(tmp_path, monkeypatch):
     """Rows written in chunks as the run goes are the rows a whole recording writes."""
+    monkeypatch.setattr("cosim.core.recording.CHUNK_ROWS", 64)
     master = Master(system("waves_smc"))
     try:
         whole = master.run(30.0)
         master.reset()
-        streamed = master.run(30.0, csv_path=tmp_path / "streamed.csv", chunk_rows=64)
+        streamed = master.run(30.0, csv_path=tmp_path / "streamed.csv")
     finally:
         master.free()
     whole.write_csv(tmp_path / "whole.csv")
@@ -422,4 +424,6 @@ def test_the_overhead_benchmark_runs_and_restores_the_ship(fmu_paths, capsys):
     assert Vessel.step is step
     assert set(per_step) == {"direct", "idle", "inprocess"}
     out = capsys.readouterr().out
-    assert "the in-process master beyond cosim.direct:" in out
+    assert "the in-process master beyond the modules wired by hand:" in out
+    assert re.search(r"on .+ \(family \d+, model \d+, (no )?AVX-512\), \d+ cores, .+; load "
+                     r"average [\d.]+ [\d.]+ [\d.]+", out), out

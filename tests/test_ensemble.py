@@ -160,7 +160,7 @@ def test_a_member_going_non_finite_runs_alone_and_leaves_the_others_bits(monkeyp
 
 
 def test_a_system_the_kernel_does_not_cover_runs_in_process_with_a_note(tmp_path):
-    from cosim.ensemble.members import coverage
+    from cosim.ensemble.reference import coverage
 
     assert coverage(scenarios.load("turning_circle")) is not None
     system = scenarios.load("calm_pd", autopilot=scenarios.SCENARIO_DIR.parent.parent

@@ -197,8 +197,8 @@ def test_simulate_takes_the_version():
 
 
 def test_a_step_that_asks_to_end_the_simulation_fails_the_run(twins, monkeypatch):
-    """FMI 3.0's terminateSimulation, through fmpy's doStep and the master's prepared step
-    (the raw fmi3DoStep): the run cannot go on without that FMU."""
+    """FMI 3.0's terminateSimulation, through ``do_step`` and the master's prepared step
+    (both the raw fmi3DoStep): the run cannot go on without that FMU."""
     def asks_to_end(instance, t, h, no_earlier_state, event, terminate, early, last) -> int:
         terminate._obj.value = True
         return 0                                        # fmi3OK
@@ -208,10 +208,9 @@ def test_a_step_that_asks_to_end_the_simulation_fails_the_run(twins, monkeypatch
     try:
         fmu.initialize()
         with monkeypatch.context() as patch:
-            patch.setattr(fmu.slave, "doStep", lambda t, h: (False, True, False, t + h))
+            patch.setattr(fmu.slave, "dll", SimpleNamespace(fmi3DoStep=asks_to_end))
             with pytest.raises(FmuCallError, match=said):
                 fmu.do_step(0.0, 0.1)
-            patch.setattr(fmu.slave, "dll", SimpleNamespace(fmi3DoStep=asks_to_end))
             step = fmu.stepper()
             with pytest.raises(FmuCallError, match=said):
                 step(0.0, 0.1)

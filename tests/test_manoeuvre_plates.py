@@ -8,20 +8,20 @@ import math
 import numpy as np
 import pytest
 
+from cosim import simulate
+from cosim.analysis.kinds import analysis
 from cosim.analysis.manoeuvres import (ADVANCE_LIMIT, TACTICAL_DIAMETER_LIMIT, Criterion,
                                        TurningCircle, ZigZagResult, fitted_circle,
                                        length_over_speed, overshoot_limits,
                                        turning_circle_criteria, turning_circle_figures,
                                        turning_circle_of, zigzag_criteria, zigzag_figures,
                                        zigzag_of)
-from cosim.analysis.plates import analysis, turning_circle_plate, zigzag_plate
+from cosim.analysis.plates import turning_circle_plate, zigzag_plate
 from cosim.analysis.reports import criterion_text, turning_circle_report, zigzag_report
 from cosim.analysis.seastate import SCALE
 from cosim.core.recording import Recording
 from ship_fmu.data import Hull
 from ship_fmu.manoeuvres import RudderProgram
-from ship_fmu.trial import trial
-from ship_fmu.vessel import VesselParameters
 
 DEG = math.radians(1.0)
 STEP = 0.01                          # s, of the synthetic trajectories
@@ -151,8 +151,8 @@ def test_the_circle_fit_finds_centre_and_diameter():
 def test_the_simulated_steady_turn_is_consistent_with_its_recorded_velocities():
     """The fitted circle of the track equals 2U/|r| from u, v, r; the course at 180 deg
     heading change, from the track's tangent, is what the drift angle says."""
-    track = {k: np.array(v) for k, v in trial(RudderProgram(35 * DEG, 0.0), 300.0,
-                                                VesselParameters()).items()}
+    run = simulate("turning_circle", backend="inprocess")         # 35 deg of rudder, 300 s
+    track = {n: run[f"ship.{n}"] for n in ("x", "y", "psi", "u", "v", "r")}
     tc = turning_circle_figures(*(track[n] for n in ("x", "y", "psi", "u", "v", "r")))
     assert tc.steady_diameter == pytest.approx(tc.diameter_from_rates, rel=1e-6)
     k = int(np.argmax(np.abs(track["psi"]) >= math.pi))

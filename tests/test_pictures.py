@@ -183,14 +183,14 @@ def test_no_progress_bar_where_standard_error_is_not_a_terminal(fmu_paths, tmp_p
     assert "step/s" not in capsys.readouterr().err
 
 
-def test_a_sweep_says_its_units_as_the_command_line_does(fmu_paths, tmp_path):
+def test_a_sweep_says_its_units_as_the_command_line_does(fmu_paths, tmp_path, scheduler):
     from cosim import sweep as sweep_cli
 
     spec = tmp_path / "spec.toml"
     spec.write_text('name = "units"\nstop_time = 100\n[controllers]\npd = "waves_pd"\n'
                     '[axes]\nwave_seed = [1, 2]\n[plots]\ntracks = { controller = "pd" }\n')
-    assert sweep_cli.main([str(spec), "--out", str(tmp_path), "--workers", "1",
-                           "--no-progress"]) == 0
+    assert sweep_cli.main([str(spec), "--out", str(tmp_path), "--scheduler",
+                           scheduler, "--no-progress"]) == 0
     out = tmp_path / "units"
     units = json.loads((out / "results.json").read_text())["units"]
     assert units["max_delta_deg"] == "deg" and units["J"] == "rad^2"

@@ -159,7 +159,7 @@ def test_a_failing_fmu_stops_the_run_cleanly(fmu_paths, fault_fmu, tmp_path, fau
 @pytest.mark.long
 def test_24_hours_in_waves_stay_finite_bounded_and_phase_accurate(fmu_paths):
     """A day at sea under the PD autopilot, in-process; the wave phases at t = 86400 s."""
-    from cosim.ensemble.members import initialise
+    from cosim.ensemble.reference import initialise
     system = scenarios.load("waves_pd")
     system.components["guidance"].parameters["waypoints"] = "0,0;1e6,1e6"  # 45 deg to the waves
     with Master(system, backend="inprocess") as master:

@@ -12,7 +12,7 @@ import pytest
 from cosim import score as cli
 from cosim import simulate
 from cosim.analysis.metrics import cost
-from cosim.studies import scorecard
+from cosim.studies import scorecard_report
 from cosim.studies.merit import CRITERIA
 
 MINE = ["--set", "autopilot.Kp=1", "--set", "autopilot.Kd=30"]
@@ -56,10 +56,10 @@ def _reached(csv) -> int:
 
 
 def test_the_scorecard_names_the_criteria_each_autopilot_wins_and_loses(fmu_paths, tmp_path,
-                                                                        capsys):
+                                                                        capsys, scheduler):
     out = tmp_path / "score"
     assert cli.main([str(fmu_paths["pd_autopilot"]), "--name", "mine", *MINE, "--seeds", "2",
-                     "--workers", "1", "--out", str(out), "--backend", "inprocess"]) == 0
+                     "--scheduler", scheduler, "--out", str(out), "--backend", "inprocess"]) == 0
     text = (out / "scorecard.md").read_text()
     assert text in capsys.readouterr().out
     # results up front: per sea, every criterion with its side, each controller's verdict
@@ -127,15 +127,15 @@ def test_a_win_is_the_better_value_on_the_same_sea_and_a_tie_within_one_percent(
             _row("mine", 3, J=330.0, waypoints_reached=2.0),    # worse on both
             _row("mine", 4, J=1.0, waypoints_reached=4.0),      # no PD run on seed 4
             {**_row("PD", 4, J=1.0), "status": "failed"}]
-    p = scorecard.paired(J, rows, "mine")
+    p = scorecard_report.paired(J, rows, "mine")
     assert (p.wins, p.losses, p.ties, p.seeds) == (1, 1, 1, 3)
     assert p.median == pytest.approx(1.005) and p.verdict == "mixed"
-    q = scorecard.paired(waypoints, rows, "mine")
+    q = scorecard_report.paired(waypoints, rows, "mine")
     assert (q.wins, q.losses, q.ties) == (1, 1, 1) and q.median == 0.0
-    better = scorecard.paired(J, [r for r in rows if r["wave_seed"] != 3], "mine")
+    better = scorecard_report.paired(J, [r for r in rows if r["wave_seed"] != 3], "mine")
     assert (better.wins, better.ties, better.verdict) == (1, 1, "mixed")
-    assert scorecard.Paired(3, 1, 0, math.nan).verdict == "better"
-    assert scorecard.Paired(0, 1, 3, math.nan).verdict == "even"
+    assert scorecard_report.Paired(3, 1, 0, math.nan).verdict == "better"
+    assert scorecard_report.Paired(0, 1, 3, math.nan).verdict == "even"
 
 
 def test_the_spread_of_a_criterion_over_decades_is_drawn_on_a_log_scale(tmp_path,
@@ -178,11 +178,11 @@ def test_the_scorecard_refuses_a_name_that_is_a_baseline_s(fmu_paths, tmp_path, 
 
 
 def test_an_autopilot_that_fails_is_scored_as_failed_and_the_rest_goes_on(tmp_path, capsys,
-                                                                         faulty_fmu):
+                                                                         faulty_fmu, scheduler):
     failing = faulty_fmu("idle_pilot")
     out = tmp_path / "score"
     assert cli.main([str(failing), "--set", "autopilot.fail_time=150", "--seeds", "1",
-                     "--workers", "1", "--out", str(out), "--backend", "inprocess"]) == 0
+                     "--scheduler", scheduler, "--out", str(out), "--backend", "inprocess"]) == 0
     err = capsys.readouterr().err
     assert ("note: controller 'idle_pilot': autopilot (idle_pilot.fmu) runs through FMI, not "
             "in-process: its module idle_pilot_slave is not importable here") in err

@@ -21,7 +21,7 @@ from cosim.studies.cluster import NoWorkers, SweepError
 from cosim.studies.merit import METRICS
 from cosim.studies.sweep_spec import Spec
 from cosim.studies.sweep_tables import comparison, write_tables
-from helpers import reference_seconds
+from helpers import command, reference_seconds
 
 EXAMPLE = Path(__file__).resolve().parent.parent / "docs" / "sweeps" / "example.toml"
 
@@ -162,11 +162,11 @@ def test_task_records_a_failed_run_with_its_message(fmu_paths, tmp_path):
 
 
 @pytest.mark.timeout(180, method="thread")
-def test_dask_sweep_writes_resumes_and_plots(fmu_paths, tmp_path, capsys):
+def test_dask_sweep_writes_resumes_and_plots(fmu_paths, tmp_path, capsys, scheduler):
     spec = Spec.read(write_spec(tmp_path, SMALL))
     out = tmp_path / "out"
     out.mkdir()
-    rows = campaign.execute(spec, out, workers=2, progress=False)
+    rows = campaign.execute(spec, out, scheduler, progress=False)
     assert [r["status"] for r in rows] == ["ok"] * 4
     journal = (out / "runs.jsonl").read_text().splitlines()
     assert len(journal) == 4
@@ -209,10 +209,13 @@ def test_a_journal_has_one_writer(fmu_paths, tmp_path):
 @pytest.mark.timeout(600, method="thread")
 def test_a_worker_killed_on_every_retry_is_recorded_as_failed(fmu_paths, tmp_path):
     """The nanny restarts the worker each time; were it to fail to (as it once did in CI, on
-    another machine), the sweep stops for want of a worker and the test fails, naming that."""
+    another machine), the sweep stops for want of a worker and the test fails, naming that.
+    It waits for a worker as long as its time limit allows: a restart on a busy machine
+    took longer than the sweep's default minute."""
     from sweep_faults import killing_task
     spec = Spec.read(write_spec(tmp_path, 'stop_time = 5\n[axes]\nwave_seed = [1, 2]\n'))
-    rows = campaign.execute(spec, tmp_path, workers=1, progress=False, task=killing_task)
+    rows = campaign.execute(spec, tmp_path, workers=1, progress=False, task=killing_task,
+                            no_worker_timeout=500)
     by_seed = {(r["controller"], r["wave_seed"]): r for r in rows}
     assert by_seed[("pd", 1)]["status"] == "ok"
     assert by_seed[("pd", 2)]["status"] == "failed"
@@ -257,13 +260,15 @@ def test_a_sweep_left_without_a_worker_stops_keeps_its_rows_and_says_why(
 
 
 @pytest.mark.timeout(30, method="thread")
-def test_a_sweep_on_a_cluster_that_never_had_a_worker_stops_too(fmu_paths, tmp_path):
+def test_a_sweep_on_a_cluster_that_never_had_a_worker_stops_too(fmu_paths, tmp_path, capsys):
+    from cosim import sweep as command
     from cosim.studies.cluster import local_cluster
 
-    spec = Spec.read(write_spec(tmp_path, 'stop_time = 5\n[axes]\nwave_seed = [1]\n'))
-    with pytest.raises(ValueError, match="no_worker_timeout must be a number of seconds > 0, "
-                                         "got 0"):
-        campaign.execute(spec, tmp_path, progress=False, no_worker_timeout=0)
+    path = write_spec(tmp_path, 'stop_time = 5\n[axes]\nwave_seed = [1]\n')
+    with pytest.raises(SystemExit):
+        command.main([str(path), "--no-worker-timeout", "0"])
+    assert "expected a positive number of seconds, got '0'" in capsys.readouterr().err
+    spec = Spec.read(path)
     cluster = local_cluster(0)
     try:
         with pytest.raises(NoWorkers, match=r"no worker in the cluster for 0.5 s \(none "
@@ -300,15 +305,14 @@ def test_two_sweeps_on_one_cluster_both_finish_with_every_row(fmu_paths, tmp_pat
     assert all(r["status"] == "ok" for rows in done for r in rows), done
 
 
-def test_when_every_run_fails_the_summary_still_names_each_failure(fmu_paths, tmp_path):
-    import subprocess
-    import sys
+def test_when_every_run_fails_the_summary_still_names_each_failure(fmu_paths, tmp_path,
+                                                                  scheduler):
+    from cosim import sweep as sweep_command
 
     # each value in its range, the two together against the ship's rule: the FMU's refusal
     spec = write_spec(tmp_path, 'name = "bad"\nstop_time = 5\n[axes]\nHs = [0.1]\nT0 = [0.2]\n')
-    child = subprocess.run([sys.executable, "-m", "cosim.sweep", str(spec), "--workers", "1",
-                            "--out", str(tmp_path / "out"), "--no-progress"],
-                           capture_output=True, text=True, timeout=300)
+    child = command(sweep_command.main, str(spec), "--scheduler", scheduler, "--out",
+                    str(tmp_path / "out"), "--no-progress")
     assert child.returncode == 1, child.stderr
     assert "bad: 2 runs, 0 ok, 2 failed" in child.stdout
     for controller in ("pd", "smc"):

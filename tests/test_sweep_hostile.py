@@ -218,6 +218,7 @@ def test_a_worker_count_that_makes_no_sense_is_refused_or_capped(capsys):
 
 @pytest.mark.timeout(60, method="thread")
 def test_the_command_ends_bad_cluster_options_in_one_line(tmp_path):
+    """What the command says, in this process (a test of messages, not of processes)."""
     spec = spec_file(tmp_path, "stop_time = 5\n[axes]\nwave_seed = [1]\n")
     for options, said in [(["--scheduler", "tcp://127.0.0.1:9", "--connect-timeout", "1"],
                            "error: cannot reach the Dask scheduler at tcp://127.0.0.1:9"),
@@ -225,9 +226,7 @@ def test_the_command_ends_bad_cluster_options_in_one_line(tmp_path):
                            f"error: scheduler file {tmp_path / 'none.json'} does not exist"),
                           (["--workers", "0"], "argument --workers: give a whole number >= 1"),
                           (["--max-runs", "-1"], "argument --max-runs: give a whole number")]:
-        child = subprocess.run([sys.executable, "-m", "cosim.sweep", str(spec), "--out",
-                                str(tmp_path / "out"), *options],
-                               capture_output=True, text=True, timeout=50)
+        child = command(sweep_command.main, str(spec), "--out", str(tmp_path / "out"), *options)
         assert child.returncode == 2 and said in child.stderr, child
         assert "Traceback" not in child.stderr
     assert not list((tmp_path / "out").rglob("*.*"))         # no file of any kind
@@ -458,18 +457,19 @@ def test_ctrl_c_during_the_runs_prints_one_line_that_says_how_to_resume(fmu_path
 
 
 @pytest.mark.timeout(300, method="thread")
-@pytest.mark.parametrize("step, stage", [
-    ("write_tables", "writing the tables"),
-    pytest.param("save_figures", "drawing the figures", marks=pytest.mark.long),
-    pytest.param("comparison", "writing comparison.md", marks=pytest.mark.long)])
-def test_ctrl_c_after_the_runs_says_they_are_kept_and_how_to_finish(fmu_paths, tmp_path, step,
-                                                                   stage):
+@pytest.mark.parametrize("module, step, stage", [
+    ("cosim.sweep", "write_tables", "writing the tables"),
+    pytest.param("cosim.studies.sweep_figures", "save_figures", "drawing the figures",
+                 marks=pytest.mark.long),
+    pytest.param("cosim.sweep", "comparison", "writing comparison.md", marks=pytest.mark.long)])
+def test_ctrl_c_after_the_runs_says_they_are_kept_and_how_to_finish(fmu_paths, tmp_path, module,
+                                                                   step, stage):
     """The stage is made to take the signal: it signals its own process, then waits."""
     spec = spec_file(tmp_path, 'name = "late"\nstop_time = 5\n[axes]\nwave_seed = [1]\n')
     code = ("import os, signal, sys, time\nimport cosim.sweep as command\n"
-            "from cosim._cli import entry\n"
+            f"import {module} as stage\nfrom cosim._cli import entry\n"
             f"def {step}(*args, **kwargs):\n    os.kill(os.getpid(), signal.SIGINT)\n"
-            f"    time.sleep(60)\ncommand.{step} = {step}\nsys.exit(entry(command.main))\n")
+            f"    time.sleep(60)\nstage.{step} = {step}\nsys.exit(entry(command.main))\n")
     with _sweep_child(tmp_path, spec, code) as child:
         _, stderr = child.communicate(timeout=240)
     assert child.returncode == 130, stderr

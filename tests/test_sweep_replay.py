@@ -136,7 +136,7 @@ def test_a_row_s_command_gives_every_setting_exactly(fmu_paths, tmp_path):
 
 
 @pytest.mark.timeout(600, method="thread")
-def test_running_a_row_s_command_gives_its_J_bit_for_bit(fmu_paths, tmp_path):
+def test_running_a_row_s_command_gives_its_J_bit_for_bit(fmu_paths, tmp_path, scheduler):
     """The sweep on Dask, then each kind of row's command in a child process: a wave run,
     a calm-water row that shares another seed's run, a controller with its own settings and
     a user's autopilot FMU."""
@@ -144,7 +144,7 @@ def test_running_a_row_s_command_gives_its_J_bit_for_bit(fmu_paths, tmp_path):
     spec = Spec.read(spec_file(tmp_path, REPLAYED))
     out = tmp_path / "out"
     out.mkdir()
-    rows = campaign.execute(spec, out, workers=2, progress=False)
+    rows = campaign.execute(spec, out, scheduler, progress=False)
     assert len(rows) == 24 and all(r["status"] == "ok" for r in rows), rows
     chosen = {(r["controller"], r["sea_state"], r["run_id"] != r["ran_as"]): r for r in rows
               if r["route"] == "0,0;40,10" and (r["wave_seed"] == 5 or r["controller"] == "pd")}

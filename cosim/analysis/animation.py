@@ -22,11 +22,6 @@ VIDEO_SECONDS = 25.0
 NEEDS = ("ship.x", "ship.y", "ship.psi", "ship.delta")
 
 
-def video_format() -> str:
-    """'mp4' where ffmpeg is installed, else 'gif'."""
-    return "mp4" if shutil.which("ffmpeg") else "gif"
-
-
 def require_track(columns: list[str]) -> None:
     if missing := [c for c in NEEDS if c not in columns]:
         raise ValueError(f"--animate needs the ship's track; this system records no "

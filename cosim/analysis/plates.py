@@ -1,10 +1,10 @@
 """IMO-style plates of a zig-zag and a turning circle (MSC/Circ.1053) with the MSC.137(76)
-criteria, the rudder drawn as -delta (the heading's sense); which report and figure a kind gets."""
+criteria in the words of ``reports``; the rudder drawn as -delta, in the heading's sense."""
 from __future__ import annotations
 
 import math
 from functools import partial
-from typing import Any, Callable, NamedTuple
+from typing import Any, Callable
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -13,10 +13,10 @@ from matplotlib.patches import Circle, Polygon
 from ship_fmu.data import Hull
 
 from ..core.recording import Recording
-from .figures import course_keeping_figure, text_grid, text_panel, time_axes
+from .figures import text_grid, text_panel, time_axes
 from .manoeuvres import (approach_frame, at_heading_change, steady_circle, turning_circle_of,
                          zigzag_of)
-from .reports import course_keeping_report, turning_circle_report, zigzag_report
+from .reports import turning_circle_report, zigzag_report
 from .track import hull_outline, legend_if_any, outlines, to_earth, track_panel
 
 _ORDINALS = ("1st", "2nd", "3rd", "4th")
@@ -201,24 +201,3 @@ def turning_circle_plate(run: Recording, **_: Any) -> Figure:
     legend_if_any(rudder)
     text_panel(fig.add_subplot(grid[5, :]), lines)
     return fig
-
-
-class Analysis(NamedTuple):
-    """What ``cosim.run`` prints (``report``) and draws (``figure``) for a kind of scenario."""
-    report: Callable[..., list[str]]
-    figure: Callable[[Recording], Figure] | None = None
-
-
-ANALYSES = {
-    "course_keeping": Analysis(course_keeping_report, course_keeping_figure),
-    "turning_circle": Analysis(turning_circle_report, turning_circle_plate),
-    "zigzag": Analysis(zigzag_report, zigzag_plate),
-    "none": Analysis(lambda recording, **_: []),
-}
-
-
-def analysis(kind: str) -> Analysis:
-    """The analysis of a kind (the .ssd's ``report``); ValueError naming the known kinds."""
-    if kind not in ANALYSES:
-        raise ValueError(f"unknown report kind {kind!r}; known: {', '.join(ANALYSES)}")
-    return ANALYSES[kind]

@@ -33,8 +33,7 @@ def close_matches(name: str, names: Iterable[str]) -> list[str]:
 
 def did_you_mean(matches: list[str]) -> str:
     """"; did you mean 'Hs'?" for ``matches``; '' for none."""
-    quoted = [f"'{n}'" for n in matches]
-    if not quoted:
+    if not matches:
         return ""
-    listed = quoted[0] if len(quoted) == 1 else f"{', '.join(quoted[:-1])} or {quoted[-1]}"
-    return f"; did you mean {listed}?"
+    *rest, last = [f"'{n}'" for n in matches]
+    return f"; did you mean {', '.join(rest) + ' or ' if rest else ''}{last}?"

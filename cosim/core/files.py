@@ -1,6 +1,5 @@
-"""Output files written whole or not at all (under a temporary name beside the target, then
-renamed; a failure is ``OutputError``, naming the file and what was kept), and output folders
-written by one process at a time."""
+"""Output files written whole or not at all (under a temporary name, then renamed; a failure
+names the file and what was kept), and output folders written by one process at a time."""
 from __future__ import annotations
 
 import contextlib
@@ -47,13 +46,8 @@ def _writing(error: OSError, place: Path) -> bool:
     return not error.filename or Path(error.filename).resolve().is_relative_to(place.resolve())
 
 
-class FolderBusy(RuntimeError):
-    """Another process is writing into this output folder."""
-
-
 def read_small_text(path: Path, limit: int) -> str:
     """The text of a regular UTF-8 file of at most ``limit`` bytes; ValueError saying why not."""
-    path = Path(path)
     if not path.is_file():
         raise ValueError("no such file" if not path.exists() else "not a regular file")
     if path.stat().st_size > limit:
@@ -88,7 +82,7 @@ def whole_file(target: Path) -> Iterator[Path]:
 
 
 def write_atomically(target: Path, write: Callable[[Path], object]) -> Path:
-    """``write(path)`` to a temporary path beside ``target``, then rename it to ``target``."""
+    """``write(path)`` to a temporary path beside ``target``, renamed to ``target``."""
     with whole_file(target) as tmp:
         write(tmp)
     return Path(target)
@@ -112,13 +106,12 @@ def fresh_folder(target: Path) -> Iterator[Path]:
 
 
 class Outputs(contextlib.AbstractContextManager):
-    """``with Outputs(folder, stale) as outputs``: files written to ``outputs.path(name)`` (a
-    hidden stage) are renamed into ``folder`` together if the block succeeds, and ``stale``
-    paths not rewritten removed; if it fails (or on ``discard``) the folder is as it was."""
+    """``with Outputs(folder, stale) as outputs``: the files of ``outputs.writing`` enter
+    ``folder`` together, and the ``stale`` not rewritten go, if the block succeeds (none else)."""
 
     def __init__(self, folder: Path, stale: list[Path] | tuple[Path, ...] = (),
                  label: str = "outputs"):
-        self.folder, self.stale = Path(folder), [Path(p) for p in stale]
+        self.folder, self.stale = Path(folder), set(map(Path, stale))
         self.stage = Path(tempfile.mkdtemp(dir=self.folder, prefix=f"{TEMPORARY_PREFIX}{label}-"))
 
     @staticmethod
@@ -128,9 +121,6 @@ class Outputs(contextlib.AbstractContextManager):
         for entry in Path(folder).iterdir():
             if entry.is_dir() and not entry.is_symlink() and pattern.fullmatch(entry.name):
                 shutil.rmtree(entry, ignore_errors=True)
-
-    def path(self, name: str) -> Path:
-        return self.stage / name
 
     def final(self, path: Path) -> Path:
         """The name in ``folder`` of a file written to the stage."""
@@ -149,7 +139,7 @@ class Outputs(contextlib.AbstractContextManager):
     def writing(self, name: str) -> Iterator[Path]:
         """``with outputs.writing("x.csv") as path``: an OSError names ``folder/x.csv``."""
         try:
-            yield self.path(name)
+            yield self.stage / name
         except OSError as error:
             if isinstance(error, OutputError) or not _writing(error, self.stage):
                 raise
@@ -166,13 +156,17 @@ class Outputs(contextlib.AbstractContextManager):
             except OSError as error:
                 raise OutputError(target, error) from error
             placed.append(target)
-        for old in set(self.stale) - set(placed):
+        for old in self.stale - set(placed):
             old.unlink(missing_ok=True)
         self.discard()
         return placed
 
     def discard(self) -> None:
         shutil.rmtree(self.stage, ignore_errors=True)
+
+
+class FolderBusy(RuntimeError):
+    """Another process is writing into this output folder."""
 
 
 class FolderLock:

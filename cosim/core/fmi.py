@@ -2,6 +2,7 @@
 The master speaks FMI 2.0's names; FMI 3.0's types and calls are mapped to them."""
 from __future__ import annotations
 
+import contextlib
 import functools
 import shutil
 from collections import deque
@@ -77,8 +78,7 @@ def described(description: ModelDescription) -> tuple[dict[str, Any], dict[str, 
 
 
 class FmuInstance(Instance):
-    """A co-simulation FMU instantiated through fmpy (FmuCallError if it cannot be); an FMI
-    3.0 step that asks to end the simulation fails."""
+    """A co-simulation FMU through fmpy; an FMI 3.0 step asking to end the simulation fails."""
 
     def __init__(self, path: str | Path, name: str, unzip_dir: str | Path | None = None):
         """``unzip_dir``: the FMU extracted there already, kept (tests/fmu_fuzz.py's)."""
@@ -143,10 +143,6 @@ class FmuInstance(Instance):
         if status > 1:                      # discard, error, fatal
             raise FmuCallError(self.name, what, time, STATUS[status], self._since(before))
 
-    def _terminated(self, t: float, before: int) -> FmuCallError:
-        return FmuCallError(self.name, "doStep", t, "OK but asked to end the simulation "
-                            "(terminateSimulation)", self._since(before))
-
     def fmi(self, name: str):
         return getattr(self.slave, CALLS.get(name, name) if self.fmi_version == 3 else name)
 
@@ -158,20 +154,12 @@ class FmuInstance(Instance):
             self.call("enterInitializationMode", self.slave.enterInitializationMode,
                       startTime=start_time)
 
-    def do_step(self, t: float, h: float) -> None:
-        before = self.logged
-        result = self.call("doStep", self.slave.doStep, t, h, time=t)
-        if self.fmi_version == 3 and result[1]:          # terminateSimulation
-            raise self._terminated(t, before)
-
     def reset(self) -> None:
         self.call("reset", self.slave.reset)
 
     def free(self) -> None:
-        try:
+        with contextlib.suppress(FMICallException):
             self.slave.terminate()
-        except FMICallException:
-            pass
         self.slave.freeInstance()
         self._remove_unzip_dir()
 
@@ -234,5 +222,6 @@ class FmuInstance(Instance):
             if status:
                 self._status("doStep", status, before, t)
             if terminate.value:
-                raise self._terminated(t, before)
+                raise FmuCallError(self.name, "doStep", t, "OK but asked to end the simulation "
+                                   "(terminateSimulation)", self._since(before))
         return step

@@ -50,10 +50,8 @@ def in_process_refusal(path: str | Path) -> Reason | None:
 def fallback_note(name: str, path: str | Path) -> Reason | None:
     """The note for component ``name`` whose FMU must run through FMI, not in-process."""
     refusal = in_process_refusal(path)
-    if refusal is None:
-        return None
-    return Reason(f"{name} ({Path(path).name}) runs through FMI, not in-process: {refusal}",
-                  refusal.stale_module)
+    return refusal and Reason(f"{name} ({Path(path).name}) runs through FMI, not in-process: "
+                              f"{refusal}", refusal.stale_module)
 
 
 @cache
@@ -117,8 +115,7 @@ class InProcessInstance(Instance):
     """A slave class instantiated and driven in this process."""
 
     def __init__(self, path: str | Path, name: str):
-        """For an FMU that ``in_process_refusal`` passes (the master's ``fallback_note``): its
-        variables and feedthrough are then its class's."""
+        """For an FMU that ``in_process_refusal`` passes: its variables are its class's."""
         description, manifest = read_description(self.path, name), read(self.path)
         self.slave = slave_class(manifest)(instance_name=name)
         self.fmi_version, self.guid = manifest.fmi, description.guid

@@ -1,7 +1,5 @@
-"""What the master needs of a component, whichever backend runs it: a backend supplies
-``call``, ``fmi(name)`` (the function behind an FMI 2.0 call name, "setReal"),
-``enter_initialization``, ``reset``, ``free`` and ``stepper`` (the loop's step), and may
-replace the loop's other prepared calls."""
+"""What the master needs of a component, whichever backend runs it (``Instance``), and the
+errors and log records of its FMI calls."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -9,12 +7,8 @@ from typing import Any, Callable, Iterable, NamedTuple
 
 from .values import fmi_value, no_variable
 
-_CALL_TYPE = {"Enumeration": "Integer"}          # fmi2SetInteger sets an Enumeration
-
-
 class LogRecord(NamedTuple):
     """One message an FMU logged."""
-
     status: str                 # ok, warning, discard, error, fatal, pending
     category: str | None
     text: str
@@ -51,8 +45,9 @@ def logged_error(records: Iterable[LogRecord]) -> bool:
 
 
 class Instance:
-    """One instantiated component: its variables, its feedthrough, and FMI calls. ``path``
-    and ``name`` are set in ``__new__``, so that a watchdog can always name it."""
+    """One instantiated component. A backend supplies ``call``, ``fmi(name)`` (the function
+    behind an FMI 2.0 call name), ``enter_initialization``, ``reset``, ``free`` and ``stepper``;
+    ``path`` and ``name`` are set in ``__new__``, so that a watchdog can always name it."""
 
     name: str
     path: Path
@@ -83,31 +78,30 @@ class Instance:
     def unit(self, name: str) -> str:
         """The unit a variable declares (its own or its type's), "" if none."""
         variable = self.variable(name)
-        declared = getattr(variable, "declaredType", None)
-        return getattr(variable, "unit", None) or getattr(declared, "unit", None) or ""
+        return variable.unit or getattr(variable.declaredType, "unit", None) or ""
 
     def set(self, values: dict[str, Any], time: float | None = None) -> None:
         """Set variables by name; ValueError for a value the call cannot carry exactly."""
         for name, value in values.items():
-            kind = _CALL_TYPE.get(self.variable(name).type, self.variable(name).type)
+            kind = self._kind(name)
             exact = fmi_value(f"{self.name}.{name}", kind, value)
             self.call(f"set {name} = {exact!r}", self.fmi(f"set{kind}"), [self.vr(name)],
                       [exact], time=time)
 
     def get(self, names: Iterable[str]) -> dict[str, Any]:
         """Current values of variables by name, one FMI call per type."""
-        names = list(names)
-        by_type: dict[str, list[str]] = {}
-        for name in names:
-            kind = self.variable(name).type
-            by_type.setdefault(_CALL_TYPE.get(kind, kind), []).append(name)
-        values = {}
-        for kind, group in by_type.items():
+        names, values = list(names), {}
+        for kind in dict.fromkeys(self._kind(name) for name in names):
+            group = [name for name in names if self._kind(name) == kind]
             read = self.call(f"get {', '.join(group)}", self.fmi(f"get{kind}"),
                              [self.vr(name) for name in group])
-            values.update(zip(group, read))
-        return {name: values[name].decode("utf-8") if isinstance(values[name], bytes)
-                else values[name] for name in names}
+            values.update((n, v.decode("utf-8") if isinstance(v, bytes) else v)
+                          for n, v in zip(group, read))
+        return {name: values[name] for name in names}
+
+    def _kind(self, name: str) -> str:              # fmi2SetInteger sets an Enumeration
+        kind = self.variable(name).type
+        return "Integer" if kind == "Enumeration" else kind
 
     def parameter_values(self) -> dict[str, Any]:
         """Every parameter's value as the FMU holds it."""
@@ -125,7 +119,7 @@ class Instance:
                   strict=True)
 
     def do_step(self, t: float, h: float) -> None:
-        self.call("doStep", self.fmi("doStep"), t, h, time=t)
+        self.stepper()(t, h)
 
     # Prepared calls for a fixed list of value references, valid until ``reset``.
     def reader(self, vrs: list[int]) -> Callable[[], list[float]]:

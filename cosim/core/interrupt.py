@@ -31,7 +31,6 @@ class StopSignals:
 
     def __init__(self) -> None:
         self.received: signal.Signals | None = None
-        self._previous: dict = {}
         self._keepers: list[Callable[[], str]] = []
         self._ending = threading.Lock()
 
@@ -61,8 +60,7 @@ class StopSignals:
         os._exit(128 + self.received)
 
     def keep(self, keeper: Callable[[], str]) -> Callable[[], None]:
-        """Have ``keeper`` say what it kept if a second signal ends the process; returns the
-        function that forgets it."""
+        """Have ``keeper`` say what it kept if a second signal ends the process; returns an undo."""
         self._keepers.append(keeper)
         return lambda: self._keepers.remove(keeper) if keeper in self._keepers else None
 

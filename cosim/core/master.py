@@ -18,8 +18,7 @@ from .values import declarations, parameters
 from .watchdog import TimeLimit, Watchdog, no_limit
 from .wiring import COUPLINGS, check_connections, feedthrough_order, layout, settle
 
-# fmi: the FMUs through fmpy; inprocess: their Python classes (an FMU not current here runs
-# through FMI, with a note: ``fallback_note``)
+# the FMUs through fmpy, or their Python classes (else through FMI, with a ``fallback_note``)
 BACKENDS: dict[str, type[Instance]] = {"fmi": FmuInstance, "inprocess": InProcessInstance}
 RUN_BACKENDS = tuple(BACKENDS)          # the backends a run of a scenario may take
 
@@ -94,13 +93,13 @@ class Master(contextlib.AbstractContextManager):
 
     def run(self, stop_time: float | None = None,
             progress: Callable[[int, int], None] | None = None,
-            csv_path: str | Path | None = None, chunk_rows: int = 10_000,
-            stop: StopSignals | None = None, watchdog: Watchdog | None = None) -> Recording:
+            csv_path: str | Path | None = None, stop: StopSignals | None = None,
+            watchdog: Watchdog | None = None) -> Recording:
         """Simulate to ``stop_time`` (default: the system's); an FMU failure, a signal on
         ``stop`` or a limit of ``watchdog`` ends it early between steps (``Recording.error``,
         the rows kept). ``csv_path``: the rows streamed there (else TooManyRows if too many)."""
         t0, h, n_steps = self.system.steps(stop_time)
-        recorder = self._recorder = Recorder(self.columns, n_steps + 1, csv_path, chunk_rows,
+        recorder = self._recorder = Recorder(self.columns, n_steps + 1, csv_path,
                                              run_meta(self, n_steps), self.units)
         exchange, values = COUPLINGS[self.coupling], [0.0] * len(self.columns)
         k, t, error, self.parameter_values = 0, t0, None, {}
@@ -150,8 +149,7 @@ class Master(contextlib.AbstractContextManager):
 
 
 def run_meta(master: Master, n_steps: int) -> dict[str, Any]:
-    """What a run of ``n_steps`` records of itself as it starts (it adds ``parameters``
-    and ``wall_time_s`` as it ends)."""
+    """A run's metadata as it starts (``parameters`` and ``wall_time_s`` are added at its end)."""
     system, (t0, h, _) = master.system, master.system.steps()
     return {"system": system.name, "description": system.description,
             "scenario_file": str(system.path) if system.path else None,

@@ -2,6 +2,7 @@
 streamed to a CSV file in chunks (memory stays flat; the ``Recording`` then holds no rows)."""
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import os
 import time
@@ -10,6 +11,8 @@ from pathlib import Path
 from typing import IO, Any, Sequence
 
 import numpy as np
+
+CHUNK_ROWS = 10_000                     # rows streamed to CSV at a time
 
 
 @dataclass
@@ -67,14 +70,13 @@ class Recorder:
     """Takes a run's rows one at a time; with ``csv_path``, streams them in chunks."""
 
     def __init__(self, columns: list[str], rows: int, csv_path: str | Path | None = None,
-                 chunk_rows: int = 10_000, meta: dict[str, Any] | None = None,
-                 units: dict[str, str] | None = None):
+                 meta: dict[str, Any] | None = None, units: dict[str, str] | None = None):
         self.columns, self.meta, self.units = columns, meta or {}, units or {}
         self.path = None if csv_path is None else Path(csv_path)
         if csv_path is None:
             require_memory(rows, len(columns) + 1)
         else:
-            rows, self.file = min(chunk_rows, rows), _open_csv(self.path, columns)
+            rows, self.file = min(CHUNK_ROWS, rows), _open_csv(self.path, columns)
         self.time, self.data = np.empty(rows), np.full((rows, len(columns)), np.nan)
         self.held = self.written = 0         # rows in the buffer, and rows written
         self.interrupted: str | None = None
@@ -114,12 +116,9 @@ def require_memory(rows: int, columns: int) -> None:
     """TooManyRows if ``rows`` x ``columns`` floats would not fit in 80 % of the memory
     available to a new allocation (Linux's MemAvailable; else all RAM)."""
     available = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-    try:
-        with open("/proc/meminfo") as meminfo:
-            available = next(int(line.split()[1]) * 1024 for line in meminfo
-                             if line.startswith("MemAvailable:"))
-    except (OSError, StopIteration):
-        pass
+    with contextlib.suppress(OSError, StopIteration), open("/proc/meminfo") as meminfo:
+        available = next(int(line.split()[1]) * 1024 for line in meminfo
+                         if line.startswith("MemAvailable:"))
     needed = rows * columns * 8
     if needed > 0.8 * available:
         raise TooManyRows(f"the run would hold {rows} rows of {columns} values in memory, "

@@ -89,8 +89,7 @@ class _Reader:
         for i, element in enumerate(system.findall("ssd:Elements/*", NS), 1):
             component = self.component(element, i)
             if component.name in components:
-                raise self.error(f"Component {i}", f"a second Component named "
-                                                   f"'{component.name}'")
+                raise self.error(f"Component {i}", f"a second Component named '{component.name}'")
             components[component.name] = component
         if not components:
             raise self.error("System", "no Component in its Elements")
@@ -172,8 +171,7 @@ class _Reader:
                                             f"does not have; it has {', '.join(components)}")
             end = (connection.end_element, connection.end_connector)
             if end in fed:
-                raise self.error(where, f"{'.'.join(end)} is fed already by Connection "
-                                        f"{fed[end]}")
+                raise self.error(where, f"{'.'.join(end)} is fed already by Connection {fed[end]}")
             fed[end] = i
             connections.append(connection)
         return connections
@@ -236,9 +234,8 @@ def _el(parent: ET.Element, path: str, **attributes: str) -> ET.Element:
 
 def write_ssd(system: SystemDescription, path: str | Path,
               sources: dict[str, str] | None = None, units: Units | None = None) -> None:
-    """Write ``system`` as a .ssd, ``sources`` replacing component sources by name; with
-    ``units``, connectors carry units. The step goes into OSP's and OpenModelica's annotations,
-    the kind of report into ours."""
+    """Write ``system`` as a .ssd, ``sources`` replacing component sources by name, ``units`` on
+    connectors; the step in OSP's and OpenModelica's annotations, the report's kind in ours."""
     unit_of = units.connectors if units else {}
     root = ET.Element(_q("ssd:SystemStructureDescription"), version="1.0", name=system.name)
     sys_el = _el(root, "ssd:System", name=system.name, description=system.description)

@@ -22,9 +22,8 @@ def split_name(name: str) -> tuple[str, str]:
 
 @dataclass(frozen=True)
 class FmuFolders:
-    """Where the caller builds its FMUs, a folder per FMI version, and their names (stems).
-    A .ssd's FMU is also looked for in the first folder, by its path after the last folder
-    of that name (``fmi3/ship.fmu`` for ``../../fmus/fmi3/ship.fmu``): a copied .ssd finds it."""
+    """Where the caller builds its FMUs (a folder per FMI version) and their names (stems); a
+    copied .ssd finds them there (``fmu_candidates``)."""
     by_fmi: dict[int, Path]
     names: frozenset[str]
 
@@ -106,7 +105,8 @@ class SystemDescription:
 
     def fmu_candidates(self, component: str) -> list[Path]:
         """Where a component's FMU may be: its source relative to the .ssd (or the current
-        folder), then in ``fmus`` unless absolute (another file would run in its place unseen)."""
+        folder), then unless absolute (another file would run unseen), in the first folder of
+        ``fmus`` by its path after that folder's name (``../fmi3/ship.fmu``: ``fmi3/ship.fmu``)."""
         source = Path(self.components[component].source)
         candidates = [((self.path.parent if self.path else Path.cwd()) / source).resolve()]
         if self.fmus is not None and not source.is_absolute():

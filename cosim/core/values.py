@@ -1,7 +1,6 @@
-"""Values for FMU variables, checked before any FMU call: ``fmi_value``, exactly what the FMI
-2.0 call carries (section 2.1.2); ``checked``, against the declaration (2.2.7); ``setting``,
-also settable in initialisation mode (4.2.4). A refusal names the variable, value and what
-it takes."""
+"""Values for FMU variables, checked before any FMU call: exactly what the FMI 2.0 call carries
+(section 2.1.2), within the declaration (2.2.7), settable in initialisation mode (4.2.4). A
+refusal names the variable, the value and what it takes."""
 from __future__ import annotations
 
 import math
@@ -82,8 +81,8 @@ def declarations(description: ModelDescription) -> dict[str, Declaration]:
     return out
 
 
-class _Refusal(ValueError):             # why a value is refused: 'is not a whole number'
-    pass
+class _Refusal(ValueError):
+    """Why a value is refused: 'is not a whole number'."""
 
 
 def fmi_value(target: str, type_name: str, value: Any) -> Value:
@@ -228,9 +227,8 @@ def parameters(system: SystemDescription, paths: dict[str, Path],
                declared: dict[str, dict[str, Declaration]],
                overrides: Mapping[str, Mapping[str, Any]] | None = None
                ) -> tuple[dict[str, dict[str, Value]], dict[str, dict[str, Value]]]:
-    """(the system's bindings updated by ``overrides``, the overrides alone), by component,
-    as ``setting`` returns them; ValueError naming the value (and the .ssd, for a binding),
-    also for an input that a connection sets."""
+    """(the system's bindings updated by ``overrides``, the overrides alone), by component, as
+    ``setting`` returns them; ValueError naming the value (and the .ssd, for a binding)."""
     if not isinstance(overrides or {}, Mapping):
         raise ValueError(f"set: overrides must map component names to their values, got "
                          f"{overrides!r}")

@@ -23,7 +23,6 @@ STEP_LIMIT_S = 60.0          # the default step limit, far above a step's or ins
 class Limits(NamedTuple):
     """Wall-clock limits in seconds (None: none): of a step (or instantiation), of the run
     (the loop stops at its next step), of the step under way after a signal or the run's."""
-
     step: float | None = STEP_LIMIT_S
     run: float | None = None
     grace: float = 3.0
@@ -58,7 +57,6 @@ class Watchdog:
         self.limits, self.stop, self.salvage = limits.check(), stop, salvage
         self.expired: str | None = None
         self._what: str | float = "the start of the run"
-        self._beat = self._start = time.monotonic()
         self._grace: tuple[float, str] | None = None   # since when, after what
         self._raise = True                             # TimeLimit may be raised into the loop
         self._target = threading.get_ident()
@@ -122,9 +120,9 @@ class Watchdog:
         if limits.run is not None and self.expired is None:
             candidates.append((self._start + limits.run, ""))
         if self._grace is not None:
-            candidates.append((self._grace[0] + limits.grace, f"{what} did not end within "
-                                                              f"{limits.grace:g} s of "
-                                                              f"{self._grace[1]}"))
+            since, after = self._grace
+            candidates.append((since + limits.grace,
+                               f"{what} did not end within {limits.grace:g} s of {after}"))
         return min(candidates)
 
     def _watch(self) -> None:

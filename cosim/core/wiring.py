@@ -20,12 +20,10 @@ def check_connections(system: SystemDescription, instances: dict[str, Instance])
     for c in system.connections:
         for element, connector, kind in ((c.start_element, c.start_connector, "output"),
                                          (c.end_element, c.end_connector, "input")):
-            instance = instances[element]
-            if connector not in instance.variables:
-                raise WiringError(f"connection {c}: FMU '{element}' "
-                                  f"({instance.path.name}) has no variable '{connector}'; "
-                                  f"it has {', '.join(instance.variables)}")
-            variable = instance.variables[connector]
+            try:
+                variable = instances[element].variable(connector)
+            except ValueError as error:
+                raise WiringError(f"connection {c}: {error}") from None
             if variable.causality != kind or variable.type != "Real":
                 raise WiringError(f"connection {c}: {element}.{connector} is a "
                                   f"{variable.type} {variable.causality}; a connection "
@@ -47,9 +45,7 @@ def feedthrough_order(system: SystemDescription, instances: dict[str, Instance])
 
 @dataclass
 class Node:
-    """One component as the loop sees it: its output columns and prepared calls (None where
-    it has nothing of that kind)."""
-
+    """One component as the loop sees it: its output columns and prepared calls (or None)."""
     step: Callable[[float, float], None]
     state: slice                        # Real outputs, no feedthrough
     feedthrough: slice                  # Real outputs, with feedthrough
@@ -119,8 +115,7 @@ def _input_applier(write: Callable[[list[float]], None], sources: list[int],
 def gauss_seidel(nodes: list[Node], values: list[float], t: float, h: float,
                  step: bool) -> None:
     """Outputs without feedthrough (the ship's states) at t_k, then each FMU in signal-flow
-    order gets its inputs, gives its feedthrough outputs and steps (the paper's guidance ->
-    autopilot -> ship, as in its Simulink model)."""
+    order (the paper's guidance -> autopilot -> ship) takes inputs, gives outputs, steps."""
     for node in nodes:
         if node.read_state:
             values[node.state] = node.read_state()

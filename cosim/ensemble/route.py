@@ -23,8 +23,7 @@ from ..core.recording import Recording
 from ..core.ssd import SystemDescription
 from ..core.watchdog import TimeLimit, no_limit
 from .control import KINDS, GuidanceArrays
-from .members import COMPONENTS, Member, coverage, initialise
-from .reference import SIGNALS as ALL_SIGNALS, step_models
+from .reference import COMPONENTS, SIGNALS as ALL_SIGNALS, Member, coverage, initialise, step_models
 from .vessel import VesselArrays
 
 SIGNALS = ("guidance.psi_d", "guidance.wp_index", "ship.x", "ship.y", "ship.psi",

@@ -1,6 +1,5 @@
 """``Vessel.step`` for M members, states (M,) and wave components (M, N): the scalar model's
-own rates, forces and RK4 update on arrays; its branches and wave loads rewritten on arrays
-operation for operation."""
+rates, forces and RK4 update on arrays; its branches and wave loads rewritten op for op."""
 from __future__ import annotations
 
 from operator import attrgetter
@@ -75,12 +74,11 @@ def _no_travel(u: np.ndarray, v: np.ndarray) -> float:
 
 
 class VesselArrays:
-    """M vessels stepped together, built from the scalar vessels as initialised."""
+    """M vessels stepped together, built from initialised vessels of one sea (calm, or N wave
+    components), none cutting a step, and their shafts (n1, n2, n3)."""
     STATES = ("x", "y", "psi", "u", "v", "r", "xi")
 
     def __init__(self, vessels: Sequence[Vessel], shafts: tuple[float, float, float]):
-        """Vessels of one sea (calm, or N wave components), none cutting a step, and their
-        shafts (n1, n2, n3)."""
         self.vessel = vessels[0]                            # the hull and mass matrix of all
         self.forces = actuator_model(self.vessel.actuators, *shafts)
         self.waves = None if self.vessel.waves is None else WaveArrays(vessels)

@@ -1,6 +1,5 @@
-"""Studies on the co-simulation core: sweeps on Dask (``campaign`` runs one), the scorecard,
-the benchmarks (``timing``, ``sweep_timing``, ``memory``), the accuracy study
-(``integration_error``, ``coupling_error``), ``cpu_variants`` and ``spread``."""
+"""Studies on the co-simulation core: sweeps, scorecard, benchmarks, accuracy
+(docs/architecture.md lists the modules); ``table`` for their Markdown."""
 from __future__ import annotations
 
 from typing import Iterable, Sequence
@@ -11,9 +10,5 @@ def table(header: Sequence[str], rows: Iterable[Sequence[str]],
     """A Markdown table's lines; columns after the first ``text_columns`` (default: none)
     aligned right."""
     left = len(header) if text_columns is None else text_columns
-    rule = "|" + "---|" * left + "---:|" * (len(header) - left)
-    return [_row(header), rule, *map(_row, rows)]
-
-
-def _row(cells: Sequence[str]) -> str:
-    return "| " + " | ".join(cells) + " |"
+    lines = ["| " + " | ".join(cells) + " |" for cells in (header, *rows)]
+    return [lines[0], "|" + "---|" * left + "---:|" * (len(header) - left), *lines[1:]]

@@ -25,11 +25,6 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
     if backend not in SWEEP_BACKENDS:
         raise ValueError(f"backend must be {', '.join(SWEEP_BACKENDS[:-1])} or "
                          f"{SWEEP_BACKENDS[-1]}, got {backend!r}")
-    if batch_size is not None and backend != BATCH:
-        raise ValueError(f"batch_size is the batch backend's, not the {backend} backend's")
-    if not 0 < no_worker_timeout < float("inf"):
-        raise ValueError(f"no_worker_timeout must be a number of seconds > 0, got "
-                         f"{no_worker_timeout!r}")
     try:
         with FolderLock(out):
             journal = Journal(out / "runs.jsonl")

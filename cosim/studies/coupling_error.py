@@ -17,7 +17,7 @@ from ship_fmu.thrusters import actuator_model
 from .. import scenarios
 from ..analysis.metrics import LAMBDA, cost_terms
 from ..core.master import Master
-from ..ensemble.members import COMPONENTS, initialise
+from ..ensemble.reference import COMPONENTS, initialise
 from . import table
 from .integration_error import H
 

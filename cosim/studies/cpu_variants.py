@@ -1,6 +1,5 @@
 """Does a run depend on the CPU? The same run in a child process under other CPUs' numpy
-dispatch, OpenBLAS kernels and libm FMA variants (read at start-up), compared on the bytes of
-its CSV."""
+dispatch, OpenBLAS kernels and libm FMA variants (read at start-up), compared on its CSV's bytes."""
 from __future__ import annotations
 
 import json

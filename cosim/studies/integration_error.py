@@ -67,8 +67,7 @@ def reference(delta_c: np.ndarray, tolerance: float = TOLERANCE) -> dict[str, np
             return list(vessel.rates(t + s, tuple(state), forces(gear(s))))
 
         for a, b in pieces:
-            y = solve_ivp(f, (a, b), y, method="DOP853", rtol=tolerance,
-                          atol=tolerance).y[:, -1]
+            y = solve_ivp(f, (a, b), y, method="DOP853", rtol=tolerance, atol=tolerance).y[:, -1]
         delta = gear(H)
         rows.append([y[2], y[5], y[0], y[1]])
     return dict(zip(STATES, np.array(rows).T))

@@ -1,6 +1,5 @@
 """The memory benchmarks: a long run streamed to disk (``bench memory``) and the batch route's
-memory against its members and the sweep's size (``bench sweep --parts memory``); a run's own
-peak memory is measured in a fresh process."""
+against its members and the sweep's size (``bench sweep --parts memory``), in fresh processes."""
 from __future__ import annotations
 
 import subprocess
@@ -11,8 +10,8 @@ from pathlib import Path
 
 from ..core.master import RUN_BACKENDS
 from .sweep_task import BATCH
-from .sweep_timing import bench_spec, load, require_batch, seeds, sizes, timed_sweep, verdict
-from .timing import machine, peak_rss_mb
+from .sweep_timing import bench_spec, require_batch, seeds, sizes, timed_sweep, verdict
+from .timing import load, machine, peak_rss_mb
 
 MEMORY_MEMBERS = (64, 256, 1024, 4096)
 MEMORY_STOP_TIME = 40.0
@@ -49,7 +48,7 @@ def batch_memory(members: tuple[int, ...] = MEMORY_MEMBERS,
                  stop_time: float = MEMORY_STOP_TIME, batch_size: int | None = None) -> dict:
     """Peak memory (MB) of waves_pd runs on the batch route: of ``simulate_members`` in a
     fresh process, and of a one-worker sweep's worker, for each number of ``members``."""
-    print(f"batch route memory: waves_pd runs of {stop_time:g} s, on {machine()}; {load()}")
+    print(f"batch route memory: waves_pd runs of {stop_time:g} s, on {machine()}")
     calls = {}
     for m in members:
         wall, before, peak, results = calls[m] = _in_child(f"simulate_members of {m} members",

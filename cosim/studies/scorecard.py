@@ -17,16 +17,13 @@ from ..api import SimulationError, overrides_of
 from ..core.files import fresh_folder, write_atomically
 from ..core.recording import Recording
 from ..outputs import Options, run_and_write
-from .scorecard_report import (BASELINE, SEA_NAMES, Paired, Sea, change, markdown, paired,
-                               pairs)
+from .scorecard_report import BASELINE, SEA_NAMES, Sea, change, markdown, pairs
 from .campaign import execute
 from .spec_file import controller_entry
 from .sweep_spec import Spec
 from .sweep_figures import distribution, paired_figure, tracks
 from .merit import CRITERIA, run_metrics
 from .sweep_task import BATCH
-
-__all__ = ["BASELINES", "SEAS", "Paired", "paired", "score", "backend_notes"]
 
 BASELINES = {"PD": "pd", "SMC": "smc", "PID": "pid"}   # display name: scenarios <sea>_<suffix>
 COURSE_CHANGE = math.radians(40.0)
@@ -156,5 +153,5 @@ def _ensemble(contenders: list[Contender], seeds: int, out: Path, sea: Sea = SEA
 def backend_notes(fmu: Path, name: str, port_map: dict | None, backend: str) -> list[str]:
     """Which of the scorecard's FMUs run through FMI although ``backend`` asks otherwise,
     and on "batch" which contenders' ensemble runs run alone (``Spec.backend_notes``)."""
-    return _ensemble(_contenders(fmu, name, port_map, None), 1, fmu.parent).backend_notes(
-        backend)
+    spec = _ensemble(_contenders(fmu, name, port_map, None), 1, fmu.parent)
+    return spec.backend_notes(backend)

@@ -44,11 +44,9 @@ class Paired:
     @property
     def verdict(self) -> str:
         """better / worse on more than half the seeds; else even (mostly ties) or mixed."""
-        if 2 * self.wins > self.seeds:
-            return "better"
-        if 2 * self.losses > self.seeds:
-            return "worse"
-        return "even" if 2 * self.ties > self.seeds else "mixed"
+        return next((word for word, count in (("better", self.wins), ("worse", self.losses),
+                                              ("even", self.ties)) if 2 * count > self.seeds),
+                    "mixed")
 
 
 def pairs(criterion: Merit, rows: list[dict], controller: str,

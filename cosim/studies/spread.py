@@ -32,12 +32,12 @@ class Spread:
     nominal: dict[str, float]       # figure: the unperturbed run's value
     deviation: dict[str, float]     # figure: the largest |member - nominal|
 
-    def describe(self, digits: int = 2) -> str:
+    def describe(self) -> str:
         """'psi_E 472.76 +- 18.67, J 612.45 +- 20.18': the figures whose value +- deviation
-        shows at ``digits`` decimals; or 'every figure as printed'."""
+        shows at 2 decimals; or 'every figure as printed'."""
         value, change = self.nominal, self.deviation
-        wide = [f"{f} {value[f]:.{digits}f} +- {change[f]:.{digits}f}" for f in FIGURES
-                if f"{value[f] - change[f]:.{digits}f}" != f"{value[f] + change[f]:.{digits}f}"]
+        wide = [f"{f} {value[f]:.2f} +- {change[f]:.2f}" for f in FIGURES
+                if f"{value[f] - change[f]:.2f}" != f"{value[f] + change[f]:.2f}"]
         return ", ".join(wide) or "every figure as printed"
 
 
@@ -45,12 +45,9 @@ def spread(system: SystemDescription, overrides: dict[str, dict[str, Any]] | Non
            ulps: int = 20, lam: float = LAMBDA, coupling: str = "gauss-seidel",
            stop_time: float | None = None) -> Spread:
     """The run and those with each of ``PERTURBED`` moved by -ulps ... +ulps, in-process;
-    ValueError if ulps < 1 or the system lacks one; RuntimeError naming a failed run."""
-    if ulps < 1:
-        raise ValueError(f"spread: ulps must be >= 1, got {ulps}")
+    ValueError if the system lacks one; RuntimeError naming a failed run."""
     overrides = overrides or {}
-    members = [(None, 0)] + [(p, k) for p in PERTURBED
-                             for j in range(1, ulps + 1) for k in (-j, j)]
+    members = [(None, 0), *((p, k) for p in PERTURBED for j in range(1, ulps + 1) for k in (-j, j))]
     costs: list[Cost] = []
     with Master(system, coupling=coupling, backend="inprocess", overrides=overrides) as master:
         for component, name in PERTURBED:

@@ -19,7 +19,7 @@ from ..core.inprocess import fallback_note, in_process_refusal
 from ..core.ssd import SystemDescription
 from ..core.values import Declaration, declarations
 from ..core.watchdog import Limits
-from ..ensemble.members import coverage
+from ..ensemble.reference import coverage
 from ..provenance import code_version
 from .bundle import Bundle, bundle
 from .spec_file import MAX_RUNS, assignments, check_values, parse

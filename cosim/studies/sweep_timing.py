@@ -14,18 +14,13 @@ from .spec_file import controller_entry
 from .sweep_client import plan
 from .sweep_spec import Spec
 from .sweep_task import BATCH, SWEEP_BACKENDS
-from .timing import machine, peak_rss_mb, require_in_process
+from .timing import load, machine, peak_rss_mb, require_in_process
 
 SEAS = {"waves": ("waves_pd", "waves_smc"), "calm": ("calm_pd", "calm_smc")}
 GOALS = {"waves": 5.0, "calm": 10.0}   # batch runs/s per core over the in-process route's
 # the campaign's goal: these runs of this stop time on these workers within this many s
 CAMPAIGN_RUNS, CAMPAIGN_STOP_TIME, CAMPAIGN_WORKERS, CAMPAIGN_GOAL = 1000, 400.0, 2, 30.0
 WORKERS = (1, 2)            # the throughput's sweeps: on 1 and on 2 workers
-
-
-def load() -> str:
-    one, five, fifteen = os.getloadavg()
-    return f"load average {one:.2f} {five:.2f} {fifteen:.2f} (1, 5, 15 min)"
 
 
 @dataclass(frozen=True)
@@ -60,7 +55,7 @@ def sweep_throughput(runs: int = 32, batch_runs: int = 1024, seas: tuple[str, ..
     print(f"sweep throughput: runs of {stop_time:g} s (waves: {' and '.join(SEAS['waves'])} "
           f"over wave seeds; calm: {' and '.join(SEAS['calm'])} over initial headings), "
           f"{runs} runs a sweep ({batch_runs} on the batch backend), each on a fresh local "
-          f"cluster, on {machine()}; {load()}")
+          f"cluster, on {machine()}")
     for sea in seas:                              # before minutes of measuring the others
         spec = _sea_spec(sea, 2, 1.0)
         require_in_process(spec.backend_notes("inprocess"))
@@ -82,7 +77,20 @@ def sweep_throughput(runs: int = 32, batch_runs: int = 1024, seas: tuple[str, ..
                           f"({outside / m.simulated:4.1%}); load {m.load:.2f}")
                     measured.setdefault((sea, backend, workers), []).append(m.rate)
     rates = {key: statistics.median(values) for key, values in measured.items()}
-    _print_rates(rates, seas, rounds)
+    print("  runs/s per core (runs/s / workers" + (f", median of {rounds} rounds" if rounds > 1
+                                                 else "") + "):")
+    print(f"    {'':15}" + "".join(f"{_workers(w):>11}" for w in WORKERS)
+          + f"{'efficiency 1->2':>17}")
+    for sea in seas:
+        for backend in SWEEP_BACKENDS:
+            one, two = (rates[sea, backend, w] for w in WORKERS)
+            print(f"    {sea:5} {backend:9}{one:11.2f}{two / 2:11.2f}{two / one / 2:17.2f}")
+    print("    (efficiency 1.00: each worker as fast as one alone)")
+    for sea in seas:
+        for backend in SWEEP_BACKENDS[1:]:
+            print(f"  {sea:5} {backend} / fmi: " + ", ".join(
+                f"{rates[sea, backend, w] / rates[sea, 'fmi', w]:5.2f}x with {_workers(w)}"
+                for w in WORKERS))
     for sea in seas:
         ratios = {w: [b / i for b, i in zip(measured[sea, BATCH, w], measured[sea, "inprocess", w])]
                   for w in WORKERS}
@@ -102,7 +110,7 @@ def campaign(runs: int = CAMPAIGN_RUNS, workers: int = CAMPAIGN_WORKERS,
     if runs < 1:
         raise ValueError(f"the campaign's runs must be at least 1, got {runs}")
     print(f"campaign: {runs} waves_pd runs of {stop_time:g} s on the batch route, a local "
-          f"cluster of {_workers(workers)}, on {machine()}; {load()}")
+          f"cluster of {_workers(workers)}, on {machine()}")
     spec = bench_spec({"pd": "waves_pd"}, seeds(runs), stop_time)
     require_batch(spec)
     measure = timed_sweep(spec, workers, BATCH)
@@ -206,21 +214,3 @@ def timed_sweep(spec: Spec, workers: int, backend: str, batch_size: int | None =
                    math.fsum(r["sim_seconds"] for r in rows) / len(rows),
                    math.fsum(r["seconds"] - r["sim_seconds"] for r in rows) / len(rows),
                    tuple(map(len, batches)), peaks, os.getloadavg()[0])
-
-
-def _print_rates(rates: dict[tuple[str, str, int], float], seas: tuple[str, ...],
-                 rounds: int) -> None:
-    print("  runs/s per core (runs/s / workers" + (f", median of {rounds} rounds" if rounds > 1
-                                                 else "") + "):")
-    print(f"    {'':15}" + "".join(f"{_workers(w):>11}" for w in WORKERS)
-          + f"{'efficiency 1->2':>17}")
-    for sea in seas:
-        for backend in SWEEP_BACKENDS:
-            one, two = (rates[sea, backend, w] for w in WORKERS)
-            print(f"    {sea:5} {backend:9}{one:11.2f}{two / 2:11.2f}{two / one / 2:17.2f}")
-    print("    (efficiency 1.00: each worker as fast as one alone)")
-    for sea in seas:
-        for backend in (b for b in SWEEP_BACKENDS if b != "fmi"):
-            print(f"  {sea:5} {backend} / fmi: " + ", ".join(
-                f"{rates[sea, backend, w] / rates[sea, 'fmi', w]:5.2f}x with {_workers(w)}"
-                for w in WORKERS))

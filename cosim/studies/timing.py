@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Callable
 
 STEPS = 4000
-ROWS = {"direct": "(a) cosim.direct: the modules wired by hand",
+ROWS = {"direct": "(a) the modules wired by hand (run_direct)",
         "inprocess": "(b) our master, in-process backend",
         "fmi": "(c) our master, FMUs via fmpy",
         "libcosim": "(d) OSP libcosim, same SSP",
@@ -33,14 +33,24 @@ def peak_rss_mb() -> float:
 
 
 def machine() -> str:
-    """One line on the machine the figures come from."""
+    """One line on the machine the figures come from and its load now: its CPU (by family,
+    model and AVX-512, which numpy's kernels use where the CPU has it), cores, Python, OS."""
     try:
-        cpu = next(line.split(":", 1)[1].strip() for line in
-                   Path("/proc/cpuinfo").read_text().splitlines() if line.startswith("model name"))
-    except (OSError, StopIteration):
+        info = dict(line.split(":", 1) for line in Path("/proc/cpuinfo").read_text().split(
+            "\n\n")[0].splitlines() if ":" in line)
+        info = {key.strip(): value.strip() for key, value in info.items()}
+        avx512 = "AVX-512" if "avx512f" in info["flags"].split() else "no AVX-512"
+        cpu = (f"{info['model name']} (family {info['cpu family']}, model {info['model']}, "
+               f"{avx512})")
+    except (OSError, KeyError):
         cpu = platform.processor() or platform.machine()
     return (f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}, "
-            f"{platform.system()} {platform.release()}")
+            f"{platform.system()} {platform.release()}; {load()}")
+
+
+def load() -> str:
+    one, five, fifteen = os.getloadavg()
+    return f"load average {one:.2f} {five:.2f} {fifteen:.2f} (1, 5, 15 min)"
 
 
 def side_by_side(runners: dict[str, Callable[[], object]], repeats: int) -> dict[str, float]:
@@ -108,7 +118,10 @@ def engines(repeats: int) -> dict[str, dict[str, float]]:
                     except Exception as error:          # not installed here: say so
                         print(f"  {key} unavailable: {type(error).__name__}: {error}")
                 times = results[name] = side_by_side(runners, repeats)
-                calls, per_call = fmi_calls_per_step(fmi), fmi_call_cost(fmi)
+                calls = sum(bool(call) for node in fmi.nodes for call in (   # a step's calls
+                    node.read_state, node.apply_inputs, node.read_feedthrough,
+                    node.read_integers, node.step))
+                per_call = fmi_call_cost(fmi)
             times["floor"] = times["direct"] + STEPS * calls * per_call
             print(f"\n{name}:\n  {'':44} {'wall s':>7} {'us/step':>8} {'RTF':>6} {'x (a)':>6}")
             for key, label in ROWS.items():
@@ -122,7 +135,7 @@ def engines(repeats: int) -> dict[str, dict[str, float]]:
                   "loop) + the model compute (a)")
     calm, waves = results["calm_pd"], results["waves_pd"]
     print(f"\nwaves_pd / calm_pd in-process: {waves['inprocess'] / calm['inprocess']:.2f} "
-          f"(cosim.direct: {waves['direct'] / calm['direct']:.2f})")
+          f"(wired by hand: {waves['direct'] / calm['direct']:.2f})")
     return results
 
 
@@ -140,16 +153,9 @@ def _master_runner(master) -> Callable[[], None]:
     return run
 
 
-def fmi_calls_per_step(master) -> int:
-    """FMI calls one Gauss-Seidel step of ``master`` makes."""
-    return sum(bool(call) for node in master.nodes
-               for call in (node.read_state, node.apply_inputs, node.read_feedthrough,
-                            node.read_integers, node.step))
-
-
-def fmi_call_cost(master, calls: int = 20_000) -> float:
-    """Seconds per FMI call of the cheapest kind: setReal and getReal of one value on the
-    autopilot FMU."""
+def fmi_call_cost(master) -> float:
+    """Seconds per FMI call of the cheapest kind: setReal, getReal of one autopilot value."""
+    calls = 20_000
     master.reset()
     master.initialize()
     instance = master.instances["autopilot"]
@@ -202,11 +208,11 @@ def overhead(repeats: int) -> dict[str, float]:
     per_step = {key: t / STEPS * 1e6 for key, t in times.items()}
     print(f"What the routes do besides the models: calm_pd, {STEPS} steps with the ship's step "
           f"doing nothing, median of {repeats} runs taken in turn, on {machine()}")
-    for key, label in (("direct", "cosim.direct (the modules wired by hand)"),
+    for key, label in (("direct", "the modules wired by hand (run_direct)"),
                        ("idle", "our master, its calls into the FMUs idle"),
                        ("inprocess", "our master, in-process backend")):
         print(f"  {label:48} {per_step[key]:6.1f} us/step")
-    print(f"  the in-process master beyond cosim.direct: "
+    print(f"  the in-process master beyond the modules wired by hand: "
           f"{per_step['inprocess'] - per_step['direct']:.1f} us/step (its calls into the slaves, "
           "and its bookkeeping beyond direct's)")
     return per_step

@@ -1,6 +1,5 @@
-"""pythonfmu 0.7.0's linux64 binary: where ``fmubuild.exit_fix`` patches its exit-time heap
-corruption, and where its logger keeps the debug-logging flag that alone decides what the
-host hears. With another binary the host is taken not to hear: errors go to standard error.
+"""pythonfmu 0.7.0's linux64 binary: where ``fmubuild.exit_fix`` patches it and where its
+logger keeps the debug-logging flag (another binary's host is taken not to hear).
 """
 from ..entry import Binary
 

@@ -1,7 +1,5 @@
-"""``Fmi2Entry``: the mixin that makes a ``ModelSlave`` an FMI 2.0 FMU of pythonfmu 0.7
-(``class <Model>(Fmi2Entry, <Model>, Fmi2Slave)``: pythonfmu takes the class with the
-longest MRO). Every refusal is an exception: fmi2Fatal (pythonfmu 0.7's fmi2Discard would
-pass for a normal end).
+"""``Fmi2Entry``: the mixin that makes a ``ModelSlave`` an FMI 2.0 FMU of pythonfmu 0.7.
+Every refusal is an exception: fmi2Fatal (pythonfmu 0.7's fmi2Discard would pass for an end).
 """
 from __future__ import annotations
 
@@ -13,7 +11,7 @@ from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, In
 from pythonfmu import String
 from pythonfmu.enums import Fmi2Status
 
-from ..entry import HostLog, fmi_entry
+from ..entry import fmi_entry
 from ..registry import pythonfmu_variable
 from ..variables import Var, describe
 from . import ACTIVE, binary
@@ -23,13 +21,10 @@ _TYPE = {float: Real, int: Integer, str: String}
 
 class Fmi2Entry:
     """FMI 2.0 through pythonfmu 0.7: the version's half of an FMU's class."""
-
     API, FMI_VERSION = "fmi2", 2
     STATUS_ERROR, STATUS_FATAL = Fmi2Status.error, Fmi2Status.fatal
     RELEASES_ON_EXCEPTION = ACTIVE
-
-    def _host_log(self, kwargs: dict[str, Any]) -> HostLog:
-        return HostLog(kwargs, binary.KNOWN_BINARIES, unknown=False)
+    KNOWN_BINARIES, HEARS_UNKNOWN = binary.KNOWN_BINARIES, False
 
     def fmi_variable(self, var: Var, getter: Callable[[], Any] | None) -> Any:
         return pythonfmu_variable(var, getter, _TYPE[var.kind], Fmi2Causality,
@@ -65,8 +60,7 @@ class Fmi2Entry:
         return super().get_integer(vrs) if read is None else read()
 
     def to_xml(self, model_options: dict[str, str] = dict()) -> Element:
-        """pythonfmu's model description with the units, ranges, exact starts and
-        dependencies (by 1-based index) it leaves out."""
+        """pythonfmu's model description with what it leaves out (``describe``)."""
         root = super().to_xml(model_options)
         structure, unknowns = describe(root, self.variables, [
             e.find("Real" if v.is_real else "Integer")
@@ -80,8 +74,7 @@ class Fmi2Entry:
 
 
 def hold_namespace(namespace: dict[str, Any]) -> None:
-    """One more reference on an FMU entry module's namespace, each time its code runs:
-    pythonfmu 0.7's ``findClass`` reruns the module at every instantiation and releases
-    the namespace ``PyModule_GetDict`` only lent it (the second instance would segfault)."""
+    """One more reference on an FMU entry module's namespace each time it runs: pythonfmu
+    0.7 reruns it at every instantiation and releases the namespace it was only lent."""
     if ACTIVE:
         ctypes.pythonapi.Py_IncRef(ctypes.py_object(namespace))

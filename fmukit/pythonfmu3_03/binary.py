@@ -1,7 +1,5 @@
-"""pythonfmu3 0.3.4's x86_64-linux binary: where ``fmubuild.exit_fix`` patches its exit-time
-use-after-free, and where its logger keeps the host's logging flag, which the logger never
-reads (``cppfmu::Logger::Log`` forwards every message; FMI 3.0 says not while logging is
-off). With another binary the host is taken to hear: pythonfmu3 forwards.
+"""pythonfmu3 0.3.4's x86_64-linux binary: where ``fmubuild.exit_fix`` patches it and where
+its logger keeps the host's logging flag, which it never reads (another's host hears all).
 """
 from ..entry import Binary
 

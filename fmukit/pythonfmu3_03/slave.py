@@ -1,6 +1,5 @@
-"""``Fmi3Entry``: the mixin that makes a ``ModelSlave`` an FMI 3.0 FMU of pythonfmu3 0.3.4
-(``class <Model>(Fmi3Entry, <Model>, Fmi3Slave)``: pythonfmu3 finds it by a regular
-expression on the ``class`` line), with the independent variable ``time``.
+"""``Fmi3Entry``: the mixin that makes a ``ModelSlave`` an FMI 3.0 FMU of pythonfmu3 0.3.4,
+with the independent variable ``time``.
 """
 from __future__ import annotations
 
@@ -10,15 +9,14 @@ from xml.etree.ElementTree import Element, SubElement
 from pythonfmu3 import Fmi3Causality, Fmi3Initial, Fmi3Slave, Fmi3Status, Fmi3StepResult
 from pythonfmu3 import Fmi3Variability, Float64, Int32, String
 
-from ..entry import HostLog, fmi_entry
+from ..entry import fmi_entry
 from ..registry import pythonfmu_variable
 from ..variables import Var, describe
 from . import ACTIVE, binary
 
 _TYPE = {float: Float64, int: Int32, str: String}
 _FROM_CLASS = ("description", "author", "license", "version", "copyright",
-               "default_experiment")
-"""What pythonfmu3 writes from the instance only, which its __init__ sets to None."""
+               "default_experiment")      # pythonfmu3 writes them from the instance only
 
 
 def _refused_step() -> Fmi3StepResult:
@@ -27,10 +25,10 @@ def _refused_step() -> Fmi3StepResult:
 
 class Fmi3Entry:
     """FMI 3.0 through pythonfmu3 0.3.4: the version's half of an FMU's class."""
-
     API, FMI_VERSION = "fmi3", 3
     STATUS_ERROR, STATUS_FATAL = Fmi3Status.error, Fmi3Status.fatal
     RELEASES_ON_EXCEPTION = ACTIVE
+    KNOWN_BINARIES, HEARS_UNKNOWN = binary.KNOWN_BINARIES, True
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
@@ -38,12 +36,8 @@ class Fmi3Entry:
             setattr(self, attribute, getattr(type(self), attribute, None))
         self.start_time = None                 # pythonfmu3 drops it: messages name none
 
-    def _host_log(self, kwargs: dict[str, Any]) -> HostLog:
-        return HostLog(kwargs, binary.KNOWN_BINARIES, unknown=True)
-
     def _before_variables(self) -> None:
-        """``time``, registered first: value reference 0, so that a variable's reference is
-        its FMI 2.0 twin's plus one (``to_xml`` writes it last)."""
+        """``time`` at value reference 0: a variable's is its FMI 2.0 twin's plus one."""
         self.time = 0.0
         self.register_variable(Float64("time", causality=Fmi3Causality.independent,
                                        variability=Fmi3Variability.continuous,
@@ -57,8 +51,7 @@ class Fmi3Entry:
 
     def log(self, msg: str, status: Fmi3Status = Fmi3Status.ok, category: str | None = None,
             debug: bool = False) -> None:
-        """pythonfmu3's log, kept off the host's callback while its logging is off (FMI
-        3.0's rule; ``host_log.tell`` writes the errors to standard error then)."""
+        """pythonfmu3's log, kept off the host's callback while its logging is off."""
         if self.host_log.hears():
             super().log(msg, status, category, debug)
 
@@ -87,10 +80,9 @@ class Fmi3Entry:
         return super().get_int32(vrs) if read is None else read()
 
     def to_xml(self, model_options: dict[str, str] = dict()) -> Element:
-        """pythonfmu3's model description with <UnitDefinitions> (else fmpy refuses the
-        units), ranges, exact starts (it writes 16 digits) and dependencies (its bare
-        <Output>: every output on every input, an algebraic loop to a master); ``time`` last,
-        for an importer that reads dependencies as 1-based indices (OMSimulator)."""
+        """pythonfmu3's model description with what it leaves out (``describe``; its bare
+        <Output> is an algebraic loop to a master); ``time`` last, for an importer that
+        reads dependencies as 1-based indices (OMSimulator)."""
         root = super().to_xml(model_options)
         listed = root.find("ModelVariables")
         elements = {e.get("name"): e for e in listed}
