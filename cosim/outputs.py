@@ -6,8 +6,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
-from .analysis.cost import LAMBDA, Cost, cost
 from .analysis.kinds import Analysis, analysis
+from .analysis.metrics import LAMBDA, Cost, cost
 from .core.files import FolderLock, Outputs
 from .core.interrupt import StopSignals
 from .core.master import Master

@@ -23,9 +23,8 @@ from tqdm import tqdm
 from . import scenarios
 from ._cli import (add_fmu_options, checked_autopilot, chosen_scenarios, entry, number_option,
                    positive_seconds, say_error, say_note, setting_option, writable_folder)
-from .analysis.cost import LAMBDA, Cost
-from .analysis.describe import conditions, headline
-from .analysis.reports import tables
+from .analysis.metrics import LAMBDA, Cost
+from .analysis.reports import conditions, headline, tables
 from .api import overrides_of
 from .core.wiring import COUPLINGS
 from .core.files import FolderBusy, OutputError

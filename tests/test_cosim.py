@@ -15,8 +15,7 @@ from autopilot_fmu.guidance import parse_waypoints
 from autopilot_fmu.pd import PDAutopilot
 from cosim import run as cli
 from cosim import scenarios
-from cosim.analysis.cost import LAMBDA
-from cosim.analysis.metrics import cost_terms
+from cosim.analysis.metrics import LAMBDA, cost_terms
 from cosim.core.fmi import FmuInstance
 from cosim.core.master import Master
 from cosim.core.ssd import write_ssd

@@ -20,8 +20,7 @@ from cosim import engines as engines_cli
 from cosim import export as export_cli
 from cosim import scenarios
 from cosim.core.master import Master
-from cosim.interop import omsimulator
-from cosim.interop.engines import EngineError, run
+from cosim.interop.engines import EngineError, run, run_omsimulator
 from cosim.interop.ssp import export, fmi_versions
 from helpers import ecos_missing
 
@@ -93,8 +92,8 @@ def test_omsimulator_runs_the_fmi3_package_as_the_fmi2_one(packages, name, inter
     """Its CSV holds 12 significant digits: the FMI 3.0 package gives the FMI 2.0 one's
     columns, and our Gauss-Seidel run rounded to them; and each twin's independent
     variable, ``time``, the result's time."""
-    three = omsimulator.run(packages[name, 3], OMS, interface, timeout=300)
-    two = omsimulator.run(packages[name, 2], OMS, interface, timeout=300)
+    three = run_omsimulator(packages[name, 3], OMS, interface, timeout=300)
+    two = run_omsimulator(packages[name, 2], OMS, interface, timeout=300)
     clocks = {f"{component}.time" for component in scenarios.load(name).components}
     assert set(three) == set(two) | clocks
     for clock in clocks:

@@ -10,12 +10,12 @@ import pytest
 
 from cosim import simulate
 from cosim.analysis.kinds import analysis
-from cosim.analysis.criteria import (ADVANCE_LIMIT, TACTICAL_DIAMETER_LIMIT, Criterion,
-                                     length_over_speed, overshoot_limits,
-                                     turning_circle_criteria, turning_circle_of, zigzag_criteria,
-                                     zigzag_of)
-from cosim.analysis.manoeuvres import (TurningCircle, ZigZagResult, fitted_circle,
-                                       turning_circle_figures, zigzag_figures)
+from cosim.analysis.manoeuvres import (ADVANCE_LIMIT, TACTICAL_DIAMETER_LIMIT, Criterion,
+                                       TurningCircle, ZigZagResult, fitted_circle,
+                                       length_over_speed, overshoot_limits,
+                                       turning_circle_criteria, turning_circle_figures,
+                                       turning_circle_of, zigzag_criteria, zigzag_figures,
+                                       zigzag_of)
 from cosim.analysis.plates import turning_circle_plate, zigzag_plate
 from cosim.analysis.reports import criterion_text, turning_circle_report, zigzag_report
 from cosim.analysis.seastate import SCALE

@@ -20,7 +20,7 @@ from cosim import scenarios
 from cosim.core.master import Master
 from cosim.core.ssd import write_ssd
 from cosim.interop.engines import EngineError
-from cosim.interop.omsimulator import run
+from cosim.interop.engines import run_omsimulator as run
 from cosim.interop.ssp import SSD_NAME, export, read_package
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from cosim.interop.engines import run
-from cosim.interop.osp import OSP_FILE, read_osp
+from cosim.interop.ssp import OSP_FILE, read_osp
 from cosim.interop.ssp import export, read_package
 
 NAMES = ["calm_pd", "waves_smc", "turning_circle"]

@@ -16,7 +16,7 @@ from cosim import simulate
 from cosim.analysis.animation import animate, frame_times
 from cosim.analysis.figures import RUDDER_LABEL, course_keeping_figure, save
 from cosim.analysis.track import outlines
-from cosim.analysis.criteria import zigzag_of
+from cosim.analysis.manoeuvres import zigzag_of
 from cosim.provenance import write_metadata
 from cosim.core.recording import Recording
 from ship_fmu.data import Hull

@@ -12,11 +12,10 @@ from matplotlib.text import Text
 
 from cosim import simulate
 from cosim.analysis.animation import leg_text
-from cosim.analysis.cost import cost
-from cosim.analysis.describe import paper_row, title
+from cosim.analysis.metrics import cost
 from cosim.analysis.figures import RUDDER_LABEL, comparison, course_keeping_figure
 from cosim.analysis.track import outline_scale, waypoint_name
-from cosim.analysis.reports import PAPER_TABLES
+from cosim.analysis.reports import PAPER_TABLES, paper_row, title
 from cosim.studies.scorecard import COURSE_CHANGE_ROUTE, COURSE_CHANGE_TIME
 from ship_fmu.data import Hull
 

@@ -11,7 +11,7 @@ import pytest
 
 from cosim import score as cli
 from cosim import simulate
-from cosim.analysis.cost import cost
+from cosim.analysis.metrics import cost
 from cosim.studies import scorecard_report
 from cosim.studies.merit import CRITERIA
 

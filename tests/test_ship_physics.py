@@ -6,7 +6,7 @@ import pytest
 from scipy.integrate import quad
 
 from cosim import simulate
-from cosim.analysis.criteria import turning_circle_of, zigzag_of
+from cosim.analysis.manoeuvres import turning_circle_of, zigzag_of
 from ship_fmu.data import Actuators, Hull
 from ship_fmu.hull import coriolis_forces, damping_forces, mass_matrix
 from ship_fmu.steering_gear import RudderMotion

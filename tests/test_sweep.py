@@ -11,7 +11,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from cosim import scenarios
-from cosim.analysis.cost import cost
+from cosim.analysis.metrics import cost
 from cosim.analysis.seastate import model_scale
 from cosim.core.files import FolderLock
 from cosim.core.master import Master

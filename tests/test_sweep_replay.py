@@ -15,8 +15,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from cosim import scenarios
-from cosim.analysis.cost import LAMBDA, Cost
-from cosim.analysis.metrics import cost_terms
+from cosim.analysis.metrics import LAMBDA, Cost, cost_terms
 from cosim.analysis.seastate import model_scale
 from cosim.core.master import Master
 from cosim.studies import campaign, sweep_task

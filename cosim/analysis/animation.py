@@ -1,5 +1,4 @@
-"""An animation of a run, a GIF (Pillow) or an MP4 (ffmpeg) of about 25 s at 10 frames per
-second: the track panel drawn once as a background, each frame only what moves."""
+"""A run's animation, a GIF (Pillow) or an MP4 (ffmpeg), about 25 s at 10 frames per second."""
 from __future__ import annotations
 
 import math
@@ -14,8 +13,8 @@ from autopilot_fmu.guidance import route as followed_route
 
 from ..core.files import whole_file
 from ..core.recording import Recording
-from .describe import title
 from .figures import RUDDER_LABEL, new_figure
+from .reports import title
 from .track import hull_outline, legend_if_any, outlines, track_panel, waypoint_name
 
 FPS = 10
@@ -24,8 +23,7 @@ NEEDS = ("ship.x", "ship.y", "ship.psi", "ship.delta")
 
 
 def require_track(columns: list[str]) -> None:
-    missing = [c for c in NEEDS if c not in columns]
-    if missing:
+    if missing := [c for c in NEEDS if c not in columns]:
         raise ValueError(f"--animate needs the ship's track; this system records no "
                          f"{', '.join(missing)}")
 
@@ -93,7 +91,7 @@ def animate(run: Recording, path: Path, label: str, fmt: str) -> Path:
     readout = track.set_title(draw(0), loc="left", fontsize=8, family="monospace")
     dynamic = [wake, hull, active, readout, *cursors]
     for artist in dynamic:
-        artist.set_animated(True)           # left out of the background drawn once
+        artist.set_animated(True)           # left out of the background, drawn once
     fig.canvas.draw()
     background = fig.canvas.copy_from_bbox(fig.bbox)
     target = path.with_suffix(f".{fmt}")

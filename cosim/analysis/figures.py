@@ -1,5 +1,4 @@
-"""Figures of a run, in degrees: the track panel beside the signals over time, eq (19) and
-the paper's values for its own runs; on Agg canvases without pyplot (no backend picked)."""
+"""Figures of a run, in degrees: the track panel beside the signals over time, with eq (19)."""
 from __future__ import annotations
 
 import itertools
@@ -15,9 +14,8 @@ from matplotlib.figure import Figure
 
 from ..core.files import whole_file
 from ..core.recording import Recording
-from .cost import LAMBDA, cost
-from .describe import paper_row, title
-from .metrics import heading_error
+from .metrics import LAMBDA, cost, heading_error
+from .reports import paper_row, title
 from .track import legend_if_any, track_panel
 
 RUDDER_LABEL = "rudder delta (deg)\n+ turns to port"     # a positive rudder turns to port

@@ -1,4 +1,5 @@
-"""Figures of merit of a heading response and of a route, SI units and radians."""
+"""Figures of merit of a heading response and of a route, SI units and radians; eq (19):
+J = psi_E + lambda sum(delta^2), lambda calibrated once on calm_pd and held (test_cosim.py)."""
 from __future__ import annotations
 
 import math
@@ -8,9 +9,12 @@ from typing import Sequence
 import numpy as np
 
 from autopilot_fmu.guidance import WaypointGuidance
+
+from ..core.recording import Recording
 from ..ensemble.exact import wrap
 
 RUDDER_DEADBAND = math.radians(0.5)   # past amidships for a crossing to count: no dither
+LAMBDA = 1.8649470947066942     # psi_E / sum(delta^2) of calm_pd: 100.175 / 53.715 rad^2
 
 
 def heading_error(psi_d: np.ndarray, psi: np.ndarray) -> np.ndarray:
@@ -21,6 +25,28 @@ def heading_error(psi_d: np.ndarray, psi: np.ndarray) -> np.ndarray:
 def cost_terms(psi_d: np.ndarray, psi: np.ndarray, delta: np.ndarray) -> tuple[float, float]:
     """(psi_E, sum delta^2) of eq (19), over the samples given, rad^2."""
     return float(np.sum(heading_error(psi_d, psi) ** 2)), float(np.sum(np.square(delta)))
+
+
+@dataclass(frozen=True)
+class Cost:
+    """Eq (19) over the recorded samples."""
+    psi_E: float
+    sum_delta2: float
+    lam: float
+
+    @property
+    def delta_E(self) -> float:
+        return self.lam * self.sum_delta2
+
+    @property
+    def J(self) -> float:
+        return self.psi_E + self.delta_E
+
+
+def cost(recording: Recording, lam: float = LAMBDA) -> Cost:
+    """Eq (19) with Delta psi = psi_d - psi (wrapped) and delta the actual rudder."""
+    return Cost(*cost_terms(recording["guidance.psi_d"], recording["ship.psi"],
+                            recording["ship.delta"]), lam)
 
 
 def rms(values: np.ndarray) -> float:
@@ -77,8 +103,7 @@ def cross_track_error(x: np.ndarray, y: np.ndarray, wp_index: np.ndarray,
 
 @dataclass(frozen=True)
 class RouteCompletion:
-    """How close the track came to each waypoint, reached if within R_accept (the guidance
-    also moves on past a waypoint it never reached)."""
+    """How close the track came to each waypoint, reached if within R_accept."""
     points: tuple[tuple[float, float], ...]     # the route, m
     closest: tuple[float, ...]                  # the track's closest approach to each, m
     R_accept: float                             # radius of the circle of acceptance, m

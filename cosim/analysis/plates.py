@@ -13,9 +13,9 @@ from matplotlib.patches import Circle, Polygon
 from ship_fmu.data import Hull
 
 from ..core.recording import Recording
-from .criteria import turning_circle_of, zigzag_of
 from .figures import text_grid, text_panel, time_axes
-from .manoeuvres import TurningCircle, approach_frame, at_heading_change, steady_circle
+from .manoeuvres import (approach_frame, at_heading_change, steady_circle, turning_circle_of,
+                         zigzag_of)
 from .reports import turning_circle_report, zigzag_report
 from .track import hull_outline, legend_if_any, outlines, to_earth, track_panel
 
@@ -132,61 +132,56 @@ def _dimension(ax: Any, earth: Callable, start: tuple[float, float], end: tuple[
                                                               linewidth=0.7))
 
 
-def _turning_track(ax: Any, run: Recording, tc: TurningCircle) -> None:
-    """The track dimensioned: advance, transfer, tactical and steady diameters."""
-    track_panel(ax, run)
-    L, x, y, psi = Hull.L, run["ship.x"], run["ship.y"], run["ship.psi"]
-    along, across = approach_frame(x, y, float(psi[0]))
-    earth = partial(to_earth, x[0], y[0], psi[0])
-    side = math.copysign(1.0, across[np.argmax(np.abs(across))])     # the turn's side
-    top, gap = along.max(), 0.08 * max(np.ptp(across), L)
-    outside = -side * (max(-side * across.min(), -side * across.max(), 0.0) + gap)
-    _line(ax, earth, (-gap, 0.0), (top + 2 * gap, 0.0))
-    ax.annotate("approach course", earth(-gap, 0.0), fontsize=7, color="0.4",
-                ha="center", va="top", bbox=_BOX, zorder=7)
-    a90 = at_heading_change(psi, math.pi / 2, along, across)
-    if not math.isnan(tc.advance):
-        _dimension(ax, earth, (0.0, outside), (tc.advance, outside),
-                   f"advance\n{tc.advance:.2f} m\n{tc.advance / L:.2f} L", "tab:green",
-                   feet=((0.0, 0.0), a90))
-        _dimension(ax, earth, (a90[0], 0.0), a90,
-                   f"transfer {tc.transfer:.2f} m = {tc.transfer / L:.2f} L (at 90 deg)",
-                   "tab:purple", label_at=(a90[0] - 1.5 * gap, side * 3.5 * gap))
-    a180 = at_heading_change(psi, math.pi, along, across)
-    if not math.isnan(tc.tactical_diameter):
-        _dimension(ax, earth, (top + gap, 0.0), (top + gap, a180[1]),
-                   f"tactical diameter {tc.tactical_diameter:.2f} m = "
-                   f"{tc.tactical_diameter / L:.2f} L (at 180 deg)", "tab:brown",
-                   feet=((a180[0], 0.0), a180))
-    north, east, diameter = steady_circle(x, y, psi)
-    if not math.isnan(diameter):
-        ax.add_patch(Circle((east, north), diameter / 2, fill=False, linestyle="--",
-                            color="tab:orange", linewidth=0.9, zorder=4))
-        ax.annotate("", xy=(east + diameter / 2, north), xytext=(east - diameter / 2, north),
-                    arrowprops=dict(color="tab:orange", **_BOTH_WAYS), zorder=6)
-        ax.text(east, north, f"steady turning diameter {diameter:.2f} m = {diameter / L:.2f} L"
-                f"\n(circle fitted to the last lap; 2U/|r| = {tc.diameter_from_rates:.2f} m)",
-                ha="center", va="bottom", fontsize=7, color="tab:orange", zorder=7, bbox=_ROUND)
-
-
 def turning_circle_plate(run: Recording, **_: Any) -> Figure:
     """Track with the diameters; heading, speed, drift, yaw rate and rudder; criteria."""
     tc = turning_circle_of(run).figures
     lines = turning_circle_report(run)
     fig, grid = text_grid((1.15, 1.0), 5, lines)
     track = fig.add_subplot(grid[0:5, 0])
-    _turning_track(track, run, tc)
+    track_panel(track, run)
+    L, x, y, psi = Hull.L, run["ship.x"], run["ship.y"], run["ship.psi"]
+    along, across = approach_frame(x, y, float(psi[0]))
+    earth = partial(to_earth, x[0], y[0], psi[0])
+    side = math.copysign(1.0, across[np.argmax(np.abs(across))])     # the turn's side
+    top, gap = along.max(), 0.08 * max(np.ptp(across), L)
+    outside = -side * (max(-side * across.min(), -side * across.max(), 0.0) + gap)
+    _line(track, earth, (-gap, 0.0), (top + 2 * gap, 0.0))
+    track.annotate("approach course", earth(-gap, 0.0), fontsize=7, color="0.4",
+                ha="center", va="top", bbox=_BOX, zorder=7)
+    a90 = at_heading_change(psi, math.pi / 2, along, across)
+    if not math.isnan(tc.advance):
+        _dimension(track, earth, (0.0, outside), (tc.advance, outside),
+                   f"advance\n{tc.advance:.2f} m\n{tc.advance / L:.2f} L", "tab:green",
+                   feet=((0.0, 0.0), a90))
+        _dimension(track, earth, (a90[0], 0.0), a90,
+                   f"transfer {tc.transfer:.2f} m = {tc.transfer / L:.2f} L (at 90 deg)",
+                   "tab:purple", label_at=(a90[0] - 1.5 * gap, side * 3.5 * gap))
+    a180 = at_heading_change(psi, math.pi, along, across)
+    if not math.isnan(tc.tactical_diameter):
+        _dimension(track, earth, (top + gap, 0.0), (top + gap, a180[1]),
+                   f"tactical diameter {tc.tactical_diameter:.2f} m = "
+                   f"{tc.tactical_diameter / L:.2f} L (at 180 deg)", "tab:brown",
+                   feet=((a180[0], 0.0), a180))
+    north, east, diameter = steady_circle(x, y, psi)
+    if not math.isnan(diameter):
+        track.add_patch(Circle((east, north), diameter / 2, fill=False, linestyle="--",
+                            color="tab:orange", linewidth=0.9, zorder=4))
+        track.annotate("", xy=(east + diameter / 2, north), xytext=(east - diameter / 2, north),
+                    arrowprops=dict(color="tab:orange", **_BOTH_WAYS), zorder=6)
+        track.text(east, north, f"steady turning diameter {diameter:.2f} m = {diameter / L:.2f} L"
+                f"\n(circle fitted to the last lap; 2U/|r| = {tc.diameter_from_rates:.2f} m)",
+                ha="center", va="bottom", fontsize=7, color="tab:orange", zorder=7, bbox=_ROUND)
     heading, speed, drift, r, rudder = time_axes(fig, [grid[i, 1] for i in range(5)], (
         "heading psi\n(deg, 0-360)", "speed U (m/s)", "drift angle (deg)", "yaw rate r (deg/s)",
         "rudder -delta (deg,\n+ to starboard)"))
-    t, u, v, psi = run.t, run["ship.u"], run["ship.v"], run["ship.psi"]
+    t, u, v = run.t, run["ship.u"], run["ship.v"]
     compass = np.degrees(psi) % 360.0          # broken where it wraps
     compass[1:][np.abs(np.diff(compass)) > 180.0] = np.nan
     heading.plot(t, compass, color="k")
     heading.set(ylim=(0, 360), yticks=(0, 90, 180, 270, 360))
     scale = outlines(run).scale
     for target in (math.pi / 2, math.pi):       # the ship and the time at 90 and 180 deg
-        xs, ys, ps, when = at_heading_change(psi, target, run["ship.x"], run["ship.y"], psi, t)
+        xs, ys, ps, when = at_heading_change(psi, target, x, y, psi, t)
         if math.isnan(when):
             continue
         track.add_patch(Polygon(hull_outline(xs, ys, ps, scale), closed=True, facecolor="gold",

@@ -1,7 +1,5 @@
-"""WMO sea state codes at the 1:70 model's scale (Froude: heights / 70, periods / sqrt(70)):
-Hs the middle of the code's range, the modal period the open North Atlantic's most probable
-(Lee and Bales 1980, STANAG 4194); code 1 takes code 2's, since shorter waves break the block
-model of eqs (14)-(16). The paper's waves (Hs 5 mm, T0 0.8 s) are code 2."""
+"""WMO sea state codes at the 1:70 model's scale (Froude: heights / 70, periods / sqrt(70));
+the choice of Hs and T0 per code is in docs/sweeps.md."""
 from __future__ import annotations
 
 import math
@@ -24,6 +22,5 @@ def model_scale(code: int) -> tuple[float, float]:
     """(Hs, T0) at model scale for a WMO sea state code 0-6, in m and s."""
     if code not in WMO:
         raise ValueError(f"sea_state must be a WMO code 0-6, got {code!r}")
-    _, hs, t0 = WMO[code]
-    # Code 0 is calm water (Hs = 0); its period only has to be valid.
+    _, hs, t0 = WMO[code]               # code 0, calm water: its period only has to be valid
     return hs / SCALE, (t0 if t0 > 0.0 else 8.0) / math.sqrt(SCALE)

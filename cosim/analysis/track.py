@@ -1,5 +1,5 @@
-"""The track panel every figure of a run shares: north up at equal scale, the route with its
-named waypoints, the leg switches, the ship's outline at regular times, the wave direction."""
+"""The track panel every figure of a run shares: north up at equal scale, the named route,
+leg switches, the ship's outline at regular times and the wave direction."""
 from __future__ import annotations
 
 import itertools
@@ -120,8 +120,7 @@ def _route(ax: Any, guidance: dict[str, Any], tracks: list[np.ndarray]) -> None:
 
 def track_panel(ax: Any, run: Recording, ship: bool = True,
                 others: Iterable[Recording] = ()) -> None:
-    """The route, waves and, with ``ship``, the track, leg switches and outlines; framed on
-    the tracks of ``run`` and ``others`` (which the caller draws)."""
+    """Route, waves and, with ``ship``, the track; framed on ``others`` too (the caller's)."""
     p = run.meta.get("parameters", {})
     x, y, psi = run["ship.x"], run["ship.y"], run["ship.psi"]
     tracks = [np.column_stack([r["ship.y"], r["ship.x"]]) for r in (run, *others)]

@@ -1,12 +1,13 @@
-"""Run an exported SSP package in ``libcosim`` (libcosimpy; also the OSP folder beside it),
-``ecos`` (ecospy) or ``fmpy`` (its SSP runner) in a child process: libcosimpy 0.0.6 aborts
-its host when an FMU fails, ecos 0.7.2 ignores FMI status codes (docs/interop.md)."""
+"""Run an SSP package (libcosim: or its OSP folder) in libcosim, ecos, fmpy or OMSimulator, in a
+child process: libcosimpy 0.0.6 aborts its host when an FMU fails, ecos 0.7.2 ignores statuses."""
 from __future__ import annotations
 
 import math
+import os
 import signal
 import subprocess
 import sys
+import sysconfig
 import tempfile
 import zipfile
 from pathlib import Path
@@ -104,16 +105,14 @@ RUNNERS = {"libcosim": _libcosim, "ecos": _ecos, "fmpy": _fmpy}
 
 def refuse_strings(ssp: Path, who: str) -> None:
     """EngineError if ``ssp`` binds a String away from its FMU's default: ``who`` sets none."""
-    dropped = unapplied_strings(ssp)
-    if dropped:
+    if dropped := unapplied_strings(ssp):
         raise EngineError(f"{who} applies no String binding; it would run " + ", ".join(
             f"{v} = {default!r}, not {value!r}" for v, (value, default) in dropped.items()))
 
 
 def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = TRACED) -> dict[str, np.ndarray]:
-    """The traced signals of ``ssp`` run in ``engine``; EngineError naming what it cannot run
-    (the file, a parameter, the FMUs) or with the child's output if it fails, ``Interrupted``
-    if SIGINT or SIGTERM ended it."""
+    """The traced signals of ``ssp`` run in ``engine``; EngineError naming what it cannot run or
+    with the child's output if it fails, ``Interrupted`` if SIGINT or SIGTERM ended it."""
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
     ssp = Path(ssp).resolve()
@@ -130,10 +129,9 @@ def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = TRACED) -> dict
                           f"{', '.join(newer)}: run it with ecos or OMSimulator, or export "
                           "the FMI 2.0 package (python -m cosim.export without --fmi 3)")
     for name, component in system.components.items():
-        for variable, value in component.parameters.items():
-            if isinstance(value, float) and not math.isfinite(value):
-                raise EngineError(f"{ssp.name}: parameter {name}.{variable} = {value} is not "
-                                  "finite")
+        for variable, x in component.parameters.items():
+            if isinstance(x, float) and not math.isfinite(x):
+                raise EngineError(f"{ssp.name}: parameter {name}.{variable} = {x} is not finite")
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "trace.npz"
         return child_trace(engine, ssp, [sys.executable, "-c", _CHILD, engine, str(ssp), str(out),
@@ -143,9 +141,8 @@ def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = TRACED) -> dict
 def child_trace(who: str, ssp: Path, argv: list[str], out: Path,
                 read: Callable[[Path], dict[str, np.ndarray]], timeout: float = 600.0,
                 **options: Any) -> dict[str, np.ndarray]:
-    """``read(out)`` after ``argv``, a child run of ``ssp``, wrote ``out``: ``Interrupted`` if a
-    signal stopped it, EngineError naming ``who`` with its output if it failed, ran out of time
-    or left a signal undefined (a tool that ignores FMI statuses goes on after a failed FMU)."""
+    """``read(out)`` once ``argv`` ran ``ssp``: ``Interrupted`` if a signal stopped it, else
+    EngineError with its output if it failed, ran out of time or left a signal undefined."""
     try:
         child = subprocess.run(argv, capture_output=True, text=True, timeout=timeout, **options)
     except subprocess.TimeoutExpired:
@@ -176,8 +173,8 @@ _CHILD = ("import sys\nfrom cosim.interop.engines import record\n"
 
 
 def record(engine: str, ssp: str, out: str, signals: tuple[str, ...]) -> int:
-    """The child's side of ``run``: the trace saved to ``out`` (.npz); 1 and the reason on
-    stderr if it fails; 130 or 143 if SIGINT or SIGTERM stopped it (between steps)."""
+    """The child's side of ``run``: 0 and the trace in ``out`` (.npz), 1 and the reason on
+    stderr, or 130 / 143 if SIGINT or SIGTERM stopped it."""
     try:
         with StopSignals() as stop:
             system = read_package(Path(ssp))
@@ -196,3 +193,47 @@ def record(engine: str, ssp: str, out: str, signals: tuple[str, ...]) -> int:
 def save_trace(path: Path, result: dict[str, np.ndarray]) -> None:
     with whole_file(path) as tmp, open(tmp, "wb") as f:
         np.savez(f, **result)
+
+
+_OMS_API = """import sys
+from OMSimulator import SSP
+ssp, result, step, temp = sys.argv[1:]
+model = SSP(ssp, temp_dir=temp).instantiate()
+model.setResultFile(result)
+model.setFixedStepSize(float(step))
+for call in (model.initialize, model.simulate, model.terminate, model.delete):
+    call()
+"""
+
+
+def omsimulator_result(path: Path) -> dict[str, np.ndarray]:
+    """'time' and each 'component.variable' of a result CSV, at each time its last row."""
+    header = path.read_text().split("\n", 1)[0].replace('"', "").split(",")
+    table = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    last = np.append(table[1:, 0] != table[:-1, 0], True)      # the last row of each time
+    return dict(zip(["time"] + [".".join(h.split(".")[-2:]) for h in header[1:]], table[last].T))
+
+
+def run_omsimulator(ssp: str | Path, home: str | Path, interface: str = "cli",
+                    timeout: float = 600.0) -> dict[str, np.ndarray]:
+    """The trace of ``ssp`` run in OMSimulator at ``home``, or EngineError with its output."""
+    if interface not in ("cli", "api"):
+        raise ValueError(f"interface must be one of cli, api, got {interface!r}")
+    ssp, home = Path(ssp).resolve(), Path(home).resolve()
+    refuse_strings(ssp, "OMSimulator")
+    system, site = read_package(ssp), sysconfig.get_paths()["purelib"]
+    with tempfile.TemporaryDirectory() as tmp:
+        result = Path(tmp) / "result.csv"
+        if interface == "cli":              # its Python FMUs need libpython loaded first
+            argv = [str(home / "bin" / "OMSimulator"), f"--stopTime={system.stop_time!r}",
+                    f"--startTime={system.start_time!r}", f"--resultFile={result}",
+                    f"--tempDir={tmp}", str(ssp)]
+            env = {"LD_PRELOAD": os.path.join(sysconfig.get_config_var("LIBDIR"),
+                                              sysconfig.get_config_var("LDLIBRARY")),
+                   "PYTHONPATH": site}
+        else:
+            argv = [sys.executable, "-c", _OMS_API, str(ssp), str(result),
+                    repr(system.step_size), tmp]
+            env = {"PYTHONPATH": os.pathsep.join([str(home / "lib" / "x86_64-linux-gnu"), site])}
+        return child_trace(f"OMSimulator ({interface})", ssp, argv, result, omsimulator_result,
+                           timeout, cwd=tmp, env={**os.environ, **env})

@@ -1,9 +1,10 @@
 """A scenario as one .ssp (SystemStructure.ssd, resources/<fmu>.fmu) and an OSP folder beside
-it, each whole or not at all; the route as numbers, since some tools set no String."""
+it (OspSystemStructure.xml, libcosim's schema 0.1), each whole or not at all."""
 from __future__ import annotations
 
 import shutil
 import tempfile
+import xml.etree.ElementTree as ET
 import zipfile
 from pathlib import Path
 
@@ -14,15 +15,81 @@ from autopilot_fmu.guidance import ROUTE_PARAMETERS, numeric_route, route
 from .. import scenarios
 from ..core.files import fresh_folder, whole_file
 from ..core.fmi import read_description
-from ..core.ssd import SystemDescription, Units, read_ssd, write_ssd
-from .osp import OSP_FILE, read_osp, write_osp
+from ..core.ssd import (Component, Connection, SystemDescription, Units, read_ssd, ssv_value,
+                        write_ssd)
+from ..core.values import fmi_value
 
 SSD_NAME = "SystemStructure.ssd"
 FMI2_ONLY = {"libcosim": "OSP libcosim", "fmpy": "fmpy's SSP runner"}   # FMI 2.0 FMUs only
+OSP_FILE = "OspSystemStructure.xml"
+NS = "http://opensimulationplatform.com/MSMI/OSPSystemStructure"
+
+
+def _q(tag: str) -> str:
+    return f"{{{NS}}}{tag}"
+
+
+def write_osp(system: SystemDescription, path: Path, sources: dict[str, str]) -> None:
+    """Write ``system`` at ``path``, ``sources`` each FMU relative to the file's folder."""
+    ET.register_namespace("", NS)
+    root = ET.Element(_q("OspSystemStructure"), version="0.1")
+    for tag, value in (("StartTime", system.start_time), ("EndTime", system.stop_time),
+                       ("BaseStepSize", system.step_size)):
+        ET.SubElement(root, _q(tag)).text = repr(value)
+    ET.SubElement(root, _q("Algorithm")).text = "fixedStep"
+    simulators = ET.SubElement(root, _q("Simulators"))
+    for name, component in system.components.items():
+        simulator = ET.SubElement(simulators, _q("Simulator"), name=name, source=sources[name],
+                                  stepSize=repr(system.step_size))
+        if component.parameters:
+            values = ET.SubElement(simulator, _q("InitialValues"))
+            for variable, value in component.parameters.items():
+                type_name, text = ssv_value(value)
+                initial = ET.SubElement(values, _q("InitialValue"), variable=variable)
+                ET.SubElement(initial, _q(type_name), value=text)
+    connections = ET.SubElement(root, _q("Connections"))
+    for c in system.connections:
+        connection = ET.SubElement(connections, _q("VariableConnection"))
+        ET.SubElement(connection, _q("Variable"), simulator=c.start_element, name=c.start_connector)
+        ET.SubElement(connection, _q("Variable"), simulator=c.end_element, name=c.end_connector)
+    ET.indent(root)
+    ET.ElementTree(root).write(path, encoding="utf-8", xml_declaration=True)
+
+
+def read_osp(path: Path) -> SystemDescription:
+    """The system in an OspSystemStructure.xml (or its folder); ValueError naming it."""
+    path = path / OSP_FILE if path.is_dir() else path
+    try:
+        root = ET.parse(path).getroot()
+    except (ET.ParseError, OSError) as error:
+        raise ValueError(f"cannot read OSP system structure {path}: {error}") from error
+    if root.tag != _q("OspSystemStructure"):
+        raise ValueError(f"{path} is not an OspSystemStructure")
+    components = {}
+    for simulator in root.iterfind(f"{_q('Simulators')}/{_q('Simulator')}"):
+        name, source = simulator.get("name"), simulator.get("source")
+        if not (name and source):
+            raise ValueError(f"{path}: a Simulator without name or source")
+        component = Component(name=name, source=source)
+        for initial in simulator.iterfind(f"{_q('InitialValues')}/{_q('InitialValue')}"):
+            (value,) = list(initial)
+            component.parameters[initial.get("variable", "")] = fmi_value(
+                f"{name}.{initial.get('variable')}", value.tag.rpartition("}")[2],
+                value.get("value", ""))
+        components[name] = component
+    connections = [Connection(start.get("simulator", ""), start.get("name", ""),
+                              end.get("simulator", ""), end.get("name", ""))
+                   for start, end in root.iterfind(f"{_q('Connections')}/"
+                                                   f"{_q('VariableConnection')}")]
+    start, stop, step = (fmi_value(f"{path.name} {tag}", "Real", root.findtext(_q(tag), "0.0"))
+                         for tag in ("StartTime", "EndTime", "BaseStepSize"))
+    return SystemDescription(name=path.parent.name, components=components,
+                             connections=connections, start_time=start, stop_time=stop,
+                             step_size=step, path=path)
 
 
 def _with_numeric_route(system: SystemDescription, fmus: dict[str, Path]) -> None:
-    """A String route replaced by its numbers where the FMU declares both (our guidance)."""
+    """A String route as numbers where the FMU declares both: some tools set no String."""
     for name, component in system.components.items():
         if not isinstance(component.parameters.get("waypoints"), str):
             continue

@@ -16,11 +16,6 @@ SCENARIO_DIR = Path(__file__).resolve().parent
 PAPER = ("calm_pd", "calm_smc", "waves_pd", "waves_smc")    # Tomera (2010), Tables 1-2
 
 
-def fmus() -> FmuFolders:
-    """Where this project builds its FMUs (``fmubuild.project``)."""
-    return FmuFolders(dict(project.FMU_DIRS), frozenset({*project.FMUS, *project.C_FMUS}))
-
-
 def names() -> list[str]:
     return sorted(p.stem for p in SCENARIO_DIR.glob("*.ssd"))
 
@@ -50,7 +45,8 @@ def load(scenario: str | Path, autopilot: str | Path | None = None,
          port_map: dict[str, str] | None = None, name: str | None = None,
          fmi: int | None = None) -> SystemDescription:
     """A scenario's system, this project's FMUs of FMI version ``fmi`` and ``autopilot`` in."""
-    system = read_ssd(path(scenario), fmus())
+    system = read_ssd(path(scenario), FmuFolders(dict(project.FMU_DIRS),
+                                                 frozenset({*project.FMUS, *project.C_FMUS})))
     if fmi is not None:
         system = with_fmi(system, fmi)
     return system if autopilot is None else with_autopilot(system, autopilot, port_map, name)

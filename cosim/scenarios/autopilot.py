@@ -1,6 +1,5 @@
-"""Your own autopilot in the paper's scenarios: an FMI 2.0 or 3.0 co-simulation FMU with inputs
-psi (rad), r (rad/s), psi_d (rad), output delta_c (rad) (docs/own_autopilot.md). A port in
-another unit is refused, not converted: a run never rests on a guess."""
+"""Your own autopilot in the paper's scenarios (docs/own_autopilot.md): the port contract checked,
+a port in another unit refused, not converted (a run never rests on a guess)."""
 from __future__ import annotations
 
 import copy
@@ -85,8 +84,7 @@ def check_autopilot(fmu: str | Path, port_map: dict[str, str] | None = None,
     if fmpy.platform not in platforms:
         raise AutopilotError(f"{fmu} has no binary for this platform ({fmpy.platform}); it has "
                              f"{', '.join(platforms) or 'none'}")
-    unknown = sorted(set(port_map) - set(PORTS))
-    if unknown:
+    if unknown := sorted(set(port_map) - set(PORTS)):
         close = [m for u in unknown for m in close_matches(u, PORTS)]
         raise AutopilotError(f"{fmu}: --map names {', '.join(map(repr, unknown))}, which "
                              f"{'is not a port' if len(unknown) == 1 else 'are not ports'} "

@@ -15,8 +15,7 @@ from ship_fmu.steering_gear import rudder_target
 from ship_fmu.thrusters import actuator_model
 
 from .. import scenarios
-from ..analysis.cost import LAMBDA
-from ..analysis.metrics import cost_terms
+from ..analysis.metrics import LAMBDA, cost_terms
 from ..core.master import Master
 from ..ensemble.reference import COMPONENTS, initialise
 from . import table

@@ -7,9 +7,9 @@ from dataclasses import dataclass
 
 from autopilot_fmu.guidance import R_ACCEPT, route as followed_route
 
-from ..analysis.cost import cost
-from ..analysis.metrics import (cross_track_error, fraction_at_stops, heading_error, mean_abs_rate,
-                                peak, rms, route_completion, rudder_reversals_per_minute)
+from ..analysis.metrics import (cost, cross_track_error, fraction_at_stops, heading_error,
+                                mean_abs_rate, peak, rms, route_completion,
+                                rudder_reversals_per_minute)
 
 # A run's figures of merit and their units, as cosim.run prints them (NaN in a failed run's row)
 METRICS = {"psi_E": "rad^2", "sum_delta2": "rad^2", "J": "rad^2", "rms_heading_error_deg": "deg",

@@ -7,8 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..analysis.cost import cost
-from ..analysis.metrics import RUDDER_DEADBAND, RouteCompletion, route_completion
+from ..analysis.metrics import RUDDER_DEADBAND, RouteCompletion, cost, route_completion
 from ..core.recording import Recording
 from . import table
 from .merit import CRITERIA, Merit, route_of, run_metrics

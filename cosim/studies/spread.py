@@ -7,7 +7,7 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from ..analysis.cost import LAMBDA, Cost, cost
+from ..analysis.metrics import LAMBDA, Cost, cost
 from ..core.master import Master
 from ..core.ssd import SystemDescription
 
