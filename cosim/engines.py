@@ -1,4 +1,4 @@
-"""Run an SSP package in another engine (``cosim.interop.engines``) and save the signals; a
+"""Run an SSP package in another engine (``cosim.interop.hosts``) and save the signals; a
 failure is status 1 with the engine's messages."""
 import argparse
 import sys
@@ -6,7 +6,7 @@ from pathlib import Path
 
 from ._cli import entry
 from .core.files import OutputError
-from .interop.engines import ENGINES, TRACED, EngineError, run, save_trace
+from .interop.hosts import ENGINES, TRACED, EngineError, run, save_trace
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -13,7 +13,7 @@ from fmpy.validation import validate_fmu
 
 from cosim import scenarios
 from cosim.core.master import Master
-from cosim.interop.engines import run as run_engine
+from cosim.interop.hosts import run as run_engine
 from cosim.interop.ssp import export
 from fmubuild import cli
 from fmubuild.project import ROOT

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cosim.interop.engines import TRACED, EngineError, run
+from cosim.interop.hosts import TRACED, EngineError, run
 from cosim.interop.ssp import export
 from fmukit.timebase import nanoseconds
 from helpers import ecos_missing, recorded

@@ -20,7 +20,7 @@ from cosim import engines as engines_cli
 from cosim import export as export_cli
 from cosim import scenarios
 from cosim.core.master import Master
-from cosim.interop.engines import EngineError, run, run_omsimulator
+from cosim.interop.hosts import EngineError, run, run_omsimulator
 from cosim.interop.ssp import export, fmi_versions
 from helpers import ecos_missing
 

@@ -19,8 +19,8 @@ from cosim import export as export_cli
 from cosim import scenarios
 from cosim.core.master import Master
 from cosim.core.ssd import write_ssd
-from cosim.interop.engines import EngineError
-from cosim.interop.engines import run_omsimulator as run
+from cosim.interop.hosts import EngineError
+from cosim.interop.hosts import run_omsimulator as run
 from cosim.interop.ssp import SSD_NAME, export, read_package
 
 ROOT = Path(__file__).resolve().parent.parent

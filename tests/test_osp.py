@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cosim.interop.engines import run
+from cosim.interop.hosts import run
 from cosim.interop.ssp import OSP_FILE, read_osp
 from cosim.interop.ssp import export, read_package
 

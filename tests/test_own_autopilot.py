@@ -12,7 +12,7 @@ import pytest
 from cosim import run as cli
 from cosim import scenarios
 from cosim.core.master import Master
-from cosim.interop.engines import run as run_engine
+from cosim.interop.hosts import run as run_engine
 from cosim.interop.ssp import export
 from cosim.scenarios.autopilot import AutopilotError, check_autopilot
 from cosim.studies import campaign, sweep_task

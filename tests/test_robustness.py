@@ -23,7 +23,7 @@ from cosim import scenarios
 from cosim.core.fmi import FmuInstance
 from cosim.core.master import Master
 from cosim.core.ssd import Component, Connection, SystemDescription, write_ssd
-from cosim.interop.engines import run as run_engine
+from cosim.interop.hosts import run as run_engine
 from cosim.interop.ssp import export
 from fmubuild.project import ROOT
 from helpers import command

@@ -168,7 +168,7 @@ def child_trace(who: str, ssp: Path, argv: list[str], out: Path,
     return trace
 
 
-_CHILD = ("import sys\nfrom cosim.interop.engines import record\n"
+_CHILD = ("import sys\nfrom cosim.interop.hosts import record\n"
           "sys.exit(record(sys.argv[1], sys.argv[2], sys.argv[3], tuple(sys.argv[4:])))\n")
 
 
