@@ -74,6 +74,7 @@ def test_the_example_test_file_passes_for_the_pd_the_pid_and_the_c_autopilot(
     result.assert_outcomes(passed=8)
 
 
+@pytest.mark.long     # the quick suite: the example file passing and failing, above and below
 def test_the_example_test_file_tells_what_the_smc_as_printed_does(fmu_paths, pytester):
     """It turns slowly (eq 39, k2 = -2000; docs/reproduction.md): over 25 deg off course 60 s
     after the first turn, held here to 30 deg. And it asks for rudder it cannot have, and

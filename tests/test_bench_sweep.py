@@ -17,6 +17,7 @@ def _figure(pattern: str, text: str) -> float:
     return float(found.group(1))
 
 
+@pytest.mark.long          # the quick suite: the campaign below, on the same sweep code
 @pytest.mark.timeout(120, method="thread")
 def test_throughput_prints_per_core_rates_and_the_goal_from_what_it_measured(fmu_paths,
                                                                               capsys):
@@ -54,6 +55,7 @@ def test_campaign_times_the_sweep_and_judges_only_the_issues_campaign(fmu_paths,
     assert "not judged here" in out and "goal:" not in out
 
 
+@pytest.mark.long
 @pytest.mark.timeout(90, method="thread")
 def test_memory_counts_the_results_and_judges_full_batches(fmu_paths, capsys):
     found = memory.batch_memory((2, 4), 2.0, batch_size=2)

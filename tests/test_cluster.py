@@ -87,6 +87,7 @@ def cluster(wheel_python, tmp_path):
             process.wait(timeout=10)
 
 
+@pytest.mark.long      # the quick suite runs sweeps on local clusters (test_sweep.py)
 @pytest.mark.timeout(300, method="signal")
 def test_a_wheel_cluster_runs_a_sweep_and_loses_only_the_runs_in_flight(
         fmu_paths, cluster, tmp_path):

@@ -84,7 +84,9 @@ def varied_members() -> list[dict]:
             {"ship": {"Hs": 0.01, "T0": 1.1, "wave_seed": 7}}]
 
 
-@pytest.mark.parametrize("scenario", COURSE_KEEPING)
+@pytest.mark.parametrize("scenario", [   # quick: a calm and a waves run, a PD and an SMC
+    s if s in ("calm_pd", "waves_smc") else pytest.param(s, marks=pytest.mark.long)
+    for s in COURSE_KEEPING])
 def test_every_member_equals_its_in_process_run(scenario):
     system = scenarios.load(scenario)
     members = varied_members()
@@ -100,7 +102,8 @@ def test_every_member_equals_its_in_process_run(scenario):
         assert batch.meta["parameters"] == in_process(system, member, 1.0).meta["parameters"]
 
 
-@pytest.mark.parametrize("scenario", ("waves_pd", "waves_smc"))
+@pytest.mark.parametrize("scenario", ("waves_pd", pytest.param("waves_smc",
+                                                            marks=pytest.mark.long)))
 def test_full_runs_of_the_paper_equal_in_process_runs(scenario):
     """400 s, where the chattering SMC turns any last bit into a visibly different run."""
     system = scenarios.load(scenario)

@@ -4,9 +4,10 @@ A crash of the host ends the child with a signal, a hang hits the time limit: bo
 here instead of taking the test session down. FMI 2.0: 1,500 examples per FMU, one
 campaign at a time. The FMI 3.0 twins: 500 examples per twin, two campaigns at a time
 (``fmi3_campaigns``): an FMI 3.0 example costs more (fmpy loads every FMI 3.0 function at
-each instantiation). The quick suite (without ``pytest --long``) fuzzes every FMU and twin
-with 300 and 250 examples (``EXAMPLES``), against thresholds that are the same fractions of
-the examples (fewer examples miss the valid path of some FMUs). The documented long run
+each instantiation). The quick suite (without ``pytest --long``) fuzzes every FMU with 300
+examples and the ship's and the PD autopilot's twins with 250 (``EXAMPLES``), against
+thresholds that are the same fractions of the examples (fewer examples miss the valid path
+of some FMUs). The documented long run
 takes 10,000 of either (docs/robustness.md).
 """
 from __future__ import annotations
@@ -64,7 +65,9 @@ def fmi3_campaigns(request, fmi3_paths, long_run) -> dict[str, Future]:
         return {name: pool.submit(_fuzz, name, 3, EXAMPLES[3][long_run]) for name in names}
 
 
-@pytest.mark.parametrize("name", FUZZED[3])
+@pytest.mark.parametrize("name", [     # quick: the ship's twin and an autopilot's
+    n if n in ("ship", "pd_autopilot") else pytest.param(n, marks=pytest.mark.long)
+    for n in FUZZED[3]])
 def test_fmi3_twins_refuse_fuzzed_calls_by_name_and_never_crash_or_hang(fmi3_campaigns,
                                                                       long_run, name):
     examples = EXAMPLES[3][long_run]

@@ -19,7 +19,8 @@ def packages(fmu_paths, tmp_path_factory) -> dict[str, Path]:
     return {name: export(name, out) for name in NAMES}
 
 
-@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("name", [NAMES[0], *(pytest.param(n, marks=pytest.mark.long)
+                                              for n in NAMES[1:])])   # quick: calm_pd
 def test_libcosim_runs_the_osp_file_to_the_same_bits_as_the_package(packages, name):
     ssp = packages[name]
     folder = ssp.with_suffix("")

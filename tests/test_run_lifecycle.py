@@ -166,8 +166,9 @@ def test_whole_file_and_outputs_leave_nothing_when_interrupted(tmp_path):
     assert _folder(tmp_path) == {"x.ssp": b"old", "x.csv": b"old"}
 
 
-@pytest.mark.parametrize("backend", ["fmi", "inprocess"])
-@pytest.mark.parametrize("kind", ["loop", "block"])
+@pytest.mark.parametrize("kind, backend", [    # quick: each kind and each backend once
+    ("loop", "fmi"), ("block", "inprocess"), pytest.param("block", "fmi", marks=pytest.mark.long),
+    pytest.param("loop", "inprocess", marks=pytest.mark.long)])
 def test_a_hung_fmu_ends_at_the_step_time_limit_with_its_rows(hung, kind, backend, tmp_path,
                                                                reference):
     started = time.monotonic()
@@ -434,7 +435,7 @@ def test_an_absolute_fmu_source_that_is_missing_is_not_replaced_by_one_of_its_na
         system.fmu_path("autopilot")
 
 
-@pytest.mark.parametrize("backend", ["fmi", "inprocess"])
+@pytest.mark.parametrize("backend", ["inprocess", pytest.param("fmi", marks=pytest.mark.long)])
 def test_an_fmu_that_hangs_in_terminate_keeps_the_finished_run(fmu_paths, tmp_path, backend,
                                                                faulty_fmu):
     """Nothing is raised into fmi2Terminate (an exception there has no safe way out of

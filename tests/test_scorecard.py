@@ -177,6 +177,7 @@ def test_the_scorecard_refuses_a_name_that_is_a_baseline_s(fmu_paths, tmp_path, 
     assert not (tmp_path / "s").exists()
 
 
+@pytest.mark.long    # the quick suite: the scorecard of an autopilot that works, above
 def test_an_autopilot_that_fails_is_scored_as_failed_and_the_rest_goes_on(tmp_path, capsys,
                                                                          faulty_fmu, scheduler):
     failing = faulty_fmu("idle_pilot")

@@ -341,6 +341,7 @@ def test_a_comparison_that_cannot_be_written_leaves_the_old_one(tmp_path, monkey
 
 
 # -- a rebuild of unchanged sources reruns nothing --------------------------------------
+@pytest.mark.long     # the quick suite resumes sweeps in test_sweep.py
 @pytest.mark.timeout(120, method="thread")
 def test_a_finished_sweep_resumed_after_a_rebuild_reruns_nothing(fmu_paths, tmp_path, capsys):
     """The FMUs are built into a folder of the test's, the sweep runs on waves_pd pointed at
