@@ -17,7 +17,7 @@ import pytest
 
 import cosim
 from cosim.studies import campaign, sweep_task
-from cosim.studies.sweep_client import _say_batch_refusals, plan
+from cosim.studies.sweep_client import plan
 from cosim.studies.sweep_spec import Spec
 
 from helpers import fmu_variant

@@ -7,7 +7,8 @@ import ctypes
 from typing import Any, Callable
 from xml.etree.ElementTree import Element, SubElement
 
-from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Integer, Real
+from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Variability, Integer, Real
+from pythonfmu import Fmi2Slave  # noqa: F401  fmukit.compose takes the base class from here
 from pythonfmu import String
 from pythonfmu.enums import Fmi2Status
 

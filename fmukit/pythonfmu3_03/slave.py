@@ -6,7 +6,8 @@ from __future__ import annotations
 from typing import Any, Callable
 from xml.etree.ElementTree import Element, SubElement
 
-from pythonfmu3 import Fmi3Causality, Fmi3Initial, Fmi3Slave, Fmi3Status, Fmi3StepResult
+from pythonfmu3 import Fmi3Causality, Fmi3Initial, Fmi3Status, Fmi3StepResult
+from pythonfmu3 import Fmi3Slave  # noqa: F401  fmukit.compose takes the base class from here
 from pythonfmu3 import Fmi3Variability, Float64, Int32, String
 
 from ..entry import fmi_entry
