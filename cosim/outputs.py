@@ -140,13 +140,13 @@ def _analyse(outcome: Outcome, system: SystemDescription, kind: Analysis, label:
              outputs: Outputs, options: Options, parameters: dict) -> None:
     recording = outcome.recording
     outcome.report = kind.report(recording, lam=options.lam, parameters=parameters)
-    from .analysis.animation import animate           # matplotlib, only where it draws
-    from .analysis.figures import save_figure
     if options.plot and kind.figure is not None:
+        from .analysis.figures import save_figure     # matplotlib: only a run that draws
         with outputs.writing(f"{label}.{options.formats[0]}") as path:
             outcome.written += save_figure(recording, kind.figure, path.with_suffix(""),
                                            label, options.formats, lam=options.lam)
     if options.animate:
+        from .analysis.animation import animate
         with outputs.writing(f"{label}.{options.animate}") as path:
             outcome.written.append(animate(recording, path.with_suffix(""), label,
                                            options.animate))

@@ -117,13 +117,15 @@ def test_the_plugin_checks_say_what_is_wrong_and_when(fmu_paths):
         check_rudder_rate(simulate("calm_pd"), share=0.01)
 
 
-def test_importing_cosim_and_its_pytest_plugin_picks_no_backend_and_takes_no_signal():
+def test_importing_cosim_and_its_pytest_plugin_picks_no_backend_and_takes_no_signal(tmp_path):
     """An import has no side effects on the process: matplotlib's backend is left for the
     caller to choose (the commands that draw do it without pyplot), and SIGINT and SIGTERM
-    keep Python's own handlers; nor do the run and sweep commands load matplotlib before they
-    draw (every run in a child process would pay for it). A fresh interpreter, since this is
-    about the process."""
+    keep Python's own handlers; nor do the run and sweep commands load matplotlib unless they
+    draw (every run in a child process would pay for it), not even after a run without a
+    figure. A fresh interpreter, since this is about the process."""
     probe = ("import signal, sys, cosim, cosim.testing, cosim.run, cosim.sweep\n"
+             f"cosim.run.main(['calm_pd', '--no-plot', '--stop-time', '1', '--out', "
+             f"{str(tmp_path)!r}])\n"
              "assert 'matplotlib' not in sys.modules\nimport matplotlib\n"
              "assert matplotlib.rcParams._get_backend_or_none() is None\n"
              "assert signal.getsignal(signal.SIGINT) is signal.default_int_handler\n"
