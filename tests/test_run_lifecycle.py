@@ -239,6 +239,25 @@ def test_a_second_signal_ends_the_run_at_once_keeping_the_earlier_results(hung, 
     assert _folder(tmp_path) == {"block.csv": b"earlier\n"}
 
 
+@pytest.mark.parametrize("first", ["raised", "between steps"])
+def test_a_second_signal_while_the_first_is_handled_ends_the_command_at_once(first):
+    """The second Ctrl-C may fall anywhere after the first (here: while a command keeps what it
+    did, in a weakref callback as the garbage collector runs): one line, no traceback."""
+    catch = ("with StopSignals() as stop:\n        os.kill(os.getpid(), signal.SIGINT)\n"
+             "    stop.check()" if first == "between steps" else
+             "os.kill(os.getpid(), signal.SIGINT)\n    time.sleep(5)")
+    code = ("import gc, os, signal, sys, time, weakref\n"
+            "from cosim._cli import entry\nfrom cosim.core.interrupt import Interrupted, "
+            "StopSignals\nclass Kept: pass\n"
+            "def main():\n  try:\n    " + catch + "\n  except Interrupted:\n"
+            "    kept = Kept()\n    weakref.finalize(kept, os.kill, os.getpid(), signal.SIGINT)\n"
+            "    del kept\n    gc.collect()\n    time.sleep(5)\n    print('not ended')\n"
+            "  return 0\nsys.exit(entry(main))\n")
+    done = subprocess.run([PY, "-c", code], capture_output=True, text=True, timeout=60)
+    assert (done.returncode, done.stdout, done.stderr) == (130, "",
+                                                           "SIGINT again: stopped at once\n")
+
+
 def test_the_run_time_limit_keeps_the_rows(tmp_path, capsys):
     assert cli.main(["calm_pd", "--out", str(tmp_path), "--backend", "inprocess",
                      "--stop-time", "100000", "--stream", "--run-timeout", "1"]) == 1

@@ -40,6 +40,8 @@ class StopSignals:
 
     def __exit__(self, *exc) -> None:
         give_back(self._previous)
+        if self.received is not None and not _received:    # a later one ends at once
+            _received.append(self.received)
 
     def receive(self, number: signal.Signals) -> None:
         """The first signal asks the run to stop between steps; a second ends the process at
@@ -83,13 +85,24 @@ class Interrupted(BaseException):
         super().__init__(f"interrupted by {self.signal.name}")
 
 
+_received: list[signal.Signals] = []      # this command's signals so far
+
+
 def _raise(number: int, frame) -> None:
+    """The first signal raises ``Interrupted``; one more while it is handled (what was done
+    being kept) ends the process at once, as in ``StopSignals``."""
+    number = signal.Signals(number)
+    if _received:
+        print(f"{number.name} again: stopped at once", file=sys.stderr, flush=True)
+        os._exit(128 + _received[0])
+    _received.append(number)
     raise Interrupted(number)
 
 
 @contextmanager
 def raise_on_signals() -> Iterator[None]:
-    """Within: SIGINT and SIGTERM raise ``Interrupted`` (main thread only)."""
+    """Within: SIGINT and SIGTERM raise ``Interrupted``, once (main thread only)."""
+    _received.clear()
     previous = take_signals(_raise)
     try:
         yield
