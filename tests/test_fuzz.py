@@ -4,11 +4,11 @@ A crash of the host ends the child with a signal, a hang hits the time limit: bo
 here instead of taking the test session down. FMI 2.0: 1,500 examples per FMU, one
 campaign at a time. The FMI 3.0 twins: 500 examples per twin, two campaigns at a time
 (``fmi3_campaigns``): an FMI 3.0 example costs more (fmpy loads every FMI 3.0 function at
-each instantiation). The quick suite (without ``pytest --long``) fuzzes every FMU with 300
-examples and the ship's and the PD autopilot's twins with 250 (``EXAMPLES``), against
-thresholds that are the same fractions of the examples (fewer examples miss the valid path
-of some FMUs). The documented long run
-takes 10,000 of either (docs/robustness.md).
+each instantiation). The quick suite (without ``pytest --long``) fuzzes the ship, the PD
+autopilot and the guidance with 300 examples and the ship's and the PD autopilot's twins with
+250 (``EXAMPLES``), against thresholds that are the same fractions of the examples (fewer
+examples miss the valid path of some FMUs). The documented long run takes 10,000 of either
+(docs/robustness.md).
 """
 from __future__ import annotations
 
@@ -44,7 +44,9 @@ def _counts(child: subprocess.CompletedProcess, name: str) -> dict:
     return counts
 
 
-@pytest.mark.parametrize("name", FMUS)
+@pytest.mark.parametrize("name", [   # quick: the ship, an autopilot and the guidance
+    n if n in ("ship", "pd_autopilot", "guidance") else pytest.param(n, marks=pytest.mark.long)
+    for n in FMUS])
 def test_fuzzed_calls_are_refused_by_name_and_never_crash_or_hang(fmu_paths, long_run, name):
     examples = EXAMPLES[2][long_run]
     counts = _counts(_fuzz(name, 2, examples), name)

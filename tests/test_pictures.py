@@ -5,11 +5,13 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import sys
 
 import numpy as np
 import pytest
 from fmpy import read_model_description
 from matplotlib.patches import Circle, Polygon
+from tqdm import tqdm
 
 from cosim import run as cli
 from cosim import simulate
@@ -125,10 +127,11 @@ def test_animate_writes_a_gif_with_one_frame_per_tenth_of_a_second_of_video(fmu_
                                                                            tmp_path):
     from PIL import Image
 
-    run = simulate("calm_pd", stop_time=100)
+    assert len(frame_times(np.arange(1001.0))) == 250            # a 25 s video at most
+    run = simulate("calm_pd", stop_time=5)
     gif = animate(run, tmp_path / "calm_pd", "calm_pd", "gif")
     with Image.open(gif) as image:
-        assert image.n_frames == len(frame_times(run.t)) == 250
+        assert image.n_frames == len(frame_times(run.t)) == 51
         assert image.info["duration"] == 100                      # 10 frames per second
     assert [p.name for p in tmp_path.iterdir()] == ["calm_pd.gif"]
 
@@ -177,9 +180,18 @@ def test_svg_and_pdf_on_request(fmu_paths, tmp_path):
     assert (tmp_path / "calm_pd.pdf").read_bytes()[:4] == b"%PDF"
 
 
-def test_no_progress_bar_where_standard_error_is_not_a_terminal(fmu_paths, tmp_path, capsys):
-    assert cli.main(["calm_pd", "--stop-time", "3000", "--no-plot", "--out",
-                     str(tmp_path)]) == 0
+def test_no_progress_bar_where_standard_error_is_not_a_terminal(fmu_paths, tmp_path, capsys,
+                                                                monkeypatch):
+    """tqdm's own test of the terminal (``disable=None``), on the command's standard error."""
+    bars = []
+
+    def bar(**options):
+        bars.append((options, tqdm(**options)))
+        return bars[-1][1]
+    monkeypatch.setattr(cli, "tqdm", bar)
+    assert cli.main(["calm_pd", "--stop-time", "10", "--no-plot", "--out", str(tmp_path)]) == 0
+    ((options, made),) = bars
+    assert options["file"] is sys.stderr and options["disable"] is None and made.disable
     assert "step/s" not in capsys.readouterr().err
 
 

@@ -177,7 +177,7 @@ def test_dask_sweep_writes_resumes_and_plots(fmu_paths, tmp_path, capsys, schedu
     (out / "runs.jsonl").write_text("\n".join([json.dumps(failed), *journal[1:3], torn]))
     # resumed in-process: the same rows, bit for bit (the backend is not part of a run's id)
     assert spec.backend_notes("inprocess") == []
-    again = campaign.execute(spec, out, workers=1, progress=False, backend="inprocess")
+    again = campaign.execute(spec, out, scheduler, progress=False, backend="inprocess")
     err = capsys.readouterr().err
     assert "is not a whole journal row" in err and "2 of 4 runs already done in" in err
     assert [r["J"] for r in again] == [r["J"] for r in rows]
@@ -213,9 +213,12 @@ def test_a_worker_killed_on_every_retry_is_recorded_as_failed(fmu_paths, tmp_pat
     It waits for a worker as long as its time limit allows: a restart on a busy machine
     took longer than the sweep's default minute."""
     from sweep_faults import killing_task
+    import dask
+
     spec = Spec.read(write_spec(tmp_path, 'stop_time = 5\n[axes]\nwave_seed = [1, 2]\n'))
-    rows = campaign.execute(spec, tmp_path, workers=1, progress=False, task=killing_task,
-                            no_worker_timeout=500)
+    with dask.config.set({"distributed.scheduler.allowed-failures": 1}):    # two deaths, not 4
+        rows = campaign.execute(spec, tmp_path, workers=1, progress=False, task=killing_task,
+                                no_worker_timeout=500)
     by_seed = {(r["controller"], r["wave_seed"]): r for r in rows}
     assert by_seed[("pd", 1)]["status"] == "ok"
     assert by_seed[("pd", 2)]["status"] == "failed"
@@ -326,7 +329,7 @@ def test_when_every_run_fails_the_summary_still_names_each_failure(fmu_paths, tm
 
 @pytest.mark.timeout(300)
 def test_a_finished_sweep_removes_what_an_earlier_spec_of_its_name_wrote(fmu_paths, tmp_path,
-                                                                        capsys):
+                                                                        capsys, scheduler):
     """Run a spec with pd and smc, then one of the same name with pd alone: the ratio map
     and comparison.md of the first would otherwise stand beside the second's tables."""
     from cosim import sweep as command
@@ -335,15 +338,15 @@ def test_a_finished_sweep_removes_what_an_earlier_spec_of_its_name_wrote(fmu_pat
     alone = SMALL.replace('map = ["wave_seed", "ship.delta_rate_max"]', "") + \
         '[controllers]\npd = { scenario = "waves_pd" }\n'
     out = tmp_path / "out"
-    assert command.main([str(write_spec(tmp_path, both)), "--out", str(out), "--workers", "1",
-                         "--no-progress"]) == 0
+    assert command.main([str(write_spec(tmp_path, both)), "--out", str(out), "--scheduler",
+                         scheduler, "--no-progress"]) == 0
     assert {"comparison.md", "J_smc_over_pd.png"} <= {p.name for p in (out / "small").iterdir()}
     # a clean finish leaves no lock and no hidden file
     assert [p.name for p in (out / "small").iterdir()
             if p.name.startswith(".") or p.suffix == ".lock"] == []
     (out / "small" / "notes.txt").write_text("the user's")
-    assert command.main([str(write_spec(tmp_path, alone)), "--out", str(out), "--workers", "1",
-                         "--no-progress"]) == 0
+    assert command.main([str(write_spec(tmp_path, alone)), "--out", str(out), "--scheduler",
+                         scheduler, "--no-progress"]) == 0
     left = {p.name for p in (out / "small").iterdir()}
     assert "comparison.md" not in left and "J_smc_over_pd.png" not in left
     assert {"results.parquet", "results.json", "J_distribution.png", "notes.txt"} <= left

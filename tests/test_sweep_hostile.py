@@ -343,7 +343,8 @@ def test_a_comparison_that_cannot_be_written_leaves_the_old_one(tmp_path, monkey
 # -- a rebuild of unchanged sources reruns nothing --------------------------------------
 @pytest.mark.long     # the quick suite resumes sweeps in test_sweep.py
 @pytest.mark.timeout(120, method="thread")
-def test_a_finished_sweep_resumed_after_a_rebuild_reruns_nothing(fmu_paths, tmp_path, capsys):
+def test_a_finished_sweep_resumed_after_a_rebuild_reruns_nothing(fmu_paths, tmp_path, capsys,
+                                                                  scheduler):
     """The FMUs are built into a folder of the test's, the sweep runs on waves_pd pointed at
     them, they are built again from the same sources, and the sweep is resumed."""
     built = tmp_path / "fmus"
@@ -364,13 +365,13 @@ def test_a_finished_sweep_resumed_after_a_rebuild_reruns_nothing(fmu_paths, tmp_
     assert set(spec.files().values()) == {built / name for name in before}
     out = tmp_path / "out"
     out.mkdir()
-    rows = campaign.execute(spec, out, workers=1, progress=False)
+    rows = campaign.execute(spec, out, scheduler, progress=False)
     assert [r["status"] for r in rows] == ["ok", "ok"]
     journal = (out / "runs.jsonl").read_text()
     assert build() == before                                   # the same bytes
     capsys.readouterr()
-    again = campaign.execute(Spec.read(tmp_path / "spec.toml"), out, workers=1,
-                          progress=False)
+    again = campaign.execute(Spec.read(tmp_path / "spec.toml"), out, scheduler,
+                             progress=False)
     assert "2 of 2 runs already done" in capsys.readouterr().err
     assert (out / "runs.jsonl").read_text() == journal and again == rows
 
