@@ -67,23 +67,14 @@ def journal(out: Path) -> dict[str, dict]:
 
 
 @pytest.fixture(scope="module")
-def cluster():
-    from cosim.studies.cluster import local_cluster
-
-    cluster = local_cluster(2)
-    yield cluster
-    cluster.close()
-
-
-@pytest.fixture(scope="module")
-def mixed(fmu_paths, cluster, tmp_path_factory) -> tuple[Spec, dict, dict]:
+def mixed(fmu_paths, scheduler, tmp_path_factory) -> tuple[Spec, dict, dict]:
     """MIXED run on both routes: (its spec, the in-process journal, the batch journal)."""
     folder = tmp_path_factory.mktemp("mixed")
     spec = Spec.read(write_spec(folder, MIXED))
     journals = {}
     for backend in ("inprocess", "batch"):
         (folder / backend).mkdir()
-        rows = campaign.execute(spec, folder / backend, scheduler=cluster.scheduler_address,
+        rows = campaign.execute(spec, folder / backend, scheduler=scheduler,
                              progress=False, backend=backend)
         assert [r["status"] for r in rows] == ["ok"] * 10
         journals[backend] = journal(folder / backend)
@@ -107,12 +98,12 @@ def test_a_batch_sweep_journals_the_in_process_rows(mixed):
 
 @pytest.mark.timeout(240, method="thread")
 @pytest.mark.parametrize("first, then", [("inprocess", "batch"), ("batch", "inprocess")])
-def test_a_sweep_resumes_on_the_other_backend(mixed, cluster, tmp_path, first, then):
+def test_a_sweep_resumes_on_the_other_backend(mixed, scheduler, tmp_path, first, then):
     spec, *full = mixed
     done = dict(zip(("inprocess", "batch"), full))[first]
     kept = list(done.values())[:5]
     (tmp_path / "runs.jsonl").write_text("".join(json.dumps(r) + "\n" for r in kept))
-    rows = campaign.execute(spec, tmp_path, scheduler=cluster.scheduler_address, progress=False,
+    rows = campaign.execute(spec, tmp_path, scheduler=scheduler, progress=False,
                          backend=then)
     assert len(rows) == 10
     resumed = journal(tmp_path)
@@ -167,7 +158,7 @@ def test_a_batch_has_the_time_limits_of_its_runs_together():
 
 
 @pytest.mark.timeout(240, method="thread")
-def test_a_foreign_autopilot_runs_alone_in_process_with_a_note(fmu_paths, cluster, tmp_path,
+def test_a_foreign_autopilot_runs_alone_in_process_with_a_note(fmu_paths, scheduler, tmp_path,
                                                               capsys):
     """Our PD without its manifest is an FMU not built with fmukit: not the kernel's."""
     from cosim import sweep as command
@@ -189,7 +180,7 @@ def test_a_foreign_autopilot_runs_alone_in_process_with_a_note(fmu_paths, cluste
     assert [[j.run["controller"] for j in b] for b in plan_batches] == [["pd", "pd"]]
     assert [j.run["controller"] for j in alone] == ["mine", "mine"]
     assert command.main([str(spec_file), "--backend", "batch", "--scheduler",
-                         cluster.scheduler_address, "--out", str(tmp_path / "out"),
+                         scheduler, "--out", str(tmp_path / "out"),
                          "--no-progress"]) == 0
     assert f"note: controller 'mine' runs on the in-process route, one run per task, not in " \
            f"batches: {why}" in capsys.readouterr().err
@@ -325,11 +316,11 @@ def killing_batch(jobs, blobs):
 
 
 @pytest.mark.timeout(240, method="thread")
-def test_a_batch_whose_worker_dies_on_every_retry_runs_each_run_alone(fmu_paths, cluster,
+def test_a_batch_whose_worker_dies_on_every_retry_runs_each_run_alone(fmu_paths, scheduler,
                                                                      tmp_path):
     spec = Spec.read(write_spec(tmp_path, "stop_time = 5\n[controllers]\n"
                                                 'pd = "waves_pd"\n[axes]\nwave_seed = [1, 2]\n'))
-    rows = campaign.execute(spec, tmp_path, scheduler=cluster.scheduler_address, progress=False,
+    rows = campaign.execute(spec, tmp_path, scheduler=scheduler, progress=False,
                          backend="batch", batch_task=killing_batch, no_worker_timeout=60)
     assert [r["status"] for r in rows] == ["ok", "ok"]
     for row in rows:

@@ -213,12 +213,9 @@ def test_a_worker_killed_on_every_retry_is_recorded_as_failed(fmu_paths, tmp_pat
     It waits for a worker as long as its time limit allows: a restart on a busy machine
     took longer than the sweep's default minute."""
     from sweep_faults import killing_task
-    import dask
-
     spec = Spec.read(write_spec(tmp_path, 'stop_time = 5\n[axes]\nwave_seed = [1, 2]\n'))
-    with dask.config.set({"distributed.scheduler.allowed-failures": 1}):    # two deaths, not 4
-        rows = campaign.execute(spec, tmp_path, workers=1, progress=False, task=killing_task,
-                                no_worker_timeout=500)
+    rows = campaign.execute(spec, tmp_path, workers=1, progress=False, task=killing_task,
+                            no_worker_timeout=500)
     by_seed = {(r["controller"], r["wave_seed"]): r for r in rows}
     assert by_seed[("pd", 1)]["status"] == "ok"
     assert by_seed[("pd", 2)]["status"] == "failed"
@@ -284,26 +281,19 @@ def test_a_sweep_on_a_cluster_that_never_had_a_worker_stops_too(fmu_paths, tmp_p
 
 
 @pytest.mark.timeout(300, method="thread")
-def test_two_sweeps_on_one_cluster_both_finish_with_every_row(fmu_paths, tmp_path):
+def test_two_sweeps_on_one_cluster_both_finish_with_every_row(fmu_paths, tmp_path, scheduler):
     """Each sweep frees only its own FMUs: the first to end must not free the other's."""
     from concurrent.futures import ThreadPoolExecutor
-
-    from cosim.studies.cluster import local_cluster
 
     for name in ("short", "long"):
         (tmp_path / name).mkdir()
     specs = [Spec.read(write_spec(tmp_path / name, text)) for name, text in (
         ("short", 'name = "short"\nstop_time = 5\n[axes]\nwave_seed = [1, 2]\n'),
         ("long", 'name = "long"\nstop_time = 60\n[axes]\nwave_seed = [1, 2, 3]\n'))]
-    cluster = local_cluster(2)
-    try:
-        with ThreadPoolExecutor(2) as pool:
-            running = [pool.submit(campaign.execute, spec, tmp_path / spec.name,
-                                   scheduler=cluster.scheduler_address, progress=False)
-                       for spec in specs]
-            done = [future.result(timeout=240) for future in running]   # not stuck
-    finally:
-        cluster.close()
+    with ThreadPoolExecutor(2) as pool:
+        running = [pool.submit(campaign.execute, spec, tmp_path / spec.name,
+                               scheduler=scheduler, progress=False) for spec in specs]
+        done = [future.result(timeout=240) for future in running]   # not stuck
     assert [len(rows) for rows in done] == [4, 6]
     assert all(r["status"] == "ok" for rows in done for r in rows), done
 
