@@ -185,19 +185,13 @@ class FmuInstance(Instance):
                 self._status(what, status, before)
         return values, run
 
-    def _reader(self, kind: str, vrs: list[int]) -> Callable[[], list]:
+    def reader(self, vrs: list[int], kind: str = "Real") -> Callable[[], list]:
         values, run = self._raw("get", kind, vrs)
 
         def read() -> list:
             run()
             return values[:]
         return read
-
-    def reader(self, vrs: list[int]):
-        return self._reader("Real", vrs)
-
-    def integer_reader(self, vrs: list[int]):
-        return self._reader("Integer", vrs)
 
     def writer(self, vrs: list[int]):
         values, run = self._raw("set", "Real", vrs)

@@ -162,11 +162,9 @@ class InProcessInstance(Instance):
                                                 else name))
 
     # Prepared calls: the slave's own plans (until ``reset``), else or if one raises: as FMI
-    def reader(self, vrs: list[int]):
-        return _prepared(self.slave.plans.real_reader(vrs), super().reader(vrs))
-
-    def integer_reader(self, vrs: list[int]):
-        return _prepared(self.slave.plans.integer_reader(vrs), super().integer_reader(vrs))
+    def reader(self, vrs: list[int], kind: str = "Real"):
+        plan = getattr(self.slave.plans, f"{kind.lower()}_reader")(vrs)
+        return _prepared(plan, super().reader(vrs, kind))
 
     def writer(self, vrs: list[int]):
         return self.slave.plans.input_writer(vrs) or super().writer(vrs)

@@ -122,11 +122,8 @@ class Instance:
         self.stepper()(t, h)
 
     # Prepared calls for a fixed list of value references, valid until ``reset``.
-    def reader(self, vrs: list[int]) -> Callable[[], list[float]]:
-        return lambda: self.call("getReal", self.fmi("getReal"), vrs)
-
-    def integer_reader(self, vrs: list[int]) -> Callable[[], list[int]]:
-        return lambda: self.call("getInteger", self.fmi("getInteger"), vrs)
+    def reader(self, vrs: list[int], kind: str = "Real") -> Callable[[], list]:
+        return lambda: self.call(f"get{kind}", self.fmi(f"get{kind}"), vrs)
 
     def writer(self, vrs: list[int]) -> Callable[[list[float]], None]:
         return lambda values: self.call("setReal", self.fmi("setReal"), vrs, values)
