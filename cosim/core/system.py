@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from fmukit.timebase import MAX_TIME, nanoseconds, on_time_base, seconds, step_count
+from fmukit.timebase import nanoseconds, seconds, step_count
 
 from .errors import FmuNotFound, close_matches, did_you_mean
 
@@ -86,19 +86,6 @@ class SystemDescription:
         h = seconds(nanoseconds(self.step_size))
         return self.start_time, h, step_count(
             self.start_time, self.stop_time if stop_time is None else stop_time, h)
-
-    def check_times(self) -> None:
-        """ValueError unless start, stop and step are on the time base, within what an FMU
-        takes, with a whole number of steps from start to stop."""
-        for name, t in (("startTime", self.start_time), ("stopTime", self.stop_time),
-                        ("baseStepSize", self.step_size)):
-            if abs(t) > MAX_TIME:
-                raise ValueError(f"{name} {t!r} s is beyond +-{MAX_TIME:g} s, the times an FMU "
-                                 "takes (fmukit.timebase)")
-            if on_time_base(t) != t:
-                raise ValueError(f"{name} {t!r} s is not a whole number of nanoseconds, the "
-                                 "time base (fmukit.timebase)")
-        step_count(self.start_time, self.stop_time, self.step_size)
 
     def ours(self, path: str | Path) -> bool:           # named as one of the FMUs of ``fmus``
         return self.fmus is not None and Path(path).stem in self.fmus.names
