@@ -107,20 +107,17 @@ def fresh_folder(target: Path) -> Iterator[Path]:
 
 class Outputs(contextlib.AbstractContextManager):
     """``with Outputs(folder, stale) as outputs``: the files of ``outputs.writing`` enter
-    ``folder`` together, and the ``stale`` not rewritten go, if the block succeeds (none else)."""
+    ``folder`` together, and the ``stale`` not rewritten go, if the block succeeds (none else).
+    The stages of ``label`` a killed process left in ``folder`` go first (under its lock)."""
 
     def __init__(self, folder: Path, stale: list[Path] | tuple[Path, ...] = (),
                  label: str = "outputs"):
         self.folder, self.stale = Path(folder), set(map(Path, stale))
-        self.stage = Path(tempfile.mkdtemp(dir=self.folder, prefix=f"{TEMPORARY_PREFIX}{label}-"))
-
-    @staticmethod
-    def remove_abandoned(folder: Path, label: str) -> None:
-        """Remove the stages of ``label`` a killed process left in ``folder`` (under its lock)."""
         pattern = re.compile(re.escape(f"{TEMPORARY_PREFIX}{label}-") + r"[\w]{8}")
-        for entry in Path(folder).iterdir():
+        for entry in self.folder.iterdir():
             if entry.is_dir() and not entry.is_symlink() and pattern.fullmatch(entry.name):
                 shutil.rmtree(entry, ignore_errors=True)
+        self.stage = Path(tempfile.mkdtemp(dir=self.folder, prefix=f"{TEMPORARY_PREFIX}{label}-"))
 
     def final(self, path: Path) -> Path:
         """The name in ``folder`` of a file written to the stage."""

@@ -20,7 +20,6 @@ from .wiring import COUPLINGS, check_connections, feedthrough_order, layout, set
 
 # the FMUs through fmpy, or their Python classes (else through FMI, with a ``fallback_note``)
 BACKENDS: dict[str, type[Instance]] = {"fmi": FmuInstance, "inprocess": InProcessInstance}
-RUN_BACKENDS = tuple(BACKENDS)          # the backends a run of a scenario may take
 
 
 class Master(contextlib.AbstractContextManager):
