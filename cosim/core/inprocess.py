@@ -1,6 +1,5 @@
-"""The master's in-process backend: the class an FMU built with fmukit was made from,
-composed for its FMI version and called without FMI. The FMU must be current here, so that a
-run equals one through FMI bit for bit; refusals carry the same messages."""
+"""The master's in-process backend: an FMU built with fmukit run as its Python class, without
+FMI, if it is current here (then a run equals one through FMI bit for bit)."""
 from __future__ import annotations
 
 import hashlib

@@ -1,6 +1,5 @@
-"""Ctrl-C and SIGTERM: within ``StopSignals`` a request to stop between steps (our FMUs' Python
-runs in the master's interpreter, where a KeyboardInterrupt would fail a call; a second signal
-ends the process at once), within ``raise_on_signals`` an exception where no FMU runs."""
+"""Ctrl-C and SIGTERM: a request to stop between steps (``StopSignals``: a KeyboardInterrupt
+would fail an FMU's call), or an exception where no FMU runs (``raise_on_signals``)."""
 from __future__ import annotations
 
 import os

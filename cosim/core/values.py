@@ -1,6 +1,5 @@
 """Values for FMU variables, checked before any FMU call: exactly what the FMI 2.0 call carries
-(section 2.1.2), within the declaration (2.2.7), settable in initialisation mode (4.2.4). A
-refusal names the variable, the value and what it takes."""
+(section 2.1.2), within the declaration (2.2.7), settable in initialisation mode (4.2.4)."""
 from __future__ import annotations
 
 import math
