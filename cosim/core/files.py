@@ -60,8 +60,7 @@ def read_small_text(path: Path, limit: int) -> str:
 
 @contextlib.contextmanager
 def whole_file(target: Path) -> Iterator[Path]:
-    """``with whole_file(target) as tmp``: ``tmp`` (of the same suffix, which tells the
-    format) becomes ``target`` if the block succeeds, and is removed if it fails."""
+    """``tmp`` (of ``target``'s suffix) becomes ``target`` if the block succeeds, else goes."""
     target = Path(target)
     if target.exists() and not target.is_file():
         raise OutputError(target, OSError(errno.EEXIST, "it exists and is not a regular file "
@@ -90,8 +89,7 @@ def write_atomically(target: Path, write: Callable[[Path], object]) -> Path:
 
 @contextlib.contextmanager
 def fresh_folder(target: Path) -> Iterator[Path]:
-    """``with fresh_folder(target) as folder``: an empty folder that replaces ``target`` if
-    the block succeeds, and is removed if it fails."""
+    """An empty folder that replaces ``target`` if the block succeeds, else goes."""
     target = Path(target)
     folder = Path(tempfile.mkdtemp(dir=target.parent, prefix=f"{TEMPORARY_PREFIX}{target.name}-"))
     try:
@@ -106,9 +104,8 @@ def fresh_folder(target: Path) -> Iterator[Path]:
 
 
 class Outputs(contextlib.AbstractContextManager):
-    """``with Outputs(folder, stale) as outputs``: the files of ``outputs.writing`` enter
-    ``folder`` together, and the ``stale`` not rewritten go, if the block succeeds (none else).
-    The stages of ``label`` a killed process left in ``folder`` go first (under its lock)."""
+    """The files of ``outputs.writing`` enter ``folder`` together, and the ``stale`` not
+    rewritten go, if the block succeeds (none else); a killed process's stages go first."""
 
     def __init__(self, folder: Path, stale: list[Path] | tuple[Path, ...] = (),
                  label: str = "outputs"):

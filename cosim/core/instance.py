@@ -24,8 +24,7 @@ class LogRecord(NamedTuple):
 
 
 class FmuCallError(RuntimeError):
-    """An FMI call returned discard, error or fatal; carries the FMU's log (``records``, and
-    as lines, ``messages``) and the cause of the refusal where the FMU says it."""
+    """An FMI call returned discard, error or fatal: the FMU's log and its refusal's cause."""
 
     def __init__(self, instance: str, call: str, time: float | None, status: str,
                  records: Iterable[LogRecord]):
@@ -45,9 +44,8 @@ def logged_error(records: Iterable[LogRecord]) -> bool:
 
 
 class Instance:
-    """One instantiated component. A backend supplies ``call``, ``fmi(name)`` (the function
-    behind an FMI 2.0 call name), ``enter_initialization``, ``reset``, ``free`` and ``stepper``;
-    ``path`` and ``name`` are set in ``__new__``, so that a watchdog can always name it."""
+    """One instantiated component: a backend supplies ``call``, ``fmi(name)``, ``reset``,
+    ``enter_initialization``, ``free`` and ``stepper``; ``__new__`` names it for a watchdog."""
 
     name: str
     path: Path

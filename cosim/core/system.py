@@ -22,8 +22,7 @@ def split_name(name: str) -> tuple[str, str]:
 
 @dataclass(frozen=True)
 class FmuFolders:
-    """Where the caller builds its FMUs (a folder per FMI version) and their names (stems); a
-    copied .ssd finds them there (``fmu_candidates``)."""
+    """Where the caller builds its FMUs (a folder per FMI version) and their names (stems)."""
     by_fmi: dict[int, Path]
     names: frozenset[str]
 
@@ -69,8 +68,7 @@ class SystemDescription:
 
     def parameters(self, overrides: dict[str, dict[str, Any]] | None = None
                    ) -> dict[str, dict[str, Any]]:
-        """Each component's parameter values, updated by ``overrides`` (by component);
-        ValueError naming a component the system does not have, and the closest."""
+        """Each component's parameter values updated by ``overrides``; ValueError if unknown."""
         parameters = {name: dict(c.parameters) for name, c in self.components.items()}
         for component, values in (overrides or {}).items():
             if component not in parameters:
@@ -81,8 +79,7 @@ class SystemDescription:
         return parameters
 
     def steps(self, stop_time: float | None = None) -> tuple[float, float, int]:
-        """(t0, h on the time base, steps) of a run to ``stop_time`` (default: the system's);
-        ValueError unless that is a whole number of steps."""
+        """(t0, h on the time base, whole steps) to ``stop_time`` (default: the system's)."""
         h = seconds(nanoseconds(self.step_size))
         return self.start_time, h, step_count(
             self.start_time, self.stop_time if stop_time is None else stop_time, h)

@@ -30,8 +30,7 @@ _TAKES = {"Real": "a Real (a double)", "Integer": "an Integer, a whole number fr
 
 @dataclass(frozen=True)
 class Declaration:
-    """What an FMU declares of one variable (section 2.2.7); min and max None where
-    undeclared, an Enumeration's items as (name, value)."""
+    """What an FMU declares of one variable (section 2.2.7); items: (name, value)."""
     name: str
     type: str
     causality: str = "parameter"
@@ -67,8 +66,7 @@ class Declaration:
 
 
 def declarations(description: ModelDescription) -> dict[str, Declaration]:
-    """Every variable's declaration in a model description (``fmi.read_description``), min
-    and max from the variable or else its declared type."""
+    """Every variable's declaration, min and max its own or else its declared type's."""
     out = {}
     for v in description.modelVariables:
         declared, number = v.declaredType, float if v.type == "Real" else int
@@ -115,8 +113,7 @@ def _carried(target: str, type_name: str, value: Any, takes: str,
 
 
 def _within(declaration: Declaration, value: Value) -> None:
-    """A Real finite (+-inf only where max="INF" / min="-INF"), within min and max; an
-    Enumeration one of its items."""
+    """Within min and max (+-inf only where declared so), an Enumeration's items."""
     if declaration.type == "Real" and math.isnan(value):
         raise _Refusal("is not a number (NaN)")
     if declaration.type == "Real" and math.isinf(value) and \
