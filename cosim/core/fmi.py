@@ -139,10 +139,6 @@ class FmuInstance(Instance):
             records = [r for r in records if r.category is not None or r.status != "fatal"]
         return records
 
-    def _status(self, what: str, status: int, before: int, time: float | None = None) -> None:
-        if status > 1:                      # discard, error, fatal
-            raise FmuCallError(self.name, what, time, STATUS[status], self._since(before))
-
     def fmi(self, name: str):
         return getattr(self.slave, CALLS.get(name, name) if self.fmi_version == 3 else name)
 
@@ -181,8 +177,8 @@ class FmuInstance(Instance):
         def run() -> None:
             before = self.logged
             status = function(component, refs, counts[0], values, *counts[1:])
-            if status:
-                self._status(what, status, before)
+            if status > 1:                      # discard, error, fatal
+                raise FmuCallError(self.name, what, None, STATUS[status], self._since(before))
         return values, run
 
     def reader(self, vrs: list[int], kind: str = "Real") -> Callable[[], list]:
@@ -213,8 +209,8 @@ class FmuInstance(Instance):
         def step(t: float, h: float) -> None:
             before = self.logged
             status = do_step(component, t, h, True, *rest)
-            if status:
-                self._status("doStep", status, before, t)
+            if status > 1:
+                raise FmuCallError(self.name, "doStep", t, STATUS[status], self._since(before))
             if terminate.value:
                 raise FmuCallError(self.name, "doStep", t, "OK but asked to end the simulation "
                                    "(terminateSimulation)", self._since(before))

@@ -44,7 +44,8 @@ def logged_error(records: Iterable[LogRecord]) -> bool:
 
 
 class Instance:
-    """One instantiated component: a backend supplies ``call``, ``fmi(name)``, ``reset``,
+    """One instantiated component: a backend supplies ``call(what, function, *args, time,
+    strict)`` (FmuCallError if it fails or, ``strict``, logs an error), ``fmi(name)``, ``reset``,
     ``enter_initialization``, ``free`` and ``stepper``; ``__new__`` names it for a watchdog."""
 
     name: str
@@ -57,11 +58,6 @@ class Instance:
         instance = super().__new__(cls)
         instance.path, instance.name = Path(path), name
         return instance
-
-    def call(self, what: str, function: Callable, *args, time: float | None = None,
-             strict: bool = False) -> Any:
-        """Run ``function``; FmuCallError if it fails or, ``strict``, logs an error."""
-        raise NotImplementedError
 
     def variable(self, name: str):
         """The model variable, or ValueError listing the valid names."""
