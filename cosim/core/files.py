@@ -163,30 +163,25 @@ class FolderBusy(RuntimeError):
     """Another process is writing into this output folder."""
 
 
-class FolderLock:
+@contextlib.contextmanager
+def FolderLock(folder: Path) -> Iterator[None]:
     """``with FolderLock(folder)``: this process alone writes into ``folder``, FolderBusy at
     once if another does; the kernel's lock on the folder (Windows: on ``.cosim-lock`` in it)."""
-
-    def __init__(self, folder: Path):
-        self.folder = Path(folder)
-
-    def __enter__(self) -> FolderLock:
-        windows = fcntl is None
-        self._handle = os.open(self.folder / ".cosim-lock" if windows else self.folder,
-                               os.O_RDWR | os.O_CREAT if windows else os.O_RDONLY)
-        try:
-            if windows:
-                msvcrt.locking(self._handle, msvcrt.LK_NBLCK, 1)
-            else:
-                fcntl.flock(self._handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError as error:
-            os.close(self._handle)
-            if not (windows or isinstance(error, BlockingIOError)):
-                raise
-            raise FolderBusy(f"output folder {self.folder} is being written by another "
-                             "command; wait for it to end, or give this one another --out"
-                             ) from None
-        return self
-
-    def __exit__(self, *exc) -> None:
-        os.close(self._handle)          # closing releases the lock
+    windows = fcntl is None
+    handle = os.open(Path(folder) / ".cosim-lock" if windows else folder,
+                     os.O_RDWR | os.O_CREAT if windows else os.O_RDONLY)
+    try:
+        if windows:
+            msvcrt.locking(handle, msvcrt.LK_NBLCK, 1)
+        else:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError as error:
+        os.close(handle)
+        if not (windows or isinstance(error, BlockingIOError)):
+            raise
+        raise FolderBusy(f"output folder {folder} is being written by another command; wait "
+                         "for it to end, or give this one another --out") from None
+    try:
+        yield
+    finally:
+        os.close(handle)          # closing releases the lock
