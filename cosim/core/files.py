@@ -110,9 +110,8 @@ class Outputs(contextlib.AbstractContextManager):
     def __init__(self, folder: Path, stale: list[Path] | tuple[Path, ...] = (),
                  label: str = "outputs"):
         self.folder, self.stale = Path(folder), set(map(Path, stale))
-        pattern = re.compile(re.escape(f"{TEMPORARY_PREFIX}{label}-") + r"[\w]{8}")
-        for entry in self.folder.iterdir():
-            if entry.is_dir() and not entry.is_symlink() and pattern.fullmatch(entry.name):
+        for entry in self.folder.glob(f"{TEMPORARY_PREFIX}{label}-{'?' * 8}"):   # mkdtemp's
+            if entry.is_dir() and not entry.is_symlink():
                 shutil.rmtree(entry, ignore_errors=True)
         self.stage = Path(tempfile.mkdtemp(dir=self.folder, prefix=f"{TEMPORARY_PREFIX}{label}-"))
 
