@@ -18,7 +18,7 @@ from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFr
 from fmpy.fmi3 import FMU3Slave, fmi3Boolean, fmi3Float64, fmi3Int32, fmi3ValueReference
 from fmpy.model_description import ModelDescription
 
-from .errors import FmuNotFound, FmuUnreadable
+from .system import FmuNotFound, FmuUnreadable
 from .instance import FmuCallError, Instance, LogRecord, logged_error
 
 STATUS = ("ok", "warning", "discard", "error", "fatal", "pending")

@@ -12,8 +12,7 @@ from typing import Any, Iterable, Mapping
 
 from fmpy.model_description import ModelDescription
 
-from .errors import close_matches, did_you_mean
-from .system import SystemDescription
+from .system import SystemDescription, close_matches, did_you_mean
 
 INTEGER_RANGE = (-2**31, 2**31 - 1)                 # fmi2Integer, a C int
 
