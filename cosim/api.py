@@ -5,7 +5,7 @@ from pathlib import Path
 from typing import Any, Iterable, Mapping, Sequence
 
 from . import scenarios
-from .core.master import RUN_BACKENDS, Master
+from .core.master import BACKENDS, Master
 from .core.system import SystemDescription, split_name
 from .core.recording import Recording
 
@@ -79,7 +79,7 @@ def simulate_many(scenario: str | Path, sets: Sequence[Mapping[str, Any]],
     """The recordings of a scenario run once for each of ``sets`` (each ``simulate``'s
     ``set``), in order; "batch" steps them together as arrays, holding ``signals``. A failed
     run raises nothing (its ``error`` says why); a refused setting, ValueError naming its member."""
-    if backend not in (*RUN_BACKENDS, "batch"):
+    if backend not in (*BACKENDS, "batch"):
         raise ValueError(f"backend must be fmi, inprocess or batch, got {backend!r}")
     overrides = []
     for i, settings in enumerate(sets):

@@ -60,7 +60,6 @@ def run_and_write(system: SystemDescription, label: str, out: Path,
     FileNotFoundError, FmuCallError, TimedOut, FolderBusy, OutputError) leaves ``out`` as it was."""
     kind = analysis(system.report)
     with FolderLock(out):
-        Outputs.remove_abandoned(out, label)          # a killed run's, if any
         with Outputs(out, [out / f"{label}{suffix}" for suffix in SUFFIXES], label) as outputs:
             forget = stop.keep(lambda: _discard(outputs, label)) if stop else lambda: None
             master: Master | None = None

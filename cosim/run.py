@@ -30,7 +30,7 @@ from .core.wiring import COUPLINGS
 from .core.files import FolderBusy, OutputError
 from .core.instance import FmuCallError
 from .core.interrupt import StopSignals
-from .core.master import RUN_BACKENDS
+from .core.master import BACKENDS
 from .core.ssd import SystemDescription
 from .core.watchdog import STEP_LIMIT_S, Limits
 from .outputs import Options, TimedOut, run_and_write
@@ -102,7 +102,7 @@ def main(argv: list[str] | None = None) -> int:
                              "model (default); jacobi: all FMUs on the previous step's outputs")
     parser.add_argument("--lambda", dest="lam", type=number_option, default=LAMBDA,
                         help=f"weight of eq (19) (default {LAMBDA:.4f}, calibrated on calm_pd)")
-    parser.add_argument("--backend", choices=RUN_BACKENDS, default="fmi",
+    parser.add_argument("--backend", choices=BACKENDS, default="fmi",
                         help="fmi: load the FMUs through FMI (default); inprocess: call their "
                              "Python classes, the same results bit for bit (an FMU not built "
                              "from this checkout's sources runs through FMI, with a note)")

@@ -18,7 +18,7 @@ import pytest
 
 from cosim import simulate
 from cosim.api import SimulationError
-from cosim.core.errors import close_matches
+from cosim.core.system import close_matches
 from cosim.run import main as run_cli
 from cosim.scenarios.autopilot import DESCRIPTIONS, PORTS, AutopilotError, check_autopilot
 from fmubuild import cli

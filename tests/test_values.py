@@ -16,7 +16,7 @@ from cosim.api import overrides_of, parse_setting
 from cosim.core import master as master_module
 from cosim.core.fmi import FmuInstance, read_description
 from cosim.core.instance import FmuCallError
-from cosim.core.master import RUN_BACKENDS, Master
+from cosim.core.master import BACKENDS, Master
 from cosim.core.values import Declaration, checked, declarations, fmi_value, setting
 from cosim import run as run_command
 from helpers import command, fmu_variant
@@ -180,7 +180,7 @@ class _NoFmuCall:
 def test_both_backends_refuse_a_value_alike_before_any_fmu_call(fmu_paths, monkeypatch,
                                                                 overrides, fragment):
     messages = set()
-    for backend in RUN_BACKENDS:
+    for backend in BACKENDS:
         monkeypatch.setitem(master_module.BACKENDS, backend, _NoFmuCall)
         with pytest.raises(ValueError) as refused:
             Master(scenarios.load("waves_pd"), backend=backend, overrides=overrides)
@@ -198,7 +198,7 @@ def test_a_bad_binding_in_the_ssd_is_refused_naming_the_file(fmu_paths):
                                   "Integer, a whole number from 1 to 5000")
 
 
-@pytest.mark.parametrize("backend", RUN_BACKENDS)
+@pytest.mark.parametrize("backend", BACKENDS)
 def test_the_master_keeps_the_values_as_set(fmu_paths, backend):
     overrides = {"ship": {"wave_seed": "7.0", "Hs": "1e-2", "T0": 1}}
     with Master(scenarios.load("waves_pd"), backend=backend, overrides=overrides) as master:
@@ -223,7 +223,7 @@ def flag_pilot(fmu_paths, tmp_path) -> Path:
                        xml=lambda t: t.replace("</ModelVariables>", flag + "</ModelVariables>"))
 
 
-@pytest.mark.parametrize("backend", RUN_BACKENDS)
+@pytest.mark.parametrize("backend", BACKENDS)
 def test_a_boolean_reads_false_as_false(flag_pilot, backend):
     system = scenarios.load("calm_pd", flag_pilot)
     for text, value in (("false", False), ("False", False), ("0", False), ("TRUE", True)):
@@ -286,7 +286,7 @@ def _cli(tmp_path: Path, *args: str) -> subprocess.CompletedProcess:
 def test_the_command_line_refuses_a_bad_value_alike_on_both_backends(fmu_paths, tmp_path,
                                                                      value, fragment):
     errors = set()
-    for backend in RUN_BACKENDS:
+    for backend in BACKENDS:
         child = _cli(tmp_path, "waves_pd", "--set", f"ship.wave_seed={value}",
                      "--backend", backend)
         assert child.returncode == 2, child.stderr

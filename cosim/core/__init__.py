@@ -1,2 +1,1 @@
-"""The co-simulation core (docs/architecture.md); it imports nothing of the project: where
-FMUs are built, the caller says (``system.FmuFolders``)."""
+"""The co-simulation core (docs/architecture.md): where FMUs are built, the caller says."""

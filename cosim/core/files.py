@@ -60,8 +60,7 @@ def read_small_text(path: Path, limit: int) -> str:
 
 @contextlib.contextmanager
 def whole_file(target: Path) -> Iterator[Path]:
-    """``with whole_file(target) as tmp``: ``tmp`` (of the same suffix, which tells the
-    format) becomes ``target`` if the block succeeds, and is removed if it fails."""
+    """``tmp`` (of ``target``'s suffix) becomes ``target`` if the block succeeds, else goes."""
     target = Path(target)
     if target.exists() and not target.is_file():
         raise OutputError(target, OSError(errno.EEXIST, "it exists and is not a regular file "
@@ -90,8 +89,7 @@ def write_atomically(target: Path, write: Callable[[Path], object]) -> Path:
 
 @contextlib.contextmanager
 def fresh_folder(target: Path) -> Iterator[Path]:
-    """``with fresh_folder(target) as folder``: an empty folder that replaces ``target`` if
-    the block succeeds, and is removed if it fails."""
+    """An empty folder that replaces ``target`` if the block succeeds, else goes."""
     target = Path(target)
     folder = Path(tempfile.mkdtemp(dir=target.parent, prefix=f"{TEMPORARY_PREFIX}{target.name}-"))
     try:
@@ -106,21 +104,16 @@ def fresh_folder(target: Path) -> Iterator[Path]:
 
 
 class Outputs(contextlib.AbstractContextManager):
-    """``with Outputs(folder, stale) as outputs``: the files of ``outputs.writing`` enter
-    ``folder`` together, and the ``stale`` not rewritten go, if the block succeeds (none else)."""
+    """The files of ``outputs.writing`` enter ``folder`` together, and the ``stale`` not
+    rewritten go, if the block succeeds (none else); a killed process's stages go first."""
 
     def __init__(self, folder: Path, stale: list[Path] | tuple[Path, ...] = (),
                  label: str = "outputs"):
         self.folder, self.stale = Path(folder), set(map(Path, stale))
-        self.stage = Path(tempfile.mkdtemp(dir=self.folder, prefix=f"{TEMPORARY_PREFIX}{label}-"))
-
-    @staticmethod
-    def remove_abandoned(folder: Path, label: str) -> None:
-        """Remove the stages of ``label`` a killed process left in ``folder`` (under its lock)."""
-        pattern = re.compile(re.escape(f"{TEMPORARY_PREFIX}{label}-") + r"[\w]{8}")
-        for entry in Path(folder).iterdir():
-            if entry.is_dir() and not entry.is_symlink() and pattern.fullmatch(entry.name):
+        for entry in self.folder.glob(f"{TEMPORARY_PREFIX}{label}-{'?' * 8}"):   # mkdtemp's
+            if entry.is_dir() and not entry.is_symlink():
                 shutil.rmtree(entry, ignore_errors=True)
+        self.stage = Path(tempfile.mkdtemp(dir=self.folder, prefix=f"{TEMPORARY_PREFIX}{label}-"))
 
     def final(self, path: Path) -> Path:
         """The name in ``folder`` of a file written to the stage."""
@@ -169,30 +162,25 @@ class FolderBusy(RuntimeError):
     """Another process is writing into this output folder."""
 
 
-class FolderLock:
+@contextlib.contextmanager
+def FolderLock(folder: Path) -> Iterator[None]:
     """``with FolderLock(folder)``: this process alone writes into ``folder``, FolderBusy at
     once if another does; the kernel's lock on the folder (Windows: on ``.cosim-lock`` in it)."""
-
-    def __init__(self, folder: Path):
-        self.folder = Path(folder)
-
-    def __enter__(self) -> FolderLock:
-        windows = fcntl is None
-        self._handle = os.open(self.folder / ".cosim-lock" if windows else self.folder,
-                               os.O_RDWR | os.O_CREAT if windows else os.O_RDONLY)
-        try:
-            if windows:
-                msvcrt.locking(self._handle, msvcrt.LK_NBLCK, 1)
-            else:
-                fcntl.flock(self._handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError as error:
-            os.close(self._handle)
-            if not (windows or isinstance(error, BlockingIOError)):
-                raise
-            raise FolderBusy(f"output folder {self.folder} is being written by another "
-                             "command; wait for it to end, or give this one another --out"
-                             ) from None
-        return self
-
-    def __exit__(self, *exc) -> None:
-        os.close(self._handle)          # closing releases the lock
+    windows = fcntl is None
+    handle = os.open(Path(folder) / ".cosim-lock" if windows else folder,
+                     os.O_RDWR | os.O_CREAT if windows else os.O_RDONLY)
+    try:
+        if windows:
+            msvcrt.locking(handle, msvcrt.LK_NBLCK, 1)
+        else:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError as error:
+        os.close(handle)
+        if not (windows or isinstance(error, BlockingIOError)):
+            raise
+        raise FolderBusy(f"output folder {folder} is being written by another command; wait "
+                         "for it to end, or give this one another --out") from None
+    try:
+        yield
+    finally:
+        os.close(handle)          # closing releases the lock

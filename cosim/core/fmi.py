@@ -18,7 +18,7 @@ from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFr
 from fmpy.fmi3 import FMU3Slave, fmi3Boolean, fmi3Float64, fmi3Int32, fmi3ValueReference
 from fmpy.model_description import ModelDescription
 
-from .errors import FmuNotFound, FmuUnreadable
+from .system import FmuNotFound, FmuUnreadable
 from .instance import FmuCallError, Instance, LogRecord, logged_error
 
 STATUS = ("ok", "warning", "discard", "error", "fatal", "pending")
@@ -139,10 +139,6 @@ class FmuInstance(Instance):
             records = [r for r in records if r.category is not None or r.status != "fatal"]
         return records
 
-    def _status(self, what: str, status: int, before: int, time: float | None = None) -> None:
-        if status > 1:                      # discard, error, fatal
-            raise FmuCallError(self.name, what, time, STATUS[status], self._since(before))
-
     def fmi(self, name: str):
         return getattr(self.slave, CALLS.get(name, name) if self.fmi_version == 3 else name)
 
@@ -181,23 +177,17 @@ class FmuInstance(Instance):
         def run() -> None:
             before = self.logged
             status = function(component, refs, counts[0], values, *counts[1:])
-            if status:
-                self._status(what, status, before)
+            if status > 1:                      # discard, error, fatal
+                raise FmuCallError(self.name, what, None, STATUS[status], self._since(before))
         return values, run
 
-    def _reader(self, kind: str, vrs: list[int]) -> Callable[[], list]:
+    def reader(self, vrs: list[int], kind: str = "Real") -> Callable[[], list]:
         values, run = self._raw("get", kind, vrs)
 
         def read() -> list:
             run()
             return values[:]
         return read
-
-    def reader(self, vrs: list[int]):
-        return self._reader("Real", vrs)
-
-    def integer_reader(self, vrs: list[int]):
-        return self._reader("Integer", vrs)
 
     def writer(self, vrs: list[int]):
         values, run = self._raw("set", "Real", vrs)
@@ -219,8 +209,8 @@ class FmuInstance(Instance):
         def step(t: float, h: float) -> None:
             before = self.logged
             status = do_step(component, t, h, True, *rest)
-            if status:
-                self._status("doStep", status, before, t)
+            if status > 1:
+                raise FmuCallError(self.name, "doStep", t, STATUS[status], self._since(before))
             if terminate.value:
                 raise FmuCallError(self.name, "doStep", t, "OK but asked to end the simulation "
                                    "(terminateSimulation)", self._since(before))

@@ -1,6 +1,5 @@
-"""The master's in-process backend: the class an FMU built with fmukit was made from,
-composed for its FMI version and called without FMI. The FMU must be current here, so that a
-run equals one through FMI bit for bit; refusals carry the same messages."""
+"""The master's in-process backend: an FMU built with fmukit run as its Python class, without
+FMI, if it is current here (then a run equals one through FMI bit for bit)."""
 from __future__ import annotations
 
 import hashlib
@@ -162,11 +161,9 @@ class InProcessInstance(Instance):
                                                 else name))
 
     # Prepared calls: the slave's own plans (until ``reset``), else or if one raises: as FMI
-    def reader(self, vrs: list[int]):
-        return _prepared(self.slave.plans.real_reader(vrs), super().reader(vrs))
-
-    def integer_reader(self, vrs: list[int]):
-        return _prepared(self.slave.plans.integer_reader(vrs), super().integer_reader(vrs))
+    def reader(self, vrs: list[int], kind: str = "Real"):
+        plan = getattr(self.slave.plans, f"{kind.lower()}_reader")(vrs)
+        return _prepared(plan, super().reader(vrs, kind))
 
     def writer(self, vrs: list[int]):
         return self.slave.plans.input_writer(vrs) or super().writer(vrs)

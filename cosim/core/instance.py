@@ -24,8 +24,7 @@ class LogRecord(NamedTuple):
 
 
 class FmuCallError(RuntimeError):
-    """An FMI call returned discard, error or fatal; carries the FMU's log (``records``, and
-    as lines, ``messages``) and the cause of the refusal where the FMU says it."""
+    """An FMI call returned discard, error or fatal: the FMU's log and its refusal's cause."""
 
     def __init__(self, instance: str, call: str, time: float | None, status: str,
                  records: Iterable[LogRecord]):
@@ -45,9 +44,9 @@ def logged_error(records: Iterable[LogRecord]) -> bool:
 
 
 class Instance:
-    """One instantiated component. A backend supplies ``call``, ``fmi(name)`` (the function
-    behind an FMI 2.0 call name), ``enter_initialization``, ``reset``, ``free`` and ``stepper``;
-    ``path`` and ``name`` are set in ``__new__``, so that a watchdog can always name it."""
+    """One instantiated component: a backend supplies ``call(what, function, *args, time,
+    strict)`` (FmuCallError if it fails or, ``strict``, logs an error), ``fmi(name)``, ``reset``,
+    ``enter_initialization``, ``free`` and ``stepper``; ``__new__`` names it for a watchdog."""
 
     name: str
     path: Path
@@ -59,11 +58,6 @@ class Instance:
         instance = super().__new__(cls)
         instance.path, instance.name = Path(path), name
         return instance
-
-    def call(self, what: str, function: Callable, *args, time: float | None = None,
-             strict: bool = False) -> Any:
-        """Run ``function``; FmuCallError if it fails or, ``strict``, logs an error."""
-        raise NotImplementedError
 
     def variable(self, name: str):
         """The model variable, or ValueError listing the valid names."""
@@ -122,11 +116,8 @@ class Instance:
         self.stepper()(t, h)
 
     # Prepared calls for a fixed list of value references, valid until ``reset``.
-    def reader(self, vrs: list[int]) -> Callable[[], list[float]]:
-        return lambda: self.call("getReal", self.fmi("getReal"), vrs)
-
-    def integer_reader(self, vrs: list[int]) -> Callable[[], list[int]]:
-        return lambda: self.call("getInteger", self.fmi("getInteger"), vrs)
+    def reader(self, vrs: list[int], kind: str = "Real") -> Callable[[], list]:
+        return lambda: self.call(f"get{kind}", self.fmi(f"get{kind}"), vrs)
 
     def writer(self, vrs: list[int]) -> Callable[[list[float]], None]:
         return lambda values: self.call("setReal", self.fmi("setReal"), vrs, values)

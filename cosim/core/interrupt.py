@@ -1,6 +1,5 @@
-"""Ctrl-C and SIGTERM: within ``StopSignals`` a request to stop between steps (our FMUs' Python
-runs in the master's interpreter, where a KeyboardInterrupt would fail a call; a second signal
-ends the process at once), within ``raise_on_signals`` an exception where no FMU runs."""
+"""Ctrl-C and SIGTERM: a request to stop between steps (``StopSignals``: a KeyboardInterrupt
+would fail an FMU's call), or an exception where no FMU runs (``raise_on_signals``)."""
 from __future__ import annotations
 
 import os
@@ -26,8 +25,7 @@ def give_back(handlers: dict) -> None:
 
 
 class StopSignals:
-    """``with StopSignals() as stop``: ``stop.received`` is the first SIGINT or SIGTERM that
-    arrived, or None (main thread only; elsewhere this does nothing)."""
+    """``stop.received``: the first SIGINT or SIGTERM that arrived, or None (main thread)."""
 
     def __init__(self) -> None:
         self.received: signal.Signals | None = None
@@ -89,8 +87,7 @@ _received: list[signal.Signals] = []      # this command's signals so far
 
 
 def _raise(number: int, frame) -> None:
-    """The first signal raises ``Interrupted``; one more while it is handled (what was done
-    being kept) ends the process at once, as in ``StopSignals``."""
+    """The first signal raises ``Interrupted``; one more while it is handled ends at once."""
     number = signal.Signals(number)
     if _received:
         print(f"{number.name} again: stopped at once", file=sys.stderr, flush=True)

@@ -20,7 +20,6 @@ from .wiring import COUPLINGS, check_connections, feedthrough_order, layout, set
 
 # the FMUs through fmpy, or their Python classes (else through FMI, with a ``fallback_note``)
 BACKENDS: dict[str, type[Instance]] = {"fmi": FmuInstance, "inprocess": InProcessInstance}
-RUN_BACKENDS = tuple(BACKENDS)          # the backends a run of a scenario may take
 
 
 class Master(contextlib.AbstractContextManager):
@@ -95,9 +94,8 @@ class Master(contextlib.AbstractContextManager):
             progress: Callable[[int, int], None] | None = None,
             csv_path: str | Path | None = None, stop: StopSignals | None = None,
             watchdog: Watchdog | None = None) -> Recording:
-        """Simulate to ``stop_time`` (default: the system's); an FMU failure, a signal on
-        ``stop`` or a limit of ``watchdog`` ends it early between steps (``Recording.error``,
-        the rows kept). ``csv_path``: the rows streamed there (else TooManyRows if too many)."""
+        """Simulate to ``stop_time``; a failure, signal or time limit ends it early, rows kept
+        (``Recording.error``). ``csv_path``: the rows streamed there (else maybe TooManyRows)."""
         t0, h, n_steps = self.system.steps(stop_time)
         recorder = self._recorder = Recorder(self.columns, n_steps + 1, csv_path,
                                              run_meta(self, n_steps), self.units)

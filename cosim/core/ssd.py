@@ -8,6 +8,8 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
+from fmukit.timebase import on_time_base, step_count
+
 from .system import Component, Connection, FmuFolders, SystemDescription
 from .values import fmi_value
 
@@ -180,24 +182,25 @@ class _Reader:
         where = "DefaultExperiment"
         description.start_time = self.number(experiment, "startTime", where, 0.0)
         description.stop_time = self.number(experiment, "stopTime", where, description.stop_time)
-        if not description.stop_time > description.start_time:
-            raise self.error(where, f"stopTime {description.stop_time!r} is not after "
-                                    f"startTime {description.start_time!r}")
         annotations = "ssd:Annotations/ssc:Annotation/"
         algorithm = experiment.find(f"{annotations}osp:Algorithm/osp:FixedStepAlgorithm", NS)
         if algorithm is not None:
             at = f"{where}, osp:FixedStepAlgorithm"
             self.required(algorithm, "baseStepSize", at)
             description.step_size = self.number(algorithm, "baseStepSize", at, math.nan)
-            if not description.step_size > 0:
-                raise self.error(at, f"baseStepSize {description.step_size!r} is not > 0")
         report = experiment.find(f"{annotations}sap:Report", NS)
         if report is not None:
             description.report = self.required(report, "kind", f"{where}, sap:Report")
-        try:
-            description.check_times()
+        times = {"startTime": description.start_time, "stopTime": description.stop_time,
+                 "baseStepSize": description.step_size}
+        try:        # within what an FMU takes, a whole number of steps (fmukit.timebase)
+            step_count(*times.values())
         except ValueError as error:
             raise self.error(where, str(error)) from None
+        for name, t in times.items():
+            if on_time_base(t) != t:
+                raise self.error(where, f"{name} {t!r} s is not a whole number of nanoseconds, "
+                                        "the time base (fmukit.timebase)")
 
 
 def read_ssd(path: str | Path, fmus: FmuFolders | None = None) -> SystemDescription:

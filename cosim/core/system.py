@@ -1,15 +1,49 @@
 """A system: its components, their connections and experiment, and where its FMUs are (the
-core's model of a flat co-simulation; ``ssd`` reads and writes it as SSP 1.0)."""
+core's model of a flat co-simulation; ``ssd`` reads and writes it as SSP 1.0); the errors of
+an FMU file, and the advice a message ends with ("did you mean")."""
 from __future__ import annotations
 
 import copy
+import difflib
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterable
 
-from fmukit.timebase import MAX_TIME, nanoseconds, on_time_base, seconds, step_count
+from fmukit.timebase import nanoseconds, seconds, step_count
 
-from .errors import FmuNotFound, close_matches, did_you_mean
+
+class _FmuFileError(Exception):
+    """``ours``: the file is named as one of the FMUs the caller builds (a command may say how)."""
+
+    def __init__(self, message: str, ours: bool):
+        super().__init__(message)
+        self.ours = ours
+
+
+class FmuNotFound(_FmuFileError, FileNotFoundError):
+    """No FMU file where a component's source says."""
+
+
+class FmuUnreadable(_FmuFileError, ValueError):
+    """A file that is not a readable FMU."""
+
+
+def close_matches(name: str, names: Iterable[str]) -> list[str]:
+    """The names a user who typed ``name`` likely meant, best first: equal but for case, then
+    up to three alike (difflib's ratio 0.7: 'ship' for 'shp', not 'wave_seed' for 'wave_height')."""
+    names = list(dict.fromkeys(names))
+    folded = {n.lower(): n for n in reversed(names)}            # the first of each
+    close = [folded[n] for n in difflib.get_close_matches(name.lower(), list(folded), 3, 0.7)]
+    same = [n for n in names if n.lower() == name.lower()]
+    return list(dict.fromkeys(n for n in [*same, *close] if n != name))
+
+
+def did_you_mean(matches: list[str]) -> str:
+    """"; did you mean 'Hs'?" for ``matches``; '' for none."""
+    if not matches:
+        return ""
+    *rest, last = [f"'{n}'" for n in matches]
+    return f"; did you mean {', '.join(rest) + ' or ' if rest else ''}{last}?"
 
 
 def split_name(name: str) -> tuple[str, str]:
@@ -22,8 +56,7 @@ def split_name(name: str) -> tuple[str, str]:
 
 @dataclass(frozen=True)
 class FmuFolders:
-    """Where the caller builds its FMUs (a folder per FMI version) and their names (stems); a
-    copied .ssd finds them there (``fmu_candidates``)."""
+    """Where the caller builds its FMUs (a folder per FMI version) and their names (stems)."""
     by_fmi: dict[int, Path]
     names: frozenset[str]
 
@@ -69,8 +102,7 @@ class SystemDescription:
 
     def parameters(self, overrides: dict[str, dict[str, Any]] | None = None
                    ) -> dict[str, dict[str, Any]]:
-        """Each component's parameter values, updated by ``overrides`` (by component);
-        ValueError naming a component the system does not have, and the closest."""
+        """Each component's parameter values updated by ``overrides``; ValueError if unknown."""
         parameters = {name: dict(c.parameters) for name, c in self.components.items()}
         for component, values in (overrides or {}).items():
             if component not in parameters:
@@ -81,24 +113,10 @@ class SystemDescription:
         return parameters
 
     def steps(self, stop_time: float | None = None) -> tuple[float, float, int]:
-        """(t0, h on the time base, steps) of a run to ``stop_time`` (default: the system's);
-        ValueError unless that is a whole number of steps."""
+        """(t0, h on the time base, whole steps) to ``stop_time`` (default: the system's)."""
         h = seconds(nanoseconds(self.step_size))
         return self.start_time, h, step_count(
             self.start_time, self.stop_time if stop_time is None else stop_time, h)
-
-    def check_times(self) -> None:
-        """ValueError unless start, stop and step are on the time base, within what an FMU
-        takes, with a whole number of steps from start to stop."""
-        for name, t in (("startTime", self.start_time), ("stopTime", self.stop_time),
-                        ("baseStepSize", self.step_size)):
-            if abs(t) > MAX_TIME:
-                raise ValueError(f"{name} {t!r} s is beyond +-{MAX_TIME:g} s, the times an FMU "
-                                 "takes (fmukit.timebase)")
-            if on_time_base(t) != t:
-                raise ValueError(f"{name} {t!r} s is not a whole number of nanoseconds, the "
-                                 "time base (fmukit.timebase)")
-        step_count(self.start_time, self.stop_time, self.step_size)
 
     def ours(self, path: str | Path) -> bool:           # named as one of the FMUs of ``fmus``
         return self.fmus is not None and Path(path).stem in self.fmus.names

@@ -1,6 +1,5 @@
 """Values for FMU variables, checked before any FMU call: exactly what the FMI 2.0 call carries
-(section 2.1.2), within the declaration (2.2.7), settable in initialisation mode (4.2.4). A
-refusal names the variable, the value and what it takes."""
+(section 2.1.2), within the declaration (2.2.7), settable in initialisation mode (4.2.4)."""
 from __future__ import annotations
 
 import math
@@ -13,8 +12,7 @@ from typing import Any, Iterable, Mapping
 
 from fmpy.model_description import ModelDescription
 
-from .errors import close_matches, did_you_mean
-from .system import SystemDescription
+from .system import SystemDescription, close_matches, did_you_mean
 
 INTEGER_RANGE = (-2**31, 2**31 - 1)                 # fmi2Integer, a C int
 
@@ -31,8 +29,7 @@ _TAKES = {"Real": "a Real (a double)", "Integer": "an Integer, a whole number fr
 
 @dataclass(frozen=True)
 class Declaration:
-    """What an FMU declares of one variable (section 2.2.7); min and max None where
-    undeclared, an Enumeration's items as (name, value)."""
+    """What an FMU declares of one variable (section 2.2.7); items: (name, value)."""
     name: str
     type: str
     causality: str = "parameter"
@@ -68,8 +65,7 @@ class Declaration:
 
 
 def declarations(description: ModelDescription) -> dict[str, Declaration]:
-    """Every variable's declaration in a model description (``fmi.read_description``), min
-    and max from the variable or else its declared type."""
+    """Every variable's declaration, min and max its own or else its declared type's."""
     out = {}
     for v in description.modelVariables:
         declared, number = v.declaredType, float if v.type == "Real" else int
@@ -81,14 +77,21 @@ def declarations(description: ModelDescription) -> dict[str, Declaration]:
     return out
 
 
-class _Refusal(ValueError):
-    """Why a value is refused: 'is not a whole number'."""
-
-
-def fmi_value(target: str, type_name: str, value: Any) -> Value:
-    """``value`` exactly as the FMI 2.0 call of ``type_name`` carries it, or ValueError naming
-    ``target`` (component.variable), the value and what the type takes."""
-    return _carried(target, type_name, value, _TAKES.get(type_name, ""))
+def fmi_value(target: str, type_name: str, value: Any,
+              declaration: Declaration | None = None) -> Value:
+    """``value`` exactly as the FMI 2.0 call of ``type_name`` carries it (and within
+    ``declaration``), or ValueError naming ``target``, the value and what it takes."""
+    carry = _CARRIED.get(type_name)
+    if carry is None:
+        raise ValueError(f"{target} is of type {type_name!r}, which FMI 2.0 does not have")
+    try:
+        exact = carry(value)
+        if declaration is not None:
+            _within(declaration, exact)
+    except ValueError as refusal:           # why: 'is not a whole number'
+        takes = declaration.takes() if declaration else _TAKES[type_name]
+        raise ValueError(f"{target} = {value!r} {refusal}; {target} is {takes}") from None
+    return exact
 
 
 def checked(component: str, declaration: Declaration, value: Any) -> Value:
@@ -97,37 +100,21 @@ def checked(component: str, declaration: Declaration, value: Any) -> Value:
     if isinstance(value, str) and value.strip() in items:
         return items[value.strip()]
     kind = "Integer" if declaration.type == "Enumeration" else declaration.type
-    return _carried(f"{component}.{declaration.name}", kind, value, declaration.takes(),
-                    declaration)
-
-
-def _carried(target: str, type_name: str, value: Any, takes: str,
-             declaration: Declaration | None = None) -> Value:
-    carry = _CARRIED.get(type_name)
-    if carry is None:
-        raise ValueError(f"{target} is of type {type_name!r}, which FMI 2.0 does not have")
-    try:
-        exact = carry(value)
-        if declaration is not None:
-            _within(declaration, exact)
-    except _Refusal as refusal:
-        raise ValueError(f"{target} = {value!r} {refusal}; {target} is {takes}") from None
-    return exact
+    return fmi_value(f"{component}.{declaration.name}", kind, value, declaration)
 
 
 def _within(declaration: Declaration, value: Value) -> None:
-    """A Real finite (+-inf only where max="INF" / min="-INF"), within min and max; an
-    Enumeration one of its items."""
+    """Within min and max (+-inf only where declared so), an Enumeration's items."""
     if declaration.type == "Real" and math.isnan(value):
-        raise _Refusal("is not a number (NaN)")
+        raise ValueError("is not a number (NaN)")
     if declaration.type == "Real" and math.isinf(value) and \
             value != (declaration.max if value > 0 else declaration.min):
-        raise _Refusal("is not finite")
+        raise ValueError("is not finite")
     low, high = declaration.min, declaration.max
     if (low is not None and value < low) or (high is not None and value > high):
-        raise _Refusal("is outside its declared range")
+        raise ValueError("is outside its declared range")
     if declaration.items and value not in dict(declaration.items).values():
-        raise _Refusal("is not one of its items")
+        raise ValueError("is not one of its items")
 
 
 def setting(component: str, path: str | Path, declared: dict[str, Declaration], name: str,
@@ -168,21 +155,21 @@ def _real(value: Any) -> float:
         if _SPECIAL.fullmatch(text):
             return float(text)
         if not _DECIMAL.fullmatch(text):
-            raise _Refusal("is not a number")
+            raise ValueError("is not a number")
         number = float(text)
         if math.isinf(number):
-            raise _Refusal("is beyond the range of a double")
+            raise ValueError("is beyond the range of a double")
         if number == 0 and Decimal(text) != 0:
-            raise _Refusal("is below the smallest double (it would be set as 0)")
+            raise ValueError("is below the smallest double (it would be set as 0)")
         return number
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise _Refusal("is not a number")
+        raise ValueError("is not a number")
     try:
         number = float(value)
     except OverflowError:
-        raise _Refusal("is beyond the range of a double") from None
+        raise ValueError("is beyond the range of a double") from None
     if number != value and not math.isnan(number):
-        raise _Refusal(f"has no exact double (the nearest is {number!r})")
+        raise ValueError(f"has no exact double (the nearest is {number!r})")
     return number
 
 
@@ -192,11 +179,11 @@ def _integer(value: Any) -> int:
     elif isinstance(value, numbers.Real) and not isinstance(value, bool):
         exact = Decimal(int(value) if isinstance(value, numbers.Integral) else float(value))
     else:
-        raise _Refusal("is not a whole number")
+        raise ValueError("is not a whole number")
     if not exact.is_finite() or exact != exact.to_integral_value():
-        raise _Refusal("is not a whole number")
+        raise ValueError("is not a whole number")
     if not INTEGER_RANGE[0] <= exact <= INTEGER_RANGE[1]:
-        raise _Refusal("is outside the range of an FMI Integer (32 bits)")
+        raise ValueError("is outside the range of an FMI Integer (32 bits)")
     return int(exact)
 
 
@@ -205,18 +192,18 @@ def _boolean(value: Any) -> bool:
         return _BOOLEAN[value.strip().lower()]
     if isinstance(value, numbers.Integral) and value in (0, 1):
         return bool(value)
-    raise _Refusal("is not a Boolean")
+    raise ValueError("is not a Boolean")
 
 
 def _string(value: Any) -> str:
     if not isinstance(value, str):
-        raise _Refusal("is not text")
+        raise ValueError("is not text")
     if "\0" in value:
-        raise _Refusal("holds a NUL character, where an FMI string ends")
+        raise ValueError("holds a NUL character, where an FMI string ends")
     try:
         value.encode("utf-8")
     except UnicodeEncodeError:
-        raise _Refusal("is not encodable as UTF-8") from None
+        raise ValueError("is not encodable as UTF-8") from None
     return value
 
 

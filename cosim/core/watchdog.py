@@ -40,17 +40,15 @@ def no_limit(what: str | float) -> None:
 
 
 class TimeLimit(BaseException):
-    """Raised in the loop's thread when a limit is passed (``Watchdog.expired`` says which);
-    a BaseException, so that no ``except Exception`` swallows it."""
+    """Raised in the loop's thread past a limit; a BaseException: no ``except`` swallows it."""
 
     def __init__(self, *args: object):
         super().__init__(*(args or ("a time limit of the run was passed",)))
 
 
 class Watchdog:
-    """``with Watchdog(limits, stop, salvage) as dog``: ``dog.beat(what)`` as each step or
-    call begins; ``dog.expired`` says which limit was passed; ``salvage(reason)`` writes
-    what it can if the loop never returns and says what was kept."""
+    """``dog.beat(what)`` as each step or call begins; ``dog.expired``: the limit passed;
+    ``salvage(reason)`` writes what it can if the loop never returns, saying what it kept."""
 
     def __init__(self, limits: Limits = Limits(), stop: StopSignals | None = None,
                  salvage: Callable[[str], str] | None = None):

@@ -84,7 +84,7 @@ def layout(instances: dict[str, Instance], connections: list[Connection]
         node.read_state = instance.reader(vrs[:len(state)]) if state else None
         node.read_feedthrough = instance.reader(vrs[len(state):]) if ft else None
         node.read_outputs = instance.reader(vrs) if vrs else None
-        node.read_integers = instance.integer_reader([instance.vr(v) for v in ints]) \
+        node.read_integers = instance.reader([instance.vr(v) for v in ints], "Integer") \
             if ints else None
     for name, node in nodes.items():
         incoming = [c for c in connections if c.end_element == name]

@@ -6,10 +6,10 @@ from pathlib import Path
 
 from fmubuild import project
 
-from ..core.errors import close_matches, did_you_mean
 from ..core.files import plain_name
 from ..core.ssd import read_ssd
-from ..core.system import FmuFolders, SystemDescription, with_fmi
+from ..core.system import (FmuFolders, SystemDescription, close_matches, did_you_mean,
+                           with_fmi)
 from .autopilot import with_autopilot
 
 SCENARIO_DIR = Path(__file__).resolve().parent

@@ -12,7 +12,7 @@ import fmukit.autopilot
 from fmubuild.instantiate import InstantiationFailed, instantiate_in_child
 from fmukit.variables import UNITS
 
-from ..core.errors import close_matches, did_you_mean
+from ..core.system import close_matches, did_you_mean
 from ..core.ssd import Connection, SystemDescription
 
 COMPONENT = "autopilot"

@@ -8,7 +8,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from ..core.master import RUN_BACKENDS
+from ..core.master import BACKENDS
 from .sweep_task import BATCH
 from .sweep_timing import bench_spec, require_batch, seeds, sizes, timed_sweep, verdict
 from .timing import load, machine, peak_rss_mb
@@ -21,7 +21,7 @@ FLAT = 0.10     # flat: the largest sweep's peak within this of the smallest's a
 def memory(hours: float) -> None:
     """Peak RSS of a long calm_pd run streamed to disk against a short one's, each backend."""
     print(f"Memory: calm_pd streamed to CSV in chunks of 10,000 rows, on {machine()}")
-    for backend in RUN_BACKENDS:
+    for backend in BACKENDS:
         for duration in (3600.0, hours * 3600.0):
             rows, wall, size, peak = _in_child(f"calm_pd on {backend}", "streamed_run",
                                                backend, duration)

@@ -13,7 +13,7 @@ from typing import Any
 
 from fmukit.manifest import read as read_manifest
 
-from ..core.errors import FmuNotFound, FmuUnreadable
+from ..core.system import FmuNotFound, FmuUnreadable
 from ..core.fmi import read_description
 from ..core.inprocess import fallback_note, in_process_refusal
 from ..core.ssd import SystemDescription

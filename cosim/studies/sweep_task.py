@@ -12,14 +12,14 @@ from typing import Any
 from distributed import WorkerPlugin
 
 from .. import ensemble
-from ..core.master import RUN_BACKENDS, Master
+from ..core.master import BACKENDS, Master
 from ..core.watchdog import Limits, TimeLimit, Watchdog
 from ..provenance import code_version
 from .bundle import Bundle, materialise
 from .merit import METRICS, run_metrics, track
 
 BATCH = "batch"                         # the sweep backend of ``run_batch``
-SWEEP_BACKENDS = (*RUN_BACKENDS, BATCH)
+SWEEP_BACKENDS = (*BACKENDS, BATCH)
 
 
 @dataclass(frozen=True)

@@ -172,13 +172,13 @@ def _nothing(*args, **kwargs) -> None:
     return None
 
 
-def _idle_reader(self, vrs: list[int]) -> Callable[[], list[float]]:
+def _idle_reader(self, vrs: list[int], kind: str = "Real") -> Callable[[], list[float]]:
     values = [0.0] * len(vrs)
     return lambda: values
 
 
 # the in-process instance's prepared calls doing nothing: the master's own work remains
-IDLE_CALLS = {"reader": _idle_reader, "integer_reader": _idle_reader,
+IDLE_CALLS = {"reader": _idle_reader,
               "writer": lambda self, vrs: _nothing, "stepper": lambda self: _nothing}
 
 
