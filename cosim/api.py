@@ -104,25 +104,16 @@ def simulate_many(scenario: str | Path, sets: Sequence[Mapping[str, Any]],
 def _one_at_a_time(system: SystemDescription, overrides: list[dict[str, dict[str, Any]]],
                    stop_time: float | None, backend: str, signals: Sequence[str] | None
                    ) -> list[Recording]:
-    """Each member's run on one master, reset between runs, made anew after a failed one."""
-    master = Master(system, backend=backend)
-    recordings = []
-    try:
+    """Each member's run on a master of its own, once every member's settings are accepted."""
+    with Master(system, backend=backend) as master:
         for i, member in enumerate(overrides):
             try:
                 master.configure(member)
             except ValueError as error:
                 raise ValueError(f"member {i}: {error}") from None
-        for i, member in enumerate(overrides):
-            if i:
-                master.reset()
-            master.configure(member)
+    recordings = []
+    for member in overrides:
+        with Master(system, backend=backend, overrides=member) as master:
             recording = master.run(stop_time)
-            if recording.error:             # its FMUs may be in an error state
-                master.free()
-                master = Master(system, backend=backend)
-            recordings.append(recording if signals is None else recording.holding(signals))
-    finally:
-        master.free()
+        recordings.append(recording if signals is None else recording.holding(signals))
     return recordings
-

@@ -10,7 +10,7 @@ from . import scenarios
 from ._cli import (add_fmu_options, checked_autopilot, chosen_scenarios, entry, say_error,
                    writable_folder)
 from .core.files import OutputError
-from .interop.ssp import FMI2_ONLY, export, fmi_versions, unapplied_strings
+from .interop.ssp import FMI2_ONLY, described, export, unapplied_strings
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -34,7 +34,7 @@ def main(argv: list[str] | None = None) -> int:
             package = export(name, out, None, args.autopilot, dict(args.map), args.name,
                              args.fmi)
             print(f"wrote {package} and {package.with_suffix('')}/")
-            newer = sorted({v for v in fmi_versions(package).values() if v != "2.0"})
+            newer = sorted({d.fmiVersion for d in described(package)[1].values()} - {"2.0"})
             if newer:
                 print(f"note: {package.name} holds FMI {' and '.join(newer)} FMUs: ecos and "
                       f"OMSimulator run it; {' and '.join(FMI2_ONLY.values())} run FMI 2.0 "

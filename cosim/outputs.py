@@ -8,6 +8,7 @@ from typing import Any, Callable
 
 from .analysis.kinds import Analysis, analysis
 from .analysis.metrics import LAMBDA, Cost, cost
+from .analysis.reports import title
 from .core.files import FolderLock, Outputs
 from .core.interrupt import StopSignals
 from .core.master import Master
@@ -141,10 +142,11 @@ def _analyse(outcome: Outcome, system: SystemDescription, kind: Analysis, label:
     recording = outcome.recording
     outcome.report = kind.report(recording, lam=options.lam, parameters=parameters)
     if options.plot and kind.figure is not None:
-        from .analysis.figures import save_figure     # matplotlib: only a run that draws
+        from .analysis.figures import save     # matplotlib: only a run that draws
+        fig = kind.figure(recording, lam=options.lam)
+        fig.suptitle(title(label, recording.meta), fontsize=8)
         with outputs.writing(f"{label}.{options.formats[0]}") as path:
-            outcome.written += save_figure(recording, kind.figure, path.with_suffix(""),
-                                           label, options.formats, lam=options.lam)
+            outcome.written += save(fig, path.with_suffix(""), options.formats)
     if options.animate:
         from .analysis.animation import animate
         with outputs.writing(f"{label}.{options.animate}") as path:

@@ -4,7 +4,6 @@ from __future__ import annotations
 import itertools
 import math
 import textwrap
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -15,7 +14,7 @@ from matplotlib.figure import Figure
 from ..core.files import whole_file
 from ..core.recording import Recording
 from .metrics import LAMBDA, cost, heading_error
-from .reports import paper_row, title
+from .reports import paper_row
 from .track import legend_if_any, track_panel
 
 RUDDER_LABEL = "rudder delta (deg)\n+ turns to port"     # a positive rudder turns to port
@@ -131,13 +130,6 @@ def save(fig: Figure, path: Path, formats: tuple[str, ...] = ("png",)) -> list[P
         with whole_file(target) as tmp:
             fig.savefig(tmp, dpi=120, format=fmt)
     return written
-
-
-def save_figure(run: Recording, draw: Callable[..., Figure], path: Path, label: str,
-                formats: tuple[str, ...] = ("png",), **draw_options: Any) -> list[Path]:
-    fig = draw(run, **draw_options)
-    fig.suptitle(title(label, run.meta), fontsize=8)
-    return save(fig, path, formats)
 
 
 def comparison(runs: dict[str, Recording], caption: str) -> Figure:
