@@ -137,13 +137,11 @@ def comparison(runs: dict[str, Recording], caption: str) -> Figure:
     fig, track, (heading, rudder) = _layout(("heading psi (deg)", RUDDER_LABEL))
     first = next(iter(runs.values()))
     track_panel(track, first, ship=False, others=runs.values())    # the route and the waves
-    heading.plot(first.t, np.degrees(first["guidance.psi_d"]), "--", color="0.4",
-                 label="psi_d")
+    heading.plot(first.t, np.degrees(first["guidance.psi_d"]), "--", color="0.4", label="psi_d")
     for label, run in runs.items():
         line, = track.plot(run["ship.y"], run["ship.x"], label=label)
         heading.plot(run.t, np.degrees(run["ship.psi"]), color=line.get_color(), label=label)
-        rudder.plot(run.t, np.degrees(run["ship.delta"]), color=line.get_color(),
-                    linewidth=0.7)
+        rudder.plot(run.t, np.degrees(run["ship.delta"]), color=line.get_color(), linewidth=0.7)
     legend_if_any(track)
     legend_if_any(heading)
     fig.suptitle(caption, fontsize=10)
