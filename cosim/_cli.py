@@ -21,7 +21,7 @@ from .scenarios.autopilot import AutopilotError, check_autopilot
 
 
 def chosen_scenarios(parser: argparse.ArgumentParser, args: argparse.Namespace) -> list[str]:
-    """One SCENARIO (a name or a .ssd path) or --all (the paper's four), checked."""
+    """One SCENARIO (a name or a .ssd path) or --all (the paper's four); --autopilot checked."""
     if args.all == bool(args.scenario):
         parser.error("give one SCENARIO or --all")
     names = list(scenarios.PAPER) if args.all else [args.scenario]
@@ -30,6 +30,7 @@ def chosen_scenarios(parser: argparse.ArgumentParser, args: argparse.Namespace) 
             scenarios.path(name)
         except (ValueError, FileNotFoundError) as error:
             parser.error(str(error))
+    checked_autopilot(parser, args)
     return names
 
 

@@ -6,7 +6,7 @@ from typing import Any, Iterable, Mapping, Sequence
 
 from . import scenarios
 from .core.master import BACKENDS, Master
-from .core.system import SystemDescription, split_name
+from .core.system import split_name
 from .core.recording import Recording
 
 
@@ -81,13 +81,15 @@ def simulate_many(scenario: str | Path, sets: Sequence[Mapping[str, Any]],
     run raises nothing (its ``error`` says why); a refused setting, ValueError naming its member."""
     if backend not in (*BACKENDS, "batch"):
         raise ValueError(f"backend must be fmi, inprocess or batch, got {backend!r}")
-    overrides = []
-    for i, settings in enumerate(sets):
-        try:
-            overrides.append(overrides_of(settings))
-        except ValueError as error:
-            raise ValueError(f"member {i}: {error}") from None
     system = scenarios.load(scenario, autopilot, port_map, fmi=fmi)
+    overrides = []
+    with Master(system, backend="inprocess") as master:     # every member's settings, first
+        for i, settings in enumerate(sets):
+            try:
+                overrides.append(overrides_of(settings))
+                master.configure(overrides[-1])
+            except ValueError as error:
+                raise ValueError(f"member {i}: {error}") from None
     if backend == "batch":
         from .ensemble import simulate_members
         from .ensemble.reference import SIGNALS
@@ -95,34 +97,11 @@ def simulate_many(scenario: str | Path, sets: Sequence[Mapping[str, Any]],
         recordings = simulate_members(system, overrides, stop_time,
                                       SIGNALS if signals is None else signals)
     else:
-        recordings = _one_at_a_time(system, overrides, stop_time, backend, signals)
+        recordings = []
+        for member in overrides:
+            with Master(system, backend=backend, overrides=member) as master:
+                recording = master.run(stop_time)
+            recordings.append(recording if signals is None else recording.holding(signals))
     for note in dict.fromkeys(n for r in recordings for n in r.meta.get("notes", [])):
         warnings.warn(note, stacklevel=2)
     return recordings
-
-
-def _one_at_a_time(system: SystemDescription, overrides: list[dict[str, dict[str, Any]]],
-                   stop_time: float | None, backend: str, signals: Sequence[str] | None
-                   ) -> list[Recording]:
-    """Each member's run on one master, reset between runs, made anew after a failed one."""
-    master = Master(system, backend=backend)
-    recordings = []
-    try:
-        for i, member in enumerate(overrides):
-            try:
-                master.configure(member)
-            except ValueError as error:
-                raise ValueError(f"member {i}: {error}") from None
-        for i, member in enumerate(overrides):
-            if i:
-                master.reset()
-            master.configure(member)
-            recording = master.run(stop_time)
-            if recording.error:             # its FMUs may be in an error state
-                master.free()
-                master = Master(system, backend=backend)
-            recordings.append(recording if signals is None else recording.holding(signals))
-    finally:
-        master.free()
-    return recordings
-

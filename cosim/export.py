@@ -7,10 +7,9 @@ import sys
 from pathlib import Path
 
 from . import scenarios
-from ._cli import (add_fmu_options, checked_autopilot, chosen_scenarios, entry, say_error,
-                   writable_folder)
+from ._cli import add_fmu_options, chosen_scenarios, entry, say_error, writable_folder
 from .core.files import OutputError
-from .interop.ssp import FMI2_ONLY, export, fmi_versions, unapplied_strings
+from .interop.ssp import FMI2_ONLY, described, export, unapplied_strings
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -26,15 +25,13 @@ def main(argv: list[str] | None = None) -> int:
                             "scenarios")
     args = parser.parse_args(argv)
     names = chosen_scenarios(parser, args)
-    checked_autopilot(parser, args)
     out = args.out or Path("results/ssp") / ("fmi3" if args.fmi == 3 else "")
     writable_folder(out)
     for name in names:
         try:
-            package = export(name, out, None, args.autopilot, dict(args.map), args.name,
-                             args.fmi)
+            package = export(name, out, None, args.autopilot, dict(args.map), args.name, args.fmi)
             print(f"wrote {package} and {package.with_suffix('')}/")
-            newer = sorted({v for v in fmi_versions(package).values() if v != "2.0"})
+            newer = sorted({d.fmiVersion for d in described(package)[1].values()} - {"2.0"})
             if newer:
                 print(f"note: {package.name} holds FMI {' and '.join(newer)} FMUs: ecos and "
                       f"OMSimulator run it; {' and '.join(FMI2_ONLY.values())} run FMI 2.0 "

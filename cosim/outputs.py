@@ -3,11 +3,12 @@ the outputs are staged and put in place together (a refused run, a full disk or 
 Ctrl-C leaves the folder as it was), by one process a folder at a time; nothing printed."""
 import signal
 from dataclasses import dataclass, field
+from importlib import import_module
 from pathlib import Path
 from typing import Any, Callable
 
-from .analysis.kinds import Analysis, analysis
 from .analysis.metrics import LAMBDA, Cost, cost
+from .analysis.reports import course_keeping_report, title, turning_circle_report, zigzag_report
 from .core.files import FolderLock, Outputs
 from .core.interrupt import StopSignals
 from .core.master import Master
@@ -17,6 +18,14 @@ from .core.ssd import SystemDescription
 from .core.watchdog import Limits, TimeLimit, Watchdog
 
 SUFFIXES = (".csv", ".json", ".png", ".svg", ".pdf", ".gif", ".mp4")   # a run's files
+# A scenario's kind (its .ssd's ``report``): the report printed, and the "module.function" of
+# cosim.analysis drawing its figure, imported only to draw (a run without one loads no matplotlib)
+KINDS: dict[str, tuple[Callable[..., list[str]], str | None]] = {
+    "course_keeping": (course_keeping_report, "figures.course_keeping_figure"),
+    "turning_circle": (turning_circle_report, "plates.turning_circle_plate"),
+    "zigzag": (zigzag_report, "plates.zigzag_plate"),
+    "none": (lambda recording, **_: [], None),
+}
 
 
 @dataclass(frozen=True)
@@ -58,7 +67,8 @@ def run_and_write(system: SystemDescription, label: str, out: Path,
     """Run ``system`` and write its CSV, JSON and, once finished, figure and animation as
     ``label`` in ``out``; ``stop`` ends it between steps on a signal. An exception (ValueError,
     FileNotFoundError, FmuCallError, TimedOut, FolderBusy, OutputError) leaves ``out`` as it was."""
-    kind = analysis(system.report)
+    if system.report not in KINDS:
+        raise ValueError(f"unknown report kind {system.report!r}; known: {', '.join(KINDS)}")
     with FolderLock(out):
         with Outputs(out, [out / f"{label}{suffix}" for suffix in SUFFIXES], label) as outputs:
             forget = stop.keep(lambda: _discard(outputs, label)) if stop else lambda: None
@@ -109,7 +119,7 @@ def run_and_write(system: SystemDescription, label: str, out: Path,
                         return outcome
                 outcome.written = _write_rows(recording, outputs, label, options.stream)
                 if not (recording.error or options.stream):
-                    _analyse(outcome, system, kind, label, outputs, options, parameters)
+                    _analyse(outcome, system, label, outputs, options, parameters)
                 outcome.written = [outputs.final(path) for path in outcome.written]
             finally:
                 forget()
@@ -135,15 +145,24 @@ def _write_rows(recording: Recording, outputs: Outputs, label: str, streamed: bo
     return [csv_path, json_path]
 
 
-def _analyse(outcome: Outcome, system: SystemDescription, kind: Analysis, label: str,
-             outputs: Outputs, options: Options, parameters: dict) -> None:
+def figure(kind: str) -> Callable[..., Any] | None:
+    """The function drawing a kind's figure, or None; importing it loads matplotlib."""
+    if KINDS[kind][1] is None:
+        return None
+    module, name = KINDS[kind][1].split(".")
+    return getattr(import_module(f"{__package__}.analysis.{module}"), name)
+
+
+def _analyse(outcome: Outcome, system: SystemDescription, label: str, outputs: Outputs,
+             options: Options, parameters: dict) -> None:
     recording = outcome.recording
-    outcome.report = kind.report(recording, lam=options.lam, parameters=parameters)
-    if options.plot and kind.figure is not None:
-        from .analysis.figures import save_figure     # matplotlib: only a run that draws
+    outcome.report = KINDS[system.report][0](recording, lam=options.lam, parameters=parameters)
+    if options.plot and (draw := figure(system.report)) is not None:
+        from .analysis.figures import save
+        fig = draw(recording, lam=options.lam)
+        fig.suptitle(title(label, recording.meta), fontsize=8)
         with outputs.writing(f"{label}.{options.formats[0]}") as path:
-            outcome.written += save_figure(recording, kind.figure, path.with_suffix(""),
-                                           label, options.formats, lam=options.lam)
+            outcome.written += save(fig, path.with_suffix(""), options.formats)
     if options.animate:
         from .analysis.animation import animate
         with outputs.writing(f"{label}.{options.animate}") as path:

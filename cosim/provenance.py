@@ -42,7 +42,7 @@ def _fmu(fmu: dict[str, Any]) -> dict[str, Any]:
     try:
         manifest = read(fmu["file"])
     except (OSError, ValueError, zipfile.BadZipFile):
-        manifest = None
+        return entry
     if manifest is not None:
         stale = staleness(manifest)
         entry.update(sources_digest=manifest.digest, current=stale is None)
@@ -64,8 +64,7 @@ def _commit() -> str | None:
 
 @functools.lru_cache(maxsize=1)
 def code_version() -> str:
-    """This package's version and a SHA-256 of its Python sources: the same string, the same
-    code."""
+    """This package's version and a SHA-256 of its Python sources: the same string, same code."""
     digest = hashlib.sha256()
     for package in CODE_PACKAGES:
         for path in sorted((ROOT / package).rglob("*.py")):

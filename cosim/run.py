@@ -21,8 +21,8 @@ from pathlib import Path
 from tqdm import tqdm
 
 from . import scenarios
-from ._cli import (add_fmu_options, checked_autopilot, chosen_scenarios, entry, number_option,
-                   positive_seconds, say_error, say_note, setting_option, writable_folder)
+from ._cli import (add_fmu_options, chosen_scenarios, entry, number_option, positive_seconds,
+                   say_error, say_note, setting_option, writable_folder)
 from .analysis.metrics import LAMBDA, Cost
 from .analysis.reports import conditions, headline, tables
 from .api import overrides_of
@@ -132,7 +132,6 @@ def main(argv: list[str] | None = None) -> int:
                              "wall-clock time (default: no limit)")
     args = parser.parse_args(argv)
     names = chosen_scenarios(parser, args)
-    checked_autopilot(parser, args)
     try:
         overrides = overrides_of(args.set)
     except ValueError as error:             # a variable set twice

@@ -21,7 +21,7 @@ from cosim import export as export_cli
 from cosim import scenarios
 from cosim.core.master import Master
 from cosim.interop.hosts import EngineError, run, run_omsimulator
-from cosim.interop.ssp import export, fmi_versions
+from cosim.interop.ssp import described, export
 from helpers import ecos_missing
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -50,12 +50,12 @@ def _master(name: str, coupling: str):
 def test_the_fmi3_package_holds_the_twins_and_the_same_system(packages):
     for name in NAMES:
         two, three = packages[name, 2], packages[name, 3]
-        assert set(fmi_versions(three).values()) == {"3.0"}
-        assert set(fmi_versions(two).values()) == {"2.0"}
+        assert {d.fmiVersion for d in described(three)[1].values()} == {"3.0"}
+        assert {d.fmiVersion for d in described(two)[1].values()} == {"2.0"}
         with zipfile.ZipFile(two) as a, zipfile.ZipFile(three) as b:
             assert a.read("SystemStructure.ssd") == b.read("SystemStructure.ssd")
             assert a.namelist() == b.namelist()
-        assert set(fmi_versions(three.with_suffix(""))) == set(fmi_versions(three))
+        assert set(described(three.with_suffix(""))[1]) == set(described(three)[1])
 
 
 def test_the_export_command_writes_it_and_says_who_cannot_run_it(fmi3_paths, tmp_path,

@@ -21,7 +21,7 @@ from cosim.core.master import Master
 from cosim.core.ssd import write_ssd
 from cosim.interop.hosts import EngineError
 from cosim.interop.hosts import run_omsimulator as run
-from cosim.interop.ssp import SSD_NAME, export, read_package
+from cosim.interop.ssp import SSD_NAME, described, export
 
 ROOT = Path(__file__).resolve().parent.parent
 OMS = Path(os.environ.get("OMSIMULATOR_HOME") or ROOT.parent / "shared" / "tools" / "omsimulator")
@@ -81,7 +81,7 @@ def test_a_route_other_than_the_default_reaches_the_guidance_in_omsimulator(pack
 
 
 def test_the_package_gives_the_route_as_numbers_only(packages):
-    guidance = read_package(packages["south"]).components["guidance"].parameters
+    guidance = described(packages["south"])[0].components["guidance"].parameters
     assert "waypoints" not in guidance
     assert guidance["n_waypoints"] == 4 and (guidance["wp2_x"], guidance["wp2_y"]) == (60.0, -25.0)
     assert route(guidance) == route({"waypoints": SOUTH})

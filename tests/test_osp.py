@@ -8,7 +8,7 @@ import pytest
 
 from cosim.interop.hosts import run
 from cosim.interop.ssp import OSP_FILE, read_osp
-from cosim.interop.ssp import export, read_package
+from cosim.interop.ssp import described, export
 
 NAMES = ["calm_pd", "waves_smc", "turning_circle"]
 
@@ -25,7 +25,7 @@ def test_libcosim_runs_the_osp_file_to_the_same_bits_as_the_package(packages, na
     ssp = packages[name]
     folder = ssp.with_suffix("")
     assert sorted(p.name for p in folder.iterdir()) == sorted(
-        [OSP_FILE, *{Path(c.source).name for c in read_package(ssp).components.values()}])
+        [OSP_FILE, *{Path(c.source).name for c in described(ssp)[0].components.values()}])
     from_ssp = run("libcosim", ssp)
     for osp in (folder, folder / OSP_FILE):           # the folder, as OSP's tools take it
         from_osp = run("libcosim", osp)
@@ -35,7 +35,7 @@ def test_libcosim_runs_the_osp_file_to_the_same_bits_as_the_package(packages, na
 
 @pytest.mark.parametrize("name", NAMES)
 def test_the_osp_file_holds_what_the_ssd_does(packages, name):
-    ssd, osp = read_package(packages[name]), read_osp(packages[name].with_suffix(""))
+    ssd, osp = described(packages[name])[0], read_osp(packages[name].with_suffix(""))
     assert (osp.start_time, osp.stop_time, osp.step_size) == (ssd.start_time, ssd.stop_time,
                                                              ssd.step_size)
     assert osp.connections == ssd.connections

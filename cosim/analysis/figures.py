@@ -4,7 +4,6 @@ from __future__ import annotations
 import itertools
 import math
 import textwrap
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -15,7 +14,7 @@ from matplotlib.figure import Figure
 from ..core.files import whole_file
 from ..core.recording import Recording
 from .metrics import LAMBDA, cost, heading_error
-from .reports import paper_row, title
+from .reports import paper_row
 from .track import legend_if_any, track_panel
 
 RUDDER_LABEL = "rudder delta (deg)\n+ turns to port"     # a positive rudder turns to port
@@ -133,25 +132,16 @@ def save(fig: Figure, path: Path, formats: tuple[str, ...] = ("png",)) -> list[P
     return written
 
 
-def save_figure(run: Recording, draw: Callable[..., Figure], path: Path, label: str,
-                formats: tuple[str, ...] = ("png",), **draw_options: Any) -> list[Path]:
-    fig = draw(run, **draw_options)
-    fig.suptitle(title(label, run.meta), fontsize=8)
-    return save(fig, path, formats)
-
-
 def comparison(runs: dict[str, Recording], caption: str) -> Figure:
     """Several controllers on one scenario: their tracks, headings and rudders, overlaid."""
     fig, track, (heading, rudder) = _layout(("heading psi (deg)", RUDDER_LABEL))
     first = next(iter(runs.values()))
     track_panel(track, first, ship=False, others=runs.values())    # the route and the waves
-    heading.plot(first.t, np.degrees(first["guidance.psi_d"]), "--", color="0.4",
-                 label="psi_d")
+    heading.plot(first.t, np.degrees(first["guidance.psi_d"]), "--", color="0.4", label="psi_d")
     for label, run in runs.items():
         line, = track.plot(run["ship.y"], run["ship.x"], label=label)
         heading.plot(run.t, np.degrees(run["ship.psi"]), color=line.get_color(), label=label)
-        rudder.plot(run.t, np.degrees(run["ship.delta"]), color=line.get_color(),
-                    linewidth=0.7)
+        rudder.plot(run.t, np.degrees(run["ship.delta"]), color=line.get_color(), linewidth=0.7)
     legend_if_any(track)
     legend_if_any(heading)
     fig.suptitle(caption, fontsize=10)

@@ -105,19 +105,16 @@ def approach_frame(x: np.ndarray, y: np.ndarray, psi0: float) -> tuple[np.ndarra
     return dx * c + dy * s, -dx * s + dy * c
 
 
-def fitted_circle(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
-    """(x, y) of the centre and the diameter of the least-squares circle (Kasa's fit), m."""
-    A = np.column_stack([2.0 * x, 2.0 * y, np.ones_like(x)])
-    (cx, cy, c), *_ = np.linalg.lstsq(A, x * x + y * y, rcond=None)
-    return float(cx), float(cy), 2.0 * math.sqrt(c + cx * cx + cy * cy)
-
-
 def steady_circle(x: np.ndarray, y: np.ndarray, psi: np.ndarray) -> tuple[float, float, float]:
-    """``fitted_circle`` of the last lap; NaNs unless it turned 540 deg."""
+    """(x, y) of the centre and the diameter, m, of the least-squares circle (Kasa's fit) of
+    the last lap; NaNs unless it turned 540 deg."""
     if abs(psi[-1] - psi[0]) < 3.0 * math.pi:
         return math.nan, math.nan, math.nan
     lap = np.abs(psi[-1] - psi) <= 2.0 * math.pi
-    return fitted_circle(x[lap], y[lap])
+    x, y = x[lap], y[lap]
+    (cx, cy, c), *_ = np.linalg.lstsq(np.column_stack([2.0 * x, 2.0 * y, np.ones_like(x)]),
+                                      x * x + y * y, rcond=None)
+    return float(cx), float(cy), 2.0 * math.sqrt(c + cx * cx + cy * cy)
 
 
 def turning_circle_figures(x, y, psi, u, v, r) -> TurningCircle:

@@ -20,7 +20,7 @@ from fmukit.timebase import communication_point, step_count
 from ..core.files import whole_file
 from ..core.interrupt import STOP_SIGNALS, Interrupted, StopSignals
 from ..core.system import SystemDescription, split_name
-from .ssp import FMI2_ONLY, described, is_osp, read_package, unapplied_strings
+from .ssp import FMI2_ONLY, described, is_osp, unapplied_strings
 
 ENGINES = ("libcosim", "ecos", "fmpy")
 TRACED = ("ship.psi", "ship.r", "ship.delta")
@@ -177,7 +177,7 @@ def record(engine: str, ssp: str, out: str, signals: tuple[str, ...]) -> int:
     stderr, or 130 / 143 if SIGINT or SIGTERM stopped it."""
     try:
         with StopSignals() as stop:
-            system = read_package(Path(ssp))
+            system = described(Path(ssp))[0]
             n_steps = step_count(system.start_time, system.stop_time, system.step_size)
             result = RUNNERS[engine](Path(ssp), system, n_steps, signals, stop)
     except Interrupted as interrupted:
@@ -221,7 +221,7 @@ def run_omsimulator(ssp: str | Path, home: str | Path, interface: str = "cli",
         raise ValueError(f"interface must be one of cli, api, got {interface!r}")
     ssp, home = Path(ssp).resolve(), Path(home).resolve()
     refuse_strings(ssp, "OMSimulator")
-    system, site = read_package(ssp), sysconfig.get_paths()["purelib"]
+    system, site = described(ssp)[0], sysconfig.get_paths()["purelib"]
     with tempfile.TemporaryDirectory() as tmp:
         result = Path(tmp) / "result.csv"
         if interface == "cli":              # its Python FMUs need libpython loaded first

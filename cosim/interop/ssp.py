@@ -173,16 +173,6 @@ def described(path: Path) -> tuple[SystemDescription, dict[str, ModelDescription
                         for name, component in system.components.items()}
 
 
-def read_package(path: Path) -> SystemDescription:
-    """The system of an SSP package or of an OSP folder or file."""
-    return described(path)[0]
-
-
-def fmi_versions(path: Path) -> dict[str, str]:
-    """Each component's FMI version ("2.0", "3.0") in a package or OSP folder."""
-    return {name: d.fmiVersion for name, d in described(path)[1].items()}
-
-
 def unapplied_strings(ssp: Path) -> dict[str, tuple[str, str]]:
     """String bindings a tool applying none would drop without a word, not at their FMU's
     default: 'component.variable': (value, default)."""
