@@ -53,16 +53,12 @@ def main(argv: list[str] | None = None) -> int:
         print("".join(tables[-2:]), flush=True)
     section("Integration error, open loop (calm water)", integration_error.open_loop_table(
         [integration_error.open_loop(p, open_end) for p in ("step", "sine", "zigzag")]))
-    closed = {name: coupling_error.closed_loop(name, closed_end) for name in runs}
+    results = {name: coupling_error.study(name, steps, closed_end) for name in runs}
     section("Co-simulation at 0.1 s against the monolithic reference",
-            coupling_error.closed_loop_table(closed))
-    references = {name: result["monolithic"] for name, result in closed.items()}
-    converging = {name: coupling_error.convergence(name, references[name], steps, closed_end)
-                  for name in runs}
-    section("J against the communication step",
-            coupling_error.convergence_table(converging, references))
+            coupling_error.closed_loop_table(results))
+    section("J against the communication step", coupling_error.convergence_table(results))
     write_atomically(out / "accuracy.md", lambda path: path.write_text("\n".join(tables) + "\n"))
-    figure = coupling_error.convergence_figure(converging, out / "convergence.png")
+    figure = coupling_error.convergence_figure(results, out / "convergence.png")
     print(f"wrote {out / 'accuracy.md'}, {figure} ({time.perf_counter() - started:.0f} s)")
     return 0
 

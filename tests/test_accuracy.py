@@ -5,7 +5,6 @@ from __future__ import annotations
 import pytest
 
 from cosim.studies import coupling_error, integration_error
-from cosim.studies.coupling_error import monolithic
 from helpers import command
 
 
@@ -39,12 +38,9 @@ def test_the_reference_is_100_times_more_accurate_than_what_it_measures(step_res
 def test_cosimulation_converges_to_the_monolithic_model_as_the_step_shrinks():
     """calm_smc over its first turn: J's distance from the monolithic value shrinks with
     every halving of the communication step, for both couplings."""
-    from cosim import scenarios
-
-    reference = coupling_error.figures(monolithic(scenarios.load("calm_smc"), 120.0))
-    for rows in coupling_error.convergence("calm_smc", reference, (0.1, 0.05, 0.025),
-                                     120.0).values():
-        errors = [row["J_error"] for row in rows]
+    result = coupling_error.study("calm_smc", (0.1, 0.05, 0.025), 120.0)
+    for coupling in coupling_error.COUPLINGS:
+        errors = [row["J_error"] for row in result[coupling]]
         assert errors[0] > errors[1] > errors[2], errors
         assert errors[2] < 0.05
 

@@ -19,7 +19,7 @@ from ..analysis.metrics import LAMBDA, cost_terms
 from ..core.master import Master
 from ..ensemble.reference import COMPONENTS, initialise
 from . import table
-from .integration_error import H
+from .integration_error import H, orders
 
 PAPER_RUNS = ("calm_pd", "calm_smc", "waves_pd", "waves_smc")
 COUPLINGS = ("gauss-seidel", "jacobi")
@@ -113,51 +113,42 @@ def figures(run: dict[str, np.ndarray]) -> dict[str, float]:
     return {"psi_E": psi_E, "sum_delta2": sum_delta2, "J": psi_E + LAMBDA * sum_delta2}
 
 
-def closed_loop(name: str, stop_time: float | None = None) -> dict[str, dict]:
-    """Part 2 for one run: the figures of the reference and of both couplings at 0.1 s."""
-    reference_run = monolithic(scenarios.load(name), stop_time)
-    out = {"monolithic": {**figures(reference_run), "max_dpsi": 0.0}}
+def study(name: str, steps=STEPS, stop_time: float | None = None) -> dict[str, list[dict]]:
+    """Parts 2 and 3 for one run: {"monolithic": [its figures], coupling: [the figures at each
+    step, J's relative distance from the monolithic J and, at 0.1 s, psi's largest]}."""
+    reference = monolithic(scenarios.load(name), stop_time)
+    out = {"monolithic": [{"step": H, **figures(reference), "J_error": 0.0, "max_dpsi": 0.0}]}
+    J = out["monolithic"][0]["J"]
     for coupling in COUPLINGS:
-        run = cosimulation(name, H, coupling, stop_time)
-        out[coupling] = {**figures(run),
-                         "max_dpsi": float(np.abs(run["psi"] - reference_run["psi"]).max())}
+        out[coupling] = []
+        for step in steps:
+            run = cosimulation(name, step, coupling, stop_time)
+            f = {"step": step, **figures(run)}
+            out[coupling].append({**f, "J_error": abs(f["J"] - J) / J, "max_dpsi": float(
+                np.abs(run["psi"] - reference["psi"]).max()) if step == H else math.nan})
     return out
 
 
 def closed_loop_table(results: dict[str, dict]) -> str:
+    """Part 2: each run's reference and couplings at 0.1 s."""
     return "\n".join(table(
         ["run", "model", "psi_E (rad^2)", "sum delta^2 (rad^2)", "J",
          "max abs(psi - psi_ref) (deg)"],
         ([name, model, f"{f['psi_E']:.2f}", f"{f['sum_delta2']:.3f}", f"{f['J']:.2f}",
           f"{math.degrees(f['max_dpsi']):.3f}"]
-         for name, result in results.items() for model, f in result.items()), 2))
+         for name, result in results.items() for model, rows in result.items()
+         for f in rows if f["step"] == H), 2))
 
 
-def convergence(name: str, reference_figures: dict[str, float], steps=STEPS,
-                stop_time: float | None = None) -> dict[str, list[dict]]:
-    """Part 3 for one run: the figures at each step and coupling, and J's relative distance
-    from the monolithic value."""
-    J = reference_figures["J"]
-
-    def row(coupling: str, step: float) -> dict:
-        f = figures(cosimulation(name, step, coupling, stop_time))
-        return {"step": step, **f, "J_error": abs(f["J"] - J) / J}
-    return {coupling: [row(coupling, step) for step in steps] for coupling in COUPLINGS}
-
-
-def convergence_table(results: dict[str, dict], references: dict[str, dict]) -> str:
-    steps = [r["step"] for r in next(iter(next(iter(results.values())).values()))]
-
-    def order(rows: list[dict]) -> float:
-        e = [r["J_error"] for r in rows]
-        found = [math.log2(a / b) for a, b in zip(e, e[1:]) if a > 0 and b > 0]
-        return np.median(found) if found else math.nan
+def convergence_table(results: dict[str, dict]) -> str:
+    """Part 3: J at each step, its observed order and the monolithic J."""
+    steps = [r["step"] for r in next(iter(results.values()))[COUPLINGS[0]]]
     return "\n".join(table(
         ["run", "coupling", *(f"J at {s:g} s" for s in steps), "order", "J monolithic"],
-        ([name, coupling, *(f"{r['J']:.2f}" for r in rows), f"{order(rows):.2f}",
-          f"{references[name]['J']:.2f}"]
-         for name, by_coupling in results.items() for coupling, rows in by_coupling.items()),
-        2))
+        ([name, coupling, *(f"{r['J']:.2f}" for r in result[coupling]),
+          f"{np.median(orders([r['J_error'] for r in result[coupling]]) or [math.nan]):.2f}",
+          f"{result['monolithic'][0]['J']:.2f}"]
+         for name, result in results.items() for coupling in COUPLINGS), 2))
 
 
 def convergence_figure(results: dict[str, dict], path: Path) -> Path:
@@ -167,12 +158,12 @@ def convergence_figure(results: dict[str, dict], path: Path) -> Path:
 
     fig = Figure(figsize=(7, 4.5))
     ax = fig.subplots()
-    for name, by_coupling in results.items():
-        for coupling, rows in by_coupling.items():
-            ax.loglog([r["step"] for r in rows], [max(r["J_error"], 1e-12) for r in rows],
-                      "o-" if coupling == "gauss-seidel" else "s--",
+    for name, result in results.items():
+        for coupling, style in zip(COUPLINGS, ("o-", "s--")):
+            ax.loglog([r["step"] for r in result[coupling]],
+                      [max(r["J_error"], 1e-12) for r in result[coupling]], style,
                       label=f"{name}, {coupling}")
-    steps = [r["step"] for r in next(iter(next(iter(results.values())).values()))]
+    steps = [r["step"] for r in next(iter(results.values()))[COUPLINGS[0]]]
     ax.set_xticks(steps, [f"{step:g}" for step in steps])
     ax.xaxis.set_minor_locator(matplotlib.ticker.NullLocator())
     ax.set(xlabel="communication step (s)", ylabel="|J - J monolithic| / J monolithic",
