@@ -1,7 +1,9 @@
 """Studies on the co-simulation core: sweeps, scorecard, benchmarks, accuracy
-(docs/architecture.md lists the modules); ``table`` for their Markdown."""
+(docs/architecture.md lists the modules); ``table`` for their Markdown, ``in_child``."""
 from __future__ import annotations
 
+import subprocess
+import sys
 from typing import Iterable, Sequence
 
 
@@ -12,3 +14,15 @@ def table(header: Sequence[str], rows: Iterable[Sequence[str]],
     left = len(header) if text_columns is None else text_columns
     lines = ["| " + " | ".join(cells) + " |" for cells in (header, *rows)]
     return [lines[0], "|" + "---|" * left + "---:|" * (len(header) - left), *lines[1:]]
+
+
+def in_child(what: str, code: str, *args: str, env: dict[str, str] | None = None,
+             timeout: float | None = None) -> str:
+    """The output of ``python -c code args`` in a fresh process; RuntimeError naming ``what``
+    with the child's last words if it fails."""
+    done = subprocess.run([sys.executable, "-c", code, *args], env=env, capture_output=True,
+                          text=True, timeout=timeout)
+    if done.returncode:
+        raise RuntimeError(f"{what} failed (status {done.returncode}): "
+                           f"{done.stderr.strip().splitlines()[-1:]}")
+    return done.stdout

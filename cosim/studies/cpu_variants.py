@@ -4,15 +4,13 @@ from __future__ import annotations
 
 import json
 import os
-import subprocess
-import sys
 import tempfile
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
 
-from . import table
+from . import in_child, table
 
 _AVX512 = "AVX512F AVX512CD AVX512_SKX AVX512_CLX AVX512_CNL AVX512_ICL AVX512_SPR X86_V4"
 VARIANTS: dict[str, dict[str, str]] = {     # "default": this machine as it is
@@ -36,12 +34,8 @@ def run_in(variant: str, scenario: str, csv_path: Path,
            stop_time: float | None = None) -> Path:
     """Run ``scenario`` in-process in a child under ``VARIANTS[variant]``; its CSV.
     RuntimeError with the child's last words if it fails; killed after ``TIMEOUT``."""
-    child = subprocess.run([sys.executable, "-c", _CHILD, scenario, str(csv_path),
-                            json.dumps(stop_time)], env={**os.environ, **VARIANTS[variant]},
-                           capture_output=True, text=True, timeout=TIMEOUT)
-    if child.returncode != 0:
-        raise RuntimeError(f"{scenario} under {variant!r} failed (status {child.returncode}): "
-                           f"{child.stderr.strip().splitlines()[-1:]}")
+    in_child(f"{scenario} under {variant!r}", _CHILD, scenario, str(csv_path),
+             json.dumps(stop_time), env={**os.environ, **VARIANTS[variant]}, timeout=TIMEOUT)
     return csv_path
 
 

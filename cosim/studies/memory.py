@@ -2,13 +2,12 @@
 against its members and the sweep's size (``bench sweep --parts memory``), in fresh processes."""
 from __future__ import annotations
 
-import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 from ..core.master import RUN_BACKENDS
+from . import in_child
 from .sweep_task import BATCH
 from .sweep_timing import bench_spec, require_batch, seeds, sizes, timed_sweep, verdict
 from .timing import load, machine, peak_rss_mb
@@ -101,10 +100,6 @@ def members_call(members: int, stop_time: float) -> tuple[float, float, float, f
 
 
 def _in_child(what: str, function: str, *args: object) -> list[float]:
-    """``function(*args)`` of this module run in a fresh process; RuntimeError naming
-    ``what`` with the child's last words if it fails."""
+    """``function(*args)`` of this module in a fresh process (its own peak memory)."""
     code = f"from cosim.studies.memory import {function}; print(*{function}(*{args!r}))"
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
-    if done.returncode:
-        raise RuntimeError(f"{what} failed: {done.stderr.strip().splitlines()[-1:]}")
-    return [float(value) for value in done.stdout.split()]
+    return [float(value) for value in in_child(what, code).split()]

@@ -188,18 +188,14 @@ def timed_sweep(spec: Spec, workers: int, backend: str, batch_size: int | None =
     from .campaign import execute
     from .cluster import local_cluster
 
-    with tempfile.TemporaryDirectory() as tmp:
-        started = time.perf_counter()
-        cluster = local_cluster(workers)
-        try:
-            ready = time.perf_counter()
-            rows = execute(spec, Path(tmp), scheduler=cluster.scheduler_address,
-                           progress=False, backend=backend, batch_size=batch_size)
-            done = time.perf_counter()
-            with Client(cluster) as client:
-                peaks = tuple(sorted(client.run(peak_rss_mb).values()))
-        finally:
-            cluster.close()
+    started = time.perf_counter()
+    with tempfile.TemporaryDirectory() as tmp, local_cluster(workers) as cluster:
+        ready = time.perf_counter()
+        rows = execute(spec, Path(tmp), scheduler=cluster.scheduler_address,
+                       progress=False, backend=backend, batch_size=batch_size)
+        done = time.perf_counter()
+        with Client(cluster) as client:
+            peaks = tuple(sorted(client.run(peak_rss_mb).values()))
     failed = [r for r in rows if r["status"] != "ok"]
     if failed:
         raise RuntimeError(f"{len(failed)} of {len(rows)} runs of the {backend} sweep failed: "
