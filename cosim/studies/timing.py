@@ -33,8 +33,8 @@ def peak_rss_mb() -> float:
 
 
 def machine() -> str:
-    """One line on the machine the figures come from and its load now: its CPU (by family,
-    model and AVX-512, which numpy's kernels use where the CPU has it), cores, Python, OS."""
+    """One line on the machine and its load now: its CPU (family, model and AVX-512, which
+    numpy's kernels use), cores, Python, OS."""
     try:
         info = dict(line.split(":", 1) for line in Path("/proc/cpuinfo").read_text().split(
             "\n\n")[0].splitlines() if ":" in line)
@@ -54,8 +54,7 @@ def load() -> str:
 
 
 def side_by_side(runners: dict[str, Callable[[], object]], repeats: int) -> dict[str, float]:
-    """Median wall time of each runner, timed in turn round after round (the same load on a
-    shared machine) after a warm-up round."""
+    """Median wall time of each runner, timed in turn round after round after a warm-up."""
     times: dict[str, list[float]] = {key: [] for key in runners}
     for round_ in range(repeats + 1):
         for key, run in runners.items():
@@ -93,8 +92,7 @@ def _ecos_runner(ssp: Path) -> Callable[[], None]:
 
 
 def engines(repeats: int) -> dict[str, dict[str, float]]:
-    """calm_pd and waves_pd by each of ``ROWS`` (docs/performance.md), printed with their
-    ratios; the times by scenario and row."""
+    """calm_pd and waves_pd by each of ``ROWS``, printed with their ratios; the times."""
     from .. import scenarios
     from ..core.master import Master
     from ..ensemble.reference import run_direct
@@ -183,8 +181,8 @@ IDLE_CALLS = {"reader": _idle_reader, "integer_reader": _idle_reader,
 
 
 def overhead(repeats: int) -> dict[str, float]:
-    """Microseconds per step of calm_pd with the ship's step doing nothing: by hand, by the
-    master with its calls into the FMUs idle (``IDLE_CALLS``), and in-process."""
+    """Microseconds per step of calm_pd, the ship's step idle: by hand, by the master with
+    its calls into the FMUs idle (``IDLE_CALLS``), and in-process."""
     from unittest import mock
 
     from ship_fmu.vessel import Vessel
