@@ -45,13 +45,13 @@ def _benchmark(name: str, args: argparse.Namespace, repeats: int) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m cosim.bench", description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--repeats", type=int, default=5, help="runs per median (default 5)")
-    commands = parser.add_subparsers(dest="command")
-    repeats = argparse.ArgumentParser(add_help=False)       # also after the subcommand
+    repeats = argparse.ArgumentParser(add_help=False)       # before or after the subcommand
     repeats.add_argument("--repeats", type=int, default=argparse.SUPPRESS,
                          help="runs per median (default 5)")
+    parser = argparse.ArgumentParser(prog="python -m cosim.bench", description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter,
+                                     parents=[repeats])
+    commands = parser.add_subparsers(dest="command")
     commands.add_parser("engines", parents=[repeats], help="engines side by side (the default)")
     commands.add_parser("overhead", parents=[repeats],
                         help="what the routes do besides the models (the ship's step idle)")
@@ -84,7 +84,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         for name in BENCHMARKS if args.command == "all" else (args.command or "engines",):
             _benchmark(name, args if name == args.command or name not in own
-                       else own[name].parse_args([]), args.repeats)
+                       else own[name].parse_args([]), getattr(args, "repeats", 5))
     except (RuntimeError, ValueError, FileNotFoundError) as error:   # e.g. stale FMUs
         say_error(error)
         return 2

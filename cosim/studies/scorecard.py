@@ -13,7 +13,7 @@ from ..analysis.figures import comparison, save
 from ..analysis.metrics import heading_error, overshoot, settling_time
 from ..analysis.reports import PAPER_TABLES
 from ..analysis.seastate import WMO, model_scale
-from ..api import SimulationError, overrides_of
+from ..api import overrides_of
 from ..core.files import fresh_folder, write_atomically
 from ..core.recording import Recording
 from ..outputs import Options, run_and_write
@@ -49,21 +49,6 @@ class Contender:
     port_map: dict[str, str] | None = None
     settings: dict[str, Any] | None = None   # --set values, for the user's autopilot only
 
-    def run(self, label: str, out: Path, sea: str, backend: str, stop_time: float | None = None,
-            route: str | None = None) -> Recording:
-        """One test's run, written to out/<label>_<name>.*; SimulationError if an FMU fails."""
-        settings = dict(self.settings or {})
-        if route is not None:
-            settings["guidance.waypoints"] = route
-        system = scenarios.load(f"{sea}_{self.suffix}", self.fmu, self.port_map)
-        out.mkdir(parents=True, exist_ok=True)
-        recording = run_and_write(system, f"{label}_{self.name}", out, overrides_of(settings),
-                                  Options(stop_time=stop_time, backend=backend,
-                                          plot=False)).recording
-        if recording.error:
-            raise SimulationError(recording.error, recording)
-        return recording
-
     @property
     def paper_cost(self) -> str:
         """J calm / waves in the paper, for one of its controllers; '-' for any other."""
@@ -92,16 +77,25 @@ def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | Non
     contenders = _contenders(fmu, name, port_map, settings)
     failures: dict[tuple[str, str], str] = {}
 
-    def tested(test: str, label: str, title: str, **kwargs: Any) -> dict[str, Recording]:
+    def tested(test: str, label: str, title: str, sea: str, stop_time: float | None = None,
+               route: str | None = None) -> dict[str, Recording]:
+        """Each contender's run, written to out/runs/<label>_<name>.*, and their figure."""
         runs = {}
-        for contender in contenders:
-            progress(f"{test}, {contender.name}")
-            try:
-                runs[contender.name] = contender.run(
-                    label, out / "runs", backend="inprocess" if backend == BATCH else backend,
-                    **kwargs)
-            except SimulationError as error:
-                failures[contender.name, test] = str(error).splitlines()[0]
+        (out / "runs").mkdir(parents=True, exist_ok=True)
+        for c in contenders:
+            progress(f"{test}, {c.name}")
+            settings = dict(c.settings or {})
+            if route is not None:
+                settings["guidance.waypoints"] = route
+            recording = run_and_write(
+                scenarios.load(f"{sea}_{c.suffix}", c.fmu, c.port_map), f"{label}_{c.name}",
+                out / "runs", overrides_of(settings), Options(
+                    stop_time=stop_time, backend="inprocess" if backend == BATCH else backend,
+                    plot=False)).recording
+            if recording.error:
+                failures[c.name, test] = recording.error.splitlines()[0]
+            else:
+                runs[c.name] = recording
         save(comparison(runs, title), out / f"{label}.png")
         return runs
 
