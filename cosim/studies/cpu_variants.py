@@ -30,15 +30,6 @@ _CHILD = ("import json, sys; from cosim import simulate; simulate(sys.argv[1], s
           "json.loads(sys.argv[3]), backend='inprocess').write_csv(sys.argv[2])")
 
 
-def run_in(variant: str, scenario: str, csv_path: Path,
-           stop_time: float | None = None) -> Path:
-    """Run ``scenario`` in-process in a child under ``VARIANTS[variant]``; its CSV.
-    RuntimeError with the child's last words if it fails; killed after ``TIMEOUT``."""
-    in_child(f"{scenario} under {variant!r}", _CHILD, scenario, str(csv_path),
-             json.dumps(stop_time), env={**os.environ, **VARIANTS[variant]}, timeout=TIMEOUT)
-    return csv_path
-
-
 def difference(a: Path, b: Path) -> str | None:
     """None if two CSVs are the same bytes; else where they first differ."""
     if a.read_bytes() == b.read_bytes():
@@ -55,14 +46,19 @@ def difference(a: Path, b: Path) -> str | None:
 
 def audit(scenario_names: list[str], variants: list[str] | None = None,
           stop_time: float | None = None) -> dict[str, dict[str, str | None]]:
-    """Each scenario under each variant against "default": {scenario: {variant: difference}}."""
+    """Each scenario under each variant against "default": {scenario: {variant: difference}};
+    each run in-process in a child, killed after ``TIMEOUT``."""
     variants = [v for v in (variants or list(VARIANTS)) if v != "default"]
     with tempfile.TemporaryDirectory(prefix="cosim-cpus-") as folder, \
             ThreadPoolExecutor(2) as pool:
+        def run(scenario: str, variant: str) -> Path:
+            csv = Path(folder) / f"{scenario} {variant}.csv"
+            in_child(f"{scenario} under {variant!r}", _CHILD, scenario, str(csv),
+                     json.dumps(stop_time), env={**os.environ, **VARIANTS[variant]},
+                     timeout=TIMEOUT)
+            return csv
         jobs = [(s, v) for s in scenario_names for v in ["default", *variants]]
-        paths = dict(zip(jobs, pool.map(
-            lambda i: run_in(jobs[i][1], jobs[i][0], Path(folder) / f"{i}.csv", stop_time),
-            range(len(jobs)))))
+        paths = dict(zip(jobs, pool.map(lambda job: run(*job), jobs)))
         return {s: {v: difference(paths[(s, "default")], paths[(s, v)]) for v in variants}
                 for s in scenario_names}
 

@@ -9,7 +9,7 @@ from pathlib import Path
 from ..core.master import RUN_BACKENDS
 from . import in_child
 from .sweep_task import BATCH
-from .sweep_timing import bench_spec, require_batch, seeds, sizes, timed_sweep, verdict
+from .sweep_timing import bench_spec, require_batch, sizes, timed_sweep, verdict
 from .timing import load, machine, peak_rss_mb
 
 MEMORY_MEMBERS = (64, 256, 1024, 4096)
@@ -58,7 +58,7 @@ def batch_memory(members: tuple[int, ...] = MEMORY_MEMBERS,
               f"{results:6.1f} MB, the rest {rest:6.1f} MB ({rest / m * 1024:5.1f} kB a member)")
     sweeps = {}
     for m in members:
-        spec = bench_spec({"pd": "waves_pd"}, seeds(m), stop_time)
+        spec = bench_spec(("waves_pd",), m, stop_time)
         require_batch(spec)
         s = sweeps[m] = timed_sweep(spec, 1, BATCH, batch_size)
         print(f"  sweep of {m:5} runs, 1 worker, {len(s.batches):3} batch"

@@ -107,7 +107,7 @@ def engines(repeats: int) -> dict[str, dict[str, float]]:
             ssp = export(name, Path(tmp))
             with Master(system, backend="inprocess") as inprocess, \
                     Master(system, backend="fmi") as fmi:
-                require_in_process(inprocess.notes)
+                require("in-process backend", inprocess.notes)
                 runners = {"direct": lambda: run_direct(inprocess),
                            "inprocess": _master_runner(inprocess), "fmi": _master_runner(fmi)}
                 for key, make in (("libcosim", _libcosim_runner), ("ecos", _ecos_runner)):
@@ -137,10 +137,10 @@ def engines(repeats: int) -> dict[str, dict[str, float]]:
     return results
 
 
-def require_in_process(notes: list[str]) -> None:
-    """RuntimeError if a component would run through FMI (its ``notes``)."""
+def require(route: str, notes: list[str]) -> None:
+    """RuntimeError if ``route`` cannot be measured: ``notes`` say what would run otherwise."""
     if notes:
-        raise RuntimeError("the in-process backend cannot be measured: " + "; ".join(notes))
+        raise RuntimeError(f"the {route} cannot be measured: " + "; ".join(notes))
 
 
 def _master_runner(master) -> Callable[[], None]:
@@ -195,7 +195,7 @@ def overhead(repeats: int) -> dict[str, float]:
     system = scenarios.load("calm_pd")
     with Master(system, backend="inprocess") as inprocess, \
             Master(system, backend="inprocess") as idle:
-        require_in_process(inprocess.notes)
+        require("in-process backend", inprocess.notes)
 
         def idle_run() -> None:
             with mock.patch.multiple(InProcessInstance, **IDLE_CALLS):
