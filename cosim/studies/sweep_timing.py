@@ -1,5 +1,5 @@
-"""The sweep benchmark (``python -m cosim.bench sweep``): every backend side by side and the
-batch route's campaign, each on fresh local clusters, each goal printed beside its figure."""
+"""The sweep benchmark (``python -m cosim.bench sweep``): every backend side by side, the batch
+route's campaign and memory, on fresh local clusters, each goal printed beside its figure."""
 from __future__ import annotations
 
 import math
@@ -14,12 +14,15 @@ from .spec_file import controller_entry
 from .sweep_client import plan
 from .sweep_spec import Spec
 from .sweep_task import BATCH, SWEEP_BACKENDS
-from .timing import load, machine, peak_rss_mb, require
+from .timing import in_fresh_process, load, machine, peak_rss_mb, require
 
 SEAS = {"waves": ("waves_pd", "waves_smc"), "calm": ("calm_pd", "calm_smc")}
 GOALS = {"waves": 5.0, "calm": 10.0}   # batch runs/s per core over the in-process route's
 # the campaign's goal: these runs of this stop time on these workers within this many s
 CAMPAIGN_RUNS, CAMPAIGN_STOP_TIME, CAMPAIGN_WORKERS, CAMPAIGN_GOAL = 1000, 400.0, 2, 30.0
+MEMORY_MEMBERS = (64, 256, 1024, 4096)
+MEMORY_STOP_TIME = 40.0
+FLAT = 0.10     # flat: the largest sweep's peak within this of the smallest's as large batches
 WORKERS = (1, 2)            # the throughput's sweeps: on 1 and on 2 workers
 
 
@@ -199,3 +202,59 @@ def timed_sweep(spec: Spec, workers: int, backend: str, batch_size: int | None =
                    math.fsum(r["sim_seconds"] for r in rows) / len(rows),
                    math.fsum(r["seconds"] - r["sim_seconds"] for r in rows) / len(rows),
                    tuple(map(len, batches)), peaks, os.getloadavg()[0])
+
+
+def batch_memory(members: tuple[int, ...] = MEMORY_MEMBERS,
+                 stop_time: float = MEMORY_STOP_TIME, batch_size: int | None = None) -> dict:
+    """Peak memory (MB) of waves_pd runs on the batch route: of ``simulate_members`` in a
+    fresh process, and of a one-worker sweep's worker, for each number of ``members``."""
+    print(f"batch route memory: waves_pd runs of {stop_time:g} s, on {machine()}")
+    calls = {}
+    for m in members:
+        wall, before, peak, results = calls[m] = in_fresh_process(
+            f"simulate_members of {m} members", members_call, m, stop_time)
+        rest = peak - before - results
+        print(f"  simulate_members, {m:5} members: {wall:6.1f} s, peak RSS {peak:7.1f} MB, "
+              f"{peak - before:7.1f} MB over the process before the call: results "
+              f"{results:6.1f} MB, the rest {rest:6.1f} MB ({rest / m * 1024:5.1f} kB a member)")
+    sweeps = {}
+    for m in members:
+        spec = bench_spec(("waves_pd",), m, stop_time)
+        require_batch(spec)
+        s = sweeps[m] = timed_sweep(spec, 1, BATCH, batch_size)
+        print(f"  sweep of {m:5} runs, 1 worker, {len(s.batches):3} batch"
+              f"{'es' if len(s.batches) > 1 else '  '} of {sizes(s.batches):9}: worker peak "
+              f"RSS {s.peak_rss[0]:7.1f} MB ({s.wall:6.1f} s)")
+    largest = max(max(s.batches) for s in sweeps.values())
+    full = [m for m in members if max(sweeps[m].batches) == largest]
+    if len(full) < 2:
+        print(f"  memory in the sweep's size: not judged (it takes two sweeps whose batches "
+              f"are of {largest} runs, the largest here)")
+    else:
+        low, high = sweeps[min(full)].peak_rss[0], sweeps[max(full)].peak_rss[0]
+        growth = high / low - 1.0
+        print(f"  goal: memory flat in the sweep's size (batches of at most {largest} runs): "
+              f"worker peak RSS {low:.1f} MB at {min(full)} runs, {high:.1f} MB at "
+              f"{max(full)} runs ({growth:+.1%}; flat: within {FLAT:.0%}): "
+              f"{verdict(growth <= FLAT)}")
+    print(f"  {load()}")
+    return {"calls": calls, "sweeps": sweeps}
+
+
+def members_call(members: int, stop_time: float) -> tuple[float, float, float, float]:
+    """(wall s, peak RSS before the call, peak RSS, results; MB) of ``simulate_members`` of
+    ``members`` waves_pd runs; RuntimeError if one ran alone."""
+    from .. import scenarios
+    from ..ensemble import selftest, simulate_members
+
+    system = scenarios.load("waves_pd")
+    selftest()
+    before, started = peak_rss_mb(), time.perf_counter()
+    recordings = simulate_members(system, [{"ship": {"wave_seed": seed}}
+                                           for seed in range(1, members + 1)], stop_time)
+    wall = time.perf_counter() - started
+    alone = [r.meta["notes"] for r in recordings if r.meta["backend"] != "batch"]
+    if alone:
+        raise RuntimeError(f"{len(alone)} members ran alone: {alone[0]}")
+    results = sum(r.data.nbytes for r in recordings) + recordings[0].t.nbytes
+    return wall, before, peak_rss_mb(), results / 2**20

@@ -1,5 +1,5 @@
 """The engine benchmarks of ``python -m cosim.bench`` (figures printed, never asserted):
-``engines`` and ``overhead``; the helpers the other benchmarks share."""
+``engines``, ``overhead`` and ``memory``; the helpers the sweep benchmarks share."""
 from __future__ import annotations
 
 import os
@@ -10,6 +10,11 @@ import tempfile
 import time
 from pathlib import Path
 from typing import Callable
+
+from .. import scenarios
+from ..core.master import RUN_BACKENDS, Master
+from ..ensemble.reference import run_direct
+from . import in_child
 
 STEPS = 4000
 ROWS = {"direct": "(a) the modules wired by hand (run_direct)",
@@ -93,9 +98,6 @@ def _ecos_runner(ssp: Path) -> Callable[[], None]:
 
 def engines(repeats: int) -> dict[str, dict[str, float]]:
     """calm_pd and waves_pd by each of ``ROWS``, printed with their ratios; the times."""
-    from .. import scenarios
-    from ..core.master import Master
-    from ..ensemble.reference import run_direct
     from ..interop.ssp import export
 
     print(f"Engines on the same system, 400 s = {STEPS} macro steps of 0.1 s, median of "
@@ -187,10 +189,7 @@ def overhead(repeats: int) -> dict[str, float]:
 
     from ship_fmu.vessel import Vessel
 
-    from .. import scenarios
     from ..core.inprocess import InProcessInstance
-    from ..core.master import Master
-    from ..ensemble.reference import run_direct
 
     system = scenarios.load("calm_pd")
     with Master(system, backend="inprocess") as inprocess, \
@@ -214,3 +213,33 @@ def overhead(repeats: int) -> dict[str, float]:
           f"{per_step['inprocess'] - per_step['direct']:.1f} us/step (its calls into the slaves, "
           "and its bookkeeping beyond direct's)")
     return per_step
+
+
+def memory(hours: float) -> None:
+    """Peak RSS of a long calm_pd run streamed to disk against a short one's, each backend."""
+    print(f"Memory: calm_pd streamed to CSV in chunks of 10,000 rows, on {machine()}")
+    for backend in RUN_BACKENDS:
+        for duration in (3600.0, hours * 3600.0):
+            rows, wall, size, peak = in_fresh_process(f"calm_pd on {backend}", streamed_run,
+                                                      backend, duration)
+            print(f"  {backend:9} {duration / 3600:5.1f} h simulated: {rows:>8.0f} rows, "
+                  f"{wall:6.1f} s wall, CSV {size / 1e6:7.1f} MB, peak RSS {peak:6.1f} MB")
+
+
+def streamed_run(backend: str, duration: float) -> tuple[int, float, int, float]:
+    """(rows, wall s, CSV bytes, peak RSS MB) of calm_pd to ``duration`` streamed to disk."""
+    with tempfile.TemporaryDirectory() as tmp, \
+            Master(scenarios.load("calm_pd"), backend=backend) as master:
+        started = time.perf_counter()
+        recording = master.run(duration, csv_path=Path(tmp) / "run.csv")
+        wall = time.perf_counter() - started
+        if recording.error:
+            raise RuntimeError(recording.error)
+        return recording.rows, wall, recording.path.stat().st_size, peak_rss_mb()
+
+
+def in_fresh_process(what: str, function: Callable, *args: object) -> list[float]:
+    """``function(*args)`` in a fresh process (its own peak memory): the numbers it returns."""
+    name = function.__name__
+    code = f"from {function.__module__} import {name}; print(*{name}(*{args!r}))"
+    return [float(value) for value in in_child(what, code).split()]
