@@ -46,8 +46,7 @@ def difference(a: Path, b: Path) -> str | None:
 
 def audit(scenario_names: list[str], variants: list[str] | None = None,
           stop_time: float | None = None) -> dict[str, dict[str, str | None]]:
-    """Each scenario under each variant against "default": {scenario: {variant: difference}};
-    each run in-process in a child, killed after ``TIMEOUT``."""
+    """{scenario: {variant: difference from "default"}}, each run in a child process."""
     variants = [v for v in (variants or list(VARIANTS)) if v != "default"]
     with tempfile.TemporaryDirectory(prefix="cosim-cpus-") as folder, \
             ThreadPoolExecutor(2) as pool:

@@ -196,8 +196,7 @@ def monolithic(system, stop_time: float | None = None) -> dict[str, np.ndarray]:
 
 def cosimulation(name: str, step: float, coupling: str,
                  stop_time: float | None = None) -> dict[str, np.ndarray]:
-    """Our master in-process at ``step``, sampled on the 0.1 s grid (a coarser step at its
-    own points, each ``weight`` samples)."""
+    """Our master at ``step`` on the 0.1 s grid (a coarser step: its points, each weighed)."""
     system = dataclasses.replace(scenarios.load(name), step_size=step)
     with Master(system, coupling=coupling, backend="inprocess") as master:
         recording = master.run(stop_time)

@@ -59,8 +59,7 @@ class Contender:
 
 
 def course_change(run: Recording) -> dict[str, float]:
-    """The run's ``merit.run_metrics``, its settling_time (s, inf if it never settles) and
-    overshoot (rad)."""
+    """``run_metrics``, settling_time (s, inf if never settled) and overshoot (rad)."""
     psi = run["ship.psi"]
     error = heading_error(run["guidance.psi_d"], psi)
     return {**run_metrics(run), "settling_time": settling_time(run.t, error, SETTLING_BAND),
@@ -71,9 +70,8 @@ def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | Non
           settings: dict[str, Any] | None = None, workers: int | None = None,
           scheduler: str | None = None,
           progress: Callable[[str], None] = lambda step: None, backend: str = "fmi") -> str:
-    """Run the scorecard of ``fmu`` (called ``name``), write out/scorecard.md and figures;
-    the markdown. A failed run is reported as failed and the scorecard goes on. On "batch"
-    the ensembles run on the batch backend, the rest in-process."""
+    """out/scorecard.md of ``fmu`` (called ``name``) and its figures; the markdown. A failed
+    run is reported and the scorecard goes on. On "batch" the single runs run in-process."""
     contenders = _contenders(fmu, name, port_map, settings)
     failures: dict[tuple[str, str], str] = {}
 
@@ -145,7 +143,6 @@ def _ensemble(contenders: list[Contender], seeds: int, out: Path, sea: Sea = SEA
 
 
 def backend_notes(fmu: Path, name: str, port_map: dict | None, backend: str) -> list[str]:
-    """Which of the scorecard's FMUs run through FMI although ``backend`` asks otherwise,
-    and on "batch" which contenders' ensemble runs run alone (``Spec.backend_notes``)."""
+    """``Spec.backend_notes`` of the scorecard's ensembles on ``backend``."""
     spec = _ensemble(_contenders(fmu, name, port_map, None), 1, fmu.parent)
     return spec.backend_notes(backend)

@@ -242,8 +242,7 @@ def batch_memory(members: tuple[int, ...] = MEMORY_MEMBERS,
 
 
 def members_call(members: int, stop_time: float) -> tuple[float, float, float, float]:
-    """(wall s, peak RSS before the call, peak RSS, results; MB) of ``simulate_members`` of
-    ``members`` waves_pd runs; RuntimeError if one ran alone."""
+    """(wall s, MB: peak RSS before, peak RSS, results) of ``members`` waves_pd members."""
     from .. import scenarios
     from ..ensemble import selftest, simulate_members
 

@@ -28,8 +28,7 @@ RATIOS = (("b/a", "inprocess", "direct"), ("c/b", "fmi", "inprocess"), ("c/f", "
 
 
 def peak_rss_mb() -> float:
-    """This process's peak resident memory, MB: Linux's VmHWM (``ru_maxrss`` keeps a forked
-    parent's peak)."""
+    """This process's peak RSS, MB: Linux's VmHWM (``ru_maxrss`` keeps a forked parent's)."""
     try:
         return next(int(line.split()[1]) / 1024 for line in
                     Path("/proc/self/status").read_text().splitlines() if line.startswith("VmHWM:"))
@@ -183,8 +182,7 @@ IDLE_CALLS = {"reader": _idle_reader, "integer_reader": _idle_reader,
 
 
 def overhead(repeats: int) -> dict[str, float]:
-    """Microseconds per step of calm_pd, the ship's step idle: by hand, by the master with
-    its calls into the FMUs idle (``IDLE_CALLS``), and in-process."""
+    """us per step of calm_pd, the ship's step idle: by hand, by the master idle, in-process."""
     from unittest import mock
 
     from ship_fmu.vessel import Vessel
