@@ -114,9 +114,7 @@ def campaign(runs: int = CAMPAIGN_RUNS, workers: int = CAMPAIGN_WORKERS,
         raise ValueError(f"the campaign's runs must be at least 1, got {runs}")
     print(f"campaign: {runs} waves_pd runs of {stop_time:g} s on the batch route, a local "
           f"cluster of {_workers(workers)}, on {machine()}")
-    spec = bench_spec(("waves_pd",), runs, stop_time)
-    require_batch(spec)
-    measure = timed_sweep(spec, workers, BATCH)
+    measure = timed_sweep(bench_spec(("waves_pd",), runs, stop_time), workers, BATCH)
     total = measure.wall + measure.startup
     print(f"  {measure.runs} runs in {measure.wall:.1f} s from submission to the last row "
           f"({measure.rate:.1f} runs/s, {measure.rate / workers:.1f} per core; batches of "
@@ -180,6 +178,8 @@ def timed_sweep(spec: Spec, workers: int, backend: str, batch_size: int | None =
     from .campaign import execute
     from .cluster import local_cluster
 
+    if backend == BATCH:
+        require_batch(spec)
     started = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp, local_cluster(workers) as cluster:
         ready = time.perf_counter()
@@ -219,9 +219,7 @@ def batch_memory(members: tuple[int, ...] = MEMORY_MEMBERS,
               f"{results:6.1f} MB, the rest {rest:6.1f} MB ({rest / m * 1024:5.1f} kB a member)")
     sweeps = {}
     for m in members:
-        spec = bench_spec(("waves_pd",), m, stop_time)
-        require_batch(spec)
-        s = sweeps[m] = timed_sweep(spec, 1, BATCH, batch_size)
+        s = sweeps[m] = timed_sweep(bench_spec(("waves_pd",), m, stop_time), 1, BATCH, batch_size)
         print(f"  sweep of {m:5} runs, 1 worker, {len(s.batches):3} batch"
               f"{'es' if len(s.batches) > 1 else '  '} of {sizes(s.batches):9}: worker peak "
               f"RSS {s.peak_rss[0]:7.1f} MB ({s.wall:6.1f} s)")
