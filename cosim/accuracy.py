@@ -17,7 +17,7 @@ from pathlib import Path
 from ._cli import entry, writable_folder
 from .core.files import write_atomically
 from .scenarios import names
-from .studies import coupling_error, cpu_variants, integration_error
+from .studies import cpu_variants, numerical_error
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -43,26 +43,22 @@ def main(argv: list[str] | None = None) -> int:
         print(f"wrote {out / 'cpus.md'} ({time.perf_counter() - started:.0f} s)")
         return 0
     open_end, closed_end = (60.0, 120.0) if args.quick else (400.0, None)
-    runs = coupling_error.PAPER_RUNS[:2] if args.quick else coupling_error.PAPER_RUNS
-    steps = (0.1, 0.05, 0.025) if args.quick else coupling_error.STEPS
+    runs = numerical_error.PAPER_RUNS[:2] if args.quick else numerical_error.PAPER_RUNS
+    steps = (0.1, 0.05, 0.025) if args.quick else numerical_error.STEPS
 
     tables: list[str] = []
 
     def section(title: str, text: str) -> None:
         tables.extend([("\n" if tables else "") + f"## {title}\n", text])
         print("".join(tables[-2:]), flush=True)
-    section("Integration error, open loop (calm water)", integration_error.open_loop_table(
-        [integration_error.open_loop(p, open_end) for p in ("step", "sine", "zigzag")]))
-    closed = {name: coupling_error.closed_loop(name, closed_end) for name in runs}
+    section("Integration error, open loop (calm water)", numerical_error.open_loop_table(
+        [numerical_error.open_loop(p, open_end) for p in ("step", "sine", "zigzag")]))
+    results = {name: numerical_error.study(name, steps, closed_end) for name in runs}
     section("Co-simulation at 0.1 s against the monolithic reference",
-            coupling_error.closed_loop_table(closed))
-    references = {name: result["monolithic"] for name, result in closed.items()}
-    converging = {name: coupling_error.convergence(name, references[name], steps, closed_end)
-                  for name in runs}
-    section("J against the communication step",
-            coupling_error.convergence_table(converging, references))
+            numerical_error.closed_loop_table(results))
+    section("J against the communication step", numerical_error.convergence_table(results))
     write_atomically(out / "accuracy.md", lambda path: path.write_text("\n".join(tables) + "\n"))
-    figure = coupling_error.convergence_figure(converging, out / "convergence.png")
+    figure = numerical_error.convergence_figure(results, out / "convergence.png")
     print(f"wrote {out / 'accuracy.md'}, {figure} ({time.perf_counter() - started:.0f} s)")
     return 0
 

@@ -13,7 +13,7 @@ import argparse
 import sys
 
 from ._cli import entry, say_error
-from .studies import memory, sweep_timing, timing
+from .studies import sweep_timing, timing
 
 SWEEP_PARTS = ("throughput", "campaign", "memory")
 BENCHMARKS = ("engines", "overhead", "memory", "sweep")
@@ -29,7 +29,7 @@ def _counts(text: str) -> tuple[int, ...]:
 
 def _benchmark(name: str, args: argparse.Namespace, repeats: int) -> None:
     if name == "memory":
-        memory.memory(args.hours)
+        timing.memory(args.hours)
     elif name == "sweep":                       # the parts asked for, in their order
         if "throughput" in args.parts:
             seas = ("waves", "calm") if args.sea == "both" else (args.sea,)
@@ -37,7 +37,7 @@ def _benchmark(name: str, args: argparse.Namespace, repeats: int) -> None:
         if "campaign" in args.parts:
             sweep_timing.campaign(args.campaign_runs)
         if "memory" in args.parts:
-            memory.batch_memory(args.memory_members)
+            sweep_timing.batch_memory(args.memory_members)
     elif name == "overhead":
         timing.overhead(repeats)
     else:
@@ -45,13 +45,13 @@ def _benchmark(name: str, args: argparse.Namespace, repeats: int) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m cosim.bench", description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--repeats", type=int, default=5, help="runs per median (default 5)")
-    commands = parser.add_subparsers(dest="command")
-    repeats = argparse.ArgumentParser(add_help=False)       # also after the subcommand
+    repeats = argparse.ArgumentParser(add_help=False)       # before or after the subcommand
     repeats.add_argument("--repeats", type=int, default=argparse.SUPPRESS,
                          help="runs per median (default 5)")
+    parser = argparse.ArgumentParser(prog="python -m cosim.bench", description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter,
+                                     parents=[repeats])
+    commands = parser.add_subparsers(dest="command")
     commands.add_parser("engines", parents=[repeats], help="engines side by side (the default)")
     commands.add_parser("overhead", parents=[repeats],
                         help="what the routes do besides the models (the ship's step idle)")
@@ -74,9 +74,9 @@ def main(argv: list[str] | None = None) -> int:
     sweep.add_argument("--campaign-runs", type=int, default=sweep_timing.CAMPAIGN_RUNS,
                        help=f"waves_pd runs of the campaign (default "
                             f"{sweep_timing.CAMPAIGN_RUNS})")
-    sweep.add_argument("--memory-members", type=_counts, default=memory.MEMORY_MEMBERS,
+    sweep.add_argument("--memory-members", type=_counts, default=sweep_timing.MEMORY_MEMBERS,
                        help="members of the memory measurement, comma-separated (default "
-                            + ",".join(map(str, memory.MEMORY_MEMBERS)) + ")")
+                            + ",".join(map(str, sweep_timing.MEMORY_MEMBERS)) + ")")
     commands.add_parser("all", parents=[repeats], help="engines, overhead, memory and sweep in "
                                                       "turn, each with its defaults")
     args = parser.parse_args(argv)
@@ -84,7 +84,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         for name in BENCHMARKS if args.command == "all" else (args.command or "engines",):
             _benchmark(name, args if name == args.command or name not in own
-                       else own[name].parse_args([]), args.repeats)
+                       else own[name].parse_args([]), getattr(args, "repeats", 5))
     except (RuntimeError, ValueError, FileNotFoundError) as error:   # e.g. stale FMUs
         say_error(error)
         return 2

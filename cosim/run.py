@@ -35,7 +35,7 @@ from .core.ssd import SystemDescription
 from .core.watchdog import STEP_LIMIT_S, Limits
 from .outputs import Options, TimedOut, run_and_write
 from .scenarios.autopilot import COMPONENT
-from .studies.spread import PERTURBED, spread
+from .studies.cpu_variants import PERTURBED, spread
 
 
 def video_format() -> str:

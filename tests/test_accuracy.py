@@ -1,17 +1,15 @@
-"""The accuracy study's reference and RK4's convergence (cosim.studies.integration_error and
-coupling_error)."""
+"""The accuracy study's reference and RK4's convergence (cosim.studies.numerical_error)."""
 from __future__ import annotations
 
 import pytest
 
-from cosim.studies import coupling_error, integration_error
-from cosim.studies.coupling_error import monolithic
+from cosim.studies import numerical_error
 from helpers import command
 
 
 @pytest.fixture(scope="module")
 def step_response() -> dict:
-    return integration_error.open_loop("step", t_end=60.0)
+    return numerical_error.open_loop("step", t_end=60.0)
 
 
 def test_rk4_converges_at_fourth_order_in_the_smooth_regime(step_response):
@@ -24,14 +22,14 @@ def test_rk4_converges_at_fourth_order_in_the_smooth_regime(step_response):
 def test_rk4_keeps_fourth_order_when_the_rudder_reaches_its_command_inside_a_step():
     """A sine command moves the rudder a little every step, so the gear's kink falls
     inside almost every step; the vessel cuts its RK4 steps there (order about 2 without)."""
-    sine = integration_error.open_loop("sine", t_end=30.0)
+    sine = numerical_error.open_loop("sine", t_end=30.0)
     for signal, orders in sine["orders"].items():
         assert 3.8 < orders[0] < 4.2, (signal, orders)
     assert sine["errors"][0.1]["psi"].max < 1e-7
 
 
 def test_the_reference_is_100_times_more_accurate_than_what_it_measures(step_response):
-    finest = step_response["errors"][integration_error.H_MAX[-1]]
+    finest = step_response["errors"][numerical_error.H_MAX[-1]]
     for signal, own in step_response["reference_error"].items():
         assert own.max * 100 <= finest[signal].max, (signal, own, finest[signal])
 
@@ -39,12 +37,9 @@ def test_the_reference_is_100_times_more_accurate_than_what_it_measures(step_res
 def test_cosimulation_converges_to_the_monolithic_model_as_the_step_shrinks():
     """calm_smc over its first turn: J's distance from the monolithic value shrinks with
     every halving of the communication step, for both couplings."""
-    from cosim import scenarios
-
-    reference = coupling_error.figures(monolithic(scenarios.load("calm_smc"), 120.0))
-    for rows in coupling_error.convergence("calm_smc", reference, (0.1, 0.05, 0.025),
-                                     120.0).values():
-        errors = [row["J_error"] for row in rows]
+    result = numerical_error.study("calm_smc", (0.1, 0.05, 0.025), 120.0)
+    for coupling in numerical_error.COUPLINGS:
+        errors = [row["J_error"] for row in result[coupling]]
         assert errors[0] > errors[1] > errors[2], errors
         assert errors[2] < 0.05
 

@@ -8,7 +8,7 @@ import re
 import pytest
 
 from cosim import bench as command
-from cosim.studies import memory, sweep_timing
+from cosim.studies import sweep_timing
 
 
 def _figure(pattern: str, text: str) -> float:
@@ -58,7 +58,7 @@ def test_campaign_times_the_sweep_and_judges_only_the_issues_campaign(fmu_paths,
 @pytest.mark.long
 @pytest.mark.timeout(90, method="thread")
 def test_memory_counts_the_results_and_judges_full_batches(fmu_paths, capsys):
-    found = memory.batch_memory((2, 4), 2.0, batch_size=2)
+    found = sweep_timing.batch_memory((2, 4), 2.0, batch_size=2)
     samples = 21                                        # 2 s at 0.1 s, both ends
     for members, (wall, before, peak, results) in found["calls"].items():
         assert results * 2**20 == (members * 6 + 1) * samples * 8   # six signals and the time
@@ -66,7 +66,7 @@ def test_memory_counts_the_results_and_judges_full_batches(fmu_paths, capsys):
     assert [s.batches for s in found["sweeps"].values()] == [(2,), (2, 2)]
     out = capsys.readouterr().out
     low, high = (found["sweeps"][m].peak_rss[0] for m in (2, 4))
-    verdict = "met" if high / low - 1 <= memory.FLAT else "NOT met"
+    verdict = "met" if high / low - 1 <= sweep_timing.FLAT else "NOT met"
     assert f"at 2 runs, {high:.1f} MB at 4 runs" in out and out.rstrip().splitlines()[-2] \
         .endswith(f": {verdict}")
 

@@ -255,7 +255,7 @@ def _check_published(cell: str, value: str) -> None:
 
 def test_the_spread_of_a_run_is_how_far_a_last_bit_moves_it(capsys):
     """Calm water amplifies no last bit; the chattering SMC in waves does, within 60 s."""
-    from cosim.studies.spread import nudged, spread
+    from cosim.studies.cpu_variants import nudged, spread
 
     assert nudged(0.3, 2) == math.nextafter(math.nextafter(0.3, 1.0), 1.0)
     assert nudged(math.pi, -1) == math.nextafter(math.pi, 0.0)

@@ -13,7 +13,7 @@ from ..analysis.figures import comparison, save
 from ..analysis.metrics import heading_error, overshoot, settling_time
 from ..analysis.reports import PAPER_TABLES
 from ..analysis.seastate import WMO, model_scale
-from ..api import SimulationError, overrides_of
+from ..api import overrides_of
 from ..core.files import fresh_folder, write_atomically
 from ..core.recording import Recording
 from ..outputs import Options, run_and_write
@@ -49,21 +49,6 @@ class Contender:
     port_map: dict[str, str] | None = None
     settings: dict[str, Any] | None = None   # --set values, for the user's autopilot only
 
-    def run(self, label: str, out: Path, sea: str, backend: str, stop_time: float | None = None,
-            route: str | None = None) -> Recording:
-        """One test's run, written to out/<label>_<name>.*; SimulationError if an FMU fails."""
-        settings = dict(self.settings or {})
-        if route is not None:
-            settings["guidance.waypoints"] = route
-        system = scenarios.load(f"{sea}_{self.suffix}", self.fmu, self.port_map)
-        out.mkdir(parents=True, exist_ok=True)
-        recording = run_and_write(system, f"{label}_{self.name}", out, overrides_of(settings),
-                                  Options(stop_time=stop_time, backend=backend,
-                                          plot=False)).recording
-        if recording.error:
-            raise SimulationError(recording.error, recording)
-        return recording
-
     @property
     def paper_cost(self) -> str:
         """J calm / waves in the paper, for one of its controllers; '-' for any other."""
@@ -74,8 +59,7 @@ class Contender:
 
 
 def course_change(run: Recording) -> dict[str, float]:
-    """The run's ``merit.run_metrics``, its settling_time (s, inf if it never settles) and
-    overshoot (rad)."""
+    """``run_metrics``, settling_time (s, inf if never settled) and overshoot (rad)."""
     psi = run["ship.psi"]
     error = heading_error(run["guidance.psi_d"], psi)
     return {**run_metrics(run), "settling_time": settling_time(run.t, error, SETTLING_BAND),
@@ -86,22 +70,30 @@ def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | Non
           settings: dict[str, Any] | None = None, workers: int | None = None,
           scheduler: str | None = None,
           progress: Callable[[str], None] = lambda step: None, backend: str = "fmi") -> str:
-    """Run the scorecard of ``fmu`` (called ``name``), write out/scorecard.md and figures;
-    the markdown. A failed run is reported as failed and the scorecard goes on. On "batch"
-    the ensembles run on the batch backend, the rest in-process."""
+    """out/scorecard.md of ``fmu`` (called ``name``) and its figures; the markdown. A failed
+    run is reported and the scorecard goes on. On "batch" the single runs run in-process."""
     contenders = _contenders(fmu, name, port_map, settings)
     failures: dict[tuple[str, str], str] = {}
 
-    def tested(test: str, label: str, title: str, **kwargs: Any) -> dict[str, Recording]:
+    def tested(test: str, label: str, title: str, sea: str, stop_time: float | None = None,
+               route: str | None = None) -> dict[str, Recording]:
+        """Each contender's run, written to out/runs/<label>_<name>.*, and their figure."""
         runs = {}
-        for contender in contenders:
-            progress(f"{test}, {contender.name}")
-            try:
-                runs[contender.name] = contender.run(
-                    label, out / "runs", backend="inprocess" if backend == BATCH else backend,
-                    **kwargs)
-            except SimulationError as error:
-                failures[contender.name, test] = str(error).splitlines()[0]
+        (out / "runs").mkdir(parents=True, exist_ok=True)
+        for c in contenders:
+            progress(f"{test}, {c.name}")
+            settings = dict(c.settings or {})
+            if route is not None:
+                settings["guidance.waypoints"] = route
+            recording = run_and_write(
+                scenarios.load(f"{sea}_{c.suffix}", c.fmu, c.port_map), f"{label}_{c.name}",
+                out / "runs", overrides_of(settings), Options(
+                    stop_time=stop_time, backend="inprocess" if backend == BATCH else backend,
+                    plot=False)).recording
+            if recording.error:
+                failures[c.name, test] = recording.error.splitlines()[0]
+            else:
+                runs[c.name] = recording
         save(comparison(runs, title), out / f"{label}.png")
         return runs
 
@@ -151,7 +143,6 @@ def _ensemble(contenders: list[Contender], seeds: int, out: Path, sea: Sea = SEA
 
 
 def backend_notes(fmu: Path, name: str, port_map: dict | None, backend: str) -> list[str]:
-    """Which of the scorecard's FMUs run through FMI although ``backend`` asks otherwise,
-    and on "batch" which contenders' ensemble runs run alone (``Spec.backend_notes``)."""
+    """``Spec.backend_notes`` of the scorecard's ensembles on ``backend``."""
     spec = _ensemble(_contenders(fmu, name, port_map, None), 1, fmu.parent)
     return spec.backend_notes(backend)

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..analysis.metrics import RUDDER_DEADBAND, RouteCompletion, cost, route_completion
+from ..analysis.metrics import LAMBDA, RUDDER_DEADBAND, route_completion
 from ..core.recording import Recording
 from . import table
 from .merit import CRITERIA, Merit, route_of, run_metrics
@@ -84,6 +84,7 @@ def markdown(fmu: Path, name: str, seeds: int, paper: dict[str, str],
     """scorecard.md: ``paper`` gives each controller's J calm / waves in the paper ('-');
     ``course`` the course change's duration (s) and leg (m)."""
     names = list(paper)
+    metrics = {sea: {n: run_metrics(run) for n, run in runs.items()} for sea, runs in route.items()}
     lines = [f"# Scorecard: {name}", "",
              f"Autopilot `{fmu}` beside the paper's PD and sliding-mode (SMC) autopilots and "
              "the project's PID, on CyberShip II (docs/own_autopilot.md says how each is run).",
@@ -93,8 +94,8 @@ def markdown(fmu: Path, name: str, seeds: int, paper: dict[str, str],
              "(waypoints are numbered from 1, the start); a rudder reversal is a crossing "
              "from one side to the other, counted once the rudder is "
              f"{math.degrees(RUDDER_DEADBAND):g} deg past amidships on the new side.", ""]
-    lines += _at_a_glance(names, route, ensembles, seeds)
-    lines += _paper_route(paper, route)
+    lines += _at_a_glance(names, metrics, ensembles, seeds)
+    lines += _paper_route(paper, route, metrics)
     lines += _course_change(names, changes, *course)
     for sea, rows in ensembles.items():
         lines += _ensemble_section(sea, names, seeds, rows)
@@ -116,20 +117,17 @@ def _of(criterion: Merit, row: dict) -> str:
     return f" of {row[criterion.out_of]:.0f}" if criterion.out_of else ""
 
 
-def _completion(run: Recording) -> RouteCompletion:
-    return route_completion(run["ship.x"], run["ship.y"], *route_of(run))
-
-
-def _reached(done: RouteCompletion) -> str:
-    last = "the last included" if done.last_reached else "**not** the last"
-    return f"reached {done.count} of {len(done.points)} waypoints, {last}"
+def _reached(m: dict) -> str:
+    """'reached 3 of 4 waypoints, the last included' of a run's ``run_metrics``."""
+    last = "the last included" if m["last_waypoint_reached"] else "**not** the last"
+    return f"{_waypoints_reached([m])}, {last}"
 
 
 def _ok(rows: list[dict], name: str) -> list[dict]:
     return [r for r in rows if r["status"] == "ok" and r["controller"] == name]
 
 
-def _at_a_glance(names: list[str], route: dict[str, dict[str, Recording]],
+def _at_a_glance(names: list[str], metrics: dict[str, dict[str, dict]],
                  ensembles: dict[Sea, list[dict]], seeds: int) -> list[str]:
     """Each controller's verdicts against the PD per ensemble, and route completion."""
     lines = [f"## At a glance: each controller against the {BASELINE}", "",
@@ -145,7 +143,7 @@ def _at_a_glance(names: list[str], route: dict[str, dict[str, Recording]],
                                                 for name in names[1:])] for c in CRITERIA)), ""]
     lines += ["Route completion (higher is better):", "", *table(
         ["controller", *SEA_NAMES.values(), *(f"ensemble, {sea.name}" for sea in ensembles)],
-        ([name, *(_reached(_completion(route[sea][name])) if name in route[sea] else "failed"
+        ([name, *(_reached(metrics[sea][name]) if name in metrics[sea] else "failed"
                   for sea in SEA_NAMES),
           *(_ensemble_completion(_ok(rows, name)) for rows in ensembles.values())]
          for name in names)), ""]
@@ -190,38 +188,34 @@ def _waypoints_reached(ok: list[dict]) -> str:
     return f"reached {spread} of {ok[0]['waypoints']:.0f} waypoints"
 
 
-def _paper_route(paper: dict[str, str], route: dict[str, dict[str, Recording]]) -> list[str]:
-    metrics = {(sea, name): run_metrics(run) for sea, runs in route.items()
-               for name, run in runs.items()}
+def _paper_route(paper: dict[str, str], route: dict[str, dict[str, Recording]],
+                 metrics: dict[str, dict[str, dict]]) -> list[str]:
+    def cost(m: dict | None) -> list[str]:          # psi_E, delta_E and J of eq (19)
+        if m is None:
+            return ["failed"] * 3
+        return [f"{m['psi_E']:.1f}", f"{LAMBDA * m['sum_delta2']:.1f}", f"{m['J']:.1f}"]
     lines = ["## The paper's route (Tables 1-2, eq 19; lower is better)", "", *table(
         ["controller", "calm psi_E", "calm delta_E", "calm J", "waves psi_E", "waves delta_E",
          "waves J", "paper J calm / waves"],
-        ([name, *_cost_cells(route["calm"].get(name)), *_cost_cells(route["waves"].get(name)),
-          theirs] for name, theirs in paper.items())),
+        ([name, *cost(metrics["calm"].get(name)), *cost(metrics["waves"].get(name)), theirs]
+         for name, theirs in paper.items())),
         "", "Every criterion, one run each (the scenarios' wave seed):", "",
         *table(["controller", "sea", *(_label(c, better=True) for c in CRITERIA)],
                ([name, sea, *(c.format(row[c.column]) + _of(c, row) for c in CRITERIA)]
-                for (sea, name), row in metrics.items())), ""]
-    for sea, runs in route.items():
-        for name, run in runs.items():
-            done = _completion(run)
-            if done.count < len(done.points):
+                for sea, rows in metrics.items() for name, row in rows.items())), ""]
+    for sea, rows in metrics.items():
+        for name, m in rows.items():
+            if m["waypoints_reached"] < m["waypoints"]:
+                run = route[sea][name]
+                done = route_completion(run["ship.x"], run["ship.y"], *route_of(run))
                 missed = ", ".join(f"waypoint {k} ({x:g}, {y:g}) by {d:.1f} m"
                                    for k, ((x, y), d, hit) in enumerate(
                                        zip(done.points, done.closest, done.reached), start=1)
                                    if not hit)
-                lines.append(f"- {name}, {sea}: {_reached(done)}; missed {missed} "
+                lines.append(f"- {name}, {sea}: {_reached(m)}; missed {missed} "
                              f"(circle of acceptance {done.R_accept:g} m)")
     return lines + ["", "![route in calm water](route_calm.png)",
                     "![route in waves](route_waves.png)", ""]
-
-
-def _cost_cells(run: Recording | None) -> list[str]:
-    """psi_E, delta_E and J of eq (19), or 'failed'."""
-    if run is None:
-        return ["failed"] * 3
-    c = cost(run)
-    return [f"{c.psi_E:.1f}", f"{c.delta_E:.1f}", f"{c.J:.1f}"]
 
 
 def _course_change(names: list[str], changes: dict[str, dict], time: float,

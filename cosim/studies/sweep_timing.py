@@ -1,5 +1,5 @@
-"""The sweep benchmark (``python -m cosim.bench sweep``): every backend side by side and the
-batch route's campaign, each on fresh local clusters, each goal printed beside its figure."""
+"""The sweep benchmark (``python -m cosim.bench sweep``): every backend side by side, the batch
+route's campaign and memory, on fresh local clusters, each goal printed beside its figure."""
 from __future__ import annotations
 
 import math
@@ -14,12 +14,15 @@ from .spec_file import controller_entry
 from .sweep_client import plan
 from .sweep_spec import Spec
 from .sweep_task import BATCH, SWEEP_BACKENDS
-from .timing import load, machine, peak_rss_mb, require_in_process
+from .timing import in_fresh_process, load, machine, peak_rss_mb, require
 
 SEAS = {"waves": ("waves_pd", "waves_smc"), "calm": ("calm_pd", "calm_smc")}
 GOALS = {"waves": 5.0, "calm": 10.0}   # batch runs/s per core over the in-process route's
 # the campaign's goal: these runs of this stop time on these workers within this many s
 CAMPAIGN_RUNS, CAMPAIGN_STOP_TIME, CAMPAIGN_WORKERS, CAMPAIGN_GOAL = 1000, 400.0, 2, 30.0
+MEMORY_MEMBERS = (64, 256, 1024, 4096)
+MEMORY_STOP_TIME = 40.0
+FLAT = 0.10     # flat: the largest sweep's peak within this of the smallest's as large batches
 WORKERS = (1, 2)            # the throughput's sweeps: on 1 and on 2 workers
 
 
@@ -57,16 +60,16 @@ def sweep_throughput(runs: int = 32, batch_runs: int = 1024, seas: tuple[str, ..
           f"{runs} runs a sweep ({batch_runs} on the batch backend), each on a fresh local "
           f"cluster, on {machine()}")
     for sea in seas:                              # before minutes of measuring the others
-        spec = _sea_spec(sea, 2, 1.0)
-        require_in_process(spec.backend_notes("inprocess"))
+        spec = bench_spec(SEAS[sea], 2, 1.0)
+        require("in-process backend", spec.backend_notes("inprocess"))
         require_batch(spec)
     measured: dict[tuple[str, str, int], list[float]] = {}
     for _ in range(rounds):
         for workers in WORKERS:                   # backends side by side, under the same load
             for sea in seas:
                 for backend in SWEEP_BACKENDS:
-                    m = timed_sweep(_sea_spec(sea, batch_runs if backend == BATCH else runs,
-                                              stop_time), workers, backend)
+                    m = timed_sweep(bench_spec(SEAS[sea], batch_runs if backend == BATCH
+                                               else runs, stop_time), workers, backend)
                     batched = f"; batches of {sizes(m.batches)}" if m.batches else ""
                     outside = m.wall * m.workers / m.runs - m.simulated - m.in_task
                     print(f"  {sea:5} {backend:9} {_workers(workers):9}: {m.rate:6.2f} runs/s "
@@ -111,9 +114,7 @@ def campaign(runs: int = CAMPAIGN_RUNS, workers: int = CAMPAIGN_WORKERS,
         raise ValueError(f"the campaign's runs must be at least 1, got {runs}")
     print(f"campaign: {runs} waves_pd runs of {stop_time:g} s on the batch route, a local "
           f"cluster of {_workers(workers)}, on {machine()}")
-    spec = bench_spec({"pd": "waves_pd"}, seeds(runs), stop_time)
-    require_batch(spec)
-    measure = timed_sweep(spec, workers, BATCH)
+    measure = timed_sweep(bench_spec(("waves_pd",), runs, stop_time), workers, BATCH)
     total = measure.wall + measure.startup
     print(f"  {measure.runs} runs in {measure.wall:.1f} s from submission to the last row "
           f"({measure.rate:.1f} runs/s, {measure.rate / workers:.1f} per core; batches of "
@@ -146,35 +147,24 @@ def sizes(sizes: tuple[int, ...]) -> str:
     return f"{low}" if low == high else f"{low}-{high}"
 
 
-def seeds(runs: int) -> dict[str, list]:        # the axis of ``runs`` wave seeds from 1
-    return {"wave_seed": list(range(1, runs + 1))}
-
-
-def bench_spec(controllers: dict[str, str], axes: dict[str, list], stop_time: float) -> Spec:
-    """A sweep of ``controllers`` (name: scenario) over ``axes`` (name: its values)."""
-    return Spec(name="bench", controllers={name: controller_entry(scenario, Path.cwd(), name)
-                                           for name, scenario in controllers.items()},
-                axes=axes, stop_time=stop_time)
-
-
-def _sea_spec(sea: str, runs: int, stop_time: float) -> Spec:
-    """``runs`` runs, half with each scenario of the sea: over wave seeds, or in calm water
-    (where the seed changes nothing) over headings 1 mrad apart."""
-    axes = seeds(runs // 2) if sea == "waves" else {
-        "ship.psi0": [k / 1000 for k in range(runs // 2)]}
-    return bench_spec(dict(zip(("pd", "smc"), SEAS[sea])), axes, stop_time)
+def bench_spec(scenarios: tuple[str, ...], runs: int, stop_time: float) -> Spec:
+    """``runs`` runs, an equal share for each of ``scenarios`` (as pd, smc): over wave seeds
+    from 1, or in calm water (where the seed changes nothing) over headings 1 mrad apart."""
+    share = runs // len(scenarios)
+    axes = ({"ship.psi0": [k / 1000 for k in range(share)]} if scenarios[0].startswith("calm")
+            else {"wave_seed": list(range(1, share + 1))})
+    return Spec(name="bench", axes=axes, stop_time=stop_time, controllers={
+        name: controller_entry(scenario, Path.cwd(), name)
+        for name, scenario in zip(("pd", "smc"), scenarios)})
 
 
 def require_batch(spec: Spec) -> None:
-    """RuntimeError if the runs of ``spec`` would not all run in batches; prints the
-    self-test's time."""
+    """``require`` that every run of ``spec`` runs in batches; prints the self-test's time."""
     from ..ensemble import selftest
 
-    notes = spec.backend_notes(BATCH)
     first, started = selftest.cache_info().currsize == 0, time.perf_counter()
-    notes += [refusal] if (refusal := selftest()) else []
-    if notes:
-        raise RuntimeError("the batch route cannot be measured: " + "; ".join(notes))
+    refusal = selftest()
+    require("batch route", spec.backend_notes(BATCH) + ([refusal] if refusal else []))
     if first:
         print(f"  the batch route's self-test: {time.perf_counter() - started:.1f} s, once "
               "per worker process (within each batch sweep's time)")
@@ -188,18 +178,16 @@ def timed_sweep(spec: Spec, workers: int, backend: str, batch_size: int | None =
     from .campaign import execute
     from .cluster import local_cluster
 
-    with tempfile.TemporaryDirectory() as tmp:
-        started = time.perf_counter()
-        cluster = local_cluster(workers)
-        try:
-            ready = time.perf_counter()
-            rows = execute(spec, Path(tmp), scheduler=cluster.scheduler_address,
-                           progress=False, backend=backend, batch_size=batch_size)
-            done = time.perf_counter()
-            with Client(cluster) as client:
-                peaks = tuple(sorted(client.run(peak_rss_mb).values()))
-        finally:
-            cluster.close()
+    if backend == BATCH:
+        require_batch(spec)
+    started = time.perf_counter()
+    with tempfile.TemporaryDirectory() as tmp, local_cluster(workers) as cluster:
+        ready = time.perf_counter()
+        rows = execute(spec, Path(tmp), scheduler=cluster.scheduler_address,
+                       progress=False, backend=backend, batch_size=batch_size)
+        done = time.perf_counter()
+        with Client(cluster) as client:
+            peaks = tuple(sorted(client.run(peak_rss_mb).values()))
     failed = [r for r in rows if r["status"] != "ok"]
     if failed:
         raise RuntimeError(f"{len(failed)} of {len(rows)} runs of the {backend} sweep failed: "
@@ -214,3 +202,56 @@ def timed_sweep(spec: Spec, workers: int, backend: str, batch_size: int | None =
                    math.fsum(r["sim_seconds"] for r in rows) / len(rows),
                    math.fsum(r["seconds"] - r["sim_seconds"] for r in rows) / len(rows),
                    tuple(map(len, batches)), peaks, os.getloadavg()[0])
+
+
+def batch_memory(members: tuple[int, ...] = MEMORY_MEMBERS,
+                 stop_time: float = MEMORY_STOP_TIME, batch_size: int | None = None) -> dict:
+    """Peak memory (MB) of waves_pd runs on the batch route: of ``simulate_members`` in a
+    fresh process, and of a one-worker sweep's worker, for each number of ``members``."""
+    print(f"batch route memory: waves_pd runs of {stop_time:g} s, on {machine()}")
+    calls = {}
+    for m in members:
+        wall, before, peak, results = calls[m] = in_fresh_process(
+            f"simulate_members of {m} members", members_call, m, stop_time)
+        rest = peak - before - results
+        print(f"  simulate_members, {m:5} members: {wall:6.1f} s, peak RSS {peak:7.1f} MB, "
+              f"{peak - before:7.1f} MB over the process before the call: results "
+              f"{results:6.1f} MB, the rest {rest:6.1f} MB ({rest / m * 1024:5.1f} kB a member)")
+    sweeps = {}
+    for m in members:
+        s = sweeps[m] = timed_sweep(bench_spec(("waves_pd",), m, stop_time), 1, BATCH, batch_size)
+        print(f"  sweep of {m:5} runs, 1 worker, {len(s.batches):3} batch"
+              f"{'es' if len(s.batches) > 1 else '  '} of {sizes(s.batches):9}: worker peak "
+              f"RSS {s.peak_rss[0]:7.1f} MB ({s.wall:6.1f} s)")
+    largest = max(max(s.batches) for s in sweeps.values())
+    full = [m for m in members if max(sweeps[m].batches) == largest]
+    if len(full) < 2:
+        print(f"  memory in the sweep's size: not judged (it takes two sweeps whose batches "
+              f"are of {largest} runs, the largest here)")
+    else:
+        low, high = sweeps[min(full)].peak_rss[0], sweeps[max(full)].peak_rss[0]
+        growth = high / low - 1.0
+        print(f"  goal: memory flat in the sweep's size (batches of at most {largest} runs): "
+              f"worker peak RSS {low:.1f} MB at {min(full)} runs, {high:.1f} MB at "
+              f"{max(full)} runs ({growth:+.1%}; flat: within {FLAT:.0%}): "
+              f"{verdict(growth <= FLAT)}")
+    print(f"  {load()}")
+    return {"calls": calls, "sweeps": sweeps}
+
+
+def members_call(members: int, stop_time: float) -> tuple[float, float, float, float]:
+    """(wall s, MB: peak RSS before, peak RSS, results) of ``members`` waves_pd members."""
+    from .. import scenarios
+    from ..ensemble import selftest, simulate_members
+
+    system = scenarios.load("waves_pd")
+    selftest()
+    before, started = peak_rss_mb(), time.perf_counter()
+    recordings = simulate_members(system, [{"ship": {"wave_seed": seed}}
+                                           for seed in range(1, members + 1)], stop_time)
+    wall = time.perf_counter() - started
+    alone = [r.meta["notes"] for r in recordings if r.meta["backend"] != "batch"]
+    if alone:
+        raise RuntimeError(f"{len(alone)} members ran alone: {alone[0]}")
+    results = sum(r.data.nbytes for r in recordings) + recordings[0].t.nbytes
+    return wall, before, peak_rss_mb(), results / 2**20

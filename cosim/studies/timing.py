@@ -1,5 +1,5 @@
 """The engine benchmarks of ``python -m cosim.bench`` (figures printed, never asserted):
-``engines`` and ``overhead``; the helpers the other benchmarks share."""
+``engines``, ``overhead`` and ``memory``; the helpers the sweep benchmarks share."""
 from __future__ import annotations
 
 import os
@@ -10,6 +10,11 @@ import tempfile
 import time
 from pathlib import Path
 from typing import Callable
+
+from .. import scenarios
+from ..core.master import BACKENDS, Master
+from ..ensemble.reference import run_direct
+from . import in_child
 
 STEPS = 4000
 ROWS = {"direct": "(a) the modules wired by hand (run_direct)",
@@ -23,8 +28,7 @@ RATIOS = (("b/a", "inprocess", "direct"), ("c/b", "fmi", "inprocess"), ("c/f", "
 
 
 def peak_rss_mb() -> float:
-    """This process's peak resident memory, MB: Linux's VmHWM (``ru_maxrss`` keeps a forked
-    parent's peak)."""
+    """This process's peak RSS, MB: Linux's VmHWM (``ru_maxrss`` keeps a forked parent's)."""
     try:
         return next(int(line.split()[1]) / 1024 for line in
                     Path("/proc/self/status").read_text().splitlines() if line.startswith("VmHWM:"))
@@ -33,8 +37,8 @@ def peak_rss_mb() -> float:
 
 
 def machine() -> str:
-    """One line on the machine the figures come from and its load now: its CPU (by family,
-    model and AVX-512, which numpy's kernels use where the CPU has it), cores, Python, OS."""
+    """One line on the machine and its load now: its CPU (family, model and AVX-512, which
+    numpy's kernels use), cores, Python, OS."""
     try:
         info = dict(line.split(":", 1) for line in Path("/proc/cpuinfo").read_text().split(
             "\n\n")[0].splitlines() if ":" in line)
@@ -54,8 +58,7 @@ def load() -> str:
 
 
 def side_by_side(runners: dict[str, Callable[[], object]], repeats: int) -> dict[str, float]:
-    """Median wall time of each runner, timed in turn round after round (the same load on a
-    shared machine) after a warm-up round."""
+    """Median wall time of each runner, timed in turn round after round after a warm-up."""
     times: dict[str, list[float]] = {key: [] for key in runners}
     for round_ in range(repeats + 1):
         for key, run in runners.items():
@@ -93,11 +96,7 @@ def _ecos_runner(ssp: Path) -> Callable[[], None]:
 
 
 def engines(repeats: int) -> dict[str, dict[str, float]]:
-    """calm_pd and waves_pd by each of ``ROWS`` (docs/performance.md), printed with their
-    ratios; the times by scenario and row."""
-    from .. import scenarios
-    from ..core.master import Master
-    from ..ensemble.reference import run_direct
+    """calm_pd and waves_pd by each of ``ROWS``, printed with their ratios; the times."""
     from ..interop.ssp import export
 
     print(f"Engines on the same system, 400 s = {STEPS} macro steps of 0.1 s, median of "
@@ -109,7 +108,7 @@ def engines(repeats: int) -> dict[str, dict[str, float]]:
             ssp = export(name, Path(tmp))
             with Master(system, backend="inprocess") as inprocess, \
                     Master(system, backend="fmi") as fmi:
-                require_in_process(inprocess.notes)
+                require("in-process backend", inprocess.notes)
                 runners = {"direct": lambda: run_direct(inprocess),
                            "inprocess": _master_runner(inprocess), "fmi": _master_runner(fmi)}
                 for key, make in (("libcosim", _libcosim_runner), ("ecos", _ecos_runner)):
@@ -139,10 +138,10 @@ def engines(repeats: int) -> dict[str, dict[str, float]]:
     return results
 
 
-def require_in_process(notes: list[str]) -> None:
-    """RuntimeError if a component would run through FMI (its ``notes``)."""
+def require(route: str, notes: list[str]) -> None:
+    """RuntimeError if ``route`` cannot be measured: ``notes`` say what would run otherwise."""
     if notes:
-        raise RuntimeError("the in-process backend cannot be measured: " + "; ".join(notes))
+        raise RuntimeError(f"the {route} cannot be measured: " + "; ".join(notes))
 
 
 def _master_runner(master) -> Callable[[], None]:
@@ -183,21 +182,17 @@ IDLE_CALLS = {"reader": _idle_reader,
 
 
 def overhead(repeats: int) -> dict[str, float]:
-    """Microseconds per step of calm_pd with the ship's step doing nothing: by hand, by the
-    master with its calls into the FMUs idle (``IDLE_CALLS``), and in-process."""
+    """us per step of calm_pd, the ship's step idle: by hand, by the master idle, in-process."""
     from unittest import mock
 
     from ship_fmu.vessel import Vessel
 
-    from .. import scenarios
     from ..core.inprocess import InProcessInstance
-    from ..core.master import Master
-    from ..ensemble.reference import run_direct
 
     system = scenarios.load("calm_pd")
     with Master(system, backend="inprocess") as inprocess, \
             Master(system, backend="inprocess") as idle:
-        require_in_process(inprocess.notes)
+        require("in-process backend", inprocess.notes)
 
         def idle_run() -> None:
             with mock.patch.multiple(InProcessInstance, **IDLE_CALLS):
@@ -216,3 +211,33 @@ def overhead(repeats: int) -> dict[str, float]:
           f"{per_step['inprocess'] - per_step['direct']:.1f} us/step (its calls into the slaves, "
           "and its bookkeeping beyond direct's)")
     return per_step
+
+
+def memory(hours: float) -> None:
+    """Peak RSS of a long calm_pd run streamed to disk against a short one's, each backend."""
+    print(f"Memory: calm_pd streamed to CSV in chunks of 10,000 rows, on {machine()}")
+    for backend in BACKENDS:
+        for duration in (3600.0, hours * 3600.0):
+            rows, wall, size, peak = in_fresh_process(f"calm_pd on {backend}", streamed_run,
+                                                      backend, duration)
+            print(f"  {backend:9} {duration / 3600:5.1f} h simulated: {rows:>8.0f} rows, "
+                  f"{wall:6.1f} s wall, CSV {size / 1e6:7.1f} MB, peak RSS {peak:6.1f} MB")
+
+
+def streamed_run(backend: str, duration: float) -> tuple[int, float, int, float]:
+    """(rows, wall s, CSV bytes, peak RSS MB) of calm_pd to ``duration`` streamed to disk."""
+    with tempfile.TemporaryDirectory() as tmp, \
+            Master(scenarios.load("calm_pd"), backend=backend) as master:
+        started = time.perf_counter()
+        recording = master.run(duration, csv_path=Path(tmp) / "run.csv")
+        wall = time.perf_counter() - started
+        if recording.error:
+            raise RuntimeError(recording.error)
+        return recording.rows, wall, recording.path.stat().st_size, peak_rss_mb()
+
+
+def in_fresh_process(what: str, function: Callable, *args: object) -> list[float]:
+    """``function(*args)`` in a fresh process (its own peak memory): the numbers it returns."""
+    name = function.__name__
+    code = f"from {function.__module__} import {name}; print(*{name}(*{args!r}))"
+    return [float(value) for value in in_child(what, code).split()]
