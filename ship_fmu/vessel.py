@@ -70,7 +70,6 @@ class Vessel:
         self._m11_inv = 1.0 / M[0][0]
         self._minv = (M[2][2] / det, -M[1][2] / det, -M[2][1] / det, M[1][1] / det)
         self.waves, self._wave_loads = None, calm_water
-        self._shaft_speeds, self._forces = None, None  # the last shaft speeds, their tau_th
         if params.Hs > 0.0:
             components = WaveComponents.from_spectrum(
                 params.Hs, params.T0, params.wave_components, params.wave_seed)
@@ -88,28 +87,26 @@ class Vessel:
     def step(self, t: float, h: float, delta_c: float,
              n1: float = N_PROPELLER, n2: float = N_PROPELLER, n3: float = 0.0) -> None:
         require_finite(delta_c=delta_c, n1=n1, n2=n2, n3=n3)
-        p = self.params
-        if (n1, n2, n3) != self._shaft_speeds:
-            self._shaft_speeds, self._forces = (n1, n2, n3), actuator_model(
-                self.actuators, n1, n2, n3)
-        gear = RudderMotion(self.delta, delta_c, p.delta_max, p.delta_rate_max)
+        forces = actuator_model(self.actuators, n1, n2, n3)
+        gear = RudderMotion(self.delta, delta_c, self.params.delta_max,
+                            self.params.delta_rate_max)
         y = (self.x, self.y, self.psi, self.u, self.v, self.r, self.xi)
         if 0.0 < gear.reach < h:               # the rudder's kink: a step either side
-            y = self._integrate(t, 0.0, gear.reach, y, gear)
-            y = self._integrate(t, gear.reach, h - gear.reach, y, gear)
+            y = self._integrate(t, 0.0, gear.reach, y, gear, forces)
+            y = self._integrate(t, gear.reach, h - gear.reach, y, gear, forces)
         else:
-            y = self._integrate(t, 0.0, h, y, gear)
+            y = self._integrate(t, 0.0, h, y, gear, forces)
         self.x, self.y, self.psi, self.u, self.v, self.r, self.xi = y
         self.delta = gear(h)
         self.t = t + h
         self.X_w, self.Y_w, self.N_w = self._wave_loads(self.t, self.xi, self.psi)
 
     def _integrate(self, t: float, start: float, length: float, y: State,
-                   gear: RudderMotion) -> State:
+                   gear: RudderMotion, forces: Callable) -> State:
         """RK4 over [t + start, t + start + length] in equal sub-steps <= h_max."""
         n_sub, hs = self._cut_of(length)
         hh, c = 0.5 * hs, hs / 6.0
-        forces, rates = self._forces, self.rates
+        rates = self.rates
         for j in range(n_sub):
             s = start + j * hs
             ts = t + s
