@@ -29,23 +29,24 @@ PAPER_EQ45 = SwayYawModel(
 )
 
 
-def _derivative(f: Callable[[float], np.ndarray], x: float, step: float = 1e-3) -> np.ndarray:
-    """Central differences with one Richardson step (exact for the |a| b terms at a = 0)."""
+def _derivative(f: Callable[[float], np.ndarray], step: float = 1e-3) -> np.ndarray:
+    """df/dx at 0: central differences with one Richardson step (exact for the |a| b terms)."""
     def central(h: float) -> np.ndarray:
-        return (f(x + h) - f(x - h)) / (2.0 * h)
+        return (f(h) - f(-h)) / (2.0 * h)
     return 2.0 * central(step / 2.0) - central(step)
 
 
-def linearised_ship(u0: float, n: float = N_PROPELLER, hull: Hull = Hull(),
-                    actuators: Actuators = Actuators()) -> SwayYawModel:
+def linearised_ship(u0: float) -> SwayYawModel:
     """Sway-yaw model of the ship linearised at surge speed u0, eqs (23)-(25)."""
+    hull = Hull()
+
     def hydrodynamic(v: float, r: float) -> np.ndarray:
         return np.add(coriolis_forces(hull, u0, v, r), damping_forces(hull, u0, v, r))[1:]
-    N = np.column_stack([_derivative(lambda v: hydrodynamic(v, 0.0), 0.0),
-                         _derivative(lambda r: hydrodynamic(0.0, r), 0.0)])
-    forces = actuator_model(actuators, n, n, 0.0)
-    b = _derivative(lambda d: np.array(forces(d)[1:]), 0.0)
-    return SwayYawModel(M=mass_matrix(hull)[1:, 1:], N=N, b=b)
+    N = np.column_stack([_derivative(lambda v: hydrodynamic(v, 0.0)),
+                         _derivative(lambda r: hydrodynamic(0.0, r))])
+    forces = actuator_model(Actuators(), N_PROPELLER, N_PROPELLER, 0.0)
+    return SwayYawModel(M=mass_matrix(hull)[1:, 1:], N=N,
+                        b=_derivative(lambda d: np.array(forces(d)[1:])))
 
 
 @dataclass(frozen=True)
