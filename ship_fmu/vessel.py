@@ -91,35 +91,15 @@ class Vessel:
         gear = RudderMotion(self.delta, delta_c, self.params.delta_max,
                             self.params.delta_rate_max)
         y = (self.x, self.y, self.psi, self.u, self.v, self.r, self.xi)
-        if 0.0 < gear.reach < h:               # the rudder's kink: a step either side
-            y = self._integrate(t, 0.0, gear.reach, y, gear, forces)
-            y = self._integrate(t, gear.reach, h - gear.reach, y, gear, forces)
-        else:
-            y = self._integrate(t, 0.0, h, y, gear, forces)
+        ends = (gear.reach, h) if 0.0 < gear.reach < h else (h,)   # the rudder's kink: a
+        for start, end in zip((0.0, *ends), ends):                   # piece either side
+            n_sub, hs = self._cut_of(end - start)
+            for j in range(n_sub):
+                y = rk4_step(self.rates, forces, gear, t, start + j * hs, hs, y)
         self.x, self.y, self.psi, self.u, self.v, self.r, self.xi = y
         self.delta = gear(h)
         self.t = t + h
         self.X_w, self.Y_w, self.N_w = self._wave_loads(self.t, self.xi, self.psi)
-
-    def _integrate(self, t: float, start: float, length: float, y: State,
-                   gear: RudderMotion, forces: Callable) -> State:
-        """RK4 over [t + start, t + start + length] in equal sub-steps <= h_max."""
-        n_sub, hs = self._cut_of(length)
-        hh, c = 0.5 * hs, hs / 6.0
-        rates = self.rates
-        for j in range(n_sub):
-            s = start + j * hs
-            ts = t + s
-            delta0, delta1, delta2 = gear(s), gear(s + hh), gear(s + hs)
-            tau0 = forces(delta0)             # the rudder at rest: the same forces
-            tau1 = tau0 if delta1 == delta0 != 0.0 else forces(delta1)
-            tau2 = tau1 if delta2 == delta1 != 0.0 else forces(delta2)
-            k1 = rates(ts, y, tau0)
-            k2 = rates(ts + hh, axpy(hh, k1, y), tau1)
-            k3 = rates(ts + hh, axpy(hh, k2, y), tau1)
-            k4 = rates(ts + hs, axpy(hs, k3, y), tau2)
-            y = rk4_update(c, y, k1, k2, k3, k4)
-        return y
 
     def _cut_of(self, length: float) -> tuple[int, float]:
         """(number, length) of the equal RK4 sub-steps <= h_max that cut ``length``."""
@@ -158,6 +138,28 @@ def state_rates(hull: Hull, minv: tuple[float, float, float, float], m11_inv: fl
 
 def calm_water(t: float, xi: float, psi: float) -> tuple[float, float, float]:
     return (0.0, 0.0, 0.0)
+
+
+def _at_rest(delta: float, before: float) -> bool:
+    """The rudder has not moved: its forces stand (not at 0, whose sign they keep)."""
+    return delta == before != 0.0
+
+
+def rk4_step(rates: Callable, forces: Callable, gear: Callable, t: float, s: float, hs: float,
+             y: State, same: Callable = _at_rest) -> State:
+    """One RK4 step of hs from t + s, the rudder's forces at s, s + hs/2 and s + hs; floats,
+    or arrays with an array ``same`` (``cosim.ensemble``)."""
+    hh = 0.5 * hs
+    delta0, delta1, delta2 = gear(s), gear(s + hh), gear(s + hs)
+    tau0 = forces(delta0)
+    tau1 = tau0 if same(delta1, delta0) else forces(delta1)
+    tau2 = tau1 if same(delta2, delta1) else forces(delta2)
+    ts = t + s
+    k1 = rates(ts, y, tau0)
+    k2 = rates(ts + hh, axpy(hh, k1, y), tau1)
+    k3 = rates(ts + hh, axpy(hh, k2, y), tau1)
+    k4 = rates(ts + hs, axpy(hs, k3, y), tau2)
+    return rk4_update(hs / 6.0, y, k1, k2, k3, k4)
 
 
 def axpy(a: float, x: State, y: State) -> State:

@@ -8,7 +8,7 @@ from typing import Sequence
 import numpy as np
 
 from ship_fmu.thrusters import actuator_model
-from ship_fmu.vessel import Vessel, axpy, calm_water, rk4_update, state_rates
+from ship_fmu.vessel import Vessel, calm_water, rk4_step, state_rates
 from ship_fmu.waves import slope_sums
 
 from . import exact
@@ -114,15 +114,4 @@ class VesselArrays:
         def rates(t: np.ndarray | float, state: Arrays, tau_th: Arrays) -> Arrays:
             return state_rates(v.hull, v._minv, v._m11_inv, loads, psi_w, t, state, tau_th,
                                hypot, np.cos, np.sin)
-        hh, c = 0.5 * hs, hs / 6.0
-        s = start + 0.0 * hs
-        ts = t + s
-        delta0, delta1, delta2 = gear(s), gear(s + hh), gear(s + hs)
-        tau0 = forces(delta0)
-        tau1 = tau0 if np.array_equal(delta1, delta0) else forces(delta1)
-        tau2 = tau1 if np.array_equal(delta2, delta1) else forces(delta2)
-        k1 = rates(ts, y, tau0)
-        k2 = rates(ts + hh, axpy(hh, k1, y), tau1)
-        k3 = rates(ts + hh, axpy(hh, k2, y), tau1)
-        k4 = rates(ts + hs, axpy(hs, k3, y), tau2)
-        return rk4_update(c, y, k1, k2, k3, k4)
+        return rk4_step(rates, self.forces, gear, t, start + 0.0 * hs, hs, y, np.array_equal)
