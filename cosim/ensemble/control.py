@@ -9,7 +9,6 @@ import numpy as np
 from autopilot_fmu.guidance import WaypointGuidance
 from autopilot_fmu.pd import PDAutopilot
 from autopilot_fmu.smc import SlidingModeAutopilot, reference_acceleration, reference_rk4
-from fmukit.numerics import substeps
 
 from .exact import hypot, tanh, wrap
 
@@ -97,14 +96,14 @@ class PIDArrays:
 
 
 class SMCArrays:
-    """``SlidingModeAutopilot``: the law (37)-(43) and the reference model (44) by RK4."""
+    """``SlidingModeAutopilot``: the law (37)-(43) and the reference model (44) by RK4, of
+    members whose reference model takes the step whole."""
 
     def __init__(self, pilots: Sequence[SlidingModeAutopilot]):
         self.k1, self.k2 = (np.array([p.design.K[j] for p in pilots]) for j in (0, 1))
         self.h1, self.h2 = (np.array([p.design.h[j] for p in pilots]) for j in (0, 1))
         self.tracking = np.array([p.tracking for p in pilots])
-        _columns(self, pilots, ("eta_h", "phi_h", "omega_n", "zeta", "psi_z", "r_z", "_h_max"))
-        self.cuts: np.ndarray | None = None      # sub-steps of the reference model a step
+        _columns(self, pilots, ("eta_h", "phi_h", "omega_n", "zeta", "psi_z", "r_z"))
 
     def command(self, psi: np.ndarray, r: np.ndarray, psi_d: np.ndarray) -> np.ndarray:
         error = wrap(self.psi_z - psi)
@@ -117,16 +116,8 @@ class SMCArrays:
 
     def step(self, t: float, h: float, psi: np.ndarray, r: np.ndarray,
              psi_d: np.ndarray) -> None:
-        if self.cuts is None:                # h is the batch's, the same at every step
-            self.cuts = np.array([substeps(h, bound, "of the reference model")
-                                  for bound in self.h_max])
-        hs = h / self.cuts
-        psi_z, r_z = self.psi_z, self.r_z
-        for j in range(int(self.cuts.max())):
-            stepped = reference_rk4(psi_d, psi_z, r_z, hs, self.omega_n, self.zeta, wrap)
-            active = j < self.cuts
-            psi_z, r_z = (np.where(active, new, old) for new, old in zip(stepped, (psi_z, r_z)))
-        self.psi_z, self.r_z = psi_z, r_z
+        self.psi_z, self.r_z = reference_rk4(psi_d, self.psi_z, self.r_z, h, self.omega_n,
+                                             self.zeta, wrap)
 
 
 KINDS = {"PDAutopilot": PDArrays, "PIDAutopilot": PIDArrays,   # by class name: the PID's
