@@ -52,8 +52,6 @@ def linearised_ship(u0: float) -> SwayYawModel:
 @dataclass(frozen=True)
 class NomotoModel:
     """psi/delta = K / (s (1 + T s)), eqs (26)-(34), as the state model (33)."""
-    K_R: float      # eq (29)
-    T3: float       # eq (30)
     T: float        # T1 + T2 - T3, s
     a22: float      # -1/T (the paper writes a_11 after eq (34); it is a_22)
     b2: float       # K / T, K = -K_R (31)
@@ -68,7 +66,7 @@ class NomotoModel:
         K_R = float((n21 * b1 - n11 * b2) / det_N)                              # (29)
         T3 = (m21 * b1 - m11 * b2) / det_N / K_R                                # (30)
         T = float(T1_plus_T2 - T3)
-        return cls(K_R=K_R, T3=float(T3), T=T, a22=-1.0 / T, b2=-K_R / T)
+        return cls(T=T, a22=-1.0 / T, b2=-K_R / T)
 
 
 def design_model(name: str, u0: float) -> SwayYawModel:

@@ -46,7 +46,6 @@ class SlidingModeDesign:
     nomoto: NomotoModel
     K: tuple[float, float]
     h: tuple[float, float]
-    N: float
 
     @classmethod
     def from_model(cls, model: SwayYawModel, lambda1: float = -0.0005,
@@ -66,8 +65,8 @@ class SlidingModeDesign:
         h1, h2 = _null_vector(A_c_T, slow)
         scale = math.copysign(1.0, h1) / math.hypot(h1, h2)
         # Eqs (40)-(41): [N_x; N_u] = [[A, B], [C, D]]^-1 [0; 1] = [1, 0; 0] with C = [1, 0]
-        # and D = 0, so N = N_u + K^T N_x = k1.
-        return cls(nomoto=nomoto, K=(k1, k2), h=(h1 * scale, h2 * scale), N=k1)
+        # and D = 0, so N = N_u + K^T N_x = k1: u_eq (39) = k1 (psi_z - psi) - k2 r.
+        return cls(nomoto=nomoto, K=(k1, k2), h=(h1 * scale, h2 * scale))
 
 
 # The design's linear algebra written out in exactly rounded operations, not by LAPACK,
