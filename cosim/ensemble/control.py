@@ -15,7 +15,7 @@ from .exact import hypot, tanh, wrap
 NEAR = 1e-12           # relative distance from the circle within which math.hypot decides
 
 
-def _columns(target: object, models: Sequence, names: tuple[str, ...], dtype=float) -> None:
+def columns(target: object, models: Sequence, names: tuple[str, ...], dtype=float) -> None:
     """Each attribute ``name`` of the models as an (M,) array (a leading _ dropped)."""
     for name in names:
         setattr(target, name.lstrip("_"), np.array([getattr(m, name) for m in models], dtype))
@@ -35,12 +35,11 @@ class GuidanceArrays:
         self.length = hypot(self.delta[..., 0], self.delta[..., 1])   # 0 past a route's end
         self.points = np.array([len(g.points) for g in guidances])
         self.R_accept = np.array([g.R_accept for g in guidances], dtype=float)
-        _columns(self, guidances, ("leg", "finished"), None)
+        columns(self, guidances, ("leg", "finished"), None)
         self.members = np.arange(count)
 
     def outputs(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(psi_d, wp_index) at (x, y), the leg switches committed: from the committed leg,
-        the next while the circle of acceptance is reached or the leg's end passed."""
+        """(psi_d, wp_index) at (x, y), the leg switches (``WaypointGuidance``) committed."""
         i, leg, finished = self.members, self.leg, self.finished.copy()
         moving = ~finished
         while moving.any():
@@ -70,7 +69,7 @@ class PDArrays:
     """``PDAutopilot.command``, eq (20): memoryless."""
 
     def __init__(self, pilots: Sequence[PDAutopilot]):
-        _columns(self, pilots, ("Kp", "Kd"))
+        columns(self, pilots, ("Kp", "Kd"))
 
     def command(self, psi: np.ndarray, r: np.ndarray, psi_d: np.ndarray) -> np.ndarray:
         return self.Kp * wrap(psi - psi_d) + self.Kd * r
@@ -83,7 +82,7 @@ class PIDArrays:
     """``PIDAutopilot`` (pid_autopilot_slave): eq (20) with conditional integration."""
 
     def __init__(self, pilots: Sequence):
-        _columns(self, pilots, ("Kp", "Ki", "Kd", "delta_max", "e_int", "z"))
+        columns(self, pilots, ("Kp", "Ki", "Kd", "delta_max", "e_int", "z"))
 
     def command(self, psi: np.ndarray, r: np.ndarray, psi_d: np.ndarray) -> np.ndarray:
         return self.Kp * wrap(psi - psi_d) + self.Ki * self.z + self.Kd * r
@@ -103,7 +102,7 @@ class SMCArrays:
         self.k1, self.k2 = (np.array([p.design.K[j] for p in pilots]) for j in (0, 1))
         self.h1, self.h2 = (np.array([p.design.h[j] for p in pilots]) for j in (0, 1))
         self.tracking = np.array([p.tracking for p in pilots])
-        _columns(self, pilots, ("eta_h", "phi_h", "omega_n", "zeta", "psi_z", "r_z"))
+        columns(self, pilots, ("eta_h", "phi_h", "omega_n", "zeta", "psi_z", "r_z"))
 
     def command(self, psi: np.ndarray, r: np.ndarray, psi_d: np.ndarray) -> np.ndarray:
         error = wrap(self.psi_z - psi)

@@ -1,5 +1,5 @@
 """``Vessel.step`` for M members, states (M,) and wave components (M, N): the scalar model's
-rates, forces and RK4 update on arrays; its branches and wave loads rewritten op for op."""
+functions on arrays, its branches rewritten op for op."""
 from __future__ import annotations
 
 from operator import attrgetter
@@ -12,6 +12,7 @@ from ship_fmu.vessel import Vessel, calm_water, rk4_step, state_rates
 from ship_fmu.waves import slope_sums
 
 from . import exact
+from .control import columns
 
 Arrays = tuple[np.ndarray, ...]
 
@@ -78,10 +79,8 @@ class VesselArrays:
         self.vessel = vessels[0]                            # the hull and mass matrix of all
         self.forces = actuator_model(self.vessel.actuators, *shafts)
         self.waves = None if self.vessel.waves is None else WaveArrays(vessels)
-        for name in ("psi_w", "delta_max", "delta_rate_max"):
-            setattr(self, name, np.array([getattr(v.params, name) for v in vessels]))
-        for name in (*self.STATES, "delta"):
-            setattr(self, name, np.array([getattr(v, name) for v in vessels]))
+        columns(self, [v.params for v in vessels], ("psi_w", "delta_max", "delta_rate_max"))
+        columns(self, vessels, (*self.STATES, "delta"))
 
     def step(self, t: float, h: float, delta_c: np.ndarray) -> None:
         """``Vessel.step``: two RK4 steps for the members whose rudder kinks in the step."""
@@ -106,8 +105,7 @@ class VesselArrays:
 
     def _rk4(self, t: float, start: np.ndarray | float, hs: np.ndarray, y: Arrays,
              gear: RudderArrays, waves: WaveArrays | None, psi_w: np.ndarray) -> Arrays:
-        """One RK4 step of ``Vessel._integrate``, ``hs`` from ``t + start``, of the members of
-        ``waves``, ``psi_w`` and ``gear`` (all or some)."""
+        """``rk4_step`` of the members of ``waves``, ``psi_w`` and ``gear`` (all or some)."""
         v, forces = self.vessel, self.forces
         loads, hypot = (waves, exact.hypot) if waves is not None else (calm_water, _no_travel)
 
