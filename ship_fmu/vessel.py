@@ -80,8 +80,8 @@ class Vessel:
         gear = RudderMotion(self.delta, delta_c, self.params.delta_max,
                             self.params.delta_rate_max)
         y = (self.x, self.y, self.psi, self.u, self.v, self.r, self.xi)
-        ends = (gear.reach, h) if 0.0 < gear.reach < h else (h,)   # the rudder's kink: a
-        for start, end in zip((0.0, *ends), ends):                   # piece either side
+        ends = (gear.reach, h) if 0.0 < gear.reach < h else (h,)   # a piece either side of
+        for start, end in zip((0.0, *ends), ends):                   # the rudder's kink
             n_sub, hs = self._cut_of(end - start)
             for j in range(n_sub):
                 y = rk4_step(self.rates, forces, gear, t, start + j * hs, hs, y)

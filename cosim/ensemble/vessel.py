@@ -106,7 +106,7 @@ class VesselArrays:
     def _rk4(self, t: float, start: np.ndarray | float, hs: np.ndarray, y: Arrays,
              gear: RudderArrays, waves: WaveArrays | None, psi_w: np.ndarray) -> Arrays:
         """``rk4_step`` of the members of ``waves``, ``psi_w`` and ``gear`` (all or some)."""
-        v, forces = self.vessel, self.forces
+        v = self.vessel
         loads, hypot = (waves, exact.hypot) if waves is not None else (calm_water, _no_travel)
 
         def rates(t: np.ndarray | float, state: Arrays, tau_th: Arrays) -> Arrays:
