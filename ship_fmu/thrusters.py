@@ -22,14 +22,16 @@ def actuator_model(act: Actuators, n1: float, n2: float,
         else (0.0, 0.0)
     lift2, drag2 = (T2 * (1.0 + act.k_Ln * n2), T2 * (1.0 + act.k_Dn * n2)) if n2 >= 0.0 \
         else (0.0, 0.0)
+    k_Ld1, k_Ld2, k_Dd1, k_Dd2 = act.k_Ld1, act.k_Ld2, act.k_Dd1, act.k_Dd2
+    l_yT, l_xT3, l_xR = act.l_yT, act.l_xT3, act.l_xR
 
     def forces(delta: float) -> tuple[float, float, float]:
         a = abs(delta)
-        lift = act.k_Ld1 + act.k_Ld2 * a         # eq (9):  L_i = lift_i (k_Ld1 + k_Ld2 |d|) d
-        drag = act.k_Dd1 * a + act.k_Dd2 * a * a  # eq (10): D_i = drag_i (k_Dd1 |d| + k_Dd2 d^2)
+        lift = k_Ld1 + k_Ld2 * a                 # eq (9):  L_i = lift_i (k_Ld1 + k_Ld2 |d|) d
+        drag = k_Dd1 * a + k_Dd2 * a * a         # eq (10): D_i = drag_i (k_Dd1 |d| + k_Dd2 d^2)
         L1, L2 = lift1 * lift * delta, lift2 * lift * delta
         F1, F2 = T1 - drag1 * drag, T2 - drag2 * drag
         return (F1 + F2,                                             # eqs (11)-(13)
                 T3 + L1 + L2,
-                act.l_yT * (F1 - F2) + act.l_xT3 * T3 - act.l_xR * (L1 + L2))
+                l_yT * (F1 - F2) + l_xT3 * T3 - l_xR * (L1 + L2))
     return forces

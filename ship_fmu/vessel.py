@@ -59,6 +59,7 @@ class Vessel:
         self._m11_inv = 1.0 / M[0][0]
         self._minv = (M[2][2] / det, -M[1][2] / det, -M[2][1] / det, M[1][1] / det)
         self.waves, self._wave_loads = None, calm_water
+        self._shafts, self._forces = None, None        # the last shaft speeds, their tau_th
         if params.Hs > 0.0:
             components = WaveComponents.from_spectrum(
                 params.Hs, params.T0, params.wave_components, params.wave_seed)
@@ -76,7 +77,9 @@ class Vessel:
     def step(self, t: float, h: float, delta_c: float,
              n1: float = N_PROPELLER, n2: float = N_PROPELLER, n3: float = 0.0) -> None:
         require_finite(delta_c=delta_c, n1=n1, n2=n2, n3=n3)
-        forces = actuator_model(self.actuators, n1, n2, n3)
+        if (n1, n2, n3) != self._shafts:
+            self._shafts, self._forces = (n1, n2, n3), actuator_model(self.actuators, n1, n2, n3)
+        forces = self._forces
         gear = RudderMotion(self.delta, delta_c, self.params.delta_max,
                             self.params.delta_rate_max)
         y = (self.x, self.y, self.psi, self.u, self.v, self.r, self.xi)

@@ -60,39 +60,39 @@ class WaveComponents:
                    amplitude=np.sqrt(2.0 * m0_bins), phase=phase)
 
 
-def slope_sums(omega: np.ndarray, k: np.ndarray, phase: np.ndarray, slope_amplitude: np.ndarray,
-               t: float | np.ndarray, xi: float | np.ndarray, s: np.ndarray,
-               work: np.ndarray) -> tuple:
-    """(sum s_i, sum s_i^2) along the last axis, s_i = A_i k_i sin(omega_i t - k_i xi + phi_i),
-    into the buffers s and work; by np.add.reduce in order, not np.dot, whose BLAS bits vary."""
-    np.subtract(np.multiply(omega, t, s), np.multiply(k, xi, work), s)
-    np.add(s, phase, s)
-    np.sin(s, s)
-    np.multiply(slope_amplitude, s, s)
-    return np.add.reduce(s, axis=-1), np.add.reduce(np.multiply(s, s, work), axis=-1)
-
-
 class WaveLoads:
     """Eqs (14)-(16) on a block hull, s_i = A_i k_i sin(theta_i), beta = psi_w - psi:
     X_w, Y_w = rho g B L T (cos, sin)(beta) sum s_i, N_w = rho g B L (L^2 - B^2) / 24
-    sin(2 beta) sum s_i^2."""
+    sin(2 beta) sum s_i^2; summed in order (no matrix product), into arrays made once."""
 
     def __init__(self, components: WaveComponents, h: Hull, psi_w: float):
-        self.components, self.psi_w = components, psi_w
-        self._c_force = RHO_WATER * G * h.B * h.L * h.T
-        self._c_moment = RHO_WATER * G * h.B * h.L * (h.L * h.L - h.B * h.B) / 24.0
+        n, rho = len(components.omega), RHO_WATER
+        self.components = components
+        self.psi_w = psi_w
+        self._c_force = rho * G * h.B * h.L * h.T
+        self._c_moment = rho * G * h.B * h.L * (h.L * h.L - h.B * h.B) / 24.0
         self._slope_amplitude = components.amplitude * components.k
-        self._work = (np.empty_like(components.omega), np.empty_like(components.omega))
+        self._omega_t, self._s, self._s2 = np.empty(n), np.empty(n), np.empty(n)
+        self._t: float | None = None                  # the time of _omega_t
         self._key: tuple = (None, None, None)         # the last evaluation's arguments,
         self._loads = (0.0, 0.0, 0.0)                 # and its loads
 
     def __call__(self, t: float, xi: float, psi: float) -> tuple[float, float, float]:
-        if self._key != (t, xi, psi):
-            c = self.components
-            sum_s, sum_s2 = slope_sums(c.omega, c.k, c.phase, self._slope_amplitude, t, xi,
-                                       *self._work)
-            force, beta = self._c_force * float(sum_s), self.psi_w - psi
-            self._key = (t, xi, psi)
-            self._loads = (force * math.cos(beta), force * math.sin(beta),
-                           self._c_moment * math.sin(2.0 * beta) * float(sum_s2))
+        if self._key == (t, xi, psi):
+            return self._loads
+        if t != self._t:
+            np.multiply(self.components.omega, t, self._omega_t)
+            self._t = t
+        s = np.multiply(self.components.k, xi, self._s)    # theta_i, in place
+        np.subtract(self._omega_t, s, s)
+        np.add(s, self.components.phase, s)
+        np.sin(s, s)
+        np.multiply(self._slope_amplitude, s, s)          # s_i = A_i k_i sin(theta_i)
+        beta = self.psi_w - psi
+        # np.add.reduce: s.sum() without its wrapper; not np.dot, whose BLAS bits vary
+        force = self._c_force * float(np.add.reduce(s))
+        sum_s2 = float(np.add.reduce(np.multiply(s, s, self._s2)))
+        self._key = (t, xi, psi)
+        self._loads = (force * math.cos(beta), force * math.sin(beta),
+                       self._c_moment * math.sin(2.0 * beta) * sum_s2)
         return self._loads

@@ -9,7 +9,6 @@ import numpy as np
 
 from ship_fmu.thrusters import actuator_model
 from ship_fmu.vessel import Vessel, calm_water, rk4_step, state_rates
-from ship_fmu.waves import slope_sums
 
 from . import exact
 from .control import columns
@@ -57,10 +56,15 @@ class WaveArrays:
         # into arrays made once: made afresh, each would be an mmap where glibc's mmap
         # threshold is fixed, as Dask's workers fix it
         m = len(xi)
-        sum_s, sum_s2 = slope_sums(self.omega, self.k, self.phase, self.slope_amplitude,
-                                   t[:, None] if isinstance(t, np.ndarray) else t, xi[:, None],
-                                   self._work[0][:m], self._work[1][:m])
-        force, beta = self.c_force * sum_s, self.psi_w - psi
+        s, ks = self._work[0][:m], self._work[1][:m]
+        np.multiply(self.omega, t[:, None] if isinstance(t, np.ndarray) else t, s)
+        np.subtract(s, np.multiply(self.k, xi[:, None], ks), s)
+        np.add(s, self.phase, s)
+        np.sin(s, s)
+        np.multiply(self.slope_amplitude, s, s)               # s_i = A_i k_i sin(theta_i)
+        beta = self.psi_w - psi
+        force = self.c_force * np.add.reduce(s, axis=1)
+        sum_s2 = np.add.reduce(np.multiply(s, s, s), axis=1)
         return (force * np.cos(beta), force * np.sin(beta),
                 self.c_moment * np.sin(2.0 * beta) * sum_s2)
 
