@@ -29,30 +29,29 @@ PAPER_EQ45 = SwayYawModel(
 )
 
 
-def _derivative(f: Callable[[float], np.ndarray], x: float, step: float = 1e-3) -> np.ndarray:
-    """Central differences with one Richardson step (exact for the |a| b terms at a = 0)."""
+def _derivative(f: Callable[[float], np.ndarray], step: float = 1e-3) -> np.ndarray:
+    """df/dx at 0: central differences with one Richardson step (exact for the |a| b terms)."""
     def central(h: float) -> np.ndarray:
-        return (f(x + h) - f(x - h)) / (2.0 * h)
+        return (f(h) - f(-h)) / (2.0 * h)
     return 2.0 * central(step / 2.0) - central(step)
 
 
-def linearised_ship(u0: float, n: float = N_PROPELLER, hull: Hull = Hull(),
-                    actuators: Actuators = Actuators()) -> SwayYawModel:
+def linearised_ship(u0: float) -> SwayYawModel:
     """Sway-yaw model of the ship linearised at surge speed u0, eqs (23)-(25)."""
+    hull = Hull()
+
     def hydrodynamic(v: float, r: float) -> np.ndarray:
         return np.add(coriolis_forces(hull, u0, v, r), damping_forces(hull, u0, v, r))[1:]
-    N = np.column_stack([_derivative(lambda v: hydrodynamic(v, 0.0), 0.0),
-                         _derivative(lambda r: hydrodynamic(0.0, r), 0.0)])
-    forces = actuator_model(actuators, n, n, 0.0)
-    b = _derivative(lambda d: np.array(forces(d)[1:]), 0.0)
-    return SwayYawModel(M=mass_matrix(hull)[1:, 1:], N=N, b=b)
+    N = np.column_stack([_derivative(lambda v: hydrodynamic(v, 0.0)),
+                         _derivative(lambda r: hydrodynamic(0.0, r))])
+    forces = actuator_model(Actuators(), N_PROPELLER, N_PROPELLER, 0.0)
+    return SwayYawModel(M=mass_matrix(hull)[1:, 1:], N=N,
+                        b=_derivative(lambda d: np.array(forces(d)[1:])))
 
 
 @dataclass(frozen=True)
 class NomotoModel:
     """psi/delta = K / (s (1 + T s)), eqs (26)-(34), as the state model (33)."""
-    K_R: float      # eq (29)
-    T3: float       # eq (30)
     T: float        # T1 + T2 - T3, s
     a22: float      # -1/T (the paper writes a_11 after eq (34); it is a_22)
     b2: float       # K / T, K = -K_R (31)
@@ -67,7 +66,7 @@ class NomotoModel:
         K_R = float((n21 * b1 - n11 * b2) / det_N)                              # (29)
         T3 = (m21 * b1 - m11 * b2) / det_N / K_R                                # (30)
         T = float(T1_plus_T2 - T3)
-        return cls(K_R=K_R, T3=float(T3), T=T, a22=-1.0 / T, b2=-K_R / T)
+        return cls(T=T, a22=-1.0 / T, b2=-K_R / T)
 
 
 def design_model(name: str, u0: float) -> SwayYawModel:

@@ -10,7 +10,7 @@ import math
 from dataclasses import dataclass
 
 from fmukit.autopilot import INPUTS, rudder_command
-from fmukit.numerics import require_finite, wrap
+from fmukit.numerics import wrap
 from fmukit.slave import ModelSlave, Var
 
 
@@ -29,7 +29,6 @@ class PIDAutopilot:
 
     def step(self, h: float, psi: float, r: float, psi_d: float) -> None:
         """Integrate the heading error over a step of h s, unless that winds up."""
-        require_finite(psi=psi, r=r, psi_d=psi_d)
         e, u = wrap(psi - psi_d), self.command(psi, r, psi_d)
         if abs(e) < self.e_int and (abs(u) < self.delta_max or u * e < 0.0):
             self.z += e * h

@@ -1,6 +1,5 @@
-"""The 3-DOF manoeuvring model, eqs (1)-(6): eta_dot = R(psi) nu (1)-(2) and
-M nu_dot + C(nu) nu + D(nu) nu = tau (3), eta = [x, y, psi] (north, east, heading),
-nu = [u, v, r]; C(nu) nu and D(nu) nu as force vectors."""
+"""The 3-DOF manoeuvring model, eqs (1)-(6): eta_dot = R(psi) nu (1)-(2), M nu_dot + C(nu) nu
++ D(nu) nu = tau (3), eta = [x, y, psi] (north, east, heading), nu = [u, v, r]."""
 import math
 from typing import Callable
 

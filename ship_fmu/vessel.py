@@ -2,7 +2,7 @@
 held, in equal sub-steps <= h_max, cut where the rudder reaches its command or stop (RK4 keeps
 its order only on smooth pieces, ``cosim.accuracy``). psi is not wrapped."""
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from typing import Callable
 
 from fmukit.numerics import require_finite, substeps
@@ -36,21 +36,10 @@ class VesselParameters:
     wave_components: int = 50
     h_max: float = 0.1          # s, largest RK4 step
 
-    def __post_init__(self) -> None:               # ValueError naming the first invalid one
-        for f in fields(self):
-            value = getattr(self, f.name)
-            if not math.isfinite(value):
-                raise ValueError(f"parameter {f.name} = {value} is not finite")
-        for name, ok, rule in (
-            ("delta_max", self.delta_max > 0.0, "> 0"),
-            ("delta_rate_max", self.delta_rate_max > 0.0, "> 0"),
-            ("Hs", self.Hs >= 0.0, ">= 0 (0 = calm water)"),
-            ("T0", self.T0 > 0.0, "> 0"),
-            ("wave_components", self.wave_components >= 1, ">= 1"),
-            ("h_max", self.h_max > 0.0, "> 0"),
-        ):
-            if not ok:
-                raise ValueError(f"parameter {name} must be {rule}, got {getattr(self, name)}")
+    def __post_init__(self) -> None:     # what the FMU's declared ranges do not refuse
+        for name in ("delta_max", "delta_rate_max"):
+            if not getattr(self, name) > 0.0:
+                raise ValueError(f"parameter {name} must be > 0, got {getattr(self, name)}")
         # steeper waves break (Stokes' limit): the block model's loads would diverge
         peak_wavelength = G * self.T0 * self.T0 / (2.0 * math.pi)
         if self.Hs > peak_wavelength / MAX_STEEPNESS:
@@ -70,7 +59,7 @@ class Vessel:
         self._m11_inv = 1.0 / M[0][0]
         self._minv = (M[2][2] / det, -M[1][2] / det, -M[2][1] / det, M[1][1] / det)
         self.waves, self._wave_loads = None, calm_water
-        self._shaft_speeds, self._forces = None, None  # the last shaft speeds, their tau_th
+        self._shafts, self._forces = None, None        # the last shaft speeds, their tau_th
         if params.Hs > 0.0:
             components = WaveComponents.from_spectrum(
                 params.Hs, params.T0, params.wave_components, params.wave_seed)
@@ -88,41 +77,21 @@ class Vessel:
     def step(self, t: float, h: float, delta_c: float,
              n1: float = N_PROPELLER, n2: float = N_PROPELLER, n3: float = 0.0) -> None:
         require_finite(delta_c=delta_c, n1=n1, n2=n2, n3=n3)
-        p = self.params
-        if (n1, n2, n3) != self._shaft_speeds:
-            self._shaft_speeds, self._forces = (n1, n2, n3), actuator_model(
-                self.actuators, n1, n2, n3)
-        gear = RudderMotion(self.delta, delta_c, p.delta_max, p.delta_rate_max)
+        if (n1, n2, n3) != self._shafts:
+            self._shafts, self._forces = (n1, n2, n3), actuator_model(self.actuators, n1, n2, n3)
+        forces = self._forces
+        gear = RudderMotion(self.delta, delta_c, self.params.delta_max,
+                            self.params.delta_rate_max)
         y = (self.x, self.y, self.psi, self.u, self.v, self.r, self.xi)
-        if 0.0 < gear.reach < h:               # the rudder's kink: a step either side
-            y = self._integrate(t, 0.0, gear.reach, y, gear)
-            y = self._integrate(t, gear.reach, h - gear.reach, y, gear)
-        else:
-            y = self._integrate(t, 0.0, h, y, gear)
+        ends = (gear.reach, h) if 0.0 < gear.reach < h else (h,)   # a piece either side of
+        for start, end in zip((0.0, *ends), ends):                   # the rudder's kink
+            n_sub, hs = self._cut_of(end - start)
+            for j in range(n_sub):
+                y = rk4_step(self.rates, forces, gear, t, start + j * hs, hs, y)
         self.x, self.y, self.psi, self.u, self.v, self.r, self.xi = y
         self.delta = gear(h)
         self.t = t + h
         self.X_w, self.Y_w, self.N_w = self._wave_loads(self.t, self.xi, self.psi)
-
-    def _integrate(self, t: float, start: float, length: float, y: State,
-                   gear: RudderMotion) -> State:
-        """RK4 over [t + start, t + start + length] in equal sub-steps <= h_max."""
-        n_sub, hs = self._cut_of(length)
-        hh, c = 0.5 * hs, hs / 6.0
-        forces, rates = self._forces, self.rates
-        for j in range(n_sub):
-            s = start + j * hs
-            ts = t + s
-            delta0, delta1, delta2 = gear(s), gear(s + hh), gear(s + hs)
-            tau0 = forces(delta0)             # the rudder at rest: the same forces
-            tau1 = tau0 if delta1 == delta0 != 0.0 else forces(delta1)
-            tau2 = tau1 if delta2 == delta1 != 0.0 else forces(delta2)
-            k1 = rates(ts, y, tau0)
-            k2 = rates(ts + hh, axpy(hh, k1, y), tau1)
-            k3 = rates(ts + hh, axpy(hh, k2, y), tau1)
-            k4 = rates(ts + hs, axpy(hs, k3, y), tau2)
-            y = rk4_update(c, y, k1, k2, k3, k4)
-        return y
 
     def _cut_of(self, length: float) -> tuple[int, float]:
         """(number, length) of the equal RK4 sub-steps <= h_max that cut ``length``."""
@@ -161,6 +130,28 @@ def state_rates(hull: Hull, minv: tuple[float, float, float, float], m11_inv: fl
 
 def calm_water(t: float, xi: float, psi: float) -> tuple[float, float, float]:
     return (0.0, 0.0, 0.0)
+
+
+def _at_rest(delta: float, before: float) -> bool:
+    """The rudder has not moved: its forces stand (not at 0, whose sign they keep)."""
+    return delta == before != 0.0
+
+
+def rk4_step(rates: Callable, forces: Callable, gear: Callable, t: float, s: float, hs: float,
+             y: State, same: Callable = _at_rest) -> State:
+    """One RK4 step of hs from t + s, the rudder's forces at s, s + hs/2 and s + hs; floats,
+    or arrays with an array ``same`` (``cosim.ensemble``)."""
+    hh = 0.5 * hs
+    delta0, delta1, delta2 = gear(s), gear(s + hh), gear(s + hs)
+    tau0 = forces(delta0)
+    tau1 = tau0 if same(delta1, delta0) else forces(delta1)
+    tau2 = tau1 if same(delta2, delta1) else forces(delta2)
+    ts = t + s
+    k1 = rates(ts, y, tau0)
+    k2 = rates(ts + hh, axpy(hh, k1, y), tau1)
+    k3 = rates(ts + hh, axpy(hh, k2, y), tau1)
+    k4 = rates(ts + hs, axpy(hs, k3, y), tau2)
+    return rk4_update(hs / 6.0, y, k1, k2, k3, k4)
 
 
 def axpy(a: float, x: State, y: State) -> State:

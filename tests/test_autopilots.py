@@ -31,7 +31,6 @@ def test_sliding_mode_design_from_eq_45():
     design = SlidingModeDesign.from_model(PAPER_EQ45)
     assert design.K == pytest.approx((-0.98656, -1999.96), rel=1e-4)
     assert design.h == pytest.approx((0.99191, 0.12696), abs=1e-5)
-    assert design.N == pytest.approx(design.K[0], rel=1e-12)      # N_x = [1, 0], N_u = 0
     A = np.array([[0.0, 1.0], [0.0, design.nomoto.a22]])       # eq (33), state [psi, r]
     A_c = A - np.outer([0.0, design.nomoto.b2], design.K)
     assert sorted(np.linalg.eigvals(A_c).real) == pytest.approx([-7.8128, -0.0005])

@@ -127,6 +127,19 @@ def test_a_member_refused_at_configure_is_named_before_anything_runs():
         simulate_members(scenarios.load("waves_pd"), [{}, {"ship": {"Hs": -1.0}}], 10.0)
 
 
+def test_an_smc_member_whose_reference_model_cuts_the_step_runs_alone_and_exact():
+    system = scenarios.load("calm_smc")
+    members = [{}, {"autopilot": {"omega_n": 3.0, "zeta": 2.0}}]
+    batch = simulate_members(system, members, 20.0)
+    assert [r.meta["backend"] for r in batch] == ["batch", "inprocess"]
+    assert batch[1].meta["notes"][-1] == (
+        "ran on the in-process route, not in the batch: autopilot.omega_n = 3.0 rad/s and "
+        "zeta = 2.0 cut the 0.1 s step of the reference model (44) into RK4 sub-steps, which "
+        "the batch kernel does not")
+    for member, recording in zip(members, batch):
+        assert_same(recording, in_process(system, member, 20.0), str(member))
+
+
 def test_a_member_failing_its_initialisation_has_the_in_process_error():
     system = scenarios.load("waves_pd")
     members = [{"ship": {"wave_seed": 1}}, {"ship": {"Hs": 0.1, "T0": 0.3}},

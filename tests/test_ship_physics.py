@@ -242,9 +242,8 @@ def test_encounter_phase_follows_speed_and_heading():
     assert vessel.xi == pytest.approx(-vessel.x, rel=1e-6)
 
 
-@pytest.mark.parametrize("name, value", [
-    ("Hs", -0.1), ("T0", 0.0), ("wave_components", 0), ("delta_max", 0.0),
-    ("delta_rate_max", -1.0), ("u0", math.nan), ("h_max", 0.0),
+@pytest.mark.parametrize("name, value", [      # the FMU's ranges refuse the rest (test_ship_fmu)
+    ("delta_max", 0.0), ("delta_rate_max", -1.0), ("delta_max", math.nan),
 ])
 def test_invalid_parameters_are_refused_by_name(name, value):
     with pytest.raises(ValueError, match=name):

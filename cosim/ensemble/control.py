@@ -9,14 +9,13 @@ import numpy as np
 from autopilot_fmu.guidance import WaypointGuidance
 from autopilot_fmu.pd import PDAutopilot
 from autopilot_fmu.smc import SlidingModeAutopilot, reference_acceleration, reference_rk4
-from fmukit.numerics import substeps
 
 from .exact import hypot, tanh, wrap
 
 NEAR = 1e-12           # relative distance from the circle within which math.hypot decides
 
 
-def _columns(target: object, models: Sequence, names: tuple[str, ...], dtype=float) -> None:
+def columns(target: object, models: Sequence, names: tuple[str, ...], dtype=float) -> None:
     """Each attribute ``name`` of the models as an (M,) array (a leading _ dropped)."""
     for name in names:
         setattr(target, name.lstrip("_"), np.array([getattr(m, name) for m in models], dtype))
@@ -36,12 +35,11 @@ class GuidanceArrays:
         self.length = hypot(self.delta[..., 0], self.delta[..., 1])   # 0 past a route's end
         self.points = np.array([len(g.points) for g in guidances])
         self.R_accept = np.array([g.R_accept for g in guidances], dtype=float)
-        _columns(self, guidances, ("leg", "finished"), None)
+        columns(self, guidances, ("leg", "finished"), None)
         self.members = np.arange(count)
 
     def outputs(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(psi_d, wp_index) at (x, y), the leg switches committed: from the committed leg,
-        the next while the circle of acceptance is reached or the leg's end passed."""
+        """(psi_d, wp_index) at (x, y), the leg switches (``WaypointGuidance``) committed."""
         i, leg, finished = self.members, self.leg, self.finished.copy()
         moving = ~finished
         while moving.any():
@@ -71,7 +69,7 @@ class PDArrays:
     """``PDAutopilot.command``, eq (20): memoryless."""
 
     def __init__(self, pilots: Sequence[PDAutopilot]):
-        _columns(self, pilots, ("Kp", "Kd"))
+        columns(self, pilots, ("Kp", "Kd"))
 
     def command(self, psi: np.ndarray, r: np.ndarray, psi_d: np.ndarray) -> np.ndarray:
         return self.Kp * wrap(psi - psi_d) + self.Kd * r
@@ -84,7 +82,7 @@ class PIDArrays:
     """``PIDAutopilot`` (pid_autopilot_slave): eq (20) with conditional integration."""
 
     def __init__(self, pilots: Sequence):
-        _columns(self, pilots, ("Kp", "Ki", "Kd", "delta_max", "e_int", "z"))
+        columns(self, pilots, ("Kp", "Ki", "Kd", "delta_max", "e_int", "z"))
 
     def command(self, psi: np.ndarray, r: np.ndarray, psi_d: np.ndarray) -> np.ndarray:
         return self.Kp * wrap(psi - psi_d) + self.Ki * self.z + self.Kd * r
@@ -97,14 +95,14 @@ class PIDArrays:
 
 
 class SMCArrays:
-    """``SlidingModeAutopilot``: the law (37)-(43) and the reference model (44) by RK4."""
+    """``SlidingModeAutopilot``: the law (37)-(43) and the reference model (44) by RK4, of
+    members whose reference model takes the step whole."""
 
     def __init__(self, pilots: Sequence[SlidingModeAutopilot]):
         self.k1, self.k2 = (np.array([p.design.K[j] for p in pilots]) for j in (0, 1))
         self.h1, self.h2 = (np.array([p.design.h[j] for p in pilots]) for j in (0, 1))
         self.tracking = np.array([p.tracking for p in pilots])
-        _columns(self, pilots, ("eta_h", "phi_h", "omega_n", "zeta", "psi_z", "r_z", "_h_max"))
-        self.cuts: np.ndarray | None = None      # sub-steps of the reference model a step
+        columns(self, pilots, ("eta_h", "phi_h", "omega_n", "zeta", "psi_z", "r_z"))
 
     def command(self, psi: np.ndarray, r: np.ndarray, psi_d: np.ndarray) -> np.ndarray:
         error = wrap(self.psi_z - psi)
@@ -117,16 +115,8 @@ class SMCArrays:
 
     def step(self, t: float, h: float, psi: np.ndarray, r: np.ndarray,
              psi_d: np.ndarray) -> None:
-        if self.cuts is None:                # h is the batch's, the same at every step
-            self.cuts = np.array([substeps(h, bound, "of the reference model")
-                                  for bound in self.h_max])
-        hs = h / self.cuts
-        psi_z, r_z = self.psi_z, self.r_z
-        for j in range(int(self.cuts.max())):
-            stepped = reference_rk4(psi_d, psi_z, r_z, hs, self.omega_n, self.zeta, wrap)
-            active = j < self.cuts
-            psi_z, r_z = (np.where(active, new, old) for new, old in zip(stepped, (psi_z, r_z)))
-        self.psi_z, self.r_z = psi_z, r_z
+        self.psi_z, self.r_z = reference_rk4(psi_d, self.psi_z, self.r_z, h, self.omega_n,
+                                             self.zeta, wrap)
 
 
 KINDS = {"PDAutopilot": PDArrays, "PIDAutopilot": PIDArrays,   # by class name: the PID's

@@ -7,16 +7,8 @@ import math
 
 import numpy as np
 
-_hypot = np.frompyfunc(math.hypot, 2, 1)
-_tanh = np.frompyfunc(math.tanh, 1, 1)
-
-
-def hypot(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    return _hypot(x, y).astype(float)
-
-
-def tanh(x: np.ndarray) -> np.ndarray:
-    return _tanh(x).astype(float)
+hypot = np.vectorize(math.hypot, otypes=[float])
+tanh = np.vectorize(math.tanh, otypes=[float])
 
 
 def remainder(x: np.ndarray, y: float) -> np.ndarray:

@@ -1,6 +1,5 @@
-"""The scalar models stepped as the master steps them (Gauss-Seidel, guidance -> autopilot ->
-ship): the reference the batch kernel is pinned to, and what ``cosim.bench`` times as (a);
-which systems the kernel runs, each member initialised by the in-process master as a run."""
+"""The scalar models stepped as the master steps them (guidance -> autopilot -> ship): the
+batch kernel's reference and ``cosim.bench``'s (a); which systems the kernel runs."""
 from __future__ import annotations
 
 from dataclasses import dataclass

@@ -15,6 +15,7 @@ from autopilot_fmu.guidance import WaypointGuidance
 from autopilot_fmu.pd import PDAutopilot
 from autopilot_fmu.smc import SlidingModeAutopilot, SlidingModeDesign
 from fmukit.autopilot import INPUTS
+from fmukit.numerics import substeps
 from fmukit.timebase import communication_point
 from ship_fmu.vessel import N_PROPELLER, Vessel, VesselParameters
 
@@ -78,10 +79,14 @@ def _check(expired: str | None) -> None:
 def _outside(member: Member | None, h: float) -> str | None:
     if member is None:
         return "its initialisation failed"
-    ship = member.models["ship"]
+    ship, pilot = member.models["ship"], member.models["autopilot"]
     if ship._cut_of(h)[0] != 1:
         return (f"ship.h_max = {ship.params.h_max} s cuts the {h} s step into RK4 sub-steps, "
                 "which the batch kernel does not")
+    if isinstance(pilot, SlidingModeAutopilot) and substeps(h, pilot._h_max, "") != 1:
+        return (f"autopilot.omega_n = {pilot.omega_n} rad/s and zeta = {pilot.zeta} cut the {h} "
+                "s step of the reference model (44) into RK4 sub-steps, which the batch kernel "
+                "does not")
     return None
 
 

@@ -1,5 +1,5 @@
 """``Vessel.step`` for M members, states (M,) and wave components (M, N): the scalar model's
-rates, forces and RK4 update on arrays; its branches and wave loads rewritten op for op."""
+functions on arrays, its branches rewritten op for op."""
 from __future__ import annotations
 
 from operator import attrgetter
@@ -8,9 +8,10 @@ from typing import Sequence
 import numpy as np
 
 from ship_fmu.thrusters import actuator_model
-from ship_fmu.vessel import Vessel, axpy, calm_water, rk4_update, state_rates
+from ship_fmu.vessel import Vessel, calm_water, rk4_step, state_rates
 
 from . import exact
+from .control import columns
 
 Arrays = tuple[np.ndarray, ...]
 
@@ -82,10 +83,8 @@ class VesselArrays:
         self.vessel = vessels[0]                            # the hull and mass matrix of all
         self.forces = actuator_model(self.vessel.actuators, *shafts)
         self.waves = None if self.vessel.waves is None else WaveArrays(vessels)
-        for name in ("psi_w", "delta_max", "delta_rate_max"):
-            setattr(self, name, np.array([getattr(v.params, name) for v in vessels]))
-        for name in (*self.STATES, "delta"):
-            setattr(self, name, np.array([getattr(v, name) for v in vessels]))
+        columns(self, [v.params for v in vessels], ("psi_w", "delta_max", "delta_rate_max"))
+        columns(self, vessels, (*self.STATES, "delta"))
 
     def step(self, t: float, h: float, delta_c: np.ndarray) -> None:
         """``Vessel.step``: two RK4 steps for the members whose rudder kinks in the step."""
@@ -110,23 +109,11 @@ class VesselArrays:
 
     def _rk4(self, t: float, start: np.ndarray | float, hs: np.ndarray, y: Arrays,
              gear: RudderArrays, waves: WaveArrays | None, psi_w: np.ndarray) -> Arrays:
-        """One RK4 step of ``Vessel._integrate``, ``hs`` from ``t + start``, of the members of
-        ``waves``, ``psi_w`` and ``gear`` (all or some)."""
-        v, forces = self.vessel, self.forces
+        """``rk4_step`` of the members of ``waves``, ``psi_w`` and ``gear`` (all or some)."""
+        v = self.vessel
         loads, hypot = (waves, exact.hypot) if waves is not None else (calm_water, _no_travel)
 
         def rates(t: np.ndarray | float, state: Arrays, tau_th: Arrays) -> Arrays:
             return state_rates(v.hull, v._minv, v._m11_inv, loads, psi_w, t, state, tau_th,
                                hypot, np.cos, np.sin)
-        hh, c = 0.5 * hs, hs / 6.0
-        s = start + 0.0 * hs
-        ts = t + s
-        delta0, delta1, delta2 = gear(s), gear(s + hh), gear(s + hs)
-        tau0 = forces(delta0)
-        tau1 = tau0 if np.array_equal(delta1, delta0) else forces(delta1)
-        tau2 = tau1 if np.array_equal(delta2, delta1) else forces(delta2)
-        k1 = rates(ts, y, tau0)
-        k2 = rates(ts + hh, axpy(hh, k1, y), tau1)
-        k3 = rates(ts + hh, axpy(hh, k2, y), tau1)
-        k4 = rates(ts + hs, axpy(hs, k3, y), tau2)
-        return rk4_update(c, y, k1, k2, k3, k4)
+        return rk4_step(rates, self.forces, gear, t, start + 0.0 * hs, hs, y, np.array_equal)
