@@ -11,13 +11,14 @@ import sys
 import uuid
 from pathlib import Path
 
+from distributed import as_completed
 from fmukit.timebase import step_count
 from tqdm import tqdm
 
 from ..core.interrupt import Interrupted, StopSignals
 from ..core.watchdog import Limits
 from ..ensemble import SIGNALS
-from .cluster import Completions, NoWorkers, check_workers, say
+from .cluster import NoWorkers, check_workers, completed, say
 from .sweep_spec import Spec
 from .sweep_task import BATCH, Job, SweepTeardown, batch_refusal, blank_row, noted, run_batch
 
@@ -115,7 +116,7 @@ def run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, p
         # keyed by sweep (another sweep's release of a shared key would strand these runs).
         shipped = {sha: client.submit(bytes, fmu.read_bytes(), key=f"fmu-{token}-{sha}", pure=False)
                    for sha, fmu in spec.files().items()}
-        completions = Completions(client, no_worker_timeout)
+        completions = as_completed(loop=client.loop, with_results=True, raise_errors=False)
 
         def submit(jobs: list[Job], batch: bool, why: str = "") -> None:
             blobs = {sha: shipped[sha] for sha in jobs[0].bundle.fmu_hashes()}
@@ -137,14 +138,10 @@ def run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, p
             submit([job], False)
         with tqdm(total=len(todo), desc=spec.name, unit="run", file=sys.stderr,
                   disable=None if progress else True) as bar:   # None: only on a terminal
-            for future in completions:
+            for future, result in completed(client, completions, no_worker_timeout):
                 jobs, batch, why = tasks.pop(future)
-                try:
-                    result = completions.result(future)
-                except NoWorkers:
-                    raise
-                except Exception as error:      # the worker died on every retry
-                    died = f"{type(error).__name__}: {error}"
+                if future.status == "error":    # the worker died on every retry
+                    died = f"{type(result[1]).__name__}: {result[1]}"
                     if batch:                   # each run alone: only a run that kills fails
                         future.release()
                         for job in jobs:
