@@ -10,7 +10,6 @@ import sys
 from pathlib import Path
 
 from ._cli import entry, positive_seconds, say_error, say_note, writable_folder
-from .core.files import write_atomically
 from .core.interrupt import Interrupted
 from .core.watchdog import STEP_LIMIT_S, Limits
 from .studies import campaign
@@ -18,7 +17,7 @@ from .studies.cluster import CONNECT_TIMEOUT, NoWorkers, SweepError
 from .studies.sweep_client import MAX_BATCH, MIN_BATCH
 from .studies.sweep_spec import MAX_RUNS, Spec
 from .studies.sweep_task import BATCH, SWEEP_BACKENDS
-from .studies.sweep_tables import MONTE_CARLO, comparison, distinct, summary, write_tables
+from .studies.sweep_tables import distinct, summary, write_comparison, write_tables
 
 EXAMPLES = """\
   python -m cosim.sweep docs/sweeps/smc_vs_pd.toml             # local cluster, 1 worker/core
@@ -106,16 +105,7 @@ def main(argv: list[str] | None = None) -> int:
         else:
             print("no run succeeded: no figures drawn", file=sys.stderr)
         stage = "writing comparison.md"
-        if "pd" in spec.controllers and len(spec.controllers) > 1:
-            pairs = (f"paired by {MONTE_CARLO} (the same sea)" if MONTE_CARLO in spec.axes
-                     else "one run each")
-            table = (f"# {spec.name}: each controller against pd\n\nJ of eq (19) in rad^2, lower "
-                     f"is better; per setting, the median over its runs and, {pairs}, the runs "
-                     "where the controller's J is lower than pd's and the median of their "
-                     "ratio. A run shared by several combinations (every seed in calm water) "
-                     "counts once.\n\n" + comparison(spec, rows) + "\n")
-            written.append(write_atomically(out / "comparison.md",
-                                            lambda path: path.write_text(table)))
+        written += write_comparison(spec, rows, out)
     except (SweepError, ValueError, OSError) as error:  # OSError: the journal's folder, or
         say_error(error)                                # OutputError, which names its file
         if isinstance(error, OSError) and stage != "running the sweep":

@@ -20,7 +20,7 @@ from cosim.studies import campaign, sweep_task
 from cosim.studies.cluster import NoWorkers, SweepError
 from cosim.studies.merit import METRICS
 from cosim.studies.sweep_spec import Spec
-from cosim.studies.sweep_tables import comparison, write_tables
+from cosim.studies.sweep_tables import write_comparison, write_tables
 from helpers import command, reference_seconds
 
 EXAMPLE = Path(__file__).resolve().parent.parent / "docs" / "sweeps" / "example.toml"
@@ -191,7 +191,8 @@ def test_dask_sweep_writes_resumes_and_plots(fmu_paths, tmp_path, capsys, schedu
         table.column_names)
     from cosim.studies.sweep_figures import save_figures
     assert all(p.stat().st_size > 5000 for p in save_figures(spec, again, out))
-    header, rule, *settings = comparison(spec, again).splitlines()
+    (path,) = write_comparison(spec, again, out)
+    header, rule, *settings = path.read_text().split("\n\n")[-1].splitlines()
     assert "smc wins" in header and len(settings) == 1          # one setting, two seeds
     J = {(r["controller"], r["wave_seed"]): r["J"] for r in again}
     wins = sum(J[("smc", s)] < J[("pd", s)] for s in (1, 2))
