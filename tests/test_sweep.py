@@ -140,8 +140,6 @@ def test_an_in_process_sweep_notes_each_fmu_that_runs_through_fmi(c_autopilot, t
     assert spec.backend_notes("inprocess") == [
         "controller 'c': autopilot (pd_autopilot_c.fmu) runs through FMI, not in-process: it "
         "was not built with fmukit (it has no manifest)"]
-    with pytest.raises(ValueError, match="backend must be fmi, inprocess or batch, got 'null'"):
-        campaign.execute(spec, tmp_path, backend="null")
     # a row says how its components ran, not only what was asked
     spec = Spec.read(write_spec(tmp_path, f'stop_time = 5\n[controllers]\npd = "waves_pd"\n'
                                                 f'c = "{c_autopilot}"\n[axes]\nwave_seed = [1]\n'))

@@ -10,7 +10,7 @@ from ..core.watchdog import Limits
 from .cluster import CONNECT_TIMEOUT, SweepError, connect
 from .sweep_client import Journal, read_rows, run_on_cluster
 from .sweep_spec import Spec
-from .sweep_task import BATCH, SWEEP_BACKENDS, run_batch, run_one
+from .sweep_task import BATCH, run_batch, run_one
 
 NO_WORKER_TIMEOUT = 60.0        # s a sweep waits while its cluster has no worker
 
@@ -22,9 +22,6 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
             batch_size: int | None = None, batch_task=None) -> list[dict]:
     """Run every run of ``spec`` without an ok row in ``out``'s journal; every row. SweepError
     if a worker runs other code or another sweep writes ``out``; ClusterError for no cluster."""
-    if backend not in SWEEP_BACKENDS:
-        raise ValueError(f"backend must be {', '.join(SWEEP_BACKENDS[:-1])} or "
-                         f"{SWEEP_BACKENDS[-1]}, got {backend!r}")
     try:
         with FolderLock(out):
             journal = Journal(out / "runs.jsonl")

@@ -65,7 +65,8 @@ class Spec:
         return {sha: path for _, files, _ in self._shipped.values() for sha, path in files.items()}
 
     @cached_property
-    def _fmus(self) -> dict[tuple[str, str], tuple[Path, dict[str, Any], dict[str, Declaration]]]:
+    def fmus(self) -> dict[tuple[str, str], tuple[Path, dict[str, Any], dict[str, Declaration]]]:
+        """(controller, component): its FMU, its model variables and their declarations."""
         fmus = {}
         for controller, shipped in self.bundles().items():
             for name, component in shipped.system.components.items():
@@ -74,12 +75,6 @@ class Spec:
                 fmus[controller, name] = (fmu, {v.name: v for v in description.modelVariables},
                                           declarations(description))
         return fmus
-
-    def declared(self, controller: str, component: str
-                 ) -> tuple[Path | None, dict[str, Declaration]]:
-        """A component's FMU and its variables' declarations; (None, {}) for no component."""
-        fmu, _, variables = self._fmus.get((controller, component), (None, None, {}))
-        return fmu, variables
 
     def runs(self) -> list[dict[str, Any]]:
         """Every combination of controller and axis values, with its run id."""
@@ -108,7 +103,7 @@ class Spec:
     @cached_property
     def _ships(self) -> dict[str, dict[str, Any]]:       # our ship components: the Hs they have
         ships: dict[str, dict[str, Any]] = {controller: {} for controller in self.controllers}
-        for (controller, name), (fmu, variables, _) in self._fmus.items():
+        for (controller, name), (fmu, variables, _) in self.fmus.items():
             manifest = read_manifest(fmu)
             if (manifest is not None and manifest.slave_module == SHIP_SLAVE
                     and in_process_refusal(fmu) is None):
@@ -166,7 +161,7 @@ class Spec:
         for axis, values in self.axes.items():
             target, *others = assignments(axis, values[0])
             component, _, name = target.partition(".")
-            variable = self._fmus[controller, component][1][name]
+            variable = self.fmus[controller, component][1][name]
             declared = variable.declaredType.unit if variable.declaredType else ""
             units[axis] = "" if others else variable.unit or declared or ""
         return units
