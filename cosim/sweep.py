@@ -14,7 +14,6 @@ from .core.interrupt import Interrupted
 from .core.watchdog import STEP_LIMIT_S, Limits
 from .studies import campaign
 from .studies.cluster import CONNECT_TIMEOUT, NoWorkers, SweepError
-from .studies.sweep_client import MAX_BATCH, MIN_BATCH
 from .studies.sweep_spec import MAX_RUNS, Spec
 from .studies.sweep_task import BATCH, SWEEP_BACKENDS
 from .studies.sweep_tables import distinct, summary, write_comparison, write_tables
@@ -61,8 +60,8 @@ def main(argv: list[str] | None = None) -> int:
                         "stepped together as arrays; the same rows, bit for bit")
     parser.add_argument("--batch-size", type=count, metavar="N", help="with --backend batch: at "
                         f"most N runs a batch (default: as few as keep every worker busy, of at "
-                        f"most {MAX_BATCH} runs and, where there are as many, at least "
-                        f"{MIN_BATCH})")
+                        f"most {campaign.MAX_BATCH} runs and, where there are as many, at least "
+                        f"{campaign.MIN_BATCH})")
     parser.add_argument("--no-worker-timeout", type=positive_seconds, metavar="SECONDS",
                         default=campaign.NO_WORKER_TIMEOUT, help="stop, every row kept, when the "
                         f"cluster has had no worker this long (exit {NoWorkers.exit_status}; "

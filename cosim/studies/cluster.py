@@ -120,7 +120,7 @@ def connect(scheduler: str | None = None, workers: int | None = None,
                            f"{str(error)[:200]}") from None
 
 
-def completed(client, futures: as_completed, timeout: float) -> Iterator[tuple[Any, Any]]:
+def watched(client, futures: as_completed, timeout: float) -> Iterator[tuple[Any, Any]]:
     """``futures`` (``with_results``) as they complete, raising ``NoWorkers`` once the cluster
     has had no worker for ``timeout`` s (``as_completed``'s timeout is one deadline for all)."""
     interval = max(0.05, min(1.0, timeout / 4))         # Dask fails a shorter wait
