@@ -26,7 +26,7 @@ from cosim.core.ssd import write_ssd
 from cosim.studies import campaign, sweep_task
 from cosim.studies.merit import METRICS
 from cosim.studies.sweep_spec import Spec
-from cosim.studies.bundle import UnsafeCache, file_hash, fmu_cache
+from cosim.studies.sweep_task import UnsafeCache, file_hash, fmu_cache
 from cosim.studies.cluster import ClusterError, SweepError, connect, local_cluster, local_workers
 from fmubuild.instantiate import InstantiationFailed, instantiate_in_child
 from cosim import sweep as sweep_command

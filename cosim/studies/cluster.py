@@ -19,7 +19,7 @@ from dask.system import CPU_COUNT
 
 from ..core.files import read_small_text
 from ..provenance import PACKAGE, code_version
-from .bundle import UnsafeCache, fmu_cache
+from .sweep_task import UnsafeCache, fmu_cache
 
 CONNECT_TIMEOUT = 30.0          # s a client tries to reach a scheduler (Dask's default)
 
