@@ -46,8 +46,8 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
             todo = [group[0] for group in groups
                     if (_result(group, journal.rows) or {}).get("status") != "ok"]
             if len(todo) < len(groups):
-                print(f"{len(groups) - len(todo)} of {len(groups)} runs already done in "
-                      f"{journal.path}; {len(todo)} to run", file=sys.stderr, flush=True)
+                say(f"{len(groups) - len(todo)} of {len(groups)} runs already done in "
+                    f"{journal.path}; {len(todo)} to run")
             if todo:
                 run_on_cluster(spec, todo, journal,
                                connect(scheduler, workers, scheduler_file, connect_timeout),
