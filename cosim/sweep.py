@@ -10,15 +10,13 @@ import sys
 from pathlib import Path
 
 from ._cli import entry, positive_seconds, say_error, say_note, writable_folder
-from .core.files import write_atomically
 from .core.interrupt import Interrupted
 from .core.watchdog import STEP_LIMIT_S, Limits
 from .studies import campaign
 from .studies.cluster import CONNECT_TIMEOUT, NoWorkers, SweepError
-from .studies.sweep_client import MAX_BATCH, MIN_BATCH
 from .studies.sweep_spec import MAX_RUNS, Spec
 from .studies.sweep_task import BATCH, SWEEP_BACKENDS
-from .studies.sweep_tables import MONTE_CARLO, comparison, distinct, summary, write_tables
+from .studies.sweep_tables import distinct, summary, write_comparison, write_tables
 
 EXAMPLES = """\
   python -m cosim.sweep docs/sweeps/smc_vs_pd.toml             # local cluster, 1 worker/core
@@ -62,8 +60,8 @@ def main(argv: list[str] | None = None) -> int:
                         "stepped together as arrays; the same rows, bit for bit")
     parser.add_argument("--batch-size", type=count, metavar="N", help="with --backend batch: at "
                         f"most N runs a batch (default: as few as keep every worker busy, of at "
-                        f"most {MAX_BATCH} runs and, where there are as many, at least "
-                        f"{MIN_BATCH})")
+                        f"most {campaign.MAX_BATCH} runs and, where there are as many, at least "
+                        f"{campaign.MIN_BATCH})")
     parser.add_argument("--no-worker-timeout", type=positive_seconds, metavar="SECONDS",
                         default=campaign.NO_WORKER_TIMEOUT, help="stop, every row kept, when the "
                         f"cluster has had no worker this long (exit {NoWorkers.exit_status}; "
@@ -106,16 +104,7 @@ def main(argv: list[str] | None = None) -> int:
         else:
             print("no run succeeded: no figures drawn", file=sys.stderr)
         stage = "writing comparison.md"
-        if "pd" in spec.controllers and len(spec.controllers) > 1:
-            pairs = (f"paired by {MONTE_CARLO} (the same sea)" if MONTE_CARLO in spec.axes
-                     else "one run each")
-            table = (f"# {spec.name}: each controller against pd\n\nJ of eq (19) in rad^2, lower "
-                     f"is better; per setting, the median over its runs and, {pairs}, the runs "
-                     "where the controller's J is lower than pd's and the median of their "
-                     "ratio. A run shared by several combinations (every seed in calm water) "
-                     "counts once.\n\n" + comparison(spec, rows) + "\n")
-            written.append(write_atomically(out / "comparison.md",
-                                            lambda path: path.write_text(table)))
+        written += write_comparison(spec, rows, out)
     except (SweepError, ValueError, OSError) as error:  # OSError: the journal's folder, or
         say_error(error)                                # OutputError, which names its file
         if isinstance(error, OSError) and stage != "running the sweep":

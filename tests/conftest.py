@@ -110,7 +110,7 @@ def session_tmpdir(tmp_path_factory) -> Iterator[Path]:
 @pytest.fixture(scope="session", autouse=True)
 def fmu_cache(tmp_path_factory) -> Iterator[Path]:
     """The sweeps' workers keep the FMUs they are sent in the test session's own folder,
-    not the user's cache (``cosim.studies.bundle.fmu_cache``); set before any cluster
+    not the user's cache (``cosim.studies.sweep_task.fmu_cache``); set before any cluster
     starts, so that its workers inherit it."""
     folder = tmp_path_factory.mktemp("fmu_cache")
     folder.chmod(0o700)

@@ -17,7 +17,7 @@ import pytest
 
 import cosim
 from cosim.studies import campaign, sweep_task
-from cosim.studies.sweep_client import plan
+from cosim.studies.campaign import plan
 from cosim.studies.sweep_spec import Spec
 
 from helpers import fmu_variant
@@ -117,7 +117,7 @@ def test_a_sweep_resumes_on_the_other_backend(mixed, scheduler, tmp_path, first,
 def test_batch_sizes_keep_every_worker_busy_within_the_memory_of_their_recordings(tmp_path):
     from dataclasses import replace
 
-    from cosim.studies.sweep_client import BATCH_MEMORY, MAX_BATCH, batch_counts, batch_limit
+    from cosim.studies.campaign import BATCH_MEMORY, MAX_BATCH, batch_counts, batch_limit
 
     spec = Spec.read(write_spec(tmp_path, 'name = "b"\n[axes]\n'
                                       'wave_seed = { start = 1, count = 2 }\n'))

@@ -6,7 +6,6 @@ import importlib.util
 import json
 import logging
 import os
-import queue
 import signal
 import sys
 import time
@@ -15,12 +14,12 @@ from pathlib import Path
 from typing import Any, Iterator
 
 import dask
-from dask.distributed import Client, LocalCluster
+from dask.distributed import Client, LocalCluster, as_completed
 from dask.system import CPU_COUNT
 
 from ..core.files import read_small_text
 from ..provenance import PACKAGE, code_version
-from .bundle import UnsafeCache, fmu_cache
+from .sweep_task import UnsafeCache, fmu_cache
 
 CONNECT_TIMEOUT = 30.0          # s a client tries to reach a scheduler (Dask's default)
 
@@ -68,11 +67,10 @@ def local_cluster(workers: int | None = None) -> LocalCluster:
 
 
 def local_workers(workers: int | None) -> int | None:
-    """``workers`` (None: one per core) capped, with a note, at the cores this process has."""
-    if workers is None or (type(workers) is int and 1 <= workers <= CPU_COUNT):
+    """``workers`` (None: one per core; the commands refuse < 1) capped, with a note, at the
+    cores this process has."""
+    if workers is None or workers <= CPU_COUNT:
         return workers
-    if type(workers) is not int or workers < 1:     # a bool too
-        raise ClusterError(f"--workers {workers!r}: a local cluster needs at least one worker")
     print(f"note: --workers {workers}: this machine gives this process {CPU_COUNT} cores, and "
           f"a run holds one core from start to end; starting {CPU_COUNT} workers", file=sys.stderr)
     return CPU_COUNT
@@ -122,54 +120,30 @@ def connect(scheduler: str | None = None, workers: int | None = None,
                            f"{str(error)[:200]}") from None
 
 
-class Completions:
-    """Futures as they complete (more may be added), raising ``NoWorkers`` once the cluster has
-    had no worker for ``timeout`` s (Dask's ``as_completed`` has one deadline for all)."""
-
-    def __init__(self, client, timeout: float):
-        self.client, self.timeout = client, timeout
-        self.interval = max(0.05, min(1.0, timeout / 4))   # Dask fails a shorter wait
-        self.done: queue.SimpleQueue = queue.SimpleQueue()
-        self.waiting, self.seen, self.gone = 0, False, None  # gone: since when none counted
-        self.check()
-
-    def add(self, future) -> None:
-        self.waiting += 1
-        future.add_done_callback(self.done.put)
-
-    def __iter__(self) -> Iterator:
-        while self.waiting:
-            try:
-                future = self.done.get(timeout=self.interval)
-            except queue.Empty:
-                self.check()
-                continue
-            self.waiting -= 1
-            yield future
-
-    def result(self, future) -> Any:
-        """``future.result()``, checking the cluster while a lost result is computed again."""
-        while True:
-            try:
-                return future.result(timeout=self.interval)
-            except TimeoutError:
-                if future.status == "error":    # the task's own TimeoutError
-                    raise
-                self.check()
-
-    def check(self) -> None:
+def watched(client, futures: as_completed, timeout: float) -> Iterator[tuple[Any, Any]]:
+    """``futures`` (``with_results``) as they complete, raising ``NoWorkers`` once the cluster
+    has had no worker for ``timeout`` s (``as_completed``'s timeout is one deadline for all)."""
+    interval = max(0.05, min(1.0, timeout / 4))         # Dask fails a shorter wait
+    seen, gone = False, None                            # gone: since when none counted
+    while not futures.is_empty():
+        batch = futures.next_batch(block=False)
+        yield from batch
+        if batch:
+            continue
         try:
-            workers = len(self.client.nthreads())
+            workers = len(client.nthreads())
         except OSError:                     # the scheduler cannot be reached: no worker either
             workers = 0
         if workers:
-            self.seen, self.gone = True, None
-        elif self.gone is None:
-            self.gone = time.monotonic(), time.strftime("%Y-%m-%d %H:%M:%S")
-        elif time.monotonic() - self.gone[0] >= self.timeout:
-            since = "the last one left by" if self.seen else "none has joined since"
-            raise NoWorkers(f"no worker in the cluster for {self.timeout:g} s ({since} "
-                            f"{self.gone[1]}); the sweep stopped")
+            seen, gone = True, None
+        elif gone is None:
+            gone = time.monotonic(), time.strftime("%Y-%m-%d %H:%M:%S")
+        elif time.monotonic() - gone[0] >= timeout:
+            since = "the last one left by" if seen else "none has joined since"
+            raise NoWorkers(f"no worker in the cluster for {timeout:g} s ({since} "
+                            f"{gone[1]}); the sweep stopped")
+        with futures.thread_condition:      # woken as soon as one completes
+            futures.thread_condition.wait_for(futures.has_ready, timeout=interval)
 
 
 def say(message: str) -> None:

@@ -137,15 +137,15 @@ def check_values(spec, path: Path) -> None:
 
 def _declared(spec, controller: str, target: str):
     component, _, variable = target.partition(".")
-    return spec.declared(controller, component)[1].get(variable)
+    return spec.fmus.get((controller, component), (None, {}, {}))[2].get(variable)
 
 
 def _received(spec, path: Path, controller: str, target: str, value: Any, key: str) -> Any:
-    declaration = _declared(spec, controller, target)
     component, _, variable = target.partition(".")
+    fmu, _, variables = spec.fmus.get((controller, component), (None, {}, {}))
+    declaration = variables.get(variable)
     if getattr(declaration, "causality", "") != "parameter":
         where = f"{path}: {key} sets {target}, but in controller {controller!r}"
-        fmu, variables = spec.declared(controller, component)
         if fmu is None:
             raise ValueError(f"{where} there is no component {component!r} (there are "
                              f"{', '.join(spec.bundles()[controller].system.components)})")

@@ -2,6 +2,7 @@
 determines its result; combinations that differ only in what changes nothing run once."""
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import itertools
 import json
@@ -13,6 +14,7 @@ from typing import Any
 
 from fmukit.manifest import read as read_manifest
 
+from .. import scenarios
 from ..core.system import FmuNotFound, FmuUnreadable
 from ..core.fmi import read_description
 from ..core.inprocess import fallback_note, in_process_refusal
@@ -21,9 +23,8 @@ from ..core.values import Declaration, declarations
 from ..core.watchdog import Limits
 from ..ensemble.reference import coverage
 from ..provenance import code_version
-from .bundle import Bundle, bundle
 from .spec_file import MAX_RUNS, assignments, check_values, parse
-from .sweep_task import Job
+from .sweep_task import Bundle, Job, file_hash
 
 SHIP_SLAVE = "ship_fmu.ship_slave"        # this project's ship FMU (its manifest's module)
 # Our ship's parameters that change no bit of a run in calm water (Hs = 0: no wave loads)
@@ -54,7 +55,7 @@ class Spec:
 
     @cached_property
     def _shipped(self) -> dict[str, tuple[Bundle, dict[str, Path], SystemDescription]]:
-        return {name: bundle(controller) for name, controller in self.controllers.items()}
+        return {name: _bundle(controller) for name, controller in self.controllers.items()}
 
     def bundles(self) -> dict[str, Bundle]:
         """Each controller's system with its FMUs named by content."""
@@ -65,7 +66,8 @@ class Spec:
         return {sha: path for _, files, _ in self._shipped.values() for sha, path in files.items()}
 
     @cached_property
-    def _fmus(self) -> dict[tuple[str, str], tuple[Path, dict[str, Any], dict[str, Declaration]]]:
+    def fmus(self) -> dict[tuple[str, str], tuple[Path, dict[str, Any], dict[str, Declaration]]]:
+        """(controller, component): its FMU, its model variables and their declarations."""
         fmus = {}
         for controller, shipped in self.bundles().items():
             for name, component in shipped.system.components.items():
@@ -75,12 +77,6 @@ class Spec:
                                           declarations(description))
         return fmus
 
-    def declared(self, controller: str, component: str
-                 ) -> tuple[Path | None, dict[str, Declaration]]:
-        """A component's FMU and its variables' declarations; (None, {}) for no component."""
-        fmu, _, variables = self._fmus.get((controller, component), (None, None, {}))
-        return fmu, variables
-
     def runs(self) -> list[dict[str, Any]]:
         """Every combination of controller and axis values, with its run id."""
         runs = []
@@ -89,7 +85,7 @@ class Spec:
                 point = {"controller": controller, **dict(zip(self.axes, values))}
                 point["run_id"] = _digest({"system": shipped.digest,
                                            "settings": self.settings(point)[1],
-                                           "stop_time": self.stop_time, "point": point})
+                                           "stop_time": self.stop_time, "point": point})[:16]
                 runs.append(point)
         return runs
 
@@ -108,7 +104,7 @@ class Spec:
     @cached_property
     def _ships(self) -> dict[str, dict[str, Any]]:       # our ship components: the Hs they have
         ships: dict[str, dict[str, Any]] = {controller: {} for controller in self.controllers}
-        for (controller, name), (fmu, variables, _) in self._fmus.items():
+        for (controller, name), (fmu, variables, _) in self.fmus.items():
             manifest = read_manifest(fmu)
             if (manifest is not None and manifest.slave_module == SHIP_SLAVE
                     and in_process_refusal(fmu) is None):
@@ -166,7 +162,7 @@ class Spec:
         for axis, values in self.axes.items():
             target, *others = assignments(axis, values[0])
             component, _, name = target.partition(".")
-            variable = self._fmus[controller, component][1][name]
+            variable = self.fmus[controller, component][1][name]
             declared = variable.declaredType.unit if variable.declaredType else ""
             units[axis] = "" if others else variable.unit or declared or ""
         return units
@@ -212,13 +208,24 @@ class Spec:
         return controller["scenario"], overrides
 
 
-def _digest(identity: dict[str, Any]) -> str:
-    key = json.dumps(identity, sort_keys=True, default=str)
-    return hashlib.sha256(key.encode()).hexdigest()[:16]
-
-
 def _exact(value: Any) -> str:
     """A setting as ``--set`` text that reads back as exactly the value."""
     if isinstance(value, bool):
         return "true" if value else "false"
     return repr(value) if isinstance(value, float) else str(value)
+
+
+def _bundle(controller: dict[str, Any]) -> tuple[Bundle, dict[str, Path], SystemDescription]:
+    """A sweep controller's bundle, its FMUs' files by hash, and its system as loaded here."""
+    system = scenarios.load(controller["scenario"], controller["autopilot"], controller["map"])
+    hashes = {name: file_hash(system.fmu_path(name)) for name in system.components}
+    files = {sha: system.fmu_path(name) for name, sha in hashes.items()}
+    components = {name: dataclasses.replace(component, source=f"{hashes[name]}.fmu")
+                  for name, component in system.components.items()}
+    shipped = dataclasses.replace(system, components=components, path=None, fmus=None)
+    return Bundle(shipped, _digest(dataclasses.asdict(shipped))), files, system
+
+
+def _digest(identity: Any) -> str:
+    """The SHA-256 of ``identity`` as JSON, keys sorted (what is not JSON: its str)."""
+    return hashlib.sha256(json.dumps(identity, sort_keys=True, default=str).encode()).hexdigest()

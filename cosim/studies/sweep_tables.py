@@ -132,15 +132,24 @@ def summary(spec: Spec, rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
-def comparison(spec: Spec, rows: list[dict]) -> str:
-    """Markdown table: per setting, each controller's median J, wins and J ratio to the PD."""
+def write_comparison(spec: Spec, rows: list[dict], out: Path) -> list[Path]:
+    """comparison.md (where there are pd and others): per setting, each controller's median J,
+    wins and J ratio to the PD; its path."""
+    if "pd" not in spec.controllers or len(spec.controllers) == 1:
+        return []
     others = [c for c in spec.controllers if c != "pd"]
     axes, settings = _settings(spec)
     ok = {(r["controller"], *(json.dumps(r[a]) for a in spec.axes)): r
           for r in rows if r["status"] == "ok"}
     header = [*axes, "J pd median", *(f"J {c} median" for c in others),
               *(f"{c} wins" for c in others), *(f"J {c} / J pd median" for c in others)]
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    pairs = (f"paired by {MONTE_CARLO} (the same sea)" if MONTE_CARLO in spec.axes
+             else "one run each")
+    lines = [f"# {spec.name}: each controller against pd\n\nJ of eq (19) in rad^2, lower is "
+             f"better; per setting, the median over its runs and, {pairs}, the runs where the "
+             "controller's J is lower than pd's and the median of their ratio. A run shared by "
+             "several combinations (every seed in calm water) counts once.\n",
+             "| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     for where in settings:
         runs = {controller: [ok.get((controller, *(json.dumps(where.get(a, seed))
                                                    for a in spec.axes)))
@@ -158,7 +167,8 @@ def comparison(spec: Spec, rows: list[dict]) -> str:
             defined = [J_c / J_b for J_c, J_b in pairs if J_b > 1e-9]
             ratios.append(f"{np.median(defined):.2f}" if defined else "-")
         lines.append("| " + " | ".join(cells + wins + ratios) + " |")
-    return "\n".join(lines)
+    table = "\n".join(lines) + "\n"
+    return [write_atomically(out / "comparison.md", lambda path: path.write_text(table))]
 
 
 def _median_J(found: list[dict | None]) -> str:

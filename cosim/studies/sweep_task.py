@@ -1,25 +1,93 @@
 """A sweep's tasks on a worker: one co-simulation (``run_one``) or a batch of one system's runs
-(``run_batch``), the same row either way; masters kept per sweep, thread, system and backend."""
+(``run_batch``), the same row either way; masters kept per sweep, thread, system and backend;
+the FMUs sent by SHA-256, kept in the worker's private cache (``fmu_cache``), checked when used."""
 from __future__ import annotations
 
 import contextlib
+import dataclasses
+import hashlib
 import math
+import os
+import stat
+import sys
 import threading
 import time
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 from distributed import WorkerPlugin
 
 from .. import ensemble
+from ..core.files import write_atomically
 from ..core.master import BACKENDS, Master
+from ..core.ssd import SystemDescription
 from ..core.watchdog import Limits, TimeLimit, Watchdog
 from ..provenance import code_version
-from .bundle import Bundle, materialise
 from .merit import METRICS, run_metrics, track
 
 BATCH = "batch"                         # the sweep backend of ``run_batch``
 SWEEP_BACKENDS = (*BACKENDS, BATCH)
+
+
+class UnsafeCache(RuntimeError):
+    """The FMU cache is not private: whoever else may write it could change the FMUs run."""
+
+
+@dataclass(frozen=True)
+class Bundle:
+    """A controller's system as a worker rebuilds it."""
+    system: SystemDescription          # component sources: "<sha256>.fmu"
+    digest: str                        # SHA-256 of the system and its FMUs' contents
+
+    def fmu_hashes(self) -> set[str]:
+        return {Path(c.source).stem for c in self.system.components.values()}
+
+
+def file_hash(path: Path) -> str:
+    with open(path, "rb") as f:
+        return hashlib.file_digest(f, "sha256").hexdigest()
+
+
+def fmu_cache() -> Path:
+    """Where a worker keeps the FMUs it was sent: $COSIM_FMU_CACHE, else cosim-fmus in
+    $XDG_CACHE_HOME or ~/.cache, made 0o700; UnsafeCache unless only this user may write it."""
+    folder = Path(os.environ.get("COSIM_FMU_CACHE")
+                  or Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
+                  / "cosim-fmus")
+    folder.mkdir(mode=0o700, parents=True, exist_ok=True)
+    facts = os.lstat(folder)
+    if not stat.S_ISDIR(facts.st_mode):
+        raise UnsafeCache(f"the FMU cache {folder} is not a folder (a symbolic link?); remove "
+                          "it, or set COSIM_FMU_CACHE to a folder of your own")
+    if facts.st_uid != os.getuid() or facts.st_mode & 0o022:
+        whose = (f"belongs to another user (uid {facts.st_uid})" if facts.st_uid != os.getuid()
+                 else f"may be written by others (mode {stat.filemode(facts.st_mode)})")
+        raise UnsafeCache(f"the FMU cache {folder} {whose}, who could change the FMUs run "
+                          "from it; use a folder only you may write (chmod go-w, or set "
+                          "COSIM_FMU_CACHE)")
+    return folder
+
+
+def materialise(shipped: Bundle, blobs: dict[str, bytes]) -> SystemDescription:
+    """The bundle's system, its FMUs in this machine's cache (a corrupt one written again)."""
+    cache = fmu_cache()
+    components = {}
+    for name, component in shipped.system.components.items():
+        sha = Path(component.source).stem
+        target = cache / f"{sha}.fmu"
+        corrupt = target.exists() and file_hash(target) != sha
+        if corrupt:
+            print(f"warning: the FMU cache's {target} does not match its hash (a corrupt or "
+                  "changed file); written again from the FMU sent", file=sys.stderr)
+        if corrupt or not target.exists():
+            data = blobs[sha]
+            if hashlib.sha256(data).hexdigest() != sha:
+                raise ValueError(f"the FMU sent for component '{name}' does not match its "
+                                 f"hash {sha[:12]}")
+            write_atomically(target, lambda path: path.write_bytes(data))  # noqa: B023
+        components[name] = dataclasses.replace(component, source=str(target))
+    return dataclasses.replace(shipped.system, components=components)
 
 
 @dataclass(frozen=True)

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .spec_file import controller_entry
-from .sweep_client import plan
+from .campaign import plan
 from .sweep_spec import Spec
 from .sweep_task import BATCH, SWEEP_BACKENDS
 from .timing import in_fresh_process, load, machine, peak_rss_mb, require
