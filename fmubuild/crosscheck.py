@@ -61,11 +61,6 @@ def files(name: str, fmi: int = 2) -> dict[str, Path]:
             "ref": folder / f"{name}_ref.csv", "opt": folder / f"{name}_ref.opt"}
 
 
-def read_opt(path: Path) -> dict[str, float]:
-    pairs = (line.split(",", 1) for line in path.read_text().splitlines() if "," in line)
-    return {key.strip(): float(value) for key, value in pairs}
-
-
 def generate(name: str, fmi: int = 2) -> Path:
     """The cross-check folder of ``FMU_DIRS[fmi]/<name>.fmu``, written again whole."""
     case, paths = CASES[name], files(name, fmi)
