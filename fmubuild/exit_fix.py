@@ -15,12 +15,12 @@ def patch(binary: bytes, where: str, fmi: int = 2) -> bytes:
     """The binary with ``onLibraryUnload`` made a no-op; RuntimeError naming ``where`` if
     fmukit does not know it."""
     route, digest = ROUTES[fmi], hashlib.sha256(binary).hexdigest()
-    fix = importlib.import_module(f"{route.adapter}.binary").KNOWN_BINARIES.get(digest)
+    fix = importlib.import_module(route.adapter).KNOWN_BINARIES.get(digest)
     if fix is None:
         raise RuntimeError(f"{where} is not the {route.pythonfmu} {route.known} {route.linux} "
                            f"binary whose exit-time heap corruption fmubuild.exit_fix knows how "
                            f"to fix (SHA-256 {digest}); check the new binary and extend "
-                           f"{route.adapter}.binary")
+                           f"{route.adapter}")
     end = fix.offset + len(fix.code)
     fixed = binary[:fix.offset] + fix.patched + binary[end:]
     if binary[fix.offset:end] != fix.code or hashlib.sha256(fixed).hexdigest() != fix.fixed_sha256:

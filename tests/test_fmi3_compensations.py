@@ -31,7 +31,7 @@ from fmubuild.packaging import build_script
 from fmubuild.project import FMUS, ROOT
 from fmubuild.instantiate import InstantiationFailed, instantiate_in_child
 from fmukit.compose import fmu_class
-from fmukit.pythonfmu3_03.binary import KNOWN_BINARIES
+from fmukit.pythonfmu3_03 import KNOWN_BINARIES
 from fmukit.pythonfmu3_03.slave import Fmi3Entry
 from fmukit.slave import DefaultExperiment, ModelSlave, Var
 
