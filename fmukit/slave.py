@@ -4,11 +4,12 @@ that ignores statuses cannot pass the run off as results (docs/robustness.md).
 """
 from __future__ import annotations
 
+import json
 import signal
 from dataclasses import dataclass
 from typing import Any, Callable, ClassVar, NoReturn
 
-from . import hostsignals, state
+from . import hostsignals
 from .entry import HostLog, fmi_entry
 from .refusals import CAUSES, Refused, explain, naming
 from .registry import Registry
@@ -104,8 +105,7 @@ class ModelSlave:
         raise NotImplementedError
 
     def start_model(self, model: Any) -> None:
-        """Set a model's initial state from the inputs (apart from build_model: restoring a
-        state must not depend on them)."""
+        """Set a model's initial state from the inputs (a restored state does not use them)."""
 
     def _started_model(self) -> Any:
         model = self.build_model()
@@ -249,10 +249,35 @@ class ModelSlave:
 
     @fmi_entry
     def _get_fmu_state(self) -> dict[str, Any]:
-        return state.capture(self)
+        """The whole state, which pythonfmu serialises as JSON; the model's: its ``snapshot()``."""
+        return {"phase": self.sequence.phase,
+                "values": {v.name: getattr(self, v.name) for v in self.vars.values()
+                           if v.causality.name != "output"},
+                "model": self._model.snapshot() if self._model is not None else None,
+                "failure": self.failure, "failure_cause": self.failure_cause}
 
     @fmi_entry
     def _set_fmu_state(self, saved: dict[str, Any]) -> None:
-        state.restore(self, saved)
+        """Back to a saved state: the model rebuilt and handed its snapshot (bit for bit)."""
+        if "invalid" in saved:
+            raise ValueError(f"cannot restore FMU state: {saved['invalid']}")
+        for name, value in saved["values"].items():
+            setattr(self, name, value)
+        self.sequence.phase = saved["phase"]
+        self.failure, self.failure_cause = saved.get("failure"), saved.get("failure_cause", "model")
+        self._model = None
+        if saved["model"] is not None:
+            self._model = self.build_model()
+            self._model.restore(saved["model"])
 
-    _fmu_state_from_bytes = staticmethod(state.decode)
+    @staticmethod
+    def _fmu_state_from_bytes(data: bytes) -> dict[str, Any]:
+        """A serialised state, or ``{"invalid": why}`` for ``_set_fmu_state`` to refuse
+        (pythonfmu calls this on the class, where an exception cannot be made safe)."""
+        try:
+            decoded = json.loads(data.decode("utf-8"))
+            if not {"phase", "values", "model"} <= set(decoded):
+                raise ValueError("not a state of this FMU")
+            return decoded
+        except (ValueError, UnicodeDecodeError, TypeError) as error:
+            return {"invalid": f"serialized state unreadable ({error})"}
