@@ -1,6 +1,5 @@
 """FMUs written in C, compiled reproducibly with the system compiler and, where mingw-w64 is
-installed, for 64-bit Windows; zipped with their sources and validated.
-"""
+installed, for 64-bit Windows; zipped with their sources and validated."""
 from __future__ import annotations
 
 import os

@@ -2,8 +2,7 @@
 simulated by fmpy; regenerate them, saying why in the commit, only when results change.
 
     python -m fmubuild.crosscheck            # both versions: fmus/crosscheck/2.0/..., 3.0/...
-    python -m fmubuild.crosscheck --fmi 3    # only the FMI 3.0 twins (fmus/fmi3/)
-"""
+    python -m fmubuild.crosscheck --fmi 3    # only the FMI 3.0 twins (fmus/fmi3/)"""
 from __future__ import annotations
 
 import argparse

@@ -1,6 +1,5 @@
 """What an FMU says of itself, derived from its entries alone (the same sources, the same
-bytes): generation tool and identity in its model description, its page and its icon.
-"""
+bytes): generation tool and identity in its model description, its page and its icon."""
 from __future__ import annotations
 
 import html

@@ -1,8 +1,7 @@
 """A fix for pythonfmu's Linux binaries: their static destructor frees the global
 ``shared_ptr<PyState>`` at exit, then ``onLibraryUnload`` assigns to the dead pointer (an
 intermittent SIGABRT of every host). The destructor already shuts Python down, so
-``onLibraryUnload`` becomes a plain return, in a binary the adapter knows by SHA-256.
-"""
+``onLibraryUnload`` becomes a plain return, in a binary the adapter knows by SHA-256."""
 from __future__ import annotations
 
 import hashlib

@@ -1,6 +1,5 @@
 """A slave script built into an FMU that carries exactly its model (the script, what it
-imports of fmukit and this project, the ``--include``s), reproducibly.
-"""
+imports of fmukit and this project, the ``--include``s), reproducibly."""
 from __future__ import annotations
 
 import ast

@@ -1,6 +1,5 @@
 """The FMI versions fmubuild builds, each by the one pythonfmu version its adapter knows, and
-the entry module written into each FMU: the slave class composed as ``fmukit.compose`` does.
-"""
+the entry module written into each FMU: the slave class composed as ``fmukit.compose`` does."""
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass

@@ -1,7 +1,6 @@
 """What an FMU built with fmukit carries about itself (no time, path or machine: the same
 sources, the same manifest), and whether it is current here. Format 1 (before FMI 3.0) is
-read so that ``staleness`` can say to rebuild.
-"""
+read so that ``staleness`` can say to rebuild."""
 from __future__ import annotations
 
 import hashlib

@@ -1,6 +1,5 @@
 """Numerical rules every model here follows: finite inputs, bounded sub-stepping (a huge
-step is refused instead of hanging the host), angle differences wrapped the short way round.
-"""
+step is refused instead of hanging the host), angle differences wrapped the short way round."""
 from __future__ import annotations
 
 import math

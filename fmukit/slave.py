@@ -1,7 +1,6 @@
 """``ModelSlave``: the base of every FMU here (FMI 2.0 and 3.0) and its FMI call sequence.
 A failed FMU reads NaN and refuses every step with the first reason until reset, so a host
-that ignores statuses cannot pass the run off as results (docs/robustness.md).
-"""
+that ignores statuses cannot pass the run off as results (docs/robustness.md)."""
 from __future__ import annotations
 
 import json

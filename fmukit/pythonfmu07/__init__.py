@@ -2,8 +2,7 @@
 references released once per exception (``fmukit.entry``) and the entry module's namespace
 once per instantiation (``slave.hold_namespace``), log messages forwarded only under debug
 logging (``fmukit.entry.HostLog``), a heap corrupted at exit (``KNOWN_BINARIES``), units,
-ranges and dependencies left out of modelDescription.xml (``slave``).
-"""
+ranges and dependencies left out of modelDescription.xml (``slave``)."""
 from pythonfmu import __version__ as PYTHONFMU_VERSION
 
 from ..entry import Binary

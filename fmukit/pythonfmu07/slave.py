@@ -1,6 +1,5 @@
 """``Fmi2Entry``: the mixin that makes a ``ModelSlave`` an FMI 2.0 FMU of pythonfmu 0.7.
-Every refusal is an exception: fmi2Fatal (pythonfmu 0.7's fmi2Discard would pass for an end).
-"""
+Every refusal is an exception: fmi2Fatal (pythonfmu 0.7's fmi2Discard would pass for an end)."""
 from __future__ import annotations
 
 import ctypes

@@ -2,8 +2,7 @@
 references released once per exception (``fmukit.entry``), every exception fmi3Fatal
 (``Fmi3Entry.do_step`` returns fmi3Error), log messages forwarded whatever ``loggingOn``
 (``Fmi3Entry.log``), a double free at exit (``KNOWN_BINARIES``), units, ranges, exact starts,
-dependencies and the instance-only description, author, default experiment (``slave``).
-"""
+dependencies and the instance-only description, author, default experiment (``slave``)."""
 from pythonfmu3 import __version__ as PYTHONFMU_VERSION
 
 from ..entry import Binary

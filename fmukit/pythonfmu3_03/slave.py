@@ -1,6 +1,5 @@
 """``Fmi3Entry``: the mixin that makes a ``ModelSlave`` an FMI 3.0 FMU of pythonfmu3 0.3.4,
-with the independent variable ``time``.
-"""
+with the independent variable ``time``."""
 from __future__ import annotations
 
 from typing import Any, Callable
