@@ -13,8 +13,7 @@ from fmukit.manifest import version
 
 from . import documentation
 from .packaging import write_fmu
-from .project import C_FMUS, FMU_DIRS, ROOT, project_identity
-from .routes import ROUTES
+from .project import C_FMUS, FMU_DIRS, ROOT, ROUTES, project_identity
 
 WINDOWS = {2: "win64", 3: "x86_64-windows"}                # FMI version: the platform folder
 C_HOSTS = {fmi: {ROUTES[fmi].linux: f"any FMI {fmi}.0 co-simulation host; the library needs "

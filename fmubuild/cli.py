@@ -19,8 +19,7 @@ from pathlib import Path
 
 from .cbuild import NoCompiler, build_c
 from .packaging import build, build_script, imports
-from .project import C_FMUS, FMU_DIRS, FMUS, ROOT
-from .routes import ROUTES
+from .project import C_FMUS, FMU_DIRS, FMUS, ROOT, ROUTES
 
 
 def main(argv: list[str] | None = None) -> int:

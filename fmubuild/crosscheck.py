@@ -16,8 +16,7 @@ from pathlib import Path
 
 from cosim.core.files import fresh_folder
 
-from .project import FMU_DIR, FMU_DIRS
-from .routes import ROUTES
+from .project import FMU_DIR, FMU_DIRS, ROUTES
 
 TOOL, VERSION = "ship_autopilot_cosim", "0.1.0"
 CROSSCHECK_DIRS = {fmi: FMU_DIR / "crosscheck" / f"{fmi}.0" / "cs" / route.linux / TOOL / VERSION

@@ -7,7 +7,7 @@ from __future__ import annotations
 import hashlib
 import importlib
 
-from .routes import ROUTES
+from .project import ROUTES
 
 
 def patch(binary: bytes, where: str, fmi: int = 2) -> bytes:

@@ -22,8 +22,7 @@ from fmukit.manifest import Manifest, digest_of, sha256, version
 
 from . import documentation, exit_fix
 from .instantiate import InstantiationFailed, instantiate_in_child
-from .project import FMU_DIRS, FMUS, ROOT, project_identity
-from .routes import ROUTES
+from .project import FMU_DIRS, FMUS, ROOT, ROUTES, project_identity
 
 PROJECT_PACKAGES = ("fmukit", "ship_fmu", "autopilot_fmu")
 _IMPORT_ERRORS = {"ImportError", "ModuleNotFoundError", "Exception", "BaseException"}

@@ -89,5 +89,5 @@ def staleness(manifest: Manifest,
     if entry_source is not None and manifest.entry and hashlib.sha256(
             entry_source(manifest).encode()).hexdigest() != manifest.entry["sha256"]:
         return (f"its entry module {manifest.entry['module']} is not the one this build writes "
-                "(built before a change of fmubuild.routes: rebuild it)")
+                "(built before a change of fmubuild.project: rebuild it)")
     return None
