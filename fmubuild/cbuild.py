@@ -57,8 +57,7 @@ def sources(name: str, fmi: int = 2) -> list[Path]:
 
 
 def build_c(name: str, dest: Path | None = None, fmi: int = 2) -> Path:
-    """The C FMU ``name`` built as FMI ``fmi`` into dest/name.fmu (default: ``FMU_DIRS``);
-    NoCompiler without a compiler."""
+    """The C FMU ``name`` as FMI ``fmi`` in dest/name.fmu; NoCompiler without a compiler."""
     import fmpy
     if (compiler := c_compiler()) is None:
         raise NoCompiler(f"no C compiler found (set CC, or install gcc): {name}.fmu, an "

@@ -11,8 +11,7 @@ from .project import ROUTES
 
 
 def patch(binary: bytes, where: str, fmi: int = 2) -> bytes:
-    """The binary with ``onLibraryUnload`` made a no-op; RuntimeError naming ``where`` if
-    fmukit does not know it."""
+    """The binary, ``onLibraryUnload`` a no-op; RuntimeError naming ``where`` if unknown."""
     route, digest = ROUTES[fmi], hashlib.sha256(binary).hexdigest()
     fix = importlib.import_module(route.adapter).KNOWN_BINARIES.get(digest)
     if fix is None:

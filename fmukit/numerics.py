@@ -23,8 +23,7 @@ def require_finite(**values: float) -> None:
 
 
 def substeps(h: float, h_max: float, what: str) -> int:
-    """Equal integration steps that cut a communication step h into pieces <= h_max;
-    ``what`` names them in the error."""
+    """Equal integration steps that cut a communication step h into pieces <= h_max."""
     n = max(1, math.ceil(h / h_max - 1e-9))
     if n > MAX_SUBSTEPS:
         raise ValueError(f"a communication step of {h} s needs {n} RK4 steps {what}; "

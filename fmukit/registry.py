@@ -1,7 +1,5 @@
-"""A slave's variables by value reference, registered with pythonfmu, and plans reading or
-setting a list of them, made once per list (a master asks for the same lists at every step).
-A plan gives what the FMI call gives in every state of the slave, so a host in this process
-may call it; a list no plan serves gets ``None`` (pythonfmu serves it)."""
+"""A slave's variables by value reference, and plans reading or setting a list of them, made
+once per list; a plan gives what the FMI call gives, so a host in this process may call it."""
 from __future__ import annotations
 
 import functools

@@ -150,8 +150,7 @@ class ModelSlave:
         raise Refused(reason, cause) from error
 
     def interrupted(self, where: str, error: BaseException) -> Refused:
-        """The refusal to raise for a BaseException (Ctrl-C, one with a ``signal``) raised
-        in the FMU's code during ``where``; it fails the FMU."""
+        """Fail the FMU for a BaseException (Ctrl-C, a ``signal``) in ``where``: its Refused."""
         number = getattr(error, "signal",
                          signal.SIGINT if isinstance(error, KeyboardInterrupt) else None)
         if not self.failure:
