@@ -53,7 +53,7 @@ class Binary:
     """A pythonfmu binary fmukit knows inside out."""
     offset: int                 # file offset of onLibraryUnload
     code: bytes                 # its first instructions
-    patched: bytes              # what they become (fmubuild.exit_fix)
+    patched: bytes              # what they become (fmubuild.packaging.fix_exit)
     fixed_sha256: str           # the binary once patched
     logger_offset: int          # where the host's logging flag is, from the logger
     through_pointer: bool = False   # there is a pointer to the flag instead

@@ -260,7 +260,7 @@ def test_without_the_exit_fix_the_same_host_aborts(fmu_paths, exit_heap_host, tm
 
 
 def test_the_exit_fix_refuses_a_binary_it_does_not_know():
-    from fmubuild.exit_fix import patch
+    from fmubuild.packaging import fix_exit
 
     with pytest.raises(RuntimeError, match="ship.so is not the pythonfmu 0.7.0 linux64 binary"):
-        patch(b"\x7fELF something else", "ship.fmu:binaries/linux64/ship.so")
+        fix_exit(b"\x7fELF something else", "ship.fmu:binaries/linux64/ship.so")

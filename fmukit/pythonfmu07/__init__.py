@@ -8,7 +8,7 @@ from pythonfmu import __version__ as PYTHONFMU_VERSION
 from ..entry import Binary
 
 ACTIVE = PYTHONFMU_VERSION == "0.7.0"         # the version whose defects these are
-# Its linux64 binary, where fmubuild.exit_fix patches it (another binary's host is taken not
+# Its linux64 binary, where fmubuild fixes its exit (another binary's host is taken not
 # to hear): endbr64; jmp finalizePythonInterpreter  ->  endbr64; ret. PyLogger::log tests
 # ``cmpb $0x0, 0x8(%rdi)``: the debug-logging flag sits 8 bytes into the logger.
 KNOWN_BINARIES = {

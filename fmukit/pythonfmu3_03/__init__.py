@@ -8,7 +8,7 @@ from pythonfmu3 import __version__ as PYTHONFMU_VERSION
 from ..entry import Binary
 
 ACTIVE = PYTHONFMU_VERSION == "0.3.4"         # the version whose defects these are
-# Its x86_64-linux binary, where fmubuild.exit_fix patches it; its logger keeps the host's
+# Its x86_64-linux binary, where fmubuild fixes its exit; its logger keeps the host's
 # logging flag, which it never reads (another's host hears all).
 # jmp finalizePythonInterpreter@plt  ->  ret. cppfmu::Logger holds its environment, its
 # callback and a shared_ptr<Settings>, whose pointer is 16 bytes into the logger;
