@@ -20,15 +20,11 @@ _ENTRY_FILE = os.path.join(os.path.dirname(__file__), "entry.py")  # fmi_entry's
 _pending: set[signal.Signals] = set()   # arrived while FMU code ran; not yet handled
 
 
-def _in_fmu_code(frame: FrameType | None) -> bool:
-    return frame is not None and any(f.f_code.co_name == "entry" and f.f_code.co_filename
-                                     == _ENTRY_FILE for f, _ in traceback.walk_stack(frame))
-
-
 def _deferring(host_handler: Callable) -> Callable:
     """The host's handler, run only outside FMU code."""
     def deferring_handler(number: int, frame: FrameType | None) -> object:
-        if _in_fmu_code(frame):
+        if frame is not None and any(f.f_code.co_name == "entry" and f.f_code.co_filename
+                                     == _ENTRY_FILE for f, _ in traceback.walk_stack(frame)):
             first = not _pending
             _pending.add(signal.Signals(number))
             if first:

@@ -69,12 +69,8 @@ class ModelSlave:
     model_name: ClassVar[str]
     variables: ClassVar[tuple[Var, ...]]
     default_experiment = DefaultExperiment(start_time=0.0, stop_time=400.0, step_size=0.1)
-    # The adapter's, with ``KNOWN_BINARIES``, ``HEARS_UNKNOWN`` (does the host of another
-    # binary hear?) and ``fmi_variable(var, output_getter)``:
-    API: ClassVar[str]
-    STATUS_ERROR: ClassVar[Any]
-    STATUS_FATAL: ClassVar[Any]
-    RELEASES_ON_EXCEPTION: ClassVar[bool]
+    # The adapter gives API, STATUS_ERROR, STATUS_FATAL, RELEASES_ON_EXCEPTION, KNOWN_BINARIES,
+    # HEARS_UNKNOWN (does the host of another binary hear?) and fmi_variable(var, getter).
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)            # pythonfmu's slave, next in the FMU class's MRO
