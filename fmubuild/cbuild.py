@@ -1,6 +1,5 @@
 """FMUs written in C, compiled reproducibly with the system compiler and, where mingw-w64 is
-installed, for 64-bit Windows; zipped with their sources and validated.
-"""
+installed, for 64-bit Windows; zipped with their sources and validated."""
 from __future__ import annotations
 
 import os
@@ -14,8 +13,7 @@ from fmukit.manifest import version
 
 from . import documentation
 from .packaging import write_fmu
-from .project import C_FMUS, FMU_DIRS, ROOT, project_identity
-from .routes import ROUTES
+from .project import C_FMUS, FMU_DIRS, ROOT, ROUTES, project_identity
 
 WINDOWS = {2: "win64", 3: "x86_64-windows"}                # FMI version: the platform folder
 C_HOSTS = {fmi: {ROUTES[fmi].linux: f"any FMI {fmi}.0 co-simulation host; the library needs "
@@ -59,8 +57,7 @@ def sources(name: str, fmi: int = 2) -> list[Path]:
 
 
 def build_c(name: str, dest: Path | None = None, fmi: int = 2) -> Path:
-    """The C FMU ``name`` built as FMI ``fmi`` into dest/name.fmu (default: ``FMU_DIRS``);
-    NoCompiler without a compiler."""
+    """The C FMU ``name`` as FMI ``fmi`` in dest/name.fmu; NoCompiler without a compiler."""
     import fmpy
     if (compiler := c_compiler()) is None:
         raise NoCompiler(f"no C compiler found (set CC, or install gcc): {name}.fmu, an "

@@ -19,8 +19,7 @@ from pathlib import Path
 
 from .cbuild import NoCompiler, build_c
 from .packaging import build, build_script, imports
-from .project import C_FMUS, FMU_DIRS, FMUS, ROOT
-from .routes import ROUTES
+from .project import C_FMUS, FMU_DIRS, FMUS, ROOT, ROUTES
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -60,8 +59,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _build_script(script: Path, includes: list[Path], out: Path | None, fmi: int) -> Path:
-    """A user's script built into ``out``; ValueError naming what is missing, what it would
-    not carry, or its exit."""
+    """A user's script built into ``out``; ValueError naming what is missing or uncarried."""
     if not script.is_file():
         raise ValueError(f"{script} does not exist")
     for include in includes:
@@ -83,8 +81,7 @@ def _build_script(script: Path, includes: list[Path], out: Path | None, fmi: int
 
 
 def _uncarried(script: Path, includes: list[Path]) -> str | None:
-    """What to do about the modules ``script`` or ``includes`` import unconditionally that a
-    host would lack (not included, standard, or installed here), or None."""
+    """What to do about the modules ``script`` or ``includes`` need that a host lacks, or None."""
     provided = {"fmukit", *(p.stem if p.is_file() else p.name for p in includes)}
     local = [script.resolve().parent, Path.cwd().resolve(), ROOT,
              *(p.resolve().parent for p in includes)]

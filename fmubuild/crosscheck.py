@@ -2,8 +2,7 @@
 simulated by fmpy; regenerate them, saying why in the commit, only when results change.
 
     python -m fmubuild.crosscheck            # both versions: fmus/crosscheck/2.0/..., 3.0/...
-    python -m fmubuild.crosscheck --fmi 3    # only the FMI 3.0 twins (fmus/fmi3/)
-"""
+    python -m fmubuild.crosscheck --fmi 3    # only the FMI 3.0 twins (fmus/fmi3/)"""
 from __future__ import annotations
 
 import argparse
@@ -17,8 +16,7 @@ from pathlib import Path
 
 from cosim.core.files import fresh_folder
 
-from .project import FMU_DIR, FMU_DIRS
-from .routes import ROUTES
+from .project import FMU_DIR, FMU_DIRS, ROUTES
 
 TOOL, VERSION = "ship_autopilot_cosim", "0.1.0"
 CROSSCHECK_DIRS = {fmi: FMU_DIR / "crosscheck" / f"{fmi}.0" / "cs" / route.linux / TOOL / VERSION
@@ -59,11 +57,6 @@ def files(name: str, fmi: int = 2) -> dict[str, Path]:
     folder = CROSSCHECK_DIRS[fmi] / name
     return {"dir": folder, "fmu": folder / f"{name}.fmu", "in": folder / f"{name}_in.csv",
             "ref": folder / f"{name}_ref.csv", "opt": folder / f"{name}_ref.opt"}
-
-
-def read_opt(path: Path) -> dict[str, float]:
-    pairs = (line.split(",", 1) for line in path.read_text().splitlines() if "," in line)
-    return {key.strip(): float(value) for key, value in pairs}
 
 
 def generate(name: str, fmi: int = 2) -> Path:

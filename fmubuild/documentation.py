@@ -1,6 +1,5 @@
 """What an FMU says of itself, derived from its entries alone (the same sources, the same
-bytes): generation tool and identity in its model description, its page and its icon.
-"""
+bytes): generation tool and identity in its model description, its page and its icon."""
 from __future__ import annotations
 
 import html
@@ -165,8 +164,7 @@ def _inline(text: str) -> str:
 
 
 def model_png(model: ModelDescription) -> bytes:
-    """model.png: a vessel (outputs x, y, psi) as CyberShip II's waterline to scale, any
-    other model as a block with its ports."""
+    """model.png: a vessel (outputs x, y, psi) as CyberShip II's waterline, else a block."""
     inputs, outputs = ([v.name for v in model.modelVariables if v.causality == c]
                        for c in ("input", "output"))
     name = model.modelName

@@ -1,6 +1,5 @@
 """An FMU instantiated once with fmpy in a child process, since pythonfmu's C++ takes its
-host down when the script fails to import.
-"""
+host down when the script fails to import."""
 from __future__ import annotations
 
 import signal

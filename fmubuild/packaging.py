@@ -1,6 +1,5 @@
 """A slave script built into an FMU that carries exactly its model (the script, what it
-imports of fmukit and this project, the ``--include``s), reproducibly.
-"""
+imports of fmukit and this project, the ``--include``s), reproducibly."""
 from __future__ import annotations
 
 import ast
@@ -21,10 +20,9 @@ from pathlib import Path
 
 from fmukit.manifest import Manifest, digest_of, sha256, version
 
-from . import documentation, exit_fix
+from . import documentation
 from .instantiate import InstantiationFailed, instantiate_in_child
-from .project import FMU_DIRS, FMUS, ROOT, project_identity
-from .routes import ROUTES
+from .project import FMU_DIRS, FMUS, ROOT, ROUTES, project_identity
 
 PROJECT_PACKAGES = ("fmukit", "ship_fmu", "autopilot_fmu")
 _IMPORT_ERRORS = {"ImportError", "ModuleNotFoundError", "Exception", "BaseException"}
@@ -101,7 +99,7 @@ def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,
                              f"{type(error).__name__}: {why}") from error
         fmu = dest if dest.suffix == ".fmu" else dest / Path(built).name
         with zipfile.ZipFile(built) as package:     # the Linux binary with its exit fixed
-            entries = {name: exit_fix.patch(package.read(name), f"{fmu}:{name}", fmi)
+            entries = {name: fix_exit(package.read(name), f"{fmu}:{name}", fmi)
                        if name.startswith(f"binaries/{route.linux}/") else package.read(name)
                        for name in package.namelist() if not name.endswith("/")}
     tool = f"fmukit {version()} ({route.pythonfmu} {adapter.PYTHONFMU_VERSION})"
@@ -149,6 +147,26 @@ def write_fmu(fmu: Path, entries: Mapping[str, bytes], derive_guid: bool = False
     if problems:
         raise RuntimeError(f"{fmu} does not validate:\n" + "\n".join(problems))
     return fmu
+
+
+def fix_exit(binary: bytes, where: str, fmi: int = 2) -> bytes:
+    """A pythonfmu Linux binary fixed: its static destructor frees the global
+    ``shared_ptr<PyState>`` at exit, then ``onLibraryUnload`` assigns to the dead pointer (an
+    intermittent SIGABRT of every host). The destructor already shuts Python down, so
+    ``onLibraryUnload`` becomes a plain return, in a binary the adapter knows by SHA-256;
+    RuntimeError naming ``where`` if it knows none."""
+    route, digest = ROUTES[fmi], hashlib.sha256(binary).hexdigest()
+    fix = importlib.import_module(route.adapter).KNOWN_BINARIES.get(digest)
+    if fix is None:
+        raise RuntimeError(f"{where} is not the {route.pythonfmu} {route.known} {route.linux} "
+                           f"binary whose exit-time heap corruption fmubuild knows how "
+                           f"to fix (SHA-256 {digest}); check the new binary and extend "
+                           f"{route.adapter}")
+    end = fix.offset + len(fix.code)
+    fixed = binary[:fix.offset] + fix.patched + binary[end:]
+    if binary[fix.offset:end] != fix.code or hashlib.sha256(fixed).hexdigest() != fix.fixed_sha256:
+        raise RuntimeError(f"{where}: the patched binary is not the one fmukit expects")
+    return fixed
 
 
 def needed_modules(scripts: Iterable[Path], packages: Iterable[str]) -> dict[str, Path]:

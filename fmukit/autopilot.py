@@ -1,7 +1,6 @@
 """The autopilot port contract: inputs ``psi`` (rad), ``r`` (rad/s), ``psi_d`` (rad); output
 ``delta_c`` (rad), positive turning the ship to port. An autopilot written with fmukit declares
-``variables = (*INPUTS, rudder_command(depends=..., get=...), ...)``.
-"""
+``variables = (*INPUTS, rudder_command(depends=..., get=...), ...)``."""
 from __future__ import annotations
 
 from typing import Any, Callable

@@ -1,6 +1,5 @@
 """An FMU's class composed in code, as its entry module defines it, for a host that runs the
-model in its own process (it uses ``registry``, ``plans`` and ``fmukit.entry.unguarded``).
-"""
+model in its own process (it uses ``registry``, ``plans`` and ``fmukit.entry.unguarded``)."""
 from __future__ import annotations
 
 import functools

@@ -1,7 +1,6 @@
 """Every FMI entry point's error path made safe (``fmi_entry``: both pythonfmus' C++ layers
 release the instance, its class and its log queue once per exception), and the error told to
-the user where the host does not hear it (``HostLog``, reading the host's flag in the binary).
-"""
+the user where the host does not hear it (``HostLog``, reading the host's flag in the binary)."""
 from __future__ import annotations
 
 import ctypes
@@ -54,7 +53,7 @@ class Binary:
     """A pythonfmu binary fmukit knows inside out."""
     offset: int                 # file offset of onLibraryUnload
     code: bytes                 # its first instructions
-    patched: bytes              # what they become (fmubuild.exit_fix)
+    patched: bytes              # what they become (fmubuild.packaging.fix_exit)
     fixed_sha256: str           # the binary once patched
     logger_offset: int          # where the host's logging flag is, from the logger
     through_pointer: bool = False   # there is a pointer to the flag instead
@@ -69,7 +68,8 @@ class HostLog:
         logger, resources = kwargs.get("logger"), kwargs.get("resources")
         fixed = {b.fixed_sha256: b for b in known_binaries.values()}
         binaries = (Path(resources).parent / "binaries").glob("*/*") if logger and resources else ()
-        known = next((fixed[d] for d in map(_sha256, binaries) if d in fixed), None)
+        digests = (hashlib.sha256(p.read_bytes()).hexdigest() for p in binaries if p.is_file())
+        known = next((fixed[d] for d in digests if d in fixed), None)
         address = None if known is None else logger + known.logger_offset
         if known is not None and known.through_pointer:
             address = ctypes.c_void_p.from_address(address).value
@@ -88,10 +88,3 @@ class HostLog:
             sys.stderr.write(naming(instance_name, message) + "\n")   # one write: hosts
             sys.stderr.flush()                              # step FMUs in parallel threads
             self._told = message
-
-
-def _sha256(path: Path) -> str | None:
-    try:
-        return hashlib.sha256(path.read_bytes()).hexdigest()
-    except OSError:
-        return None

@@ -1,7 +1,6 @@
 """Ctrl-C while an FMU computes: the host's signal handler runs in the host's code, not ours
 (in FMU code a KeyboardInterrupt would escape to pythonfmu's C++ layer, which loses it and
-releases the instance once too often): the signal is raised again until the host's code runs.
-"""
+releases the instance once too often): the signal is raised again until the host's code runs."""
 from __future__ import annotations
 
 import _thread
@@ -21,26 +20,20 @@ _ENTRY_FILE = os.path.join(os.path.dirname(__file__), "entry.py")  # fmi_entry's
 _pending: set[signal.Signals] = set()   # arrived while FMU code ran; not yet handled
 
 
-def _in_fmu_code(frame: FrameType | None) -> bool:
-    return frame is not None and any(f.f_code.co_name == "entry" and f.f_code.co_filename
-                                     == _ENTRY_FILE for f, _ in traceback.walk_stack(frame))
-
-
-class _DeferringHandler:
+def _deferring(host_handler: Callable) -> Callable:
     """The host's handler, run only outside FMU code."""
-
-    def __init__(self, host_handler: Callable):
-        self.host_handler = host_handler
-
-    def __call__(self, number: int, frame: FrameType | None) -> object:
-        if _in_fmu_code(frame):
+    def deferring_handler(number: int, frame: FrameType | None) -> object:
+        if frame is not None and any(f.f_code.co_name == "entry" and f.f_code.co_filename
+                                     == _ENTRY_FILE for f, _ in traceback.walk_stack(frame)):
             first = not _pending
             _pending.add(signal.Signals(number))
             if first:
                 threading.Thread(target=_signal_again, name="fmukit-signals", daemon=True).start()
             return None
         _pending.discard(signal.Signals(number))
-        return self.host_handler(number, frame)
+        return host_handler(number, frame)
+    deferring_handler.safe_in_fmu_code = True       # deferred already: not wrapped again
+    return deferring_handler
 
 
 def _signal_again() -> None:
@@ -60,9 +53,8 @@ def defer_host_handlers() -> None:
     elif threading.current_thread() is threading.main_thread():
         for number in SIGNALS:
             handler = signal.getsignal(number)
-            if (callable(handler) and not isinstance(handler, _DeferringHandler)
-                    and not getattr(handler, "safe_in_fmu_code", False)):
-                signal.signal(number, _DeferringHandler(handler))
+            if callable(handler) and not getattr(handler, "safe_in_fmu_code", False):
+                signal.signal(number, _deferring(handler))
 
 
 def _restore_default_sigint() -> None:

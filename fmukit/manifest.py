@@ -1,7 +1,6 @@
 """What an FMU built with fmukit carries about itself (no time, path or machine: the same
 sources, the same manifest), and whether it is current here. Format 1 (before FMI 3.0) is
-read so that ``staleness`` can say to rebuild.
-"""
+read so that ``staleness`` can say to rebuild."""
 from __future__ import annotations
 
 import hashlib
@@ -90,5 +89,5 @@ def staleness(manifest: Manifest,
     if entry_source is not None and manifest.entry and hashlib.sha256(
             entry_source(manifest).encode()).hexdigest() != manifest.entry["sha256"]:
         return (f"its entry module {manifest.entry['module']} is not the one this build writes "
-                "(built before a change of fmubuild.routes: rebuild it)")
+                "(built before a change of fmubuild.project: rebuild it)")
     return None

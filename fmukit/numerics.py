@@ -1,6 +1,5 @@
 """Numerical rules every model here follows: finite inputs, bounded sub-stepping (a huge
-step is refused instead of hanging the host), angle differences wrapped the short way round.
-"""
+step is refused instead of hanging the host), angle differences wrapped the short way round."""
 from __future__ import annotations
 
 import math
@@ -24,8 +23,7 @@ def require_finite(**values: float) -> None:
 
 
 def substeps(h: float, h_max: float, what: str) -> int:
-    """Equal integration steps that cut a communication step h into pieces <= h_max;
-    ``what`` names them in the error."""
+    """Equal integration steps that cut a communication step h into pieces <= h_max."""
     n = max(1, math.ceil(h / h_max - 1e-9))
     if n > MAX_SUBSTEPS:
         raise ValueError(f"a communication step of {h} s needs {n} RK4 steps {what}; "

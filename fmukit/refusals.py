@@ -1,6 +1,5 @@
 """``Refused``: how an FMU refuses a call, with a message and its cause as data (the log
-category ``fmukit.<cause>``: a host tells a bad parameter from a NaN input without reading).
-"""
+category ``fmukit.<cause>``: a host tells a bad parameter from a NaN input without reading)."""
 from __future__ import annotations
 
 import functools

@@ -1,8 +1,5 @@
-"""A slave's variables by value reference, registered with pythonfmu, and plans reading or
-setting a list of them, made once per list (a master asks for the same lists at every step).
-A plan gives what the FMI call gives in every state of the slave, so a host in this process
-may call it; a list no plan serves gets ``None`` (pythonfmu serves it).
-"""
+"""A slave's variables by value reference, and plans reading or setting a list of them, made
+once per list; a plan gives what the FMI call gives, so a host in this process may call it."""
 from __future__ import annotations
 
 import functools
@@ -35,23 +32,17 @@ class Registry:
             slave.register_variable(sv)
             self.by_vr[sv.value_reference] = var
 
-    def real_reader(self, vrs: list[int]) -> Reader | None:
-        """The plan reading these Reals, or None if one is not a Real."""
-        return self._planned(float, vrs)
-
-    def integer_reader(self, vrs: list[int]) -> Reader | None:
-        return self._planned(int, vrs)
-
-    def input_writer(self, vrs: list[int]) -> Writer | None:
-        """The plan setting these Real inputs, or None if one is not a Real input."""
-        return self._planned(None, vrs)
-
     def _planned(self, kind: type | None, vrs: list[int]) -> Reader | Writer | None:
         key = (kind, *vrs)
         if key not in self._plans:
             self._plans[key] = (self._writer(key[1:]) if kind is None
                                 else self._reader(key[1:], kind))
         return self._plans[key]
+
+    # The plan reading these Reals (Integers), setting these Real inputs; None if one is not.
+    real_reader = functools.partialmethod(_planned, float)
+    integer_reader = functools.partialmethod(_planned, int)
+    input_writer = functools.partialmethod(_planned, None)
 
     def _reader(self, vrs: tuple[int, ...], kind: type) -> Reader | None:
         slave, by_vr = self._slave, self.by_vr

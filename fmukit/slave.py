@@ -1,14 +1,14 @@
 """``ModelSlave``: the base of every FMU here (FMI 2.0 and 3.0) and its FMI call sequence.
 A failed FMU reads NaN and refuses every step with the first reason until reset, so a host
-that ignores statuses cannot pass the run off as results (docs/robustness.md).
-"""
+that ignores statuses cannot pass the run off as results (docs/robustness.md)."""
 from __future__ import annotations
 
+import json
 import signal
 from dataclasses import dataclass
 from typing import Any, Callable, ClassVar, NoReturn
 
-from . import hostsignals, state
+from . import hostsignals
 from .entry import HostLog, fmi_entry
 from .refusals import CAUSES, Refused, explain, naming
 from .registry import Registry
@@ -69,12 +69,8 @@ class ModelSlave:
     model_name: ClassVar[str]
     variables: ClassVar[tuple[Var, ...]]
     default_experiment = DefaultExperiment(start_time=0.0, stop_time=400.0, step_size=0.1)
-    # The adapter's, with ``KNOWN_BINARIES``, ``HEARS_UNKNOWN`` (does the host of another
-    # binary hear?) and ``fmi_variable(var, output_getter)``:
-    API: ClassVar[str]
-    STATUS_ERROR: ClassVar[Any]
-    STATUS_FATAL: ClassVar[Any]
-    RELEASES_ON_EXCEPTION: ClassVar[bool]
+    # The adapter gives API, STATUS_ERROR, STATUS_FATAL, RELEASES_ON_EXCEPTION, KNOWN_BINARIES,
+    # HEARS_UNKNOWN (does the host of another binary hear?) and fmi_variable(var, getter).
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)            # pythonfmu's slave, next in the FMU class's MRO
@@ -104,8 +100,7 @@ class ModelSlave:
         raise NotImplementedError
 
     def start_model(self, model: Any) -> None:
-        """Set a model's initial state from the inputs (apart from build_model: restoring a
-        state must not depend on them)."""
+        """Set a model's initial state from the inputs (a restored state does not use them)."""
 
     def _started_model(self) -> Any:
         model = self.build_model()
@@ -151,8 +146,7 @@ class ModelSlave:
         raise Refused(reason, cause) from error
 
     def interrupted(self, where: str, error: BaseException) -> Refused:
-        """The refusal to raise for a BaseException (Ctrl-C, one with a ``signal``) raised
-        in the FMU's code during ``where``; it fails the FMU."""
+        """Fail the FMU for a BaseException (Ctrl-C, a ``signal``) in ``where``: its Refused."""
         number = getattr(error, "signal",
                          signal.SIGINT if isinstance(error, KeyboardInterrupt) else None)
         if not self.failure:
@@ -249,10 +243,35 @@ class ModelSlave:
 
     @fmi_entry
     def _get_fmu_state(self) -> dict[str, Any]:
-        return state.capture(self)
+        """The whole state, which pythonfmu serialises as JSON; the model's: its ``snapshot()``."""
+        return {"phase": self.sequence.phase,
+                "values": {v.name: getattr(self, v.name) for v in self.vars.values()
+                           if v.causality.name != "output"},
+                "model": self._model.snapshot() if self._model is not None else None,
+                "failure": self.failure, "failure_cause": self.failure_cause}
 
     @fmi_entry
     def _set_fmu_state(self, saved: dict[str, Any]) -> None:
-        state.restore(self, saved)
+        """Back to a saved state: the model rebuilt and handed its snapshot (bit for bit)."""
+        if "invalid" in saved:
+            raise ValueError(f"cannot restore FMU state: {saved['invalid']}")
+        for name, value in saved["values"].items():
+            setattr(self, name, value)
+        self.sequence.phase = saved["phase"]
+        self.failure, self.failure_cause = saved.get("failure"), saved.get("failure_cause", "model")
+        self._model = None
+        if saved["model"] is not None:
+            self._model = self.build_model()
+            self._model.restore(saved["model"])
 
-    _fmu_state_from_bytes = staticmethod(state.decode)
+    @staticmethod
+    def _fmu_state_from_bytes(data: bytes) -> dict[str, Any]:
+        """A serialised state, or ``{"invalid": why}`` for ``_set_fmu_state`` to refuse
+        (pythonfmu calls this on the class, where an exception cannot be made safe)."""
+        try:
+            decoded = json.loads(data.decode("utf-8"))
+            if not {"phase", "values", "model"} <= set(decoded):
+                raise ValueError("not a state of this FMU")
+            return decoded
+        except (ValueError, UnicodeDecodeError, TypeError) as error:
+            return {"invalid": f"serialized state unreadable ({error})"}

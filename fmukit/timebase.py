@@ -1,7 +1,6 @@
 """The time base: FMUs round time and step to whole nanoseconds and masters compute
 t_k = t_0 + k h in integer nanoseconds, so masters that form time differently (libcosim
-counts nanoseconds, fmpy adds floats) drive the FMUs bit for bit alike.
-"""
+counts nanoseconds, fmpy adds floats) drive the FMUs bit for bit alike."""
 NANOSECONDS = 1_000_000_000
 MAX_TIME = 1e15                         # s: largest |t| an FMU accepts (30 million years)
 EXACT_TIME = 2**53 / NANOSECONDS        # s: largest |t| whose every nanosecond a float holds

@@ -1,6 +1,5 @@
 """``Var``: an FMU variable declared once, the source of its registration, its
-modelDescription.xml entry (``describe``) and its range check; the SI units (``UNITS``).
-"""
+modelDescription.xml entry (``describe``) and its range check; the SI units (``UNITS``)."""
 from __future__ import annotations
 
 import math

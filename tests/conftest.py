@@ -18,9 +18,8 @@ from typing import Callable, Iterator
 import pytest
 
 from fmubuild.cbuild import build_c, c_compiler, sources
-from fmubuild.routes import entry_source
 from fmubuild.packaging import build, build_script
-from fmubuild.project import C_FMUS, FMU_DIRS, FMUS, ROOT
+from fmubuild.project import C_FMUS, FMU_DIRS, FMUS, ROOT, entry_source
 from fmukit.manifest import read, staleness
 
 pytest_plugins = ["pytester"]       # to run the example test file for each autopilot

@@ -12,10 +12,16 @@ import pytest
 from fmpy.cross_check.validate_vendor_repo import validate_test_fmu
 
 from fmubuild import crosscheck
-from fmubuild.crosscheck import CASES, CROSSCHECK_DIRS, files, read_opt
+from fmubuild.crosscheck import CASES, CROSSCHECK_DIRS, files
 from fmubuild.project import FMU_DIR
 
 VERSIONS = sorted(CROSSCHECK_DIRS)
+
+
+def read_opt(path: Path) -> dict[str, float]:
+    """A cross-check .opt file: key: value."""
+    pairs = (line.split(",", 1) for line in path.read_text().splitlines() if "," in line)
+    return {key.strip(): float(value) for key, value in pairs}
 
 
 def fmpy_simulate(fmu: Path, opt: dict[str, float], inputs: Path, cwd: Path) -> Path:

@@ -26,12 +26,12 @@ from pythonfmu3.builder import get_class_name
 
 import fmukit.pythonfmu3_03 as adapter
 from autopilot_fmu.pd_autopilot_slave import PDAutopilotSlave
-from fmubuild.exit_fix import patch
+from fmubuild.packaging import fix_exit
 from fmubuild.packaging import build_script
 from fmubuild.project import FMUS, ROOT
 from fmubuild.instantiate import InstantiationFailed, instantiate_in_child
 from fmukit.compose import fmu_class
-from fmukit.pythonfmu3_03.binary import KNOWN_BINARIES
+from fmukit.pythonfmu3_03 import KNOWN_BINARIES
 from fmukit.pythonfmu3_03.slave import Fmi3Entry
 from fmukit.slave import DefaultExperiment, ModelSlave, Var
 
@@ -302,7 +302,7 @@ def test_without_the_exit_fix_a_host_aborts_where_with_it_it_exits_cleanly(
 
 def test_the_exit_fix_and_the_build_refuse_what_they_do_not_know(monkeypatch, tmp_path):
     with pytest.raises(RuntimeError, match="is not the pythonfmu3 0.3.4 x86_64-linux binary"):
-        patch(b"\x7fELF something else", "pd.fmu:binaries/x86_64-linux/pd.so", 3)
+        fix_exit(b"\x7fELF something else", "pd.fmu:binaries/x86_64-linux/pd.so", 3)
     monkeypatch.setattr(adapter, "PYTHONFMU_VERSION", "0.3.5")
     monkeypatch.setattr(adapter, "ACTIVE", False)
     with pytest.raises(RuntimeError, match=r"pythonfmu3 0\.3\.5 is installed; fmukit builds "

@@ -9,9 +9,8 @@ from pathlib import Path
 import pytest
 
 from fmubuild.cbuild import build_c
-from fmubuild.routes import entry_source
 from fmubuild.packaging import build
-from fmubuild.project import FMUS, ROOT
+from fmubuild.project import FMUS, ROOT, entry_source
 from fmukit.manifest import digest_of, read, staleness
 
 PROJECT = {"cosim", "fmubuild", "fmukit", "ship_fmu", "autopilot_fmu"}
@@ -65,7 +64,7 @@ def test_an_fmu_whose_entry_module_this_build_would_not_write_is_stale(fmu_paths
         other = dataclasses.replace(manifest, entry={**manifest.entry, "sha256": "0" * 64})
         assert staleness(other, entry_source) == (f"its entry module {manifest.entry['module']} is not the "
                                     "one this build writes (built before a change of "
-                                    "fmubuild.routes: rebuild it)")
+                                    "fmubuild.project: rebuild it)")
 
 
 def _imports(path: Path) -> set[str]:

@@ -243,7 +243,7 @@ def test_a_host_that_loaded_an_fmu_exits_with_its_heap_intact(fmu_paths, exit_he
 
 def test_without_the_exit_fix_the_same_host_aborts(fmu_paths, exit_heap_host, tmp_path):
     """The check above can fail: pythonfmu 0.7.0's own binary corrupts the heap at exit."""
-    from fmukit.pythonfmu07.binary import KNOWN_BINARIES
+    from fmukit.pythonfmu07 import KNOWN_BINARIES
 
     known = next(iter(KNOWN_BINARIES.values()))
     offset, original, patched = known.offset, known.code, known.patched
@@ -260,7 +260,7 @@ def test_without_the_exit_fix_the_same_host_aborts(fmu_paths, exit_heap_host, tm
 
 
 def test_the_exit_fix_refuses_a_binary_it_does_not_know():
-    from fmubuild.exit_fix import patch
+    from fmubuild.packaging import fix_exit
 
     with pytest.raises(RuntimeError, match="ship.so is not the pythonfmu 0.7.0 linux64 binary"):
-        patch(b"\x7fELF something else", "ship.fmu:binaries/linux64/ship.so")
+        fix_exit(b"\x7fELF something else", "ship.fmu:binaries/linux64/ship.so")

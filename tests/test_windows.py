@@ -116,7 +116,7 @@ result = slave.do_step(0.0, 0.1)
 stepped = result is True if fmi == "2" else (result.status == 0 and not any(result[1:]))
 slave.terminate()
 print(json.dumps({"fmukit": sys.modules["fmukit.slave"].__file__, "c_calls": c_calls,
-                  "sigint": type(signal.getsignal(signal.SIGINT)).__name__,
+                  "sigint": signal.getsignal(signal.SIGINT).__qualname__,
                   "stepped": stepped}))
 '''
 """A child process's script: instantiate and step an FMU's slave class (of FMI version
@@ -204,10 +204,10 @@ def test_each_python_fmu_instantiates_and_steps_on_windows(python_fmus, tmp_path
     assert seen["stepped"] is True
     if host == "c++":   # Ctrl-C ends the host: SIGINT's default action, in the UCRT
         assert seen["c_calls"] == [["ucrtbase", "signal", 2, None]]
-        assert seen["sigint"] == "builtin_function_or_method"   # Python's record unchanged
+        assert seen["sigint"] == "default_int_handler"   # Python's record unchanged
     else:               # the host's handler, deferred while FMU code runs
         assert seen["c_calls"] == []
-        assert seen["sigint"] == "_DeferringHandler"
+        assert seen["sigint"] == "_deferring.<locals>.deferring_handler"
 
 
 @pytest.mark.parametrize("name", list(FMUS))

@@ -1,6 +1,5 @@
 """``Fmi2Entry``: the mixin that makes a ``ModelSlave`` an FMI 2.0 FMU of pythonfmu 0.7.
-Every refusal is an exception: fmi2Fatal (pythonfmu 0.7's fmi2Discard would pass for an end).
-"""
+Every refusal is an exception: fmi2Fatal (pythonfmu 0.7's fmi2Discard would pass for an end)."""
 from __future__ import annotations
 
 import ctypes
@@ -15,7 +14,7 @@ from pythonfmu.enums import Fmi2Status
 from ..entry import fmi_entry
 from ..registry import pythonfmu_variable
 from ..variables import Var, describe
-from . import ACTIVE, binary
+from . import ACTIVE, KNOWN_BINARIES
 
 _TYPE = {float: Real, int: Integer, str: String}
 
@@ -25,7 +24,7 @@ class Fmi2Entry:
     API, FMI_VERSION = "fmi2", 2
     STATUS_ERROR, STATUS_FATAL = Fmi2Status.error, Fmi2Status.fatal
     RELEASES_ON_EXCEPTION = ACTIVE
-    KNOWN_BINARIES, HEARS_UNKNOWN = binary.KNOWN_BINARIES, False
+    KNOWN_BINARIES, HEARS_UNKNOWN = KNOWN_BINARIES, False
 
     def fmi_variable(self, var: Var, getter: Callable[[], Any] | None) -> Any:
         return pythonfmu_variable(var, getter, _TYPE[var.kind], Fmi2Causality,

@@ -1,6 +1,5 @@
 """``Fmi3Entry``: the mixin that makes a ``ModelSlave`` an FMI 3.0 FMU of pythonfmu3 0.3.4,
-with the independent variable ``time``.
-"""
+with the independent variable ``time``."""
 from __future__ import annotations
 
 from typing import Any, Callable
@@ -13,7 +12,7 @@ from pythonfmu3 import Fmi3Variability, Float64, Int32, String
 from ..entry import fmi_entry
 from ..registry import pythonfmu_variable
 from ..variables import Var, describe
-from . import ACTIVE, binary
+from . import ACTIVE, KNOWN_BINARIES
 
 _TYPE = {float: Float64, int: Int32, str: String}
 _FROM_CLASS = ("description", "author", "license", "version", "copyright",
@@ -29,7 +28,7 @@ class Fmi3Entry:
     API, FMI_VERSION = "fmi3", 3
     STATUS_ERROR, STATUS_FATAL = Fmi3Status.error, Fmi3Status.fatal
     RELEASES_ON_EXCEPTION = ACTIVE
-    KNOWN_BINARIES, HEARS_UNKNOWN = binary.KNOWN_BINARIES, True
+    KNOWN_BINARIES, HEARS_UNKNOWN = KNOWN_BINARIES, True
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
