@@ -316,12 +316,12 @@ def killing_batch(jobs, blobs):
 
 
 @pytest.mark.timeout(240, method="thread")
-def test_a_batch_whose_worker_dies_on_every_retry_runs_each_run_alone(fmu_paths, scheduler,
-                                                                     tmp_path):
+def test_a_batch_whose_worker_dies_on_every_retry_runs_each_run_alone(fmu_paths, tmp_path):
+    """On a cluster of its own: the session's workers are not killed."""
     spec = Spec.read(write_spec(tmp_path, "stop_time = 5\n[controllers]\n"
                                                 'pd = "waves_pd"\n[axes]\nwave_seed = [1, 2]\n'))
-    rows = campaign.execute(spec, tmp_path, scheduler=scheduler, progress=False,
-                         backend="batch", batch_task=killing_batch, no_worker_timeout=60)
+    rows = campaign.execute(spec, tmp_path, workers=2, progress=False, backend="batch",
+                            batch_task=killing_batch, no_worker_timeout=60)
     assert [r["status"] for r in rows] == ["ok", "ok"]
     for row in rows:
         assert row["backend"].startswith("inprocess (not in a batch: its batch's worker died, "
