@@ -10,6 +10,7 @@ from __future__ import annotations
 import contextlib
 import fcntl
 import gc
+import os
 import shutil
 import tempfile
 from pathlib import Path
@@ -44,6 +45,13 @@ def pytest_addoption(parser: pytest.Parser) -> None:
                      help="run the whole suite: the tests marked long too, and the fuzzing "
                           "campaigns at full length (without it: the quick suite, as CI "
                           "runs it)")
+
+
+def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
+    """``-n auto``: a worker per core this process may use, and one more: many tests wait on a
+    child process, a cluster or a grace period with their core idle (docs/performance.md)."""
+    return len(os.sched_getaffinity(0)) + 1 if hasattr(os, "sched_getaffinity") else (
+        (os.cpu_count() or 1) + 1)
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
