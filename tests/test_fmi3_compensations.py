@@ -277,7 +277,7 @@ def test_without_the_exit_fix_a_host_aborts_where_with_it_it_exits_cleanly(
     """Whether malloc notices the write into a freed block depends on the heap's layout,
     which the size of the environment and the length of the FMU folder's path shift (and
     the FMU's own Python code: any edit of it): the host is run with the environment padded
-    more and more, in folders of three lengths, the FMU as built and its unfixed variant in
+    more and more, in folders of six lengths, the FMU as built and its unfixed variant in
     each layout, until the variant aborts. The FMU as built must exit cleanly in every
     layout tried."""
     ship = fmi3_paths["ship"]
@@ -288,7 +288,7 @@ def test_without_the_exit_fix_a_host_aborts_where_with_it_it_exits_cleanly(
                        binary[known.offset - 8:known.offset + len(known.patched)],
                        binary[known.offset - 8:known.offset] + known.code)
     for padding in range(0, 4096, 64):
-        for folder in ("x", "x" * 9, "x" * 17):
+        for folder in ("x" * n for n in range(1, 24, 4)):   # 3 lengths once found none
             intact = _child(EXIT_HOST, ship, late_malloc, folder, cwd=tmp_path, padding=padding)
             assert intact.returncode == 0, (padding, folder, intact.stderr)
             aborted = _child(EXIT_HOST, unfixed, late_malloc, folder, cwd=tmp_path,
