@@ -1,6 +1,7 @@
 """What the commands share: scenario and autopilot options, output folders, messages. Only
 the commands import this."""
 import argparse
+import contextlib
 import functools
 import math
 import signal
@@ -57,6 +58,14 @@ def number_option(text: str) -> float:
     if not math.isfinite(value):
         raise ValueError(f"expected a finite number, got {text!r}")
     return value
+
+
+def count(text: str) -> int:
+    """A whole number >= 1, for argparse."""
+    with contextlib.suppress(ValueError):
+        if int(text) >= 1:
+            return int(text)
+    raise argparse.ArgumentTypeError(f"give a whole number >= 1, got {text!r}")
 
 
 @option

@@ -14,7 +14,7 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from ._cli import (add_port_options, checked_autopilot, entry, say_error, say_note,
+from ._cli import (add_port_options, checked_autopilot, count, entry, say_error, say_note,
                    setting_option, writable_folder)
 from .api import overrides_of
 from .core.files import FolderBusy, OutputError
@@ -44,7 +44,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--scheduler", metavar="ADDRESS",
                         help="run the ensembles on this Dask scheduler (default: a local "
                              "cluster)")
-    parser.add_argument("--workers", type=int, help="local Dask worker processes "
+    parser.add_argument("--workers", type=count, help="local Dask worker processes "
                                                     "(default: one per core)")
     parser.add_argument("--backend", choices=SWEEP_BACKENDS, default="fmi",
                         help="fmi: every run through the FMUs (default); inprocess: this "
@@ -62,8 +62,6 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"--set sets your autopilot's parameters (autopilot.NAME=VALUE); "
                      f"{', '.join(others)} would change only your runs' conditions, not the "
                      "others': the comparison would not be fair")
-    if args.workers is not None and args.workers < 1:
-        parser.error(f"--workers must be at least 1, got {args.workers}")
     checked_autopilot(parser, args)
     name = args.name or args.autopilot.stem
     if name in BASELINES:

@@ -2,14 +2,13 @@
 from __future__ import annotations
 
 import argparse
-import contextlib
 import os
 import shlex
 import signal
 import sys
 from pathlib import Path
 
-from ._cli import entry, positive_seconds, say_error, say_note, writable_folder
+from ._cli import count, entry, positive_seconds, say_error, say_note, writable_folder
 from .core.interrupt import Interrupted
 from .core.watchdog import STEP_LIMIT_S, Limits
 from .studies import campaign
@@ -28,14 +27,6 @@ SPEC: a TOML file of controllers, axes and plots (docs/sweeps.md, docs/sweeps/ex
 
 OUTPUTS = ("results.parquet", "results.json", "results.csv", "summary.csv", "J_distribution.png",
            "tracks.png", "J_*_over_pd.png", "comparison.md")    # written beside the journal
-
-
-def count(text: str) -> int:
-    """A whole number >= 1, for argparse."""
-    with contextlib.suppress(ValueError):
-        if int(text) >= 1:
-            return int(text)
-    raise argparse.ArgumentTypeError(f"give a whole number >= 1, got {text!r}")
 
 
 def main(argv: list[str] | None = None) -> int:

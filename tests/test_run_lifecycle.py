@@ -403,7 +403,9 @@ def test_a_file_is_not_written_over_a_device_or_a_folder_or_into_a_missing_one(t
 def test_the_scorecard_refuses_settings_that_would_make_it_unfair(tmp_path, capsys):
     from cosim import score
     for argv, said in ((["--set", "ship.Hs=0.01"], "would change only your runs' conditions"),
-                       (["--seeds", "1000000000"], "--seeds must be from 1 to")):
+                       (["--seeds", "1000000000"], "--seeds must be from 1 to"),
+                       (["--workers", "0"], "argument --workers: give a whole number >= 1, "
+                                            "got '0'")):
         with pytest.raises(SystemExit) as refused:
             score.main(["fmus/pid_autopilot.fmu", "--out", str(tmp_path), *argv])
         assert refused.value.code == 2 and said in capsys.readouterr().err
