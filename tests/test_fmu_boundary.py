@@ -62,9 +62,10 @@ def test_an_fmu_whose_entry_module_this_build_would_not_write_is_stale(fmu_paths
         manifest = read(fmu)
         assert staleness(manifest, entry_source) is None
         other = dataclasses.replace(manifest, entry={**manifest.entry, "sha256": "0" * 64})
-        assert staleness(other, entry_source) == (f"its entry module {manifest.entry['module']} is not the "
-                                    "one this build writes (built before a change of "
-                                    "fmubuild.project: rebuild it)")
+        module = manifest.entry["module"]
+        assert staleness(other, entry_source) == (
+            f"its entry module {module} is not the one this build writes (built before a "
+            "change of fmubuild.project: rebuild it)")
 
 
 def _imports(path: Path) -> set[str]:

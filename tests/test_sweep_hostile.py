@@ -460,7 +460,8 @@ def test_ctrl_c_during_the_runs_prints_one_line_that_says_how_to_resume(fmu_path
     ("cosim.sweep", "write_tables", "writing the tables"),
     pytest.param("cosim.studies.sweep_figures", "save_figures", "drawing the figures",
                  marks=pytest.mark.long),
-    pytest.param("cosim.sweep", "write_comparison", "writing comparison.md", marks=pytest.mark.long)])
+    pytest.param("cosim.sweep", "write_comparison", "writing comparison.md",
+                 marks=pytest.mark.long)])
 def test_ctrl_c_after_the_runs_says_they_are_kept_and_how_to_finish(fmu_paths, tmp_path, module,
                                                                    step, stage):
     """The stage is made to take the signal: it signals its own process, then waits."""
