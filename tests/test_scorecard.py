@@ -67,10 +67,9 @@ def _sketch(monkeypatch) -> set[str]:
     def stand_in(real, path_at):
         def sketch(*args, **kwargs):
             inspect.signature(real).bind(*args, **kwargs)
-            path = Path(args[path_at] if path_at is not None else "")
             if path_at is not None:
-                path.write_bytes(b"figure")
-                written.add(path.stem)
+                Path(args[path_at]).write_bytes(b"figure")
+                written.add(Path(args[path_at]).stem)
             return args
         return sketch
     for name, path_at in (("comparison", None), ("save", 1), ("distribution", 2),
