@@ -4,6 +4,7 @@ import argparse
 import contextlib
 import functools
 import math
+import re
 import signal
 import sys
 import tempfile
@@ -16,6 +17,7 @@ from . import scenarios
 from .api import parse_port_map, parse_setting
 from .core.files import plain_name
 from .core.interrupt import Interrupted, raise_on_signals
+from .core.isolated import Isolation, default_memory_limit
 from .core.recording import TooManyRows
 from .core.values import fmi_value
 from .scenarios.autopilot import AutopilotError, check_autopilot
@@ -75,6 +77,44 @@ def positive_seconds(text: str) -> float:
     if not value > 0:
         raise ValueError(f"expected a positive number of seconds, got {text!r}")
     return value
+
+
+SIZES = {"": 1, "k": 2**10, "m": 2**20, "g": 2**30, "t": 2**40}
+
+
+@option
+def size_option(text: str) -> int:
+    """A size in bytes: a number with K, M, G or T (binary multiples; B or iB may follow)."""
+    found = re.fullmatch(r"(\d+(?:\.\d*)?)\s*([kmgt]?)(?:i?b)?", text.strip().lower())
+    if not found:
+        raise ValueError(f"expected a size such as 512M or 4G, got {text!r}")
+    return int(float(found[1]) * SIZES[found[2]])
+
+
+def add_isolation_options(parser: argparse.ArgumentParser, default: str) -> None:
+    """--isolate [WHICH] and --memory-limit SIZE."""
+    limit = default_memory_limit()
+    parser.add_argument("--isolate", nargs="?", const="all", default=default, metavar="WHICH",
+                        help="run FMUs each in a process of its own, so that one that crashes, "
+                             "exits or hangs fails its run, not the command: all (--isolate "
+                             "alone), foreign (FMUs not built from this checkout), none, or "
+                             f"component names, e.g. autopilot,guidance (default: {default}; "
+                             "docs/robustness.md)")
+    parser.add_argument("--memory-limit", type=size_option, metavar="SIZE",
+                        help="the address space each isolated FMU's process may take, e.g. 2G; "
+                             "past it the FMU's allocations fail and its run fails, naming "
+                             "the limit (default: 3/4 of this machine's memory" +
+                             (f", {limit / 2**30:.1f}G)" if limit else ")"))
+
+
+def isolation(parser: argparse.ArgumentParser, args: argparse.Namespace) -> Isolation:
+    """The isolation --isolate and --memory-limit ask for (else the parser's error)."""
+    if args.memory_limit is not None and args.isolate == "none":
+        parser.error("--memory-limit limits the processes of isolated FMUs; add --isolate")
+    try:
+        return Isolation.of(args.isolate, args.memory_limit or default_memory_limit())
+    except ValueError as error:
+        parser.error(str(error))
 
 
 def add_fmu_options(parser: argparse.ArgumentParser, also: str) -> None:

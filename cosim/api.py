@@ -5,6 +5,7 @@ from pathlib import Path
 from typing import Any, Iterable, Mapping, Sequence
 
 from . import scenarios
+from .core.isolated import Isolation, default_memory_limit
 from .core.master import BACKENDS, Master
 from .core.system import split_name
 from .core.recording import Recording
@@ -57,12 +58,16 @@ def overrides_of(settings: Mapping[str, Any] | Iterable[tuple[str, Any]]
 def simulate(scenario: str | Path, autopilot: str | Path | None = None,
              set: dict[str, Any] | None = None, stop_time: float | None = None,
              coupling: str = "gauss-seidel", backend: str = "fmi",
-             port_map: dict[str, str] | None = None, fmi: int | None = None) -> Recording:
+             port_map: dict[str, str] | None = None, fmi: int | None = None,
+             isolate: bool | str | Sequence[str] = False,
+             memory_limit: int | None = default_memory_limit()) -> Recording:
     """The recording of a scenario (a name or a .ssd path): ``autopilot`` an FMU in its
-    autopilot's place, ``set`` values by "component.variable" (SI units), the rest as
+    autopilot's place, ``set`` values by "component.variable" (SI units), ``isolate`` which
+    FMUs run in a process of their own (True: all; ``memory_limit`` in bytes), the rest as
     ``cosim.run``'s options. ValueError for bad input; SimulationError if an FMU fails."""
     with Master(scenarios.load(scenario, autopilot, port_map, fmi=fmi), coupling=coupling,
-                backend=backend, overrides=overrides_of(set or {})) as master:
+                backend=backend, overrides=overrides_of(set or {}),
+                isolation=Isolation.of(isolate, memory_limit)) as master:
         for note in master.notes:
             warnings.warn(note, stacklevel=2)
         recording = master.run(stop_time)
@@ -74,13 +79,19 @@ def simulate(scenario: str | Path, autopilot: str | Path | None = None,
 def simulate_many(scenario: str | Path, sets: Sequence[Mapping[str, Any]],
                   autopilot: str | Path | None = None, stop_time: float | None = None,
                   backend: str = "batch", port_map: dict[str, str] | None = None,
-                  fmi: int | None = None, signals: Sequence[str] | None = None
-                  ) -> list[Recording]:
+                  fmi: int | None = None, signals: Sequence[str] | None = None,
+                  isolate: bool | str | Sequence[str] = False,
+                  memory_limit: int | None = default_memory_limit()) -> list[Recording]:
     """The recordings of a scenario run once for each of ``sets`` (each ``simulate``'s
-    ``set``), in order; "batch" steps them together as arrays, holding ``signals``. A failed
-    run raises nothing (its ``error`` says why); a refused setting, ValueError naming its member."""
+    ``set``), in order; "batch" steps them together as arrays, holding ``signals`` (``isolate``
+    as ``simulate``'s, on the other backends). A failed run raises nothing (its ``error`` says
+    why); a refused setting, ValueError naming its member."""
     if backend not in (*BACKENDS, "batch"):
         raise ValueError(f"backend must be fmi, inprocess or batch, got {backend!r}")
+    isolation = Isolation.of(isolate, memory_limit)
+    if backend == "batch" and isolation.chosen != "none":
+        raise ValueError("isolate: the batch route runs no FMU; isolate on the fmi or "
+                         "inprocess backend")
     system = scenarios.load(scenario, autopilot, port_map, fmi=fmi)
     overrides = []
     with Master(system, backend="inprocess") as master:     # every member's settings, first
@@ -99,7 +110,8 @@ def simulate_many(scenario: str | Path, sets: Sequence[Mapping[str, Any]],
     else:
         recordings = []
         for member in overrides:
-            with Master(system, backend=backend, overrides=member) as master:
+            with Master(system, backend=backend, overrides=member,
+                        isolation=isolation) as master:
                 recording = master.run(stop_time)
             recordings.append(recording if signals is None else recording.holding(signals))
     for note in dict.fromkeys(n for r in recordings for n in r.meta.get("notes", [])):

@@ -11,11 +11,12 @@ from .analysis.metrics import LAMBDA, Cost, cost
 from .analysis.reports import course_keeping_report, title, turning_circle_report, zigzag_report
 from .core.files import FolderLock, Outputs
 from .core.interrupt import StopSignals
+from .core.isolated import Isolation
 from .core.master import Master
 from .provenance import write_metadata
 from .core.recording import Recording
 from .core.ssd import SystemDescription
-from .core.watchdog import Limits, TimeLimit, Watchdog
+from .core.watchdog import Limits, Watchdog
 
 SUFFIXES = (".csv", ".json", ".png", ".svg", ".pdf", ".gif", ".mp4")   # a run's files
 # A scenario's kind (its .ssd's ``report``): the report printed, and the "module.function" of
@@ -40,10 +41,7 @@ class Options:
     stream: bool = False
     animate: str | None = None          # "gif" or "mp4"
     limits: Limits = Limits()           # step and run time limits (``core.watchdog``)
-
-
-class TimedOut(RuntimeError):
-    """The FMUs did not come up within the step time limit."""
+    isolation: Isolation = Isolation()  # which FMUs run in a process of their own
 
 
 @dataclass
@@ -66,7 +64,7 @@ def run_and_write(system: SystemDescription, label: str, out: Path,
                   notes: Callable[[str], None] = lambda note: None) -> Outcome:
     """Run ``system`` and write its CSV, JSON and, once finished, figure and animation as
     ``label`` in ``out``; ``stop`` ends it between steps on a signal. An exception (ValueError,
-    FileNotFoundError, FmuCallError, TimedOut, FolderBusy, OutputError) leaves ``out`` as it was."""
+    FileNotFoundError, FmuCallError, FolderBusy, OutputError) leaves ``out`` as it was."""
     if system.report not in KINDS:
         raise ValueError(f"unknown report kind {system.report!r}; known: {', '.join(KINDS)}")
     with FolderLock(out):
@@ -87,15 +85,8 @@ def run_and_write(system: SystemDescription, label: str, out: Path,
             try:
                 with Watchdog(options.limits, stop, salvage) as watchdog:
                     watchdog.beat(f"instantiating {', '.join(system.components)}")
-                    try:
-                        master = Master(system, coupling=options.coupling, overrides=overrides,
-                                        backend=options.backend)
-                    except TimeLimit:
-                        raise TimedOut(watchdog.expired) from None
-                    except Exception as error:
-                        if watchdog.expired:
-                            raise TimedOut(f"{watchdog.expired}: {error}") from None
-                        raise
+                    master = Master(system, coupling=options.coupling, overrides=overrides,
+                                    backend=options.backend, isolation=options.isolation)
                     with master:
                         for note in master.notes:
                             notes(note)
@@ -108,7 +99,7 @@ def run_and_write(system: SystemDescription, label: str, out: Path,
                                                    stop=stop, watchdog=watchdog)
                         finished.append(recording)
                         parameters = master.parameters
-                        watchdog.finishing("terminating and freeing the FMUs")
+                        watchdog.beat("terminating and freeing the FMUs")
                 outcome = Outcome(recording, out / f"{label}.csv")
                 if recording.interrupted:
                     outcome.status = 128 + int(signal.Signals[recording.interrupted])

@@ -7,6 +7,7 @@ Examples:
   python -m cosim.run --all                    the paper's four runs, Tables 1-2
   python -m cosim.run --all --spread           ... and how far one last bit moves each figure
   python -m cosim.run waves_pd --autopilot my.fmu   your own autopilot in waves_pd's place
+  python -m cosim.run waves_pd --autopilot my.fmu --isolate   ... each FMU in a process of its own
   python -m cosim.run --all --fmi 3            the same runs through the FMI 3.0 twins
 
 A scenario is an SSP system structure file (cosim/scenarios/*.ssd). A run writes every
@@ -21,8 +22,9 @@ from pathlib import Path
 from tqdm import tqdm
 
 from . import scenarios
-from ._cli import (add_fmu_options, chosen_scenarios, entry, number_option, positive_seconds,
-                   say_error, say_note, setting_option, writable_folder)
+from ._cli import (add_fmu_options, add_isolation_options, chosen_scenarios, entry, isolation,
+                   number_option, positive_seconds, say_error, say_note, setting_option,
+                   writable_folder)
 from .analysis.metrics import LAMBDA, Cost
 from .analysis.reports import conditions, headline, tables
 from .api import overrides_of
@@ -33,7 +35,7 @@ from .core.interrupt import StopSignals
 from .core.master import BACKENDS
 from .core.ssd import SystemDescription
 from .core.watchdog import STEP_LIMIT_S, Limits
-from .outputs import Options, TimedOut, run_and_write
+from .outputs import Options, run_and_write
 from .scenarios.autopilot import COMPONENT
 from .studies.cpu_variants import PERTURBED, spread
 
@@ -130,6 +132,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--run-timeout", type=positive_seconds, metavar="S",
                         help="end the run with an error, keeping its rows, after S s of "
                              "wall-clock time (default: no limit)")
+    add_isolation_options(parser, "none")
     args = parser.parse_args(argv)
     names = chosen_scenarios(parser, args)
     try:
@@ -145,7 +148,7 @@ def main(argv: list[str] | None = None) -> int:
         parser.error("--animate mp4 needs ffmpeg, which is not installed here; use gif")
     options = Options(args.coupling, args.stop_time, args.lam, args.backend,
                       not args.no_plot, ("png", *args.figure_format), args.stream, args.animate,
-                      Limits(args.step_timeout, args.run_timeout))
+                      Limits(args.step_timeout, args.run_timeout), isolation(parser, args))
     # (scenario, autopilot, row of Tables 1-2): with --all and --autopilot, the user's
     # autopilot also in calm_pd's and waves_pd's place
     runs = [(s, None, tuple(s.split("_"))) for s in names] if args.all else \
@@ -166,12 +169,11 @@ def main(argv: list[str] | None = None) -> int:
         try:
             system = scenarios.load(scenario, autopilot, dict(args.map), args.name, args.fmi)
             code, result = run_scenario(system, label, out, settings, options)
-        except (ValueError, FileNotFoundError, FmuCallError, FolderBusy, OutputError,
-                TimedOut) as error:
+        except (ValueError, FileNotFoundError, FmuCallError, FolderBusy, OutputError) as error:
             say_error(error)
             if created and not any(out.iterdir()):
                 out.rmdir()                     # nothing was run: leave nothing behind
-            return 1 if isinstance(error, (OutputError, TimedOut)) else 2
+            return 1 if isinstance(error, OutputError) else 2
         status = max(status, code)
         if code > 128:                          # interrupted: no further run
             return code

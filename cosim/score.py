@@ -14,11 +14,10 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from ._cli import (add_port_options, checked_autopilot, count, entry, say_error, say_note,
-                   setting_option, writable_folder)
+from ._cli import (add_isolation_options, add_port_options, checked_autopilot, count, entry,
+                   isolation, say_error, say_note, setting_option, writable_folder)
 from .api import overrides_of
 from .core.files import FolderBusy, OutputError
-from .outputs import TimedOut
 from .studies.scorecard import BASELINES, SEAS, backend_notes, score
 from .studies.cluster import NoWorkers, SweepError
 from .studies.sweep_spec import MAX_RUNS
@@ -53,7 +52,9 @@ def main(argv: list[str] | None = None) -> int:
                              "arrays, the same results again. An FMU that cannot run so is "
                              "noted before the scorecard starts")
     parser.add_argument("--out", type=Path, help="output folder (default: results/score/NAME)")
+    add_isolation_options(parser, "foreign")
     args = parser.parse_args(argv)
+    isolated = isolation(parser, args)
     if not 1 <= args.seeds <= MAX_RUNS // 4:
         parser.error(f"--seeds must be from 1 to {MAX_RUNS // 4} (four contenders, at most "
                      f"{MAX_RUNS} runs an ensemble), got {args.seeds}")
@@ -81,9 +82,10 @@ def main(argv: list[str] | None = None) -> int:
                   disable=None, bar_format="{desc}: {n}/{total} {bar} {elapsed} {postfix}") as bar:
             overrides_of(args.set)              # refuses a variable set twice
             text = score(args.autopilot.resolve(), name, out, args.seeds, dict(args.map),
-                         dict(args.set), args.workers, args.scheduler, progress, args.backend)
+                         dict(args.set), args.workers, args.scheduler, progress, args.backend,
+                         isolated)
             bar.update()
-    except (ValueError, FileNotFoundError, FolderBusy, OutputError, TimedOut,
+    except (ValueError, FileNotFoundError, FolderBusy, OutputError,
             SweepError) as error:         # SweepError: a worker runs other code
         say_error(error)
         return 1

@@ -8,7 +8,8 @@ import signal
 import sys
 from pathlib import Path
 
-from ._cli import count, entry, positive_seconds, say_error, say_note, writable_folder
+from ._cli import (add_isolation_options, count, entry, isolation, positive_seconds, say_error,
+                   say_note, writable_folder)
 from .core.interrupt import Interrupted
 from .core.watchdog import STEP_LIMIT_S, Limits
 from .studies import campaign
@@ -64,7 +65,9 @@ def main(argv: list[str] | None = None) -> int:
                         "over S s; a batch of N runs gets N times S (default: no limit)")
     parser.add_argument("--csv", action="store_true", help="also write results.csv")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar (for logs)")
+    add_isolation_options(parser, "foreign")
     args = parser.parse_args(argv)
+    isolated = isolation(parser, args)
     if args.batch_size is not None and args.backend != BATCH:
         parser.error(f"--batch-size sizes the batches of --backend batch, not of "
                      f"--backend {args.backend}")
@@ -85,7 +88,8 @@ def main(argv: list[str] | None = None) -> int:
                                 scheduler_file=args.scheduler_file, backend=args.backend,
                                 limits=Limits(args.step_timeout, args.run_timeout),
                                 no_worker_timeout=args.no_worker_timeout,
-                                connect_timeout=args.connect_timeout, batch_size=args.batch_size)
+                                connect_timeout=args.connect_timeout, batch_size=args.batch_size,
+                                isolation=isolated)
         stage = "writing the tables"
         written = write_tables(rows, out, args.csv, spec)
         stage = "drawing the figures"

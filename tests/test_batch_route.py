@@ -187,7 +187,7 @@ def test_a_foreign_autopilot_runs_alone_in_process_with_a_note(fmu_paths, schedu
     rows = journal(tmp_path / "out" / "foreign")
     by = {(r["controller"], r["wave_seed"]): r for r in rows.values()}
     assert {by["pd", s]["backend"] for s in (1, 2)} == {"batch"}
-    assert {by["mine", s]["backend"] for s in (1, 2)} == {"inprocess; autopilot: fmi"}
+    assert {by["mine", s]["backend"] for s in (1, 2)} == {"inprocess; autopilot: fmi, isolated"}
     for seed in (1, 2):
         assert by["mine", seed]["J"] == by["pd", seed]["J"]            # the same PD law
 

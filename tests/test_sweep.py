@@ -145,7 +145,7 @@ def test_an_in_process_sweep_notes_each_fmu_that_runs_through_fmi(c_autopilot, t
                                                 f'c = "{c_autopilot}"\n[axes]\nwave_seed = [1]\n'))
     rows = {r["controller"]: campaign.run_locally(spec, r, "inprocess") for r in spec.runs()}
     assert rows["pd"]["backend"] == "inprocess"
-    assert rows["c"]["backend"] == "inprocess; autopilot: fmi"
+    assert rows["c"]["backend"] == "inprocess; autopilot: fmi, isolated"
     assert rows["c"]["J"] == rows["pd"]["J"]                 # the same PD law, in C
     sweep_task.free_masters()
 

@@ -171,6 +171,13 @@ def overrides(meta: dict[str, Any]) -> str:
                     for n, x in values.items())
 
 
+def _isolated(backends: dict[str, str]) -> str:
+    """", isolated: NAMES" (every FMU), or ""."""
+    names = [name for name, kind in backends.items() if kind.endswith("isolated")]
+    return "" if not names else ", every FMU isolated" if len(names) == len(backends) else \
+        f", isolated: {', '.join(names)}"
+
+
 def conditions(meta: dict[str, Any]) -> list[str]:
     """What a run was, line by line."""
     p, units = meta.get("parameters", {}), meta.get("parameter_units", {})
@@ -178,7 +185,7 @@ def conditions(meta: dict[str, Any]) -> list[str]:
     if "stop_time" in meta:
         lines.append(f"{meta['stop_time'] - meta['start_time']:g} s in steps of "
                      f"{meta['step_size']:g} s, {meta['coupling']} coupling, "
-                     f"{meta['backend']} backend")
+                     f"{meta['backend']} backend" + _isolated(meta.get("backends") or {}))
     if "guidance" in p:
         try:
             points = " ".join(f"({x:g},{y:g})" for x, y in followed_route(p["guidance"]))

@@ -9,6 +9,8 @@ import threading
 from contextlib import contextmanager
 from typing import Callable, Iterator
 
+from .isolated import kill_all
+
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 
@@ -57,7 +59,7 @@ class StopSignals:
                 kept.append(f"(could not tidy up: {error})")
         print(f"{number.name} again: stopped at once; " + ("; ".join(kept) or
               "nothing of the run under way was written"), file=sys.stderr, flush=True)
-        os._exit(128 + self.received)
+        end_now(128 + self.received)
 
     def keep(self, keeper: Callable[[], str]) -> Callable[[], None]:
         """Have ``keeper`` say what it kept if a second signal ends the process; returns an undo."""
@@ -91,7 +93,7 @@ def _raise(number: int, frame) -> None:
     number = signal.Signals(number)
     if _received:
         print(f"{number.name} again: stopped at once", file=sys.stderr, flush=True)
-        os._exit(128 + _received[0])
+        end_now(128 + _received[0])
     _received.append(number)
     raise Interrupted(number)
 
@@ -105,3 +107,9 @@ def raise_on_signals() -> Iterator[None]:
         yield
     finally:
         give_back(previous)
+
+
+def end_now(status: int) -> None:
+    """End the process at once, its FMUs' children first (``core.isolated``)."""
+    kill_all("the master ended")
+    os._exit(status)

@@ -9,14 +9,16 @@ from typing import Any, Callable
 from fmukit.timebase import communication_point
 
 from .fmi import FmuInstance, read_description
-from .inprocess import InProcessInstance, fallback_note
+from .inprocess import InProcessInstance, fallback_note, in_process_refusal
 from .instance import FmuCallError, Instance
+from .isolated import IsolatedInstance, Isolation, one_cpu
 from .interrupt import StopSignals
 from .recording import Recorder, Recording
 from .system import SystemDescription, split_name
 from .values import declarations, parameters
-from .watchdog import TimeLimit, Watchdog, no_limit
-from .wiring import COUPLINGS, check_connections, feedthrough_order, layout, settle
+from .watchdog import Watchdog, no_limit
+from .wiring import (COUPLINGS, check_connections, communication_step, feedthrough_order,
+                     layout, settle)
 
 # the FMUs through fmpy, or their Python classes (else through FMI, with a ``fallback_note``)
 BACKENDS: dict[str, type[Instance]] = {"fmi": FmuInstance, "inprocess": InProcessInstance}
@@ -27,12 +29,14 @@ class Master(contextlib.AbstractContextManager):
     manager: ``with Master(system) as master: recording = master.run()`` frees the FMUs."""
 
     def __init__(self, system: SystemDescription, coupling: str = "gauss-seidel",
-                 backend: str = "fmi", overrides: dict[str, dict[str, Any]] | None = None):
+                 backend: str = "fmi", overrides: dict[str, dict[str, Any]] | None = None,
+                 isolation: Isolation = Isolation()):
         for what, value, known in (("coupling", coupling, COUPLINGS),
                                    ("backend", backend, BACKENDS)):
             if value not in known:
                 raise ValueError(f"{what} must be one of {', '.join(known)}, got {value!r}")
         self.system, self.coupling, self.backend = system, coupling, backend
+        self.isolation = isolation.check(system.components)
         self.paths = {name: system.fmu_path(name) for name in system.components}
         self.declarations = {name: declarations(read_description(path, name, system.ours(path)))
                              for name, path in self.paths.items()}
@@ -40,13 +44,19 @@ class Master(contextlib.AbstractContextManager):
         self.instances: dict[str, Instance] = {}
         self.notes: list[str] = []            # what the user should know about how this runs
         self.backends: dict[str, str] = {}    # how each component runs
+        self.calling: list[str | None] = [None]   # the component whose calls are under way
         self._recorder: Recorder | None = None
         try:
             for name, path in self.paths.items():
                 note = fallback_note(name, path) if backend == "inprocess" else None
                 self.notes += [note] if note else []
-                self.backends[name] = "fmi" if note else backend
-                self.instances[name] = BACKENDS[self.backends[name]](path, name)
+                kind = self.backends[name] = "fmi" if note else backend
+                if isolation.isolates(name, foreign=in_process_refusal(path) is not None):
+                    self.backends[name] = f"{kind}, isolated"
+                    self.instances[name] = IsolatedInstance(path, name, BACKENDS[kind],
+                                                            isolation.memory_limit)
+                else:
+                    self.instances[name] = BACKENDS[kind](path, name)
             check_connections(system, self.instances)
             self.order = feedthrough_order(system, self.instances)
             self._prepare()
@@ -62,7 +72,8 @@ class Master(contextlib.AbstractContextManager):
                                                      self.declarations, overrides)
 
     def _prepare(self) -> None:                 # anew after a reset
-        self.columns, nodes = layout(self.instances, self.system.connections)
+        self.columns, nodes = layout(self.instances, self.system.connections,
+                                     self.coupling == "gauss-seidel", self.calling)
         self.nodes = [nodes[name] for name in (self.order if self.coupling == "gauss-seidel"
                                                else self.instances)]
 
@@ -76,6 +87,7 @@ class Master(contextlib.AbstractContextManager):
         """Enter initialisation, set parameters, propagate initial outputs, exit."""
         t0 = self.system.start_time
         for name, instance in self.instances.items():
+            self.calling[0] = name
             instance.enter_initialization(t0)
             instance.set(self.parameters[name], time=t0)
         self.parameter_values = {name: instance.parameter_values()
@@ -99,32 +111,36 @@ class Master(contextlib.AbstractContextManager):
         t0, h, n_steps = self.system.steps(stop_time)
         recorder = self._recorder = Recorder(self.columns, n_steps + 1, csv_path,
                                              run_meta(self, n_steps), self.units)
-        exchange, values = COUPLINGS[self.coupling], [0.0] * len(self.columns)
+        values = [0.0] * len(self.columns)
         k, t, error, self.parameter_values = 0, t0, None, {}
         beat = watchdog.beat if watchdog is not None else no_limit
+        if watchdog is not None:
+            watchdog.calling = self.calling
         try:
             beat("the initialisation")
             self.initialize()
-            for k in range(n_steps + 1):
-                t = communication_point(t0, k, h)
-                expired, signal = beat(t), stop and stop.received
-                if signal or expired:
-                    t = communication_point(t0, k - 1, h) if k else t0
-                    recorder.interrupted = signal.name if signal else None
-                    error = (f"{'interrupted' if signal else f'{expired}: stopped'} at t = "
-                             f"{t:.6g} s, {recorder.rows} rows kept")
-                    break
-                exchange(self.nodes, values, t, h, k < n_steps)
-                recorder.append(t, values)
-                if progress is not None and k % 100 == 0:
-                    progress(k, n_steps)
-        except (FmuCallError, TimeLimit) as failure:
-            error = f"{failure}\n  " if isinstance(failure, FmuCallError) else ""
-            if watchdog is not None and watchdog.expired:
-                error = f"{watchdog.expired}\n  {error}"
+            with one_cpu(self.instances.values()):
+                for k in range(n_steps + 1):
+                    t = communication_point(t0, k, h)
+                    expired, signal = beat(t), stop and stop.received
+                    if signal or expired:
+                        t = communication_point(t0, k - 1, h) if k else t0
+                        recorder.interrupted = signal.name if signal else None
+                        error = (f"{'interrupted' if signal else f'{expired}: stopped'} at "
+                                 f"t = {t:.6g} s, {recorder.rows} rows kept")
+                        break
+                    communication_step(self.nodes, values, t, h, k < n_steps)
+                    recorder.append(t, values)
+                    if progress is not None and k % 100 == 0:
+                        progress(k, n_steps)
+        except FmuCallError as failure:
+            recorder.meta["failure"] = {"fmu": failure.instance, "call": failure.call,
+                                        "time": failure.time, "status": failure.status,
+                                        "cause": failure.cause}
             if stop is not None and stop.received:     # the step the signal waited for
                 recorder.interrupted = stop.received.name
-            error += f"(run stopped at step {k}, t = {t:.6g} s; {recorder.rows} rows recorded)"
+            error = (f"{failure}\n  (run stopped at step {k}, t = {t:.6g} s; {recorder.rows} "
+                     "rows recorded)")
         finally:
             self._recorder = None
             if self.parameter_values:
@@ -141,7 +157,8 @@ class Master(contextlib.AbstractContextManager):
         self.free()
 
     def free(self) -> None:
-        for instance in self.instances.values():
+        for name, instance in self.instances.items():
+            self.calling[0] = name
             instance.free()
         self.instances = {}
 

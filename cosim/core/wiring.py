@@ -2,7 +2,7 @@
 (a ``Node`` per component) and the coupling algorithms that step it."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from graphlib import CycleError, TopologicalSorter
 from operator import itemgetter
 from typing import Callable
@@ -45,26 +45,40 @@ def feedthrough_order(system: SystemDescription, instances: dict[str, Instance])
 
 @dataclass
 class Node:
-    """One component as the loop sees it: its output columns and prepared calls (or None)."""
-    step: Callable[[float, float], None]
+    """One component as the loop sees it: its columns and prepared calls (or None), and the
+    two it takes part in a communication step with (``start``, ``exchange``; ``couple``)."""
     state: slice                        # Real outputs, no feedthrough
     feedthrough: slice                  # Real outputs, with feedthrough
     integers: slice                     # Integer outputs
+    name: str = ""
+    inputs: slice = field(default_factory=lambda: slice(0))     # connected inputs, as sent
+    sources: list[int] = field(default_factory=list)    # the column feeding each input
+    vrs: list[int] = field(default_factory=list)        # of the outputs, then the inputs
     read_state: Callable[[], list[float]] | None = None
     read_feedthrough: Callable[[], list[float]] | None = None
     read_outputs: Callable[[], list[float]] | None = None   # state and feedthrough at once
     read_integers: Callable[[], list[int]] | None = None
     apply_inputs: Callable[[list[float]], None] | None = None  # values -> this node's inputs
+    start: Callable[[list], None] = lambda values: None
+    exchange: Callable[[list, float, float, bool], None] = lambda values, t, h, step: None
 
     @property
     def outputs(self) -> slice:
         return slice(self.state.start, self.feedthrough.stop)
 
+    def phases(self, gauss_seidel: bool) -> tuple[slice, slice]:
+        """(the outputs read as a step starts, those read once its inputs are set)."""
+        if gauss_seidel:
+            return self.state, slice(self.feedthrough.start, self.integers.stop)
+        return slice(self.state.start, self.integers.stop), slice(self.integers.stop, self.integers.stop)
 
-def layout(instances: dict[str, Instance], connections: list[Connection]
+
+def layout(instances: dict[str, Instance], connections: list[Connection],
+           gauss_seidel: bool = True, calling: list[str | None] | None = None
            ) -> tuple[list[str], dict[str, Node]]:
     """(columns, nodes by name): every output, then every connected input, per component;
-    ``apply_inputs(values)`` sets a node's inputs from their sources and records them as sent."""
+    ``apply_inputs(values)`` sets a node's inputs from their sources and records them as sent;
+    ``calling[0]``: the component whose calls the loop is in (for a watchdog)."""
     columns: list[str] = []
 
     def block(name: str, variables: list) -> slice:
@@ -78,23 +92,24 @@ def layout(instances: dict[str, Instance], connections: list[Connection]
         state = [v.name for v in reals if not instance.feedthrough.get(v.name)]
         ft = [v.name for v in reals if instance.feedthrough.get(v.name)]
         ints = [v.name for v in outputs if v.type == "Integer"]
-        node = nodes[name] = Node(instance.stepper(), block(name, state), block(name, ft),
-                                  block(name, ints))
-        vrs = [instance.vr(v) for v in state + ft]
+        node = nodes[name] = Node(block(name, state), block(name, ft), block(name, ints), name)
+        node.vrs = vrs = [instance.vr(v) for v in state + ft + ints]
         node.read_state = instance.reader(vrs[:len(state)]) if state else None
-        node.read_feedthrough = instance.reader(vrs[len(state):]) if ft else None
-        node.read_outputs = instance.reader(vrs) if vrs else None
-        node.read_integers = instance.reader([instance.vr(v) for v in ints], "Integer") \
-            if ints else None
+        node.read_feedthrough = instance.reader(vrs[len(state):len(reals)]) if ft else None
+        node.read_outputs = instance.reader(vrs[:len(reals)]) if reals else None
+        node.read_integers = instance.reader(vrs[len(reals):], "Integer") if ints else None
     for name, node in nodes.items():
         incoming = [c for c in connections if c.end_element == name]
-        inputs = block(name, [c.end_connector for c in incoming])
+        node.inputs = block(name, [c.end_connector for c in incoming])
         if incoming:
-            sources = [columns.index(f"{c.start_element}.{c.start_connector}")
-                       for c in incoming]
-            write = instances[name].writer([instances[name].vr(c.end_connector)
-                                            for c in incoming])
-            node.apply_inputs = _input_applier(write, sources, inputs)
+            node.sources = [columns.index(f"{c.start_element}.{c.start_connector}")
+                            for c in incoming]
+            node.vrs += [instances[name].vr(c.end_connector) for c in incoming]
+            write = instances[name].writer(node.vrs[-len(incoming):])
+            node.apply_inputs = _input_applier(write, node.sources, node.inputs)
+        own = getattr(instances[name], "couple", None)     # an isolated FMU's: one message
+        node.start, node.exchange = own(node, gauss_seidel) if own else \
+            couple(node, instances[name].stepper(), gauss_seidel, calling or [None])
     return columns, nodes
 
 
@@ -109,44 +124,49 @@ def _input_applier(write: Callable[[list[float]], None], sources: list[int],
     return apply
 
 
-# A coupling algorithm does one communication step from the nodes, the values (one per
-# column), t_k and h: after it ``values`` holds every signal at t_k and, if ``step``, every
-# FMU is at t_k + h.
-def gauss_seidel(nodes: list[Node], values: list[float], t: float, h: float,
-                 step: bool) -> None:
-    """Outputs without feedthrough (the ship's states) at t_k, then each FMU in signal-flow
-    order (the paper's guidance -> autopilot -> ship) takes inputs, gives outputs, steps."""
-    for node in nodes:
-        if node.read_state:
-            values[node.state] = node.read_state()
-    for node in nodes:
-        if node.apply_inputs:
-            node.apply_inputs(values)
-        if node.read_feedthrough:
-            values[node.feedthrough] = node.read_feedthrough()
-        if node.read_integers:
-            values[node.integers] = node.read_integers()
-        if step:
-            node.step(t, h)
+def couple(node: Node, step: Callable[[float, float], None], gauss_seidel: bool,
+           calling: list[str | None]):
+    """(start, exchange) of ``node`` from its prepared calls: Gauss-Seidel's outputs without
+    feedthrough as a step starts, its inputs, outputs with feedthrough and step in signal-flow
+    order; Jacobi's outputs all as the step starts, its inputs and step after."""
+    read_first = node.read_state if gauss_seidel else node.read_outputs
+    first = node.state if gauss_seidel else node.outputs
+    read_ints, apply, name = node.read_integers, node.apply_inputs, node.name
+    read_ft = node.read_feedthrough if gauss_seidel else None
+
+    def start(values: list) -> None:
+        calling[0] = name
+        if read_first:
+            values[first] = read_first()
+        if read_ints and not gauss_seidel:
+            values[node.integers] = read_ints()
+
+    def exchange(values: list, t: float, h: float, advance: bool) -> None:
+        calling[0] = name
+        if apply:
+            apply(values)
+        if read_ft:
+            values[node.feedthrough] = read_ft()
+        if read_ints and gauss_seidel:
+            values[node.integers] = read_ints()
+        if advance:
+            step(t, h)
+    return start, exchange
 
 
-def jacobi(nodes: list[Node], values: list[float], t: float, h: float, step: bool) -> None:
-    """All outputs as they stand, then all inputs, then all FMUs step (OSP libcosim's and
-    ecos's): a feedthrough signal arrives one step later per feedthrough FMU."""
+def communication_step(nodes: list[Node], values: list[float], t: float, h: float,
+                       step: bool) -> None:
+    """After it ``values`` holds every signal at t_k and, if ``step``, every FMU is at t_k + h.
+    Gauss-Seidel (the paper's guidance -> autopilot -> ship, in signal-flow order) or Jacobi
+    (OSP libcosim's and ecos's: a feedthrough signal arrives a step later per feedthrough FMU),
+    as the nodes were laid out: Jacobi's inputs depend only on outputs read as it starts."""
     for node in nodes:
-        if node.read_outputs:
-            values[node.outputs] = node.read_outputs()
-        if node.read_integers:
-            values[node.integers] = node.read_integers()
+        node.start(values)
     for node in nodes:
-        if node.apply_inputs:
-            node.apply_inputs(values)
-    if step:
-        for node in nodes:
-            node.step(t, h)
+        node.exchange(values, t, h, step)
 
 
-COUPLINGS = {"gauss-seidel": gauss_seidel, "jacobi": jacobi}
+COUPLINGS = ("gauss-seidel", "jacobi")
 
 
 def settle(nodes: list[Node], columns: int) -> None:

@@ -18,6 +18,7 @@ from tqdm import tqdm
 
 from ..core.files import FolderBusy, FolderLock
 from ..core.interrupt import Interrupted, StopSignals
+from ..core.isolated import Isolation
 from ..core.watchdog import Limits
 from ..ensemble import SIGNALS
 from .cluster import CONNECT_TIMEOUT, NoWorkers, SweepError, check_workers, connect, say, watched
@@ -36,7 +37,8 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
             progress: bool = True, task=None, scheduler_file: str | None = None,
             backend: str = "fmi", no_worker_timeout: float = NO_WORKER_TIMEOUT,
             connect_timeout: float = CONNECT_TIMEOUT, limits: Limits = Limits(),
-            batch_size: int | None = None, batch_task=None) -> list[dict]:
+            batch_size: int | None = None, batch_task=None,
+            isolation: Isolation = Isolation("foreign")) -> list[dict]:
     """Run every run of ``spec`` without an ok row in ``out``'s journal; every row. SweepError
     if a worker runs other code or another sweep writes ``out``; ClusterError for no cluster."""
     try:
@@ -52,7 +54,7 @@ def execute(spec: Spec, out: Path, scheduler: str | None = None, workers: int | 
                 run_on_cluster(spec, todo, journal,
                                connect(scheduler, workers, scheduler_file, connect_timeout),
                                progress, task or run_one, backend, no_worker_timeout,
-                               limits.check(), batch_task or run_batch, batch_size)
+                               limits.check(), batch_task or run_batch, batch_size, isolation)
     except FolderBusy as busy:
         raise SweepError(str(busy)) from None
     return completed(spec, out)
@@ -79,9 +81,10 @@ def _result(group: list[dict], rows: dict[str, dict]) -> dict | None:
 
 
 def run_locally(spec: Spec, run: dict[str, Any], backend: str = "fmi",
-                limits: Limits = Limits()) -> dict[str, Any]:
+                limits: Limits = Limits(), isolation: Isolation = Isolation("foreign")
+                ) -> dict[str, Any]:
     """One run of ``spec`` in this process, as a worker would (on "batch": a batch of one)."""
-    job = spec.job(run, "local", "inprocess" if backend == BATCH else backend, limits)
+    job = spec.job(run, "local", "inprocess" if backend == BATCH else backend, limits, isolation)
     blobs = {sha: spec.files()[sha].read_bytes() for sha in job.bundle.fmu_hashes()}
     return run_batch([job], blobs)[0] if backend == BATCH else run_one(job, blobs)
 
@@ -162,7 +165,8 @@ def plan(spec: Spec, jobs: list[Job], workers: int, size: int | None = None
 
 def run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, progress: bool,
                    task, backend: str, no_worker_timeout: float, limits: Limits,
-                   batch_task=run_batch, batch_size: int | None = None) -> None:
+                   batch_task=run_batch, batch_size: int | None = None,
+                   isolation: Isolation = Isolation("foreign")) -> None:
     """Run ``todo`` on ``connection`` (client, local cluster or None), journaling each row."""
     client, cluster = connection
     teardown = SweepTeardown(uuid.uuid4().hex[:12])
@@ -185,7 +189,7 @@ def run_on_cluster(spec: Spec, todo: list[dict], journal: Journal, connection, p
             completions.add(future)
 
         route = "inprocess" if backend == BATCH else backend  # a batch's runs alone: in-process
-        jobs = [spec.job(run, token, route, limits) for run in todo]
+        jobs = [spec.job(run, token, route, limits, isolation) for run in todo]
         together, alone = (plan(spec, jobs, sum(client.nthreads().values()) or 1, batch_size)
                            if backend == BATCH else ([], jobs))
         if together:

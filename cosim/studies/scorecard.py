@@ -15,8 +15,11 @@ from ..analysis.reports import PAPER_TABLES
 from ..analysis.seastate import WMO, model_scale
 from ..api import overrides_of
 from ..core.files import fresh_folder, write_atomically
+from ..core.inprocess import in_process_refusal
+from ..core.isolated import Isolation
 from ..core.recording import Recording
 from ..outputs import Options, run_and_write
+from ..scenarios.autopilot import COMPONENT
 from .scorecard_report import BASELINE, SEA_NAMES, Sea, change, markdown, pairs
 from .campaign import execute
 from .spec_file import controller_entry
@@ -69,7 +72,8 @@ def course_change(run: Recording) -> dict[str, float]:
 def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | None = None,
           settings: dict[str, Any] | None = None, workers: int | None = None,
           scheduler: str | None = None,
-          progress: Callable[[str], None] = lambda step: None, backend: str = "fmi") -> str:
+          progress: Callable[[str], None] = lambda step: None, backend: str = "fmi",
+          isolation: Isolation = Isolation("foreign")) -> str:
     """out/scorecard.md of ``fmu`` (called ``name``) and its figures; the markdown. A failed
     run is reported and the scorecard goes on. On "batch" the single runs run in-process."""
     contenders = _contenders(fmu, name, port_map, settings)
@@ -89,7 +93,7 @@ def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | Non
                 scenarios.load(f"{sea}_{c.suffix}", c.fmu, c.port_map), f"{label}_{c.name}",
                 out / "runs", overrides_of(settings), Options(
                     stop_time=stop_time, backend="inprocess" if backend == BATCH else backend,
-                    plot=False)).recording
+                    plot=False, isolation=isolation)).recording
             if recording.error:
                 failures[c.name, test] = recording.error.splitlines()[0]
             else:
@@ -109,15 +113,18 @@ def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | Non
         with fresh_folder(out / ("ensemble" if sea is SEAS[0] else f"ensemble_{sea.key}")) \
                 as folder:
             rows = ensembles[sea] = execute(spec, folder, scheduler=scheduler, workers=workers,
-                                            progress=False, backend=backend)
+                                            progress=False, backend=backend,
+                                            isolation=isolation)
         distribution(spec, rows, out / f"criteria_{sea.key}.png", CRITERIA)
         paired_figure(f"The route in {sea.name}", {
             criterion: {c.name: change(criterion, *pairs(criterion, rows, c.name))
                         for c in contenders if c.name != BASELINE}
             for criterion in CRITERIA}, BASELINE, out / f"paired_{sea.key}.png")
         tracks(spec, rows, out / f"tracks_{sea.key}.png")
+    isolated = isolation.isolates(COMPONENT, foreign=in_process_refusal(fmu) is not None)
     text = markdown(fmu, name, seeds, {c.name: c.paper_cost for c in contenders}, route,
-                    changes, (COURSE_CHANGE_TIME, COURSE_CHANGE_LEG), failures, ensembles)
+                    changes, (COURSE_CHANGE_TIME, COURSE_CHANGE_LEG), failures, ensembles,
+                    isolated)
     write_atomically(out / "scorecard.md", lambda path: path.write_text(text))
     return text
 

@@ -80,9 +80,9 @@ def paired(criterion: Merit, rows: list[dict], controller: str,
 def markdown(fmu: Path, name: str, seeds: int, paper: dict[str, str],
              route: dict[str, dict[str, Recording]], changes: dict[str, dict],
              course: tuple[float, float], failures: dict[tuple[str, str], str],
-             ensembles: dict[Sea, list[dict]]) -> str:
+             ensembles: dict[Sea, list[dict]], isolated: bool = False) -> str:
     """scorecard.md: ``paper`` gives each controller's J calm / waves in the paper ('-');
-    ``course`` the course change's duration (s) and leg (m)."""
+    ``course`` the course change's duration (s) and leg (m); ``isolated``: how ``fmu`` ran."""
     names = list(paper)
     metrics = {sea: {n: run_metrics(run) for n, run in runs.items()} for sea, runs in route.items()}
     lines = [f"# Scorecard: {name}", "",
@@ -93,7 +93,11 @@ def markdown(fmu: Path, name: str, seeds: int, paper: dict[str, str],
              "reached when the ship comes within the guidance's circle of acceptance of it "
              "(waypoints are numbered from 1, the start); a rudder reversal is a crossing "
              "from one side to the other, counted once the rudder is "
-             f"{math.degrees(RUDDER_DEADBAND):g} deg past amidships on the new side.", ""]
+             f"{math.degrees(RUDDER_DEADBAND):g} deg past amidships on the new side.", "",
+             f"`{fmu.name}` ran " + ("in a process of its own (isolated): a crash, exit or hang "
+                                     "in it failed only its own runs, listed below if any." if
+                                     isolated else "in the scorecard's processes (not "
+                                     "isolated)."), ""]
     lines += _at_a_glance(names, metrics, ensembles, seeds)
     lines += _paper_route(paper, route, metrics)
     lines += _course_change(names, changes, *course)

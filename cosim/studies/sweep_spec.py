@@ -18,6 +18,7 @@ from .. import scenarios
 from ..core.system import FmuNotFound, FmuUnreadable
 from ..core.fmi import read_description
 from ..core.inprocess import fallback_note, in_process_refusal
+from ..core.isolated import Isolation
 from ..core.ssd import SystemDescription
 from ..core.values import Declaration, declarations
 from ..core.watchdog import Limits
@@ -168,12 +169,12 @@ class Spec:
         return units
 
     def job(self, run: dict[str, Any], sweep: str, backend: str = "fmi",
-            limits: Limits = Limits()) -> Job:
+            limits: Limits = Limits(), isolation: Isolation = Isolation("foreign")) -> Job:
         """What a worker needs for ``run`` of the sweep whose token is ``sweep``."""
         track = self.tracks is not None and all(run.get(k) == v for k, v in self.tracks.items())
         return Job(sweep=sweep, run=run, bundle=self.bundles()[run["controller"]],
                    overrides=self.settings(run)[1], stop_time=self.stop_time, track=track,
-                   code=code_version(), backend=backend, limits=limits)
+                   code=code_version(), backend=backend, limits=limits, isolation=isolation)
 
     def backend_notes(self, backend: str) -> list[str]:
         """What runs through FMI on "inprocess" or "batch", and alone on "batch", and why."""

@@ -20,9 +20,10 @@ from distributed import WorkerPlugin
 
 from .. import ensemble
 from ..core.files import write_atomically
+from ..core.isolated import Isolation
 from ..core.master import BACKENDS, Master
 from ..core.ssd import SystemDescription
-from ..core.watchdog import Limits, TimeLimit, Watchdog
+from ..core.watchdog import Limits, Watchdog
 from ..provenance import code_version
 from .merit import METRICS, run_metrics, track
 
@@ -102,27 +103,30 @@ class Job:
     code: str                           # the client's code_version(): the worker's must match
     backend: str = "fmi"                # the master's: fmi, or inprocess for our FMUs
     limits: Limits = Limits()           # the run's step and run time limits
+    isolation: Isolation = Isolation("foreign")     # FMUs run in processes of their own
 
 
-Key = tuple[str, int, str, str]                  # (sweep, thread, system digest, backend)
+Key = tuple[str, int, str, str, Isolation]   # (sweep, thread, system digest, backend, isolation)
 _masters: dict[Key, Any] = {}                   # the idle masters
 _busy: dict[Key, Watchdog] = {}                 # the watchdogs of the runs under way
 _ended: set[str] = set()                        # the sweeps torn down in this process
 _lock = threading.Lock()
 
 
-def _key(job: Job) -> Key:
-    return job.sweep, threading.get_ident(), job.bundle.digest, job.backend
+def _key(job: Job, isolated: bool = True) -> Key:
+    return (job.sweep, threading.get_ident(), job.bundle.digest, job.backend,
+            job.isolation if isolated else Isolation())
 
 
-def _take(job: Job, blobs: dict[str, bytes], watchdog: Watchdog):
+def _take(job: Job, blobs: dict[str, bytes], watchdog: Watchdog, isolated: bool = True):
     with _lock:
         if job.sweep in _ended:
             raise RuntimeError("the sweep has ended")
-        master = _masters.pop(_key(job), None)
-        _busy[_key(job)] = watchdog
+        master = _masters.pop(_key(job, isolated), None)
+        _busy[_key(job, isolated)] = watchdog
     if master is None:
-        return Master(materialise(job.bundle, blobs), backend=job.backend)
+        return Master(materialise(job.bundle, blobs), backend=job.backend,
+                      isolation=job.isolation if isolated else Isolation())
     try:
         master.reset()
     except BaseException:
@@ -131,12 +135,12 @@ def _take(job: Job, blobs: dict[str, bytes], watchdog: Watchdog):
     return master
 
 
-def _give_back(job: Job, master, healthy: bool) -> None:
+def _give_back(job: Job, master, healthy: bool, isolated: bool = True) -> None:
     with _lock:
-        _busy.pop(_key(job), None)
+        _busy.pop(_key(job, isolated), None)
         keep = master is not None and healthy and job.sweep not in _ended
         if keep:
-            _masters[_key(job)] = master
+            _masters[_key(job, isolated)] = master
     if master is not None and not keep:
         master.free()
 
@@ -194,7 +198,7 @@ def run_one(job: Job, blobs: dict[str, bytes]) -> dict[str, Any]:
             simulating = time.perf_counter()
             recording = master.run(job.stop_time, watchdog=watchdog)
         row = result_row(job, recording, time.perf_counter() - simulating)
-    except (Exception, TimeLimit) as error:  # a bad setting: not worth retrying
+    except Exception as error:  # a bad setting: not worth retrying
         recording = None
         row = blank_row(job.run, watchdog.expired or f"{type(error).__name__}: {error}")
     finally:
@@ -242,7 +246,7 @@ def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
     try:
         with watchdog:
             watchdog.beat("instantiating the FMUs")
-            master = _take(jobs[0], blobs, watchdog)
+            master = _take(jobs[0], blobs, watchdog, isolated=False)    # the kernel's settings
             members = []
             for job in jobs:                    # one the master refuses: run_one says why
                 with contextlib.suppress(Exception):
@@ -253,10 +257,10 @@ def run_batch(jobs: list[Job], blobs: dict[str, bytes]) -> list[dict[str, Any]]:
                 master.system, [job.overrides for job in members], jobs[0].stop_time,
                 beat=watchdog.beat) if members else []
         failed = watchdog.expired
-    except (Exception, TimeLimit) as error:
+    except Exception as error:
         failed = watchdog.expired or f"{type(error).__name__}: {error}"
     finally:
-        _give_back(jobs[0], master, not failed)
+        _give_back(jobs[0], master, not failed, isolated=False)
     if failed:
         return [noted(run_one(job, blobs), f"the batch failed, {failed}; run alone")
                 for job in jobs]

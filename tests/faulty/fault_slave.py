@@ -7,23 +7,27 @@ NaN), 2 'range' (the propeller command n1 is 100 rev/s, outside the ship's +-50)
 5 'sigterm' (its step sends that signal to its own process, once: Ctrl-C or a
 kill arriving while FMU code runs), 6 'loop' (its step never returns, looping in
 Python), 7 'block' (its step never returns, waiting in C: a sleep that no Python
-exception interrupts), 0 'none'. Where the environment names a file in
-``FAULT_HANG_MARKER``, a step that is about to hang creates it first, so that a test can
-wait for the hang itself instead of for a time.
+exception interrupts), 8 'segv' (a segmentation fault), 9 'exit' (``os._exit(3)``),
+10 'abort' (C's ``abort()``), 11 'memory' (64 MiB more held at each step), 0 'none'. Where
+the environment names a file in ``FAULT_HANG_MARKER``, a step that is about to hang writes
+its process id there first, so that a test can wait for the hang itself instead of for a
+time.
 """
+import ctypes
 import os
 import signal
 import time
 
 from fmukit.slave import ModelSlave, Var
 
-KINDS = ("none", "nan", "range", "raise", "sigint", "sigterm", "loop", "block")
+KINDS = ("none", "nan", "range", "raise", "sigint", "sigterm", "loop", "block", "segv", "exit",
+         "abort", "memory")
 
 
 class Fault:
     def __init__(self, fault_time: float, fault: int):
         self.fault_time, self.fault_kind, self.t = fault_time, KINDS[fault], 0.0
-        self.signalled = False
+        self.signalled, self.held = False, []
 
     def faulty(self, kind: str) -> bool:
         return self.fault_kind == kind and self.t >= self.fault_time
@@ -40,10 +44,19 @@ class Fault:
         if self.fault_kind.startswith("sig") and t >= self.fault_time and not self.signalled:
             self.signalled = True
             os.kill(os.getpid(), getattr(signal, self.fault_kind.upper()))
-        if self.fault_kind in ("loop", "block") and t >= self.fault_time:
+        if t >= self.fault_time and self.fault_kind not in ("none", "nan", "range", "raise"):
             marker = os.environ.get("FAULT_HANG_MARKER")
             if marker:
-                open(marker, "w").close()
+                with open(marker, "w") as f:
+                    f.write(str(os.getpid()))
+        if self.fault_kind == "segv" and t >= self.fault_time:
+            ctypes.string_at(0)
+        if self.fault_kind == "exit" and t >= self.fault_time:
+            os._exit(3)
+        if self.fault_kind == "abort" and t >= self.fault_time:
+            os.abort()
+        if self.fault_kind == "memory" and t >= self.fault_time:
+            self.held.append(bytearray(64 * 2**20))
         if self.fault_kind == "loop" and t >= self.fault_time:
             while True:
                 pass
@@ -67,7 +80,8 @@ class FaultSlave(ModelSlave):
         Var.output("n1", "rev/s", "propeller command", get=lambda s: s.model.n1()),
         Var.parameter("fault_time", 50.0, "s", "time of the fault"),
         Var.parameter("fault", 3, description="0 none, 1 nan, 2 range, 3 raise, 4 sigint, "
-                      "5 sigterm, 6 loop, 7 block", min=0, max=7),
+                      "5 sigterm, 6 loop, 7 block, 8 segv, 9 exit, 10 abort, 11 memory",
+                      min=0, max=11),
     )
 
     def build_model(self) -> Fault:

@@ -2,9 +2,12 @@
 
 With ``fail_time`` set it fails every step from then on (an exception: fmi2Fatal, or
 fmi3Error as an FMI 3.0 twin); with ``hang_time`` its step at that time never returns (a
-loop in Python); with ``hang_terminate`` = 1, Terminate never returns. Built as either FMI
+loop in Python); with ``crash_time``, its step at that time dereferences a null pointer (a
+segmentation fault); with ``hang_terminate`` = 1, Terminate never returns. Built as either FMI
 version from this one script.
 """
+import ctypes
+
 from fmukit.autopilot import INPUTS, rudder_command
 from fmukit.slave import ModelSlave, Var
 
@@ -23,6 +26,7 @@ class IdlePilotSlave(ModelSlave):
     variables = (*INPUTS, rudder_command(depends=(), get=lambda slave: 0.0),
                  Var.parameter("fail_time", 1e9, "s", "fail every step from then on"),
                  Var.parameter("hang_time", 1e9, "s", "loop for ever in the step at this time"),
+                 Var.parameter("crash_time", 1e9, "s", "a segmentation fault at this time"),
                  Var.parameter("hang_terminate", 0, description="1: loop for ever in "
                                "Terminate", min=0, max=1))
 
@@ -34,6 +38,8 @@ class IdlePilotSlave(ModelSlave):
             raise RuntimeError(f"injected failure at t = {t}")
         while t >= self.hang_time:
             pass
+        if t >= self.crash_time:
+            ctypes.string_at(0)
 
     def terminate(self) -> None:
         while self.hang_terminate:

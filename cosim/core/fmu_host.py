@@ -1,0 +1,120 @@
+"""The child's side of an isolated FMU (``core.isolated``): it hosts one FMU and does what
+the master's messages ask, each a kind byte and a length, then a payload; one reply each."""
+from __future__ import annotations
+
+import os
+import pickle
+import struct
+import sys
+import threading
+import time
+from typing import Any, Callable
+
+from .instance import Instance, LogRecord
+
+HEADER = struct.Struct("<cI")             # a message: its kind and length, then its payload
+
+
+def message(kind: bytes, payload: bytes) -> bytes:
+    return HEADER.pack(kind, len(payload)) + payload
+
+
+def send(fd: int, message: bytes) -> None:
+    sent = os.write(fd, message)
+    if sent < len(message):                 # above the pipe's buffer
+        data = memoryview(message)[sent:]
+        while data:
+            data = data[os.write(fd, data):]
+
+
+def receive(fd: int) -> tuple[bytes, bytes]:
+    data = os.read(fd, 65536)
+    while len(data) < HEADER.size or len(data) < HEADER.size + HEADER.unpack_from(data)[1]:
+        more = os.read(fd, 65536)
+        if not more:
+            raise EOFError
+        data += more
+    return data[:1], data[HEADER.size:]
+
+
+def serve() -> None:
+    """Host one FMU for the parent on the other ends of this process's stdin and stdout."""
+    replies = os.dup(1)
+    os.dup2(2, 1)                                  # what the FMU prints goes to stderr
+    limit = int(sys.argv[1])
+    if limit and os.name == "posix":
+        import resource
+        resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+    if os.name == "posix":
+        threading.Thread(target=_orphaned, args=(os.getppid(),), daemon=True).start()
+    host: dict[str, Any] = {}
+    while True:
+        try:
+            kind, payload = receive(0)
+        except EOFError:                            # the parent has gone
+            return
+        try:
+            if kind == b"X":
+                send(replies, host["exchange"](payload))
+                continue
+            method, args = pickle.loads(payload)
+            send(replies, message(b"R", pickle.dumps(_handle(host, method, args))))
+            if method == "free":
+                return
+        except BaseException as error:             # the parent decides what to do
+            records = getattr(error, "records", None)
+            if records is None:
+                records = [LogRecord("fatal", None, f"{type(error).__name__}: {error}")]
+            memory = isinstance(error, MemoryError) or any("MemoryError" in r.text
+                                                            for r in records)
+            send(replies, message(b"E", pickle.dumps((getattr(error, "call", None),
+                                                        getattr(error, "status", "fatal"),
+                                                        records, memory))))
+
+
+def _orphaned(parent: int) -> None:
+    """End this child once its parent has gone (it is given to another parent)."""
+    while os.getppid() == parent:
+        time.sleep(0.5)
+    os._exit(1)
+
+
+def _handle(host: dict[str, Any], method: str, args: tuple) -> Any:
+    if method == "open":                            # the class, by its module's name
+        hosted, path, name = args
+        host["instance"] = hosted(path, name)
+        return None
+    instance = host["instance"]
+    if method == "read":
+        return instance.reader(*args)()
+    if method == "write":
+        return instance.writer(args[0])(args[1])
+    if method == "step":
+        return instance.stepper()(*args)
+    if method == "prepare":
+        host["exchange"] = _exchanger(instance, *args)
+        return None
+    return getattr(instance, method)(*args)       # set, get, the modes, reset, free
+
+
+def _exchanger(instance: Instance, inputs: list[int], then: list, first: list
+               ) -> Callable[[bytes], bytes]:
+    """One step's work on a message: set the inputs, read ``then``, step, read ``first``."""
+    ask = struct.Struct(f"<dd?{len(inputs)}d")
+    size = sum(len(vrs) for vrs, _ in then + first)
+    answer = struct.Struct(f"<cI{size}d")
+    write = instance.writer(inputs) if inputs else None
+    before = [instance.reader(vrs, kind) for vrs, kind in then if vrs]
+    after = [instance.reader(vrs, kind) for vrs, kind in first if vrs]
+    step = instance.stepper()
+
+    def exchange(payload: bytes) -> bytes:
+        t, h, advance, *values = ask.unpack(payload)
+        if write:
+            write(values)
+        out = [v for read in before for v in read()]
+        if advance:
+            step(t, h)
+        out += [v for read in after for v in read()]
+        return answer.pack(b"R", answer.size - HEADER.size, *out)
+    return exchange
