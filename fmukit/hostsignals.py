@@ -1,6 +1,6 @@
-"""Ctrl-C while an FMU computes: the host's signal handler runs in the host's code, not ours
-(in FMU code a KeyboardInterrupt would escape to pythonfmu's C++ layer, which loses it and
-releases the instance once too often): the signal is raised again until the host's code runs."""
+"""Ctrl-C while an FMU computes: the host's handler runs in the host's code, not ours (in FMU
+code a KeyboardInterrupt would escape to pythonfmu's C++ layer, which loses it and releases
+the instance once too often): the signal is raised again until the host's code runs."""
 from __future__ import annotations
 
 import _thread
@@ -11,24 +11,22 @@ import sys
 import threading
 import time
 import traceback
-from types import FrameType
 from typing import Callable
 
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
 _ENTRY_FILE = os.path.join(os.path.dirname(__file__), "entry.py")  # fmi_entry's wrapper
-
 _pending: set[signal.Signals] = set()   # arrived while FMU code ran; not yet handled
 
 
 def _deferring(host_handler: Callable) -> Callable:
-    """The host's handler, run only outside FMU code."""
-    def deferring_handler(number: int, frame: FrameType | None) -> object:
+    def deferring_handler(number: int, frame) -> object:
         if frame is not None and any(f.f_code.co_name == "entry" and f.f_code.co_filename
                                      == _ENTRY_FILE for f, _ in traceback.walk_stack(frame)):
-            first = not _pending
+            first = not _pending            # signalled again each ms until host code runs
             _pending.add(signal.Signals(number))
             if first:
-                threading.Thread(target=_signal_again, name="fmukit-signals", daemon=True).start()
+                threading.Thread(target=_signal_again, name="fmukit-signals",
+                                 daemon=True).start()
             return None
         _pending.discard(signal.Signals(number))
         return host_handler(number, frame)
@@ -37,8 +35,6 @@ def _deferring(host_handler: Callable) -> Callable:
 
 
 def _signal_again() -> None:
-    """Signal the main thread again each millisecond until its handler has run in host
-    code (from the handler itself, it would run again at once, inside itself)."""
     while _pending:
         time.sleep(0.001)
         for number in tuple(_pending):
@@ -47,21 +43,16 @@ def _signal_again() -> None:
 
 def defer_host_handlers() -> None:
     """Wrap the host's Python handlers of SIGINT and SIGTERM (not one with a true
-    ``safe_in_fmu_code``); in a host that is not Python, give SIGINT its default action back."""
-    if not sys.orig_argv:                     # Python embedded by pythonfmu itself
-        _restore_default_sigint()
-    elif threading.current_thread() is threading.main_thread():
+    ``safe_in_fmu_code``); in a host that is not Python, give SIGINT its default action back
+    (undoing Python's start-up handler in the C library that installed it; on Windows, the
+    Universal CRT)."""
+    if not sys.orig_argv and signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        libc = ctypes.CDLL("ucrtbase") if sys.platform == "win32" else ctypes.CDLL(None)
+        libc.signal.argtypes = (ctypes.c_int, ctypes.c_void_p)
+        libc.signal.restype = ctypes.c_void_p
+        libc.signal(signal.SIGINT, None)      # SIG_DFL; Python's own record of it stays
+    elif sys.orig_argv and threading.current_thread() is threading.main_thread():
         for number in SIGNALS:
             handler = signal.getsignal(number)
             if callable(handler) and not getattr(handler, "safe_in_fmu_code", False):
                 signal.signal(number, _deferring(handler))
-
-
-def _restore_default_sigint() -> None:
-    """Undo Python's start-up SIGINT handler in the C library that installed it (Windows: the
-    Universal CRT, not msvcrt.dll); Python's own record of it stays."""
-    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
-        libc = ctypes.CDLL("ucrtbase") if sys.platform == "win32" else ctypes.CDLL(None)
-        libc.signal.argtypes = (ctypes.c_int, ctypes.c_void_p)
-        libc.signal.restype = ctypes.c_void_p
-        libc.signal(signal.SIGINT, None)      # SIG_DFL

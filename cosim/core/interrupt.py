@@ -1,65 +1,81 @@
-"""Ctrl-C and SIGTERM: a request to stop between steps (``StopSignals``: a KeyboardInterrupt
-would fail an FMU's call), or an exception where no FMU runs (``raise_on_signals``)."""
+"""Ctrl-C and SIGTERM: the first asks a run to stop between steps (``StopSignals``: a
+KeyboardInterrupt would fail an FMU's call) or, where no FMU runs, raises ``Interrupted``
+(``raise_on_signals``); a second ends the process at once."""
 from __future__ import annotations
 
+import functools
 import os
 import signal
 import sys
 import threading
-from contextlib import contextmanager
-from typing import Callable, Iterator
+import time
+from typing import Callable
 
-from .isolated import kill_all
+from .isolated import kill_all, kill_awaited
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+_received: list[signal.Signals] = []      # this command's signals so far
 
 
-def take_signals(handler: Callable) -> dict:
-    """``handler`` for SIGINT and SIGTERM (main thread only): the handlers it replaced."""
-    if threading.current_thread() is not threading.main_thread():
-        return {}
-    return {number: signal.signal(number, handler) for number in STOP_SIGNALS}
+class Interrupted(BaseException):
+    """A SIGINT or SIGTERM arrived (a BaseException, as KeyboardInterrupt is)."""
 
-
-def give_back(handlers: dict) -> None:
-    for number, handler in handlers.items():
-        signal.signal(number, handler)
+    def __init__(self, number: int):
+        self.signal = signal.Signals(number)
+        self.exit_status = 128 + self.signal
+        super().__init__(f"interrupted by {self.signal.name}")
 
 
 class StopSignals:
-    """``stop.received``: the first SIGINT or SIGTERM that arrived, or None (main thread)."""
+    """Within (main thread only): ``received``, the first SIGINT or SIGTERM (``raising``: it
+    raises ``Interrupted``); a second kills the isolated FMU's process the loop awaits or ends
+    the process at once, status 130 or 143, after each ``keep`` callback has said what it kept.
+    Not raising, it may run inside an FMU's code (``fmukit.hostsignals``)."""
 
-    def __init__(self) -> None:
-        self.received: signal.Signals | None = None
+    def __init__(self, raising: bool = False) -> None:
+        self.raising, self.received, self.received_at = raising, None, None
         self._keepers: list[Callable[[], str]] = []
         self._ending = threading.Lock()
 
     def __enter__(self) -> StopSignals:
-        self._previous = take_signals(lambda number, frame: self.receive(signal.Signals(number)))
+        if self.raising:                        # a command begins
+            _received.clear()
+
+        def handler(number: int, frame: object) -> None:
+            self.receive(signal.Signals(number))
+        handler.safe_in_fmu_code = not self.raising
+        main = threading.current_thread() is threading.main_thread()
+        self._previous = {n: signal.signal(n, handler) for n in STOP_SIGNALS if main}
         return self
 
     def __exit__(self, *exc) -> None:
-        give_back(self._previous)
+        for number, handler in self._previous.items():
+            signal.signal(number, handler)
         if self.received is not None and not _received:    # a later one ends at once
             _received.append(self.received)
 
     def receive(self, number: signal.Signals) -> None:
-        """The first signal asks the run to stop between steps; a second ends the process at
-        once (status 130 or 143), after each ``keep`` callback has said what is kept."""
-        if self.received is None:
-            self.received = number
+        first = self.received or (_received[0] if _received else None)
+        if first is None:
+            self.received, self.received_at = number, time.monotonic()
+            if self.raising:
+                _received.append(number)
+                raise Interrupted(number)
             return
-        if not self._ending.acquire(blocking=False):
-            return                              # already ending
+        if kill_awaited(threading.get_ident(), f"killed on a second {number.name}") or \
+                not self._ending.acquire(blocking=False):
+            return                              # the loop ends the run; or already ending
         kept = []
         for keeper in self._keepers:
             try:
                 kept.append(keeper())
             except Exception as error:          # the process ends all the same
                 kept.append(f"(could not tidy up: {error})")
-        print(f"{number.name} again: stopped at once; " + ("; ".join(kept) or
-              "nothing of the run under way was written"), file=sys.stderr, flush=True)
-        end_now(128 + self.received)
+        if not (kept or self.raising):
+            kept = ["nothing of the run under way was written"]
+        print(f"{number.name} again: stopped at once" + "".join(f"; {k}" for k in kept),
+              file=sys.stderr, flush=True)
+        end_now(128 + first)
 
     def keep(self, keeper: Callable[[], str]) -> Callable[[], None]:
         """Have ``keeper`` say what it kept if a second signal ends the process; returns an undo."""
@@ -76,37 +92,7 @@ class StopSignals:
             raise Interrupted(self.received)
 
 
-class Interrupted(BaseException):
-    """A SIGINT or SIGTERM arrived (a BaseException, as KeyboardInterrupt is)."""
-
-    def __init__(self, number: int):
-        self.signal = signal.Signals(number)
-        self.exit_status = 128 + self.signal
-        super().__init__(f"interrupted by {self.signal.name}")
-
-
-_received: list[signal.Signals] = []      # this command's signals so far
-
-
-def _raise(number: int, frame) -> None:
-    """The first signal raises ``Interrupted``; one more while it is handled ends at once."""
-    number = signal.Signals(number)
-    if _received:
-        print(f"{number.name} again: stopped at once", file=sys.stderr, flush=True)
-        end_now(128 + _received[0])
-    _received.append(number)
-    raise Interrupted(number)
-
-
-@contextmanager
-def raise_on_signals() -> Iterator[None]:
-    """Within: SIGINT and SIGTERM raise ``Interrupted``, once (main thread only)."""
-    _received.clear()
-    previous = take_signals(_raise)
-    try:
-        yield
-    finally:
-        give_back(previous)
+raise_on_signals = functools.partial(StopSignals, raising=True)
 
 
 def end_now(status: int) -> None:

@@ -22,10 +22,15 @@ from ship_fmu.vessel import N_PROPELLER, Vessel, VesselParameters
 from ..core.master import Master
 from ..core.recording import Recording
 from ..core.ssd import SystemDescription
-from ..core.watchdog import TimeLimit, no_limit
+from ..core.watchdog import no_limit
 from .control import KINDS, GuidanceArrays
 from .reference import COMPONENTS, SIGNALS as ALL_SIGNALS, Member, coverage, initialise, step_models
 from .vessel import VesselArrays
+
+
+class TimeLimit(RuntimeError):
+    """A time limit passed (``beat`` said so): the batch stops."""
+
 
 SIGNALS = ("guidance.psi_d", "guidance.wp_index", "ship.x", "ship.y", "ship.psi",
            "ship.delta")                           # what ``studies.merit.run_metrics`` needs
