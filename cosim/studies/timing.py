@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Callable
 
 from .. import scenarios
+from ..core.isolated import Isolation
 from ..core.master import BACKENDS, Master
 from ..ensemble.reference import run_direct
 from . import in_child
@@ -22,9 +23,12 @@ ROWS = {"direct": "(a) the modules wired by hand (run_direct)",
         "fmi": "(c) our master, FMUs via fmpy",
         "libcosim": "(d) OSP libcosim, same SSP",
         "ecos": "(e) ecos, same SSP",
-        "floor": "(f) FMI floor: a + calls x cost"}
+        "floor": "(f) FMI floor: a + calls x cost",
+        "isolated": "(g) our master, every FMU isolated, via fmpy",
+        "isolated_inprocess": "(h) ... every FMU isolated, in-process"}
 RATIOS = (("b/a", "inprocess", "direct"), ("c/b", "fmi", "inprocess"), ("c/f", "fmi", "floor"),
-          ("d/c", "libcosim", "fmi"), ("e/c", "ecos", "fmi"))
+          ("d/c", "libcosim", "fmi"), ("e/c", "ecos", "fmi"), ("g/c", "isolated", "fmi"),
+          ("h/c", "isolated_inprocess", "fmi"))
 
 
 def peak_rss_mb() -> float:
@@ -107,19 +111,24 @@ def engines(repeats: int) -> dict[str, dict[str, float]]:
             system = scenarios.load(name)
             ssp = export(name, Path(tmp))
             with Master(system, backend="inprocess") as inprocess, \
-                    Master(system, backend="fmi") as fmi:
+                    Master(system, backend="fmi") as fmi, \
+                    Master(system, isolation=Isolation("all")) as isolated, \
+                    Master(system, "gauss-seidel", "inprocess",
+                           isolation=Isolation("all")) as isolated_inprocess:
                 require("in-process backend", inprocess.notes)
                 runners = {"direct": lambda: run_direct(inprocess),
-                           "inprocess": _master_runner(inprocess), "fmi": _master_runner(fmi)}
+                           "inprocess": _master_runner(inprocess), "fmi": _master_runner(fmi),
+                           "isolated": _master_runner(isolated),
+                           "isolated_inprocess": _master_runner(isolated_inprocess)}
                 for key, make in (("libcosim", _libcosim_runner), ("ecos", _ecos_runner)):
                     try:
                         runners[key] = make(ssp)
                     except Exception as error:          # not installed here: say so
                         print(f"  {key} unavailable: {type(error).__name__}: {error}")
                 times = results[name] = side_by_side(runners, repeats)
-                calls = sum(bool(call) for node in fmi.nodes for call in (   # a step's calls
+                calls = sum(1 + sum(bool(call) for call in (   # a step's calls, doStep too
                     node.read_state, node.apply_inputs, node.read_feedthrough,
-                    node.read_integers, node.step))
+                    node.read_integers)) for node in fmi.nodes)
                 per_call = fmi_call_cost(fmi)
             times["floor"] = times["direct"] + STEPS * calls * per_call
             print(f"\n{name}:\n  {'':44} {'wall s':>7} {'us/step':>8} {'RTF':>6} {'x (a)':>6}")
