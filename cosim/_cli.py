@@ -16,7 +16,7 @@ from fmubuild.project import BUILD_HINT, FMU_DIRS, SLAVE_MODULES
 from . import scenarios
 from .api import parse_port_map, parse_setting
 from .core.files import plain_name
-from .core.interrupt import Interrupted, raise_on_signals
+from .core.interrupt import Interrupted, StopSignals
 from .core.isolated import Isolation, default_memory_limit
 from .core.recording import TooManyRows
 from .core.values import fmi_value
@@ -176,7 +176,7 @@ def entry(main: Callable[[], int]) -> int:
     "interrupted" and status 130 or 143, not a traceback."""
     signal.signal(signal.SIGPIPE, signal.SIG_DFL)
     try:
-        with raise_on_signals():
+        with StopSignals(raising=True):
             return main()
     except Interrupted as interrupted:
         print(interrupted, file=sys.stderr)

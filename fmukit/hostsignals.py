@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import _thread
 import ctypes
-import os
 import signal
 import sys
 import threading
@@ -14,14 +13,14 @@ import traceback
 from typing import Callable
 
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
-_ENTRY_FILE = os.path.join(os.path.dirname(__file__), "entry.py")  # fmi_entry's wrapper
+ENTRY = f"{__package__}.entry"                      # fmi_entry's wrapper: FMU code below it
 _pending: set[signal.Signals] = set()   # arrived while FMU code ran; not yet handled
 
 
 def _deferring(host_handler: Callable) -> Callable:
     def deferring_handler(number: int, frame) -> object:
-        if frame is not None and any(f.f_code.co_name == "entry" and f.f_code.co_filename
-                                     == _ENTRY_FILE for f, _ in traceback.walk_stack(frame)):
+        if frame is not None and any(f.f_code.co_name == "entry" and f.f_globals.get("__name__")
+                                     == ENTRY for f, _ in traceback.walk_stack(frame)):
             first = not _pending            # signalled again each ms until host code runs
             _pending.add(signal.Signals(number))
             if first:

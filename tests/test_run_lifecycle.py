@@ -333,7 +333,7 @@ def test_a_sweep_records_a_hung_run_as_failed_and_goes_on(fmu_paths, tmp_path, r
     assert rows[0]["error"].startswith(            # a user's FMU: isolated, by default
         "FMU 'autopilot': doStep at t = 5 s returned no reply: killed when it did not end "
         "within the step time limit of 1 s")
-    assert time.monotonic() - started < 1 + 5 * reference
+    assert time.monotonic() - started < 1 + 10 * reference   # two runs, each its own child
 
 
 def test_names_that_would_write_outside_the_folder_are_refused(tmp_path, capsys):

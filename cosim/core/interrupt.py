@@ -1,17 +1,15 @@
 """Ctrl-C and SIGTERM: the first asks a run to stop between steps (``StopSignals``: a
 KeyboardInterrupt would fail an FMU's call) or, where no FMU runs, raises ``Interrupted``
-(``raise_on_signals``); a second ends the process at once."""
+(``StopSignals(raising=True)``); a second ends the process at once."""
 from __future__ import annotations
 
-import functools
-import os
 import signal
 import sys
 import threading
 import time
 from typing import Callable
 
-from .isolated import kill_all, kill_awaited
+from .isolated import end_now, kill_awaited
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 _received: list[signal.Signals] = []      # this command's signals so far
@@ -90,12 +88,3 @@ class StopSignals:
         """Raise ``Interrupted`` if a signal has arrived."""
         if self.received is not None:
             raise Interrupted(self.received)
-
-
-raise_on_signals = functools.partial(StopSignals, raising=True)
-
-
-def end_now(status: int) -> None:
-    """End the process at once, its FMUs' children first (``core.isolated``)."""
-    kill_all("the master ended")
-    os._exit(status)

@@ -242,6 +242,12 @@ def kill_all(reason: str) -> None:
         instance.kill(reason)
 
 
+def end_now(status: int) -> None:
+    """End this process at once, its children first."""
+    kill_all("the master ended")
+    os._exit(status)
+
+
 def kill_awaited(thread: int, reason: str) -> bool:
     """Kill the child whose reply ``thread`` awaits, if any: that thread gets the failure."""
     instance = _awaited.get(thread)

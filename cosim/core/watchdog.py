@@ -10,15 +10,15 @@ import threading
 import time
 from typing import Callable, NamedTuple
 
-from .interrupt import StopSignals, end_now
-from .isolated import kill_awaited
+from .interrupt import StopSignals
+from .isolated import end_now, kill_awaited
 
 STEP_LIMIT_S = 60.0          # the default step limit, far above a step's or instantiation's
 
 
 class Limits(NamedTuple):
     """Wall-clock limits in seconds (None: none): of a step (or instantiation), of the run
-    (the loop stops at its next step), of the step under way after a signal or the run's."""
+    (it stops at its next step), of the step under way after a signal."""
     step: float | None = STEP_LIMIT_S
     run: float | None = None
     grace: float = 3.0
@@ -37,15 +37,14 @@ def no_limit(what: str | float) -> None:
 
 class Watchdog:
     """``dog.beat(what)`` as each step (its time) or call (a phrase) begins: ``expired``, not
-    None once the run should stop; ``salvage(reason)`` writes what it can and says what."""
+    None once the run should stop (set it to stop it); ``salvage(reason)`` writes what it can
+    and says what."""
 
     def __init__(self, limits: Limits = Limits(), stop: StopSignals | None = None,
                  salvage: Callable[[str], str] | None = None):
         self.limits, self.stop, self.salvage = limits.check(), stop, salvage
         self.expired: str | None = None
         self.calling: list[str | None] = [None]    # the component whose calls are under way
-        self._what: str | float = "the start of the run"
-        self._ran_out: float | None = None         # when the run time limit passed
         self._target, self._done = threading.get_ident(), threading.Event()
         self._thread = threading.Thread(target=self._watch, name="cosim-watchdog", daemon=True)
 
@@ -53,12 +52,9 @@ class Watchdog:
         self._beat, self._what = time.monotonic(), what
         return self.expired
 
-    def halt(self, reason: str) -> None:
-        """Have the loop stop at its next beat, with ``reason`` as its error."""
-        self.expired = reason
-
     def __enter__(self) -> Watchdog:
-        self._beat = self._start = time.monotonic()
+        self.beat("the start of the run")
+        self._start = self._beat
         self._thread.start()
         return self
 
@@ -67,29 +63,25 @@ class Watchdog:
         self._thread.join()
 
     def _deadline(self) -> tuple[float, str]:   # when, and the limit passed then ('': the run's)
-        limits, stop = self.limits, self.stop
-        candidates = [(math.inf, "")]
+        limits, stop, candidates = self.limits, self.stop, [(math.inf, "")]
         if limits.step is not None:
             candidates.append((self._beat + limits.step,
                                f"the step time limit of {limits.step:g} s"))
-        if limits.run is not None and self._ran_out is None:
+        if limits.run is not None and self.expired is None:
             candidates.append((self._start + limits.run, ""))
-        after = (stop.received_at, stop.received.name) if stop and stop.received else \
-            (self._ran_out, "the run time limit")
-        if after[0] is not None:            # the step under way has its grace
-            candidates.append((max(after[0], self._beat) + limits.grace,
-                               f"{limits.grace:g} s of {after[1]}"))
+        if stop and stop.received:                  # the step under way has its grace
+            candidates.append((max(stop.received_at, self._beat) + limits.grace,
+                               f"{limits.grace:g} s of {stop.received.name}"))
         return min(candidates)
 
     def _watch(self) -> None:
-        """Kill or end (status 1, or 130/143 after a signal) past a limit, keeping what can be
-        kept (``salvage``); the run time limit stops the loop at its next beat."""
+        """Past a limit, kill or end (status 1, or 130/143 after a signal) keeping what can be
+        kept (``salvage``); past the run time limit, the loop stops at its next beat."""
         while not self._done.wait(min(max(self._deadline()[0] - time.monotonic(), 0.0), 0.1)):
             deadline, limit = self._deadline()    # a beat while it waited moves the limit
             if time.monotonic() < deadline:
                 continue
             if not limit:
-                self._ran_out = time.monotonic()
                 self.expired = f"the run did not end within its time limit of " \
                                f"{self.limits.run:g} s"
             elif kill_awaited(self._target, f"killed when it did not end within {limit}"):
@@ -104,7 +96,7 @@ class Watchdog:
                     kept = self.salvage(reason) if self.salvage else "nothing was written"
                 except BaseException as error:      # whatever happens, the process ends
                     kept = f"the rows could not be written ({error})"
-                print(f"error: {reason}; {kept}; ending the process (an FMU that does not "
-                      "return cannot be stopped in it: --isolate runs each in a process of "
-                      "its own)", file=sys.stderr, flush=True)
+                print(f"error: {reason}; {kept}; ending the process (an FMU that does not return "
+                      "cannot be stopped in it: --isolate runs each in its own)",
+                      file=sys.stderr, flush=True)
                 end_now(self.stop.exit_status if self.stop and self.stop.received else 1)

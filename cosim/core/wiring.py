@@ -70,7 +70,8 @@ class Node:
         """(the outputs read as a step starts, those read once its inputs are set)."""
         if gauss_seidel:
             return self.state, slice(self.feedthrough.start, self.integers.stop)
-        return slice(self.state.start, self.integers.stop), slice(self.integers.stop, self.integers.stop)
+        end = self.integers.stop
+        return slice(self.state.start, end), slice(end, end)
 
 
 def layout(instances: dict[str, Instance], connections: list[Connection],

@@ -151,7 +151,7 @@ def free_masters(sweep: str | None = None) -> None:
         if sweep is not None:
             _ended.add(sweep)
             for watchdog in (w for key, w in _busy.items() if key[0] == sweep):
-                watchdog.halt("the sweep ended")
+                watchdog.expired = "the sweep ended"    # it stops at its next beat
         masters = [_masters.pop(k) for k in list(_masters) if sweep in (None, k[0])]
     for master in masters:
         master.free()
