@@ -26,7 +26,10 @@ from .scenarios.autopilot import AutopilotError, check_autopilot
 def chosen_scenarios(parser: argparse.ArgumentParser, args: argparse.Namespace) -> list[str]:
     """One SCENARIO (a name or a .ssd path) or --all (the paper's four); --autopilot checked."""
     if args.all == bool(args.scenario):
-        parser.error("give one SCENARIO or --all")
+        took = isinstance(args.isolate, str) and args.isolate not in ("all", "none", "foreign")
+        parser.error("give one SCENARIO or --all" + (f" (--isolate took {args.isolate!r} as the "
+                     "FMUs to isolate: put it after the scenario, or write --isolate=all)"
+                     if took and not args.all else ""))
     names = list(scenarios.PAPER) if args.all else [args.scenario]
     for name in names:
         try:

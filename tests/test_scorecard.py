@@ -89,6 +89,7 @@ def test_the_scorecard_names_the_criteria_each_autopilot_wins_and_loses(fmu_path
                      "--scheduler", scheduler, "--out", str(out), "--backend", "inprocess"]) == 0
     text = (out / "scorecard.md").read_text()
     assert text in capsys.readouterr().out
+    assert "`pd_autopilot.fmu` ran in the scorecard's processes (not isolated)." in text
     # results up front: per sea, every criterion with its side, each controller's verdict
     for sea, folder in (("the paper's waves", "ensemble"), ("WMO sea state 4", "ensemble_sea_"
                                                                                "state_4")):
@@ -216,6 +217,7 @@ def test_an_autopilot_that_fails_is_scored_as_failed_and_the_rest_goes_on(tmp_pa
             "in-process: its module idle_pilot_slave is not importable here") in err
     assert err.count("note:") == 1
     text = (out / "scorecard.md").read_text()
+    assert "`idle_pilot.fmu` ran in a process of its own (isolated)" in text   # foreign
     assert _rows(text, "## The paper's route")["idle_pilot"][:6] == ["failed"] * 6
     assert _rows(text, "## A 40 deg course change")["idle_pilot"] == ["failed"] * 6
     assert _rows(text, "## Wave ensemble: the route in the paper's")["idle_pilot"][0] == "0/1"
