@@ -29,8 +29,10 @@ from fmubuild.project import ROOT
 
 PY = sys.executable
 LIMIT = 120                      # seconds any child process here may take
-FAULTS = {"none": 0, "loop": 6, "block": 7, "segv": 8, "exit": 9, "abort": 10, "memory": 11}
+FAULTS = {"none": 0, "loop": 6, "block": 7, "segv": 8, "exit": 9, "abort": 10, "memory": 11,
+          "spawn": 12}
 CAUSES = {"segv": "its process was ended by signal SIGSEGV",
+          "spawn": "its process was ended by signal SIGSEGV",      # and its sleep ended too
           "exit": "its process exited with status 3",
           "abort": "its process was ended by signal SIGABRT",
           "loop": "killed when it did not end within the step time limit of 1 s",
@@ -96,7 +98,7 @@ def _ended(out: Path, kind: str, marker: Path, cause: str) -> dict:
     return meta
 
 
-@pytest.mark.parametrize("kind", ["segv", "exit", "abort",
+@pytest.mark.parametrize("kind", ["segv", "exit", "abort", "spawn",
                                   pytest.param("loop", marks=pytest.mark.long), "block",
                                   pytest.param("memory", marks=pytest.mark.long)])
 def test_an_isolated_fmu_that_fails_ends_its_run_with_the_rows_and_the_cause(

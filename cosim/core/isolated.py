@@ -138,6 +138,7 @@ class IsolatedInstance(Instance):
             self.kill("it closed its pipe but did not end")
             status = self.process.wait()
         self.discard()
+        self._kill_group()                  # what it started, if anything
         cause = self.killed or f"its process {_ended(status)}"
         error = FmuCallError(self.name, what, time, f"no reply: {cause}", [])
         error.cause = cause
@@ -151,7 +152,14 @@ class IsolatedInstance(Instance):
     def kill(self, reason: str) -> None:
         """End the child at once (from any thread); its caller gets ``reason`` as the cause."""
         self.killed = self.killed or reason
-        self.process.kill()
+        self._kill_group()
+
+    def _kill_group(self) -> None:
+        """The child and what it started in its session (POSIX), or the child alone."""
+        try:
+            os.killpg(self.process.pid, signal.SIGKILL)
+        except (AttributeError, OSError):   # Windows; or the group has ended
+            self.process.kill()
 
     def discard(self) -> None:
         _live.pop(self.process.pid, None)
@@ -189,6 +197,7 @@ class IsolatedInstance(Instance):
             except subprocess.TimeoutExpired:
                 self.process.kill()
                 self.process.wait()
+            self._kill_group()              # what it started and left running, if anything
 
     def reader(self, vrs: list[int], kind: str = "Real") -> Callable[[], list]:
         return lambda: self._remote("read", vrs, kind, what=f"get{kind}")

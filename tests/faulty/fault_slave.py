@@ -8,7 +8,8 @@ NaN), 2 'range' (the propeller command n1 is 100 rev/s, outside the ship's +-50)
 kill arriving while FMU code runs), 6 'loop' (its step never returns, looping in
 Python), 7 'block' (its step never returns, waiting in C: a sleep that no Python
 exception interrupts), 8 'segv' (a segmentation fault), 9 'exit' (``os._exit(3)``),
-10 'abort' (C's ``abort()``), 11 'memory' (64 MiB more held at each step), 0 'none'. Where
+10 'abort' (C's ``abort()``), 11 'memory' (64 MiB more held at each step), 12 'spawn' (a
+``sleep`` process started, then a segmentation fault), 0 'none'. Where
 the environment names a file in ``FAULT_HANG_MARKER``, a step that is about to hang writes
 its process id there first, so that a test can wait for the hang itself instead of for a
 time.
@@ -16,12 +17,13 @@ time.
 import ctypes
 import os
 import signal
+import subprocess
 import time
 
 from fmukit.slave import ModelSlave, Var
 
 KINDS = ("none", "nan", "range", "raise", "sigint", "sigterm", "loop", "block", "segv", "exit",
-         "abort", "memory")
+         "abort", "memory", "spawn")
 
 
 class Fault:
@@ -49,7 +51,9 @@ class Fault:
             if marker:
                 with open(marker, "w") as f:
                     f.write(str(os.getpid()))
-        if self.fault_kind == "segv" and t >= self.fault_time:
+        if self.fault_kind == "spawn" and t >= self.fault_time:
+            subprocess.Popen(["sleep", "1000"])
+        if self.fault_kind in ("segv", "spawn") and t >= self.fault_time:
             ctypes.string_at(0)
         if self.fault_kind == "exit" and t >= self.fault_time:
             os._exit(3)
@@ -80,8 +84,8 @@ class FaultSlave(ModelSlave):
         Var.output("n1", "rev/s", "propeller command", get=lambda s: s.model.n1()),
         Var.parameter("fault_time", 50.0, "s", "time of the fault"),
         Var.parameter("fault", 3, description="0 none, 1 nan, 2 range, 3 raise, 4 sigint, "
-                      "5 sigterm, 6 loop, 7 block, 8 segv, 9 exit, 10 abort, 11 memory",
-                      min=0, max=11),
+                      "5 sigterm, 6 loop, 7 block, 8 segv, 9 exit, 10 abort, 11 memory, "
+                      "12 spawn", min=0, max=12),
     )
 
     def build_model(self) -> Fault:
