@@ -113,3 +113,25 @@ def recorded(name: str, fmi: int = 2, coupling: str = "gauss-seidel", backend: s
         assert recording.error is None, recording.error
         _recordings[key] = recording
     return _recordings[key]
+
+
+def fault_system(path: Path, fault: Path, ship: Path, number: int, stop_time: float,
+                 description: str) -> Path:
+    """An .ssd at ``path``: the ship steered by the fault FMU (``faulty/fault_slave.py``),
+    which goes wrong as ``fault`` ``number`` says at t = 5 s."""
+    from cosim.core.ssd import Component, Connection, SystemDescription, write_ssd
+
+    system = SystemDescription(
+        path.stem, {"fault": Component("fault", str(fault),
+                                       {"psi": ("input", "Real"), "delta_c": ("output", "Real"),
+                                        "n1": ("output", "Real")},
+                                       {"fault_time": 5.0, "fault": number}),
+                    "ship": Component("ship", str(ship),
+                                      {"delta_c": ("input", "Real"), "n1": ("input", "Real"),
+                                       "psi": ("output", "Real")}, {})},
+        [Connection("ship", "psi", "fault", "psi"),
+         Connection("fault", "delta_c", "ship", "delta_c"),
+         Connection("fault", "n1", "ship", "n1")],
+        stop_time=stop_time, report="none", description=description)
+    write_ssd(system, path)
+    return path

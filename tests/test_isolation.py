@@ -22,10 +22,11 @@ import pytest
 from cosim import scenarios
 from cosim.core.isolated import Isolation
 from cosim.core.master import Master
-from cosim.core.ssd import Component, Connection, SystemDescription, read_ssd, write_ssd
+from cosim.core.ssd import read_ssd
 from cosim.core.watchdog import Limits
 from cosim.outputs import Options, run_and_write
 from fmubuild.project import ROOT
+from helpers import fault_system
 
 PY = sys.executable
 LIMIT = 120                      # seconds any child process here may take
@@ -44,23 +45,8 @@ CAUSES = {"segv": "its process was ended by signal SIGSEGV",
 def faulty(fmu_paths, tmp_path_factory, faulty_fmu) -> dict[str, Path]:
     """A system per fault: the ship steered by the fault FMU, which goes wrong at t = 5 s."""
     root, fault = tmp_path_factory.mktemp("faulty"), faulty_fmu("fault")
-    systems = {}
-    for kind, number in FAULTS.items():
-        system = SystemDescription(
-            kind, {"fault": Component("fault", str(fault),
-                                      {"psi": ("input", "Real"), "delta_c": ("output", "Real"),
-                                       "n1": ("output", "Real")},
-                                      {"fault_time": 5.0, "fault": number}),
-                   "ship": Component("ship", str(fmu_paths["ship"]),
-                                     {"delta_c": ("input", "Real"), "n1": ("input", "Real"),
-                                      "psi": ("output", "Real")}, {})},
-            [Connection("ship", "psi", "fault", "psi"),
-             Connection("fault", "delta_c", "ship", "delta_c"),
-             Connection("fault", "n1", "ship", "n1")],
-            stop_time=20.0, report="none", description=f"goes wrong: {kind}")
-        systems[kind] = root / f"{kind}.ssd"
-        write_ssd(system, systems[kind])
-    return systems
+    return {kind: fault_system(root / f"{kind}.ssd", fault, fmu_paths["ship"], number, 20.0,
+                               f"goes wrong: {kind}") for kind, number in FAULTS.items()}
 
 
 @pytest.fixture

@@ -22,10 +22,9 @@ import pytest
 from cosim import run as cli
 from cosim.core.files import FolderLock, Outputs, OutputError, whole_file
 from cosim.core.interrupt import StopSignals
-from cosim.core.ssd import Component, Connection, SystemDescription, write_ssd
 from cosim.core.watchdog import Limits, Watchdog
 from fmubuild.project import ROOT
-from helpers import reference_seconds
+from helpers import fault_system, reference_seconds
 
 PY = sys.executable
 LIMIT = 120                      # seconds any child process here may take
@@ -41,25 +40,9 @@ def reference(tmp_path_factory, fmu_paths) -> float:
 @pytest.fixture(scope="module")
 def hung(fmu_paths, tmp_path_factory, faulty_fmu) -> dict[str, Path]:
     """A system per kind: the ship steered by the fault FMU, which hangs from t = 5 s."""
-    root = tmp_path_factory.mktemp("hung")
-    fault = faulty_fmu("fault")
-    systems = {}
-    for kind, number in KINDS.items():
-        system = SystemDescription(
-            kind, {"fault": Component("fault", str(fault),
-                                      {"psi": ("input", "Real"), "delta_c": ("output", "Real"),
-                                       "n1": ("output", "Real")},
-                                      {"fault_time": 5.0, "fault": number}),
-                   "ship": Component("ship", str(fmu_paths["ship"]),
-                                     {"delta_c": ("input", "Real"), "n1": ("input", "Real"),
-                                      "psi": ("output", "Real")}, {})},
-            [Connection("ship", "psi", "fault", "psi"),
-             Connection("fault", "delta_c", "ship", "delta_c"),
-             Connection("fault", "n1", "ship", "n1")],
-            stop_time=1000.0, report="none", description=f"hangs: {kind}")
-        systems[kind] = root / f"{kind}.ssd"
-        write_ssd(system, systems[kind])
-    return systems
+    root, fault = tmp_path_factory.mktemp("hung"), faulty_fmu("fault")
+    return {kind: fault_system(root / f"{kind}.ssd", fault, fmu_paths["ship"], number, 1000.0,
+                               f"hangs: {kind}") for kind, number in KINDS.items()}
 
 
 def _run(args: list[str], cwd: Path, **popen) -> subprocess.CompletedProcess:
