@@ -106,16 +106,17 @@ class IsolatedInstance(Instance):
     def _ask(self, request: bytes, what: str, time: float | None = None) -> bytes:
         """The child's reply to ``request`` (a whole message); FmuCallError if the FMU refused
         or the child did not reply."""
-        thread = threading.get_ident()
+        thread, doing = threading.get_ident(), ("instantiate", None)
         _awaited[thread] = self
         try:
             if self._opening:
                 self._opening = False
-                self._reply(receive(self._from), "instantiate", None)
+                self._reply(receive(self._from), *doing)
+            doing = (what, time)
             send(self._to, request)
             kind, payload = receive(self._from)
         except (EOFError, OSError):
-            raise self._failure(what, time) from None
+            raise self._failure(*doing) from None
         finally:
             del _awaited[thread]
         return payload if kind == b"R" else self._reply((kind, payload), what, time)
