@@ -209,7 +209,7 @@ def test_what_to_isolate_is_checked_before_anything_runs(tmp_path, capsys):
                       (["--memory-limit", "2G"], "--memory-limit limits the processes of "
                                                  "isolated FMUs; add --isolate"),
                       (["--isolate", "--memory-limit", "2X"], "expected a size such as 512M"),
-                      (["--isolate", "--memory-limit", "1K"], "at least 1 MiB")):
+                      (["--isolate", "--memory-limit", "1K"], "must be from 1 MiB to 4 EiB")):
         with pytest.raises(SystemExit):
             cli.main(["calm_pd", "--out", str(tmp_path), *bad])
         assert said in capsys.readouterr().err

@@ -42,17 +42,24 @@ def serve() -> None:
     replies = os.dup(1)
     os.dup2(2, 1)                                  # what the FMU prints goes to stderr
     limit = int(sys.argv[1])
-    if limit and os.name == "posix":
+    if limit and os.name == "posix":                # within a hard limit already set
         import resource
-        resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+        hard = resource.getrlimit(resource.RLIMIT_AS)[1]
+        resource.setrlimit(resource.RLIMIT_AS, (limit if hard == resource.RLIM_INFINITY
+                                                else min(limit, hard), hard))
     if os.name == "posix":
         threading.Thread(target=_orphaned, args=(os.getppid(),), daemon=True).start()
+    try:
+        _serve(replies)
+    except (EOFError, OSError) as error:            # the parent has gone, or the FMU closed
+        if not isinstance(error, EOFError):         # a pipe: the parent reads the end
+            print(f"FMU host: the master's pipe failed ({error}); ending", file=sys.stderr)
+
+
+def _serve(replies: int) -> None:
     host: dict[str, Any] = {}
     while True:
-        try:
-            kind, payload = receive(0)
-        except EOFError:                            # the parent has gone
-            return
+        kind, payload = receive(0)
         try:
             if kind == b"X":
                 send(replies, host["exchange"](payload))

@@ -57,8 +57,9 @@ class Isolation:
             if not chosen:
                 raise ValueError(f"isolate: expected all, none, foreign or component names, "
                                  f"got {which!r}")
-        if memory_limit is not None and not memory_limit >= 2**20:
-            raise ValueError(f"the memory limit must be at least 1 MiB, got {memory_limit!r}")
+        if memory_limit is not None and not 2**20 <= memory_limit < 2**62:
+            raise ValueError(f"the memory limit must be from 1 MiB to 4 EiB, got "
+                             f"{memory_limit!r} bytes")
         return cls(chosen, memory_limit)
 
     def isolates(self, name: str, foreign: bool) -> bool:
