@@ -215,3 +215,21 @@ def test_what_to_isolate_is_checked_before_anything_runs(tmp_path, capsys):
         assert said in capsys.readouterr().err
     assert Isolation.of(True) == Isolation("all") and Isolation.of(None).chosen == "none"
     assert Isolation.of("autopilot, ship").chosen == ("autopilot", "ship")
+
+
+def test_a_child_dead_between_messages_fails_its_run_under_the_commands_sigpipe(fmu_paths):
+    """The commands give SIGPIPE its default action (``cosim._cli.entry``): writing to a dead
+    child must not end the master."""
+    code = ("import os, signal, time\nfrom cosim import scenarios\n"
+            "from cosim.core.isolated import Isolation\nfrom cosim.core.master import Master\n"
+            "signal.signal(signal.SIGPIPE, signal.SIG_DFL)\n"
+            "with Master(scenarios.load('calm_pd'), isolation=Isolation(('autopilot',))) as m:\n"
+            "    child = m.instances['autopilot'].process\n"
+            "    os.kill(child.pid, signal.SIGKILL)\n"
+            "    child.wait()\n"
+            "    print(m.run().error.splitlines()[0])\n")
+    done = subprocess.run([PY, "-c", code], capture_output=True, text=True, timeout=LIMIT,
+                          env={**os.environ, "PYTHONPATH": str(ROOT)})
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith("FMU 'autopilot': ") and \
+        done.stdout.rstrip().endswith("returned no reply: its process was ended by signal SIGKILL")

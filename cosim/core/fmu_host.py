@@ -2,6 +2,7 @@
 the master's messages ask, each a kind byte and a length, then a payload; one reply each."""
 from __future__ import annotations
 
+import functools
 import os
 import pickle
 import struct
@@ -19,12 +20,13 @@ def message(kind: bytes, payload: bytes) -> bytes:
     return HEADER.pack(kind, len(payload)) + payload
 
 
-def send(fd: int, message: bytes) -> None:
-    sent = os.write(fd, message)
+def send(write: Callable[[bytes], int], message: bytes) -> None:
+    """``message`` whole through ``write`` (``os.write`` on a descriptor, say)."""
+    sent = write(message)
     if sent < len(message):                 # above the pipe's buffer
         data = memoryview(message)[sent:]
         while data:
-            data = data[os.write(fd, data):]
+            data = data[write(data):]
 
 
 def receive(fd: int) -> tuple[bytes, bytes]:
@@ -39,8 +41,9 @@ def receive(fd: int) -> tuple[bytes, bytes]:
 
 def serve() -> None:
     """Host one FMU for the parent on the other ends of this process's stdin and stdout."""
-    replies = os.dup(1)
-    os.dup2(2, 1)                                  # what the FMU prints goes to stderr
+    requests, replies = os.dup(0), functools.partial(os.write, os.dup(1))   # not inherited
+    os.dup2(os.open(os.devnull, os.O_RDONLY), 0)   # by what the FMU starts, which reads
+    os.dup2(2, 1)                                  # nothing; what it prints goes to stderr
     limit = int(sys.argv[1])
     if limit and os.name == "posix":                # within a hard limit already set
         import resource
@@ -50,16 +53,16 @@ def serve() -> None:
     if os.name == "posix":
         threading.Thread(target=_orphaned, args=(os.getppid(),), daemon=True).start()
     try:
-        _serve(replies)
+        _serve(requests, replies)
     except (EOFError, OSError) as error:            # the parent has gone, or the FMU closed
         if not isinstance(error, EOFError):         # a pipe: the parent reads the end
             print(f"FMU host: the master's pipe failed ({error}); ending", file=sys.stderr)
 
 
-def _serve(replies: int) -> None:
+def _serve(requests: int, replies: Callable[[bytes], int]) -> None:
     host: dict[str, Any] = {}
     while True:
-        kind, payload = receive(0)
+        kind, payload = receive(requests)
         try:
             if kind == b"X":
                 send(replies, host["exchange"](payload))

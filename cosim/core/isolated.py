@@ -4,9 +4,11 @@ doStep, outputs) down the child's standard input and reads the reply from its st
 the child hosts the FMU as the master would have (``fmi`` or ``inprocess``)."""
 from __future__ import annotations
 
+import functools
 import os
 import pickle
 import signal
+import socket
 import struct
 import subprocess
 import sys
@@ -93,15 +95,25 @@ class IsolatedInstance(Instance):
         self.guid, self.memory_limit = self.description.guid, memory_limit
         self.variables, self.feedthrough = described(self.description)
         self.killed: str | None = None          # why the watchdog killed the child
-        own = {"start_new_session": True} if os.name == "posix" else \
-            {"creationflags": subprocess.CREATE_NEW_PROCESS_GROUP}    # no Ctrl-C from the terminal
+        if os.name == "posix":     # its own session (no Ctrl-C from the terminal); a socket,
+            mine, theirs = socket.socketpair()      # so that a dead child raises no SIGPIPE
+            own: dict[str, Any] = {"start_new_session": True, "stdin": theirs, "stdout": theirs}
+        else:
+            own = {"creationflags": subprocess.CREATE_NEW_PROCESS_GROUP,
+                   "stdin": subprocess.PIPE, "stdout": subprocess.PIPE}
         path_list = os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))
-        self.process = subprocess.Popen(
-            [sys.executable, "-c", CHILD, str(memory_limit or 0)], stdin=subprocess.PIPE,
-            stdout=subprocess.PIPE, env={**os.environ, "PYTHONPATH": path_list}, **own)
-        self._to, self._from = self.process.stdin.fileno(), self.process.stdout.fileno()
+        self.process = subprocess.Popen([sys.executable, "-c", CHILD, str(memory_limit or 0)],
+                                        env={**os.environ, "PYTHONPATH": path_list}, **own)
+        if os.name == "posix":
+            theirs.close()
+            self._pipes, self._from = [mine], mine.fileno()
+            self._write = lambda data: mine.send(data, socket.MSG_NOSIGNAL)
+        else:
+            self._pipes, self._from = [self.process.stdin, self.process.stdout], \
+                self.process.stdout.fileno()
+            self._write = functools.partial(os.write, self.process.stdin.fileno())
         _live[self.process.pid] = self
-        send(self._to, message(b"C", pickle.dumps(("open", (hosted, str(self.path), name)))))
+        send(self._write, message(b"C", pickle.dumps(("open", (hosted, str(self.path), name)))))
         self._opening = True     # its reply is read with the next call's: children start together
 
     def _ask(self, request: bytes, what: str, time: float | None = None) -> bytes:
@@ -114,7 +126,7 @@ class IsolatedInstance(Instance):
                 self._opening = False
                 self._reply(receive(self._from), *doing)
             doing = (what, time)
-            send(self._to, request)
+            send(self._write, request)
             kind, payload = receive(self._from)
         except (EOFError, OSError):
             raise self._failure(*doing) from None
@@ -165,7 +177,7 @@ class IsolatedInstance(Instance):
 
     def discard(self) -> None:
         _live.pop(self.process.pid, None)
-        for pipe in (self.process.stdin, self.process.stdout):
+        for pipe in self._pipes:
             try:
                 pipe.close()
             except OSError:                 # a write the dead child never read
