@@ -17,7 +17,7 @@ from . import scenarios
 from .api import parse_port_map, parse_setting
 from .core.files import plain_name
 from .core.interrupt import Interrupted, StopSignals
-from .core.isolated import Isolation, default_memory_limit
+from .core.isolation import Isolation, default_memory_limit
 from .core.recording import TooManyRows
 from .core.values import fmi_value
 from .scenarios.autopilot import AutopilotError, check_autopilot
@@ -115,9 +115,9 @@ def isolation(parser: argparse.ArgumentParser, args: argparse.Namespace) -> Isol
     if args.memory_limit is not None and args.isolate == "none":
         parser.error("--memory-limit limits the processes of isolated FMUs; add --isolate")
     try:
-        return Isolation.of(args.isolate, args.memory_limit or default_memory_limit())
+        return Isolation.of(args.isolate, args.memory_limit)
     except ValueError as error:
-        parser.error(str(error))
+        parser.error(str(error).replace("isolate", "--isolate", 1))
 
 
 def add_fmu_options(parser: argparse.ArgumentParser, also: str) -> None:

@@ -5,10 +5,11 @@ from pathlib import Path
 from typing import Any, Iterable, Mapping, Sequence
 
 from . import scenarios
-from .core.isolated import Isolation, default_memory_limit
+from .core.isolation import Isolation
 from .core.master import BACKENDS, Master
 from .core.system import split_name
 from .core.recording import Recording
+from .core.watchdog import STEP_LIMIT_S, Limits, Watchdog
 
 
 class SimulationError(RuntimeError):
@@ -59,29 +60,38 @@ def simulate(scenario: str | Path, autopilot: str | Path | None = None,
              set: dict[str, Any] | None = None, stop_time: float | None = None,
              coupling: str = "gauss-seidel", backend: str = "fmi",
              port_map: dict[str, str] | None = None, fmi: int | None = None,
-             isolate: bool | str | Sequence[str] = False,
-             memory_limit: int | None = default_memory_limit()) -> Recording:
+             isolate: bool | str | Sequence[str] = False, memory_limit: int | None = None,
+             step_timeout: float = STEP_LIMIT_S) -> Recording:
     """The recording of a scenario (a name or a .ssd path): ``autopilot`` an FMU in its
     autopilot's place, ``set`` values by "component.variable" (SI units), ``isolate`` which
-    FMUs run in a process of their own (True: all; ``memory_limit`` in bytes), the rest as
-    ``cosim.run``'s options. ValueError for bad input; SimulationError if an FMU fails."""
+    FMUs run in a process of their own (True: all; ``memory_limit`` in bytes; where every FMU
+    is, a step past ``step_timeout`` s kills its FMU's process), the rest as ``cosim.run``'s
+    options. ValueError for bad input; SimulationError if an FMU fails."""
     with Master(scenarios.load(scenario, autopilot, port_map, fmi=fmi), coupling=coupling,
                 backend=backend, overrides=overrides_of(set or {}),
                 isolation=Isolation.of(isolate, memory_limit)) as master:
         for note in master.notes:
             warnings.warn(note, stacklevel=2)
-        recording = master.run(stop_time)
+        recording = _run(master, stop_time, step_timeout)
     if recording.error:
         raise SimulationError(recording.error, recording)
     return recording
+
+
+def _run(master: Master, stop_time: float | None, step_timeout: float) -> Recording:
+    """``master.run``; with a step limit where every FMU is isolated (none can hang here)."""
+    if not all(kind.endswith("isolated") for kind in master.backends.values()):
+        return master.run(stop_time)
+    with Watchdog(Limits(step=step_timeout)) as watchdog:
+        return master.run(stop_time, watchdog=watchdog)
 
 
 def simulate_many(scenario: str | Path, sets: Sequence[Mapping[str, Any]],
                   autopilot: str | Path | None = None, stop_time: float | None = None,
                   backend: str = "batch", port_map: dict[str, str] | None = None,
                   fmi: int | None = None, signals: Sequence[str] | None = None,
-                  isolate: bool | str | Sequence[str] = False,
-                  memory_limit: int | None = default_memory_limit()) -> list[Recording]:
+                  isolate: bool | str | Sequence[str] = False, memory_limit: int | None = None,
+                  step_timeout: float = STEP_LIMIT_S) -> list[Recording]:
     """The recordings of a scenario run once for each of ``sets`` (each ``simulate``'s
     ``set``), in order; "batch" steps them together as arrays, holding ``signals`` (``isolate``
     as ``simulate``'s, on the other backends). A failed run raises nothing (its ``error`` says
@@ -112,7 +122,7 @@ def simulate_many(scenario: str | Path, sets: Sequence[Mapping[str, Any]],
         for member in overrides:
             with Master(system, backend=backend, overrides=member,
                         isolation=isolation) as master:
-                recording = master.run(stop_time)
+                recording = _run(master, stop_time, step_timeout)
             recordings.append(recording if signals is None else recording.holding(signals))
     for note in dict.fromkeys(n for r in recordings for n in r.meta.get("notes", [])):
         warnings.warn(note, stacklevel=2)

@@ -10,8 +10,9 @@ from typing import Any, Callable
 from .analysis.metrics import LAMBDA, Cost, cost
 from .analysis.reports import course_keeping_report, title, turning_circle_report, zigzag_report
 from .core.files import FolderLock, Outputs
-from .core.interrupt import StopSignals
-from .core.isolated import Isolation
+from .core.instance import FmuCallError
+from .core.interrupt import Interrupted, StopSignals
+from .core.isolation import Isolation
 from .core.master import Master
 from .provenance import write_metadata
 from .core.recording import Recording
@@ -76,7 +77,7 @@ def run_and_write(system: SystemDescription, label: str, out: Path,
             def salvage(reason: str) -> str:      # the watchdog's, if the run never returns
                 recording = finished[0] if finished else \
                     master.abandon(reason) if master is not None else None
-                if recording is None:
+                if recording is None or not recording.rows:
                     return f"nothing was written; {_discard(outputs, label)}"
                 _write_rows(recording, outputs, label, options.stream)
                 csv, meta = outputs.commit()
@@ -85,8 +86,13 @@ def run_and_write(system: SystemDescription, label: str, out: Path,
             try:
                 with Watchdog(options.limits, stop, salvage) as watchdog:
                     watchdog.beat(f"instantiating {', '.join(system.components)}")
-                    master = Master(system, coupling=options.coupling, overrides=overrides,
-                                    backend=options.backend, isolation=options.isolation)
+                    try:
+                        master = Master(system, coupling=options.coupling, overrides=overrides,
+                                        backend=options.backend, isolation=options.isolation)
+                    except FmuCallError:            # a child killed after a signal
+                        if stop is not None and stop.received:
+                            raise Interrupted(stop.received) from None
+                        raise
                     with master:
                         for note in master.notes:
                             notes(note)
@@ -105,9 +111,9 @@ def run_and_write(system: SystemDescription, label: str, out: Path,
                     outcome.status = 128 + int(signal.Signals[recording.interrupted])
                 elif recording.error:
                     outcome.status = 1
-                    if not recording.rows:
-                        outputs.discard()   # nothing was computed: the earlier outputs stay
-                        return outcome
+                if outcome.status and not recording.rows:
+                    outputs.discard()       # nothing was computed: the earlier outputs stay
+                    return outcome
                 outcome.written = _write_rows(recording, outputs, label, options.stream)
                 if not (recording.error or options.stream):
                     _analyse(outcome, system, label, outputs, options, parameters)

@@ -16,6 +16,7 @@ from tqdm import tqdm
 
 from ._cli import (add_isolation_options, add_port_options, checked_autopilot, count, entry,
                    isolation, say_error, say_note, setting_option, writable_folder)
+from . import scenarios
 from .api import overrides_of
 from .core.files import FolderBusy, OutputError
 from .studies.scorecard import BASELINES, SEAS, backend_notes, score
@@ -55,6 +56,10 @@ def main(argv: list[str] | None = None) -> int:
     add_isolation_options(parser, "foreign")
     args = parser.parse_args(argv)
     isolated = isolation(parser, args)
+    try:                                    # every contender has the same components
+        isolated.check(scenarios.load("calm_pd").components)
+    except ValueError as error:
+        parser.error(f"--{error}")
     if not 1 <= args.seeds <= MAX_RUNS // 4:
         parser.error(f"--seeds must be from 1 to {MAX_RUNS // 4} (four contenders, at most "
                      f"{MAX_RUNS} runs an ensemble), got {args.seeds}")

@@ -79,6 +79,11 @@ def main(argv: list[str] | None = None) -> int:
     except Interrupted as stopped:
         print(f"{stopped} while reading {args.spec}: no run was started", file=sys.stderr)
         return stopped.exit_status
+    for controller, shipped in spec.bundles().items():     # what to isolate, before any run
+        try:
+            isolated.check(shipped.system.components)
+        except ValueError as error:
+            parser.error(f"controller {controller!r}: --{error}")
     out = writable_folder(args.out / spec.name)
     stage = "running the sweep"
     try:

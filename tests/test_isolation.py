@@ -20,7 +20,7 @@ from pathlib import Path
 import pytest
 
 from cosim import scenarios
-from cosim.core.isolated import Isolation
+from cosim.core.isolation import Isolation
 from cosim.core.master import Master
 from cosim.core.ssd import read_ssd
 from cosim.core.watchdog import Limits
@@ -31,9 +31,10 @@ from helpers import fault_system
 PY = sys.executable
 LIMIT = 120                      # seconds any child process here may take
 FAULTS = {"none": 0, "loop": 6, "block": 7, "segv": 8, "exit": 9, "abort": 10, "memory": 11,
-          "spawn": 12}
+          "spawn": 12, "garble": 13}
 CAUSES = {"segv": "its process was ended by signal SIGSEGV",
           "spawn": "its process was ended by signal SIGSEGV",      # and its sleep ended too
+          "garble": "it garbled its reply (something in it wrote to the master's socket)",
           "exit": "its process exited with status 3",
           "abort": "its process was ended by signal SIGABRT",
           "loop": "killed when it did not end within the step time limit of 1 s",
@@ -84,7 +85,7 @@ def _ended(out: Path, kind: str, marker: Path, cause: str) -> dict:
     return meta
 
 
-@pytest.mark.parametrize("kind", ["segv", "exit", "abort", "spawn",
+@pytest.mark.parametrize("kind", ["segv", "exit", "abort", "spawn", "garble",
                                   pytest.param("loop", marks=pytest.mark.long), "block",
                                   pytest.param("memory", marks=pytest.mark.long)])
 def test_an_isolated_fmu_that_fails_ends_its_run_with_the_rows_and_the_cause(
@@ -202,26 +203,44 @@ def test_the_isolated_route_gives_the_fmi_route_s_bytes(fmu_paths, name, tmp_pat
 def test_what_to_isolate_is_checked_before_anything_runs(tmp_path, capsys):
     from cosim import run as cli
 
-    with pytest.raises(ValueError, match="--isolate names pilot, which the system does not "
+    with pytest.raises(ValueError, match="isolate names pilot, which the system does not "
                                          "have; its components: guidance, autopilot, ship"):
         Master(scenarios.load("calm_pd"), isolation=Isolation(("pilot",)))
     for bad, said in ((["--isolate", ","], "expected all, none, foreign or component names"),
                       (["--memory-limit", "2G"], "--memory-limit limits the processes of "
                                                  "isolated FMUs; add --isolate"),
                       (["--isolate", "--memory-limit", "2X"], "expected a size such as 512M"),
-                      (["--isolate", "--memory-limit", "1K"], "must be from 1 MiB to 4 EiB")):
+                      (["--isolate", "--memory-limit", "1K"], "bytes from 1 MiB to 4 EiB, got 1024")):
         with pytest.raises(SystemExit):
             cli.main(["calm_pd", "--out", str(tmp_path), *bad])
         assert said in capsys.readouterr().err
     assert Isolation.of(True) == Isolation("all") and Isolation.of(None).chosen == "none"
     assert Isolation.of("autopilot, ship").chosen == ("autopilot", "ship")
+    for which, limit, said in ((1, None, "expected all, none, foreign or component names"),
+                               (True, 1.5e9, "a whole number of bytes"),
+                               (True, "2G", "a whole number of bytes"),
+                               (False, 2**30, "isolate some")):
+        with pytest.raises(ValueError, match=said):
+            Isolation.of(which, limit)
+
+
+def test_a_sweep_refuses_an_fmu_to_isolate_that_a_controller_lacks(tmp_path, capsys):
+    from cosim import sweep
+
+    spec = tmp_path / "spec.toml"
+    spec.write_text('stop_time = 5\n[controllers]\npd = "calm_pd"\n[axes]\nwave_seed = [1]\n')
+    with pytest.raises(SystemExit):
+        sweep.main([str(spec), "--isolate", "pilot", "--out", str(tmp_path / "out")])
+    assert "controller 'pd': --isolate names pilot, which the system does not have" in \
+        capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
 
 
 def test_a_child_dead_between_messages_fails_its_run_under_the_commands_sigpipe(fmu_paths):
     """The commands give SIGPIPE its default action (``cosim._cli.entry``): writing to a dead
     child must not end the master."""
     code = ("import os, signal, time\nfrom cosim import scenarios\n"
-            "from cosim.core.isolated import Isolation\nfrom cosim.core.master import Master\n"
+            "from cosim.core.isolation import Isolation\nfrom cosim.core.master import Master\n"
             "signal.signal(signal.SIGPIPE, signal.SIG_DFL)\n"
             "with Master(scenarios.load('calm_pd'), isolation=Isolation(('autopilot',))) as m:\n"
             "    child = m.instances['autopilot'].process\n"

@@ -29,8 +29,14 @@ def send(write: Callable[[bytes], int], message: bytes) -> None:
             data = data[write(data):]
 
 
+class Garbled(OSError):
+    """What came is not a message: something else wrote to the descriptor."""
+
+
 def receive(fd: int) -> tuple[bytes, bytes]:
     data = os.read(fd, 65536)
+    if data[:1] not in (b"", b"C", b"X", b"R", b"E"):
+        raise Garbled(data[:20])
     while len(data) < HEADER.size or len(data) < HEADER.size + HEADER.unpack_from(data)[1]:
         more = os.read(fd, 65536)
         if not more:
@@ -45,13 +51,13 @@ def serve() -> None:
     os.dup2(os.open(os.devnull, os.O_RDONLY), 0)   # by what the FMU starts, which reads
     os.dup2(2, 1)                                  # nothing; what it prints goes to stderr
     limit = int(sys.argv[1])
+    if os.name == "posix":
+        threading.Thread(target=_orphaned, args=(os.getppid(),), daemon=True).start()
     if limit and os.name == "posix":                # within a hard limit already set
         import resource
         hard = resource.getrlimit(resource.RLIMIT_AS)[1]
         resource.setrlimit(resource.RLIMIT_AS, (limit if hard == resource.RLIM_INFINITY
                                                 else min(limit, hard), hard))
-    if os.name == "posix":
-        threading.Thread(target=_orphaned, args=(os.getppid(),), daemon=True).start()
     try:
         _serve(requests, replies)
     except (EOFError, OSError) as error:            # the parent has gone, or the FMU closed

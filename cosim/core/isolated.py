@@ -1,4 +1,4 @@
-"""FMUs in processes of their own (``--isolate``): a crash, an exit, a hang or runaway memory
+"""FMUs in processes of their own (``--isolate``, ``core.isolation``): a crash, an exit, a hang or runaway memory
 ends the FMU's child, not the run. The master sends one message per FMU per step (inputs,
 doStep, outputs) down the child's standard input and reads the reply from its standard output;
 the child hosts the FMU as the master would have (``fmi`` or ``inprocess``)."""
@@ -14,75 +14,19 @@ import subprocess
 import sys
 import threading
 from contextlib import contextmanager
-from dataclasses import dataclass
 from operator import itemgetter
 from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator
 
 from .fmi import described, read_description
-from .fmu_host import HEADER, message, receive, send
+from .fmu_host import HEADER, Garbled, message, receive, send
 from .instance import FmuCallError, Instance
 
 ROOT = Path(__file__).resolve().parents[2]
 CHILD = "from cosim.core.fmu_host import serve; serve()"
+GARBLED = "it garbled its reply (something in it wrote to the master's socket)"
 _live: dict[int, IsolatedInstance] = {}   # every child running, by process id
 _awaited: dict[int, IsolatedInstance] = {}    # thread id: the child whose reply it awaits
-
-
-def default_memory_limit() -> int | None:
-    """Three quarters of this machine's memory, in bytes (None where it cannot be read)."""
-    try:
-        return os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE") * 3 // 4
-    except (AttributeError, ValueError, OSError):
-        return None
-
-
-@dataclass(frozen=True)
-class Isolation:
-    """Which components run in a process of their own: "none", "all", "foreign" (an FMU not
-    built from this checkout) or their names; each child's address-space limit in bytes."""
-    chosen: str | tuple[str, ...] = "none"
-    memory_limit: int | None = default_memory_limit()
-
-    @classmethod
-    def of(cls, which: bool | str | Iterable[str] | None,
-           memory_limit: int | None = default_memory_limit()) -> Isolation:
-        """From what a user gives: True ("all"), False or None ("none"), "all", "none",
-        "foreign", "name,name" or names; ValueError for no name or a limit below 1 MiB."""
-        if which is None or isinstance(which, bool):
-            chosen: str | tuple[str, ...] = "all" if which else "none"
-        elif which in ("all", "none", "foreign"):
-            chosen = which
-        else:
-            chosen = tuple(n.strip() for n in (which.split(",") if isinstance(which, str)
-                                               else which) if n.strip())
-            if not chosen:
-                raise ValueError(f"isolate: expected all, none, foreign or component names, "
-                                 f"got {which!r}")
-        if memory_limit is not None and not 2**20 <= memory_limit < 2**62:
-            raise ValueError(f"the memory limit must be from 1 MiB to 4 EiB, got "
-                             f"{memory_limit!r} bytes")
-        return cls(chosen, memory_limit)
-
-    def isolates(self, name: str, foreign: bool) -> bool:
-        if isinstance(self.chosen, str):
-            return self.chosen == "all" or (self.chosen == "foreign" and foreign)
-        return name in self.chosen
-
-    def check(self, components: Iterable[str]) -> Isolation:
-        """ValueError naming a component to isolate that the system does not have."""
-        unknown = [] if isinstance(self.chosen, str) else \
-            [name for name in self.chosen if name not in components]
-        if unknown:
-            raise ValueError(f"--isolate names {', '.join(unknown)}, which the system does not "
-                             f"have; its components: {', '.join(components)}")
-        return self
-
-
-def _ended(status: int) -> str:
-    if status < 0:
-        return f"was ended by signal {signal.Signals(-status).name}"
-    return f"exited with status {status}"
 
 
 class IsolatedInstance(Instance):
@@ -95,6 +39,7 @@ class IsolatedInstance(Instance):
         self.guid, self.memory_limit = self.description.guid, memory_limit
         self.variables, self.feedthrough = described(self.description)
         self.killed: str | None = None          # why the watchdog killed the child
+        self._busy = False
         if os.name == "posix":     # its own session (no Ctrl-C from the terminal); a socket,
             mine, theirs = socket.socketpair()      # so that a dead child raises no SIGPIPE
             own: dict[str, Any] = {"start_new_session": True, "stdin": theirs, "stdout": theirs}
@@ -116,11 +61,12 @@ class IsolatedInstance(Instance):
         send(self._write, message(b"C", pickle.dumps(("open", (hosted, str(self.path), name)))))
         self._opening = True     # its reply is read with the next call's: children start together
 
-    def _ask(self, request: bytes, what: str, time: float | None = None) -> bytes:
-        """The child's reply to ``request`` (a whole message); FmuCallError if the FMU refused
-        or the child did not reply."""
+    def _ask(self, request: bytes, what: str, time: float | None = None,
+             size: int | None = None) -> bytes:
+        """The child's reply to ``request`` (a whole message; ``size``: the payload's);
+        FmuCallError if the FMU refused or the child did not reply (or garbled its reply)."""
         thread, doing = threading.get_ident(), ("instantiate", None)
-        _awaited[thread] = self
+        _awaited[thread], self._busy = self, True   # busy: an exception would leave it so
         try:
             if self._opening:
                 self._opening = False
@@ -128,17 +74,25 @@ class IsolatedInstance(Instance):
             doing = (what, time)
             send(self._write, request)
             kind, payload = receive(self._from)
-        except (EOFError, OSError):
+        except (EOFError, OSError) as error:
+            if isinstance(error, Garbled):
+                self.kill(GARBLED)
             raise self._failure(*doing) from None
         finally:
             del _awaited[thread]
-        return payload if kind == b"R" else self._reply((kind, payload), what, time)
+        self._busy = False
+        return self._reply((kind, payload), what, time, size)
 
-    def _reply(self, answer: tuple[bytes, bytes], what: str, time: float | None) -> bytes:
+    def _reply(self, answer: tuple[bytes, bytes], what: str, time: float | None,
+               size: int | None = None) -> bytes:
         kind, payload = answer
-        if kind == b"R":
+        if kind == b"R" and size in (None, len(payload)):
             return payload
-        call, status, records, memory = pickle.loads(payload)
+        try:                            # a refusal; anything else: garbled
+            call, status, records, memory = pickle.loads(payload if kind == b"E" else b"")
+        except Exception:
+            self.kill(GARBLED)
+            raise self._failure(what, time) from None
         limit = f"its memory limit of {(self.memory_limit or 0) / 2**20:.0f} MiB"
         error = FmuCallError(self.name, call or what, time,
                              f"{status}, out of {limit}" if memory else status, records)
@@ -153,7 +107,8 @@ class IsolatedInstance(Instance):
             status = self.process.wait()
         self.discard()
         self._kill_group()                  # what it started, if anything
-        cause = self.killed or f"its process {_ended(status)}"
+        cause = self.killed or (f"its process was ended by signal {signal.Signals(-status).name}"
+                                if status < 0 else f"its process exited with status {status}")
         error = FmuCallError(self.name, what, time, f"no reply: {cause}", [])
         error.cause = cause
         return error
@@ -201,13 +156,14 @@ class IsolatedInstance(Instance):
 
     def free(self) -> None:
         if self.process.poll() is None and _live.get(self.process.pid) is self:
-            try:
-                self._remote("free", what="terminate and freeInstance")
+            try:                        # after a call the master gave up on: no more calls
+                self._remote("free", what="terminate and freeInstance") if not self._busy \
+                    else self.kill("the master stopped waiting for its reply")
             except FmuCallError:
                 self.kill("it failed to end")
             self.discard()
-            try:
-                self.process.wait(5.0)
+            try:                        # it has replied: it ends now unless a thread holds it
+                self.process.wait(1.0)
             except subprocess.TimeoutExpired:
                 self.process.kill()
                 self.process.wait()
@@ -252,7 +208,8 @@ class IsolatedInstance(Instance):
         def exchange(values: list, t: float, h: float, step: bool) -> None:
             sent = gather(values)
             got = answer.unpack(self._ask(ask.pack(b"X", size, t, h, step, *sent),
-                                          "doStep" if step else "setReal and get", t))
+                                          "doStep" if step else "setReal and get", t,
+                                          answer.size))
             values[node.inputs], values[then], cached[0] = sent, got[:n_then], got[n_then:]
             if ints and gauss_seidel:
                 values[integers] = map(int, values[integers])

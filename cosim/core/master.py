@@ -11,7 +11,8 @@ from fmukit.timebase import communication_point
 from .fmi import FmuInstance, read_description
 from .inprocess import InProcessInstance, fallback_note, in_process_refusal
 from .instance import FmuCallError, Instance
-from .isolated import IsolatedInstance, Isolation, one_cpu
+from .isolated import IsolatedInstance, one_cpu
+from .isolation import Isolation
 from .interrupt import StopSignals
 from .recording import Recorder, Recording
 from .system import SystemDescription, split_name
@@ -94,7 +95,8 @@ class Master(contextlib.AbstractContextManager):
                                  for name, instance in self.instances.items()}
         settle(self.nodes, len(self.columns))
         failures = []
-        for instance in self.instances.values():
+        for name, instance in self.instances.items():
+            self.calling[0] = name
             try:
                 instance.exit_initialization(t0)
             except FmuCallError as error:

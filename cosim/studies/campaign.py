@@ -18,7 +18,7 @@ from tqdm import tqdm
 
 from ..core.files import FolderBusy, FolderLock
 from ..core.interrupt import Interrupted, StopSignals
-from ..core.isolated import Isolation
+from ..core.isolation import Isolation
 from ..core.watchdog import Limits
 from ..ensemble import SIGNALS
 from .cluster import CONNECT_TIMEOUT, NoWorkers, SweepError, check_workers, connect, say, watched

@@ -16,7 +16,7 @@ from ..analysis.seastate import WMO, model_scale
 from ..api import overrides_of
 from ..core.files import fresh_folder, write_atomically
 from ..core.inprocess import in_process_refusal
-from ..core.isolated import Isolation
+from ..core.isolation import Isolation
 from ..core.recording import Recording
 from ..outputs import Options, run_and_write
 from ..scenarios.autopilot import COMPONENT

@@ -18,7 +18,7 @@ from .. import scenarios
 from ..core.system import FmuNotFound, FmuUnreadable
 from ..core.fmi import read_description
 from ..core.inprocess import fallback_note, in_process_refusal
-from ..core.isolated import Isolation
+from ..core.isolation import Isolation
 from ..core.ssd import SystemDescription
 from ..core.values import Declaration, declarations
 from ..core.watchdog import Limits

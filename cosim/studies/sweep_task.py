@@ -20,7 +20,7 @@ from distributed import WorkerPlugin
 
 from .. import ensemble
 from ..core.files import write_atomically
-from ..core.isolated import Isolation
+from ..core.isolation import Isolation
 from ..core.master import BACKENDS, Master
 from ..core.ssd import SystemDescription
 from ..core.watchdog import Limits, Watchdog

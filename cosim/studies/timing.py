@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Callable
 
 from .. import scenarios
-from ..core.isolated import Isolation
+from ..core.isolation import Isolation
 from ..core.master import BACKENDS, Master
 from ..ensemble.reference import run_direct
 from . import in_child

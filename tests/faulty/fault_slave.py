@@ -9,7 +9,8 @@ kill arriving while FMU code runs), 6 'loop' (its step never returns, looping in
 Python), 7 'block' (its step never returns, waiting in C: a sleep that no Python
 exception interrupts), 8 'segv' (a segmentation fault), 9 'exit' (``os._exit(3)``),
 10 'abort' (C's ``abort()``), 11 'memory' (64 MiB more held at each step), 12 'spawn' (a
-``sleep`` process started, then a segmentation fault), 0 'none'. Where
+``sleep`` process started, then a segmentation fault), 13 'garble' (bytes written to every
+descriptor from 3 to 29, as a careless FMU might), 0 'none'. Where
 the environment names a file in ``FAULT_HANG_MARKER``, a step that is about to hang writes
 its process id there first, so that a test can wait for the hang itself instead of for a
 time.
@@ -23,7 +24,7 @@ import time
 from fmukit.slave import ModelSlave, Var
 
 KINDS = ("none", "nan", "range", "raise", "sigint", "sigterm", "loop", "block", "segv", "exit",
-         "abort", "memory", "spawn")
+         "abort", "memory", "spawn", "garble")
 
 
 class Fault:
@@ -51,6 +52,12 @@ class Fault:
             if marker:
                 with open(marker, "w") as f:
                     f.write(str(os.getpid()))
+        if self.fault_kind == "garble" and t >= self.fault_time:
+            for fd in range(3, 30):
+                try:
+                    os.write(fd, b"garbage")
+                except OSError:
+                    pass
         if self.fault_kind == "spawn" and t >= self.fault_time:
             subprocess.Popen(["sleep", "1000"])
         if self.fault_kind in ("segv", "spawn") and t >= self.fault_time:
@@ -85,7 +92,7 @@ class FaultSlave(ModelSlave):
         Var.parameter("fault_time", 50.0, "s", "time of the fault"),
         Var.parameter("fault", 3, description="0 none, 1 nan, 2 range, 3 raise, 4 sigint, "
                       "5 sigterm, 6 loop, 7 block, 8 segv, 9 exit, 10 abort, 11 memory, "
-                      "12 spawn", min=0, max=12),
+                      "12 spawn, 13 garble", min=0, max=13),
     )
 
     def build_model(self) -> Fault:
