@@ -149,6 +149,47 @@ def test_whole_file_and_outputs_leave_nothing_when_interrupted(tmp_path):
     assert _folder(tmp_path) == {"x.ssp": b"old", "x.csv": b"old"}
 
 
+def test_a_run_s_files_are_replaced_together_or_not_at_all(tmp_path, monkeypatch):
+    """Issue 38: the JSON could not be put in place (an immutable file, a permission) after the
+    CSV was: the folder held the new CSV beside the old JSON."""
+    from cosim.core import files
+
+    for name in ("x.csv", "x.json", "mine.txt"):
+        (tmp_path / name).write_text(f"old {name}")
+    before, replace = _folder(tmp_path), os.replace
+
+    def refuse_json(source, target):             # as for an immutable x.json
+        if Path(source) == tmp_path / "x.json":
+            raise PermissionError(1, "Operation not permitted", str(source))
+        replace(source, target)
+    monkeypatch.setattr(files.os, "replace", refuse_json)
+    with pytest.raises(OutputError, match=f"cannot write {tmp_path / 'x.json'}: Operation not "
+                                          f"permitted; the earlier files in {tmp_path} are as"):
+        with Outputs(tmp_path, [tmp_path / "x.csv", tmp_path / "x.json"], "x") as outputs:
+            for name in ("x.csv", "x.json"):
+                with outputs.writing(name) as path:
+                    path.write_text(f"new {name}")
+    assert _folder(tmp_path) == before
+    monkeypatch.setattr(files.os, "replace", replace)
+    with Outputs(tmp_path, [tmp_path / "x.csv", tmp_path / "x.json"], "x") as outputs:
+        for name in ("x.csv", "x.json"):
+            with outputs.writing(name) as path:
+                path.write_text(f"new {name}")
+    assert _folder(tmp_path) == {**before, "x.csv": b"new x.csv", "x.json": b"new x.json"}
+    before = _folder(tmp_path)
+
+    def refuse_to_x_json(source, target):       # set aside, then neither placed nor put back
+        if Path(target) == tmp_path / "x.json":
+            raise PermissionError(1, "Operation not permitted", str(target))
+        replace(source, target)
+    monkeypatch.setattr(files.os, "replace", refuse_to_x_json)
+    with pytest.raises(OutputError, match="the earlier files it could not put back are in "):
+        with Outputs(tmp_path, [], "x") as outputs, outputs.writing("x.json") as path:
+            path.write_text("newer")
+    kept = next(tmp_path.glob("earlier-*"))
+    assert (kept / "x.json").read_bytes() == before["x.json"]      # nothing lost
+
+
 @pytest.mark.parametrize("kind, backend", [    # quick: each kind and each backend once
     ("loop", "fmi"), ("block", "inprocess"), pytest.param("block", "fmi", marks=pytest.mark.long),
     pytest.param("loop", "inprocess", marks=pytest.mark.long)])

@@ -140,19 +140,37 @@ class Outputs(contextlib.AbstractContextManager):
                               f"the earlier files in {self.folder} are kept") from error
 
     def commit(self) -> list[Path]:
-        """Rename every staged file into place, then remove the stale ones."""
-        placed = []
-        for staged in sorted(self.stage.iterdir()):
-            target = self.folder / staged.name
-            try:
-                os.replace(staged, target)
-            except OSError as error:
-                raise OutputError(target, error) from error
-            placed.append(target)
-        for old in self.stale - set(placed):
+        """Rename every staged file into place, each earlier one set aside until all are in;
+        if one cannot go (a permission, an immutable file), every earlier file is put back
+        (OutputError). Then remove the stale ones."""
+        staged = sorted(self.stage.iterdir())
+        aside = Path(tempfile.mkdtemp(dir=self.stage))
+        done: list[tuple[Path, bool]] = []          # (target, an earlier file set aside)
+        try:
+            for path in staged:
+                target = self.folder / path.name
+                earlier = target.exists() or target.is_symlink()
+                if earlier:
+                    os.replace(target, aside / path.name)
+                done.append((target, earlier))
+                os.replace(path, target)
+        except OSError as error:
+            lost = False
+            for placed, earlier in reversed(done):      # the new ones out, the earlier back
+                try:
+                    os.replace(aside / placed.name, placed) if earlier else \
+                        placed.unlink(missing_ok=True)
+                except OSError:
+                    lost = True
+            kept = f"the earlier files in {self.folder} are as they were"
+            if lost:                                    # not deleted with the stage
+                kept = "the earlier files it could not put back are in " + \
+                    str(aside.rename(self.folder / f"earlier-{aside.name}"))
+            raise OutputError(target, error, kept) from error
+        for old in self.stale - {target for target, _ in done}:
             old.unlink(missing_ok=True)
         self.discard()
-        return placed
+        return [target for target, _ in done]
 
     def discard(self) -> None:
         shutil.rmtree(self.stage, ignore_errors=True)
