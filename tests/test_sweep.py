@@ -205,6 +205,30 @@ def test_a_journal_has_one_writer(fmu_paths, tmp_path):
             campaign.execute(spec, tmp_path, workers=1, progress=False)
 
 
+def test_a_journal_is_a_file_of_its_own_and_a_bad_line_is_skipped(tmp_path, capsys):
+    """Issue 38: an undecodable line stopped a resume; a symbolic link was followed."""
+    journal = tmp_path / "runs.jsonl"
+    journal.write_bytes(b'{"run_id": "a", "status": "ok"}\n\xff\xfe not UTF-8\n'
+                        b'{"run_id": "b", "status": "failed"}\n')
+    assert sorted(campaign.read_rows(journal)) == ["a", "b"]
+    assert f"warning: {journal}:2 is not a whole journal row" in capsys.readouterr().err
+    elsewhere = tmp_path / "elsewhere.jsonl"
+    elsewhere.write_text("")
+    (tmp_path / "linked").mkdir()
+    (tmp_path / "linked" / "runs.jsonl").symlink_to(elsewhere)
+    with pytest.raises(SweepError, match="runs.jsonl is a symbolic link; remove it"):
+        campaign.Journal(tmp_path / "linked" / "runs.jsonl")
+    assert elsewhere.read_text() == ""
+
+
+def test_a_spec_nested_too_deeply_is_refused_by_name(tmp_path):
+    spec = tmp_path / "deep.toml"
+    spec.write_text("x = " + "[" * 5000 + "]" * 5000 + "\n")
+    with pytest.raises(ValueError, match="deep.toml: its tables or arrays are nested too "
+                                         "deeply"):
+        Spec.read(spec)
+
+
 @pytest.mark.timeout(600, method="thread")
 def test_a_worker_killed_on_every_retry_is_recorded_as_failed(fmu_paths, tmp_path):
     """The nannies restart the workers each time. Under load, a nanny was seen to close

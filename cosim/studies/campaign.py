@@ -92,9 +92,9 @@ def run_locally(spec: Spec, run: dict[str, Any], backend: str = "fmi",
 def read_rows(path: Path, quiet: bool = False) -> dict[str, dict]:
     """A journal's rows by run id, the last for each; a torn line is skipped, with a warning."""
     rows: dict[str, dict] = {}
-    for number, line in enumerate(path.read_text().splitlines() if path.exists() else [], 1):
+    for number, line in enumerate(path.read_bytes().splitlines() if path.exists() else [], 1):
         try:
-            row = json.loads(line)
+            row = json.loads(line)              # bytes: not UTF-8 is a ValueError
             rows[row["run_id"]] = row
         except (ValueError, KeyError, TypeError):
             if line.strip() and not quiet:
@@ -107,13 +107,19 @@ class Journal:
     """A sweep's journal, opened by its one writer (who holds the folder's ``FolderLock``)."""
 
     def __init__(self, path: Path):
+        if path.is_symlink():
+            raise SweepError(f"the sweep journal {path} is a symbolic link; remove it (a "
+                             "journal is read and written only as a file of its own)")
         self.path, self.rows = path, read_rows(path)
         if path.exists() and path.read_bytes()[-1:] not in (b"", b"\n"):  # a torn last line
             with open(path, "ab") as f:
                 f.write(b"\n")
 
     def add(self, row: dict) -> None:
-        with open(self.path, "a") as f:
+        """Append ``row``, on disk before it returns; never through a symbolic link."""
+        handle = os.open(self.path, os.O_WRONLY | os.O_APPEND | os.O_CREAT |
+                         getattr(os, "O_NOFOLLOW", 0), 0o644)
+        with open(handle, "a") as f:
             f.write(json.dumps(row) + "\n")
             f.flush()
             os.fsync(f.fileno())

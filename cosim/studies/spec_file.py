@@ -69,6 +69,9 @@ def parse(path: Path, max_runs: int) -> dict[str, Any]:
         data = tomllib.loads(read_small_text(path, 16 << 20))
     except ValueError as error:                 # TOMLDecodeError too
         raise ValueError(f"cannot read sweep spec {path}: {error}") from None
+    except RecursionError:
+        raise ValueError(f"cannot read sweep spec {path}: its tables or arrays are nested "
+                         "too deeply") from None
     _table(path, "", data, FILE_KEYS)
     name = plain_name(data.get("name", path.stem), f"{path}: name")
     entries = data.get("controllers", DEFAULT_CONTROLLERS)
