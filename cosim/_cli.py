@@ -4,10 +4,12 @@ import argparse
 import contextlib
 import functools
 import math
+import os
 import re
 import signal
 import sys
 import tempfile
+import threading
 from pathlib import Path
 from typing import Any, Callable
 
@@ -184,6 +186,21 @@ def entry(main: Callable[[], int]) -> int:
     except Interrupted as interrupted:
         print(interrupted, file=sys.stderr)
         return interrupted.exit_status
+
+
+def leave(status: int) -> None:
+    """End the command with ``status``, even if an FMU in this process left a thread of its
+    own running (Python would wait for it for ever), saying so."""
+    left = [t.name for t in threading.enumerate()
+            if not t.daemon and t is not threading.main_thread()]
+    if not left:
+        sys.exit(status)
+    print(f"note: threads still running after the command ({', '.join(left)}), started by an "
+          "FMU in this process; ending without them (--isolate runs FMUs apart)",
+          file=sys.stderr)
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(status)
 
 
 def writable_folder(path: Path) -> Path:

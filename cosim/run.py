@@ -23,7 +23,7 @@ from tqdm import tqdm
 
 from . import scenarios
 from ._cli import (add_fmu_options, add_isolation_options, chosen_scenarios, entry, isolation,
-                   number_option, positive_seconds, say_error, say_note, setting_option,
+                   leave, number_option, positive_seconds, say_error, say_note, setting_option,
                    writable_folder)
 from .analysis.metrics import LAMBDA, Cost
 from .analysis.reports import conditions, headline, tables
@@ -199,4 +199,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(entry(main))
+    leave(entry(main))

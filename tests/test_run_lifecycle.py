@@ -502,6 +502,20 @@ def test_an_fmu_that_hangs_in_terminate_keeps_the_finished_run(fmu_paths, tmp_pa
     assert json.loads((out / "calm_pd-idle_pilot.json").read_text())["rows"] == 101
 
 
+def test_a_thread_an_fmu_leaves_running_does_not_keep_the_command_alive(tmp_path, faulty_fmu):
+    """Issue 38: an FMU's thread that is not a daemon kept cosim.run alive after its outputs
+    were written; now the command says so and ends with its status."""
+    pilot = faulty_fmu("idle_pilot")
+    result = _run(["calm_pd", "--autopilot", str(pilot), "--set", "autopilot.linger_time=1",
+                   "--stop-time", "3", "--no-plot", "--out", str(tmp_path / "out")], tmp_path,
+                  env={**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), str(
+                      ROOT / "tests" / "faulty")])})
+    assert result.returncode == 0, result.stderr
+    assert "note: threads still running after the command (lingerer), started by an FMU" in \
+        result.stderr
+    assert json.loads((tmp_path / "out" / "calm_pd-idle_pilot.json").read_text())["rows"] == 31
+
+
 def test_steps_each_shorter_than_the_limit_never_expire_it():
     """The watchdog waited until the deadline of the step it saw and then judged that one:
     a step begun meanwhile was flagged at once (0.1 s steps under a 1 s limit: a step would
