@@ -2,6 +2,7 @@
 attribute (issue 25), never a traceback."""
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -250,3 +251,25 @@ def test_the_command_line_refuses_a_malformed_ssd_in_one_line(tmp_path, case):
     assert "Traceback" not in child.stderr
     assert child.stderr.startswith(f"error: {path}: ") and fragment in child.stderr
     assert child.stderr.count("error:") == 1, child.stderr
+
+
+def test_names_that_no_file_takes_as_they_are_are_refused_up_front(tmp_path):
+    """Issue 38: a component named 'auto,pilot' gave a CSV whose header had more fields than
+    its rows, every column after it mislabelled, exit 0."""
+    from cosim.core.ssd import Component, SystemDescription, read_ssd, write_ssd
+
+    for bad in ("auto,pilot", "1st", "a b", "pilot\n", "é", ""):
+        with pytest.raises(ValueError, match=f"component name {re.escape(repr(bad))}: a "
+                                             "component is named with ASCII letters"):
+            SystemDescription("s", {bad: Component(bad, "x.fmu")}, [])
+    with pytest.raises(ValueError, match="pilot.psi,d: a connector's name holds no comma"):
+        SystemDescription("s", {"pilot": Component("pilot", "x.fmu",
+                                                   {"psi,d": ("input", "Real")})}, [])
+    SystemDescription("s", {"auto_pilot2": Component("auto_pilot2", "x.fmu",
+                                                     {"der(x)[1].y": ("output", "Real")})}, [])
+    ssd = tmp_path / "bad.ssd"
+    write_ssd(SystemDescription("s", {"pilot": Component("pilot", "x.fmu")}, []), ssd)
+    ssd.write_text(ssd.read_text().replace('name="pilot"', 'name="auto,pilot"'))
+    with pytest.raises(ValueError, match=f"{re.escape(str(ssd))}: System: component name "
+                                         "'auto,pilot'"):
+        read_ssd(ssd)

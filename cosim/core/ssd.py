@@ -95,9 +95,13 @@ class _Reader:
             components[component.name] = component
         if not components:
             raise self.error("System", "no Component in its Elements")
-        description = SystemDescription(name, components, self.connections(system, components),
-                                        description=system.get("description", ""),
-                                        path=self.path, fmus=fmus)
+        connections = self.connections(system, components)
+        try:
+            description = SystemDescription(name, components, connections,
+                                            description=system.get("description", ""),
+                                            path=self.path, fmus=fmus)
+        except ValueError as error:             # a name no file takes
+            raise self.error("System", str(error)) from None
         experiment = root.find("ssd:DefaultExperiment", NS)
         if experiment is not None:
             self.experiment(experiment, description)

@@ -5,11 +5,15 @@ from __future__ import annotations
 
 import copy
 import difflib
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Iterable
 
 from fmukit.timebase import nanoseconds, seconds, step_count
+
+COMPONENT_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,99}")
+PORT_NAME = re.compile(r"(?!\s)[^,\"\x00-\x1f\x7f]{1,200}(?<!\s)")
 
 
 class _FmuFileError(Exception):
@@ -99,6 +103,20 @@ class SystemDescription:
     description: str = ""
     path: Path | None = None                     # the .ssd this was read from
     fmus: FmuFolders | None = field(default=None, compare=False, repr=False)
+
+    def __post_init__(self) -> None:
+        """ValueError for a name no file format takes as it is: a component's becomes a CSV
+        column's prefix, a JSON key, a file name and an OMSimulator identifier."""
+        for name, component in self.components.items():
+            if not COMPONENT_NAME.fullmatch(name):
+                raise ValueError(f"component name {name!r}: a component is named with ASCII "
+                                 "letters, digits and _, not starting with a digit, as every "
+                                 "engine and file the name reaches takes it")
+            for port in component.connectors:
+                if not PORT_NAME.fullmatch(port):
+                    raise ValueError(f"{name}.{port}: a connector's name holds no comma, "
+                                     "quote, space at either end or control character (it "
+                                     "heads a CSV column)")
 
     def parameters(self, overrides: dict[str, dict[str, Any]] | None = None
                    ) -> dict[str, dict[str, Any]]:

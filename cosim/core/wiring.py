@@ -8,7 +8,7 @@ from operator import itemgetter
 from typing import Callable
 
 from .instance import Instance
-from .system import Connection, SystemDescription
+from .system import PORT_NAME, Connection, SystemDescription
 
 
 class WiringError(ValueError):
@@ -83,6 +83,10 @@ def layout(instances: dict[str, Instance], connections: list[Connection],
     columns: list[str] = []
 
     def block(name: str, variables: list) -> slice:
+        for v in variables:                   # a CSV column's heading, as it is
+            if not PORT_NAME.fullmatch(v):
+                raise WiringError(f"{name}.{v}: a variable recorded holds no comma, quote, "
+                                  "space at either end or control character in its name")
         columns.extend(f"{name}.{v}" for v in variables)
         return slice(len(columns) - len(variables), len(columns))
 
