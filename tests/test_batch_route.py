@@ -9,6 +9,7 @@ import dataclasses
 import json
 import math
 import os
+import re
 import time
 from pathlib import Path
 
@@ -16,6 +17,8 @@ import numpy as np
 import pytest
 
 import cosim
+from cosim import simulate_many
+from cosim.core.recording import TooManyRows
 from cosim.studies import campaign, sweep_task
 from cosim.studies.campaign import plan
 from cosim.studies.sweep_spec import Spec
@@ -367,3 +370,15 @@ def test_simulate_many_refuses_bad_settings_naming_the_member(fmu_paths, backend
         cosim.simulate_many("calm_pd", [{"Hs": 0.01}], backend=backend)
     with pytest.raises(ValueError, match="backend must be fmi, inprocess or batch, got 'gpu'"):
         cosim.simulate_many("calm_pd", [{}], backend="gpu")
+
+
+def test_the_batch_route_refuses_what_in_process_refuses_in_the_same_words():
+    """Issue 38: a batch of a billion seconds tried to allocate 745 GiB; a batch sweep whose
+    every run runs alone (a user's FMU) ended in 'max() arg is an empty sequence'."""
+    said = {}
+    for backend in ("inprocess", "batch"):
+        with pytest.raises(TooManyRows) as refused:
+            simulate_many("calm_pd", [{}], stop_time=1e9, backend=backend)
+        said[backend] = re.sub(r"\d[\d,.]*", "N", str(refused.value))
+    assert said["batch"] == said["inprocess"]
+    assert campaign.batch_counts([], workers=2) == []

@@ -20,7 +20,7 @@ from fmukit.timebase import communication_point
 from ship_fmu.vessel import N_PROPELLER, Vessel, VesselParameters
 
 from ..core.master import Master
-from ..core.recording import Recording
+from ..core.recording import Recording, require_memory
 from ..core.ssd import SystemDescription
 from ..core.watchdog import no_limit
 from .control import KINDS, GuidanceArrays
@@ -54,6 +54,7 @@ def simulate_members(system: SystemDescription, overrides: Sequence[dict[str, di
             except ValueError as error:
                 raise ValueError(f"member {i}: {error}") from None
         _, h, n_steps = master.system.steps(stop_time)
+        require_memory(n_steps + 1, len(signals) * len(overrides))   # as in-process refuses
         reason = coverage(system) or selftest()
         recordings: dict[int, Recording] = {}
         groups: dict[tuple, list[tuple[int, Member]]] = defaultdict(list)

@@ -141,7 +141,7 @@ def batch_counts(groups: list[list[Job]], workers: int, size: int | None = None)
     counts = [math.ceil(len(group) / batch_limit(group[0])) for group in groups]
     counts = [max(count, min(workers, len(group) // WAVES_SHARE)) if _in_waves(group[0])
               else count for count, group in zip(counts, groups)]
-    while sum(counts) < workers:
+    while groups and sum(counts) < workers:      # none: every run alone
         largest = max(range(len(groups)), key=lambda g: len(groups[g]) / counts[g])
         if len(groups[largest]) // (counts[largest] + 1) < MIN_BATCH:
             break
