@@ -97,7 +97,8 @@ def main(argv: list[str] | None = None) -> int:
                         help="end of the run in s (default: the scenario's, 400 s)")
     parser.add_argument("--set", action="append", default=[], type=setting_option,
                         metavar="FMU.VAR=VALUE",
-                        help="override a parameter, e.g. ship.Hs=0.01 (SI units, radians); "
+                        help="override a parameter, e.g. ship.Hs=0.01 (SI units, radians; or with a "
+                             "unit it takes: ship.psi0=40deg, ship.u0=0.3m/s); "
                              "repeatable")
     parser.add_argument("--coupling", choices=COUPLINGS, default="gauss-seidel",
                         help="gauss-seidel: along the signal flow, as the paper's Simulink "

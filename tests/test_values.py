@@ -318,3 +318,26 @@ def test_the_metadata_records_the_value_set(fmu_paths, tmp_path):
     meta = json.loads((tmp_path / "out" / "waves_pd.json").read_text())
     assert meta["overrides"] == {"ship": {"wave_seed": 7, "Hs": 0.01}}
     assert meta["settings"]["ship"]["wave_seed"] == meta["parameters"]["ship"]["wave_seed"] == 7
+
+
+def test_a_value_with_a_unit_is_converted_and_said_and_a_wrong_unit_named():
+    """Issue 38: '--set ship.psi0=40' was 40 rad without a word; '35deg' was 'not a number'."""
+    from cosim.core.values import Declaration, checked, unit_notes
+
+    psi0 = Declaration("psi0", "Real", unit="rad", min=-100.0, max=100.0)
+    assert checked("ship", psi0, "40deg") == 40 * (math.pi / 180)
+    assert checked("ship", psi0, " 40 deg ") == 40 * (math.pi / 180)
+    assert checked("ship", psi0, "5e-1rad") == 0.5 and checked("ship", psi0, "1e1") == 10.0
+    with pytest.raises(ValueError, match="ship.psi0 = '40kn' carries the unit 'kn'; it takes "
+                                         "rad or deg"):
+        checked("ship", psi0, "40kn")
+    u0 = Declaration("u0", "Real", unit="m/s")
+    assert checked("ship", u0, "1kn") == 1852 / 3600
+    with pytest.raises(ValueError, match="carries the unit 'deg'; it takes no unit"):
+        checked("pilot", Declaration("Kp", "Real"), "2deg")
+    declared = {"ship": {"psi0": psi0, "u0": u0}}
+    assert unit_notes(declared, {"ship": {"psi0": "40deg", "u0": "0.3"}},
+                      {"ship": {"psi0": 40 * (math.pi / 180), "u0": 0.3}}) == [
+        f"ship.psi0 = 40deg is {40 * (math.pi / 180)!r} rad"]
+    assert unit_notes(declared, {"ship": {"psi0": "40"}}, {"ship": {"psi0": 40.0}}) == [
+        "ship.psi0 = 40.0 is taken in rad (2291.83 deg); for degrees write 40.0deg"]

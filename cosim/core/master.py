@@ -16,7 +16,7 @@ from .isolation import Isolation
 from .interrupt import StopSignals
 from .recording import Recorder, Recording
 from .system import SystemDescription, split_name
-from .values import declarations, parameters
+from .values import declarations, parameters, unit_notes
 from .watchdog import Watchdog, no_limit
 from .wiring import (COUPLINGS, check_connections, communication_step, feedthrough_order,
                      layout, settle)
@@ -43,7 +43,7 @@ class Master(contextlib.AbstractContextManager):
                              for name, path in self.paths.items()}
         self.configure(overrides)
         self.instances: dict[str, Instance] = {}
-        self.notes: list[str] = []            # what the user should know about how this runs
+        self.notes = unit_notes(self.declarations, overrides or {}, self.overrides)  # and how
         self.backends: dict[str, str] = {}    # how each component runs
         self.calling: list[str | None] = [None]   # the component whose calls are under way
         self._recorder: Recorder | None = None
