@@ -160,7 +160,10 @@ def main(argv: list[str] | None = None) -> int:
     status, costs, spreads, count = 0, {}, {}, 0
     perturbed = ", ".join(".".join(p) for p in PERTURBED)
     for scenario, autopilot, table_row in runs:
-        label = scenarios.label(scenario, autopilot, args.name)
+        try:
+            label = scenarios.label(scenario, autopilot, args.name)
+        except ValueError as error:         # a name from a file name that is no plain name
+            parser.error(str(error))
         out = args.out / label if args.all and args.out else args.out or Path("results") / label
         # with --all, autopilot.* settings are for the user's autopilot, not the paper's
         settings = {c: v for c, v in overrides.items()

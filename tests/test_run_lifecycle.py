@@ -526,3 +526,19 @@ def test_steps_each_shorter_than_the_limit_never_expire_it():
             watchdog.beat(float(k))
             time.sleep(0.1)
     assert watchdog.expired is None
+
+
+def test_a_run_named_after_a_file_that_is_no_plain_name_is_refused(tmp_path, capsys):
+    """Issue 38: a scenario file named '...ssd', run without --out, wrote into the checkout
+    root (its label '..'); exported, it raised a raw OSError."""
+    from cosim import export
+
+    odd = tmp_path / "...ssd"
+    odd.write_bytes((ROOT / "cosim" / "scenarios" / "calm_pd.ssd").read_bytes())
+    with pytest.raises(SystemExit):
+        cli.main([str(odd)])
+    assert "error: the run's name from ...ssd (rename the file) = '..': a name in the output " \
+           "folder must be one plain file name" in capsys.readouterr().err
+    assert export.main([str(odd), "--out", str(tmp_path / "out")]) != 0
+    assert "the run's name from ...ssd" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())

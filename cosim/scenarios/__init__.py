@@ -38,7 +38,10 @@ def label(scenario: str | Path, autopilot: str | Path | None = None,
     if name is not None:
         plain_name(name, "the autopilot's name")
     stem = Path(scenario).stem
-    return f"{stem}-{name or Path(autopilot).stem}" if autopilot is not None else stem
+    made = f"{stem}-{name or Path(autopilot).stem}" if autopilot is not None else stem
+    return plain_name(made, f"the run's name from {Path(scenario).name}"
+                            f"{'' if autopilot is None else f' and {Path(autopilot).name}'}"
+                            " (rename the file)")
 
 
 def load(scenario: str | Path, autopilot: str | Path | None = None,
