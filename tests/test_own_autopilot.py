@@ -199,6 +199,6 @@ def test_the_in_process_backend_runs_a_foreign_fmu_through_fmi_and_says_so(forei
 
 def test_a_map_that_wires_two_ports_onto_one_variable_is_refused(fmu_paths):
     """Issue 38: two connections into one input are refused in an .ssd; so through --map."""
-    with pytest.raises(AutopilotError, match="--map wires psi and r onto one variable \\(psi\\); "
-                                             "each port needs its own"):
-        check_autopilot(fmu_paths["pd_autopilot"], {"r": "psi"})
+    with pytest.raises(AutopilotError, match="--map wires psi and psi_d onto one variable "
+                                             "\\(psi\\); each port needs its own"):
+        check_autopilot(fmu_paths["pd_autopilot"], {"psi_d": "psi"})

@@ -89,11 +89,6 @@ def check_autopilot(fmu: str | Path, port_map: dict[str, str] | None = None,
         raise AutopilotError(f"{fmu}: --map names {', '.join(map(repr, unknown))}, which "
                              f"{'is not a port' if len(unknown) == 1 else 'are not ports'} "
                              f"of an autopilot ({', '.join(PORTS)}){did_you_mean(close)}")
-    names = [port_map.get(port, port) for port in PORTS]
-    if twice := sorted({n for n in names if names.count(n) > 1}):      # as in an .ssd
-        ports = " and ".join(p for p, n in zip(PORTS, names) if n in twice)
-        raise AutopilotError(f"{fmu}: --map wires {ports} onto one variable "
-                             f"({', '.join(twice)}); each port needs its own")
     problems, real = port_problems(description, port_map), PORT_TYPES[description.fmiVersion]
     if problems:
         raise AutopilotError(f"{fmu} does not keep the autopilot contract of an FMI "
@@ -102,6 +97,11 @@ def check_autopilot(fmu: str | Path, port_map: dict[str, str] | None = None,
                              + "".join(f"  - {p}\n" for p in problems)
                              + f"It has {_listing(description)}. Map other names with --map "
                              "PORT=NAME (--map psi=heading)")
+    names = [port_map.get(port, port) for port in PORTS]
+    if twice := sorted({n for n in names if names.count(n) > 1}):      # as in an .ssd
+        ports = " and ".join(p for p, n in zip(PORTS, names) if n in twice)
+        raise AutopilotError(f"{fmu}: --map wires {ports} onto one variable "
+                             f"({', '.join(twice)}); each port needs its own")
     if trial:
         try:
             instantiate_in_child(fmu)
