@@ -10,7 +10,7 @@ from ctypes import byref
 from pathlib import Path
 from typing import Any, Callable
 
-from fmpy import extract, read_model_description
+from fmpy import read_model_description
 from fmpy.fmi1 import FMICallException, calloc, free
 from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
                        fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, fmi2Integer, fmi2Real,
@@ -18,6 +18,7 @@ from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFr
 from fmpy.fmi3 import FMU3Slave, fmi3Boolean, fmi3Float64, fmi3Int32, fmi3ValueReference
 from fmpy.model_description import ModelDescription
 
+from .archives import unpack
 from .system import FmuNotFound, FmuUnreadable
 from .instance import FmuCallError, Instance, LogRecord, logged_error
 
@@ -85,7 +86,7 @@ class FmuInstance(Instance):
         self.description = read_description(self.path, name)
         self.fmi_version, self.guid = fmi_version(self.description), self.description.guid
         self._owns_unzip_dir = unzip_dir is None
-        self.unzip_dir = str(unzip_dir) if unzip_dir else extract(str(self.path))
+        self.unzip_dir = str(unzip_dir) if unzip_dir else str(unpack(self.path))
         self.variables, self.feedthrough = described(self.description)
         self.log: deque[LogRecord] = deque(maxlen=50)     # the last messages
         self.logged = 0                              # how many there have been

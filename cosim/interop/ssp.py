@@ -14,6 +14,7 @@ from autopilot_fmu.guidance import ROUTE_PARAMETERS, numeric_route, route
 
 from .. import scenarios
 from ..core.files import fresh_folder, whole_file
+from ..core.archives import check_archive
 from ..core.fmi import read_description
 from ..core.ssd import (Component, Connection, SystemDescription, Units, read_ssd, ssv_value,
                         write_ssd)
@@ -166,9 +167,12 @@ def described(path: Path) -> tuple[SystemDescription, dict[str, ModelDescription
         if is_osp(path):
             system, folder = read_osp(path), path if path.is_dir() else path.parent
         else:
+            check_archive(path)             # before it, or another tool, unpacks it
             with zipfile.ZipFile(path) as package:
                 package.extractall(tmp)
             system, folder = read_ssd(Path(tmp) / SSD_NAME), Path(tmp)
+        for component in system.components.values():      # each FMU another tool unpacks
+            check_archive(folder / component.source)
         return system, {name: read_description(folder / component.source, name)
                         for name, component in system.components.items()}
 
