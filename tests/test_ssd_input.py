@@ -273,3 +273,22 @@ def test_names_that_no_file_takes_as_they_are_are_refused_up_front(tmp_path):
     with pytest.raises(ValueError, match=f"{re.escape(str(ssd))}: System: component name "
                                          "'auto,pilot'"):
         read_ssd(ssd)
+
+
+def test_an_export_names_its_system_as_every_tool_takes_an_identifier(fmu_paths, tmp_path):
+    """Issue 38: every `cosim.export --autopilot` package aborted OMSimulator's command line
+    ('"calm_pd-..." is not a valid ident')."""
+    import shutil
+    import xml.etree.ElementTree as ET
+    import zipfile
+
+    from cosim.interop.ssp import export
+
+    mine = tmp_path / "my-pid 2.fmu"
+    shutil.copy(fmu_paths["pd_autopilot"], mine)
+    (tmp_path / "out").mkdir()
+    package = export("calm_pd", tmp_path / "out", autopilot=mine)
+    with zipfile.ZipFile(package) as ssp:
+        root = ET.fromstring(ssp.read("SystemStructure.ssd"))
+    names = {root.get("name"), root.find("{*}System").get("name")}
+    assert names == {"calm_pd_my_pid_2"}

@@ -4,6 +4,7 @@ connections, the step in OSP's annotation); ``read_ssd`` refuses anything else b
 from __future__ import annotations
 
 import math
+import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
@@ -244,8 +245,10 @@ def write_ssd(system: SystemDescription, path: str | Path,
     """Write ``system`` as a .ssd, ``sources`` replacing component sources by name, ``units`` on
     connectors; the step in OSP's and OpenModelica's annotations, the report's kind in ours."""
     unit_of = units.connectors if units else {}
-    root = ET.Element(_q("ssd:SystemStructureDescription"), version="1.0", name=system.name)
-    sys_el = _el(root, "ssd:System", name=system.name, description=system.description)
+    name = re.sub(r"\W", "_", system.name, flags=re.ASCII)      # an identifier every tool
+    name = f"_{name}" if name[:1].isdigit() else name           # takes (OMSimulator's too)
+    root = ET.Element(_q("ssd:SystemStructureDescription"), version="1.0", name=name)
+    sys_el = _el(root, "ssd:System", name=name, description=system.description)
     elements = _el(sys_el, "ssd:Elements")
     for c in system.components.values():
         comp = _el(elements, "ssd:Component", name=c.name,
