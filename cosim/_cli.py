@@ -2,6 +2,7 @@
 the commands import this."""
 import argparse
 import contextlib
+import faulthandler
 import functools
 import math
 import os
@@ -180,6 +181,7 @@ def entry(main: Callable[[], int]) -> int:
     """Run a command's main: quiet when its output pipe closes; on Ctrl-C or SIGTERM,
     "interrupted" and status 130 or 143, not a traceback."""
     signal.signal(signal.SIGPIPE, signal.SIG_DFL)
+    faulthandler.enable()           # a crash in an FMU here shows its traceback, naming it
     try:
         with StopSignals(raising=True):
             return main()

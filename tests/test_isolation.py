@@ -252,3 +252,13 @@ def test_a_child_dead_between_messages_fails_its_run_under_the_commands_sigpipe(
     assert done.returncode == 0, done.stderr
     assert done.stdout.startswith("FMU 'autopilot': ") and \
         done.stdout.rstrip().endswith("returned no reply: its process was ended by signal SIGKILL")
+
+
+def test_without_isolation_a_crash_still_names_the_fmu_it_was_in(faulty, marker, tmp_path):
+    """Issue 38: a segfault in an FMU in the master's process ended cosim.run silently; where
+    the platform allows it, its traceback now names the FMU (``exchange_with_fault``)."""
+    with _command([str(faulty["segv"]), "--out", str(tmp_path)], tmp_path) as run:
+        _, stderr = run.communicate(timeout=LIMIT)
+    assert run.returncode == -signal.SIGSEGV
+    assert "Fatal Python error: Segmentation fault" in stderr
+    assert "in exchange_with_fault" in stderr

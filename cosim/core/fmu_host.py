@@ -2,6 +2,7 @@
 the master's messages ask, each a kind byte and a length, then a payload; one reply each."""
 from __future__ import annotations
 
+import faulthandler
 import functools
 import os
 import pickle
@@ -51,6 +52,7 @@ def serve() -> None:
     os.dup2(os.open(os.devnull, os.O_RDONLY), 0)   # by what the FMU starts, which reads
     os.dup2(2, 1)                                  # nothing; what it prints goes to stderr
     limit = int(sys.argv[1])
+    faulthandler.enable()                          # the FMU's traceback, if it crashes
     if os.name == "posix":
         threading.Thread(target=_orphaned, args=(os.getppid(),), daemon=True).start()
     if limit and os.name == "posix":                # within a hard limit already set
