@@ -85,7 +85,8 @@ def _ended(out: Path, kind: str, marker: Path, cause: str) -> dict:
     return meta
 
 
-@pytest.mark.parametrize("kind", ["segv", "exit", "abort", "spawn", "garble",
+@pytest.mark.parametrize("kind", ["segv", *(pytest.param(k, marks=pytest.mark.long)
+                                           for k in ("exit", "abort")), "spawn", "garble",
                                   pytest.param("loop", marks=pytest.mark.long), "block",
                                   pytest.param("memory", marks=pytest.mark.long)])
 def test_an_isolated_fmu_that_fails_ends_its_run_with_the_rows_and_the_cause(
@@ -139,7 +140,9 @@ def test_cosim_run_isolate_survives_a_segfault_and_says_where(faulty, marker, tm
     assert not _running(marker)
 
 
-@pytest.mark.parametrize("second", [False, True], ids=["one-signal", "two-signals"])
+@pytest.mark.parametrize("second", [pytest.param(False, marks=pytest.mark.long), True],
+                         ids=["one-signal", "two-signals"])     # quick: the grace is tested
+                                                                # in test_run_lifecycle
 def test_ctrl_c_kills_a_hung_isolated_fmu_and_keeps_the_rows(faulty, marker, tmp_path, second):
     """One SIGINT: the step under way has its grace, then its child is killed; a second
     SIGINT kills it at once. Either way the run ends interrupted, its 50 rows written."""
