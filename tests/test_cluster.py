@@ -154,3 +154,17 @@ def test_a_worker_running_other_code_is_refused_by_name():
     assert "tcp://10.0.0.7:4000 runs ship-autopilot-cosim 0.0.9 (code 123456789abc)" in str(
         refused.value)
     assert "tcp://10.0.0.8:4000" not in str(refused.value)
+
+
+def test_a_local_cluster_whose_worker_dies_as_it_starts_says_so(monkeypatch):
+    """Issue 38: a worker that died while the local cluster started gave a raw 'Nanny failed
+    to start'."""
+    from cosim.studies import cluster
+
+    def dying(*args, **kwargs):
+        raise RuntimeError("Nanny failed to start.")
+    monkeypatch.setattr(cluster, "LocalCluster", dying)
+    with pytest.raises(cluster.ClusterError, match="the local Dask cluster could not start: a "
+                                                   "worker process failed as it started "
+                                                   r"\(RuntimeError: Nanny failed to start.\)"):
+        cluster.connect(workers=1)

@@ -58,10 +58,15 @@ def local_cluster(workers: int | None = None) -> LocalCluster:
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                    dashboard_address=":0", silence_logs=logging.CRITICAL)
         signal.pthread_sigmask(signal.SIG_SETMASK, previous)   # a Ctrl-C meanwhile: here
-    except BaseException:
+    except BaseException as error:
         signal.pthread_sigmask(signal.SIG_SETMASK, previous)
         if cluster is not None:
             cluster.close()
+        if isinstance(error, Exception):    # e.g. 'Nanny failed to start': a worker died
+            raise ClusterError(f"the local Dask cluster could not start: a worker process "
+                               f"failed as it started ({type(error).__name__}: "
+                               f"{str(error)[:200]}); try again, or give --workers fewer"
+                               ) from error
         raise
     return cluster
 
