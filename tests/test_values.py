@@ -322,7 +322,8 @@ def test_the_metadata_records_the_value_set(fmu_paths, tmp_path):
 
 def test_a_value_with_a_unit_is_converted_and_said_and_a_wrong_unit_named():
     """Issue 38: '--set ship.psi0=40' was 40 rad without a word; '35deg' was 'not a number'."""
-    from cosim.core.values import Declaration, checked, unit_notes
+    from cosim.core.units import unit_notes
+    from cosim.core.values import Declaration, checked
 
     psi0 = Declaration("psi0", "Real", unit="rad", min=-100.0, max=100.0)
     assert checked("ship", psi0, "40deg") == 40 * (math.pi / 180)
@@ -335,7 +336,7 @@ def test_a_value_with_a_unit_is_converted_and_said_and_a_wrong_unit_named():
     assert checked("ship", u0, "1kn") == 1852 / 3600
     with pytest.raises(ValueError, match="carries the unit 'deg'; it takes no unit"):
         checked("pilot", Declaration("Kp", "Real"), "2deg")
-    declared = {"ship": {"psi0": psi0, "u0": u0}}
+    declared = {"ship": {"psi0": "rad", "u0": "m/s"}}
     assert unit_notes(declared, {"ship": {"psi0": "40deg", "u0": "0.3"}},
                       {"ship": {"psi0": 40 * (math.pi / 180), "u0": 0.3}}) == [
         f"ship.psi0 = 40deg is {40 * (math.pi / 180)!r} rad"]

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Callable, Iterable, NamedTuple
 
+from .units import unit_of
 from .values import fmi_value, no_variable
 
 class LogRecord(NamedTuple):
@@ -71,8 +72,7 @@ class Instance:
 
     def unit(self, name: str) -> str:
         """The unit a variable declares (its own or its type's), "" if none."""
-        variable = self.variable(name)
-        return variable.unit or getattr(variable.declaredType, "unit", None) or ""
+        return unit_of(self.variable(name))
 
     def set(self, values: dict[str, Any], time: float | None = None) -> None:
         """Set variables by name; ValueError for a value the call cannot carry exactly."""

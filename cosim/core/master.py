@@ -16,7 +16,8 @@ from .isolation import Isolation
 from .interrupt import StopSignals
 from .recording import Recorder, Recording
 from .system import SystemDescription, split_name
-from .values import declarations, parameters, unit_notes
+from .units import unit_notes
+from .values import declarations, parameters
 from .watchdog import Watchdog, no_limit
 from .wiring import (COUPLINGS, check_connections, communication_step, feedthrough_order,
                      layout, settle)
@@ -43,7 +44,8 @@ class Master(contextlib.AbstractContextManager):
                              for name, path in self.paths.items()}
         self.configure(overrides)
         self.instances: dict[str, Instance] = {}
-        self.notes = unit_notes(self.declarations, overrides or {}, self.overrides)  # and how
+        self.notes = unit_notes({c: {n: d.unit for n, d in ds.items()} for c, ds in
+                                 self.declarations.items()}, overrides or {}, self.overrides)
         self.backends: dict[str, str] = {}    # how each component runs
         self.calling: list[str | None] = [None]   # the component whose calls are under way
         self._recorder: Recorder | None = None

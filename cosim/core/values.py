@@ -13,12 +13,12 @@ from typing import Any, Iterable, Mapping
 from fmpy.model_description import ModelDescription
 
 from .system import SystemDescription, close_matches, did_you_mean
+from .units import DECIMAL as _DECIMAL, in_unit, unit_of
 
 INTEGER_RANGE = (-2**31, 2**31 - 1)                 # fmi2Integer, a C int
 
 Value = bool | int | float | str
 
-_DECIMAL = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 _SPECIAL = re.compile(r"[+-]?(?:inf|infinity|nan)", re.IGNORECASE)
 _BOOLEAN = {"true": True, "1": True, "false": False, "0": False}
 _TAKES = {"Real": "a Real (a double)", "Integer": "an Integer, a whole number from "
@@ -75,7 +75,7 @@ def declarations(description: ModelDescription) -> dict[str, Declaration]:
         items = tuple((i.name, int(i.value)) for i in getattr(declared, "items", None) or ())
         out[v.name] = Declaration(v.name, v.type, v.causality, v.variability, v.initial,
                                   *(None if b is None else number(b) for b in bounds), items,
-                                  v.unit or getattr(declared, "unit", None) or "")
+                                  unit_of(v))
     return out
 
 
@@ -96,50 +96,6 @@ def fmi_value(target: str, type_name: str, value: Any,
     return exact
 
 
-# The units a Real's text may carry, by the unit it declares: each its factor to that unit
-UNITS = {"rad": {"rad": 1.0, "deg": math.pi / 180},
-         "rad/s": {"rad/s": 1.0, "deg/s": math.pi / 180},
-         "rad/s^2": {"rad/s^2": 1.0, "deg/s^2": math.pi / 180},
-         "m/s": {"m/s": 1.0, "kn": 1852 / 3600, "km/h": 1 / 3.6},
-         "m": {"m": 1.0, "cm": 0.01, "mm": 0.001, "km": 1000.0},
-         "s": {"s": 1.0, "min": 60.0, "h": 3600.0},
-         "rev/s": {"rev/s": 1.0, "rpm": 1 / 60}}
-_KNOWN = {unit for units in UNITS.values() for unit in units}
-_WITH_UNIT = re.compile(rf"\s*({_DECIMAL.pattern})\s*((?![eE][+-]?[0-9])[A-Za-z][A-Za-z/^0-9]*)\s*")
-
-
-def in_unit(declaration: Declaration, text: str) -> float | None:
-    """A Real's text with a unit ('40deg') in the unit it declares (radians), or None if the
-    text has none; ValueError saying which units it may carry."""
-    found = _WITH_UNIT.fullmatch(text) if declaration.type == "Real" else None
-    if found is None or found[2] not in _KNOWN | {declaration.unit}:     # '0x10': no unit
-        return None
-    units = UNITS.get(declaration.unit, {declaration.unit: 1.0} if declaration.unit else {})
-    if found[2] not in units:
-        may = " or ".join(units) if units else "no unit (it declares none)"
-        raise ValueError(f"carries the unit {found[2]!r}; it takes {may}")
-    return _real(found[1]) * units[found[2]]
-
-
-def unit_notes(declared: dict[str, dict[str, Declaration]],
-               given: Mapping[str, Mapping[str, Any]],
-               taken: Mapping[str, Mapping[str, Any]]) -> list[str]:
-    """What a user should know of values given: one with a unit, as converted; an angle
-    given without one, past a full turn, as taken (radians)."""
-    notes = []
-    for component, values in given.items():
-        for name, raw in values.items():
-            unit, value = declared[component][name].unit, taken[component][name]
-            if isinstance(raw, str) and _WITH_UNIT.fullmatch(raw):
-                notes.append(f"{component}.{name} = {raw.strip()} is {value!r} {unit}")
-            elif unit in ("rad", "rad/s") and isinstance(value, float) and \
-                    abs(value) > 2 * math.pi:
-                notes.append(f"{component}.{name} = {value!r} is taken in {unit} "
-                             f"({math.degrees(value):.6g} {unit.replace('rad', 'deg')}); "
-                             f"for degrees write {value!r}{unit.replace('rad', 'deg')}")
-    return notes
-
-
 def checked(component: str, declaration: Declaration, value: Any) -> Value:
     """The exact value to set for ``component``'s variable so declared, or ValueError."""
     items = dict(declaration.items)
@@ -147,10 +103,10 @@ def checked(component: str, declaration: Declaration, value: Any) -> Value:
         return items[value.strip()]
     if isinstance(value, str):
         try:
-            converted = in_unit(declaration, value)
+            found = in_unit(declaration.unit if declaration.type == "Real" else None, value)
         except ValueError as refusal:
             raise ValueError(f"{component}.{declaration.name} = {value!r} {refusal}") from None
-        value = value if converted is None else converted
+        value = value if found is None else _real(found[0]) * found[1]
     kind = "Integer" if declaration.type == "Enumeration" else declaration.type
     return fmi_value(f"{component}.{declaration.name}", kind, value, declaration)
 

@@ -18,6 +18,7 @@ from ..core.archives import check_archive
 from ..core.fmi import read_description
 from ..core.ssd import (Component, Connection, SystemDescription, Units, read_ssd, ssv_value,
                         write_ssd)
+from ..core.units import unit_of
 from ..core.values import fmi_value
 
 SSD_NAME = "SystemStructure.ssd"
@@ -110,8 +111,7 @@ def connector_units(system: SystemDescription, fmus: dict[str, Path]) -> Units:
     definitions: dict[str, dict[str, float]] = {}
     for name, component in system.components.items():
         described = read_description(fmus[name], name)
-        by_name = {v.name: v.unit or (v.declaredType.unit if v.declaredType else None)
-                   for v in described.modelVariables}
+        by_name = {v.name: unit_of(v) for v in described.modelVariables}
         connectors[name] = {c: by_name[c] for c in component.connectors if by_name.get(c)}
         for unit in described.unitDefinitions:
             definitions[unit.name] = {k: getattr(unit.baseUnit, k) for k, neutral in

@@ -14,6 +14,7 @@ from fmukit.variables import UNITS
 
 from ..core.system import close_matches, did_you_mean
 from ..core.ssd import Connection, SystemDescription
+from ..core.units import unit_of
 
 COMPONENT = "autopilot"
 PORTS = {v.name: (v.causality, v.unit) for v in fmukit.autopilot.PORTS}
@@ -52,7 +53,7 @@ def port_problems(description: ModelDescription, port_map: dict[str, str]) -> li
         if variable.causality != causality or variable.type != real:
             problems.append(f"port {mapped} is of causality {variable.causality} and type "
                             f"{variable.type}: expected a {real} {causality} in {unit}")
-        declared = variable.unit or (variable.declaredType.unit if variable.declaredType else None)
+        declared = unit_of(variable)
         if declared and declared != unit:
             known = UNITS.get(declared)
             scale = (f" (1 {declared} = {known[1] / UNITS[unit][1]:.6g} {unit})"

@@ -20,6 +20,7 @@ from ..core.fmi import read_description
 from ..core.inprocess import fallback_note, in_process_refusal
 from ..core.isolation import Isolation
 from ..core.ssd import SystemDescription
+from ..core.units import unit_of
 from ..core.values import Declaration, declarations
 from ..core.watchdog import Limits
 from ..ensemble.reference import coverage
@@ -163,9 +164,7 @@ class Spec:
         for axis, values in self.axes.items():
             target, *others = assignments(axis, values[0])
             component, _, name = target.partition(".")
-            variable = self.fmus[controller, component][1][name]
-            declared = variable.declaredType.unit if variable.declaredType else ""
-            units[axis] = "" if others else variable.unit or declared or ""
+            units[axis] = "" if others else unit_of(self.fmus[controller, component][1][name])
         return units
 
     def job(self, run: dict[str, Any], sweep: str, backend: str = "fmi",
