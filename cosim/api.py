@@ -8,7 +8,7 @@ from . import scenarios
 from .core.isolation import Isolation
 from .core.master import BACKENDS, Master
 from .core.system import split_name
-from .core.recording import Recording
+from .core.recording import Recording, check_signals
 from .core.watchdog import STEP_LIMIT_S, Limits, Watchdog
 
 
@@ -111,12 +111,15 @@ def simulate_many(scenario: str | Path, sets: Sequence[Mapping[str, Any]],
                 master.configure(overrides[-1])
             except ValueError as error:
                 raise ValueError(f"member {i}: {error}") from None
+        check_signals(signals or (), master.columns)
+        recorded = master.columns
     if backend == "batch":
         from .ensemble import simulate_members
         from .ensemble.reference import SIGNALS
 
+        loop = SIGNALS if set(SIGNALS) <= set(recorded) else recorded   # a manoeuvre: all
         recordings = simulate_members(system, overrides, stop_time,
-                                      SIGNALS if signals is None else signals)
+                                      loop if signals is None else signals)
     else:
         recordings = []
         for member in overrides:

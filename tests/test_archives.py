@@ -71,3 +71,11 @@ def test_a_zip_bomb_is_refused_and_a_failed_unpack_leaves_nothing(fmu_paths, tmp
     with pytest.raises(OSError, match=f"cannot unpack {fmu_paths['ship']}: No space left"):
         unpack(fmu_paths["ship"])
     assert made and not Path(made[0]).exists()
+
+
+def test_export_refuses_to_package_an_fmu_that_would_write_outside(fmu_paths, tmp_path, capsys):
+    from cosim.export import main as export_main
+    bad = _with_member(fmu_paths["pd_autopilot"], tmp_path / "mine.fmu", "../escaped.txt")
+    assert export_main(["calm_pd", "--autopilot", str(bad), "--out", str(tmp_path / "out")]) == 2
+    assert "member '../escaped.txt' would be written outside" in capsys.readouterr().err
+    assert not list((tmp_path / "out").iterdir())

@@ -382,3 +382,38 @@ def test_the_batch_route_refuses_what_in_process_refuses_in_the_same_words():
         said[backend] = re.sub(r"\d[\d,.]*", "N", str(refused.value))
     assert said["batch"] == said["inprocess"]
     assert campaign.batch_counts([], workers=2) == []
+
+
+def _outcome(scenario: str, backend: str, **kwargs) -> str | list:
+    try:
+        return cosim.simulate_many(scenario, backend=backend, **{"stop_time": 3, **kwargs})
+    except (ValueError, TypeError) as refused:
+        return f"{type(refused).__name__}: {refused}"
+
+
+@pytest.mark.filterwarnings("ignore:ran on the in-process route")
+@pytest.mark.parametrize("scenario, kwargs", [
+    ("calm_pd", {"sets": [{}], "stop_time": 0.15}),
+    ("calm_pd", {"sets": [{"ship.wave_seed": 1.5}]}),
+    ("calm_pd", {"sets": [{"guidance.waypoints": "garbage"}]}),
+    ("calm_pd", {"sets": [{"ship.psi0": "40deg"}, {"ship.psi0": "-179deg"}]}),
+    ("calm_pd", {"sets": [{}], "signals": ["ship.nope"]}),
+    ("calm_pd", {"sets": [{}], "signals": []}),
+    ("calm_pd", {"sets": [{}], "signals": ["ship.X_w", "ship.psi"]}),   # alone: not in kernel
+    ("zigzag_10_10", {"sets": [{}, {"ship.delta_rate_max": 0.1}]}),   # alone: every signal
+])
+def test_batch_takes_and_refuses_what_in_process_does(fmu_paths, scenario, kwargs):
+    """Issue 38: the batch route crashed on no signals, refused a signal the run records and
+    a manoeuvre's default signals, and named the signals it lacks in words of its own."""
+    batch, inprocess = (_outcome(scenario, b, **kwargs) for b in ("batch", "inprocess"))
+    if isinstance(inprocess, str):
+        assert batch == inprocess
+        return
+    assert not isinstance(batch, str), batch
+    for ours, theirs in zip(batch, inprocess, strict=True):
+        assert ours.error == theirs.error and set(ours.columns) <= set(theirs.columns)
+        np.testing.assert_array_equal(ours.t, theirs.t)
+        for column in ours.columns:
+            np.testing.assert_array_equal(ours[column], theirs[column])
+    if scenario == "zigzag_10_10":
+        assert batch[0].columns == inprocess[0].columns

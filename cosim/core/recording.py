@@ -41,10 +41,7 @@ class Recording:
 
     def holding(self, columns: Sequence[str]) -> Recording:
         """This recording with only ``columns``; ValueError naming any it lacks."""
-        missing = [c for c in columns if c not in self.columns]
-        if missing:
-            raise ValueError(f"signals {', '.join(missing)}: the run records "
-                             f"{', '.join(self.columns)}")
+        check_signals(columns, self.columns)
         return dataclasses.replace(self, columns=list(columns),
                                    data=self.data[:, [self.columns.index(c) for c in columns]],
                                    units={c: self.units.get(c, "") for c in columns})
@@ -52,6 +49,13 @@ class Recording:
     def write_csv(self, path: str | Path) -> None:
         with _open_csv(path, self.columns) as file:
             _write_rows(file, self.t, self.data)
+
+
+def check_signals(signals: Sequence[str], recorded: Sequence[str]) -> None:
+    """ValueError naming each of ``signals`` that a run recording ``recorded`` lacks."""
+    missing = [c for c in signals if c not in recorded]
+    if missing:
+        raise ValueError(f"signals {', '.join(missing)}: the run records {', '.join(recorded)}")
 
 
 def _open_csv(path: str | Path, columns: list[str]) -> IO[str]:

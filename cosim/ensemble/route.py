@@ -20,7 +20,7 @@ from fmukit.timebase import communication_point
 from ship_fmu.vessel import N_PROPELLER, Vessel, VesselParameters
 
 from ..core.master import Master
-from ..core.recording import Recording, require_memory
+from ..core.recording import Recording, check_signals, require_memory
 from ..core.ssd import SystemDescription
 from ..core.watchdog import no_limit
 from .control import KINDS, GuidanceArrays
@@ -43,11 +43,8 @@ def simulate_members(system: SystemDescription, overrides: Sequence[dict[str, di
     """One recording per member with ``overrides[i]``, as in-process ``Master.run`` records
     it, of ``signals``; ValueError naming a refused member before anything runs; TimeLimit
     where ``beat`` (``Watchdog.beat``, before each initialisation and step) gives a reason."""
-    unknown = [s for s in signals if s not in ALL_SIGNALS]
-    if unknown:
-        raise ValueError(f"signals {', '.join(unknown)}: the batch route records only "
-                         f"{', '.join(ALL_SIGNALS)}")
     with Master(system, backend="inprocess") as master:
+        check_signals(signals, master.columns)              # in the in-process route's words
         for i, member in enumerate(overrides):
             try:
                 master.configure(member)
@@ -55,7 +52,7 @@ def simulate_members(system: SystemDescription, overrides: Sequence[dict[str, di
                 raise ValueError(f"member {i}: {error}") from None
         _, h, n_steps = master.system.steps(stop_time)
         require_memory(n_steps + 1, len(signals) * len(overrides))   # as in-process refuses
-        reason = coverage(system) or selftest()
+        reason = coverage(system) or _unrecorded(signals) or selftest()
         recordings: dict[int, Recording] = {}
         groups: dict[tuple, list[tuple[int, Member]]] = defaultdict(list)
         for i, member_overrides in enumerate(overrides):
@@ -80,6 +77,11 @@ def simulate_members(system: SystemDescription, overrides: Sequence[dict[str, di
 def _check(expired: str | None) -> None:
     if expired:
         raise TimeLimit(expired)
+
+
+def _unrecorded(signals: Sequence[str]) -> str | None:
+    others = [s for s in signals if s not in ALL_SIGNALS]
+    return f"the batch kernel records no {', '.join(others)}" if others else None
 
 
 def _outside(member: Member | None, h: float) -> str | None:
@@ -128,7 +130,8 @@ def lockstep(members: list[tuple[int, Member]], t0: float, h: float, n_steps: in
             delta_c = pilot.command(ship.psi, ship.r, psi_d)
             values = (psi_d, wp_index, delta_c, ship.x, ship.y, ship.psi, ship.u, ship.v,
                       ship.r, ship.delta)
-            block[k] = [values[row] for row in rows]
+            for j, row in enumerate(rows):
+                block[k, j] = values[row]
             failed |= ~np.isfinite(np.add.reduce(values[2:]) + ship.xi) | (np.abs(ship.r) > R_MAX)
             if k == n_steps:
                 break

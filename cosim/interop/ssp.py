@@ -135,6 +135,7 @@ def export(scenario: str | Path, out: Path, overrides: dict[str, dict] | None = 
     fmus = {c: system.fmu_path(c) for c in system.components}     # FileNotFoundError
     by_name: dict[str, Path] = {}
     for component, path in fmus.items():
+        check_archive(path)                 # a package we write unpacks where it says
         if by_name.setdefault(path.name, path) != path:
             raise ValueError(f"two FMUs named {path.name} ({by_name[path.name]} and {path}) "
                              "cannot both go into resources/; rename one")
