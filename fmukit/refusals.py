@@ -39,13 +39,14 @@ def explain(error: BaseException) -> str:
     if isinstance(error, Refused):
         return str(error)
     frames = traceback.extract_tb(error.__traceback__)
+    said = f"{type(error).__name__}: {error}" if str(error) else type(error).__name__
     if not frames:
-        return f"{type(error).__name__}: {error}"
+        return said
     frame = next((f for f in reversed(frames) if _users(f.filename)), frames[-1])
     path = Path(frame.filename).resolve()
     inside = [r for r in (Path(p or ".").resolve() for p in sys.path) if r in path.parents]
     where = path.relative_to(max(inside, key=lambda r: len(r.parts))) if inside else path.name
-    return f"{where}:{frame.lineno} in {frame.name}: {type(error).__name__}: {error}"
+    return f"{where}:{frame.lineno} in {frame.name}: {said}"
 
 
 @functools.cache

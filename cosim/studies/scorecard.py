@@ -101,7 +101,7 @@ def score(fmu: Path, name: str, out: Path, seeds: int = 20, port_map: dict | Non
         save(comparison(runs, title), out / f"{label}.png")
         return runs
 
-    route = {sea: tested(f"{sea} water", f"route_{sea}", f"The paper's route in {words}",
+    route = {sea: tested(words, f"route_{sea}", f"The paper's route in {words}",
                          sea=sea) for sea, words in SEA_NAMES.items()}
     changes = {n: course_change(r) for n, r in tested(
         "course change", "course_change", "40 deg course change from straight running, calm "
