@@ -187,9 +187,12 @@ def test_a_system_the_kernel_does_not_cover_runs_in_process_with_a_note(tmp_path
     assert recording.meta["backend"] == "inprocess" and why in recording.meta["notes"][-1]
 
 
-def test_signals_outside_the_loop_are_refused_by_name():
-    with pytest.raises(ValueError, match="ship.X_w"):
-        simulate_members(scenarios.load("calm_pd"), [{}], 1.0, ["ship.X_w"])
+def test_signals_outside_the_loop_run_alone_and_unknown_ones_are_refused_by_name():
+    alone, = simulate_members(scenarios.load("calm_pd"), [{}], 1.0, ["ship.X_w"])
+    assert alone.meta["backend"] == "inprocess" and alone.columns == ["ship.X_w"]
+    assert "the batch kernel records no ship.X_w" in alone.meta["notes"][-1]
+    with pytest.raises(ValueError, match="signals ship.nope: the run records "):
+        simulate_members(scenarios.load("calm_pd"), [{}], 1.0, ["ship.nope"])
 
 
 # -- the self-test -------------------------------------------------------------------------
