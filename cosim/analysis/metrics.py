@@ -22,6 +22,12 @@ def heading_error(psi_d: np.ndarray, psi: np.ndarray) -> np.ndarray:
     return wrap(np.asarray(psi_d, dtype=float) - np.asarray(psi, dtype=float))
 
 
+def stage_cost(psi_d: np.ndarray, psi: np.ndarray, delta: np.ndarray,
+               lam: float = LAMBDA) -> np.ndarray:
+    """Each sample's share of eq (19), (psi_d - psi)^2 + lambda delta^2: summed, J."""
+    return heading_error(psi_d, psi) ** 2 + lam * np.square(delta)
+
+
 def cost_terms(psi_d: np.ndarray, psi: np.ndarray, delta: np.ndarray) -> tuple[float, float]:
     """(psi_E, sum delta^2) of eq (19), over the samples given, rad^2."""
     return float(np.sum(heading_error(psi_d, psi) ** 2)), float(np.sum(np.square(delta)))

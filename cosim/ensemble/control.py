@@ -38,6 +38,11 @@ class GuidanceArrays:
         columns(self, guidances, ("leg", "finished"), None)
         self.members = np.arange(count)
 
+    def put(self, lanes: np.ndarray, guidances: Sequence[WaypointGuidance]) -> None:
+        """Lanes ``lanes`` start afresh with ``guidances`` (initialised, on the same route)."""
+        self.leg[lanes] = [g.leg for g in guidances]
+        self.finished[lanes] = [g.finished for g in guidances]
+
     def outputs(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(psi_d, wp_index) at (x, y), the leg switches (``WaypointGuidance``) committed."""
         i, leg, finished = self.members, self.leg, self.finished.copy()

@@ -86,8 +86,19 @@ class VesselArrays:
         columns(self, [v.params for v in vessels], ("psi_w", "delta_max", "delta_rate_max"))
         columns(self, vessels, (*self.STATES, "delta"))
 
-    def step(self, t: float, h: float, delta_c: np.ndarray) -> None:
-        """``Vessel.step``: two RK4 steps for the members whose rudder kinks in the step."""
+    def put(self, lanes: np.ndarray, vessels: Sequence[Vessel]) -> None:
+        """Lanes ``lanes`` become the initialised ``vessels`` (of this sea and shafts)."""
+        for models, names in (([v.params for v in vessels], ("psi_w", "delta_max",
+                                                              "delta_rate_max")),
+                              (vessels, (*self.STATES, "delta"))):
+            for name in names:
+                getattr(self, name)[lanes] = [getattr(m, name) for m in models]
+        for name, source in (WaveArrays.SOURCES.items() if self.waves is not None else ()):
+            getattr(self.waves, name)[lanes] = [attrgetter(source)(v.waves) for v in vessels]
+
+    def step(self, t: float | np.ndarray, h: float, delta_c: np.ndarray) -> None:
+        """``Vessel.step`` (at each member's own t_k, if an array): two RK4 steps for the
+        members whose rudder kinks in the step."""
         gear = RudderArrays(self.delta, delta_c, self.delta_max, self.delta_rate_max)
         y = tuple(getattr(self, name) for name in self.STATES)
         split = (0.0 < gear.reach) & (gear.reach < h)
@@ -98,7 +109,8 @@ class VesselArrays:
         elif len(lanes):
             part = RudderArrays(self.delta[lanes], delta_c[lanes], self.delta_max[lanes],
                                 self.delta_rate_max[lanes])
-            rest = self._rk4(t, part.reach, h - part.reach, tuple(a[lanes] for a in y), part,
+            rest = self._rk4(t if np.ndim(t) == 0 else t[lanes], part.reach, h - part.reach,
+                             tuple(a[lanes] for a in y), part,
                              None if self.waves is None else self.waves.take(lanes),
                              self.psi_w[lanes])
             for whole, value in zip(y, rest):

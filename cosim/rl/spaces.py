@@ -1,0 +1,89 @@
+"""What the ship environments share: the loop without its autopilot, the observation and
+action spaces, the observation and the reward (docs/rl.md). One function each, on arrays of
+M ships, so that one ship and a thousand give the same bits."""
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+import numpy as np
+from gymnasium import spaces
+
+from ..analysis.metrics import stage_cost
+from ..core.system import SystemDescription
+from ..ensemble.control import GuidanceArrays
+from ..ensemble.exact import wrap
+
+OBSERVATION = {           # name: (unit, what)
+    "e": ("rad", "heading error psi - psi_d, wrapped to (-pi, pi]"),
+    "r": ("rad/s", "yaw rate"),
+    "delta": ("rad", "rudder angle"),
+    "u": ("m/s", "surge speed"),
+    "cross_track": ("m", "distance from the active leg's line, positive to starboard of it"),
+    "to_go": ("m", "along the active leg to its end waypoint"),
+    "bearing": ("rad", "the active leg's bearing, eq (18), in (-pi, pi]"),
+}
+SIGNALS = ("guidance.psi_d", "guidance.wp_index", "ship.x", "ship.y", "ship.psi", "ship.u",
+           "ship.r", "ship.delta")     # what the observation and the reward are made of
+PILOT = "autopilot"
+
+
+def open_loop(system: SystemDescription) -> SystemDescription:
+    """``system`` without its autopilot: the ship's delta_c is the agent's action."""
+    if PILOT not in system.components or "ship" not in system.components:
+        raise ValueError(f"{system.name}: the ship environments take a scenario whose ship is "
+                         f"steered by an autopilot, not {', '.join(system.components)}")
+    return dataclasses.replace(
+        system, components={n: c for n, c in system.components.items() if n != PILOT},
+        connections=[c for c in system.connections if PILOT not in (c.start_element,
+                                                                     c.end_element)])
+
+
+def observation_space(count: int | None = None) -> spaces.Box:
+    shape = (len(OBSERVATION),) if count is None else (count, len(OBSERVATION))
+    return spaces.Box(-np.inf, np.inf, shape, np.float64)
+
+
+def action_space(delta_max: float, count: int | None = None) -> spaces.Box:
+    """delta_c, rad, within the gear's stops (beyond them the gear holds at the stop)."""
+    return spaces.Box(-delta_max, delta_max, (1,) if count is None else (count, 1), np.float64)
+
+
+def rudder_commands(action: Any, count: int) -> np.ndarray:
+    """The (count,) commands of an action (count, 1); ValueError for any that is not finite."""
+    delta_c = np.asarray(action, dtype=float).reshape(count)
+    bad = np.flatnonzero(~np.isfinite(delta_c))
+    if len(bad):
+        raise ValueError(f"action: delta_c = {delta_c[bad[0]]} is not finite"
+                         + (f" (ship {bad[0]})" if count > 1 else ""))
+    return delta_c
+
+
+def observe(route: GuidanceArrays, s: dict[str, np.ndarray]) -> np.ndarray:
+    """The (M, 7) observations of M ships from their ``SIGNALS`` (short names: psi, x, ...)."""
+    i = route.members
+    leg = np.minimum(s["wp_index"].astype(int), route.points - 1) - 1
+    (x0, y0), (dx, dy) = route.start[i, leg].T, route.delta[i, leg].T
+    length = route.length[i, leg]
+    cross = ((s["y"] - y0) * dx - (s["x"] - x0) * dy) / length
+    along = ((s["x"] - x0) * dx + (s["y"] - y0) * dy) / length
+    return np.stack((wrap(s["psi"] - s["psi_d"]), s["r"], s["delta"], s["u"], cross,
+                     length - along, route.course[i, leg]), axis=1)
+
+
+def reward(s: dict[str, np.ndarray], lam: float, first: np.ndarray | float) -> np.ndarray:
+    """Minus this sample's share of eq (19), and ``first`` (the share of t_0) on an
+    episode's first step: an episode's return is -J."""
+    return -(stage_cost(s["psi_d"], s["psi"], s["delta"], lam) + first)
+
+
+def finished(route: GuidanceArrays, s: dict[str, np.ndarray]) -> np.ndarray:
+    """Past the last waypoint."""
+    return s["wp_index"] >= route.points
+
+
+def short(signal: str) -> str:
+    return signal.split(".", 1)[1]
+
+
+MAX_SEED = 2**31 - 1                    # ship.wave_seed's range is 0 .. this
