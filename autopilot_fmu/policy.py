@@ -59,7 +59,7 @@ class Policy:
         theta = [x for rows, biases in self.layers for x in (*sum(rows, ()), *biases)]
         hidden = [len(biases) for _, biases in self.layers[:-1]]
         return json.dumps({"hidden": hidden, "scale": list(self.scale),
-                           "theta": [float(x) for x in theta], **about}, indent=1)
+                           "theta": [float(x) for x in theta], **about})
 
     def act(self, e: Any, r: Any, tanh: Callable = math.tanh) -> Any:
         """delta_c, rad, of e (rad) and r (rad/s); ``tanh`` for arrays: one exact per element."""

@@ -8,7 +8,7 @@ from autopilot_fmu.policy import Policy
 from fmukit.autopilot import INPUTS, rudder_command
 from fmukit.slave import ModelSlave, Var
 
-WEIGHTS = Path(__file__).with_name("policy_autopilot.json").read_text()
+WEIGHTS = Path(__file__).with_name("policy_autopilot.json").read_text().strip()
 
 
 class PolicyAutopilotSlave(ModelSlave):

@@ -22,7 +22,7 @@ from fmukit.manifest import Manifest, digest_of, sha256, version
 
 from . import documentation
 from .instantiate import InstantiationFailed, instantiate_in_child
-from .project import FMU_DIRS, FMUS, ROOT, ROUTES, project_identity
+from .project import DATA, FMU_DIRS, FMUS, ROOT, ROUTES, project_identity
 
 PROJECT_PACKAGES = ("fmukit", "ship_fmu", "autopilot_fmu")
 _IMPORT_ERRORS = {"ImportError", "ModuleNotFoundError", "Exception", "BaseException"}
@@ -31,8 +31,9 @@ _GUID = re.compile(rb'\s(guid|instantiationToken)="[^"]*"')
 
 def build(name: str, dest: Path | None = None, fmi: int = 2) -> Path:
     """One FMU of this project built as FMI ``fmi`` to dest/name.fmu (default: FMU_DIRS)."""
-    return build_script(ROOT / FMUS[name], PROJECT_PACKAGES,
-                        (dest or FMU_DIRS[fmi]) / f"{name}.fmu", project_identity(), fmi)
+    carried = (*PROJECT_PACKAGES, *(ROOT / file for file in DATA.get(name, ())))
+    return build_script(ROOT / FMUS[name], carried, (dest or FMU_DIRS[fmi]) / f"{name}.fmu",
+                        project_identity(), fmi)
 
 
 def build_script(script: Path, packages: tuple[str | Path, ...], dest: Path,

@@ -19,7 +19,10 @@ FMUS: dict[str, str] = {                          # name: its slave script, whos
     "guidance": "autopilot_fmu/guidance_slave.py",
     # Written as a user's own autopilot is (docs/own_autopilot.md): one file and fmukit.
     "pid_autopilot": "autopilot_fmu/pid_autopilot_slave.py",
+    # Trained by cosim.train (docs/rl.md); its weights in its resources.
+    "policy_autopilot": "autopilot_fmu/policy_autopilot_slave.py",
 }
+DATA = {"policy_autopilot": ("autopilot_fmu/policy_autopilot.json",)}   # files an FMU reads
 SLAVE_MODULES = frozenset(".".join(Path(script).with_suffix("").parts) for script in FMUS.values())
 C_FMUS = {"pd_autopilot_c": "autopilot_fmu/pd_autopilot_c"}       # name: its sources' folder
 BUILD_HINT = "build the FMUs with: python -m fmukit.build"
