@@ -43,6 +43,7 @@ CASES = {
                   (60, 0.1, 8.13, 8.13, -2.0))),
     "pd_autopilot": _HEADING,
     "pid_autopilot": _HEADING,
+    "policy_autopilot": _HEADING,
     "smc_autopilot": Case(60.0, ("psi", "r", "psi_d"),
                           ((0, 0.0, 0.0, 0.0), (10, 0.0, 0.0, 0.7), (40, 0.5, 0.005, 0.7),
                            (40, 0.5, 0.005, 0.0), (60, 0.3, -0.005, 0.0))),

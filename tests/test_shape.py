@@ -12,7 +12,8 @@ from fmubuild.project import ROOT
 
 PACKAGES = ("cosim", "fmukit", "fmubuild", "ship_fmu", "autopilot_fmu")
 COMMANDS = {"cosim.run", "cosim.sweep", "cosim.export", "cosim.bench", "cosim.engines",
-            "cosim.score", "cosim.accuracy", "cosim._cli", "fmukit.build", "fmubuild.cli"}
+            "cosim.score", "cosim.accuracy", "cosim.train", "cosim._cli", "fmukit.build",
+            "fmubuild.cli"}
 LAYERS = (("cosim.core",), ("cosim.ensemble",), ("cosim.scenarios",), ("cosim.analysis",),
           ("cosim.interop",), ("cosim", "cosim.api", "cosim.outputs", "cosim.provenance",
                                "cosim.testing"), ("cosim.studies",), ("cosim.rl",))
