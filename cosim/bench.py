@@ -5,7 +5,9 @@
     python -m cosim.bench memory          a 24 h run of calm_pd streamed to disk: peak memory
     python -m cosim.bench sweep           sweeps on a local cluster, every backend with 1 and
                                           2 workers; the batch route's goals (--parts)
-    python -m cosim.bench all             the four in turn, as docs/performance.md records them
+    python -m cosim.bench rl              the ship's vector env against Gymnasium's sync vector
+                                          env of single envs: env steps per second
+    python -m cosim.bench all             the five in turn, as docs/performance.md records them
 """
 from __future__ import annotations
 
@@ -13,10 +15,11 @@ import argparse
 import sys
 
 from ._cli import entry, say_error
+from .rl.throughput import throughput
 from .studies import sweep_timing, timing
 
 SWEEP_PARTS = ("throughput", "campaign", "memory")
-BENCHMARKS = ("engines", "overhead", "memory", "sweep")
+BENCHMARKS = ("engines", "overhead", "memory", "sweep", "rl")
 
 
 def _counts(text: str) -> tuple[int, ...]:
@@ -38,6 +41,8 @@ def _benchmark(name: str, args: argparse.Namespace, repeats: int) -> None:
             sweep_timing.campaign(args.campaign_runs)
         if "memory" in args.parts:
             sweep_timing.batch_memory(args.memory_members)
+    elif name == "rl":
+        throughput(args.ships, repeats)
     elif name == "overhead":
         timing.overhead(repeats)
     else:
@@ -77,10 +82,14 @@ def main(argv: list[str] | None = None) -> int:
     sweep.add_argument("--memory-members", type=_counts, default=sweep_timing.MEMORY_MEMBERS,
                        help="members of the memory measurement, comma-separated (default "
                             + ",".join(map(str, sweep_timing.MEMORY_MEMBERS)) + ")")
-    commands.add_parser("all", parents=[repeats], help="engines, overhead, memory and sweep in "
-                                                      "turn, each with its defaults")
+    rl = commands.add_parser("rl", parents=[repeats],
+                             help="ShipVectorEnv against a SyncVectorEnv of ShipEnv")
+    rl.add_argument("--ships", type=_counts, default=(256, 1000),
+                    help="ships per env, comma-separated (default 256,1000)")
+    commands.add_parser("all", parents=[repeats], help="engines, overhead, memory, sweep and "
+                                                      "rl in turn, each with its defaults")
     args = parser.parse_args(argv)
-    own = {"memory": mem, "sweep": sweep}
+    own = {"memory": mem, "sweep": sweep, "rl": rl}
     try:
         for name in BENCHMARKS if args.command == "all" else (args.command or "engines",):
             _benchmark(name, args if name == args.command or name not in own

@@ -27,10 +27,15 @@ SHORT_ROUTE = "0,0;5,0"
 
 
 @pytest.mark.filterwarnings("ignore:.*Box observation space m")   # unbounded: speeds, metres
-def test_the_single_env_passes_gymnasiums_checker():
-    env = ShipEnv("waves_pd", stop_time=5)
-    check_env(env)
-    env.close()
+def test_the_single_env_passes_gymnasiums_checker_on_either_route():
+    envs = [ShipEnv("waves_pd", stop_time=5, backend=b) for b in ("inprocess", "fmi")]
+    check_env(envs[0])
+    assert [e.master.backends["ship"] for e in envs] == ["inprocess", "fmi"]
+    steps = [np.concatenate([env.reset(seed=3)[0], *(np.append(*env.step([0.1 * k])[:2])
+                                                     for k in range(-3, 4))]) for env in envs]
+    assert steps[0].tobytes() == steps[1].tobytes()         # the FMUs give the same bits
+    for env in envs:
+        env.close()
 
 
 @pytest.mark.parametrize("scenario", ["waves_pd", "calm_smc"])
@@ -122,4 +127,11 @@ def test_a_trained_policy_steers_its_fmu_as_it_steered_the_env(tmp_path):
     run = cosim.simulate("calm_pd", fmu, stop_time=20)
     env = ShipVectorEnv(1, "calm_pd", stop_time=20, terminate=False)
     assert cost(run).J == pytest.approx(returns(env, policy, [0])[0], rel=1e-12)
+    env.close()
+
+
+def test_stable_baselines3s_checker_passes_where_it_is_installed():
+    checker = pytest.importorskip("stable_baselines3.common.env_checker")   # not a dependency
+    env = ShipEnv("waves_pd", stop_time=5)
+    checker.check_env(env)
     env.close()
