@@ -35,8 +35,9 @@ class ShipEnv(gymnasium.Env):
         self.t0, self.h, self.n_steps = self.master.system.steps(stop_time)
         self.lam, self.terminate, self._started = lam, terminate, False
         self.where = [self.master.columns.index(s) for s in SIGNALS]
-        self.observation_space = observation_space()
-        self.action_space = action_space(self._setting("ship", "delta_max"))
+        delta_max = self._setting("ship", "delta_max")
+        self.observation_space = observation_space(delta_max)
+        self.action_space = action_space(delta_max)
 
     def _setting(self, component: str, name: str) -> Any:
         return self.master.parameters[component].get(name, getattr(VesselParameters, name))

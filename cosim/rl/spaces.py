@@ -39,9 +39,11 @@ def open_loop(system: SystemDescription) -> SystemDescription:
                                                                      c.end_element)])
 
 
-def observation_space(count: int | None = None) -> spaces.Box:
-    shape = (len(OBSERVATION),) if count is None else (count, len(OBSERVATION))
-    return spaces.Box(-np.inf, np.inf, shape, np.float64)
+def observation_space(delta_max: float, count: int | None = None) -> spaces.Box:
+    """Angles within (-pi, pi] and the rudder within its stops; the rest unbounded."""
+    high = np.array([np.pi, np.inf, delta_max, np.inf, np.inf, np.inf, np.pi])
+    return spaces.Box(-high, high, dtype=np.float64) if count is None else \
+        spaces.Box(np.tile(-high, (count, 1)), np.tile(high, (count, 1)), dtype=np.float64)
 
 
 def action_space(delta_max: float, count: int | None = None) -> spaces.Box:

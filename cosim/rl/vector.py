@@ -54,10 +54,11 @@ class ShipVectorEnv(VectorEnv):
                              "into RK4 sub-steps, which the batch kernel does not")
         if (why := selftest()) is not None:
             warnings.warn(f"{why}: the ships' last bits may differ from ShipEnv's", stacklevel=2)
-        self.single_observation_space = observation_space()
-        self.single_action_space = action_space(vessel.params.delta_max)
-        self.observation_space = observation_space(num_envs)
-        self.action_space = action_space(vessel.params.delta_max, num_envs)
+        delta_max = vessel.params.delta_max
+        self.single_observation_space = observation_space(delta_max)
+        self.single_action_space = action_space(delta_max)
+        self.observation_space = observation_space(delta_max, num_envs)
+        self.action_space = action_space(delta_max, num_envs)
 
     def _member(self, wave_seed: int) -> tuple[Any, Any]:
         """The ship and guidance models of one ship, initialised by the in-process master."""
