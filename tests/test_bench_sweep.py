@@ -83,12 +83,12 @@ def test_the_command_refuses_bad_counts_before_any_cluster(capsys):
         capsys.readouterr().err
 
 
-def test_all_runs_the_four_benchmarks_in_turn_each_with_its_defaults(monkeypatch):
+def test_all_runs_the_five_benchmarks_in_turn_each_with_its_defaults(monkeypatch):
     ran = []
     monkeypatch.setattr(command, "_benchmark", lambda name, args, repeats: ran.append(
         (name, repeats, getattr(args, "hours", None), getattr(args, "runs", None))))
     assert command.main(["all", "--repeats", "3"]) == 0
     assert ran == [("engines", 3, None, None), ("overhead", 3, None, None),
-                   ("memory", 3, 24.0, None), ("sweep", 3, None, 32)]
+                   ("memory", 3, 24.0, None), ("sweep", 3, None, 32), ("rl", 3, None, None)]
     ran.clear()
     assert command.main(["memory", "--hours", "2"]) == 0 and ran == [("memory", 5, 2.0, None)]

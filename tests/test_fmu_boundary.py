@@ -29,6 +29,7 @@ MODELS = {
     # the circle of acceptance is two ship lengths
     "guidance": {"autopilot_fmu.guidance", "ship_fmu.data"},
     "pid_autopilot": set(),
+    "policy_autopilot": {"autopilot_fmu.policy"},      # and its weights, a data file
 }
 
 

@@ -73,7 +73,8 @@ def test_episodes_end_at_the_last_waypoint_or_the_stop_time():
     env.close()
 
 
-@pytest.mark.parametrize("scenario, seed", [("calm_pd", 0), ("waves_pd", 2010)])
+@pytest.mark.parametrize("scenario, seed", [     # quick: calm water; the waves: --long
+    ("calm_pd", 0), pytest.param("waves_pd", 2010, marks=pytest.mark.long)])
 def test_the_pd_as_a_policy_gives_the_published_J_through_either_env(scenario, seed):
     """waves_pd's own wave seed is 2010: reset(seed=2010) is its published run."""
     published = cost(cosim.simulate(scenario, backend="inprocess")).J
