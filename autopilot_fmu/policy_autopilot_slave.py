@@ -1,6 +1,7 @@
-"""The learned autopilot (autopilot_fmu.policy) as a co-simulation FMU (fmus/policy_autopilot.fmu):
-its weights, the String parameter ``policy``, default to policy_autopilot.json beside this
-file, in the FMU's resources (``cosim.train`` writes and builds them); delta_c is direct
+"""The learned autopilot (autopilot_fmu.policy) as a co-simulation FMU, policy_autopilot: its
+weights, the String parameter ``policy``, default to policy_autopilot.json beside this file,
+in the FMU's resources. cosim.train builds each policy it trains from this file, its model
+named anew, so that FMUs of other weights share no module in one host; delta_c is direct
 feedthrough from psi, r and psi_d."""
 from pathlib import Path
 

@@ -20,9 +20,9 @@ from ._cli import count, entry, say_error, writable_folder
 from .analysis.figures import comparison, save
 from .analysis.metrics import cost
 from .api import simulate
-from .core.files import OutputError, plain_name, whole_file
+from .core.files import OutputError, whole_file
 from .rl.cem import PD, TRAIN_SEEDS, Settings, evaluate, train
-from .rl.policy_fmu import build_policy_fmu
+from .rl.policy_fmu import build_policy_fmu, checked_name
 from .rl.report import learning_figure, table
 
 
@@ -45,14 +45,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=0, help="of the candidates' draws")
     parser.add_argument("--eval-seeds", type=count, default=20,
                         help="score on wave seeds 1 .. N, which training never sees")
-    parser.add_argument("--name", default="learned", help="file names (default learned)")
+    parser.add_argument("--name", default="learned",
+                        help="the FMU's model and the files' names, an identifier (default "
+                             "learned)")
     parser.add_argument("--out", type=Path, default=Path("results/rl"))
     args = parser.parse_args(argv)
     settings = Settings(args.scenario, tuple(args.hidden), args.population, args.seeds,
                         args.generations, seed=args.seed)
     seeds = list(range(1, args.eval_seeds + 1))
     try:
-        name, out = plain_name(args.name, "--name"), writable_folder(args.out)
+        name, out = checked_name(args.name), writable_folder(args.out)
         started = time.perf_counter()
         with tqdm(total=args.generations, desc="training", unit="generation", file=sys.stderr,
                   disable=None) as bar:

@@ -119,13 +119,19 @@ def test_a_policy_gives_the_same_bits_as_floats_and_as_arrays_of_many(hidden):
         Policy.from_json(json.dumps({"hidden": [2], "scale": [1, 1], "theta": [1, 2, 3]}))
 
 
-def test_a_trained_policy_steers_its_fmu_as_it_steered_the_env(tmp_path):
+def test_a_trained_policy_steers_its_fmu_as_it_steered_the_env(fmu_paths, tmp_path):
+    """In a host that ran the shipped policy's FMU first: pythonfmu runs every FMU in the
+    host's one interpreter, so a trained FMU's model is named anew (its modules with it)."""
     settings = Settings("calm_pd", population=4, seeds=1, generations=2, stop_time=20)
     policy, curve = train(settings)
     assert len(curve.best) == 2 and curve.best[-1] <= curve.elites[-1]
     assert train(settings)[0] == policy                       # its draws are seeded
+    shipped = cosim.simulate("calm_pd", fmu_paths["policy_autopilot"], stop_time=20)
     fmu = build_policy_fmu(policy, tmp_path / "mine.fmu", note="a test")
     run = cosim.simulate("calm_pd", fmu, stop_time=20)
+    assert cost(run).J != cost(shipped).J
+    with pytest.raises(ValueError, match="--name 'policy_autopilot': .* other than"):
+        build_policy_fmu(policy, tmp_path / "policy_autopilot.fmu")
     env = ShipVectorEnv(1, "calm_pd", stop_time=20, terminate=False)
     assert cost(run).J == pytest.approx(returns(env, policy, [0])[0], rel=1e-12)
     env.close()

@@ -84,13 +84,19 @@ def _unrecorded(signals: Sequence[str]) -> str | None:
     return f"the batch kernel records no {', '.join(others)}" if others else None
 
 
+def cut(ship: Vessel, h: float) -> str | None:
+    """Why the kernel cannot step ``ship``: its h_max cuts the step (or None)."""
+    return None if ship._cut_of(h)[0] == 1 else (
+        f"ship.h_max = {ship.params.h_max} s cuts the {h} s step into RK4 sub-steps, which "
+        "the batch kernel does not")
+
+
 def _outside(member: Member | None, h: float) -> str | None:
     if member is None:
         return "its initialisation failed"
-    ship, pilot = member.models["ship"], member.models["autopilot"]
-    if ship._cut_of(h)[0] != 1:
-        return (f"ship.h_max = {ship.params.h_max} s cuts the {h} s step into RK4 sub-steps, "
-                "which the batch kernel does not")
+    pilot = member.models["autopilot"]
+    if (why := cut(member.models["ship"], h)) is not None:
+        return why
     if isinstance(pilot, SlidingModeAutopilot) and substeps(h, pilot._h_max, "") != 1:
         return (f"autopilot.omega_n = {pilot.omega_n} rad/s and zeta = {pilot.zeta} cut the {h} "
                 "s step of the reference model (44) into RK4 sub-steps, which the batch kernel "

@@ -18,7 +18,7 @@ from ..core.master import Master
 from ..core.wiring import communication_step
 from ..ensemble.control import GuidanceArrays
 from .spaces import (MAX_SEED, SIGNALS, action_space, finished, observation_space, observe,
-                     open_loop, reward, rudder_commands, short)
+                     open_loop, reward, rudder_commands, seeded, short)
 
 
 class ShipEnv(gymnasium.Env):
@@ -50,8 +50,7 @@ class ShipEnv(gymnasium.Env):
         wave_seed = seed if seed is not None else int(self.np_random.integers(MAX_SEED + 1))
         if self._started:
             self.master.reset()
-        self.master.configure({**self.overrides,
-                               "ship": {**self.overrides.get("ship", {}), "wave_seed": wave_seed}})
+        self.master.configure(seeded(self.overrides, wave_seed))
         self.master.initialize()
         self._started, self.k = True, 0
         guidance = self.master.parameter_values["guidance"]

@@ -39,6 +39,11 @@ def open_loop(system: SystemDescription) -> SystemDescription:
                                                                      c.end_element)])
 
 
+def seeded(overrides: dict[str, dict[str, Any]], wave_seed: int) -> dict[str, dict[str, Any]]:
+    """``overrides`` with the ship's wave realisation ``wave_seed``, as a sweep's seed sets it."""
+    return {**overrides, "ship": {**overrides.get("ship", {}), "wave_seed": wave_seed}}
+
+
 def observation_space(delta_max: float, count: int | None = None) -> spaces.Box:
     """Angles within (-pi, pi] and the rudder within its stops; the rest unbounded."""
     high = np.array([np.pi, np.inf, delta_max, np.inf, np.inf, np.inf, np.pi])

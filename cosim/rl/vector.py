@@ -18,10 +18,11 @@ from ..api import overrides_of
 from ..core.inprocess import fallback_note
 from ..core.master import Master
 from ..ensemble import selftest
+from ..ensemble.route import cut
 from ..ensemble.control import GuidanceArrays
 from ..ensemble.vessel import VesselArrays
 from .spaces import (MAX_SEED, SIGNALS, action_space, finished, observation_space, observe,
-                     open_loop, reward, rudder_commands, short)
+                     open_loop, reward, rudder_commands, seeded, short)
 
 
 class ShipVectorEnv(VectorEnv):
@@ -49,9 +50,8 @@ class ShipVectorEnv(VectorEnv):
         vessel, _ = self._member(0)
         ship = self.master.instances["ship"].slave
         self.shafts = (ship.n1, ship.n2, ship.n3)                # held, as in the scenario
-        if vessel._cut_of(self.h)[0] != 1:
-            raise ValueError(f"ship.h_max = {vessel.params.h_max} s cuts the {self.h} s step "
-                             "into RK4 sub-steps, which the batch kernel does not")
+        if (why := cut(vessel, self.h)) is not None:
+            raise ValueError(why)
         if (why := selftest()) is not None:
             warnings.warn(f"{why}: the ships' last bits may differ from ShipEnv's", stacklevel=2)
         delta_max = vessel.params.delta_max
@@ -63,8 +63,7 @@ class ShipVectorEnv(VectorEnv):
     def _member(self, wave_seed: int) -> tuple[Any, Any]:
         """The ship and guidance models of one ship, initialised by the in-process master."""
         self.master.reset()
-        self.master.configure({**self.overrides, "ship": {**self.overrides.get("ship", {}),
-                                                           "wave_seed": wave_seed}})
+        self.master.configure(seeded(self.overrides, wave_seed))
         self.master.initialize()
         return tuple(self.master.instances[n].slave.model for n in ("ship", "guidance"))
 
