@@ -11,7 +11,6 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
 from tqdm import tqdm
 
 from fmubuild.project import FMU_DIR
@@ -21,7 +20,7 @@ from .analysis.figures import comparison, save
 from .analysis.metrics import cost
 from .api import simulate
 from .core.files import OutputError, whole_file
-from .rl.cem import PD, TRAIN_SEEDS, Settings, evaluate, train
+from .rl.cem import PD, TRAIN_SEEDS, Settings, average, evaluate, train
 from .rl.policy_fmu import build_policy_fmu, checked_name
 from .rl.report import learning_figure, table
 
@@ -65,16 +64,16 @@ def main(argv: list[str] | None = None) -> int:
         about = {"scenario": args.scenario, "trained_on_wave_seeds": [
                      TRAIN_SEEDS, TRAIN_SEEDS + args.generations * args.seeds - 1],
                  "settings": vars(settings), "minutes": round(minutes, 2),
-                 "J_mean": {k: float(np.mean(v)) for k, v in J.items()},
+                 "J_mean": {k: average(v) for k, v in J.items()},
                  "evaluated_on_wave_seeds": [seeds[0], seeds[-1]]}
         with whole_file(out / f"{name}.json") as tmp:
             tmp.write_text(policy.to_json(**about))
         fmus = [build_policy_fmu(policy, out / sub / f"{name}.fmu", fmi, **about)
                 for sub, fmi in (("", 2), ("fmi3", 3))]
-        pd_mean = float(np.mean(J["PD (eq 20)"]))
+        pd_mean = average(J["PD (eq 20)"])
         trained = evaluate({"PD": PD}, args.scenario, range(TRAIN_SEEDS, about[
             "trained_on_wave_seeds"][1] + 1))["PD"]
-        figures = save(learning_figure(curve, float(np.mean(trained)), f"{name} on "
+        figures = save(learning_figure(curve, average(trained), f"{name} on "
                                        f"{args.scenario}, {args.population} candidates x "
                                        f"{args.seeds} seeds a generation"),
                        out / f"{name}_learning.png")

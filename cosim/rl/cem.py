@@ -3,6 +3,7 @@ method, numpy only: each generation's candidates, each on the same few wave seed
 batch of the vector env; the next generation is drawn around the best quarter."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Callable, Sequence
 
@@ -52,6 +53,11 @@ def returns(env: ShipVectorEnv, policy: Policy, seeds: Sequence[int]) -> np.ndar
             return -total
 
 
+def average(values: Sequence[float]) -> float:
+    """The mean, exactly rounded (``math.fsum``): numpy's sums round by CPU."""
+    return math.fsum(values) / len(values)
+
+
 def train(settings: Settings, progress: Callable[[int, Curve], None] = lambda g, c: None
           ) -> tuple[Policy, Curve]:
     """The mean of the last generation's elites, and the learning curve."""
@@ -69,11 +75,14 @@ def train(settings: Settings, progress: Callable[[int, Curve], None] = lambda g,
             lanes = np.repeat(theta, s.seeds, axis=1)               # candidate-major
             seeds = [TRAIN_SEEDS + g * s.seeds + j for j in range(s.seeds)] * s.population
             J = returns(env, Policy.from_vector(list(lanes), s.hidden, s.scale), seeds)
-            score = J.reshape(s.population, s.seeds).mean(axis=1)
-            elites = theta[:, np.argsort(score)[:keep]]
-            mean, std = elites.mean(axis=1), elites.std(axis=1) + 0.02 * 0.9 ** g
-            curve.best.append(float(np.min(score)))
-            curve.elites.append(float(np.sort(score)[:keep].mean()))
+            score = np.array([average(row) for row in J.reshape(s.population, s.seeds)])
+            order = np.argsort(score, kind="stable")[:keep]
+            elites = theta[:, order]
+            mean = np.array([average(row) for row in elites])
+            std = np.sqrt([average((row - m) ** 2) for row, m in zip(elites, mean)])
+            std += 0.02 * 0.9 ** g                  # a floor that shrinks: no early collapse
+            curve.best.append(float(score[order[0]]))
+            curve.elites.append(average(score[order]))
             progress(g, curve)
     finally:
         env.close()

@@ -6,7 +6,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..analysis.figures import new_figure
-from .cem import Curve
+from .cem import Curve, average
 
 
 def learning_figure(curve: Curve, pd_mean: float, title: str) -> Figure:
@@ -26,11 +26,11 @@ def learning_figure(curve: Curve, pd_mean: float, title: str) -> Figure:
 def table(J: dict[str, np.ndarray], seeds: list[int]) -> list[str]:
     """A Markdown table: each policy's mean, spread and worst J on ``seeds``, and its share
     of the first's mean."""
-    first = float(np.mean(next(iter(J.values()))))
+    first = average(next(iter(J.values())))
     lines = [f"J of eq (19), rad^2, over wave seeds {seeds[0]}..{seeds[-1]} "
              f"({len(seeds)} seeds):", "", "| autopilot | mean | std | worst | vs first |",
              "|---|---|---|---|---|"]
     for name, values in J.items():
-        lines.append(f"| {name} | {np.mean(values):.2f} | {np.std(values):.2f} | "
-                     f"{np.max(values):.2f} | {np.mean(values) / first - 1:+.1%} |")
+        lines.append(f"| {name} | {average(values):.2f} | {np.std(values):.2f} | "
+                     f"{np.max(values):.2f} | {average(values) / first - 1:+.1%} |")
     return lines
