@@ -2,8 +2,8 @@
 cross-entropy method (numpy only), scored against the PD on wave seeds it never saw, and
 built as an autopilot FMU, FMI 2.0 and 3.0 (docs/rl.md).
 
-  python -m cosim.train                              # waves_pd, a linear policy, ~5 min
-  python -m cosim.train --hidden 8 --generations 60  # a tanh layer of 8 between
+  python -m cosim.train                              # waves_pd, a tanh layer of 8, ~5 min
+  python -m cosim.train --hidden --name linear       # a linear policy: a PD with a bias
   python -m cosim.run waves_pd --autopilot results/rl/learned.fmu   # then as any FMU
 """
 import argparse
@@ -22,7 +22,7 @@ from .api import simulate
 from .core.files import OutputError, whole_file
 from .rl.cem import PD, TRAIN_SEEDS, Settings, average, evaluate, train
 from .rl.policy_fmu import build_policy_fmu, checked_name
-from .rl.report import learning_figure, table
+from .rl.report import learning_figure, policy_figure, table
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -33,8 +33,9 @@ def main(argv: list[str] | None = None) -> int:
     default = Settings()
     parser.add_argument("--scenario", default=default.scenario,
                         help="a course-keeping scenario of this project (default waves_pd)")
-    parser.add_argument("--hidden", type=count, nargs="*", default=[], metavar="N",
-                        help="widths of tanh layers (default: none, a linear policy)")
+    parser.add_argument("--hidden", type=count, nargs="*", default=list(default.hidden),
+                        metavar="N", help="widths of the tanh layers (default: one of 8; "
+                                          "none: a linear policy, a PD with a bias)")
     parser.add_argument("--generations", type=count, default=default.generations)
     parser.add_argument("--population", type=count, default=default.population,
                         help="candidates per generation")
@@ -82,6 +83,8 @@ def main(argv: list[str] | None = None) -> int:
                                    (name, fmus[0]))}
         figures += save(comparison(runs, f"{args.scenario}, wave seed {seeds[0]}: PD and "
                                    f"{name}"), out / f"{name}_vs_pd.png")
+        figures += save(policy_figure({"PD (eq 20)": PD, name: policy}, runs[name]),
+                        out / f"{name}_map.png")
     except (ValueError, FileNotFoundError, OutputError) as error:
         say_error(error)
         return 2

@@ -23,7 +23,7 @@ TRAIN_SEEDS = 10_000            # generation g trains on wave seeds 10,000 + g S
 @dataclass(frozen=True)
 class Settings:
     scenario: str = "waves_pd"
-    hidden: tuple[int, ...] = ()           # tanh layers; () is linear: a PD with a bias
+    hidden: tuple[int, ...] = (8,)         # tanh layers; () is linear: a PD with a bias
     population: int = 32                   # candidates per generation
     seeds: int = 4                         # wave seeds each candidate is scored on
     generations: int = 40

@@ -2,10 +2,16 @@
 seeds training never saw."""
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from matplotlib.figure import Figure
 
+from autopilot_fmu.policy import Policy
+
 from ..analysis.figures import new_figure
+from ..core.recording import Recording
+from ..ensemble.exact import tanh, wrap
 from .cem import Curve, average
 
 
@@ -20,6 +26,30 @@ def learning_figure(curve: Curve, pd_mean: float, title: str) -> Figure:
            title=title, ylim=(0.0, 2.0 * max(pd_mean, min(curve.elites))))
     ax.grid(alpha=0.3)
     ax.legend()
+    return fig
+
+
+def policy_figure(policies: dict[str, Policy], run: Recording) -> Figure:
+    """Each policy's delta_c against e (r = 0) and against r (e = 0), held at the stops as the
+    gear holds it, over the range ``run`` went through, 90 % of its time shaded."""
+    fig = new_figure(figsize=(10, 4), layout="constrained")
+    stops = math.degrees(float(np.max(np.abs(run["ship.delta"])))) or 1.0
+    e, r = wrap(run["ship.psi"] - run["guidance.psi_d"]), run["ship.r"]
+    for column, (ax, label, values) in enumerate(zip(fig.subplots(1, 2), (
+            "e = psi - psi_d (deg), r = 0", "r (deg/s), e = 0"), (e, r))):
+        x = np.linspace(-np.max(np.abs(values)), np.max(np.abs(values)), 201)
+        ax.axvspan(*np.degrees(np.quantile(values, [0.05, 0.95])), color="0.9",
+                   label="90 % of the run's time")
+        for name, policy in policies.items():
+            inputs = (x, 0.0 * x) if column == 0 else (0.0 * x, x)
+            ax.plot(np.degrees(x), np.clip(np.degrees(policy.act(*inputs, tanh=tanh)),
+                                           -stops, stops), label=name)
+        ax.set(xlabel=label, ylabel="delta_c (deg), within the run's largest rudder",
+               ylim=(-1.1 * stops, 1.1 * stops))
+        ax.grid(alpha=0.3)
+    fig.axes[0].legend(fontsize=8)
+    fig.suptitle(f"the policies' rudder commands, over the run of {run.meta.get('system', '')}",
+                 fontsize=10)
     return fig
 
 
