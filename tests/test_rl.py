@@ -142,3 +142,21 @@ def test_stable_baselines3s_checker_passes_where_it_is_installed():
     env = ShipEnv("waves_pd", stop_time=5)
     checker.check_env(env)
     env.close()
+
+
+@pytest.mark.long
+@pytest.mark.timeout(300, method="thread")
+def test_a_training_gives_the_same_policy_under_other_cpus_numpy():
+    """The trainer's sums are exact and its sort stable: numpy's dispatch cannot move it."""
+    import os
+    import subprocess
+    import sys
+
+    from cosim.studies.cpu_variants import VARIANTS
+    child = ("from cosim.rl.cem import Settings, train; print(train(Settings('waves_pd', (3,), "
+             "6, 1, 3, stop_time=30))[0].to_json())")
+    policies = {name: subprocess.run([sys.executable, "-c", child], capture_output=True,
+                                     text=True, timeout=240, env={**os.environ, **extra},
+                                     check=True).stdout
+                for name, extra in VARIANTS.items() if name.startswith(("default", "numpy"))}
+    assert len(policies) == 3 and len(set(policies.values())) == 1, policies
