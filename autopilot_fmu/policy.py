@@ -48,11 +48,12 @@ class Policy:
             policy = cls.from_vector(theta, [int(n) for n in data["hidden"]],
                                      [float(x) for x in data["scale"]])
         except (ValueError, KeyError, TypeError) as error:
-            raise ValueError(f"policy: not a policy's JSON ({type(error).__name__}: {error})") \
+            raise ValueError(f"parameter policy: not a policy's JSON ({type(error).__name__}: "
+                             f"{error})") \
                 from None
         if len(policy.scale) != len(FEATURES) or not all(
                 math.isfinite(x) for x in (*theta, *policy.scale)) or min(policy.scale) <= 0:
-            raise ValueError("policy: its weights must be finite and its scales > 0")
+            raise ValueError("parameter policy: its weights must be finite and its scales > 0")
         return policy
 
     def to_json(self, **about: Any) -> str:

@@ -36,24 +36,29 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--hidden", type=count, nargs="*", default=list(default.hidden),
                         metavar="N", help="widths of the tanh layers (default: one of 8; "
                                           "none: a linear policy, a PD with a bias)")
-    parser.add_argument("--generations", type=count, default=default.generations)
+    parser.add_argument("--generations", type=count, default=default.generations,
+                        help=f"default {default.generations}")
     parser.add_argument("--population", type=count, default=default.population,
-                        help="candidates per generation")
+                        help=f"candidates per generation, at least 4 (default "
+                             f"{default.population})")
     parser.add_argument("--seeds", type=count, default=default.seeds,
                         help="wave seeds per candidate and generation (generation g: "
-                             f"{TRAIN_SEEDS} + g SEEDS ...)")
-    parser.add_argument("--seed", type=int, default=0, help="of the candidates' draws")
+                             f"{TRAIN_SEEDS} + g SEEDS ...; default {default.seeds})")
+    parser.add_argument("--seed", type=int, default=0,
+                        help="of the candidates' draws (default 0)")
     parser.add_argument("--eval-seeds", type=count, default=20,
-                        help="score on wave seeds 1 .. N, which training never sees")
+                        help="score on wave seeds 1 .. N, which training never sees (default "
+                             "20)")
     parser.add_argument("--name", default="learned",
                         help="the FMU's model and the files' names, an identifier (default "
                              "learned)")
-    parser.add_argument("--out", type=Path, default=Path("results/rl"))
+    parser.add_argument("--out", type=Path, default=Path("results/rl"),
+                        help="output folder (default results/rl)")
     args = parser.parse_args(argv)
-    settings = Settings(args.scenario, tuple(args.hidden), args.population, args.seeds,
-                        args.generations, seed=args.seed)
     seeds = list(range(1, args.eval_seeds + 1))
     try:
+        settings = Settings(args.scenario, tuple(args.hidden), args.population, args.seeds,
+                            args.generations, seed=args.seed)
         name, out = checked_name(args.name), writable_folder(args.out)
         started = time.perf_counter()
         with tqdm(total=args.generations, desc="training", unit="generation", file=sys.stderr,
@@ -83,12 +88,15 @@ def main(argv: list[str] | None = None) -> int:
                                    (name, fmus[0]))}
         figures += save(comparison(runs, f"{args.scenario}, wave seed {seeds[0]}: PD and "
                                    f"{name}"), out / f"{name}_vs_pd.png")
-        figures += save(policy_figure({"PD (eq 20)": PD, name: policy}, runs[name]),
-                        out / f"{name}_map.png")
+        figures += save(policy_figure({"PD (eq 20)": PD, name: policy}, runs[name], (
+            f"the rudder commands; shaded: where {name} kept the ship on {args.scenario}, "
+            f"wave seed {seeds[0]}")), out / f"{name}_map.png")
     except (ValueError, FileNotFoundError, OutputError) as error:
         say_error(error)
         return 2
-    print("\n".join([f"trained in {minutes:.1f} min: {policy.to_json()}", "",
+    weights = sum(len(biases) * (len(rows[0]) + 1) for rows, biases in policy.layers)
+    print("\n".join([f"trained in {minutes:.1f} min: {weights} weights, tanh layers "
+                      f"{list(settings.hidden)}", "",
                      *table(J, seeds), "",
                      f"through its FMU, wave seed {seeds[0]}: J = {cost(runs[name]).J:.4f} "
                      f"(the environment: {J[name][0]:.4f}; PD {pd_mean:.2f} on average)",

@@ -18,7 +18,7 @@ from cosim.ensemble.exact import tanh
 from cosim.rl import ENV_ID
 from cosim.rl.cem import PD, Settings, evaluate, returns, train
 from cosim.rl.env import ShipEnv
-from cosim.rl.policy_fmu import build_policy_fmu
+from cosim.rl.policy_fmu import build_policy_fmu, checked_name
 from cosim.rl.vector import ShipVectorEnv
 
 SHORT_ROUTE = "0,0;5,0"
@@ -99,9 +99,18 @@ def test_actions_and_settings_are_refused_by_name():
         env.reset(seed=[1, 2, 3])
     with pytest.raises(ValueError, match="ship.wave_seed = 2147483648 is outside the range"):
         env.reset(seed=[0, 2**31])
+    with pytest.raises(ValueError, match=r"action: 2 rudder commands delta_c \(shape \(2, 1\)\), "
+                                         r"got shape \(3,\)"):
+        env.step([0.0, 0.1, 0.2])
+    for name, why in (("my-policy", "is not a Python identifier"), ("class", "is a Python "
+                      "keyword"), ("json", "is the name of a Python module here")):
+        with pytest.raises(ValueError, match=f"--name '{name}' {why}"):
+            checked_name(name)
+    with pytest.raises(ValueError, match="population: at least 4 candidates, got 3"):
+        Settings(population=3)
     with pytest.raises(ValueError, match="num_envs must be a whole number >= 1, got 0"):
         ShipVectorEnv(0)
-    with pytest.raises(ValueError, match="steered by an autopilot, not program, ship"):
+    with pytest.raises(ValueError, match="zigzag_10_10 has no autopilot to take the place of"):
         ShipEnv("zigzag_10_10")
 
 
@@ -127,10 +136,10 @@ def test_a_trained_policy_steers_its_fmu_as_it_steered_the_env(fmu_paths, tmp_pa
     assert len(curve.best) == 2 and curve.best[-1] <= curve.elites[-1]
     assert train(settings)[0] == policy                       # its draws are seeded
     shipped = cosim.simulate("calm_pd", fmu_paths["policy_autopilot"], stop_time=20)
-    fmu = build_policy_fmu(policy, tmp_path / "mine.fmu", note="a test")
+    fmu = build_policy_fmu(policy, tmp_path / "trained_in_a_test.fmu", note="a test")
     run = cosim.simulate("calm_pd", fmu, stop_time=20)
     assert cost(run).J != cost(shipped).J
-    with pytest.raises(ValueError, match="--name 'policy_autopilot': .* other than"):
+    with pytest.raises(ValueError, match="--name 'policy_autopilot' is the name of one of "):
         build_policy_fmu(policy, tmp_path / "policy_autopilot.fmu")
     env = ShipVectorEnv(1, "calm_pd", stop_time=20, terminate=False)
     assert cost(run).J == pytest.approx(returns(env, policy, [0])[0], rel=1e-12)

@@ -351,13 +351,13 @@ def test_a_sweep_records_a_hung_run_as_failed_and_goes_on(fmu_paths, tmp_path, r
                          '[axes]\n"autopilot.hang_time" = [5.0, 1e9]\n')
     spec = Spec.read(spec_path)
     started = time.monotonic()
-    rows = [campaign.run_locally(spec, run, limits=Limits(step=1)) for run in spec.runs()]
+    rows = [campaign.run_locally(spec, run, limits=Limits(step=4)) for run in spec.runs()]
     sweep_task.free_masters()
-    assert [r["status"] for r in rows] == ["failed", "ok"]
+    assert [r["status"] for r in rows] == ["failed", "ok"], [r["error"] for r in rows]
     assert rows[0]["error"].startswith(            # a user's FMU: isolated, by default
         "FMU 'autopilot': doStep at t = 5 s returned no reply: killed when it did not end "
-        "within the step time limit of 1 s")
-    assert time.monotonic() - started < 1 + 10 * reference   # two runs, each its own child
+        "within the step time limit of 4 s")
+    assert time.monotonic() - started < 4 + 10 * reference   # two runs, each its own child
 
 
 def test_names_that_would_write_outside_the_folder_are_refused(tmp_path, capsys):

@@ -162,6 +162,8 @@ def value(x: Any, unit: str = "", degrees: bool = True) -> str:
     if isinstance(x, float) and degrees and unit in ("rad", "rad/s"):
         x, unit = x * math.degrees(1.0), unit.replace("rad", "deg")
     text = f"{x:.4g}" if isinstance(x, float) else str(x)
+    if len(text) > 60:                  # a network's JSON, say: the JSON file has it all
+        text = f"{text[:40]}... ({len(text)} characters)"
     return f"{text} {'' if unit == '1' else unit}".strip()
 
 

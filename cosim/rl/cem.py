@@ -32,6 +32,11 @@ class Settings:
     seed: int = 0                          # of the candidates' draws
     stop_time: float | None = None
 
+    def __post_init__(self) -> None:
+        if self.population < 4:
+            raise ValueError(f"population: at least 4 candidates, got {self.population} (the "
+                             "next generation is drawn around the best quarter, at least two)")
+
 
 @dataclass
 class Curve:

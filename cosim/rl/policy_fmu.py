@@ -3,21 +3,29 @@ with fmukit around the policy's JSON, carried in the FMU's resources, its model 
 Python modules in a host's one interpreter) named for it."""
 from __future__ import annotations
 
+import importlib.util
+import keyword
 import tempfile
 from pathlib import Path
 
 from autopilot_fmu.policy import Policy
 from fmubuild.packaging import PROJECT_PACKAGES, build_script
-from fmubuild.project import FMUS, ROOT, project_identity
+from fmubuild.project import C_FMUS, FMUS, ROOT, project_identity
 
 SHIPPED = "policy_autopilot"
 
 
 def checked_name(name: str) -> str:
-    """``name`` if it can name a trained policy's model, else ValueError saying why."""
-    if not name.isidentifier() or name == SHIPPED:
-        raise ValueError(f"--name {name!r}: a trained policy's FMU is named by an identifier "
-                         f"(letters, digits, _) other than {SHIPPED}, the shipped one's")
+    """``name`` if it can name a trained policy's model and its Python module, else
+    ValueError saying why: its FMU's modules live in the host's one interpreter."""
+    why = ("is not a Python identifier (letters, digits and _, not starting with a digit)"
+           if not name.isidentifier() else "is a Python keyword" if keyword.iskeyword(name)
+           else "is the name of one of this project's FMUs" if name in {*FMUS, *C_FMUS}
+           else "is the name of a Python module here, which the FMU's would clash with"
+           if importlib.util.find_spec(name) is not None else None)
+    if why:
+        raise ValueError(f"--name {name!r} {why}: a trained policy's FMU and its module are "
+                         "named by it; choose another, e.g. learned")
     return name
 
 

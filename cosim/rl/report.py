@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 
 from autopilot_fmu.policy import Policy
 
@@ -19,17 +20,21 @@ def learning_figure(curve: Curve, pd_mean: float, title: str) -> Figure:
     fig = new_figure(figsize=(7, 4), layout="constrained")
     ax = fig.add_subplot()
     generations = np.arange(1, len(curve.best) + 1)
-    ax.plot(generations, curve.elites, label="the best quarter's mean")
-    ax.plot(generations, curve.best, label="the best candidate")
+    top = 2.0 * max(pd_mean, min(curve.elites))
+    above = int(np.sum(np.array(curve.elites) > top))
+    ax.plot(generations, curve.elites, label="mean J of the best quarter of the candidates"
+            + (f" ({above} generation{'s' * (above > 1)} above the chart)" if above else ""))
+    ax.plot(generations, curve.best, label="J of the best candidate")
     ax.axhline(pd_mean, color="0.4", linestyle="--", label="PD, eq (20), over the training seeds")
     ax.set(xlabel="generation", ylabel="J of eq (19), rad$^2$, mean over its wave seeds",
-           title=title, ylim=(0.0, 2.0 * max(pd_mean, min(curve.elites))))
+           title=title, ylim=(0.0, top))
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.grid(alpha=0.3)
     ax.legend()
     return fig
 
 
-def policy_figure(policies: dict[str, Policy], run: Recording) -> Figure:
+def policy_figure(policies: dict[str, Policy], run: Recording, title: str) -> Figure:
     """Each policy's delta_c against e (r = 0) and against r (e = 0), held at the stops as the
     gear holds it, over the range ``run`` went through, 90 % of its time shaded."""
     fig = new_figure(figsize=(10, 4), layout="constrained")
@@ -48,17 +53,17 @@ def policy_figure(policies: dict[str, Policy], run: Recording) -> Figure:
                ylim=(-1.1 * stops, 1.1 * stops))
         ax.grid(alpha=0.3)
     fig.axes[0].legend(fontsize=8)
-    fig.suptitle(f"the policies' rudder commands, over the run of {run.meta.get('system', '')}",
-                 fontsize=10)
+    fig.suptitle(title, fontsize=10)
     return fig
 
 
 def table(J: dict[str, np.ndarray], seeds: list[int]) -> list[str]:
-    """A Markdown table: each policy's mean, spread and worst J on ``seeds``, and its share
-    of the first's mean."""
-    first = average(next(iter(J.values())))
+    """A Markdown table: each policy's mean, spread and worst J on ``seeds``, and its mean
+    against the first's."""
+    name, values = next(iter(J.items()))
+    first = average(values)
     lines = [f"J of eq (19), rad^2, over wave seeds {seeds[0]}..{seeds[-1]} "
-             f"({len(seeds)} seeds):", "", "| autopilot | mean | std | worst | vs first |",
+             f"({len(seeds)} seeds):", "", f"| autopilot | mean | std | worst | vs {name} |",
              "|---|---|---|---|---|"]
     for name, values in J.items():
         lines.append(f"| {name} | {average(values):.2f} | {np.std(values):.2f} | "

@@ -31,8 +31,9 @@ PILOT = "autopilot"
 def open_loop(system: SystemDescription) -> SystemDescription:
     """``system`` without its autopilot: the ship's delta_c is the agent's action."""
     if PILOT not in system.components or "ship" not in system.components:
-        raise ValueError(f"{system.name}: the ship environments take a scenario whose ship is "
-                         f"steered by an autopilot, not {', '.join(system.components)}")
+        raise ValueError(f"{system.name} has no autopilot to take the place of (its "
+                         f"components: {', '.join(system.components)}); the ship environments "
+                         "take a course-keeping scenario, e.g. calm_pd or waves_pd")
     return dataclasses.replace(
         system, components={n: c for n, c in system.components.items() if n != PILOT},
         connections=[c for c in system.connections if PILOT not in (c.start_element,
@@ -58,7 +59,11 @@ def action_space(delta_max: float, count: int | None = None) -> spaces.Box:
 
 def rudder_commands(action: Any, count: int) -> np.ndarray:
     """The (count,) commands of an action (count, 1); ValueError for any that is not finite."""
-    delta_c = np.asarray(action, dtype=float).reshape(count)
+    delta_c = np.asarray(action, dtype=float)
+    if delta_c.size != count:
+        raise ValueError(f"action: {count} rudder command{'s' * (count > 1)} delta_c (shape "
+                         f"{(count, 1) if count > 1 else (1,)}), got shape {delta_c.shape}")
+    delta_c = delta_c.reshape(count)
     bad = np.flatnonzero(~np.isfinite(delta_c))
     if len(bad):
         raise ValueError(f"action: delta_c = {delta_c[bad[0]]} is not finite"
