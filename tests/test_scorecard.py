@@ -161,9 +161,14 @@ def test_a_win_is_the_better_value_on_the_same_sea_and_a_tie_within_one_percent(
     q = scorecard_report.paired(waypoints, rows, "mine")
     assert (q.wins, q.losses, q.ties) == (1, 1, 1) and q.median == 0.0
     better = scorecard_report.paired(J, [r for r in rows if r["wave_seed"] != 3], "mine")
-    assert (better.wins, better.ties, better.verdict) == (1, 1, "mixed")
+    assert (better.wins, better.losses, better.ties, better.verdict) == (1, 0, 1, "better")
     assert scorecard_report.Paired(3, 1, 0, math.nan).verdict == "better"
-    assert scorecard_report.Paired(0, 1, 3, math.nan).verdict == "even"
+    # issue 40: a one-sided record is never "even", however many ties
+    assert scorecard_report.Paired(0, 8, 12, math.nan).verdict == "worse"
+    assert scorecard_report.Paired(1, 0, 19, math.nan).verdict == "better"
+    assert scorecard_report.Paired(0, 0, 20, math.nan).verdict == "even"
+    assert scorecard_report.Paired(5, 4, 11, math.nan).verdict == "mixed"
+    assert scorecard_report.Paired(11, 4, 5, math.nan).verdict == "better"
 
 
 def test_the_spread_of_a_criterion_over_decades_is_drawn_on_a_log_scale(tmp_path,

@@ -43,10 +43,13 @@ class Paired:
 
     @property
     def verdict(self) -> str:
-        """better / worse on more than half the seeds; else even (mostly ties) or mixed."""
-        return next((word for word, count in (("better", self.wins), ("worse", self.losses),
-                                              ("even", self.ties)) if 2 * count > self.seeds),
-                    "mixed")
+        """even: every seed tied; better (worse): no seed lost (won), or more than half won
+        (lost); else mixed. A one-sided record is never even."""
+        if not self.losses:
+            return "better" if self.wins else "even"
+        if not self.wins or 2 * self.losses > self.seeds:
+            return "worse"
+        return "better" if 2 * self.wins > self.seeds else "mixed"
 
 
 def pairs(criterion: Merit, rows: list[dict], controller: str,
@@ -136,8 +139,9 @@ def _at_a_glance(names: list[str], metrics: dict[str, dict[str, dict]],
     """Each controller's verdicts against the PD per ensemble, and route completion."""
     lines = [f"## At a glance: each controller against the {BASELINE}", "",
              f"Seed-paired over {seeds} wave seeds: **better** (**worse**) means better "
-             f"(worse) than the {BASELINE} on the same sea in more than half of the seeds, "
-             f"*even* that most are ties (within {100 * TIE:g} % of the {BASELINE}'s value), "
+             f"(worse) than the {BASELINE} on the same sea in more than half of the seeds, or "
+             "on some and worse (better) on none, the others tied (within "
+             f"{100 * TIE:g} % of the {BASELINE}'s value); *even* that every seed is a tie, "
              "*mixed* neither; then the seeds won, lost and tied of those both ran, and the "
              f"median paired ratio to the {BASELINE} or difference from it.", ""]
     for sea, rows in ensembles.items():
