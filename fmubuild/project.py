@@ -17,6 +17,7 @@ FMUS: dict[str, str] = {                          # name: its slave script, whos
     "pd_autopilot": "autopilot_fmu/pd_autopilot_slave.py",
     "smc_autopilot": "autopilot_fmu/smc_autopilot_slave.py",
     "guidance": "autopilot_fmu/guidance_slave.py",
+    "los_guidance": "autopilot_fmu/los_guidance_slave.py",     # in eq (18)'s guidance's place
     # Written as a user's own autopilot is (docs/own_autopilot.md): one file and fmukit.
     "pid_autopilot": "autopilot_fmu/pid_autopilot_slave.py",
     # Trained by cosim.train (docs/rl.md); its weights in its resources.

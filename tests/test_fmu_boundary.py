@@ -28,6 +28,8 @@ MODELS = {
                       "ship_fmu.vessel", "ship_fmu.waves"},
     # the circle of acceptance is two ship lengths
     "guidance": {"autopilot_fmu.guidance", "ship_fmu.data"},
+    "los_guidance": {"autopilot_fmu.guidance", "autopilot_fmu.guidance_slave", "autopilot_fmu.los",
+                     "ship_fmu.data"},                  # eq (18)'s FMU is its base
     "pid_autopilot": set(),
     "policy_autopilot": {"autopilot_fmu.policy"},      # and its weights, a data file
 }
