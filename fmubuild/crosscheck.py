@@ -51,6 +51,7 @@ CASES = {
                            (40, 0.5, 0.005, 0.0), (60, 0.3, -0.005, 0.0))),
     "guidance": _ROUTE,
     "los_guidance": _ROUTE,
+    "environment": Case(300.0, (), ((0,), (300,))),    # its defaults: no current
     "manoeuvre": Case(60.0, ("psi",), ((0, 0.0), (20, -0.5), (40, 0.5), (60, -0.5))),
 }
 

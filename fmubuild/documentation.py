@@ -131,17 +131,19 @@ def _variables(variables: list[ModelVariable], columns: tuple[str, ...],
 
 
 def _example(model: ModelDescription, inputs: list[ModelVariable]) -> str:
-    """fmpy running the FMU alone, its first input that starts at 0 held at 0.1 instead."""
+    """fmpy running the FMU alone, its first input that starts at 0 held at 0.1 instead (an
+    FMU without inputs: its first such parameter)."""
     name = model.modelName
-    held = next((v for v in inputs if v.type in ("Real", "Float64")
-                 and float(v.start or 1) == 0), None)
+    held = next((v for v in inputs or [v for v in model.modelVariables
+                                       if v.causality == "parameter"]
+                 if v.type in ("Real", "Float64") and float(v.start or 1) == 0), None)
     stop = model.defaultExperiment.stopTime if model.defaultExperiment else None
     command = f"fmpy simulate {name}.fmu" + (f" --stop-time {stop}" if stop else "")
     if held is None:
         return f"<pre>{command} --output-file {name}.csv</pre>"
     value = repr(min(max(0.1, float(held.min or "-inf")), float(held.max or "inf")))
     unit = "" if (held.unit or "1") == "1" else " " + html.escape(held.unit)
-    return (f"<p>The FMU alone{f' for {stop} s' if stop else ''}, with input "
+    return (f"<p>The FMU alone{f' for {stop} s' if stop else ''}, with {held.causality} "
             f"<code>{held.name}</code> held at {value}{unit} and every other variable at its "
             f"start value; its outputs at every step go to {name}.csv:</p>\n"
             f"<pre>{command} --start-values {held.name} {value} --output-file {name}.csv</pre>\n"

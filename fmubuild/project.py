@@ -14,6 +14,7 @@ FMU_DIRS = {2: FMU_DIR, 3: FMU_DIR / "fmi3"}       # by FMI version, the same na
 FMUS: dict[str, str] = {                          # name: its slave script, whose imports it carries
     "ship": "ship_fmu/ship_slave.py",
     "manoeuvre": "ship_fmu/manoeuvre_slave.py",
+    "environment": "ship_fmu/environment_slave.py",     # the current, wired into the ship
     "pd_autopilot": "autopilot_fmu/pd_autopilot_slave.py",
     "smc_autopilot": "autopilot_fmu/smc_autopilot_slave.py",
     "guidance": "autopilot_fmu/guidance_slave.py",

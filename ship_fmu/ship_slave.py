@@ -26,8 +26,8 @@ class ShipSlave(ModelSlave):
         Var.output("x", "m", "north position", depends=("x0",)),
         Var.output("y", "m", "east position", depends=("y0",)),
         Var.output("psi", "rad", "heading, continuous (not wrapped)", depends=("psi0",)),
-        Var.output("u", "m/s", "surge velocity", depends=("u0",)),
-        Var.output("v", "m/s", "sway velocity", depends=("v0",)),
+        Var.output("u", "m/s", "surge velocity (through the water)", depends=("u0",)),
+        Var.output("v", "m/s", "sway velocity (through the water)", depends=("v0",)),
         Var.output("r", "rad/s", "yaw rate", depends=("r0",)),
         Var.output("delta", "rad", "actual rudder angle (steering gear output)"),
         Var.output("X_w", "N", "wave surge force, eq (14)", depends=_SEA),
@@ -53,6 +53,10 @@ class ShipSlave(ModelSlave):
         Var.parameter("h_max", _P.h_max, "s", "largest RK4 step; a communication step is "
                       "cut into equal sub-steps no longer than this (RK4 diverges in "
                       "the steepest valid seas beyond about 0.4 s)", 1e-4, 0.2),
+        Var.input("V_c", 0.0, "m/s", "ocean current speed (an environment FMU's output); u "
+                  "and v are then relative to the water", 0.0, 5.0),
+        Var.input("beta_c", 0.0, "rad", "direction the current flows towards, from north",
+                  -ANGLE_MAX, ANGLE_MAX),
     )
 
     def build_model(self) -> Vessel:
@@ -60,4 +64,4 @@ class ShipSlave(ModelSlave):
                                           for f in fields(VesselParameters)}))
 
     def step_model(self, t: float, h: float) -> None:
-        self.model.step(t, h, self.delta_c, self.n1, self.n2, self.n3)
+        self.model.step(t, h, self.delta_c, self.n1, self.n2, self.n3, self.V_c, self.beta_c)

@@ -60,6 +60,7 @@ class Vessel:
         self._minv = (M[2][2] / det, -M[1][2] / det, -M[2][1] / det, M[1][1] / det)
         self.waves, self._wave_loads = None, calm_water
         self._shafts, self._forces = None, None        # the last shaft speeds, their tau_th
+        self._current: tuple[float, float] | None = None   # (north, east) m/s, held a step
         if params.Hs > 0.0:
             components = WaveComponents.from_spectrum(
                 params.Hs, params.T0, params.wave_components, params.wave_seed)
@@ -72,11 +73,15 @@ class Vessel:
     def rates(self, t: float, state: State, tau_th: tuple[float, float, float]) -> State:
         """d/dt of the state, eqs (1)-(17), under actuator forces tau_th."""
         return state_rates(self.hull, self._minv, self._m11_inv, self._wave_loads,
-                           self.params.psi_w, t, state, tau_th)
+                           self.params.psi_w, t, state, tau_th, current=self._current)
 
     def step(self, t: float, h: float, delta_c: float,
-             n1: float = N_PROPELLER, n2: float = N_PROPELLER, n3: float = 0.0) -> None:
-        require_finite(delta_c=delta_c, n1=n1, n2=n2, n3=n3)
+             n1: float = N_PROPELLER, n2: float = N_PROPELLER, n3: float = 0.0,
+             V_c: float = 0.0, beta_c: float = 0.0) -> None:
+        """A step of h s with the inputs held: the rudder command, the shaft speeds and the
+        ocean current, V_c m/s flowing towards beta_c rad from north (none if V_c = 0)."""
+        require_finite(delta_c=delta_c, n1=n1, n2=n2, n3=n3, V_c=V_c, beta_c=beta_c)
+        self._current = (V_c * math.cos(beta_c), V_c * math.sin(beta_c)) if V_c else None
         if (n1, n2, n3) != self._shafts:
             self._shafts, self._forces = (n1, n2, n3), actuator_model(self.actuators, n1, n2, n3)
         forces = self._forces
@@ -110,9 +115,13 @@ class Vessel:
 def state_rates(hull: Hull, minv: tuple[float, float, float, float], m11_inv: float,
                 wave_loads: Callable, psi_w: float, t: float, state: State,
                 tau_th: tuple[float, float, float], hypot: Callable = math.hypot,
-                cos: Callable = math.cos, sin: Callable = math.sin) -> State:
+                cos: Callable = math.cos, sin: Callable = math.sin,
+                current: tuple[float, float] | None = None) -> State:
     """d/dt of the state, eqs (1)-(17); floats, or arrays with numpy's cos, sin and an
-    exact hypot (``cosim.ensemble``)."""
+    exact hypot (``cosim.ensemble``). In an ocean current (north, east, m/s; irrotational,
+    held over the step) u and v are relative to the water, in the hull's forces as in calm
+    water, and the current carries the ship (Fossen 2011, sec. 10.3: eta_dot = R(psi) nu_r
+    + v_c)."""
     _, _, psi, u, v, r, xi = state
     cX, cY, cN = coriolis_forces(hull, u, v, r)
     dX, dY, dN = damping_forces(hull, u, v, r)
@@ -123,6 +132,8 @@ def state_rates(hull: Hull, minv: tuple[float, float, float, float], m11_inv: fl
     fN = tN + wN - cN - dN
     i22, i23, i32, i33 = minv
     x_dot, y_dot, psi_dot = kinematics(psi, u, v, r, cos, sin)
+    if current is not None:
+        x_dot, y_dot = x_dot + current[0], y_dot + current[1]
     xi_dot = hypot(u, v) * cos(psi_w - psi)
     return (x_dot, y_dot, psi_dot, fX * m11_inv,
             i22 * fY + i23 * fN, i32 * fY + i33 * fN, xi_dot)

@@ -177,8 +177,8 @@ def programs(md) -> st.SearchStrategy:
                                                 values_for(v))
                                       for v in variables if v.causality == "parameter"]),
                           max_size=3)
-    well_formed = st.builds(lambda o, p, r, a: [*o, *p, ("exit",), *r, *a],
-                            opening, parameters, running, anything)
+    well_formed = st.builds(lambda o, p, s, r, a: [*o, *p, ("exit",), s, *r, *a],
+                            opening, parameters, valid_steps, running, anything)
     return st.one_of(well_formed, well_formed, anything)
 
 

@@ -1,0 +1,54 @@
+"""The ocean current (issue 40, items 1 and 3): it carries the ship through the kinematics,
+u and v stay relative to the water, no current changes no bit, and the environment FMU's
+Gauss-Markov speed and direction are seeded, restorable and of the asked spread."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import cosim
+from ship_fmu.environment import Current
+from ship_fmu.vessel import Vessel, VesselParameters
+
+
+def test_a_current_carries_a_ship_at_rest_and_none_changes_no_bit():
+    drifting = Vessel(VesselParameters(u0=0.0))
+    for k in range(100):                                 # 10 s, shafts stopped
+        drifting.step(0.1 * k, 0.1, 0.0, 0.0, 0.0, 0.0, V_c=0.1, beta_c=math.pi / 2)
+    assert drifting.y == pytest.approx(1.0, rel=1e-9) and abs(drifting.x) < 1e-12
+    assert drifting.u == drifting.v == drifting.r == 0.0  # still, relative to the water
+    ships = [Vessel(VesselParameters(Hs=0.01, wave_seed=3)) for _ in range(2)]
+    for k in range(50):
+        ships[0].step(0.1 * k, 0.1, 0.2)
+        ships[1].step(0.1 * k, 0.1, 0.2, V_c=0.0, beta_c=1.0)
+    assert ships[0].snapshot() == ships[1].snapshot()
+
+
+def test_the_current_is_seeded_restorable_and_has_the_asked_spread():
+    current = Current(0.05, 1.0, T_c=20.0, sigma_V=0.01, sigma_beta=0.2, seed=4)
+    samples = []
+    for _ in range(20_000):
+        current.step(0.5)
+        samples.append((current.V, current.beta))
+        if len(samples) == 100:
+            saved, again = current.snapshot(), Current(0.05, 1.0, 20.0, 0.01, 0.2, 4)
+            again.restore(saved)
+    V, beta = np.array(samples).T
+    assert V.min() >= 0.0
+    assert abs(V.mean() - 0.05) < 0.002 and abs(V.std() / 0.01 - 1) < 0.1
+    assert abs(beta.mean() - 1.0) < 0.04 and abs(beta.std() / 0.2 - 1) < 0.1
+    again.step(0.5)
+    assert (again.V, again.beta) == tuple(samples[100])       # goes on as it would have
+    with pytest.raises(ValueError, match="parameter T_c must be > 0, got 0.0"):
+        Current(T_c=0.0)
+
+
+def test_waves_pd_current_drifts_east_and_runs_alike_in_process_and_through_fmi():
+    runs = [cosim.simulate("waves_pd_current", backend=b, stop_time=60)
+            for b in ("inprocess", "fmi")]
+    still = cosim.simulate("waves_pd", backend="inprocess", stop_time=60)
+    assert runs[0]["ship.y"][-1] > still["ship.y"][-1] + 1.0     # 0.03 m/s east for 60 s
+    assert runs[0]["environment.V_c"].std() > 0.0
+    np.testing.assert_array_equal(runs[0].data, runs[1].data)
