@@ -52,6 +52,8 @@ CASES = {
     "guidance": _ROUTE,
     "los_guidance": _ROUTE,
     "environment": Case(300.0, (), ((0,), (300,))),    # its defaults: no current
+    "sensors": Case(30.0, ("psi", "r", "x", "y"), ((0, 0.0, 0.0, 0.0, 0.0),
+                                                   (30, 0.7, 0.01, 9.0, 1.0))),
     "manoeuvre": Case(60.0, ("psi",), ((0, 0.0), (20, -0.5), (40, 0.5), (60, -0.5))),
 }
 

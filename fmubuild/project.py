@@ -15,6 +15,7 @@ FMUS: dict[str, str] = {                          # name: its slave script, whos
     "ship": "ship_fmu/ship_slave.py",
     "manoeuvre": "ship_fmu/manoeuvre_slave.py",
     "environment": "ship_fmu/environment_slave.py",     # the current, wired into the ship
+    "sensors": "ship_fmu/sensors_slave.py",             # between the ship and its controllers
     "pd_autopilot": "autopilot_fmu/pd_autopilot_slave.py",
     "smc_autopilot": "autopilot_fmu/smc_autopilot_slave.py",
     "guidance": "autopilot_fmu/guidance_slave.py",

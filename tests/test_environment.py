@@ -1,4 +1,4 @@
-"""The ocean current (issue 40, items 1 and 3): it carries the ship through the kinematics,
+"""The ocean current and the instruments (issue 40, items 1, 3 and 4): it carries the ship through the kinematics,
 u and v stay relative to the water, no current changes no bit, and the environment FMU's
 Gauss-Markov speed and direction are seeded, restorable and of the asked spread."""
 from __future__ import annotations
@@ -10,6 +10,7 @@ import pytest
 
 import cosim
 from ship_fmu.environment import Current
+from ship_fmu.sensors import Sensors
 from ship_fmu.vessel import Vessel, VesselParameters
 
 
@@ -51,4 +52,35 @@ def test_waves_pd_current_drifts_east_and_runs_alike_in_process_and_through_fmi(
     still = cosim.simulate("waves_pd", backend="inprocess", stop_time=60)
     assert runs[0]["ship.y"][-1] > still["ship.y"][-1] + 1.0     # 0.03 m/s east for 60 s
     assert runs[0]["environment.V_c"].std() > 0.0
+    np.testing.assert_array_equal(runs[0].data, runs[1].data)
+
+
+def test_perfect_sensors_read_true_values_and_noisy_ones_the_asked_spread():
+    perfect = Sensors()
+    assert (perfect.heading(0.3), perfect.rate(-0.01), perfect.position(1.5, -2.0)) == (
+        0.3, -0.01, (1.5, -2.0))
+    gyro = Sensors(psi_bias=0.01, psi_noise=0.005, psi_resolution=0.001, r_noise=0.002,
+                   position_noise=0.014, seed=7)
+    readings = []
+    for k in range(5000):
+        readings.append((gyro.heading(1.0), gyro.rate(0.0), *gyro.position(3.0, 4.0)))
+        if k == 10:
+            again = Sensors(0.01, 0.005, 0.001, 0.0, 0.002, 0.0, 0.014, 7)
+            again.restore(gyro.snapshot())
+        gyro.step()
+    psi_m, r_m, x_m, y_m = np.array(readings).T
+    assert np.allclose(psi_m / 0.001, np.round(psi_m / 0.001), atol=1e-9)   # its steps
+    assert abs(psi_m.mean() - 1.01) < 3e-4 and abs(psi_m.std() / 0.005 - 1) < 0.1
+    assert abs(r_m.std() / 0.002 - 1) < 0.1 and abs(x_m.std() / 0.014 - 1) < 0.1
+    assert again.heading(1.0) == readings[10][0]             # restored: the same draws
+    with pytest.raises(ValueError, match="parameter r_noise must be >= 0, got -1.0"):
+        Sensors(r_noise=-1.0)
+
+
+def test_waves_pd_sensors_steers_by_the_measured_heading():
+    runs = [cosim.simulate("waves_pd_sensors", backend=b, stop_time=30)
+            for b in ("inprocess", "fmi")]
+    run = runs[0]
+    np.testing.assert_array_equal(run["autopilot.psi"], run["sensors.psi_m"])
+    assert np.abs(run["sensors.psi_m"] - run["ship.psi"]).max() > 0.005   # bias and noise
     np.testing.assert_array_equal(runs[0].data, runs[1].data)

@@ -21,7 +21,8 @@ MODELS = {
     "ship": {"ship_fmu.data", "ship_fmu.hull", "ship_fmu.steering_gear", "ship_fmu.thrusters",
              "ship_fmu.vessel", "ship_fmu.waves"},
     "manoeuvre": {"ship_fmu.manoeuvres"},
-    "environment": {"ship_fmu.environment"},          # the current, nothing of the ship         # the rudder program, and nothing of the ship
+    "environment": {"ship_fmu.environment"},          # the current, nothing of the ship
+    "sensors": {"ship_fmu.sensors"},         # the rudder program, and nothing of the ship
     "pd_autopilot": {"autopilot_fmu.pd"},
     # design_model 'ship' linearises the vessel model
     "smc_autopilot": {"autopilot_fmu.design", "autopilot_fmu.smc", "ship_fmu.data",
