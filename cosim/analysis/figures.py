@@ -99,6 +99,9 @@ def course_keeping_figure(run: Recording, lam: float = LAMBDA) -> Figure:
     track.set_title(merit_table(run, lam), loc="left", family="monospace", fontsize=8)
     t = run.t
     u.plot(t, run["ship.u"], color="k")
+    if "sensors.psi_m" in run.columns:                  # what the autopilot was told
+        heading.plot(t, np.degrees(run["sensors.psi_m"]), color="tab:green", linewidth=0.5,
+                     label="psi measured")
     heading.plot(t, np.degrees(run["ship.psi"]), color="k", label="psi")
     heading.plot(t, np.degrees(run["guidance.psi_d"]), "--", color="tab:red", label="psi_d")
     if "autopilot.psi_z" in run.columns:
