@@ -4,6 +4,7 @@ by (seed, step), so that a saved and restored state goes on as it would have; wi
 bias or quantisation each reads its true value exactly."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -12,8 +13,10 @@ from fmukit.numerics import require_finite
 
 
 def quantised(value: float, resolution: float) -> float:
-    """``value`` to the nearest multiple of ``resolution`` (none if 0)."""
-    return resolution * round(value / resolution) if resolution else value
+    """``value`` to the nearest multiple of ``resolution``; as it is if that is 0, or finer
+    than a float tells apart (found by the fuzzer: 5e-324)."""
+    steps = value / resolution if resolution else math.inf
+    return resolution * round(steps) if abs(steps) < 2.0**52 else value
 
 
 @dataclass

@@ -73,6 +73,7 @@ def test_perfect_sensors_read_true_values_and_noisy_ones_the_asked_spread():
     assert abs(psi_m.mean() - 1.01) < 3e-4 and abs(psi_m.std() / 0.005 - 1) < 0.1
     assert abs(r_m.std() / 0.002 - 1) < 0.1 and abs(x_m.std() / 0.014 - 1) < 0.1
     assert again.heading(1.0) == readings[10][0]             # restored: the same draws
+    assert Sensors(r_bias=1.0, r_resolution=5e-324).rate(0.01) == 1.01   # finer than floats
     with pytest.raises(ValueError, match="parameter r_noise must be >= 0, got -1.0"):
         Sensors(r_noise=-1.0)
 
