@@ -110,6 +110,12 @@ def test_actions_and_settings_are_refused_by_name():
         Settings(population=3)
     with pytest.raises(ValueError, match="num_envs must be a whole number >= 1, got 0"):
         ShipVectorEnv(0)
+    with pytest.raises(ValueError, match="the batch kernel cannot step waves_pd_los: guidance "
+                                         r"\(los_guidance.fmu\) is the model 'los_guidance'"):
+        ShipVectorEnv(2, "waves_pd_los")
+    with pytest.raises(ValueError, match="the batch kernel cannot step waves_pd_current: the "
+                                         "batch route runs course keeping"):
+        ShipVectorEnv(2, "waves_pd_current")
     with pytest.raises(ValueError, match="zigzag_10_10 has no autopilot to take the place of"):
         ShipEnv("zigzag_10_10")
 

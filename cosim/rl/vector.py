@@ -15,11 +15,11 @@ from fmukit.timebase import communication_point
 from .. import scenarios
 from ..analysis.metrics import LAMBDA
 from ..api import overrides_of
-from ..core.inprocess import fallback_note
 from ..core.master import Master
 from ..ensemble import selftest
 from ..ensemble.route import cut
 from ..ensemble.control import GuidanceArrays
+from ..ensemble.reference import coverage
 from ..ensemble.vessel import VesselArrays
 from .spaces import (MAX_SEED, SIGNALS, action_space, finished, observation_space, observe,
                      open_loop, reward, rudder_commands, seeded, short)
@@ -38,12 +38,12 @@ class ShipVectorEnv(VectorEnv):
             raise ValueError(f"num_envs must be a whole number >= 1, got {num_envs!r}")
         self.num_envs, self.lam, self.terminate = num_envs, lam, terminate
         self.overrides = overrides_of(set or {})
-        system = open_loop(scenarios.load(scenario, fmi=fmi))
+        loaded = scenarios.load(scenario, fmi=fmi)
+        system = open_loop(loaded)
+        if (why := coverage(loaded)) is not None:       # LOS guidance, a current: not in it
+            raise ValueError(f"the batch kernel cannot step {loaded.name}: {why}; ShipEnv "
+                             "steps it through the FMUs (or Gymnasium's SyncVectorEnv of it)")
         self.master = Master(system, backend="inprocess", overrides=self.overrides)
-        notes = [n for n in map(fallback_note, self.master.paths, self.master.paths.values())
-                 if n is not None]
-        if notes:
-            raise ValueError(f"the batch kernel runs this project's FMUs only: {notes[0]}")
         t0, self.h, self.n_steps = self.master.system.steps(stop_time)
         self.times = np.array([communication_point(t0, k, self.h)
                                for k in range(self.n_steps + 1)])
