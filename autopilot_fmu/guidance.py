@@ -78,6 +78,14 @@ def route(parameters: Mapping[str, Any]) -> list[tuple[float, float]]:
     return points
 
 
+def leg_offsets(x: Any, y: Any, x0: Any, y0: Any, dx: Any, dy: Any, length: Any
+                ) -> tuple[Any, Any]:
+    """(e, along) of (x, y) from the leg that starts at (x0, y0) and runs (dx, dy), of
+    ``length``: the cross-track error, positive to starboard (Fossen 2011, ch. 10), and the
+    distance along the leg, m. Floats, or arrays (the batch kernel, metrics): the same bits."""
+    return ((y - y0) * dx - (x - x0) * dy) / length, ((x - x0) * dx + (y - y0) * dy) / length
+
+
 class WaypointGuidance:
     """Desired course along a route of waypoints."""
 
@@ -95,7 +103,7 @@ class WaypointGuidance:
         (x0, y0), (x1, y1) = self.points[leg], self.points[leg + 1]
         dx, dy = x1 - x0, y1 - y0
         length = math.hypot(dx, dy)
-        along = ((x - x0) * dx + (y - y0) * dy) / length
+        along = leg_offsets(x, y, x0, y0, dx, dy, length)[1]
         return math.hypot(x1 - x, y1 - y) <= self.R_accept or along >= length
 
     def active_leg(self, x: float, y: float) -> tuple[int, bool]:

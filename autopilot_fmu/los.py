@@ -5,7 +5,7 @@ leg's course wherever the ship is; LOS steers back onto the leg's line."""
 import math
 from collections.abc import Sequence
 
-from autopilot_fmu.guidance import PAPER_ROUTE, R_ACCEPT, WaypointGuidance
+from autopilot_fmu.guidance import PAPER_ROUTE, R_ACCEPT, WaypointGuidance, leg_offsets
 from fmukit.numerics import wrap
 from ship_fmu.data import Hull
 
@@ -28,7 +28,7 @@ class LOSGuidance(WaypointGuidance):
         leg = self.active_leg(x, y)[0]
         (x0, y0), (x1, y1) = self.points[leg], self.points[leg + 1]
         dx, dy = x1 - x0, y1 - y0
-        return ((y - y0) * dx - (x - x0) * dy) / math.hypot(dx, dy)
+        return leg_offsets(x, y, x0, y0, dx, dy, math.hypot(dx, dy))[0]
 
     def psi_d(self, x: float, y: float) -> float:
         leg = self.active_leg(x, y)[0]

@@ -8,7 +8,7 @@ from typing import Sequence
 
 import numpy as np
 
-from autopilot_fmu.guidance import WaypointGuidance
+from autopilot_fmu.guidance import leg_offsets
 
 from ..core.recording import Recording
 from ..ensemble.exact import wrap
@@ -98,13 +98,14 @@ def fraction_at_stops(delta: np.ndarray, delta_max: float) -> float:
 
 def cross_track_error(x: np.ndarray, y: np.ndarray, wp_index: np.ndarray,
                       points: Sequence[tuple[float, float]]) -> np.ndarray:
-    """e = -(x - x_k) sin alpha_k + (y - y_k) cos alpha_k of the leg to ``wp_index`` (past
-    the last: the last leg), m, positive to starboard (Fossen 2011, ch 10)."""
-    guidance = WaypointGuidance(points)
+    """e of the leg to ``wp_index`` (past the last: the last leg), m, positive to starboard
+    (``leg_offsets``, as LOS guidance computes it)."""
     leg = np.clip(np.asarray(wp_index, dtype=int) - 1, 0, len(points) - 2)
-    alpha = np.array([guidance.course(k) for k in range(len(points) - 1)])[leg]
-    start = np.asarray(points, dtype=float)[leg]
-    return -(x - start[:, 0]) * np.sin(alpha) + (y - start[:, 1]) * np.cos(alpha)
+    start, end = (np.asarray(points, dtype=float)[k] for k in (leg, leg + 1))
+    (x0, y0), (dx, dy) = start.T, (end - start).T
+    lengths = np.array([math.hypot(x1 - xa, y1 - ya) for (xa, ya), (x1, y1) in
+                        zip(points[:-1], points[1:])])
+    return leg_offsets(x, y, x0, y0, dx, dy, lengths[leg])[0]
 
 
 @dataclass(frozen=True)

@@ -6,7 +6,7 @@ from typing import Sequence
 
 import numpy as np
 
-from autopilot_fmu.guidance import WaypointGuidance
+from autopilot_fmu.guidance import WaypointGuidance, leg_offsets
 from autopilot_fmu.pd import PDAutopilot
 from autopilot_fmu.smc import SlidingModeAutopilot, reference_acceleration, reference_rk4
 
@@ -50,7 +50,7 @@ class GuidanceArrays:
         while moving.any():
             (x0, y0), (x1, y1), (dx, dy) = (a[i, leg].T for a in (self.start, self.end, self.delta))
             length = self.length[i, leg]
-            along = ((x - x0) * dx + (y - y0) * dy) / length
+            along = leg_offsets(x, y, x0, y0, dx, dy, length)[1]
             moving &= _within(x1 - x, y1 - y, self.R_accept) | (along >= length)
             last = leg + 2 >= self.points
             finished |= moving & last

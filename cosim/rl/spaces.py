@@ -9,6 +9,8 @@ from typing import Any
 import numpy as np
 from gymnasium import spaces
 
+from autopilot_fmu.guidance import leg_offsets
+
 from ..analysis.metrics import stage_cost
 from ..core.system import SystemDescription
 from ..ensemble.control import GuidanceArrays
@@ -77,8 +79,7 @@ def observe(route: GuidanceArrays, s: dict[str, np.ndarray]) -> np.ndarray:
     leg = np.minimum(s["wp_index"].astype(int), route.points - 1) - 1
     (x0, y0), (dx, dy) = route.start[i, leg].T, route.delta[i, leg].T
     length = route.length[i, leg]
-    cross = ((s["y"] - y0) * dx - (s["x"] - x0) * dy) / length
-    along = ((s["x"] - x0) * dx + (s["y"] - y0) * dy) / length
+    cross, along = leg_offsets(s["x"], s["y"], x0, y0, dx, dy, length)
     return np.stack((wrap(s["psi"] - s["psi_d"]), s["r"], s["delta"], s["u"], cross,
                      length - along, route.course[i, leg]), axis=1)
 
