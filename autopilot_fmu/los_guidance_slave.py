@@ -1,7 +1,7 @@
 """Line-of-sight guidance as a co-simulation FMU (fmus/los_guidance.fmu): the ports and
 parameters of eq (18)'s guidance FMU, so it takes its place in any scenario, plus the
 lookahead distance and the cross-track error e as an output."""
-from autopilot_fmu.guidance import ROUTE_PARAMETERS, route
+from autopilot_fmu.guidance import ROUTE_PARAMETERS
 from autopilot_fmu.guidance_slave import GuidanceSlave
 from autopilot_fmu.los import LOOKAHEAD, LOSGuidance
 from fmukit.slave import Var
@@ -27,5 +27,5 @@ class LOSGuidanceSlave(GuidanceSlave):
     )
 
     def build_model(self) -> LOSGuidance:
-        return LOSGuidance(route({name: getattr(self, name) for name in ROUTE_PARAMETERS}),
-                           self.R_accept, self.lookahead)
+        legs = super().build_model()                        # the route, read and checked once
+        return LOSGuidance(legs.points, legs.R_accept, self.lookahead)

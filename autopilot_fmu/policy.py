@@ -26,17 +26,22 @@ class Policy:
         return list(zip(widths[:-1], widths[1:]))
 
     @classmethod
+    def count(cls, hidden: Sequence[int]) -> int:
+        """The parameters (weights and biases) of a network with ``hidden`` tanh layers."""
+        return sum(n_in * n_out + n_out for n_in, n_out in cls.sizes(hidden))
+
+    @classmethod
     def from_vector(cls, theta: Sequence, hidden: Sequence[int], scale: Sequence) -> Policy:
         """The network of the parameters ``theta`` (each a float, or an array: many)."""
+        if cls.count(hidden) != len(theta):
+            raise ValueError(f"a policy with hidden layers {list(hidden)} has "
+                             f"{cls.count(hidden)} parameters, not {len(theta)}")
         layers, at = [], 0
         for n_in, n_out in cls.sizes(hidden):
             rows = tuple(tuple(theta[at + j * n_in:at + (j + 1) * n_in]) for j in range(n_out))
             at += n_in * n_out
             layers.append((rows, tuple(theta[at:at + n_out])))
             at += n_out
-        if at != len(theta):
-            raise ValueError(f"a policy with hidden layers {list(hidden)} has {at} "
-                             f"parameters, not {len(theta)}")
         return cls(tuple(layers), tuple(scale))
 
     @classmethod

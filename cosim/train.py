@@ -13,6 +13,7 @@ from pathlib import Path
 
 from tqdm import tqdm
 
+from autopilot_fmu.policy import Policy
 from fmubuild.project import FMU_DIR
 
 from ._cli import count, entry, say_error, writable_folder
@@ -94,8 +95,8 @@ def main(argv: list[str] | None = None) -> int:
     except (ValueError, FileNotFoundError, OutputError) as error:
         say_error(error)
         return 2
-    weights = sum(len(biases) * (len(rows[0]) + 1) for rows, biases in policy.layers)
-    print("\n".join([f"trained in {minutes:.1f} min: {weights} weights, tanh layers "
+    print("\n".join([f"trained in {minutes:.1f} min: {Policy.count(settings.hidden)} "
+                      f"weights, tanh layers "
                       f"{list(settings.hidden)}", "",
                      *table(J, seeds), "",
                      f"through its FMU, wave seed {seeds[0]}: J = {cost(runs[name]).J:.4f} "

@@ -67,7 +67,7 @@ def train(settings: Settings, progress: Callable[[int, Curve], None] = lambda g,
           ) -> tuple[Policy, Curve]:
     """The mean of the last generation's elites, and the learning curve."""
     s = settings
-    size = sum(n_in * n_out + n_out for n_in, n_out in Policy.sizes(s.hidden))
+    size = Policy.count(s.hidden)
     rng = np.random.default_rng(s.seed)
     mean, std = np.zeros(size), np.full(size, 0.5)
     keep = max(2, round(s.elite * s.population))
