@@ -18,10 +18,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, required=True, help=".npz file to write")
     parser.add_argument("--signals", nargs="+", default=list(TRACED),
                         help="component.variable names to record (Real)")
+    parser.add_argument("--events", type=Path, metavar="FILE",
+                        help="timed events, OSP's scenario file (libcosim only)")
     args = parser.parse_args(argv)
     try:
-        result = run(args.engine, args.ssp, tuple(args.signals))
+        result = run(args.engine, args.ssp, tuple(args.signals), args.events)
         save_trace(args.out, result)
+    except ValueError as error:                     # events for an engine without them
+        parser.error(str(error))
     except (EngineError, OutputError) as error:     # EngineError: with the FMU's message
         print(f"error: {error}", file=sys.stderr)
         return 1

@@ -92,5 +92,6 @@ def pythonfmu_variable(var: Var, getter: Callable[[], Any] | None, kind: type,
             variability.continuous if var.is_real else variability.discrete),
             initial=initial.calculated, description=var.description, getter=getter, **extra)
     return kind(var.name, causality=causality[var.causality], variability=(
-        variability.fixed if var.causality == "parameter" else variability.continuous),
+        variability.continuous if var.causality == "input" else
+        variability.tunable if var.tunable else variability.fixed),
         description=var.description, **extra)

@@ -43,8 +43,8 @@ class CallSequence:
         """Refused naming ``var`` if the standard forbids setting it now."""
         if var.causality == "output":
             raise Refused(f"{var.name} is an output and cannot be set", "call", var.name)
-        if var.causality == "parameter" and self.phase not in ("instantiated",
-                                                               "initialization"):
+        if var.causality == "parameter" and not var.tunable and \
+                self.phase not in ("instantiated", "initialization"):
             raise Refused(f"parameter {var.name} is fixed after initialisation "
                           f"(phase '{self.phase}')", "call", var.name)
         if self.phase == "terminated":
@@ -98,6 +98,10 @@ class ModelSlave:
     def step_model(self, t: float, h: float) -> None:
         """Advance the model from t to t + h with the current inputs."""
         raise NotImplementedError
+
+    def tune_model(self, name: str) -> None:
+        """Parameter ``name`` (tunable) was set between steps: the model takes it."""
+        setattr(self.model, name, getattr(self, name))
 
     def start_model(self, model: Any) -> None:
         """Set a model's initial state from the inputs (a restored state does not use them)."""
@@ -215,7 +219,9 @@ class ModelSlave:
             if var.kind is not convert:
                 raise Refused(f"{var.name} is not of type {convert.__name__}", "call", var.name)
             setattr(self, var.name, convert(value))
-            if var.causality == "parameter":
+            if var.causality == "parameter" and self.sequence.phase == "step":
+                self.tune_model(var.name)         # a tunable one, between steps
+            elif var.causality == "parameter":
                 self._model = None
 
     def _set_floats(self, vrs: list[int], values: list[float]) -> None:

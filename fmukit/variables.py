@@ -44,6 +44,7 @@ class Var:
     get: Callable[[Any], Any] | None = None   # outputs: value from the slave
     min: float = -math.inf            # inputs and parameters: the valid range, written to
     max: float = math.inf             # modelDescription.xml and enforced (NaN is never valid)
+    tunable: bool = False             # parameters: settable between steps (a timed event)
 
     def __post_init__(self) -> None:
         if self.kind is float and self.unit not in UNITS:
@@ -53,9 +54,11 @@ class Var:
     @classmethod
     def parameter(cls, name: str, start: float | int | str, unit: str = "1",
                   description: str = "", min: float = -math.inf,
-                  max: float = math.inf) -> Var:
-        """A fixed parameter; its Python type (float, int, str) sets the FMI type."""
-        return cls(name, "parameter", unit, description, start, type(start), min=min, max=max)
+                  max: float = math.inf, tunable: bool = False) -> Var:
+        """A fixed (``tunable``: settable between steps) parameter; its Python type (float,
+        int, str) sets the FMI type."""
+        return cls(name, "parameter", unit, description, start, type(start), min=min, max=max,
+                   tunable=tunable)
 
     @classmethod
     def input(cls, name: str, start: float, unit: str = "1", description: str = "",

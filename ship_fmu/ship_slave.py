@@ -1,7 +1,7 @@
 """The vessel as an FMI 2.0 co-simulation FMU (fmus/ship.fmu); no direct feedthrough (the
 rudder acts through the steering gear and the hull's inertia)."""
 import math
-from dataclasses import fields
+from dataclasses import fields, replace
 
 from fmukit.slave import ModelSlave, Var
 from ship_fmu.vessel import N_PROPELLER, Vessel, VesselParameters
@@ -40,8 +40,9 @@ class ShipSlave(ModelSlave):
         Var.parameter("v0", _P.v0, "m/s", "initial sway velocity", -5.0, 5.0),
         Var.parameter("r0", _P.r0, "rad/s", "initial yaw rate", -5.0, 5.0),
         Var.parameter("delta_max", _P.delta_max, "rad", "rudder stops, > 0", 0.0, math.pi / 2),
-        Var.parameter("delta_rate_max", _P.delta_rate_max, "rad/s",
-                      "steering gear rate limit, > 0", 0.0, 10.0),
+        Var.parameter("delta_rate_max", _P.delta_rate_max, "rad/s", "steering gear rate "
+                      "limit; tunable: 0 from a time on is a failed gear", 0.0, 10.0,
+                      tunable=True),
         Var.parameter("Hs", _P.Hs, "m", "significant wave height; 0 = calm water (0.1 m is "
                       "7 m at full scale)", 0.0, 0.1),
         Var.parameter("T0", _P.T0, "s", "modal period of the wave spectrum", 0.1, 10.0),
@@ -62,6 +63,9 @@ class ShipSlave(ModelSlave):
     def build_model(self) -> Vessel:
         return Vessel(VesselParameters(**{f.name: getattr(self, f.name)
                                           for f in fields(VesselParameters)}))
+
+    def tune_model(self, name: str) -> None:
+        self.model.params = replace(self.model.params, **{name: getattr(self, name)})
 
     def step_model(self, t: float, h: float) -> None:
         self.model.step(t, h, self.delta_c, self.n1, self.n2, self.n3, self.V_c, self.beta_c)

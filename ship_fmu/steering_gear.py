@@ -20,7 +20,7 @@ class RudderMotion:
         self.delta0, self.target = delta0, rudder_target(delta_c, delta_max)
         error = self.target - delta0
         self.velocity = math.copysign(delta_rate_max, error)
-        self.reach = abs(error) / delta_rate_max
+        self.reach = abs(error) / delta_rate_max if delta_rate_max else math.inf  # 0: stuck
 
     def __call__(self, s: float) -> float:
         return self.target if s >= self.reach else self.delta0 + self.velocity * s

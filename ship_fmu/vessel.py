@@ -37,9 +37,11 @@ class VesselParameters:
     h_max: float = 0.1          # s, largest RK4 step
 
     def __post_init__(self) -> None:     # what the FMU's declared ranges do not refuse
-        for name in ("delta_max", "delta_rate_max"):
-            if not getattr(self, name) > 0.0:
-                raise ValueError(f"parameter {name} must be > 0, got {getattr(self, name)}")
+        if not self.delta_max > 0.0:
+            raise ValueError(f"parameter delta_max must be > 0, got {self.delta_max}")
+        if not self.delta_rate_max >= 0.0:      # 0: the gear has failed, the rudder stays
+            raise ValueError(f"parameter delta_rate_max must be >= 0, got "
+                             f"{self.delta_rate_max}")
         # steeper waves break (Stokes' limit): the block model's loads would diverge
         peak_wavelength = G * self.T0 * self.T0 / (2.0 * math.pi)
         if self.Hs > peak_wavelength / MAX_STEEPNESS:

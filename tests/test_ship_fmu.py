@@ -129,7 +129,7 @@ def test_a_non_finite_input_fails_the_fmu_by_name_until_reset(ship, name, bad):
 
 @pytest.mark.parametrize("name, value", [
     ("Hs", -0.01), ("T0", 0.0), ("T0", -1.0), ("wave_components", 0),
-    ("delta_max", 0.0), ("delta_rate_max", 0.0), ("delta_rate_max", -1.0), ("u0", math.nan),
+    ("delta_max", 0.0), ("delta_rate_max", -1.0), ("u0", math.nan),
     ("h_max", 0.0), ("x0", math.inf),
 ])
 def test_invalid_parameters_are_reported_by_name_and_fail_the_first_step(ship, name, value):

@@ -14,13 +14,13 @@ import subprocess
 import sys
 import threading
 from contextlib import contextmanager
-from operator import itemgetter
 from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator
 
 from .fmi import described, read_description
 from .fmu_host import HEADER, Garbled, message, receive, send
 from .instance import FmuCallError, Instance
+from .wiring import gatherer
 
 ROOT = Path(__file__).resolve().parents[2]
 CHILD = "from cosim.core.fmu_host import serve; serve()"
@@ -194,8 +194,7 @@ class IsolatedInstance(Instance):
         answer = struct.Struct(f"<{then.stop - then.start + first.stop - first.start}d")
         size = ask.size - HEADER.size
         n_then, ints, cached = then.stop - then.start, integers.start < integers.stop, [None]
-        gather = itemgetter(*node.sources) if len(inputs) > 1 else \
-            (lambda values: (values[node.sources[0]],)) if inputs else (lambda values: ())
+        gather = gatherer(node)
 
         def read_first() -> list:
             return [v for vrs, kind in read if vrs for v in self._remote("read", vrs, kind)]

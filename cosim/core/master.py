@@ -8,6 +8,7 @@ from typing import Any, Callable
 
 from fmukit.timebase import communication_point
 
+from .events import Schedule
 from .fmi import FmuInstance, read_description
 from .inprocess import InProcessInstance, fallback_note, in_process_refusal
 from .instance import FmuCallError, Instance
@@ -43,6 +44,7 @@ class Master(contextlib.AbstractContextManager):
         self.declarations = {name: declarations(read_description(path, name, system.ours(path)))
                              for name, path in self.paths.items()}
         self.configure(overrides)
+        self.schedule = Schedule(system.events, self.declarations, self.paths, system.steps()[1])
         self.instances: dict[str, Instance] = {}
         self.notes = unit_notes({c: {n: d.unit for n, d in ds.items()} for c, ds in
                                  self.declarations.items()}, overrides or {}, self.overrides)
@@ -117,6 +119,7 @@ class Master(contextlib.AbstractContextManager):
                                              run_meta(self, n_steps), self.units)
         values = [0.0] * len(self.columns)
         k, t, error, self.parameter_values = 0, t0, None, {}
+        self.schedule.own.clear()
         beat = watchdog.beat if watchdog is not None else no_limit
         if watchdog is not None:
             watchdog.calling = self.calling
@@ -133,6 +136,8 @@ class Master(contextlib.AbstractContextManager):
                         error = (f"{'interrupted' if signal else f'{expired}: stopped'} at "
                                  f"t = {t:.6g} s, {recorder.rows} rows kept")
                         break
+                    if k in self.schedule.due:
+                        self.schedule.apply(k, t, self.instances, {n.name: n for n in self.nodes})
                     communication_step(self.nodes, values, t, h, k < n_steps)
                     recorder.append(t, values)
                     if progress is not None and k % 100 == 0:
@@ -173,7 +178,9 @@ def run_meta(master: Master, n_steps: int) -> dict[str, Any]:
     return {"system": system.name, "description": system.description,
             "scenario_file": str(system.path) if system.path else None,
             "backend": master.backend, "backends": master.backends, "notes": master.notes,
-            "coupling": master.coupling, "start_time": t0, "step_size": h,
+            "coupling": master.coupling, "events": [
+                e.__dict__ for due in master.schedule.due.values() for e, _ in due],
+            "start_time": t0, "step_size": h,
             "stop_time": communication_point(t0, n_steps, h),
             "scenario_stop_time": system.stop_time,
             "settings": master.parameters, "overrides": master.overrides,

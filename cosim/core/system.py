@@ -102,6 +102,7 @@ class SystemDescription:
     report: str = "none"
     description: str = ""
     path: Path | None = None                     # the .ssd this was read from
+    events: tuple = ()                           # timed events (``core.events.Event``)
     fmus: FmuFolders | None = field(default=None, compare=False, repr=False)
 
     def __post_init__(self) -> None:

@@ -53,6 +53,8 @@ class Node:
     name: str = ""
     inputs: slice = field(default_factory=lambda: slice(0))     # connected inputs, as sent
     sources: list[int] = field(default_factory=list)    # the column feeding each input
+    input_names: list[str] = field(default_factory=list)    # their columns' names
+    modifiers: dict[int, Callable[[float], float]] = field(default_factory=dict)  # by events
     vrs: list[int] = field(default_factory=list)        # of the outputs, then the inputs
     read_state: Callable[[], list[float]] | None = None
     read_feedthrough: Callable[[], list[float]] | None = None
@@ -109,24 +111,33 @@ def layout(instances: dict[str, Instance], connections: list[Connection],
         if incoming:
             node.sources = [columns.index(f"{c.start_element}.{c.start_connector}")
                             for c in incoming]
+            node.input_names = columns[node.inputs]
             node.vrs += [instances[name].vr(c.end_connector) for c in incoming]
-            write = instances[name].writer(node.vrs[-len(incoming):])
-            node.apply_inputs = _input_applier(write, node.sources, node.inputs)
+            write, gather = instances[name].writer(node.vrs[-len(incoming):]), gatherer(node)
+
+            def apply(values: list[float], write=write, gather=gather, inputs=node.inputs):
+                sent = gather(values)
+                write(sent)
+                values[inputs] = sent
+            node.apply_inputs = apply
         own = getattr(instances[name], "couple", None)     # an isolated FMU's: one message
         node.start, node.exchange = own(node, gauss_seidel) if own else \
             couple(node, instances[name].stepper(), gauss_seidel, calling or [None])
     return columns, nodes
 
 
-def _input_applier(write: Callable[[list[float]], None], sources: list[int],
-                   inputs: slice) -> Callable[[list[float]], None]:
-    gather = itemgetter(*sources) if len(sources) > 1 else (lambda v, i=sources[0]: (v[i],))
+def gatherer(node: Node) -> Callable[[list[float]], tuple[float, ...]]:
+    """The values sent to a node's connected inputs: their sources', or an event's (its
+    ``modifiers``, by the input's place)."""
+    sources, modifiers = node.sources, node.modifiers
+    pick = itemgetter(*sources) if len(sources) > 1 else \
+        (lambda v, i=sources[0]: (v[i],)) if sources else (lambda v: ())
 
-    def apply(values: list[float]) -> None:
-        sent = gather(values)
-        write(sent)
-        values[inputs] = sent
-    return apply
+    def gather(values: list[float]) -> tuple[float, ...]:
+        sent = pick(values)
+        return tuple(modifiers[i](s) if i in modifiers else s
+                     for i, s in enumerate(sent)) if modifiers else sent
+    return gather
 
 
 def couple(node: Node, step: Callable[[float, float], None], gauss_seidel: bool,

@@ -27,6 +27,8 @@ MODELS = {"guidance": ("guidance",), "ship": ("ship",),     # the models with ar
 def coverage(system: SystemDescription) -> str | None:
     """Why the batch kernel cannot run ``system`` (course keeping of this project's FMUs)."""
     names = set(system.components)
+    if system.events:
+        return "the batch route has no timed events"
     if names != set(COMPONENTS):
         return (f"the batch route runs course keeping (guidance, autopilot, ship), not "
                 f"{', '.join(sorted(names))}")

@@ -25,7 +25,8 @@ class RudderArrays:
         self.target = np.minimum(np.maximum(delta_c, -delta_max), delta_max)
         error = self.target - delta0
         self.velocity = np.copysign(delta_rate_max, error)
-        self.reach = np.abs(error) / delta_rate_max
+        self.reach = np.divide(np.abs(error), delta_rate_max, out=np.full_like(error, np.inf),
+                               where=delta_rate_max != 0.0)       # 0: the gear has failed
 
     def __call__(self, s: np.ndarray | float) -> np.ndarray:
         return np.where(s >= self.reach, self.target, self.delta0 + self.velocity * s)

@@ -31,13 +31,19 @@ class EngineError(RuntimeError):
 
 
 def _libcosim(ssp: Path, system: SystemDescription, n_steps: int, signals: tuple[str, ...],
-              stop: StopSignals) -> dict[str, np.ndarray]:
+              stop: StopSignals, events: str = "") -> dict[str, np.ndarray]:
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimManipulator import CosimManipulator
     from libcosimpy.CosimObserver import CosimObserver
     log_output_level(CosimLogLevel.ERROR)
     execution = (CosimExecution.from_osp_config_file if is_osp(ssp)
                  else CosimExecution.from_ssp_file)(str(ssp))
+    if events:                          # OSP's scenario file, its own scenario manager's
+        manager = CosimManipulator.create_scenario_manager()
+        if not (execution.add_manipulator(manager) and
+                execution.load_scenario(manager, events)):
+            raise EngineError(f"libcosim could not load the scenario file {events}")
     slaves = {s.name.decode(): s.index for s in execution.slave_infos()}
     references = {name: {v.name.decode(): v.reference for v in execution.slave_variables(i)}
                   for name, i in slaves.items()}
@@ -110,11 +116,15 @@ def refuse_strings(ssp: Path, who: str) -> None:
             f"{v} = {default!r}, not {value!r}" for v, (value, default) in dropped.items()))
 
 
-def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = TRACED) -> dict[str, np.ndarray]:
-    """The traced signals of ``ssp`` run in ``engine``; EngineError naming what it cannot run or
-    with the child's output if it fails, ``Interrupted`` if SIGINT or SIGTERM ended it."""
+def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = TRACED,
+        events: str | Path | None = None) -> dict[str, np.ndarray]:
+    """The traced signals of ``ssp`` run in ``engine`` (libcosim: with the timed ``events`` of
+    an OSP scenario file); EngineError naming what it cannot run or with the child's output if
+    it fails, ``Interrupted`` if SIGINT or SIGTERM ended it."""
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
+    if events is not None and engine != "libcosim":
+        raise ValueError(f"{engine} runs no timed events; libcosim reads the scenario file")
     ssp = Path(ssp).resolve()
     if is_osp(ssp) and engine != "libcosim":
         raise ValueError(f"{engine} reads SSP packages, not OSP's {ssp.name}; give the .ssp")
@@ -134,8 +144,9 @@ def run(engine: str, ssp: str | Path, signals: tuple[str, ...] = TRACED) -> dict
                 raise EngineError(f"{ssp.name}: parameter {name}.{variable} = {x} is not finite")
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "trace.npz"
+        events = "" if events is None else str(Path(events).resolve())
         return child_trace(engine, ssp, [sys.executable, "-c", _CHILD, engine, str(ssp), str(out),
-                                         *signals], out, lambda path: dict(np.load(path)))
+                                         events, *signals], out, lambda path: dict(np.load(path)))
 
 
 def child_trace(who: str, ssp: Path, argv: list[str], out: Path,
@@ -169,17 +180,18 @@ def child_trace(who: str, ssp: Path, argv: list[str], out: Path,
 
 
 _CHILD = ("import sys\nfrom cosim.interop.hosts import record\n"
-          "sys.exit(record(sys.argv[1], sys.argv[2], sys.argv[3], tuple(sys.argv[4:])))\n")
+          "sys.exit(record(*sys.argv[1:4], tuple(sys.argv[5:]), sys.argv[4]))\n")
 
 
-def record(engine: str, ssp: str, out: str, signals: tuple[str, ...]) -> int:
+def record(engine: str, ssp: str, out: str, signals: tuple[str, ...], events: str = "") -> int:
     """The child's side of ``run``: 0 and the trace in ``out`` (.npz), 1 and the reason on
     stderr, or 130 / 143 if SIGINT or SIGTERM stopped it."""
     try:
         with StopSignals() as stop:
             system = described(Path(ssp))[0]
             n_steps = step_count(system.start_time, system.stop_time, system.step_size)
-            result = RUNNERS[engine](Path(ssp), system, n_steps, signals, stop)
+            result = RUNNERS[engine](Path(ssp), system, n_steps, signals, stop,
+                                     *([events] if events else []))
     except Interrupted as interrupted:
         print(interrupted, file=sys.stderr)
         return interrupted.exit_status
