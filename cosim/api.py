@@ -1,5 +1,6 @@
 """The Python entry point: ``simulate`` runs a scenario, with your autopilot if you have one,
 ``simulate_many`` many runs of one (docs/running.md, "From Python")."""
+import dataclasses
 import warnings
 from pathlib import Path
 from typing import Any, Iterable, Mapping, Sequence
@@ -61,13 +62,17 @@ def simulate(scenario: str | Path, autopilot: str | Path | None = None,
              coupling: str = "gauss-seidel", backend: str = "fmi",
              port_map: dict[str, str] | None = None, fmi: int | None = None,
              isolate: bool | str | Sequence[str] = False, memory_limit: int | None = None,
-             step_timeout: float = STEP_LIMIT_S) -> Recording:
+             step_timeout: float = STEP_LIMIT_S, events: str | Path | None = None) -> Recording:
     """The recording of a scenario (a name or a .ssd path): ``autopilot`` an FMU in its
-    autopilot's place, ``set`` values by "component.variable" (SI units), ``isolate`` which
+    autopilot's place, ``set`` values by "component.variable" (SI units), ``events`` timed
+    events (a shipped name or an OSP scenario file, as ``cosim.run --events``), ``isolate`` which
     FMUs run in a process of their own (True: all; ``memory_limit`` in bytes; where every FMU
     is, a step past ``step_timeout`` s kills its FMU's process), the rest as ``cosim.run``'s
     options. ValueError for bad input; SimulationError if an FMU fails."""
-    with Master(scenarios.load(scenario, autopilot, port_map, fmi=fmi), coupling=coupling,
+    system = scenarios.load(scenario, autopilot, port_map, fmi=fmi)
+    if events is not None:
+        system = dataclasses.replace(system, events=scenarios.events(events))
+    with Master(system, coupling=coupling,
                 backend=backend, overrides=overrides_of(set or {}),
                 isolation=Isolation.of(isolate, memory_limit)) as master:
         for note in master.notes:

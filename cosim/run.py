@@ -9,12 +9,14 @@ Examples:
   python -m cosim.run waves_pd --autopilot my.fmu   your own autopilot in waves_pd's place
   python -m cosim.run waves_pd --autopilot my.fmu --isolate   ... each FMU in a process of its own
   python -m cosim.run --all --fmi 3            the same runs through the FMI 3.0 twins
+  python -m cosim.run waves_pd --events gear_failure   the steering gear fails at 150 s
 
 A scenario is an SSP system structure file (cosim/scenarios/*.ssd). A run writes every
 signal at every 0.1 s step to SCENARIO.csv and a figure like the paper's Figs 2-3 to
 SCENARIO.png, and prints the cost of eq (19) (or the manoeuvre's figures).
 """
 import argparse
+import dataclasses
 import shutil
 import sys
 from pathlib import Path
@@ -100,6 +102,10 @@ def main(argv: list[str] | None = None) -> int:
                         help="override a parameter, e.g. ship.Hs=0.01 (SI units, radians; or with a "
                              "unit it takes: ship.psi0=40deg, ship.u0=0.3m/s); "
                              "repeatable")
+    parser.add_argument("--events", metavar="NAME|FILE",
+                        help="timed events: one of "
+                             f"{', '.join(scenarios.event_names())}, or an OSP scenario "
+                             "file (.json); docs/running.md")
     parser.add_argument("--coupling", choices=COUPLINGS, default="gauss-seidel",
                         help="gauss-seidel: along the signal flow, as the paper's Simulink "
                              "model (default); jacobi: all FMUs on the previous step's outputs")
@@ -172,6 +178,8 @@ def main(argv: list[str] | None = None) -> int:
         writable_folder(out)
         try:
             system = scenarios.load(scenario, autopilot, dict(args.map), args.name, args.fmi)
+            if args.events:
+                system = dataclasses.replace(system, events=scenarios.events(args.events))
             code, result = run_scenario(system, label, out, settings, options)
         except (ValueError, FileNotFoundError, FmuCallError, FolderBusy, OutputError) as error:
             say_error(error)

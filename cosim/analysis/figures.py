@@ -123,6 +123,14 @@ def course_keeping_figure(run: Recording, lam: float = LAMBDA) -> Figure:
                          f"dotted: the stops at +-{stops:.0f} deg", loc="left", fontsize=7,
                          color="tab:orange")
     legend_if_any(rudder)
+    events: dict[float, list[str]] = {}                 # timed events: a line through time
+    for e in run.meta.get("events", []):
+        events.setdefault(e["time"], []).append(f"{e['action']} {e['variable']}")
+    for time, what in events.items():
+        for ax in (u, heading, error, r, rudder):
+            ax.axvline(time, color="tab:purple", linestyle="-.", linewidth=0.8)
+        u.annotate(", ".join(what), (time, 1.0), xycoords=("data", "axes fraction"),
+                   fontsize=6, color="tab:purple", va="bottom", rotation=15)
     return fig
 
 

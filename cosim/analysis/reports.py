@@ -212,12 +212,17 @@ def conditions(meta: dict[str, Any]) -> list[str]:
                 for name, x in p[component].items()))
     if meta.get("overrides"):
         lines.append(f"set: {overrides(meta)}")
+    if meta.get("events"):
+        lines.append("events: " + "; ".join(
+            f"{e['time']:g} s {e['action']} {e['model']}.{e['variable']}"
+            + ("" if e["value"] is None else f" {e['value']!r}") for e in meta["events"]))
     return lines
 
 
 def changes(meta: dict[str, Any]) -> str:
     """How the run differs from its scenario, as --set and --stop-time options."""
     changed = [overrides(meta)] if meta.get("overrides") else []
+    changed += ["--events"] if meta.get("events") else []
     stop = meta.get("scenario_stop_time")
     if stop is not None and meta.get("stop_time", stop) != stop:
         changed.append(f"--stop-time {meta['stop_time']:g}")

@@ -14,7 +14,9 @@ from typing import Any, Callable
 
 from fmukit.timebase import nanoseconds
 
-from .values import Declaration, checked, no_variable
+from .fmi import read_description
+from .system import SystemDescription
+from .values import Declaration, checked, declarations, no_variable
 
 ACTIONS = ("override", "bias", "reset")
 _KEYS = {"time", "model", "variable", "action", "value"}
@@ -49,7 +51,7 @@ def read_events(path: str | Path) -> list[Event]:
         raise EventsError(f"{where}: OSP's scenario format is an object with a list "
                           "'events' and, optionally, an object 'defaults'")
     end = document.get("end", math.inf)
-    if not _is_time(end):
+    if "end" in document and not _is_time(end):
         raise EventsError(f"{where}: 'end' = {end!r} is not a time in seconds >= 0")
     events = []
     for i, item in enumerate(document["events"]):
@@ -131,3 +133,10 @@ class Schedule:
             instance.set({event.variable: new}, time=t)
             if configure:
                 instance.call("exitConfigurationMode", slave.exitConfigurationMode, time=t)
+
+
+def check_events(system: SystemDescription) -> None:
+    """EventsError if ``system``'s events do not fit its FMUs, as a master would say."""
+    paths = {name: system.fmu_path(name) for name in system.components}
+    Schedule(system.events, {name: declarations(read_description(path, name, system.ours(path)))
+                             for name, path in paths.items()}, paths, system.steps()[1])

@@ -1,11 +1,13 @@
 """The scenarios, one SSP system structure file (.ssd) each, by name (``calm_pd``) or path;
-``PAPER``: the four behind Tables 1-2; ``autopilot`` puts a user's FMU into one."""
+``PAPER``: the four behind Tables 1-2; ``autopilot`` puts a user's FMU into one; timed
+events (OSP scenario files) shipped by name in events/."""
 from __future__ import annotations
 
 from pathlib import Path
 
 from fmubuild import project
 
+from ..core.events import Event, EventsError, read_events
 from ..core.files import plain_name
 from ..core.ssd import read_ssd
 from ..core.system import (FmuFolders, SystemDescription, close_matches, did_you_mean,
@@ -30,6 +32,21 @@ def path(scenario: str | Path) -> Path:
         raise ValueError(f"unknown scenario {scenario!r}; valid scenarios: {', '.join(names())}"
                          + did_you_mean(close_matches(str(scenario), names())))
     return SCENARIO_DIR / f"{scenario}.ssd"
+
+
+def events(name: str | Path) -> tuple[Event, ...]:
+    """Timed events: shipped by name (cosim/scenarios/events/NAME.json: ``event_names``) or
+    from an OSP scenario file; EventsError naming the file or listing the names."""
+    if str(name).isidentifier():
+        if name not in event_names():
+            raise EventsError(f"unknown events {name!r}; shipped: {', '.join(event_names())}, "
+                              "or give an OSP scenario file (.json)")
+        name = SCENARIO_DIR / "events" / f"{name}.json"
+    return tuple(read_events(name))
+
+
+def event_names() -> list[str]:
+    return sorted(p.stem for p in (SCENARIO_DIR / "events").glob("*.json"))
 
 
 def label(scenario: str | Path, autopilot: str | Path | None = None,

@@ -25,13 +25,15 @@ MEASURED = ("guidance.psi_d", "guidance.wp_index", "ship.psi", "ship.delta", "sh
 # type, so that each axis is one column of one type in the tables).
 FILE_KEYS = {"name": ((str,), "a plain file name"), "controllers": ((dict,), "a table"),
              "stop_time": ((int, float), "a number of seconds > 0", lambda v: 0 < v < math.inf),
-             "axes": ((dict,), "a table"), "plots": ((dict,), "a table")}
+             "axes": ((dict,), "a table"), "plots": ((dict,), "a table"),
+             "events": ((str,), "timed events: a name or an OSP scenario file (.json)")}
 PLOTS_KEYS = {"map": ((list,), "two different axes", lambda v: not v or (len(v) == 2
                                                                        and v[0] != v[1])),
               "tracks": ((dict,), "a table of axis = value")}
 CONTROLLER_KEYS = {"scenario": ((str,), "a string"), "autopilot": ((str,), "a string"),
                    "map": ((dict,), "a table of autopilot port = the FMU's name for it"),
-                   "set": ((dict,), "a table of component.variable = value")}
+                   "set": ((dict,), "a table of component.variable = value"),
+                   "events": ((str,), "timed events: a name or an OSP scenario file (.json)")}
 TOML_TYPES = {"Real": ((int, float), "a number"), "Integer": ((int,), "an integer"),
               "Enumeration": ((int, str), "an integer or an item's name"),
               "Boolean": ((bool,), "true or false"), "String": ((str,), "a string")}
@@ -86,7 +88,8 @@ def parse(path: Path, max_runs: int) -> dict[str, Any]:
                               *(f"{len(v)} {a}" for a, v in axes.items())])
         raise ValueError(f"{path}: {factors} = {runs} runs, more than the {max_runs} a sweep "
                          "may have (cosim.sweep --max-runs)")
-    controllers = {c: controller_entry(entry, path, c) for c, entry in entries.items()}
+    controllers = {c: controller_entry(entry, path, c, data.get("events"))
+                   for c, entry in entries.items()}
     setters: dict[str, str] = {}                # no parameter set in two places
     for who, targets in [*((f"axis {a!r}", assignments(a, v[0])) for a, v in axes.items()),
                          *((f"controller {c!r}", e["set"]) for c, e in controllers.items())]:
@@ -190,8 +193,10 @@ def _axis(path: Path, name: str, values: Any, max_runs: int) -> list:
     return values
 
 
-def controller_entry(entry: str | dict[str, Any], spec: Path, name: str) -> dict[str, Any]:
-    """A controller entry checked, its paths made absolute (relative to the spec file)."""
+def controller_entry(entry: str | dict[str, Any], spec: Path, name: str,
+                     events: str | None = None) -> dict[str, Any]:
+    """A controller entry checked, its paths made absolute (relative to the spec file);
+    ``events``: the sweep's timed events, for a controller that names none."""
     if isinstance(entry, str):
         entry = {"autopilot": entry} if entry.endswith(".fmu") else {"scenario": entry}
     where = f"controller {name!r}"
@@ -208,6 +213,7 @@ def controller_entry(entry: str | dict[str, Any], spec: Path, name: str) -> dict
     def beside_spec(value: str) -> str:
         return str((spec.parent / value).resolve()) if value.endswith((".ssd", ".fmu")) \
             else value
+    events = entry.get("events", events)
     scenario = beside_spec(entry.get("scenario", "waves_pd" if "autopilot" in entry else ""))
     autopilot = entry.get("autopilot")
     try:
@@ -216,7 +222,11 @@ def controller_entry(entry: str | dict[str, Any], spec: Path, name: str) -> dict
             autopilot = beside_spec(autopilot)
             check_autopilot(autopilot, entry.get("map"), trial=True)
             scenarios.load(scenario, autopilot, entry.get("map"))
+        if events is not None:
+            if events.endswith(".json"):            # else a name of the shipped ones
+                events = str((spec.parent / events).resolve())
+            scenarios.events(events)
     except (ValueError, FileNotFoundError) as error:
         raise ValueError(f"{spec}: {where}: {error}") from None
     return {"scenario": scenario, "autopilot": autopilot, "map": dict(entry.get("map", {})),
-            "set": dict(entry.get("set", {}))}
+            "set": dict(entry.get("set", {})), "events": events}

@@ -15,6 +15,7 @@ from typing import Any
 from fmukit.manifest import read as read_manifest
 
 from .. import scenarios
+from ..core.events import check_events
 from ..core.system import FmuNotFound, FmuUnreadable
 from ..core.fmi import read_description
 from ..core.inprocess import fallback_note, in_process_refusal
@@ -150,6 +151,8 @@ class Spec:
             words += ["--autopilot", controller["autopilot"]]
             for port, renamed in controller["map"].items():
                 words += ["--map", f"{port}={renamed}"]
+        if controller["events"] is not None:
+            words += ["--events", controller["events"]]
         stop_time = self.stop_time or self.bundles()[run["controller"]].system.stop_time
         words += ["--stop-time", _exact(stop_time)]
         for component, values in overrides.items():
@@ -218,6 +221,9 @@ def _exact(value: Any) -> str:
 def _bundle(controller: dict[str, Any]) -> tuple[Bundle, dict[str, Path], SystemDescription]:
     """A sweep controller's bundle, its FMUs' files by hash, and its system as loaded here."""
     system = scenarios.load(controller["scenario"], controller["autopilot"], controller["map"])
+    if controller["events"] is not None:            # checked against the FMUs here, once
+        system = dataclasses.replace(system, events=scenarios.events(controller["events"]))
+        check_events(system)
     hashes = {name: file_hash(system.fmu_path(name)) for name in system.components}
     files = {sha: system.fmu_path(name) for name, sha in hashes.items()}
     components = {name: dataclasses.replace(component, source=f"{hashes[name]}.fmu")
