@@ -5,6 +5,8 @@ from dataclasses import dataclass
 
 G = 9.81                        # m/s^2
 RHO_WATER = 1000.0              # kg/m^3, the fresh water of the model basin (MCLab)
+RHO_AIR = 1.224                 # kg/m^3, at 20 C (Fossen 2011, sec. 8.1)
+SCALE = 70.0                    # length ratio of CyberShip II to the supply ship it models
 
 
 @dataclass(frozen=True)

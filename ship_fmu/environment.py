@@ -1,15 +1,22 @@
-"""What moves the water around the ship (Fossen 2011, sec. 8.3): an ocean current whose speed
-and direction are first-order Gauss-Markov processes about their means, stepped exactly (the
-process's own decay and spread over each step), its draws seeded per step so that a saved and
-restored state goes on as it would have."""
+"""What moves the water and the air around the ship: an ocean current whose speed and
+direction are first-order Gauss-Markov processes about their means (Fossen 2011, sec. 8.3),
+stepped exactly (the process's own decay and spread over each step), its draws seeded per
+step so that a saved and restored state goes on as it would have; and a mean wind with gusts
+from the NORSOK N-003 spectrum (ISO 19901-1), a sum of seeded harmonics in time."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from decimal import Decimal, localcontext
 
 import numpy as np
 
 from fmukit.numerics import require_finite
+
+from .data import SCALE
+
+F_BAND = (Decimal("0.0005"), Decimal("0.5"))    # Hz at full scale: the gusts' frequencies
+_ROOT_SCALE = Decimal(SCALE).sqrt()
 
 
 @dataclass
@@ -52,3 +59,65 @@ class Current:
     def restore(self, snapshot: dict) -> None:
         self.V, self.beta, self.k = float(snapshot["V"]), float(snapshot["beta"]), \
             int(snapshot["k"])
+
+
+@dataclass
+class Wind:
+    """A wind of mean speed V_mean (m/s at model scale) blowing towards beta, with gusts along
+    it from the NORSOK spectrum S(f) = 320 (U/10)^2 / (1 + x^n)^(5/3n), x = 172 f (U/10)^-3/4,
+    n = 0.468 (U the full-scale mean at 10 m, m/s; f Hz), in ``components`` geometric bands
+    Froude-scaled to 1:70; the spectrum in decimal arithmetic, the same bits on any CPU."""
+    V_mean: float = 0.0
+    beta: float = 0.0
+    components: int = 0         # 0: a steady wind
+    seed: int = 0
+    gusts: tuple = field(init=False, repr=False)    # (omega rad/s, amplitude m/s, phase rad)
+
+    def __post_init__(self) -> None:
+        require_finite(V_mean=self.V_mean, beta=self.beta)
+        if self.V_mean < 0.0:
+            raise ValueError(f"parameter V_w_mean must be >= 0, got {self.V_mean}")
+        n, U = self.components, Decimal(self.V_mean) * _ROOT_SCALE / 10
+        phases = np.random.default_rng(self.seed).uniform(0.0, 2.0 * math.pi, n).tolist()
+        with localcontext() as context:
+            context.prec = 34
+            low, high = F_BAND
+            edges = [low * (high / low) ** (Decimal(i) / n) for i in range(n + 1)] \
+                if U and n else []
+            self.gusts = tuple((*_band(a, b, U), phase)
+                               for a, b, phase in zip(edges, edges[1:], phases))
+
+    def speed(self, t: float) -> float:
+        """The wind speed at time t (s, model scale), >= 0."""
+        gust = 0.0
+        for omega, amplitude, phase in self.gusts:
+            gust += amplitude * math.cos(omega * t + phase)
+        return max(0.0, self.V_mean + gust)
+
+
+@dataclass
+class Environment:
+    """The current and the wind at time t: the environment FMU's model."""
+    current: Current
+    wind: Wind
+    t: float = 0.0
+
+    def step(self, t: float, h: float) -> None:
+        self.current.step(h)
+        self.t = t + h
+
+    def snapshot(self) -> dict:
+        return {**self.current.snapshot(), "t": self.t}
+
+    def restore(self, snapshot: dict) -> None:
+        self.current.restore(snapshot)
+        self.t = float(snapshot["t"])
+
+
+def _band(a: Decimal, b: Decimal, U: Decimal) -> tuple[float, float]:
+    """(omega rad/s, amplitude m/s) at model scale of the gusts between a and b Hz at full
+    scale, U the full-scale mean / 10 m/s: the spectrum at the band's geometric middle."""
+    f, n = (a * b).sqrt(), Decimal("0.468")
+    S = 320 * U * U / (1 + (172 * f / U ** Decimal("0.75")) ** n) ** (5 / (3 * n))
+    return float(2 * Decimal(math.pi) * f * _ROOT_SCALE), float((2 * S * (b - a)).sqrt()
+                                                                  / _ROOT_SCALE)

@@ -58,6 +58,10 @@ class ShipSlave(ModelSlave):
                   "and v are then relative to the water", 0.0, 5.0),
         Var.input("beta_c", 0.0, "rad", "direction the current flows towards, from north",
                   -ANGLE_MAX, ANGLE_MAX),
+        Var.input("V_w", 0.0, "m/s", "wind speed (an environment FMU's output; 10 m/s at "
+                  "10 m above the water at full scale is 1.2 m/s at 1:70)", 0.0, 20.0),
+        Var.input("beta_w", 0.0, "rad", "direction the wind blows towards, from north",
+                  -ANGLE_MAX, ANGLE_MAX),
     )
 
     def build_model(self) -> Vessel:
@@ -68,4 +72,5 @@ class ShipSlave(ModelSlave):
         self.model.params = replace(self.model.params, **{name: getattr(self, name)})
 
     def step_model(self, t: float, h: float) -> None:
-        self.model.step(t, h, self.delta_c, self.n1, self.n2, self.n3, self.V_c, self.beta_c)
+        self.model.step(t, h, self.delta_c, self.n1, self.n2, self.n3, self.V_c, self.beta_c,
+                        self.V_w, self.beta_w)

@@ -12,6 +12,7 @@ from .hull import coriolis_forces, damping_forces, kinematics, mass_matrix
 from .steering_gear import DELTA_MAX, DELTA_RATE_MAX, RudderMotion
 from .thrusters import actuator_model
 from .waves import WaveComponents, WaveLoads
+from .wind import wind_loads
 
 State = tuple[float, float, float, float, float, float, float]   # (x, y, psi, u, v, r, xi)
 MAX_STEEPNESS = 7.0             # waves break beyond Hs / lambda_p = 1/7
@@ -63,6 +64,7 @@ class Vessel:
         self.waves, self._wave_loads = None, calm_water
         self._shafts, self._forces = None, None        # the last shaft speeds, their tau_th
         self._current: tuple[float, float] | None = None   # (north, east) m/s, held a step
+        self._wind: tuple[float, float] | None = None      # the same, relative to the water
         if params.Hs > 0.0:
             components = WaveComponents.from_spectrum(
                 params.Hs, params.T0, params.wave_components, params.wave_seed)
@@ -75,15 +77,21 @@ class Vessel:
     def rates(self, t: float, state: State, tau_th: tuple[float, float, float]) -> State:
         """d/dt of the state, eqs (1)-(17), under actuator forces tau_th."""
         return state_rates(self.hull, self._minv, self._m11_inv, self._wave_loads,
-                           self.params.psi_w, t, state, tau_th, current=self._current)
+                           self.params.psi_w, t, state, tau_th, current=self._current,
+                           wind=self._wind)
 
     def step(self, t: float, h: float, delta_c: float,
              n1: float = N_PROPELLER, n2: float = N_PROPELLER, n3: float = 0.0,
-             V_c: float = 0.0, beta_c: float = 0.0) -> None:
-        """A step of h s with the inputs held: the rudder command, the shaft speeds and the
-        ocean current, V_c m/s flowing towards beta_c rad from north (none if V_c = 0)."""
-        require_finite(delta_c=delta_c, n1=n1, n2=n2, n3=n3, V_c=V_c, beta_c=beta_c)
-        self._current = (V_c * math.cos(beta_c), V_c * math.sin(beta_c)) if V_c else None
+             V_c: float = 0.0, beta_c: float = 0.0, V_w: float = 0.0,
+             beta_w: float = 0.0) -> None:
+        """A step of h s with the inputs held: the rudder command, the shaft speeds, the
+        ocean current, V_c m/s flowing towards beta_c rad from north (none if V_c = 0), and
+        the wind, V_w m/s blowing towards beta_w (none if V_w = 0)."""
+        require_finite(delta_c=delta_c, n1=n1, n2=n2, n3=n3, V_c=V_c, beta_c=beta_c, V_w=V_w,
+                       beta_w=beta_w)
+        self._current = c = (V_c * math.cos(beta_c), V_c * math.sin(beta_c)) if V_c else None
+        self._wind = (V_w * math.cos(beta_w) - (c[0] if c else 0.0),
+                      V_w * math.sin(beta_w) - (c[1] if c else 0.0)) if V_w else None
         if (n1, n2, n3) != self._shafts:
             self._shafts, self._forces = (n1, n2, n3), actuator_model(self.actuators, n1, n2, n3)
         forces = self._forces
@@ -118,12 +126,13 @@ def state_rates(hull: Hull, minv: tuple[float, float, float, float], m11_inv: fl
                 wave_loads: Callable, psi_w: float, t: float, state: State,
                 tau_th: tuple[float, float, float], hypot: Callable = math.hypot,
                 cos: Callable = math.cos, sin: Callable = math.sin,
-                current: tuple[float, float] | None = None) -> State:
+                current: tuple[float, float] | None = None,
+                wind: tuple[float, float] | None = None) -> State:
     """d/dt of the state, eqs (1)-(17); floats, or arrays with numpy's cos, sin and an
     exact hypot (``cosim.ensemble``). In an ocean current (north, east, m/s; irrotational,
     held over the step) u and v are relative to the water, in the hull's forces as in calm
     water, and the current carries the ship (Fossen 2011, sec. 10.3: eta_dot = R(psi) nu_r
-    + v_c)."""
+    + v_c). ``wind``: the wind's velocity relative to the water, whose loads add (floats)."""
     _, _, psi, u, v, r, xi = state
     cX, cY, cN = coriolis_forces(hull, u, v, r)
     dX, dY, dN = damping_forces(hull, u, v, r)
@@ -132,6 +141,9 @@ def state_rates(hull: Hull, minv: tuple[float, float, float, float], m11_inv: fl
     fX = tX + wX - cX - dX
     fY = tY + wY - cY - dY
     fN = tN + wN - cN - dN
+    if wind is not None:
+        aX, aY, aN = wind_loads(u, v, psi, wind)
+        fX, fY, fN = fX + aX, fY + aY, fN + aN
     i22, i23, i32, i33 = minv
     x_dot, y_dot, psi_dot = kinematics(psi, u, v, r, cos, sin)
     if current is not None:

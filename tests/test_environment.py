@@ -85,3 +85,31 @@ def test_waves_pd_sensors_steers_by_the_measured_heading():
     np.testing.assert_array_equal(run["autopilot.psi"], run["sensors.psi_m"])
     assert np.abs(run["sensors.psi_m"] - run["ship.psi"]).max() > 0.005   # bias and noise
     np.testing.assert_array_equal(runs[0].data, runs[1].data)
+
+
+def test_the_wind_loads_follow_blendermann_froude_scaled_and_the_gusts_norsok():
+    from ship_fmu.data import RHO_AIR, SCALE
+    from ship_fmu.environment import Wind
+    from ship_fmu.wind import A_L, CD_T, wind_loads
+    X, Y, N = wind_loads(0.0, 0.0, 0.0, (0.0, -1.2))     # from starboard, blowing to port
+    assert X == pytest.approx(0.0, abs=1e-12) and Y < 0.0 and N < 0.0   # pushed and turned
+    full = 0.5 * RHO_AIR * (1.2 * math.sqrt(SCALE)) ** 2 * A_L * SCALE**2 * CD_T   # to port
+    assert -Y * SCALE**3 == pytest.approx(full, rel=1e-12)
+    assert wind_loads(0.3, 0.0, 0.0, (0.0, 0.0))[0] < 0.0 < wind_loads(0.0, 0.0, 0.0, (1.0, 0))[0]
+    mirrored = wind_loads(0.0, 0.0, 0.0, (0.3, 1.2))     # the hull is symmetric
+    assert mirrored == pytest.approx(tuple(s * c for s, c in zip(
+        (1, -1, -1), wind_loads(0.0, 0.0, 0.0, (0.3, -1.2)))), rel=1e-12)
+    U = 10.0                                             # m/s at full scale
+    wind = Wind(U / math.sqrt(SCALE), 0.0, components=60, seed=1)
+    speeds = np.array([wind.speed(t) for t in np.arange(0.0, 40_000.0, 1.0)]) * math.sqrt(SCALE)
+    assert speeds.mean() == pytest.approx(U, rel=0.01)
+    assert speeds.std() / speeds.mean() == pytest.approx(0.06 * (1 + 0.043 * U), rel=0.15)
+    assert Wind(0.3, 1.0).speed(5.0) == 0.3 and not Wind(0.0, 0.0, 60).gusts
+
+
+def test_waves_pd_wind_runs_alike_in_process_and_through_fmi(fmu_paths):
+    runs = [cosim.simulate("waves_pd_wind", stop_time=20, backend=b) for b in ("inprocess", "fmi")]
+    assert all(np.array_equal(runs[0][c], runs[1][c]) for c in runs[0].columns)
+    still = cosim.simulate("waves_pd", stop_time=20, backend="inprocess")
+    assert np.all(runs[0]["environment.V_w"] > 0.3)
+    assert not np.array_equal(runs[0]["ship.y"], still["ship.y"])   # the wind pushed it

@@ -19,15 +19,15 @@ ADAPTERS = {2: "pythonfmu07", 3: "pythonfmu3_03"}
 # What each FMU carries of the model packages, beside its slave and fmukit.
 MODELS = {
     "ship": {"ship_fmu.data", "ship_fmu.hull", "ship_fmu.steering_gear", "ship_fmu.thrusters",
-             "ship_fmu.vessel", "ship_fmu.waves"},
+             "ship_fmu.vessel", "ship_fmu.waves", "ship_fmu.wind"},
     "manoeuvre": {"ship_fmu.manoeuvres"},
-    "environment": {"ship_fmu.environment"},          # the current, nothing of the ship
+    "environment": {"ship_fmu.environment", "ship_fmu.data"},   # current, wind; the scale
     "sensors": {"ship_fmu.sensors"},         # the rudder program, and nothing of the ship
     "pd_autopilot": {"autopilot_fmu.pd"},
     # design_model 'ship' linearises the vessel model
     "smc_autopilot": {"autopilot_fmu.design", "autopilot_fmu.smc", "ship_fmu.data",
                       "ship_fmu.hull", "ship_fmu.steering_gear", "ship_fmu.thrusters",
-                      "ship_fmu.vessel", "ship_fmu.waves"},
+                      "ship_fmu.vessel", "ship_fmu.waves", "ship_fmu.wind"},
     # the circle of acceptance is two ship lengths
     "guidance": {"autopilot_fmu.guidance", "ship_fmu.data"},
     "los_guidance": {"autopilot_fmu.guidance", "autopilot_fmu.guidance_slave", "autopilot_fmu.los",

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-SCALE = 70.0                    # length ratio of CyberShip II to the supply ship it models
+from ship_fmu.data import SCALE
 
 # code: (description, Hs full scale m, modal period full scale s)
 WMO = {

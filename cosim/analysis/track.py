@@ -140,11 +140,12 @@ def track_panel(ax: Any, run: Recording, ship: bool = True,
                                  facecolor="0.8", edgecolor="0.3", linewidth=0.6, zorder=2.5))
         ax.plot([], [], "s", color="0.8", markeredgecolor="0.3",
                 label=f"ship outline {shown.size}, every {shown.every:g} s")
-        if "environment.V_c" in run.columns:        # where the current carried it, and how
-            k = shown.rows
-            V, beta = run["environment.V_c"][k], run["environment.beta_c"][k]
-            ax.quiver(y[k], x[k], V * np.sin(beta), V * np.cos(beta), color="tab:blue",
-                      angles="xy", zorder=4, label=f"current, up to {V.max():.3g} m/s")
+        for flow, color, what in (("c", "tab:blue", "current"), ("w", "tab:olive", "wind")):
+            if f"environment.V_{flow}" in run.columns and run[f"environment.V_{flow}"].any():
+                k = shown.rows                  # where the current (wind) was, and how strong
+                V, beta = run[f"environment.V_{flow}"][k], run[f"environment.beta_{flow}"][k]
+                ax.quiver(y[k], x[k], V * np.sin(beta), V * np.cos(beta), color=color,
+                          angles="xy", zorder=4, label=f"{what}, up to {V.max():.3g} m/s")
     sea = p.get("ship", {})
     if sea.get("Hs", 0.0) > 0.0:
         ax.plot([], [], linestyle="none", marker=_arrow(sea["psi_w"]), markersize=11,
