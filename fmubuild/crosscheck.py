@@ -51,9 +51,11 @@ CASES = {
                            (40, 0.5, 0.005, 0.0), (60, 0.3, -0.005, 0.0))),
     "guidance": _ROUTE,
     "los_guidance": _ROUTE,
-    "environment": Case(300.0, (), ((0,), (300,))),    # its defaults: no current
+    "environment": Case(300.0, (), ((0,), (300,))),    # its defaults: no current, no wind
     "sensors": Case(30.0, ("psi", "r", "x", "y"), ((0, 0.0, 0.0, 0.0, 0.0),
                                                    (30, 0.7, 0.01, 9.0, 1.0))),
+    "observer": Case(30.0, ("psi_m", "delta"), ((0, 0.0, 0.0), (10, 0.3, 0.1),
+                                                (30, 0.25, -0.1))),
     "manoeuvre": Case(60.0, ("psi",), ((0, 0.0), (20, -0.5), (40, 0.5), (60, -0.5))),
 }
 

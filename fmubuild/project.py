@@ -14,12 +14,13 @@ FMU_DIRS = {2: FMU_DIR, 3: FMU_DIR / "fmi3"}       # by FMI version, the same na
 FMUS: dict[str, str] = {                          # name: its slave script, whose imports it carries
     "ship": "ship_fmu/ship_slave.py",
     "manoeuvre": "ship_fmu/manoeuvre_slave.py",
-    "environment": "ship_fmu/environment_slave.py",     # the current, wired into the ship
+    "environment": "ship_fmu/environment_slave.py",     # current and wind, into the ship
     "sensors": "ship_fmu/sensors_slave.py",             # between the ship and its controllers
     "pd_autopilot": "autopilot_fmu/pd_autopilot_slave.py",
     "smc_autopilot": "autopilot_fmu/smc_autopilot_slave.py",
     "guidance": "autopilot_fmu/guidance_slave.py",
     "los_guidance": "autopilot_fmu/los_guidance_slave.py",     # in eq (18)'s guidance's place
+    "observer": "autopilot_fmu/observer_slave.py",      # between the compass and the autopilot
     # Written as a user's own autopilot is (docs/own_autopilot.md): one file and fmukit.
     "pid_autopilot": "autopilot_fmu/pid_autopilot_slave.py",
     # Trained by cosim.train (docs/rl.md); its weights in its resources.

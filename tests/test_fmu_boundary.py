@@ -22,7 +22,8 @@ MODELS = {
              "ship_fmu.vessel", "ship_fmu.waves", "ship_fmu.wind"},
     "manoeuvre": {"ship_fmu.manoeuvres"},
     "environment": {"ship_fmu.environment", "ship_fmu.data"},   # current, wind; the scale
-    "sensors": {"ship_fmu.sensors"},         # the rudder program, and nothing of the ship
+    "sensors": {"ship_fmu.sensors"},                  # the instruments, nothing of the ship
+    "observer": {"autopilot_fmu.observer"},           # Nomoto's T and K as numbers
     "pd_autopilot": {"autopilot_fmu.pd"},
     # design_model 'ship' linearises the vessel model
     "smc_autopilot": {"autopilot_fmu.design", "autopilot_fmu.smc", "ship_fmu.data",

@@ -99,16 +99,21 @@ def course_keeping_figure(run: Recording, lam: float = LAMBDA) -> Figure:
     track.set_title(merit_table(run, lam), loc="left", family="monospace", fontsize=8)
     t = run.t
     u.plot(t, run["ship.u"], color="k")
-    if "sensors.psi_m" in run.columns:                  # what the autopilot was told
-        heading.plot(t, np.degrees(run["sensors.psi_m"]), color="tab:green", linewidth=0.5,
-                     label="psi measured")
+    for column, color, label in (("sensors.psi_m", "tab:green", "psi measured"),
+                                 ("observer.psi_hat", "tab:purple", "psi_hat, observer")):
+        if column in run.columns:                       # what the autopilot was told
+            heading.plot(t, np.degrees(run[column]), color=color, linewidth=0.5, label=label)
     heading.plot(t, np.degrees(run["ship.psi"]), color="k", label="psi")
     heading.plot(t, np.degrees(run["guidance.psi_d"]), "--", color="tab:red", label="psi_d")
     if "autopilot.psi_z" in run.columns:
         heading.plot(t, np.degrees(run["autopilot.psi_z"]), ":", color="tab:blue", label="psi_z")
     legend_if_any(heading)
     error.plot(t, np.degrees(heading_error(run["guidance.psi_d"], run["ship.psi"])), color="k")
-    r.plot(t, np.degrees(run["ship.r"]), color="k")
+    r.plot(t, np.degrees(run["ship.r"]), color="k", label="r")
+    if "observer.r_hat" in run.columns:
+        r.plot(t, np.degrees(run["observer.r_hat"]), color="tab:purple", linewidth=0.7,
+               label="r_hat, observer")
+        legend_if_any(r)
     command = np.degrees(run["ship.delta_c"])
     rudder.plot(t, command, color="tab:orange", linewidth=0.5, alpha=0.55, zorder=1,
                 label="commanded delta_c")
