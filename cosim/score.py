@@ -1,9 +1,11 @@
 """Score your autopilot against the paper's PD and sliding-mode autopilots and the PID.
 
-Runs the paper's route in calm water and waves, a 40 deg course change, and two N-seed wave
-ensembles (the paper's waves, WMO sea state 4) on Dask, for your FMU and the three project
-autopilots, and scores each on every criterion on its own (docs/own_autopilot.md). Writes
-scorecard.md and its figures to results/score/NAME/ and prints it.
+Runs the paper's route in calm water and waves, a 40 deg course change, and three N-seed
+ensembles (the paper's waves; wind and current; a steering-gear pump failure) on Dask, for
+your FMU and the three project autopilots, and scores each on every criterion on its own
+(docs/own_autopilot.md). Writes scorecard.md and its figures to results/score/NAME/ and
+prints it. Given result files (.csv) of a run from any FMI tool instead, prints that run's
+value of every criterion.
 """
 from __future__ import annotations
 
@@ -14,12 +16,17 @@ from pathlib import Path
 
 from tqdm import tqdm
 
+from autopilot_fmu.guidance import PAPER_ROUTE, R_ACCEPT
+from ship_fmu.steering_gear import DELTA_MAX
+
 from ._cli import (add_isolation_options, add_port_options, checked_autopilot, count, entry,
                    isolation, say_error, say_note, setting_option, writable_folder)
 from . import scenarios
+from .analysis.results import read_results
 from .api import overrides_of
 from .core.files import FolderBusy, OutputError
 from .studies.scorecard import BASELINES, SEAS, backend_notes, score
+from .studies.scorecard_report import result_card
 from .studies.cluster import NoWorkers, SweepError
 from .studies.sweep_spec import MAX_RUNS
 from .studies.sweep_task import SWEEP_BACKENDS
@@ -30,9 +37,17 @@ def main(argv: list[str] | None = None) -> int:
                                      description=__doc__.split("\n\n")[0],
                                      epilog="\n\n".join(__doc__.split("\n\n")[1:]),
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("autopilot", type=Path, metavar="FMU",
+    parser.add_argument("autopilot", type=Path, metavar="FMU|CSV", nargs="+",
                         help="your autopilot: FMI 2.0 co-simulation, inputs psi (rad), r "
-                             "(rad/s), psi_d (rad), output delta_c (rad)")
+                             "(rad/s), psi_d (rad), output delta_c (rad); or a run's result "
+                             "files: OMSimulator's or fmpy's CSV, or libcosim's one per "
+                             "component")
+    parser.add_argument("--route", default=PAPER_ROUTE, metavar="X,Y;X,Y;...",
+                        help="with result files: the route their guidance followed, m "
+                             "(default: the paper's)")
+    parser.add_argument("--R-accept", dest="R_accept", type=float, default=R_ACCEPT,
+                        metavar="M", help=f"with result files: the circle of acceptance, m "
+                                          f"(default {R_ACCEPT:g})")
     add_port_options(parser)
     parser.add_argument("--set", action="append", default=[], type=setting_option,
                         metavar="autopilot.VAR=VALUE",
@@ -55,6 +70,18 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, help="output folder (default: results/score/NAME)")
     add_isolation_options(parser, "foreign")
     args = parser.parse_args(argv)
+    if all(path.suffix.lower() == ".csv" for path in args.autopilot):
+        try:
+            print(result_card(read_results(args.autopilot, {
+                "guidance": {"waypoints": args.route, "R_accept": args.R_accept},
+                "ship": {"delta_max": DELTA_MAX}}), args.autopilot))
+        except ValueError as error:
+            say_error(error)
+            return 2
+        return 0
+    if len(args.autopilot) > 1:
+        parser.error("give one autopilot FMU, or result files (.csv) only")
+    args.autopilot = args.autopilot[0]
     isolated = isolation(parser, args)
     try:                                    # every contender has the same components
         isolated.check(scenarios.load("calm_pd").components)

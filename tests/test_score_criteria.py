@@ -1,5 +1,6 @@
 """The scorecard's criteria (cosim.analysis.metrics, merit.run_metrics), each on a
-synthetic recording whose answer is known by construction."""
+synthetic recording whose answer is known by construction; and the same criteria from other
+tools' result files (cosim.score FILE.csv)."""
 from __future__ import annotations
 
 import math
@@ -7,9 +8,11 @@ import math
 import numpy as np
 import pytest
 
-from cosim.analysis.metrics import (RUDDER_DEADBAND, cross_track_error, fraction_at_stops,
-                                    mean_abs_rate, peak, rms, route_completion,
-                                    rudder_reversals_per_minute)
+import cosim
+from cosim import score
+from cosim.analysis.metrics import (RUDDER_DEADBAND, course_settling, cross_track_error,
+                                    fraction_at_stops, mean_abs_rate, peak, rms,
+                                    route_completion, rudder_reversals_per_minute)
 from cosim.core.recording import Recording
 from cosim.studies.merit import METRICS, run_metrics
 
@@ -110,3 +113,44 @@ def test_a_run_s_row_carries_every_criterion_with_the_known_answers():
     assert (row["waypoints_reached"], row["waypoints"], row["last_waypoint_reached"]) == \
         (2.0, 3.0, 0.0)
     assert row["psi_E"] == pytest.approx(len(t) * 0.05 ** 2)
+    assert row["waypoint_margin_m"] == pytest.approx(2.51 - math.hypot(10.0, 2.0))  # (40, 0)
+    assert math.isnan(row["course_settling_s"])         # psi_d never changes
+
+
+def test_the_heading_settles_when_it_stays_within_five_percent_of_the_change():
+    t = np.arange(0.0, 200.0 + 1e-9, 0.1)
+    wp_index = np.where(t < 50.0, 1, np.where(t < 120.0, 2, 3))   # two course changes
+    psi_d = np.where(wp_index == 2, 0.6, 0.0)
+    error = np.where(wp_index == 2, 0.6 * np.clip(1.0 - (t - 50.0) / 10.0, 0.0, 1.0),
+                     np.where(wp_index == 3, -0.6 * np.exp(-(t - 120.0) / 10.0), 0.0))
+    # within 5 % (0.03 rad): 9.5 s after the first change, 10 ln 20 = 29.96 s after the second
+    assert course_settling(t, psi_d, psi_d - error, wp_index) == \
+        pytest.approx((9.5 + 30.0) / 2, abs=0.051)
+
+
+def test_other_tools_result_files_give_the_same_criteria(tmp_path, capsys):
+    run = cosim.simulate("calm_pd", stop_time=150, backend="inprocess")
+    ours = tmp_path / "ours.csv"
+    run.write_csv(ours)
+    header, *rows = [line.split(",") for line in ours.read_text().splitlines()]
+    oms = tmp_path / "oms.csv"                          # OMSimulator's names, a time twice
+    oms.write_text("\n".join([",".join('"time"' if c == "time" else f'"calm_pd.calm_pd.{c}"'
+                                        for c in header),
+                              *(",".join(row) for row in [rows[0], *rows])]))
+    for component in ("guidance", "ship"):              # libcosim's: a file per component
+        keep = [i for i, c in enumerate(header) if c.startswith(component + ".")]
+        lines = [",".join(["Time", "StepCount", *(header[i].split(".", 1)[1] for i in keep)])]
+        lines += [",".join([row[0], str(k), *(row[i] for i in keep)])
+                  for k, row in enumerate(rows)]
+        (tmp_path / f"{component}_20261203_212550_085466.csv").write_text("\n".join(lines))
+    expected = run_metrics(run)
+    for files in ([ours], [oms], sorted(tmp_path.glob("*_2026*.csv"))):
+        assert score.main([str(f) for f in files]) == 0
+        text = capsys.readouterr().out
+        assert f"| J of eq (19) (rad^2) | {expected['J']:.1f} |" in text, files
+        assert f"| waypoints reached | {expected['waypoints_reached']:.0f} of 4 |" in text
+    assert score.main([str(tmp_path / "ship_20261203_212550_085466.csv")]) == 2
+    assert "hold no guidance.psi_d, guidance.wp_index" in capsys.readouterr().err
+    (tmp_path / "bad.csv").write_text("time,ship.psi\n0,abc\n")
+    assert score.main([str(tmp_path / "bad.csv")]) == 2
+    assert "result file" in capsys.readouterr().err

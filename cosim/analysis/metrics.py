@@ -71,6 +71,20 @@ def settling_time(t: np.ndarray, error: np.ndarray, band: float) -> float:
     return math.inf if outside[-1] == len(t) - 1 else float(t[outside[-1] + 1])
 
 
+def course_settling(t: np.ndarray, psi_d: np.ndarray, psi: np.ndarray, wp_index: np.ndarray,
+                    share: float = 0.05) -> float:
+    """Mean time, s, from each leg switch that turns psi_d by over 1 deg until |psi_d - psi|
+    stays within ``share`` of that turn until the next switch (the rest of the leg if it
+    never does); NaN if there is none."""
+    error = heading_error(psi_d, psi)
+    switches = np.flatnonzero(np.diff(wp_index) != 0) + 1
+    turns = np.abs(heading_error(psi_d[switches], psi_d[switches - 1]))
+    ends = [*switches[1:], len(t)]
+    times = [min(settling_time(t[a:b], error[a:b], share * turn), t[b - 1]) - t[a]
+             for a, b, turn in zip(switches, ends, turns) if turn > math.radians(1.0)]
+    return float(np.mean(times)) if times else math.nan
+
+
 def overshoot(psi: np.ndarray, psi_start: float, psi_target: float) -> float:
     """Largest excursion beyond the target in the direction of the change, rad (>= 0)."""
     direction = math.copysign(1.0, psi_target - psi_start)

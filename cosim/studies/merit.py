@@ -7,15 +7,17 @@ from dataclasses import dataclass
 
 from autopilot_fmu.guidance import R_ACCEPT, route as followed_route
 
-from ..analysis.metrics import (cost, cross_track_error, fraction_at_stops, heading_error,
-                                mean_abs_rate, peak, rms, route_completion,
+from ..analysis.metrics import (cost, course_settling, cross_track_error, fraction_at_stops,
+                                heading_error, mean_abs_rate, peak, rms, route_completion,
                                 rudder_reversals_per_minute)
 
 # A run's figures of merit and their units, as cosim.run prints them (NaN in a failed run's row)
 METRICS = {"psi_E": "rad^2", "sum_delta2": "rad^2", "J": "rad^2", "rms_heading_error_deg": "deg",
+           "course_settling_s": "s",
            "reversals_per_min": "1/min", "max_delta_deg": "deg", "mean_rudder_rate_deg_s": "deg/s",
            "at_stops_pct": "%", "cross_track_rms_m": "m", "cross_track_max_m": "m",
-           "waypoints_reached": "", "waypoints": "", "last_waypoint_reached": ""}
+           "waypoints_reached": "", "waypoints": "", "last_waypoint_reached": "",
+           "waypoint_margin_m": "m"}
 
 
 @dataclass(frozen=True)
@@ -47,6 +49,7 @@ CRITERIA = (                        # what a scorecard compares controllers by
     Merit("J", "J of eq (19)"),
     Merit("rms_heading_error_deg", "RMS heading error psi_d - psi", paired="difference",
           digits=2),
+    Merit("course_settling_s", "heading settling after a course change (to 5 %)"),
     Merit("reversals_per_min", "rudder reversals"),
     Merit("mean_rudder_rate_deg_s", "mean abs rudder rate", digits=2),
     Merit("at_stops_pct", "time on the rudder stops", paired="difference"),
@@ -54,6 +57,8 @@ CRITERIA = (                        # what a scorecard compares controllers by
     Merit("cross_track_max_m", "max cross-track error", paired="difference", digits=2),
     Merit("waypoints_reached", "waypoints reached", lower_is_better=False,
           paired="difference", digits=0, out_of="waypoints"),
+    Merit("waypoint_margin_m", "worst waypoint's margin (R_accept - closest approach; < 0: "
+          "missed by)", lower_is_better=False, paired="difference", digits=2),
 )
 
 
@@ -83,10 +88,14 @@ def run_metrics(recording) -> dict[str, float]:
     return {"psi_E": c.psi_E, "sum_delta2": c.sum_delta2, "J": c.J,
             "rms_heading_error_deg": math.degrees(rms(heading_error(
                 recording["guidance.psi_d"], recording["ship.psi"]))),
+            "course_settling_s": course_settling(t, recording["guidance.psi_d"],
+                                                 recording["ship.psi"],
+                                                 recording["guidance.wp_index"]),
             "reversals_per_min": rudder_reversals_per_minute(t, delta),
             "max_delta_deg": math.degrees(peak(delta)),
             "mean_rudder_rate_deg_s": math.degrees(mean_abs_rate(t, delta)),
             "at_stops_pct": 100.0 * fraction_at_stops(delta, stops),
             "cross_track_rms_m": rms(off_track), "cross_track_max_m": peak(off_track),
             "waypoints_reached": float(completion.count), "waypoints": float(len(points)),
-            "last_waypoint_reached": float(completion.last_reached)}
+            "last_waypoint_reached": float(completion.last_reached),
+            "waypoint_margin_m": R_accept - max(completion.closest)}

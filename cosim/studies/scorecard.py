@@ -12,7 +12,6 @@ from .. import scenarios
 from ..analysis.figures import comparison, save
 from ..analysis.metrics import heading_error, overshoot, settling_time
 from ..analysis.reports import PAPER_TABLES
-from ..analysis.seastate import WMO, model_scale
 from ..api import overrides_of
 from ..core.files import fresh_folder, write_atomically
 from ..core.inprocess import in_process_refusal
@@ -34,12 +33,16 @@ COURSE_CHANGE_ROUTE = f"0,0;1000,{1000 * math.tan(COURSE_CHANGE)!r}"   # one lon
 COURSE_CHANGE_LEG = math.hypot(1000.0, 1000 * math.tan(COURSE_CHANGE))   # m
 COURSE_CHANGE_TIME = 300.0
 SETTLING_BAND = 0.02 * COURSE_CHANGE
-HEAVY_SEA = 4                   # WMO code of the second ensemble: the rudder saturates
-_HS, _T0 = model_scale(HEAVY_SEA)
+# Ensembles where the paper's PD and SMC differ (docs/own_autopilot.md: WMO sea state 4, which
+# puts every rudder on its stops, did not tell them apart)
 SEAS = (Sea("waves", "the paper's waves", "Hs 5 mm, T0 0.8 s"),
-        Sea(f"sea_state_{HEAVY_SEA}", f"WMO sea state {HEAVY_SEA}, {WMO[HEAVY_SEA][0]}",
-            f"Hs {_HS * 1000:.1f} mm, T0 {_T0:.2f} s at 1:70; {WMO[HEAVY_SEA][1]:g} m full "
-            "scale", HEAVY_SEA))
+        Sea("wind_current", "wind and current", "the paper's waves; 0.05 m/s current (0.42 "
+            "m/s at full scale) and a 0.6 m/s gusty wind (5 m/s), both towards east",
+            "waves_pd_wind", (("environment.V_c_mean", 0.05), ("environment.beta_c_mean",
+                                                                math.pi / 2),
+                              ("environment.sigma_V", 0.005), ("environment.T_c", 120.0))),
+        Sea("pump_failure", "a steering-gear pump failure", "the paper's waves; one of the "
+            "two pumps fails at 150 s, the rudder moves at 10 deg/s", events="pump_failure"))
 
 
 @dataclass(frozen=True)
@@ -137,16 +140,28 @@ def _contenders(fmu: Path, name: str, port_map: dict | None,
 
 def _ensemble(contenders: list[Contender], seeds: int, out: Path, sea: Sea = SEAS[0]) -> Spec:
     """Every contender on the paper's route in ``sea``, over ``seeds`` wave seeds."""
-    entries = {c.name: ({"scenario": f"waves_{c.suffix}"} if c.fmu is None else
-                        {"autopilot": str(c.fmu), "map": c.port_map or {},
-                         "set": c.settings or {}})
-               for c in contenders}
+    entries = {c.name: _entry(c, sea) for c in contenders}
     axes: dict[str, list] = {"wave_seed": list(range(1, seeds + 1))}
-    if sea.sea_state is not None:
-        axes["sea_state"] = [sea.sea_state]
     return Spec(name=f"ensemble in {sea.name}", axes=axes,
                 controllers={n: controller_entry(e, out / "scorecard", n)
                              for n, e in entries.items()}, tracks={})   # every track
+
+
+def _entry(c: Contender, sea: Sea) -> dict[str, Any]:
+    """A contender's sweep entry in ``sea``: its own scenario in the paper's waves, else its
+    autopilot put into ``sea.scenario`` with the parameters its own scenario gives it."""
+    events = {} if sea.events is None else {"events": sea.events}
+    if c.fmu is None and sea.scenario == "waves":
+        return {"scenario": f"waves_{c.suffix}", **events}
+    scenario = "waves_pd" if sea.scenario == "waves" else sea.scenario
+    if c.fmu is not None:
+        return {"scenario": scenario, "autopilot": str(c.fmu), "map": c.port_map or {},
+                "set": {**(c.settings or {}), **dict(sea.sets)}, **events}
+    own = scenarios.load(f"waves_{c.suffix}")
+    autopilot = own.components[COMPONENT]
+    return {"scenario": scenario, "autopilot": str(own.fmu_path(COMPONENT)), "set": {
+        **{f"{COMPONENT}.{k}": v for k, v in autopilot.parameters.items()}, **dict(sea.sets)},
+        **events}
 
 
 def backend_notes(fmu: Path, name: str, port_map: dict | None, backend: str) -> list[str]:

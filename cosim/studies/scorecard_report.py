@@ -20,12 +20,15 @@ SEA_NAMES = {"calm": "calm water", "waves": "waves"}      # the single runs' sea
 
 @dataclass(frozen=True)
 class Sea:
-    """The sea of a wave ensemble: the scenarios' own (the paper's) or a WMO code's."""
+    """The conditions of an ensemble: the paper's waves, or ``scenario`` (each autopilot put
+    into it) with ``sets`` and timed ``events``; the wave seed varies."""
 
     key: str                             # in file names: ensemble_<key>, criteria_<key>.png
     name: str
-    detail: str                          # its Hs and T0
-    sea_state: int | None = None
+    detail: str                          # what makes it
+    scenario: str = "waves"              # "waves": each controller's own waves_<suffix>
+    sets: tuple[tuple[str, float], ...] = ()
+    events: str | None = None
 
 
 @dataclass(frozen=True)
@@ -145,10 +148,14 @@ def _at_a_glance(names: list[str], metrics: dict[str, dict[str, dict]],
              "*mixed* neither; then the seeds won, lost and tied of those both ran, and the "
              f"median paired ratio to the {BASELINE} or difference from it.", ""]
     for sea, rows in ensembles.items():
+        apart = sum(paired(c, rows, "SMC").verdict != "even" for c in CRITERIA)
         lines += [f"The route in {sea.name} ({sea.detail}):", "", *table(
             ["criterion", "better", *names[1:]],
             ([_label(c), c.better.split()[0], *(_verdict(c, paired(c, rows, name))
-                                                for name in names[1:])] for c in CRITERIA)), ""]
+                                                for name in names[1:])] for c in CRITERIA)),
+            "", f"The paper's own controllers, SMC against PD, differ here on {apart} of "
+                f"{len(CRITERIA)} criteria" + ("." if apart else ": this ensemble does not "
+                                               "tell them apart."), ""]
     lines += ["Route completion (higher is better):", "", *table(
         ["controller", *SEA_NAMES.values(), *(f"ensemble, {sea.name}" for sea in ensembles)],
         ([name, *(_reached(metrics[sea][name]) if name in metrics[sea] else "failed"
@@ -272,3 +279,15 @@ def _spread(criterion: Merit, rows: list[dict]) -> str:
     q1, median, q3 = map(criterion.format, np.percentile([r[criterion.column] for r in rows],
                                                          [25, 50, 75]))
     return f"{median} [{q1} - {q3}]{_of(criterion, rows[0])}"
+
+
+def result_card(recording: Recording, files: list[Path]) -> str:
+    """Every criterion of one run read from another tool's result ``files``."""
+    m, (points, R_accept) = run_metrics(recording), route_of(recording)
+    route = " ".join(f"({x:g},{y:g})" for x, y in points)
+    return "\n".join([f"# Criteria of {', '.join(f.name for f in files)}", "",
+                      f"Route {route} m, circle of acceptance {R_accept:g} m; "
+                      f"{len(recording.t)} samples.", "",
+                      *table(["criterion", "value", "better"],
+                             ([_label(c), c.format(m[c.column]) + _of(c, m), c.better]
+                              for c in CRITERIA)), ""])
