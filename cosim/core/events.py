@@ -10,7 +10,7 @@ import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 from fmukit.timebase import nanoseconds
 
@@ -86,23 +86,20 @@ class Schedule:
                  paths: dict[str, Path], h: float):
         self.due: dict[int, list[tuple[Event, Any]]] = {}
         for event in events:
-            if event.model not in declarations:
-                raise EventsError(f"event at {event.time:g} s: no component {event.model!r} "
-                                  f"(the system has {', '.join(declarations)})")
-            declared = declarations[event.model]
-            if event.variable not in declared:
-                raise EventsError(f"event at {event.time:g} s: " + str(no_variable(
-                    event.model, paths[event.model], declared, event.variable)))
-            d = declared[event.variable]
-            if d.causality != "input" and (d.causality, d.variability) != ("parameter",
-                                                                           "tunable"):
-                raise EventsError(
-                    f"event at {event.time:g} s: {event.model}.{event.variable} is a "
-                    f"{d.variability} {d.causality}; events set inputs and tunable parameters")
-            if event.action == "bias" and d.type != "Real":
-                raise EventsError(f"event at {event.time:g} s: bias adds to a Real; "
-                                  f"{event.model}.{event.variable} is {d.type}")
+            declared = declarations.get(event.model)
+            d = None if declared is None else declared.get(event.variable)
+            name = f"{event.model}.{event.variable}"
+            why = (f"no component {event.model!r} (the system has {', '.join(declarations)})"
+                   if declared is None else
+                   str(no_variable(event.model, paths[event.model], declared, event.variable))
+                   if d is None else
+                   f"{name} is a {d.variability} {d.causality}; events set inputs and tunable "
+                   "parameters" if d.causality != "input" and d.variability != "tunable" else
+                   f"bias adds to a Real; {name} is {d.type}"
+                   if event.action == "bias" and d.type != "Real" else None)
             try:
+                if why:
+                    raise ValueError(why)
                 value = None if event.value is None else checked(event.model, d, event.value)
             except ValueError as error:
                 raise EventsError(f"event at {event.time:g} s: {error}") from None
@@ -116,18 +113,18 @@ class Schedule:
             node, name = nodes[event.model], f"{event.model}.{event.variable}"
             if name in node.input_names:                # what the connection sends, modified
                 i = node.input_names.index(name)
-                modify: Callable[[float], float] = ((lambda s, v=value: v)
-                                                    if event.action == "override" else
-                                                    (lambda s, v=value: s + v))
-                node.modifiers.pop(i) if event.action == "reset" else \
-                    node.modifiers.update({i: modify})
+                node.modifiers.pop(i, None)
+                if event.action != "reset":
+                    node.modifiers[i] = ((lambda s, v=value: v) if event.action == "override"
+                                         else (lambda s, v=value: s + v))
                 continue
             instance, key = instances[event.model], (event.model, event.variable)
             own = self.own.setdefault(key, instance.get([event.variable])[event.variable])
             new = {"override": value, "reset": own}.get(event.action, own + (value or 0.0))
             slave = getattr(instance, "slave", None)    # FMI 3.0 tunes in configuration mode
             configure = getattr(instance, "fmi_version", 2) == 3 and hasattr(
-                slave, "enterConfigurationMode") and event.variable not in node.input_names
+                slave, "enterConfigurationMode") and \
+                instance.variables[event.variable].causality == "parameter"
             if configure:
                 instance.call("enterConfigurationMode", slave.enterConfigurationMode, time=t)
             instance.set({event.variable: new}, time=t)
