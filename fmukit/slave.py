@@ -218,10 +218,18 @@ class ModelSlave:
             var = self.registry.by_vr[vr]
             if var.kind is not convert:
                 raise Refused(f"{var.name} is not of type {convert.__name__}", "call", var.name)
-            setattr(self, var.name, convert(value))
             if var.causality == "parameter" and self.sequence.phase == "step":
-                self.tune_model(var.name)         # a tunable one, between steps
-            elif var.causality == "parameter":
+                var.check(convert(value))         # a tunable one, between steps: taken whole
+                before = getattr(self, var.name)
+                setattr(self, var.name, convert(value))
+                try:
+                    self.tune_model(var.name)
+                except ValueError:
+                    setattr(self, var.name, before)
+                    raise
+                continue
+            setattr(self, var.name, convert(value))
+            if var.causality == "parameter":
                 self._model = None
 
     def _set_floats(self, vrs: list[int], values: list[float]) -> None:

@@ -34,6 +34,7 @@ process with a time limit).
 from __future__ import annotations
 
 import argparse
+import copy
 import json
 import math
 import sys
@@ -272,8 +273,13 @@ def _predict(op, e: Expectation, clock: float) -> tuple[str, list[str]]:
         v = e.vars[op[1]]
         if v.causality == "output":
             return "refuse", [op[1]]
-        if e.phase == "terminated" or (v.causality == "parameter" and e.phase == "step"):
+        if e.phase == "terminated":
             return "refuse", [op[1]]
+        if v.causality == "parameter" and e.phase == "step":     # a tunable one, valid
+            trial = copy.copy(e)
+            trial.values = {**e.values, op[1]: _convert(v, op[2])}
+            if v.variability != "tunable" or not trial.valid(op[1]):
+                return "refuse", [op[1]]
         return "accept", []
     if kind == "step":
         h, t = op[1], _clock(op, clock)
