@@ -99,8 +99,7 @@ class ModelSlave:
         """Advance the model from t to t + h with the current inputs."""
         raise NotImplementedError
 
-    def tune_model(self, name: str) -> None:
-        """Parameter ``name`` (tunable) was set between steps: the model takes it."""
+    def tune_model(self, name: str) -> None:      # tunable parameter ``name``, set mid-run
         setattr(self.model, name, getattr(self, name))
 
     def start_model(self, model: Any) -> None:
@@ -219,14 +218,7 @@ class ModelSlave:
             if var.kind is not convert:
                 raise Refused(f"{var.name} is not of type {convert.__name__}", "call", var.name)
             if var.causality == "parameter" and self.sequence.phase == "step":
-                var.check(convert(value))         # a tunable one, between steps: taken whole
-                before = getattr(self, var.name)
-                setattr(self, var.name, convert(value))
-                try:
-                    self.tune_model(var.name)
-                except ValueError:
-                    setattr(self, var.name, before)
-                    raise
+                _tune(self, var, convert(value))  # a tunable one, between steps
                 continue
             setattr(self, var.name, convert(value))
             if var.causality == "parameter":
@@ -289,3 +281,16 @@ class ModelSlave:
             return decoded
         except (ValueError, UnicodeDecodeError, TypeError) as error:
             return {"invalid": f"serialized state unreadable ({error})"}
+
+
+def _tune(slave: ModelSlave, var: Var, value: Any) -> None:
+    """Tunable parameter ``var`` set between steps, taken whole or not at all: checked against
+    its range, then the model takes it (``tune_model``); a refusal names it."""
+    var.check(value)
+    before = getattr(slave, var.name)
+    setattr(slave, var.name, value)
+    try:
+        slave.tune_model(var.name)
+    except ValueError:
+        setattr(slave, var.name, before)
+        raise
